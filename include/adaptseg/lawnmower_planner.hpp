@@ -1,0 +1,118 @@
+#pragma once
+/// @file
+/// Zig-zag (boustrophedon) coverage with non-overlapping camera footprints (paper §3.2.1;
+/// method.md §2): the top-level plan `W^{h_max}` and the sub-lawnmower `W^{h'}` that re-maps
+/// one top-level footprint at a lower altitude.
+
+#include <adaptseg/camera.hpp>
+#include <adaptseg/error.hpp>
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace adaptseg {
+
+/// Axis-aligned rectangle in the field frame [m] (x east along the orthomosaic's columns,
+/// y north up its rows, origin at the orthomosaic's bottom-left corner).
+struct Area {
+  double x_min_m = 0.0;
+  double y_min_m = 0.0;
+  double x_max_m = 0.0;
+  double y_max_m = 0.0;
+
+  [[nodiscard]] double width_m() const noexcept { return x_max_m - x_min_m; }
+  [[nodiscard]] double height_m() const noexcept { return y_max_m - y_min_m; }
+  [[nodiscard]] Eigen::Vector2d centre() const noexcept {
+    return {0.5 * (x_min_m + x_max_m), 0.5 * (y_min_m + y_max_m)};
+  }
+  friend bool operator==(const Area&, const Area&) = default;
+};
+
+/// A place to stop, take an image and decide (paper §3.2.1: zero velocity there).
+struct Waypoint {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< x, y [m] field frame; z altitude [m]
+  double gsd_cm = 0.0;                                 ///< GSD of the image taken here [cm/px]
+  Area footprint;                                      ///< ground seen from here [m]
+};
+
+/// Lawnmower coverage of a rectangle at one altitude: the rectangle is cut into a grid of
+/// camera footprints (ceil(width / footprint width) by ceil(height / footprint height)),
+/// anchored at the starting corner so that only the far row and column may stick out, and
+/// visited row by row, alternating direction. Cells for which `keep(footprint)` is false
+/// (e.g. no valid field pixel under them) are skipped without changing the order of the rest.
+///
+/// @code
+/// adaptseg::LawnmowerPlanner planner(adaptseg::CameraModel{});
+/// adaptseg::Area field{0, 0, 40, 30};
+/// auto top = planner.plan(field, 3.0);                           // W^{h_max}
+/// auto sub = planner.plan(top[0].footprint, 1.0, top[0].position.head<2>());  // W^{h'}
+/// @endcode
+class LawnmowerPlanner {
+ public:
+  /// @throws std::invalid_argument via CameraModel for an invalid camera.
+  explicit LawnmowerPlanner(CameraModel camera) : camera_(camera) {}
+
+  [[nodiscard]] const CameraModel& camera() const noexcept { return camera_; }
+
+  /// Covers `area` at `gsd_cm`, starting in the corner of `area` nearest `start_xy` [m].
+  /// @throws std::invalid_argument if the GSD is not positive or the area is empty.
+  template <typename Keep>
+  [[nodiscard]] std::vector<Waypoint> plan(const Area& area, double gsd_cm,
+                                           const Eigen::Vector2d& start_xy, Keep&& keep) const {
+    detail::require_positive(gsd_cm, "LawnmowerPlanner::plan: gsd_cm");
+    detail::require(std::isfinite(area.width_m()) && area.width_m() > 0.0 &&
+                        std::isfinite(area.height_m()) && area.height_m() > 0.0,
+                    "LawnmowerPlanner::plan: area must have a finite positive size [m]",
+                    area.width_m() * area.height_m());
+    const Extent fp = camera_.footprint_at_gsd(gsd_cm);
+    const double altitude = camera_.altitude_m(gsd_cm);
+    const int nx = cells(area.width_m(), fp.width_m);
+    const int ny = cells(area.height_m(), fp.height_m);
+    // Start corner: the side of each axis nearest the UAV; the grid grows away from it.
+    const bool from_x_min = std::abs(start_xy.x() - area.x_min_m) <= std::abs(start_xy.x() - area.x_max_m);
+    const bool from_y_min = std::abs(start_xy.y() - area.y_min_m) <= std::abs(start_xy.y() - area.y_max_m);
+
+    std::vector<Waypoint> out;
+    out.reserve(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny));
+    for (int row = 0; row < ny; ++row) {
+      const double y0 = from_y_min ? area.y_min_m + row * fp.height_m
+                                   : area.y_max_m - (row + 1) * fp.height_m;
+      for (int k = 0; k < nx; ++k) {
+        const int col = (row % 2 == 0) ? k : nx - 1 - k;
+        const double x0 = from_x_min ? area.x_min_m + col * fp.width_m
+                                     : area.x_max_m - (col + 1) * fp.width_m;
+        Waypoint w;
+        w.footprint = {x0, y0, x0 + fp.width_m, y0 + fp.height_m};
+        const Eigen::Vector2d c = w.footprint.centre();
+        w.position = {c.x(), c.y(), altitude};
+        w.gsd_cm = gsd_cm;
+        if (keep(w.footprint)) out.push_back(w);
+      }
+    }
+    return out;
+  }
+
+  /// plan() keeping every cell.
+  [[nodiscard]] std::vector<Waypoint> plan(const Area& area, double gsd_cm,
+                                           const Eigen::Vector2d& start_xy) const {
+    return plan(area, gsd_cm, start_xy, [](const Area&) { return true; });
+  }
+
+  /// plan() from the corner (x_min, y_min), keeping every cell.
+  [[nodiscard]] std::vector<Waypoint> plan(const Area& area, double gsd_cm) const {
+    return plan(area, gsd_cm, Eigen::Vector2d(area.x_min_m, area.y_min_m));
+  }
+
+ private:
+  /// Number of footprints needed along one axis; a tolerance keeps exact multiples exact.
+  static int cells(double length_m, double footprint_m) {
+    return std::max(1, static_cast<int>(std::ceil(length_m / footprint_m - 1e-9)));
+  }
+
+  CameraModel camera_;
+};
+
+}  // namespace adaptseg

@@ -1,0 +1,98 @@
+#include <adaptseg/lawnmower_planner.hpp>
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <stdexcept>
+
+using adaptseg::Area;
+using adaptseg::CameraModel;
+using adaptseg::LawnmowerPlanner;
+using adaptseg::Waypoint;
+
+namespace {
+bool overlap(const Area& a, const Area& b) {
+  const double eps = 1e-9;
+  return a.x_min_m < b.x_max_m - eps && b.x_min_m < a.x_max_m - eps && a.y_min_m < b.y_max_m - eps &&
+         b.y_min_m < a.y_max_m - eps;
+}
+}  // namespace
+
+TEST_CASE("lawnmower: grid size, non-overlapping footprints, full coverage") {
+  const LawnmowerPlanner planner(CameraModel{});  // footprint 14.4 x 10.8 m at 3 cm/px
+  const Area field{0, 0, 40.0, 30.0};
+  const auto plan = planner.plan(field, 3.0);
+  REQUIRE(plan.size() == 3 * 3);  // ceil(40/14.4) x ceil(30/10.8)
+  for (std::size_t i = 0; i < plan.size(); ++i) {
+    CHECK(plan[i].gsd_cm == 3.0);
+    CHECK(plan[i].position.z() == doctest::Approx(16.5));
+    CHECK(plan[i].footprint.width_m() == doctest::Approx(14.4));
+    for (std::size_t j = i + 1; j < plan.size(); ++j) CHECK_FALSE(overlap(plan[i].footprint, plan[j].footprint));
+  }
+  // Every point of the field lies under some footprint.
+  for (double x = 0.05; x < 40.0; x += 0.5)
+    for (double y = 0.05; y < 30.0; y += 0.5) {
+      bool covered = false;
+      for (const auto& w : plan)
+        covered |= x >= w.footprint.x_min_m && x < w.footprint.x_max_m && y >= w.footprint.y_min_m &&
+                   y < w.footprint.y_max_m;
+      REQUIRE(covered);
+    }
+}
+
+TEST_CASE("lawnmower: exact multiples give no extra row or column") {
+  const LawnmowerPlanner planner(CameraModel{});
+  CHECK(planner.plan({0, 0, 14.4 * 4, 10.8 * 2}, 3.0).size() == 8);
+}
+
+TEST_CASE("lawnmower: zig-zag order, consecutive waypoints are neighbours") {
+  const LawnmowerPlanner planner(CameraModel{});
+  const auto plan = planner.plan({0, 0, 50.0, 40.0}, 2.0);  // 9.6 x 7.2 m footprints: 6 x 6
+  REQUIRE(plan.size() == 36);
+  CHECK(plan.front().footprint.x_min_m == doctest::Approx(0.0));
+  CHECK(plan.front().footprint.y_min_m == doctest::Approx(0.0));
+  for (std::size_t i = 1; i < plan.size(); ++i) {
+    const Eigen::Vector3d d = plan[i].position - plan[i - 1].position;
+    const bool step_x = std::abs(std::abs(d.x()) - 9.6) < 1e-9 && std::abs(d.y()) < 1e-9;
+    const bool step_y = std::abs(std::abs(d.y()) - 7.2) < 1e-9 && std::abs(d.x()) < 1e-9;
+    CHECK((step_x || step_y));
+  }
+  // Rows alternate direction.
+  CHECK(plan[5].position.x() > plan[0].position.x());
+  CHECK(plan[11].position.x() < plan[6].position.x());
+}
+
+TEST_CASE("lawnmower: sub-lawnmower starts in the corner nearest the UAV and stays on its footprint") {
+  const LawnmowerPlanner planner(CameraModel{});
+  const auto top = planner.plan({0, 0, 40.0, 30.0}, 3.0);
+  const Waypoint& parent = top[4];  // the middle region
+  for (const Eigen::Vector2d& uav : {Eigen::Vector2d(100, 100), Eigen::Vector2d(-5, -5), Eigen::Vector2d(100, -5)}) {
+    const auto sub = planner.plan(parent.footprint, 1.0, uav);
+    REQUIRE(sub.size() == 9);  // 3 x 3 footprints of 4.8 x 3.6 m over 14.4 x 10.8 m
+    const Eigen::Vector2d first = sub.front().position.head<2>();
+    for (const auto& w : sub) {
+      CHECK((w.position.head<2>() - uav).norm() >= (first - uav).norm() - 1e-9);
+      CHECK(w.footprint.x_min_m >= parent.footprint.x_min_m - 1e-9);
+      CHECK(w.footprint.x_max_m <= parent.footprint.x_max_m + 1e-9);
+      CHECK(w.position.z() == doctest::Approx(5.5));
+    }
+  }
+}
+
+TEST_CASE("lawnmower: cells rejected by the predicate are skipped, order kept") {
+  const LawnmowerPlanner planner(CameraModel{});
+  const Area field{0, 0, 40.0, 30.0};
+  const auto all = planner.plan(field, 3.0);
+  const auto kept = planner.plan(field, 3.0, {0, 0}, [](const Area& a) { return a.x_min_m < 20.0; });
+  REQUIRE(kept.size() == 6);
+  std::size_t j = 0;
+  for (const auto& w : all)
+    if (w.footprint.x_min_m < 20.0) CHECK(kept[j++].position == w.position);
+}
+
+TEST_CASE("lawnmower: bad input is rejected") {
+  const LawnmowerPlanner planner(CameraModel{});
+  CHECK_THROWS_WITH_AS((void)planner.plan({0, 0, 10, 10}, 0.0), doctest::Contains("gsd_cm"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)planner.plan({0, 0, 0, 10}, 1.0), doctest::Contains("area"), std::invalid_argument);
+  CHECK_THROWS_AS((void)planner.plan({0, 0, std::nan(""), 10}, 1.0), std::invalid_argument);
+}

@@ -1,0 +1,46 @@
+#include <adaptseg/timing.hpp>
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+using adaptseg::TimingModel;
+
+TEST_CASE("timing: velocity ramp below and above the cruise distance v^2/a") {
+  const TimingModel t({.max_speed_mps = 2.0, .max_accel_mps2 = 2.0});  // v^2/a = 2 m
+  CHECK(t.segment_time_s(0.0) == 0.0);
+  CHECK(t.segment_time_s(1.0) == doctest::Approx(2.0 * std::sqrt(0.5)));  // triangle profile
+  CHECK(t.segment_time_s(10.0) == doctest::Approx(10.0 / 2.0 + 2.0 / 2.0));  // trapezoid
+  // Continuous at the switch: 2 sqrt(d/a) = d/v + v/a = 2 v / a at d = v^2 / a.
+  CHECK(t.segment_time_s(2.0 - 1e-12) == doctest::Approx(t.segment_time_s(2.0)));
+  CHECK(t.segment_time_s(2.0) == doctest::Approx(2.0));
+  // Monotone in distance.
+  double prev = 0.0;
+  for (double d = 0.05; d < 30.0; d += 0.05) {
+    const double now = t.segment_time_s(d);
+    CHECK(now > prev);
+    prev = now;
+  }
+}
+
+TEST_CASE("timing: 3-D segments include altitude changes; paths add segments") {
+  const TimingModel t;
+  const Eigen::Vector3d a(0, 0, 10), b(3, 4, 10), c(3, 4, 22);
+  CHECK(t.segment_time_s(a, b) == doctest::Approx(t.segment_time_s(5.0)));
+  CHECK(t.segment_time_s(b, c) == doctest::Approx(t.segment_time_s(12.0)));
+  const std::vector<Eigen::Vector3d> path{a, b, c};
+  CHECK(t.path_time_s(path) == doctest::Approx(t.segment_time_s(5.0) + t.segment_time_s(12.0)));
+  // Stopping in between costs time: a straight 17 m is faster than 5 m + 12 m with a stop.
+  CHECK(t.segment_time_s(17.0) < t.path_time_s(path));
+}
+
+TEST_CASE("timing: invalid limits and distances are rejected") {
+  CHECK_THROWS_WITH_AS(TimingModel({.max_speed_mps = 0.0}), doctest::Contains("max_speed_mps"),
+                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS(TimingModel({.max_accel_mps2 = -1.0}), doctest::Contains("max_accel_mps2"),
+                       std::invalid_argument);
+  CHECK_THROWS_AS((void)TimingModel{}.segment_time_s(-0.1), std::invalid_argument);
+  CHECK_THROWS_AS((void)TimingModel{}.segment_time_s(std::nan("")), std::invalid_argument);
+}
