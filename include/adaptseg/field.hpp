@@ -1,0 +1,361 @@
+#pragma once
+/// @file
+/// A field to survey: the orthomosaic's label map (and RGB image, when there is one), its
+/// GSD and class set, loaded from the project's field directory format (docs/data_format.md).
+
+#include <adaptseg/error.hpp>
+#include <adaptseg/lawnmower_planner.hpp>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace adaptseg {
+
+/// One semantic class: its name and display colour (RGB).
+struct ClassInfo {
+  std::string name;
+  std::array<std::uint8_t, 3> color_rgb{0, 0, 0};
+};
+
+/// Fraction rectangle of a field along the image axes: `x` along columns (left to right),
+/// `y` along rows (top to bottom), each in [0, 1]. `{0, 0, 0.5, 1}` is the left half.
+struct FieldRegion {
+  double x0 = 0.0, y0 = 0.0, x1 = 1.0, y1 = 1.0;
+};
+
+/// An orthomosaic with class labels (method.md §1). The field frame has its origin at the
+/// orthomosaic's bottom-left corner, x along the columns, y up the rows, in metres; pixel
+/// (row r, col c) covers x in [c, c+1) * g0/100 and y in [H-r-1, H-r) * g0/100.
+///
+/// A Field is immutable; copies are cheap (the cv::Mat buffers are shared).
+class Field {
+ public:
+  /// @param labels 8-bit single-channel class indices; `ignore_label` marks pixels outside
+  ///        the field or unlabelled.
+  /// @param image optional 8-bit 3-channel BGR image of the same size (empty if none).
+  /// @throws std::invalid_argument for an empty/mistyped label map, a GSD that is not
+  ///         positive, no classes, duplicate or empty class names, an ignore label that is
+  ///         also a class index, labels of interest out of range, an image of another size,
+  ///         or a label value that is neither a class index nor the ignore label.
+  Field(std::string name, double gsd_cm, cv::Mat labels, std::vector<ClassInfo> classes,
+        std::vector<int> interest, int ignore_label = 255, cv::Mat image = {})
+      : name_(std::move(name)),
+        gsd_cm_(gsd_cm),
+        labels_(std::move(labels)),
+        image_(std::move(image)),
+        classes_(std::move(classes)),
+        interest_(std::move(interest)),
+        ignore_label_(ignore_label) {
+    validate();
+    valid_ = labels_ != ignore_label_;
+  }
+
+  /// Loads a field directory: `field.yaml`, the label PNG it names and the optional image.
+  /// @throws std::invalid_argument naming the file and the problem (missing file, YAML
+  ///         syntax error, missing or mistyped key, unknown key, unknown class of interest,
+  ///         wrong image type, size mismatch, out-of-range label value).
+  static Field load(const std::filesystem::path& dir);
+
+  [[nodiscard]] const std::string& name() const noexcept { return name_; }
+  /// Orthomosaic GSD g0 [cm/px].
+  [[nodiscard]] double gsd_cm() const noexcept { return gsd_cm_; }
+  /// Class indices, CV_8UC1.
+  [[nodiscard]] const cv::Mat& labels() const noexcept { return labels_; }
+  /// BGR image, CV_8UC3, or empty when the field has none.
+  [[nodiscard]] const cv::Mat& image() const noexcept { return image_; }
+  [[nodiscard]] bool has_image() const noexcept { return !image_.empty(); }
+  /// 255 where the label is a class, 0 where it is the ignore label; CV_8UC1.
+  [[nodiscard]] const cv::Mat& valid_mask() const noexcept { return valid_; }
+  [[nodiscard]] const std::vector<ClassInfo>& classes() const noexcept { return classes_; }
+  [[nodiscard]] int num_classes() const noexcept { return static_cast<int>(classes_.size()); }
+  /// Default labels of interest L (class indices, ascending).
+  [[nodiscard]] const std::vector<int>& interest() const noexcept { return interest_; }
+  [[nodiscard]] int ignore_label() const noexcept { return ignore_label_; }
+  [[nodiscard]] int width_px() const noexcept { return labels_.cols; }
+  [[nodiscard]] int height_px() const noexcept { return labels_.rows; }
+
+  /// The whole orthomosaic in the field frame [m].
+  [[nodiscard]] Area area() const noexcept {
+    return {0.0, 0.0, width_px() * gsd_cm_ / 100.0, height_px() * gsd_cm_ / 100.0};
+  }
+
+  /// Orthomosaic pixels under `a`, edges rounded to the nearest pixel boundary, so that
+  /// areas sharing an edge share it in pixels too (no gaps, no overlaps). May extend
+  /// beyond the orthomosaic.
+  [[nodiscard]] cv::Rect pixel_rect(const Area& a) const {
+    const double s = 100.0 / gsd_cm_;
+    const int c0 = static_cast<int>(std::lround(a.x_min_m * s));
+    const int c1 = static_cast<int>(std::lround(a.x_max_m * s));
+    const int r0 = static_cast<int>(std::lround(height_px() - a.y_max_m * s));
+    const int r1 = static_cast<int>(std::lround(height_px() - a.y_min_m * s));
+    return {c0, r0, c1 - c0, r1 - r0};
+  }
+
+  /// True if any valid (non-ignore) pixel lies under `a`.
+  [[nodiscard]] bool has_valid(const Area& a) const {
+    const cv::Rect r = pixel_rect(a) & cv::Rect(0, 0, width_px(), height_px());
+    return r.area() > 0 && cv::countNonZero(valid_(r)) > 0;
+  }
+
+  /// Index of the class called `class_name`, if any.
+  [[nodiscard]] std::optional<int> class_index(std::string_view class_name) const {
+    for (std::size_t i = 0; i < classes_.size(); ++i)
+      if (classes_[i].name == class_name) return static_cast<int>(i);
+    return std::nullopt;
+  }
+
+  /// Class indices of `names` (sorted, unique).
+  /// @throws std::invalid_argument for an unknown class name, listing the known ones.
+  [[nodiscard]] std::vector<int> class_indices(const std::vector<std::string>& names) const {
+    std::set<int> out;
+    for (const auto& n : names) {
+      const auto i = class_index(n);
+      if (!i) {
+        std::string known;
+        for (const auto& c : classes_) known += (known.empty() ? "" : ", ") + c.name;
+        throw std::invalid_argument("unknown class '" + n + "' in field '" + name_ +
+                                    "' (classes: " + known + ")");
+      }
+      out.insert(*i);
+    }
+    return {out.begin(), out.end()};
+  }
+
+  /// The part of the field inside `region` (fractions along the image axes) as a field of
+  /// its own, named "<name>[x0,y0,x1,y1]"; pixel edges are rounded to the nearest pixel.
+  /// @throws std::invalid_argument unless 0 <= x0 < x1 <= 1 and 0 <= y0 < y1 <= 1 and the
+  ///         region holds at least one pixel.
+  [[nodiscard]] Field sub_field(const FieldRegion& region) const {
+    const auto in01 = [](double v) { return std::isfinite(v) && v >= 0.0 && v <= 1.0; };
+    std::ostringstream desc;
+    desc << region.x0 << ',' << region.y0 << ',' << region.x1 << ',' << region.y1;
+    detail::require(in01(region.x0) && in01(region.x1) && in01(region.y0) && in01(region.y1) &&
+                        region.x0 < region.x1 && region.y0 < region.y1,
+                    "Field::sub_field: region must satisfy 0 <= x0 < x1 <= 1, 0 <= y0 < y1 <= 1",
+                    desc.str());
+    const int c0 = static_cast<int>(std::lround(region.x0 * width_px()));
+    const int c1 = static_cast<int>(std::lround(region.x1 * width_px()));
+    const int r0 = static_cast<int>(std::lround(region.y0 * height_px()));
+    const int r1 = static_cast<int>(std::lround(region.y1 * height_px()));
+    detail::require(c1 > c0 && r1 > r0, "Field::sub_field: region holds no pixel", desc.str());
+    const cv::Rect roi(c0, r0, c1 - c0, r1 - r0);
+    return Field(name_ + "[" + desc.str() + "]", gsd_cm_, labels_(roi).clone(), classes_, interest_,
+                 ignore_label_, image_.empty() ? cv::Mat() : image_(roi).clone());
+  }
+
+ private:
+  void validate() const {
+    detail::require_positive(gsd_cm_, "Field '" + name_ + "': gsd_cm");
+    detail::require(!labels_.empty(), "Field '" + name_ + "': the label map is empty", "0x0");
+    detail::require(labels_.type() == CV_8UC1,
+                    "Field '" + name_ + "': the label map must be 8-bit single channel (CV_8UC1)",
+                    "channels=" + std::to_string(labels_.channels()) +
+                        " depth=" + std::to_string(labels_.depth()));
+    detail::require(!classes_.empty(), "Field '" + name_ + "': at least one class is required", 0);
+    detail::require(ignore_label_ >= 0 && ignore_label_ <= 255,
+                    "Field '" + name_ + "': ignore_label must be in 0..255", ignore_label_);
+    detail::require(ignore_label_ >= num_classes(),
+                    "Field '" + name_ + "': ignore_label must not be a class index (there are " +
+                        std::to_string(num_classes()) + " classes)",
+                    ignore_label_);
+    std::set<std::string> names;
+    for (const auto& c : classes_) {
+      detail::require(!c.name.empty(), "Field '" + name_ + "': a class has an empty name", "''");
+      detail::require(names.insert(c.name).second,
+                      "Field '" + name_ + "': class name listed twice", c.name);
+    }
+    for (int i : interest_)
+      detail::require(i >= 0 && i < num_classes(),
+                      "Field '" + name_ + "': label of interest out of range", i);
+    if (!image_.empty()) {
+      detail::require(image_.type() == CV_8UC3,
+                      "Field '" + name_ + "': the image must be 8-bit 3-channel",
+                      "channels=" + std::to_string(image_.channels()));
+      detail::require(image_.size() == labels_.size(),
+                      "Field '" + name_ + "': image and label map differ in size",
+                      std::to_string(image_.cols) + "x" + std::to_string(image_.rows) + " vs " +
+                          std::to_string(labels_.cols) + "x" + std::to_string(labels_.rows));
+    }
+    // Every pixel must be a class index or the ignore label.
+    for (int r = 0; r < labels_.rows; ++r) {
+      const auto* row = labels_.ptr<std::uint8_t>(r);
+      for (int c = 0; c < labels_.cols; ++c) {
+        const int v = row[c];
+        if (v >= num_classes() && v != ignore_label_) {
+          throw std::invalid_argument("Field '" + name_ + "': label value " + std::to_string(v) +
+                                      " at row " + std::to_string(r) + ", col " +
+                                      std::to_string(c) + " is neither a class index (0.." +
+                                      std::to_string(num_classes() - 1) +
+                                      ") nor the ignore label " + std::to_string(ignore_label_));
+        }
+      }
+    }
+  }
+
+  std::string name_;
+  double gsd_cm_;
+  cv::Mat labels_;
+  cv::Mat image_;
+  std::vector<ClassInfo> classes_;
+  std::vector<int> interest_;
+  int ignore_label_;
+  cv::Mat valid_;
+};
+
+namespace detail {
+
+[[noreturn]] inline void field_error(const std::filesystem::path& file, const std::string& what) {
+  throw std::invalid_argument(file.string() + ": " + what);
+}
+
+inline YAML::Node field_key(const YAML::Node& root, const char* key,
+                            const std::filesystem::path& file) {
+  const YAML::Node n = root[key];
+  if (!n) field_error(file, std::string("missing key '") + key + "'");
+  return n;
+}
+
+template <typename T>
+T field_scalar(const YAML::Node& n, const char* what, const std::filesystem::path& file) {
+  if (!n.IsScalar()) field_error(file, std::string("'") + what + "' must be a scalar");
+  try {
+    return n.as<T>();
+  } catch (const YAML::Exception&) {
+    field_error(file, std::string("'") + what + "' has the wrong type (value '" + n.Scalar() + "')");
+  }
+}
+
+inline cv::Mat field_read_image(const std::filesystem::path& file, int flags,
+                                const std::filesystem::path& yaml) {
+  if (!std::filesystem::is_regular_file(file))
+    field_error(yaml, "file not found: " + file.string());
+  cv::Mat m = cv::imread(file.string(), flags);
+  if (m.empty()) field_error(yaml, "cannot decode image: " + file.string());
+  return m;
+}
+
+}  // namespace detail
+
+inline Field Field::load(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  if (!fs::is_directory(dir))
+    throw std::invalid_argument("field directory not found: " + dir.string());
+  const fs::path yaml = dir / "field.yaml";
+  if (!fs::is_regular_file(yaml)) throw std::invalid_argument("missing " + yaml.string());
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(yaml.string());
+  } catch (const YAML::Exception& e) {
+    detail::field_error(yaml, std::string("YAML error: ") + e.what());
+  }
+  if (!root.IsMap()) detail::field_error(yaml, "the document must be a mapping");
+  static const std::set<std::string> kKeys{"name", "gsd_cm", "labels", "image",
+                                           "ignore_label", "classes", "interest"};
+  for (const auto& kv : root) {
+    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "<non-scalar>";
+    if (!kKeys.count(key))
+      detail::field_error(yaml, "unknown key '" + key +
+                                    "' (known: name, gsd_cm, labels, image, ignore_label, "
+                                    "classes, interest)");
+  }
+  const auto name = detail::field_scalar<std::string>(detail::field_key(root, "name", yaml), "name", yaml);
+  const auto gsd = detail::field_scalar<double>(detail::field_key(root, "gsd_cm", yaml), "gsd_cm", yaml);
+  if (!std::isfinite(gsd) || gsd <= 0.0)
+    detail::field_error(yaml, "'gsd_cm' must be finite and > 0 (got " + std::to_string(gsd) + ")");
+  const auto labels_file =
+      detail::field_scalar<std::string>(detail::field_key(root, "labels", yaml), "labels", yaml);
+  int ignore = 255;
+  if (root["ignore_label"]) {
+    ignore = detail::field_scalar<int>(root["ignore_label"], "ignore_label", yaml);
+    if (ignore < 0 || ignore > 255)
+      detail::field_error(yaml, "'ignore_label' must be in 0..255 (got " + std::to_string(ignore) + ")");
+  }
+
+  const YAML::Node classes_node = detail::field_key(root, "classes", yaml);
+  if (!classes_node.IsSequence() || classes_node.size() == 0)
+    detail::field_error(yaml, "'classes' must be a non-empty list");
+  std::vector<ClassInfo> classes;
+  for (std::size_t i = 0; i < classes_node.size(); ++i) {
+    const YAML::Node c = classes_node[i];
+    const std::string where = "classes[" + std::to_string(i) + "]";
+    if (!c.IsMap()) detail::field_error(yaml, where + " must be a mapping {name, color}");
+    for (const auto& kv : c) {
+      const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "<non-scalar>";
+      if (key != "name" && key != "color")
+        detail::field_error(yaml, where + ": unknown key '" + key + "' (known: name, color)");
+    }
+    if (!c["name"]) detail::field_error(yaml, where + ": missing key 'name'");
+    ClassInfo info;
+    info.name = detail::field_scalar<std::string>(c["name"], (where + ".name").c_str(), yaml);
+    if (c["color"]) {
+      const YAML::Node col = c["color"];
+      if (!col.IsSequence() || col.size() != 3)
+        detail::field_error(yaml, where + ".color must be a list of 3 integers [r, g, b]");
+      for (std::size_t k = 0; k < 3; ++k) {
+        const int v = detail::field_scalar<int>(col[k], (where + ".color").c_str(), yaml);
+        if (v < 0 || v > 255)
+          detail::field_error(yaml, where + ".color values must be in 0..255 (got " + std::to_string(v) + ")");
+        info.color_rgb[k] = static_cast<std::uint8_t>(v);
+      }
+    } else {
+      detail::field_error(yaml, where + ": missing key 'color'");
+    }
+    for (const auto& earlier : classes)
+      if (earlier.name == info.name) detail::field_error(yaml, where + ": class name '" + info.name + "' listed twice");
+    classes.push_back(std::move(info));
+  }
+
+  std::vector<std::string> interest_names;
+  if (root["interest"]) {
+    const YAML::Node in = root["interest"];
+    if (!in.IsSequence()) detail::field_error(yaml, "'interest' must be a list of class names");
+    for (std::size_t i = 0; i < in.size(); ++i)
+      interest_names.push_back(detail::field_scalar<std::string>(in[i], "interest[]", yaml));
+  }
+  std::vector<int> interest;
+  for (const auto& n : interest_names) {
+    bool found = false;
+    for (std::size_t i = 0; i < classes.size(); ++i) {
+      if (classes[i].name == n) {
+        interest.push_back(static_cast<int>(i));
+        found = true;
+      }
+    }
+    if (!found) detail::field_error(yaml, "'interest' names unknown class '" + n + "'");
+  }
+  std::sort(interest.begin(), interest.end());
+  interest.erase(std::unique(interest.begin(), interest.end()), interest.end());
+
+  cv::Mat labels = detail::field_read_image(dir / labels_file, cv::IMREAD_UNCHANGED, yaml);
+  if (labels.type() != CV_8UC1)
+    detail::field_error(yaml, "'" + labels_file + "' must be an 8-bit single-channel PNG (got " +
+                                  std::to_string(labels.channels()) + " channels, depth " +
+                                  std::to_string(labels.depth()) + ")");
+  cv::Mat image;
+  if (root["image"]) {
+    const auto image_file = detail::field_scalar<std::string>(root["image"], "image", yaml);
+    image = detail::field_read_image(dir / image_file, cv::IMREAD_COLOR, yaml);
+  }
+  try {
+    return Field(name, gsd, std::move(labels), std::move(classes), std::move(interest), ignore,
+                 std::move(image));
+  } catch (const std::invalid_argument& e) {
+    detail::field_error(yaml, e.what());
+  }
+}
+
+}  // namespace adaptseg

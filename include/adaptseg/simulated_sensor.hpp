@@ -1,0 +1,87 @@
+#pragma once
+/// @file
+/// The simulated nadir camera over a Field (method.md §1): crop the footprint from the
+/// orthomosaic and resample it to the camera's pixel grid.
+
+#include <adaptseg/camera.hpp>
+#include <adaptseg/field.hpp>
+#include <adaptseg/lawnmower_planner.hpp>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <Eigen/Core>
+
+namespace adaptseg {
+
+/// One camera frame, as a segmentation backend receives it.
+struct Image {
+  /// The camera image, I_h x I_w, CV_8UC3 BGR; empty when the field has no RGB.
+  cv::Mat rgb;
+  /// Simulation only: the orthomosaic's labels under the footprint at the orthomosaic's
+  /// resolution (CV_8UC1, ignore label outside the orthomosaic); empty in live use.
+  cv::Mat ground_truth;
+  /// Orthomosaic pixels seen by the camera (may extend beyond the orthomosaic): camera
+  /// pixel (u, v) covers the part (u, v) of a uniform I_w x I_h grid over this rectangle.
+  cv::Rect footprint_px;
+  /// Where the image was taken: x, y [m] field frame, z altitude [m].
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  double gsd_cm = 0.0;    ///< [cm/px]
+  int width_px = 0;       ///< I_w
+  int height_px = 0;      ///< I_h
+  int ignore_label = 255; ///< label for "no class" in ground_truth and in segmentations
+};
+
+/// Renders camera images of a Field.
+///
+/// The footprint of a waypoint is snapped to whole orthomosaic pixels (Field::pixel_rect),
+/// so adjacent footprints tile the orthomosaic exactly. The RGB crop is resampled with area
+/// interpolation; labels are never interpolated (they are passed on at full resolution for
+/// the oracle and the metrics). Parts outside the orthomosaic are black / ignore.
+class SimulatedSensor {
+ public:
+  /// @throws std::invalid_argument via CameraModel for an invalid camera.
+  SimulatedSensor(Field field, CameraModel camera) : field_(std::move(field)), camera_(camera) {}
+
+  [[nodiscard]] const Field& field() const noexcept { return field_; }
+  [[nodiscard]] const CameraModel& camera() const noexcept { return camera_; }
+
+  /// The image taken at waypoint `w`.
+  /// @throws std::invalid_argument if the waypoint's GSD is finer than the orthomosaic's
+  ///         (the simulator would have to invent detail) or its footprint is empty.
+  [[nodiscard]] Image capture(const Waypoint& w) const {
+    detail::require(w.gsd_cm >= field_.gsd_cm() * (1.0 - 1e-9),
+                    "SimulatedSensor::capture: waypoint GSD [cm/px] is finer than the field's " +
+                        std::to_string(field_.gsd_cm()) + " cm/px",
+                    w.gsd_cm);
+    Image img;
+    img.position = w.position;
+    img.gsd_cm = w.gsd_cm;
+    img.width_px = camera_.width_px();
+    img.height_px = camera_.height_px();
+    img.ignore_label = field_.ignore_label();
+    img.footprint_px = field_.pixel_rect(w.footprint);
+    detail::require(img.footprint_px.width > 0 && img.footprint_px.height > 0,
+                    "SimulatedSensor::capture: footprint covers no orthomosaic pixel", w.gsd_cm);
+    img.ground_truth = crop(field_.labels(), img.footprint_px, cv::Scalar(field_.ignore_label()));
+    if (field_.has_image()) {
+      const cv::Mat rgb = crop(field_.image(), img.footprint_px, cv::Scalar(0, 0, 0));
+      cv::resize(rgb, img.rgb, cv::Size(img.width_px, img.height_px), 0, 0, cv::INTER_AREA);
+    }
+    return img;
+  }
+
+ private:
+  /// `src(rect)`, with `fill` where the rectangle leaves the image.
+  static cv::Mat crop(const cv::Mat& src, const cv::Rect& rect, const cv::Scalar& fill) {
+    cv::Mat out(rect.size(), src.type(), fill);
+    const cv::Rect inside = rect & cv::Rect(0, 0, src.cols, src.rows);
+    if (inside.area() > 0) src(inside).copyTo(out(inside - rect.tl()));
+    return out;
+  }
+
+  Field field_;
+  CameraModel camera_;
+};
+
+}  // namespace adaptseg

@@ -1,0 +1,47 @@
+#pragma once
+// The conformance suite every SegmentationBackend model runs (see the concept's contract in
+// include/adaptseg/segmentation_backend.hpp).
+
+#include <adaptseg/lawnmower_planner.hpp>
+#include <adaptseg/segmentation_backend.hpp>
+#include <adaptseg/simulated_sensor.hpp>
+
+#include <doctest/doctest.h>
+
+#include <string>
+
+namespace adaptseg::test {
+
+/// Segments images of `sensor`'s field at several GSDs and checks the contract: type and
+/// size, values in the class set or the ignore label, input untouched, same output for the
+/// same image, and a non-empty name.
+template <SegmentationBackend Backend>
+void check_backend_conformance(Backend& backend, const SimulatedSensor& sensor, int num_classes) {
+  CHECK_FALSE(std::string(backend.name()).empty());
+  const LawnmowerPlanner planner(sensor.camera());
+  const double g0 = sensor.field().gsd_cm();
+  for (double factor : {1.0, 1.7, 3.0}) {
+    const auto plan = planner.plan(sensor.field().area(), g0 * factor);
+    REQUIRE_FALSE(plan.empty());
+    for (std::size_t i = 0; i < plan.size() && i < 3; ++i) {
+      const Image image = sensor.capture(plan[i]);
+      const cv::Mat gt_before = image.ground_truth.clone();
+      const cv::Mat rgb_before = image.rgb.clone();
+      const cv::Mat labels = backend.segment(image);
+      REQUIRE(labels.type() == CV_8UC1);
+      REQUIRE(labels.rows == image.height_px);
+      REQUIRE(labels.cols == image.width_px);
+      for (int r = 0; r < labels.rows; ++r)
+        for (int c = 0; c < labels.cols; ++c) {
+          const int v = labels.at<std::uint8_t>(r, c);
+          REQUIRE((v < num_classes || v == image.ignore_label));
+        }
+      CHECK(cv::countNonZero(gt_before != image.ground_truth) == 0);
+      if (!rgb_before.empty()) CHECK(cv::norm(rgb_before, image.rgb, cv::NORM_INF) == 0.0);
+      const cv::Mat again = backend.segment(image);
+      CHECK(cv::countNonZero(again != labels) == 0);
+    }
+  }
+}
+
+}  // namespace adaptseg::test

@@ -1,0 +1,60 @@
+#include <adaptseg/metrics.hpp>
+
+#include <doctest/doctest.h>
+
+#include <vector>
+
+using namespace adaptseg;
+
+TEST_CASE("metrics: semantic ratio counts labels of interest over valid pixels (Eq. vr)") {
+  cv::Mat m(2, 5, CV_8UC1, cv::Scalar(0));
+  m.at<std::uint8_t>(0, 0) = 1;
+  m.at<std::uint8_t>(0, 1) = 2;
+  m.at<std::uint8_t>(1, 4) = 255;
+  m.at<std::uint8_t>(1, 3) = 255;
+  const std::vector<int> crop_weed{1, 2}, weed{2};
+  CHECK(semantic_ratio(m, crop_weed, 255) == doctest::Approx(2.0 / 8.0));
+  CHECK(semantic_ratio(m, weed, 255) == doctest::Approx(1.0 / 8.0));
+  CHECK(semantic_ratio(cv::Mat(2, 2, CV_8UC1, cv::Scalar(255)), weed, 255) == 0.0);
+}
+
+TEST_CASE("metrics: IoU and mIoU on a hand-computed example") {
+  // truth:     0 0 1 1 2 | pred: 0 1 1 1 255(none)
+  const cv::Mat truth = (cv::Mat_<std::uint8_t>(1, 6) << 0, 0, 1, 1, 2, 255);
+  const cv::Mat pred = (cv::Mat_<std::uint8_t>(1, 6) << 0, 1, 1, 1, 255, 2);
+  ConfusionMatrix cm(3);
+  cm.add(truth, pred, 255);
+  CHECK(cm.total() == 5);                       // the ignore truth pixel is skipped
+  CHECK(cm.count(2, 3) == 1);                   // weed predicted as none
+  CHECK(cm.iou(0).value() == doctest::Approx(1.0 / 2.0));  // TP 1, FN 1
+  CHECK(cm.iou(1).value() == doctest::Approx(2.0 / 3.0));  // TP 2, FP 1
+  CHECK(cm.iou(2).value() == doctest::Approx(0.0));        // FN 1
+  const std::vector<int> l{1, 2};
+  CHECK(cm.miou(l).value() == doctest::Approx((2.0 / 3.0 + 0.0) / 2.0));
+  CHECK(cm.miou_all().value() == doctest::Approx((0.5 + 2.0 / 3.0 + 0.0) / 3.0));
+}
+
+TEST_CASE("metrics: classes absent from truth and prediction do not count") {
+  const cv::Mat truth = (cv::Mat_<std::uint8_t>(1, 3) << 0, 0, 1);
+  ConfusionMatrix cm(4);
+  cm.add(truth, truth, 255);
+  CHECK_FALSE(cm.iou(2).has_value());
+  CHECK(cm.miou_all().value() == 1.0);
+  const std::vector<int> absent{2, 3};
+  CHECK_FALSE(cm.miou(absent).has_value());
+  CHECK_THROWS_AS((void)cm.iou(4), std::invalid_argument);
+  CHECK_THROWS_AS(cm.add(truth, cv::Mat(1, 2, CV_8UC1), 255), std::invalid_argument);
+}
+
+TEST_CASE("metrics: per-image confusion compares at the orthomosaic's resolution") {
+  Image img;
+  img.width_px = 2;
+  img.height_px = 1;
+  img.footprint_px = {0, 0, 4, 2};
+  img.ground_truth = (cv::Mat_<std::uint8_t>(2, 4) << 1, 1, 0, 0, 1, 0, 0, 255);
+  const cv::Mat pred = (cv::Mat_<std::uint8_t>(1, 2) << 1, 0);
+  const ConfusionMatrix cm = image_confusion(img, pred, 2);
+  CHECK(cm.total() == 7);
+  CHECK(cm.count(0, 1) == 1);  // the soil pixel under the crop camera pixel
+  CHECK(cm.iou(1).value() == doctest::Approx(3.0 / 4.0));
+}
