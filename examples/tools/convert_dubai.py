@@ -1,0 +1,127 @@
+#!/usr/bin/env python3
+"""Converts the Dubai aerial-imagery tiles into adaptseg field directories.
+
+Usage:
+  /usr/bin/python3 examples/tools/convert_dubai.py --input ../shared/data/dubai-aerial \
+      --out examples/data [--tiles 1 2 ...] [--gsd-cm 5.0] [--interest water]
+
+Every Tile_N folder present (or those named) holds images/image_part_00K.jpg and
+masks/image_part_00K.png, K = 1..9, a 3x3 grid in row-major order. Parts in one grid row
+share a height and parts in one grid column share a width (they differ by up to 1 px between
+rows or columns), so the mosaic is assembled row by row; any other size pattern, a missing
+part, or an image/mask size mismatch is an error naming the part. Mask colours are mapped to
+class indices [building, land, road, vegetation, water] with the colours the masks actually
+use (see the dataset's PROVENANCE.txt: classes.json is wrong); "unlabeled" (#9B9B9B), black
+and any other colour become ignore (255), and the counts of such pixels are printed.
+Writes OUT/dubai-tile-N/{field.yaml, labels.png, image.jpg}.
+"""
+import argparse
+import glob
+import os
+import re
+import sys
+
+import cv2
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from fieldio import IGNORE, write_field  # noqa: E402
+
+CLASSES = [
+    ("building", (0x3C, 0x10, 0x98)),
+    ("land", (0x84, 0x29, 0xF6)),
+    ("road", (0x6E, 0xC1, 0xE4)),
+    ("vegetation", (0xFE, 0xDD, 0x3A)),
+    ("water", (0xE2, 0xA9, 0x29)),
+]
+UNLABELED = (0x9B, 0x9B, 0x9B)
+
+
+def read_part(path, flags):
+    img = cv2.imread(path, flags)
+    if img is None:
+        raise ValueError(f"missing or unreadable part: {path}")
+    return img
+
+
+def assemble(parts, what):
+    """3x3 list of arrays (row-major) -> mosaic; heights equal per row, widths per column."""
+    rows = []
+    for r in range(3):
+        row = parts[3 * r: 3 * r + 3]
+        heights = {p.shape[0] for p in row}
+        if len(heights) != 1:
+            raise ValueError(f"{what}: parts of grid row {r + 1} differ in height {sorted(heights)}")
+        rows.append(np.concatenate(row, axis=1))
+    for c in range(3):
+        widths = {parts[3 * r + c].shape[1] for r in range(3)}
+        if len(widths) != 1:
+            raise ValueError(f"{what}: parts of grid column {c + 1} differ in width {sorted(widths)}")
+    return np.concatenate(rows, axis=0)
+
+
+def mask_to_labels(mask_rgb):
+    """RGB mask -> class indices; returns (labels, {colour: count} of colours mapped to ignore)."""
+    labels = np.full(mask_rgb.shape[:2], IGNORE, np.uint8)
+    for index, (_, colour) in enumerate(CLASSES):
+        labels[np.all(mask_rgb == np.array(colour, np.uint8), axis=2)] = index
+    rest = mask_rgb[labels == IGNORE]
+    colours, counts = np.unique(rest.reshape(-1, 3), axis=0, return_counts=True)
+    return labels, {"#%02X%02X%02X" % tuple(int(v) for v in c): int(n) for c, n in zip(colours, counts)}
+
+
+def convert_tile(tile_dir):
+    """Returns (image BGR, labels, ignored colours) of one Tile_N folder."""
+    images, masks = [], []
+    for k in range(1, 10):
+        img = read_part(os.path.join(tile_dir, "images", f"image_part_{k:03d}.jpg"), cv2.IMREAD_COLOR)
+        msk = read_part(os.path.join(tile_dir, "masks", f"image_part_{k:03d}.png"), cv2.IMREAD_COLOR)
+        if img.shape[:2] != msk.shape[:2]:
+            raise ValueError(f"{tile_dir}: part {k}: image {img.shape[1]}x{img.shape[0]} and mask "
+                             f"{msk.shape[1]}x{msk.shape[0]} differ in size")
+        images.append(img)
+        masks.append(msk)
+    image = assemble(images, f"{tile_dir}/images")
+    mask = assemble(masks, f"{tile_dir}/masks")
+    labels, ignored = mask_to_labels(mask[:, :, ::-1])
+    return image, labels, ignored
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--input", required=True, help="folder with Tile_N subfolders")
+    ap.add_argument("--out", required=True, help="parent folder of the field directories")
+    ap.add_argument("--tiles", type=int, nargs="*", help="tile numbers (default: every Tile_N present)")
+    ap.add_argument("--gsd-cm", type=float, default=5.0, help="nominal orthomosaic GSD [cm/px]")
+    ap.add_argument("--interest", default="water", help="default labels of interest, comma-separated")
+    a = ap.parse_args()
+    found = {}
+    for d in glob.glob(os.path.join(a.input, "Tile_*")):
+        m = re.fullmatch(r"Tile_(\d+)", os.path.basename(d))
+        if m and os.path.isdir(d):
+            found[int(m.group(1))] = d
+    tiles = sorted(found) if not a.tiles else a.tiles
+    if not tiles:
+        sys.exit(f"convert_dubai: no Tile_N folders in {a.input}")
+    interest = [s for s in a.interest.split(",") if s]
+    for n in interest:
+        if n not in [c for c, _ in CLASSES]:
+            sys.exit(f"convert_dubai: unknown class of interest '{n}'")
+    for t in tiles:
+        if t not in found:
+            sys.exit(f"convert_dubai: Tile_{t} not found in {a.input}")
+        try:
+            image, labels, ignored = convert_tile(found[t])
+        except ValueError as e:
+            sys.exit(f"convert_dubai: {e}")
+        out = os.path.join(a.out, f"dubai-tile-{t}")
+        write_field(out, f"dubai-tile-{t}", a.gsd_cm, labels, CLASSES, interest, image)
+        counts = np.bincount(labels.ravel(), minlength=256)
+        valid = counts[: len(CLASSES)].sum()
+        fr = ", ".join(f"{c} {counts[i] / max(valid, 1):.3f}" for i, (c, _) in enumerate(CLASSES))
+        print(f"dubai-tile-{t}: {labels.shape[1]}x{labels.shape[0]} px; {fr}; ignore {counts[IGNORE]} px "
+              f"(colours: {ignored})")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,100 @@
+#!/usr/bin/env python3
+"""Self-test of the data converters on synthetic inputs (run by CTest; exit code != 0 on failure).
+
+- WeedMap: a field of crop/weed rows rotated by a known angle inside a black image must come
+  back axis-aligned with the angle recovered within 1 degree, vegetation preserved up to the
+  nearest-neighbour resampling of the rotation, and ignore outside the source image.
+- Dubai: a 3x3 tile with parts differing by 1 px between rows/columns, a palette PNG mask and
+  an unknown colour must reassemble to the right size with the right classes and ignore.
+"""
+import os
+import sys
+import tempfile
+
+import cv2
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import convert_dubai  # noqa: E402
+import convert_weedmap  # noqa: E402
+from fieldio import IGNORE, check_field, write_field  # noqa: E402
+
+
+def test_weedmap(angle_deg=33.0):
+    w, h = 300, 700
+    field = np.zeros((h, w, 3), np.uint8)
+    for x in range(10, w - 10, 12):  # crop rows along the field's long axis
+        field[10:h - 10, x:x + 3] = (0, 255, 0)
+    field[200:230, 100:140] = (255, 0, 0)  # a weed patch
+    big = np.zeros((1200, 1200, 3), np.uint8)
+    big[250:250 + h, 450:450 + w] = field
+    m = cv2.getRotationMatrix2D((600, 600), angle_deg, 1.0)
+    rgb = cv2.warpAffine(big, m, (1200, 1200), flags=cv2.INTER_NEAREST, borderValue=(0, 0, 0))
+    src, out, rect, _ = convert_weedmap.convert(rgb, min_component=5)
+    angle = rect[2]
+    # minAreaRect reports the orientation modulo 90 degrees and in image coordinates (y down),
+    # where the rotation by +angle_deg appears as -angle_deg.
+    err = abs(((angle + angle_deg) + 45) % 90 - 45)
+    assert err < 1.0, f"angle {angle} vs {angle_deg}"
+    n_src = np.bincount(src.ravel(), minlength=3)[1:3]
+    n_out = np.bincount(out.ravel(), minlength=256)[1:3]
+    assert np.all(np.abs(n_out.astype(int) - n_src) <= 0.02 * n_src), (n_src, n_out)
+    hh, ww = out.shape
+    veg_w = max(range(10, w - 10, 12)) + 3 - 10  # extent of the rows across the field
+    assert abs(max(hh, ww) - (h - 20)) <= 4 and abs(min(hh, ww) - veg_w) <= 4, out.shape
+    assert set(np.unique(out)) <= {0, 1, 2, IGNORE}
+    # The crop rows run along one image axis: every row (or column) crossing them sees them.
+    long_axis = 0 if hh > ww else 1
+    profile = (out == 1).mean(axis=long_axis)
+    assert (profile > 0.5).sum() >= 15, "crop rows are not axis-aligned"
+    print("weedmap converter: ok (angle %.2f deg, field %dx%d)" % (angle, ww, hh))
+
+
+def test_dubai():
+    with tempfile.TemporaryDirectory() as tmp:
+        tile = os.path.join(tmp, "Tile_9")
+        os.makedirs(os.path.join(tile, "images"))
+        os.makedirs(os.path.join(tile, "masks"))
+        heights, widths = [20, 21, 20], [30, 30, 31]
+        colours = [c for _, c in convert_dubai.CLASSES]
+        for r in range(3):
+            for c in range(3):
+                k = 3 * r + c + 1
+                img = np.full((heights[r], widths[c], 3), 10 * k, np.uint8)
+                cv2.imwrite(os.path.join(tile, "images", f"image_part_{k:03d}.jpg"), img)
+                mask = np.zeros((heights[r], widths[c], 3), np.uint8)
+                mask[:] = colours[(k - 1) % 5][::-1]
+                mask[0, 0] = convert_dubai.UNLABELED[::-1]
+                mask[0, 1] = (1, 2, 3)  # unknown colour
+                path = os.path.join(tile, "masks", f"image_part_{k:03d}.png")
+                cv2.imwrite(path, mask)
+        # Make part 1's mask a palette PNG, as in the real tiles 2 and 4.
+        from PIL import Image
+        p1 = os.path.join(tile, "masks", "image_part_001.png")
+        Image.open(p1).convert("P", palette=Image.ADAPTIVE, colors=8).save(p1)
+        assert Image.open(p1).mode == "P"
+        image, labels, ignored = convert_dubai.convert_tile(tile)
+        assert image.shape[:2] == (61, 91) and labels.shape == (61, 91), labels.shape
+        assert labels[5, 5] == 0 and labels[5, 35] == 1 and labels[25, 5] == 3, labels[::20, ::30]
+        assert labels[0, 0] == IGNORE and labels[0, 1] == IGNORE
+        assert ignored["#9B9B9B"] == 9 and ignored["#030201"] == 9, ignored
+        out = os.path.join(tmp, "out")
+        write_field(out, "t", 5.0, labels, convert_dubai.CLASSES, ["water"], image)
+        summary = check_field(out)
+        assert summary["width"] == 91 and summary["ignore"] == 18, summary
+        # A missing part is reported by name.
+        os.remove(os.path.join(tile, "masks", "image_part_005.png"))
+        try:
+            convert_dubai.convert_tile(tile)
+        except ValueError as e:
+            assert "image_part_005.png" in str(e)
+        else:
+            raise AssertionError("missing part not reported")
+    print("dubai converter: ok")
+
+
+if __name__ == "__main__":
+    test_weedmap()
+    test_weedmap(-20.0)
+    test_dubai()
+    print("converters: 3 passed, 0 failed")

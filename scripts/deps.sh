@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs the Debian packages adaptseg needs, or says which are missing.
+#   scripts/deps.sh build   compiler, CMake and the C++ libraries (library, examples, tests)
+#   scripts/deps.sh test    build + what the test suite runs (Python for the data converters)
+#   scripts/deps.sh bench   test + what the benchmarks compare against (scikit-learn)
+#   scripts/deps.sh plots   build + matplotlib for the evaluation figures
+# As root it runs apt-get; otherwise it prints the command to run and fails if anything is missing.
+set -euo pipefail
+
+build=(cmake g++ make pkg-config libeigen3-dev libopencv-core-dev libopencv-imgproc-dev
+       libopencv-imgcodecs-dev libopencv-dnn-dev doctest-dev liblbfgspp-dev libyaml-cpp-dev
+       nlohmann-json3-dev libcli11-dev)
+python=(python3 python3-numpy python3-opencv python3-yaml python3-pil)
+case "${1:-build}" in
+  build) want=("${build[@]}") ;;
+  test) want=("${build[@]}" "${python[@]}") ;;
+  bench) want=("${build[@]}" "${python[@]}" python3-sklearn) ;;
+  plots) want=("${build[@]}" "${python[@]}" python3-matplotlib) ;;
+  *) echo "usage: $0 [build|test|bench|plots]" >&2; exit 2 ;;
+esac
+
+missing=()
+for p in "${want[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+if [ "$(id -u)" -eq 0 ]; then
+  echo "deps.sh: installing ${missing[*]}" >&2
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+else
+  echo "deps.sh: missing Debian packages: ${missing[*]}" >&2
+  echo "deps.sh: install them with: sudo apt-get install ${missing[*]}" >&2
+  exit 1
+fi
