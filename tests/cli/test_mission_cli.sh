@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# Black-box tests of adaptseg_mission: bad input gives one clear error line and exit code 2
+# (never a crash); good input writes result.json with the documented keys and the figures;
+# on the bundled WeedMap field the GSD sweep behaves as the issue demands.
+#   test_mission_cli.sh MISSION_BINARY EXAMPLES_DIR PYTHON CASE
+set -uo pipefail
+mission=$1 examples=$2 python=$3 case=$4
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+field="$examples/data/weedmap-000"
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+# expect_error FRAGMENT ARGS...: exit code 2, exactly one stderr line containing FRAGMENT.
+expect_error() {
+  local fragment=$1; shift
+  "$mission" "$@" >"$work/out" 2>"$work/err"
+  local rc=$?
+  [ "$rc" -eq 2 ] || fail "exit code $rc (want 2) for: $* ($(cat "$work/err"))"
+  [ "$(wc -l <"$work/err")" -eq 1 ] || fail "want one error line for: $*, got: $(cat "$work/err")"
+  grep -qF -- "$fragment" "$work/err" || fail "error for: $* lacks '$fragment': $(cat "$work/err")"
+  echo "ok: $(cat "$work/err")"
+}
+
+case "$case" in
+bad_inputs)
+  mkdir -p "$work/broken" "$work/nolabels"
+  printf 'name: [unclosed\n' >"$work/broken/field.yaml"
+  printf 'name: x\ngsd_cm: 1\nlabels: labels.png\nclasses: [{name: a, color: [0,0,0]}]\n' >"$work/nolabels/field.yaml"
+  expect_error "field directory not found" --field "$work/none" --gsd 3 --out "$work/o"
+  expect_error "missing" --field "$work" --gsd 3 --out "$work/o"
+  expect_error "YAML error" --field "$work/broken" --gsd 3 --out "$work/o"
+  expect_error "file not found" --field "$work/nolabels" --gsd 3 --out "$work/o"
+  expect_error "unknown class 'tree'" --field "$field" --gsd 3 --interest crop,tree --out "$work/o"
+  expect_error "finer than field" --field "$field" --gsd 0.5 --out "$work/o"
+  expect_error "needs --gsd" --field "$field" --out "$work/o"
+  expect_error "focal_length_mm" --field "$field" --gsd 3 --focal-mm 0 --out "$work/o"
+  expect_error "image_width_px" --field "$field" --gsd 3 --image-width -480 --out "$work/o"
+  expect_error "sensor_width_mm" --field "$field" --gsd 3 --sensor-width-mm -1 --out "$work/o"
+  expect_error "max_speed_mps" --field "$field" --gsd 3 --speed 0 --out "$work/o"
+  expect_error "fixed_segmentation_time_s" --field "$field" --gsd 3 --seg-time-s -1 --out "$work/o"
+  # Command-line syntax errors are CLI11's: non-zero exit, message on stderr, no crash.
+  "$mission" --field "$field" --gsd abc --out "$work/o" >/dev/null 2>&1
+  rc=$?; [ "$rc" -ne 0 ] && [ "$rc" -lt 128 ] || fail "--gsd abc: exit code $rc"
+  ;;
+weedmap_sweep)
+  for gsd in 1.0 1.5 2.0 2.5 3.0; do
+    "$mission" --field "$field" --strategy lawnmower --gsd "$gsd" --segmenter oracle \
+      --seg-time-s 0.1 --plan-time-s 0 --out "$work/lm-$gsd" >/dev/null || fail "mission at $gsd failed"
+    for f in result.json path.png map.png; do [ -s "$work/lm-$gsd/$f" ] || fail "missing $f at $gsd"; done
+  done
+  "$python" - "$work" <<'PY' || fail "result.json checks"
+import json, sys
+work = sys.argv[1]
+gsds = ["1.0", "1.5", "2.0", "2.5", "3.0"]
+res = [json.load(open(f"{work}/lm-{g}/result.json")) for g in gsds]
+keys = ["field", "strategy", "segmenter", "miou_interest", "miou_all", "iou_per_class", "images",
+        "time_s", "waypoints"]
+for r in res:
+    for k in keys:
+        assert k in r, f"missing key {k}"
+    assert set(r["time_s"]) >= {"total", "flight", "segmentation", "planning"}
+    assert set(r["iou_per_class"]) == {"soil", "crop", "weed"}
+    assert r["images"] == len(r["waypoints"]) > 0
+    for w in r["waypoints"]:
+        assert set(w) >= {"x", "y", "z", "gsd_cm"}
+    assert r["coverage"] == 1.0, f"coverage {r['coverage']}"
+assert res[0]["miou_all"] == 1.0, res[0]["miou_all"]
+mi = [r["miou_interest"] for r in res]
+tt = [r["time_s"]["total"] for r in res]
+print("miou_interest", mi)
+print("time_s.total", tt)
+assert all(a > b for a, b in zip(mi, mi[1:])), "miou_interest must fall with GSD"
+assert all(a > b for a, b in zip(tt, tt[1:])), "total time must fall with GSD"
+PY
+  ;;
+*) fail "unknown case $case" ;;
+esac
+echo "PASS: $case"
