@@ -1,0 +1,180 @@
+#pragma once
+// Shared command-line plumbing of the example programs: camera/timing options, error
+// reporting, and the result.json writer. Not part of the library.
+
+#include <adaptseg/calibration.hpp>
+#include <adaptseg/decision_model.hpp>
+#include <adaptseg/planner.hpp>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace adaptseg::examples {
+
+/// `v` with `digits` decimals.
+inline std::string fmt(double v, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
+
+/// Camera, speed and timing options shared by every program.
+struct CommonOptions {
+  MissionOptions mission;
+  std::vector<std::string> interest_names;
+  std::optional<double> seg_time_s;
+  std::optional<double> plan_time_s;
+
+  void add_to(CLI::App& app) {
+    auto& cam = mission.camera;
+    app.add_option("--image-width", cam.image_width_px, "camera image width [px]")->capture_default_str();
+    app.add_option("--image-height", cam.image_height_px, "camera image height [px]")->capture_default_str();
+    app.add_option("--sensor-width-mm", cam.sensor_width_mm, "sensor width [mm]")->capture_default_str();
+    app.add_option("--focal-mm", cam.focal_length_mm, "focal length [mm]")->capture_default_str();
+    app.add_option("--speed", mission.timing.max_speed_mps, "maximum speed [m/s]")->capture_default_str();
+    app.add_option("--accel", mission.timing.max_accel_mps2, "maximum acceleration [m/s^2]")->capture_default_str();
+    app.add_option("--seg-time-s", seg_time_s,
+                   "fixed segmentation time per image [s] (default: measured)");
+    app.add_option("--plan-time-s", plan_time_s,
+                   "fixed planning time per waypoint [s] (default: measured)");
+    app.add_option("--interest", interest_names,
+                   "labels of interest, comma-separated (default: the field's 'interest')")
+        ->delimiter(',');
+  }
+
+  /// Model-based strategies fly the model's camera and timing; explicit options must agree.
+  /// @throws std::invalid_argument naming the option that differs.
+  void check_camera_matches(const CLI::App& app, const DecisionModel& model) const {
+    const auto& c = mission.camera;
+    const auto& m = model.camera;
+    const auto differs = [&](const char* opt, double mine, double theirs) {
+      if (app.count(opt) > 0 && mine != theirs)
+        throw std::invalid_argument(std::string(opt) + " " + fmt(mine, 4) + " differs from the decision model's " +
+                                    fmt(theirs, 4) + " (the model was calibrated for its camera and speed)");
+    };
+    differs("--image-width", c.image_width_px, m.image_width_px);
+    differs("--image-height", c.image_height_px, m.image_height_px);
+    differs("--sensor-width-mm", c.sensor_width_mm, m.sensor_width_mm);
+    differs("--focal-mm", c.focal_length_mm, m.focal_length_mm);
+    differs("--speed", mission.timing.max_speed_mps, model.timing.max_speed_mps);
+    differs("--accel", mission.timing.max_accel_mps2, model.timing.max_accel_mps2);
+  }
+
+  /// Resolves names against the field and validates the values (throws invalid_argument).
+  MissionOptions resolve(const Field& field) const {
+    MissionOptions out = mission;
+    (void)CameraModel(out.camera);
+    (void)TimingModel(out.timing);
+    out.fixed_segmentation_time_s = seg_time_s;
+    out.fixed_planning_time_s = plan_time_s;
+    if (!interest_names.empty()) out.interest = field.class_indices(interest_names);
+    if (out.interest.empty() && field.interest().empty())
+      throw std::invalid_argument("no labels of interest: field '" + field.name() +
+                                  "' names none; pass --interest");
+    return out;
+  }
+};
+
+inline nlohmann::json opt_json(const std::optional<double>& v) {
+  return v && std::isfinite(*v) ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
+
+/// The result.json document of a mission (schema in docs/data_format.md).
+inline nlohmann::json result_json(const Field& field, const MissionResult& r, const MissionOptions& opt,
+                                  const std::vector<DecisionRecord>* decisions = nullptr) {
+  using nlohmann::json;
+  json j;
+  j["field"] = r.field;
+  j["strategy"] = r.strategy;
+  j["segmenter"] = r.segmenter;
+  json interest = json::array();
+  for (int c : r.interest) interest.push_back(field.classes()[static_cast<std::size_t>(c)].name);
+  j["interest"] = interest;
+  j["miou_interest"] = opt_json(r.miou_interest());
+  j["miou_all"] = opt_json(r.miou_all());
+  json per_class = json::object();
+  for (int c = 0; c < field.num_classes(); ++c)
+    per_class[field.classes()[static_cast<std::size_t>(c)].name] = opt_json(r.confusion.iou(c));
+  j["iou_per_class"] = per_class;
+  j["images"] = r.waypoints.size();
+  j["time_s"] = {{"total", r.total_s()}, {"flight", r.flight_s}, {"segmentation", r.segmentation_s},
+                 {"planning", r.planning_s}};
+  // Coverage: share of valid field pixels that received a label.
+  const cv::Mat observed = (r.fused_labels != field.ignore_label()) & field.valid_mask();
+  const int valid = cv::countNonZero(field.valid_mask());
+  j["coverage"] = valid > 0 ? static_cast<double>(cv::countNonZero(observed)) / valid : 0.0;
+  json wps = json::array();
+  for (const auto& w : r.waypoints) {
+    wps.push_back({{"x", w.waypoint.position.x()},
+                   {"y", w.waypoint.position.y()},
+                   {"z", w.waypoint.position.z()},
+                   {"gsd_cm", w.waypoint.gsd_cm},
+                   {"level", w.level},
+                   {"semantic_ratio", w.semantic_ratio},
+                   {"image_miou_interest", opt_json(w.image_miou_interest)},
+                   {"image_miou_all", opt_json(w.image_miou_all)},
+                   {"segmentation_s", w.segmentation_s}});
+  }
+  j["waypoints"] = wps;
+  if (decisions) {
+    int descend = 0, limited = 0;
+    for (const auto& d : *decisions) {
+      descend += d.decision.descend ? 1 : 0;
+      limited += d.budget_limited ? 1 : 0;
+      json dj{{"action", d.decision.descend ? "descend" : "continue"},
+              {"sigma", d.sigma},
+              {"budget_limited", d.budget_limited}};
+      if (d.decision.descend) dj["gsd_cm"] = d.decision.gsd_cm;
+      json cands = json::array();
+      for (std::size_t k = 0; k < d.candidates.size(); ++k) {
+        json cj{{"gsd_cm", d.candidates[k].gsd_cm},
+                {"images", d.candidates[k].images},
+                {"extra_time_s", d.candidates[k].extra_time_s}};
+        if (k < d.decision.scores.size()) {
+          const auto& sc = d.decision.scores[k];
+          cj["predicted_delta_sigma"] = sc.predicted_delta_sigma;
+          cj["predicted_delta_miou"] = sc.predicted_delta_miou;
+          cj["predicted_delta_miou_std"] = sc.predicted_delta_miou_std;
+          cj["utility"] = std::isfinite(sc.utility) ? json(sc.utility) : json(nullptr);
+        }
+        cands.push_back(cj);
+      }
+      dj["candidates"] = cands;
+      if (d.outcome) dj["observed_sigma_sub"] = d.outcome->sigma_sub;
+      j["waypoints"][d.waypoint_index]["decision"] = dj;
+    }
+    j["decisions"] = {{"descend", descend},
+                      {"continue", static_cast<int>(decisions->size()) - descend},
+                      {"budget_limited", limited}};
+  }
+  const auto& cam = opt.camera;
+  j["camera"] = {{"image_width_px", cam.image_width_px},
+                 {"image_height_px", cam.image_height_px},
+                 {"sensor_width_mm", cam.sensor_width_mm},
+                 {"focal_length_mm", cam.focal_length_mm}};
+  j["timing"] = {{"max_speed_mps", opt.timing.max_speed_mps}, {"max_accel_mps2", opt.timing.max_accel_mps2}};
+  j["adaptseg_version"] = kVersion;
+  return j;
+}
+
+inline void write_text(const std::filesystem::path& file, const std::string& text) {
+  std::ofstream os(file);
+  if (!os) throw std::runtime_error("cannot write " + file.string());
+  os << text;
+  if (!os) throw std::runtime_error("error writing " + file.string());
+}
+
+inline void write_png(const std::filesystem::path& file, const cv::Mat& img) {
+  if (!cv::imwrite(file.string(), img)) throw std::runtime_error("cannot write " + file.string());
+}
+
+}  // namespace adaptseg::examples

@@ -1,0 +1,132 @@
+#!/usr/bin/env python3
+"""Figures of an adaptseg_evaluate run (paper Figs. results, iouvsh, waypoints, qualitative).
+
+Usage: /usr/bin/python3 examples/tools/plot_evaluation.py OUTDIR
+
+Reads OUTDIR/results.csv and OUTDIR/per_image.csv (written by adaptseg_evaluate) and writes
+  OUTDIR/miou_vs_time.png       field mIoU over the labels of interest vs execution time
+  OUTDIR/per_image_miou.png     per-image mIoU vs image GSD, mean and standard deviation
+  OUTDIR/paths.png              top views of the paths (lawnmower, non-adaptive, adaptive, linear)
+  OUTDIR/maps.png               fused maps vs ground truth (coarsest lawnmower, adaptive)
+Needs matplotlib (Debian: python3-matplotlib).
+"""
+import csv
+import os
+import re
+import sys
+from collections import defaultdict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.image as mpimg  # noqa: E402
+
+STYLE = {
+    "adaptive": dict(color="tab:red", marker="*", s=220, label="adaptive"),
+    "nonadaptive": dict(color="tab:blue", marker="s", s=90, label="non-adaptive"),
+    "linear": dict(color="tab:green", marker="^", s=110, label="linear (ECMR 2021)"),
+}
+
+
+def slug(name):
+    return re.sub(r"[^A-Za-z0-9.\-]", "_", name)
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def num(v):
+    return float(v) if v not in ("", None) else float("nan")
+
+
+def main(out):
+    rows = read_csv(os.path.join(out, "results.csv"))
+    fields = list(dict.fromkeys(r["field"] for r in rows))
+
+    # Field mIoU vs execution time (paper Fig. results).
+    fig, axes = plt.subplots(1, len(fields), figsize=(6.5 * len(fields), 5), squeeze=False)
+    for ax, field in zip(axes[0], fields):
+        fr = [r for r in rows if r["field"] == field]
+        lm = sorted((r for r in fr if r["strategy"] == "lawnmower"), key=lambda r: num(r["time_total"]))
+        ax.plot([num(r["time_total"]) for r in lm], [num(r["miou_interest"]) for r in lm], "-o", color="0.3",
+                label="lawnmower (fixed altitude)")
+        for r in lm:
+            ax.annotate(f"{num(r['gsd_cm']):.1f} cm/px", (num(r["time_total"]), num(r["miou_interest"])),
+                        textcoords="offset points", xytext=(6, -12), fontsize=8, color="0.3")
+        for r in fr:
+            if r["strategy"] in STYLE:
+                st = STYLE[r["strategy"]]
+                ax.scatter([num(r["time_total"])], [num(r["miou_interest"])], zorder=3,
+                           label=f"{st['label']} (margin {num(r['front_margin']):+.3f})",
+                           **{k: v for k, v in st.items() if k != "label"})
+        ax.set_xlabel("mission execution time [s] (flight + segmentation + planning)")
+        ax.set_ylabel("field mIoU over the labels of interest")
+        ax.set_title(field, fontsize=10)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="lower right")
+    fig.suptitle("Field mIoU vs execution time (above the lawnmower curve: front margin > 0)", fontsize=11)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "miou_vs_time.png"), dpi=110)
+    plt.close(fig)
+
+    # Per-image mIoU vs GSD (paper Fig. iouvsh).
+    per = read_csv(os.path.join(out, "per_image.csv"))
+    fig, axes = plt.subplots(1, len(fields), figsize=(6.5 * len(fields), 4.5), squeeze=False)
+    for ax, field in zip(axes[0], fields):
+        offsets = {"nonadaptive": -0.06, "adaptive": 0.0, "lawnmower": 0.06}
+        for strategy, color in (("nonadaptive", "tab:blue"), ("adaptive", "tab:red"), ("lawnmower", "0.4")):
+            groups = defaultdict(list)
+            for r in per:
+                if r["field"] == field and r["strategy"] == strategy and r["image_miou_interest"] != "":
+                    groups[round(num(r["image_gsd_cm"]), 3)].append(num(r["image_miou_interest"]))
+            if not groups:
+                continue
+            g = sorted(groups)
+            mean = [sum(groups[k]) / len(groups[k]) for k in g]
+            std = [(sum((x - m) ** 2 for x in groups[k]) / len(groups[k])) ** 0.5 for k, m in zip(g, mean)]
+            ax.errorbar([k + offsets[strategy] for k in g], mean, yerr=std, fmt="o-", color=color, capsize=4,
+                        label=strategy if strategy != "lawnmower" else "lawnmowers (all images)")
+        ax.set_xlabel("image GSD [cm/px] (higher = flown higher)")
+        ax.set_ylabel("per-image mIoU over the labels of interest")
+        ax.set_title(field, fontsize=10)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle("Per-image mIoU vs GSD: mean and standard deviation over the images taken")
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "per_image_miou.png"), dpi=110)
+    plt.close(fig)
+
+    # Paths and maps: montages of the per-mission pictures.
+    for name, picks in (("paths.png", ["path"]), ("maps.png", ["map"])):
+        panels = []
+        for field in fields:
+            lm = sorted((r for r in rows if r["field"] == field and r["strategy"] == "lawnmower"),
+                        key=lambda r: num(r["gsd_cm"]))
+            wanted = ([f"lawnmower-{num(lm[-1]['gsd_cm']):.2f}", "nonadaptive", "adaptive", "linear"]
+                      if name == "paths.png" else [f"lawnmower-{num(lm[-1]['gsd_cm']):.2f}", "adaptive"])
+            for w in wanted:
+                p = os.path.join(out, slug(field), w, picks[0] + ".png")
+                if os.path.exists(p):
+                    panels.append(p)
+        if not panels:
+            continue
+        cols = 4 if name == "paths.png" else 2
+        rows_n = (len(panels) + cols - 1) // cols
+        fig, axes = plt.subplots(rows_n, cols, figsize=(6 * cols, 5 * rows_n), squeeze=False)
+        for ax in axes.flat:
+            ax.axis("off")
+        for ax, p in zip(axes.flat, panels):
+            ax.imshow(mpimg.imread(p))
+        fig.tight_layout()
+        fig.savefig(os.path.join(out, name), dpi=100)
+        plt.close(fig)
+    print(f"plots written to {out}")
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
+    main(sys.argv[1])

@@ -1,0 +1,78 @@
+#pragma once
+/// @file
+/// What a decision policy sees and says at a top-level waypoint (paper §3.2.2-3.2.3), and
+/// the `DecisionPolicy` concept that the adaptive planner is templated on.
+
+#include <concepts>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace adaptseg {
+
+/// One region seen from h_max and from h' (paper Eq. `eq:veg2h`: a row of O and of I).
+struct RegionSample {
+  double top_gsd_cm = 0.0;
+  double sub_gsd_cm = 0.0;
+  double delta_h_m = 0.0;    ///< Δh = h_max − h' [m]
+  double sigma_top = 0.0;    ///< σ_{h_max}
+  double sigma_sub = 0.0;    ///< σ_{h'} (fused sub-lawnmower images over the region)
+  double miou_top = 0.0;     ///< mIoU_{h_max} over L on the region
+  double miou_sub = 0.0;     ///< mIoU_{h'} over L on the region
+  [[nodiscard]] double delta_sigma() const noexcept { return sigma_top - sigma_sub; }
+  [[nodiscard]] double delta_miou() const noexcept { return miou_top - miou_sub; }
+};
+
+/// One lower altitude the UAV could re-map the current region from, with its exact cost.
+struct Candidate {
+  double gsd_cm = 0.0;        ///< GSD at the lower altitude h' [cm/px]
+  double altitude_m = 0.0;    ///< h' [m]
+  int images = 0;             ///< waypoints of the sub-lawnmower over the region
+  double extra_time_s = 0.0;  ///< mission time added by the sub-lawnmower [s] (flight, segmentation, planning)
+};
+
+/// The situation at a top-level waypoint, after its image has been segmented.
+struct DecisionContext {
+  double sigma = 0.0;             ///< semantic ratio σ of the current image (paper Eq. `eq:vr`)
+  double valid_fraction = 1.0;    ///< share of the image's ground inside the field (0..1]
+  double top_gsd_cm = 0.0;        ///< GSD at h_max [cm/px]
+  double top_altitude_m = 0.0;    ///< h_max [m]
+  std::span<const Candidate> candidates;  ///< affordable lower altitudes (may be empty)
+};
+
+/// A policy's assessment of one candidate.
+struct CandidateScore {
+  double gsd_cm = 0.0;
+  double predicted_delta_sigma = 0.0;  ///< μ_O: σ_{h_max} − σ_{h'}
+  double predicted_delta_miou = 0.0;   ///< μ_I(μ_O): mIoU_{h_max} − mIoU_{h'} (< 0: lower is better)
+  double predicted_delta_miou_std = 0.0;  ///< predictive standard deviation of the latter
+  double utility = 0.0;                ///< what the policy maximises
+};
+
+/// The outcome of a decision: continue (`descend == false`) or re-map the region from `gsd_cm`.
+struct Decision {
+  bool descend = false;
+  double gsd_cm = 0.0;                 ///< chosen GSD when descending
+  std::vector<CandidateScore> scores;  ///< one per candidate, in the context's order
+};
+
+/// What the UAV saw after re-mapping a region from a lower altitude (paper §3.2.3).
+struct DescentOutcome {
+  double top_altitude_m = 0.0;  ///< h_max [m]
+  double sub_altitude_m = 0.0;  ///< h' [m]
+  double sigma_top = 0.0;       ///< σ_{h_max} of the region
+  double sigma_sub = 0.0;       ///< σ_{h'} of the region (fused sub-lawnmower images)
+};
+
+/// Decides at each top-level waypoint: `decide(context)` returns a Decision whose `gsd_cm`,
+/// when descending, is one of the context's candidates; `observe(outcome)` is called after
+/// every descent (a policy that does not adapt ignores it); `name()` names the strategy.
+/// Rationale: the planner owns geometry and time, the policy only weighs gain against cost.
+template <typename P>
+concept DecisionPolicy = requires(P& policy, const DecisionContext& context, const DescentOutcome& outcome) {
+  { policy.decide(context) } -> std::same_as<Decision>;
+  policy.observe(outcome);
+  { policy.name() } -> std::convertible_to<std::string>;
+};
+
+}  // namespace adaptseg

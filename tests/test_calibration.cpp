@@ -1,0 +1,99 @@
+#include "test_support.hpp"
+
+#include <adaptseg/calibration.hpp>
+#include <adaptseg/decision_model.hpp>
+#include <adaptseg/oracle_segmenter.hpp>
+
+#include <doctest/doctest.h>
+
+using namespace adaptseg;
+namespace t = adaptseg::test;
+
+namespace {
+CalibrationOptions small_options() {
+  CalibrationOptions o;
+  o.adaptive.mission.fixed_segmentation_time_s = 0.1;
+  o.adaptive.mission.fixed_planning_time_s = 0.0;
+  o.adaptive.top_gsd_cm = 3.0;
+  o.adaptive.candidate_gsd_cm = {1.0, 2.0};
+  o.lawnmower_gsd_cm = {1.0, 2.0, 3.0};
+  o.threshold_steps = 3;
+  o.restarts = 1;
+  return o;
+}
+}  // namespace
+
+TEST_CASE("calibration: region samples pair every region with every candidate") {
+  const Field f = t::blob_field(2000, 1500, 1.0, 9, 30);
+  OracleSegmenter oracle(f.num_classes());
+  const auto samples = collect_region_samples(f, oracle, CameraModel{}, 3.0, {1.0, 2.0}, f.interest());
+  // 20 x 15 m field, 14.4 x 10.8 m regions: 2 x 2 regions, 2 candidates each.
+  REQUIRE(samples.size() == 8);
+  for (const auto& s : samples) {
+    CHECK(s.delta_h_m == doctest::Approx(16.5 - 5.5 * s.sub_gsd_cm));
+    if (s.sub_gsd_cm == 1.0) CHECK(s.miou_sub == doctest::Approx(1.0));  // the oracle is exact at g0
+    CHECK(s.miou_top <= s.miou_sub + 1e-12);
+    CHECK(s.sigma_top >= 0.0);
+    CHECK(s.sigma_top <= 1.0);
+  }
+  CHECK_THROWS_AS((void)collect_region_samples(f, oracle, CameraModel{}, 3.0, {4.0}, f.interest()),
+                  std::invalid_argument);
+  CHECK_THROWS_AS((void)collect_region_samples(f, oracle, CameraModel{}, 3.0, {1.0}, {}), std::invalid_argument);
+}
+
+TEST_CASE("calibration: the chosen thresholds never fall below the training lawnmower curve") {
+  const Field f = t::blob_field(2600, 2000, 1.0, 4, 30);
+  OracleSegmenter oracle(f.num_classes());
+  const CalibrationResult cal = calibrate(f, oracle, small_options());
+  CHECK(cal.samples.size() == 2u * 2u * 2u);
+  CHECK(cal.lawnmower_curve.size() == 3);
+  REQUIRE_FALSE(cal.trials.empty());
+  // "Never descend" is always tried, so the best worst-case margin is at least 0.
+  CHECK(cal.trials.front().worst_margin >= 0.0);
+  for (const auto& trial : cal.trials) CHECK(trial.worst_margin <= cal.trials.front().worst_margin);
+  CHECK(cal.decision_function.params().min_utility == cal.trials.front().params.min_utility);
+  CHECK(cal.linear.sigma_high > cal.linear.sigma_low);
+}
+
+TEST_CASE("decision model: file round trip and compatibility checks") {
+  const Field f = t::blob_field(2000, 1500, 1.0, 9, 30);
+  OracleSegmenter oracle(f.num_classes());
+  const auto samples = collect_region_samples(f, oracle, CameraModel{}, 3.0, {1.0, 2.0}, f.interest());
+  DecisionModel m{.calibration_field = f.name(),
+                  .segmenter = "oracle",
+                  .classes = {"soil", "crop", "weed"},
+                  .interest = {"crop", "weed"},
+                  .camera = {},
+                  .timing = {},
+                  .top_gsd_cm = 3.0,
+                  .candidate_gsd_cm = {1.0, 2.0},
+                  .decision_function = DecisionFunction::initialize(samples, {.min_utility = 1e-3}, 1),
+                  .linear = {0.01, 0.2},
+                  .samples = samples.size(),
+                  .train_front_margin = 0.01};
+  t::TempDir tmp;
+  m.save(tmp.path() / "model.yaml");
+  const DecisionModel back = DecisionModel::load(tmp.path() / "model.yaml");
+  CHECK(back.classes == m.classes);
+  CHECK(back.interest == m.interest);
+  CHECK(back.candidate_gsd_cm == m.candidate_gsd_cm);
+  CHECK(back.linear.sigma_high == m.linear.sigma_high);
+  CHECK(back.decision_function.params().min_utility == doctest::Approx(1e-3));
+  CHECK(back.decision_function.o_model().size() == m.decision_function.o_model().size());
+  back.check_compatible(f, {1, 2});
+  CHECK_THROWS_WITH_AS(back.check_compatible(f, {2}), doctest::Contains("labels of interest"), std::invalid_argument);
+  const Field other("o", 1.0, f.labels(), {{"a", {0, 0, 0}}, {"b", {1, 1, 1}}, {"c", {2, 2, 2}}}, {1});
+  CHECK_THROWS_WITH_AS(back.check_compatible(other, {1}), doctest::Contains("classes"), std::invalid_argument);
+
+  // Broken files: clear errors naming the file.
+  std::ifstream in(tmp.path() / "model.yaml");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  t::write_file(tmp.path() / "truncated.yaml", text.substr(0, text.size() * 3 / 4));
+  CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "truncated.yaml"), doctest::Contains("truncated.yaml"),
+                       std::invalid_argument);
+  t::write_file(tmp.path() / "other.yaml", "format: something/2\n");
+  CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "other.yaml"), doctest::Contains("not an adaptseg"),
+                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "missing.yaml"), doctest::Contains("not found"),
+                       std::invalid_argument);
+}
