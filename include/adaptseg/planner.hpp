@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// Umbrella header: every component except the ERFNet backend (which needs OpenCV DNN and
-/// sits behind its own header and CMake component).
+/// Umbrella header: every component. Backends that need heavy integrations (the ERFNet
+/// backend through OpenCV DNN) stay out of it, behind their own header and CMake component.
 
 #include <adaptseg/camera.hpp>
 #include <adaptseg/error.hpp>
