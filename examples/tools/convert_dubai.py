@@ -3,13 +3,15 @@
 
 Usage:
   /usr/bin/python3 examples/tools/convert_dubai.py --input ../shared/data/dubai-aerial \
-      --out examples/data [--tiles 1 2 ...] [--gsd-cm 5.0] [--interest water]
+      --out examples/data [--tiles 1 2 ...] [--gsd-cm 5.0] [--interest vegetation]
 
 Every Tile_N folder present (or those named) holds images/image_part_00K.jpg and
-masks/image_part_00K.png, K = 1..9, a 3x3 grid in row-major order. Parts in one grid row
-share a height and parts in one grid column share a width (they differ by up to 1 px between
-rows or columns), so the mosaic is assembled row by row; any other size pattern, a missing
-part, or an image/mask size mismatch is an error naming the part. Mask colours are mapped to
+masks/image_part_00K.png, K = 1..9, a 3x3 grid in row-major order. Part sizes may differ by
+a pixel (in tiles 1-6 parts of a grid row share a height and parts of a grid column share a
+width); each part is placed by the cumulative widths of the parts before it in its grid row
+and the cumulative heights of the parts above it in its grid column (see assemble()). A
+missing or unreadable part, an image part and mask part of different sizes, or parts whose
+sizes differ by more than 2 px are errors naming the part or tile. Mask colours are mapped to
 class indices [building, land, road, vegetation, water] with the colours the masks actually
 use (see the dataset's PROVENANCE.txt: classes.json is wrong); "unlabeled" (#9B9B9B), black
 and any other colour become ignore (255), and the counts of such pixels are printed.
@@ -44,20 +46,35 @@ def read_part(path, flags):
     return img
 
 
-def assemble(parts, what):
-    """3x3 list of arrays (row-major) -> mosaic; heights equal per row, widths per column."""
-    rows = []
+def assemble(parts, what, fill=0, max_spread=2):
+    """3x3 list of arrays (row-major) -> (mosaic, {"gap": px, "overlap": px}).
+
+    Part (r, c) is placed at x = sum of the widths of parts (r, 0..c-1) and y = sum of the
+    heights of parts (0..r-1, c), i.e. by the cumulative widths along its grid row and the
+    cumulative heights down its grid column, so parts may differ by a pixel anywhere. The
+    mosaic is as wide as the widest row and as tall as the tallest column. If the parts do
+    not tile exactly, pixels no part covers get `fill` and, where two parts overlap (at most
+    a pixel or so), the later part wins; both are counted. Parts whose sizes differ by more
+    than max_spread px are not one tile's 3x3 grid: an error.
+    """
+    hs = np.array([[parts[3 * r + c].shape[0] for c in range(3)] for r in range(3)])
+    ws = np.array([[parts[3 * r + c].shape[1] for c in range(3)] for r in range(3)])
+    for name, v in (("heights", hs), ("widths", ws)):
+        if v.max() - v.min() > max_spread:
+            raise ValueError(f"{what}: part {name} range from {v.min()} to {v.max()} px "
+                             f"(more than {max_spread} px apart): not a 3x3 grid of one tile")
+    xs = np.concatenate([np.zeros((3, 1), int), np.cumsum(ws, axis=1)[:, :2]], axis=1)
+    ys = np.concatenate([np.zeros((1, 3), int), np.cumsum(hs, axis=0)[:2, :]], axis=0)
+    width, height = int(ws.sum(axis=1).max()), int(hs.sum(axis=0).max())
+    first = parts[0]
+    out = np.full((height, width) + first.shape[2:], fill, first.dtype)
+    cover = np.zeros((height, width), np.uint8)
     for r in range(3):
-        row = parts[3 * r: 3 * r + 3]
-        heights = {p.shape[0] for p in row}
-        if len(heights) != 1:
-            raise ValueError(f"{what}: parts of grid row {r + 1} differ in height {sorted(heights)}")
-        rows.append(np.concatenate(row, axis=1))
-    for c in range(3):
-        widths = {parts[3 * r + c].shape[1] for r in range(3)}
-        if len(widths) != 1:
-            raise ValueError(f"{what}: parts of grid column {c + 1} differ in width {sorted(widths)}")
-    return np.concatenate(rows, axis=0)
+        for c in range(3):
+            y, x, p = ys[r, c], xs[r, c], parts[3 * r + c]
+            out[y:y + p.shape[0], x:x + p.shape[1]] = p
+            cover[y:y + p.shape[0], x:x + p.shape[1]] += 1
+    return out, {"gap": int((cover == 0).sum()), "overlap": int((cover > 1).sum())}
 
 
 def mask_to_labels(mask_rgb):
@@ -81,9 +98,15 @@ def convert_tile(tile_dir):
                              f"{msk.shape[1]}x{msk.shape[0]} differ in size")
         images.append(img)
         masks.append(msk)
-    image = assemble(images, f"{tile_dir}/images")
-    mask = assemble(masks, f"{tile_dir}/masks")
+    image, geo = assemble(images, f"{tile_dir}/images", fill=0)
+    mask, _ = assemble(masks, f"{tile_dir}/masks", fill=0)  # black -> ignore
+    if image.shape[:2] != mask.shape[:2]:
+        raise ValueError(f"{tile_dir}: image mosaic {image.shape[1]}x{image.shape[0]} and mask mosaic "
+                         f"{mask.shape[1]}x{mask.shape[0]} differ in size")
     labels, ignored = mask_to_labels(mask[:, :, ::-1])
+    if geo["gap"] or geo["overlap"]:
+        print(f"convert_dubai: {tile_dir}: parts do not tile exactly: {geo['gap']} px uncovered "
+              f"(ignore), {geo['overlap']} px covered twice (later part kept)", file=sys.stderr)
     return image, labels, ignored
 
 
@@ -121,6 +144,9 @@ def main():
         fr = ", ".join(f"{c} {counts[i] / max(valid, 1):.3f}" for i, (c, _) in enumerate(CLASSES))
         print(f"dubai-tile-{t}: {labels.shape[1]}x{labels.shape[0]} px; {fr}; ignore {counts[IGNORE]} px "
               f"(colours: {ignored})")
+        unknown = {c: n for c, n in ignored.items() if c not in ("#9B9B9B", "#000000")}
+        if unknown:
+            print(f"convert_dubai: Tile_{t}: unknown mask colours mapped to ignore: {unknown}", file=sys.stderr)
 
 
 if __name__ == "__main__":
