@@ -55,21 +55,7 @@ int main(int argc, char** argv) {
                  field.height_px(), g0);
     const adaptseg::CalibrationResult cal = adaptseg::calibrate(field, oracle, options);
 
-    adaptseg::DecisionModel model{
-        .calibration_field = field.name(),
-        .segmenter = oracle.name(),
-        .classes = {},
-        .interest = {},
-        .camera = mission.camera,
-        .timing = mission.timing,
-        .top_gsd_cm = options.adaptive.top_gsd_cm,
-        .candidate_gsd_cm = options.adaptive.candidate_gsd_cm,
-        .decision_function = cal.decision_function,
-        .linear = cal.linear,
-        .samples = cal.samples.size(),
-        .train_front_margin = cal.trials.front().front_margin};
-    for (const auto& c : field.classes()) model.classes.push_back(c.name);
-    for (int i : options.adaptive.mission.interest) model.interest.push_back(field.classes()[static_cast<std::size_t>(i)].name);
+    const adaptseg::DecisionModel model = adaptseg::make_decision_model(field, oracle.name(), options, cal);
     if (out_file.has_parent_path()) fs::create_directories(out_file.parent_path());
     model.save(out_file);
 

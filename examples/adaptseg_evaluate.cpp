@@ -91,19 +91,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "[%6.1f s] calibrating on %s ...\n", elapsed(), train.name().c_str());
       adaptseg::OracleSegmenter oracle(train.num_classes());
       const auto cal = adaptseg::calibrate(train, oracle, co);
-      loaded = adaptseg::DecisionModel{.calibration_field = train.name(),
-                                      .segmenter = oracle.name(),
-                                      .classes = {},
-                                      .interest = interest_names,
-                                      .camera = co.adaptive.mission.camera,
-                                      .timing = co.adaptive.mission.timing,
-                                      .top_gsd_cm = co.adaptive.top_gsd_cm,
-                                      .candidate_gsd_cm = co.adaptive.candidate_gsd_cm,
-                                      .decision_function = cal.decision_function,
-                                      .linear = cal.linear,
-                                      .samples = cal.samples.size(),
-                                      .train_front_margin = cal.trials.front().front_margin};
-      for (const auto& c : train.classes()) loaded->classes.push_back(c.name);
+      loaded = adaptseg::make_decision_model(train, oracle.name(), co, cal);
       std::fprintf(stderr, "[%6.1f s] calibrated: %zu samples, train front margin %+.4f, %d descents\n", elapsed(),
                    cal.samples.size(), loaded->train_front_margin, cal.trials.front().descents);
     }

@@ -53,6 +53,12 @@ TEST_CASE("calibration: the chosen thresholds never fall below the training lawn
   for (const auto& trial : cal.trials) CHECK(trial.worst_margin <= cal.trials.front().worst_margin);
   CHECK(cal.decision_function.params().min_utility == cal.trials.front().params.min_utility);
   CHECK(cal.linear.sigma_high > cal.linear.sigma_low);
+  const DecisionModel model = make_decision_model(f, oracle.name(), small_options(), cal);
+  CHECK(model.classes == std::vector<std::string>{"soil", "crop", "weed"});
+  CHECK(model.interest == std::vector<std::string>{"crop", "weed"});
+  CHECK(model.candidate_gsd_cm == std::vector<double>{1.0, 2.0});
+  CHECK(model.train_front_margin == cal.trials.front().front_margin);
+  model.check_compatible(f, f.interest());
 }
 
 TEST_CASE("decision model: file round trip and compatibility checks") {

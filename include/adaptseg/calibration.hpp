@@ -6,6 +6,7 @@
 
 #include <adaptseg/adaptive_planner.hpp>
 #include <adaptseg/decision_function.hpp>
+#include <adaptseg/decision_model.hpp>
 #include <adaptseg/linear_decision.hpp>
 #include <adaptseg/metrics.hpp>
 #include <adaptseg/mission.hpp>
@@ -168,6 +169,29 @@ template <SegmentationBackend Backend>
   if (!(linear.sigma_high > linear.sigma_low)) linear = {0.0, std::max(1e-6, sig.back())};
   linear.sigma_high = std::min(1.0, linear.sigma_high);
   return CalibrationResult{std::move(samples), std::move(fitted), linear, std::move(curve), std::move(trials)};
+}
+
+/// The model file's content for a calibration on `train` with the backend named `segmenter`:
+/// the fitted decision function, the linear baseline, and what they were calibrated for.
+[[nodiscard]] inline DecisionModel make_decision_model(const Field& train, const std::string& segmenter,
+                                                       const CalibrationOptions& options,
+                                                       const CalibrationResult& calibration) {
+  DecisionModel m{.calibration_field = train.name(),
+                  .segmenter = segmenter,
+                  .classes = {},
+                  .interest = {},
+                  .camera = options.adaptive.mission.camera,
+                  .timing = options.adaptive.mission.timing,
+                  .top_gsd_cm = options.adaptive.top_gsd_cm,
+                  .candidate_gsd_cm = options.adaptive.candidate_gsd_cm,
+                  .decision_function = calibration.decision_function,
+                  .linear = calibration.linear,
+                  .samples = calibration.samples.size(),
+                  .train_front_margin = calibration.trials.empty() ? 0.0 : calibration.trials.front().front_margin};
+  for (const auto& c : train.classes()) m.classes.push_back(c.name);
+  const auto& interest = options.adaptive.mission.interest.empty() ? train.interest() : options.adaptive.mission.interest;
+  for (int i : interest) m.interest.push_back(train.classes().at(static_cast<std::size_t>(i)).name);
+  return m;
 }
 
 }  // namespace adaptseg
