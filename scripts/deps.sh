@@ -7,9 +7,9 @@
 # As root it runs apt-get; otherwise it prints the command to run and fails if anything is missing.
 set -euo pipefail
 
-build=(cmake g++ make pkg-config libeigen3-dev libopencv-core-dev libopencv-imgproc-dev
-       libopencv-imgcodecs-dev libopencv-dnn-dev doctest-dev liblbfgspp-dev libyaml-cpp-dev
-       nlohmann-json3-dev libcli11-dev)
+# libopencv-dev: the only package that ships OpenCV's CMake config (OpenCVConfig.cmake).
+build=(cmake g++ make pkg-config libeigen3-dev libopencv-dev doctest-dev liblbfgspp-dev
+       libyaml-cpp-dev nlohmann-json3-dev libcli11-dev)
 python=(python3 python3-numpy python3-opencv python3-yaml python3-pil)
 case "${1:-build}" in
   build) want=("${build[@]}") ;;
