@@ -3,7 +3,7 @@
 # bundled WeedMap field (train on one half, test on the other, then swapped) and on the Dubai
 # tiles (decision function initialised on tile 4, tested on tiles 1, 2, 3, 5, 6; one target
 # class at a time). Deterministic: fixed segmentation (0.1 s/image) and planning (0 s) times.
-# Outputs under out/results/; prints the tables. About 10 minutes on 2 cores.
+# Outputs under out/results/; prints the tables. 15 to 20 minutes on 2 cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh plots
