@@ -46,9 +46,11 @@ inline void put_text(cv::Mat& img, const std::string& text, cv::Point at, double
   cv::putText(img, text, at, cv::FONT_HERSHEY_SIMPLEX, scale, color, thickness, cv::LINE_AA);
 }
 
-/// A white band with `title` above `img`.
+/// A white band with `title` above `img`, widened (white on the right) if the title needs it.
 inline cv::Mat with_title(const cv::Mat& img, const std::string& title) {
-  cv::Mat out(img.rows + 36, img.cols, CV_8UC3, cv::Scalar(255, 255, 255));
+  int baseline = 0;
+  const cv::Size text = cv::getTextSize(title, cv::FONT_HERSHEY_SIMPLEX, 0.65, 1, &baseline);
+  cv::Mat out(img.rows + 36, std::max(img.cols, text.width + 16), CV_8UC3, cv::Scalar(255, 255, 255));
   img.copyTo(out(cv::Rect(0, 36, img.cols, img.rows)));
   put_text(out, title, {8, 25}, 0.65);
   return out;
