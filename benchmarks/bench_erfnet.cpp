@@ -1,0 +1,134 @@
+// Times the ERFNet backend (OpenCV DNN) on one camera image: the network's forward pass
+// alone and the whole ErfnetSegmenter::segment (normalisation + forward + argmax).
+// Driven by benchmarks/bench_erfnet.py, which runs PyTorch on the same weights side by side.
+//
+//   bench_erfnet MODEL_DIR [--threads N] [--iters K] [--warmup W] [--image PNG]
+//                [--no-fusion]
+//
+// Prints one JSON object: {"threads": N, "iters": K, "forward_ms": {"median", "min", "max"},
+// "segment_ms": {...}, "opencv": "4.6.0"}.
+
+#include <adaptseg/erfnet_segmenter.hpp>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <iostream>
+#include <string>
+#include <vector>
+
+namespace {
+
+struct Stats {
+  double median = 0.0, min = 0.0, max = 0.0;
+};
+
+Stats stats(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  const double med = n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  return {med, v.front(), v.back()};
+}
+
+template <typename F>
+std::vector<double> time_ms(F&& f, int warmup, int iters) {
+  for (int i = 0; i < warmup; ++i) f();
+  std::vector<double> out;
+  out.reserve(static_cast<std::size_t>(iters));
+  for (int i = 0; i < iters; ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    const auto t1 = std::chrono::steady_clock::now();
+    out.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+  }
+  return out;
+}
+
+void print_stats(const char* key, const Stats& s) {
+  std::printf("\"%s\": {\"median\": %.3f, \"min\": %.3f, \"max\": %.3f}", key, s.median, s.min, s.max);
+}
+
+int usage() {
+  std::cerr << "usage: bench_erfnet MODEL_DIR [--threads N] [--iters K] [--warmup W] [--image PNG] [--no-fusion]\n";
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) return usage();
+  const std::string model_dir = argv[1];
+  int threads = 1, iters = 30, warmup = 5;
+  bool fusion = true;
+  std::string image_file;
+  for (int i = 2; i < argc; ++i) {
+    const std::string a = argv[i];
+    const auto next = [&]() -> std::string {
+      if (i + 1 >= argc) throw std::invalid_argument("missing value after " + a);
+      return argv[++i];
+    };
+    try {
+      if (a == "--threads") threads = std::stoi(next());
+      else if (a == "--iters") iters = std::stoi(next());
+      else if (a == "--warmup") warmup = std::stoi(next());
+      else if (a == "--image") image_file = next();
+      else if (a == "--no-fusion") fusion = false;
+      else return usage();
+    } catch (const std::exception& e) {
+      std::cerr << "bench_erfnet: " << e.what() << '\n';
+      return usage();
+    }
+  }
+  if (threads < 1 || iters < 1 || warmup < 0) return usage();
+  try {
+    adaptseg::ErfnetParams params;
+    params.num_threads = threads;
+    adaptseg::ErfnetSegmenter erfnet(model_dir, params);
+    const cv::Size in = erfnet.input_size();
+
+    adaptseg::Image image;
+    if (!image_file.empty()) {
+      image.rgb = cv::imread(image_file, cv::IMREAD_COLOR);
+      if (image.rgb.empty()) throw std::invalid_argument("cannot read image " + image_file);
+    } else {
+      image.rgb.create(in, CV_8UC3);
+      cv::randu(image.rgb, 0, 256);
+    }
+    image.width_px = image.rgb.cols;
+    image.height_px = image.rgb.rows;
+
+    // The raw network, loaded the same way, for the forward pass alone.
+    cv::dnn::Net net = cv::dnn::readNetFromONNX(model_dir + "/model.onnx");
+    net.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
+    net.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
+    net.enableFusion(fusion);
+    const int shape[] = {1, 3, in.height, in.width};
+    cv::Mat blob(4, shape, CV_32F);
+    cv::randn(blob, 0.0, 1.0);
+
+    const Stats fwd = stats(time_ms(
+        [&] {
+          net.setInput(blob);
+          const cv::Mat out = net.forward();
+          (void)out;
+        },
+        warmup, iters));
+    const Stats seg = stats(time_ms([&] { (void)erfnet.segment(image); }, warmup, iters));
+
+    std::printf("{\"threads\": %d, \"cv_threads\": %d, \"iters\": %d, \"fusion\": %s, \"input\": [%d, %d], ",
+                threads, cv::getNumThreads(), iters, fusion ? "true" : "false", in.height, in.width);
+    print_stats("forward_ms", fwd);
+    std::printf(", ");
+    print_stats("segment_ms", seg);
+    std::printf(", \"opencv\": \"%s\"}\n", CV_VERSION);
+  } catch (const std::exception& e) {
+    std::cerr << "bench_erfnet: " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}
