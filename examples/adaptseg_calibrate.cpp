@@ -4,27 +4,29 @@
 //
 //   adaptseg_calibrate --field examples/data/weedmap-000 --region 0,0,0.5,1 --segmenter oracle
 //                      --out model.yaml
+//   adaptseg_calibrate --field examples/data/dubai-tile-4 --segmenter erfnet
+//                      --model-file examples/models/erfnet-dubai --out erfnet-model.yaml
 
+#include "common/segmenters.hpp"
 #include "common/strategies.hpp"
 
 #include <cstdio>
 #include <filesystem>
+#include <utility>
 
 int main(int argc, char** argv) {
   namespace fs = std::filesystem;
   CLI::App app{"Initialise the adaptive decision function on a training field and save it."};
   fs::path field_dir, out_file;
-  std::string region_text, segmenter = "oracle";
+  std::string region_text;
   double top_factor = 3.0;
   std::vector<double> candidate_factors{1.0, 1.5, 2.0, 2.5};
   std::vector<double> lawnmower_factors{1.0, 1.5, 2.0, 2.5, 3.0};
   int steps = 10;
   adaptseg::examples::CommonOptions common;
+  adaptseg::examples::SegmenterOptions segmenter;  // the backend the missions will use
   app.add_option("--field", field_dir, "training field directory (with ground truth)")->required();
   app.add_option("--region", region_text, "part of the field to use: x0,y0,x1,y1 in fractions along the image axes");
-  app.add_option("--segmenter", segmenter, "segmentation backend the missions will use")
-      ->check(CLI::IsMember({"oracle"}))
-      ->capture_default_str();
   app.add_option("--out", out_file, "model file to write (YAML)")->required();
   app.add_option("--top-factor", top_factor, "top-level GSD as a multiple of the field's GSD")->capture_default_str();
   app.add_option("--candidate-factors", candidate_factors, "candidate lower GSDs, multiples of the field's GSD")
@@ -36,6 +38,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--threshold-steps", steps, "utility thresholds tried per weighting")->capture_default_str();
   common.add_to(app);
+  segmenter.add_to(app);
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -50,12 +53,13 @@ int main(int argc, char** argv) {
     for (double f : candidate_factors) options.adaptive.candidate_gsd_cm.push_back(f * g0);
     for (double f : lawnmower_factors) options.lawnmower_gsd_cm.push_back(f * g0);
     options.threshold_steps = steps;
-    adaptseg::OracleSegmenter oracle(field.num_classes());
-    std::fprintf(stderr, "calibrating on %s (%dx%d px, %.2f cm/px) ...\n", field.name().c_str(), field.width_px(),
-                 field.height_px(), g0);
-    const adaptseg::CalibrationResult cal = adaptseg::calibrate(field, oracle, options);
-
-    const adaptseg::DecisionModel model = adaptseg::make_decision_model(field, oracle.name(), options, cal);
+    std::fprintf(stderr, "calibrating on %s (%dx%d px, %.2f cm/px) with %s ...\n", field.name().c_str(),
+                 field.width_px(), field.height_px(), g0, segmenter.name.c_str());
+    const auto [cal, model] = segmenter.with_backend(field, mission.camera, [&](auto& backend) {
+      adaptseg::CalibrationResult c = adaptseg::calibrate(field, backend, options);
+      adaptseg::DecisionModel m = adaptseg::make_decision_model(field, backend.name(), options, c);
+      return std::pair{std::move(c), std::move(m)};
+    });
     if (out_file.has_parent_path()) fs::create_directories(out_file.parent_path());
     model.save(out_file);
 

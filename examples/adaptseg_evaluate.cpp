@@ -4,7 +4,10 @@
 //
 //   adaptseg_evaluate --train examples/data/weedmap-000:0,0,0.5,1
 //                     --test examples/data/weedmap-000:0.5,0,1,1 --segmenter oracle --out out/eval
+//   adaptseg_evaluate --train examples/data/dubai-tile-4 --test examples/data/dubai-tile-6
+//                     --segmenter erfnet --model-file examples/models/erfnet-dubai --out out/eval-erfnet
 
+#include "common/segmenters.hpp"
 #include "common/strategies.hpp"
 
 #include <chrono>
@@ -37,7 +40,7 @@ std::string slug(const std::string& s) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Run every strategy on test fields and write the paper's tables and figures."};
-  std::string train_spec, segmenter = "oracle";
+  std::string train_spec;
   std::vector<std::string> test_specs;
   fs::path out_dir, model_file;
   std::vector<double> lawnmower_factors{1.0, 1.5, 2.0, 2.5, 3.0};
@@ -45,10 +48,10 @@ int main(int argc, char** argv) {
   bool no_plots = false;
   int steps = 10;
   adaptseg::examples::CommonOptions common;
+  adaptseg::examples::SegmenterOptions segmenter;
   app.add_option("--train", train_spec, "training field DIR[:x0,y0,x1,y1] (decision-function initialisation)");
   app.add_option("--model", model_file, "use this decision model instead of calibrating on --train");
   app.add_option("--test", test_specs, "test field DIR[:x0,y0,x1,y1]; repeatable")->required();
-  app.add_option("--segmenter", segmenter, "segmentation backend")->check(CLI::IsMember({"oracle"}))->capture_default_str();
   app.add_option("--out", out_dir, "output directory")->required();
   app.add_option("--lawnmower-factors", lawnmower_factors, "lawnmower GSDs as multiples of each field's GSD")
       ->delimiter(',')
@@ -57,6 +60,7 @@ int main(int argc, char** argv) {
   app.add_option("--threshold-steps", steps, "utility thresholds tried in calibration")->capture_default_str();
   app.add_flag("--no-plots", no_plots, "do not run the plotting script");
   common.add_to(app);
+  segmenter.add_to(app);
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -89,9 +93,11 @@ int main(int argc, char** argv) {
       for (double f : lawnmower_factors) co.lawnmower_gsd_cm.push_back(f * g0);
       co.threshold_steps = steps;
       std::fprintf(stderr, "[%6.1f s] calibrating on %s ...\n", elapsed(), train.name().c_str());
-      adaptseg::OracleSegmenter oracle(train.num_classes());
-      const auto cal = adaptseg::calibrate(train, oracle, co);
-      loaded = adaptseg::make_decision_model(train, oracle.name(), co, cal);
+      const auto cal = segmenter.with_backend(train, co.adaptive.mission.camera, [&](auto& backend) {
+        adaptseg::CalibrationResult c = adaptseg::calibrate(train, backend, co);
+        loaded = adaptseg::make_decision_model(train, backend.name(), co, c);
+        return c;
+      });
       std::fprintf(stderr, "[%6.1f s] calibrated: %zu samples, train front margin %+.4f, %d descents\n", elapsed(),
                    cal.samples.size(), loaded->train_front_margin, cal.trials.front().descents);
     }
@@ -113,13 +119,16 @@ int main(int argc, char** argv) {
       };
       std::vector<Row> rows;
       std::vector<adaptseg::CurvePoint> curve;
-      adaptseg::OracleSegmenter oracle(field.num_classes());
       const auto fly = [&](const std::string& strategy, double gsd) {
         ++run_index;
         std::fprintf(stderr, "[%6.1f s] (%zu/%zu) %s: %s%s ...", elapsed(), run_index, total_runs, field.name().c_str(),
                      strategy.c_str(), strategy == "lawnmower" ? (" " + fmt(gsd, 2) + " cm/px").c_str() : "");
-        auto run = adaptseg::examples::run_strategy(field, oracle, strategy, gsd, &model, mo,
-                                                    strategy == "lawnmower" ? std::nullopt : budget_s);
+        auto run = segmenter.with_backend(field, strategy == "lawnmower" ? mo.camera : model.camera,
+                                          [&](auto& backend) {
+                                            return adaptseg::examples::run_strategy(
+                                                field, backend, strategy, gsd, &model, mo,
+                                                strategy == "lawnmower" ? std::nullopt : budget_s);
+                                          });
         std::fprintf(stderr, " %zu images, %.1f s, mIoU %.4f\n", run.mission.waypoints.size(), run.mission.total_s(),
                      run.mission.miou_interest().value_or(NAN));
         rows.push_back({strategy, gsd, std::move(run)});

@@ -2,10 +2,13 @@
 //
 //   adaptseg_mission --field examples/data/weedmap-000 --strategy lawnmower --gsd 3.0
 //                    --segmenter oracle --out out/lawnmower-3.0
+//   adaptseg_mission --field examples/data/dubai-tile-6 --strategy lawnmower --gsd 15
+//                    --segmenter erfnet --model-file examples/models/erfnet-dubai --out out/erfnet-15
 //   adaptseg_mission --field DIR --strategy adaptive --model model.yaml --out OUT [--budget-s 900]
 //
 // Writes OUT/result.json (scores, time, waypoints, decisions), OUT/path.png and OUT/map.png.
 
+#include "common/segmenters.hpp"
 #include "common/strategies.hpp"
 
 #include <adaptseg/planner.hpp>
@@ -19,10 +22,11 @@ int main(int argc, char** argv) {
   CLI::App app{"Fly one UAV mapping mission over a field (simulated) and score it."};
   std::string field_spec;
   fs::path out_dir, model_file;
-  std::string strategy = "lawnmower", segmenter = "oracle";
+  std::string strategy = "lawnmower";
   double gsd_cm = 0.0;
   std::optional<double> budget_s;
   adaptseg::examples::CommonOptions common;
+  adaptseg::examples::SegmenterOptions segmenter;
   app.add_option("--field", field_spec, "field directory (field.yaml, labels.png, [image]), optionally DIR:x0,y0,x1,y1")
       ->required();
   app.add_option("--strategy", strategy, "mission strategy")
@@ -31,11 +35,9 @@ int main(int argc, char** argv) {
   app.add_option("--gsd", gsd_cm, "lawnmower GSD [cm/px] (>= the field's GSD)");
   app.add_option("--model", model_file, "decision model from adaptseg_calibrate (adaptive, nonadaptive, linear)");
   app.add_option("--budget-s", budget_s, "mission-time budget [s] for adaptive strategies (never exceeded)");
-  app.add_option("--segmenter", segmenter, "segmentation backend")
-      ->check(CLI::IsMember({"oracle"}))
-      ->capture_default_str();
   app.add_option("--out", out_dir, "output directory")->required();
   common.add_to(app);
+  segmenter.add_to(app);
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -46,9 +48,12 @@ int main(int argc, char** argv) {
     if (strategy != "lawnmower" && model) common.check_camera_matches(app, *model);
     if (budget_s && strategy == "lawnmower")
       throw std::invalid_argument("--budget-s applies to adaptive strategies only");
-    adaptseg::OracleSegmenter oracle(field.num_classes());
-    const auto run = adaptseg::examples::run_strategy(field, oracle, strategy, gsd_cm, model ? &*model : nullptr,
-                                                      options, budget_s);
+    segmenter.validate();
+    const auto camera = strategy != "lawnmower" && model ? model->camera : options.camera;
+    const auto run = segmenter.with_backend(field, camera, [&](auto& backend) {
+      return adaptseg::examples::run_strategy(field, backend, strategy, gsd_cm, model ? &*model : nullptr, options,
+                                              budget_s);
+    });
     const adaptseg::MissionResult& result = run.mission;
     if (strategy != "lawnmower") options.camera = model->camera, options.timing = model->timing;
 

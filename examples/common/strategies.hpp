@@ -60,6 +60,10 @@ StrategyRun run_strategy(const Field& field, Backend& backend, const std::string
     return {run_lawnmower_mission(field, gsd_cm, backend, options), std::nullopt};
   }
   if (model == nullptr) throw std::invalid_argument("--strategy " + strategy + " needs --model (from adaptseg_calibrate)");
+  if (model->segmenter != backend.name())
+    throw std::invalid_argument("the decision model was calibrated with segmenter '" + model->segmenter +
+                                "' but the mission uses '" + backend.name() +
+                                "': calibrate with the backend the mission flies (adaptseg_calibrate --segmenter)");
   // Without --interest, the model's labels of interest (its GPs were fitted for them).
   if (options.interest.empty()) options.interest = field.class_indices(model->interest);
   model->check_compatible(field, options.interest);

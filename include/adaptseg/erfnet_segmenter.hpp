@@ -133,6 +133,16 @@ class ErfnetSegmenter {
   ErfnetSegmenter& operator=(ErfnetSegmenter&&) = default;
   ~ErfnetSegmenter() = default;
 
+  /// `params` with the expected classes of `field` and the image size of `camera`, for the
+  /// two-file constructor (the directory-and-field constructor does this itself).
+  [[nodiscard]] static Params for_field(const Field& field, const CameraModel& camera, Params params = {}) {
+    params.expected_classes.clear();
+    for (const auto& c : field.classes()) params.expected_classes.push_back(c.name);
+    params.camera_width_px = camera.width_px();
+    params.camera_height_px = camera.height_px();
+    return params;
+  }
+
   [[nodiscard]] std::string name() const { return params_.name; }
   [[nodiscard]] const Params& params() const noexcept { return params_; }
   [[nodiscard]] const ErfnetModelInfo& model_info() const noexcept { return info_; }
@@ -234,14 +244,6 @@ class ErfnetSegmenter {
     if (!std::filesystem::is_directory(dir))
       throw std::invalid_argument("ErfnetSegmenter: model directory not found: " + dir.string());
     return dir;
-  }
-
-  static Params for_field(const Field& field, const CameraModel& camera, Params params) {
-    params.expected_classes.clear();
-    for (const auto& c : field.classes()) params.expected_classes.push_back(c.name);
-    params.camera_width_px = camera.width_px();
-    params.camera_height_px = camera.height_px();
-    return params;
   }
 
   void validate_params() const {
