@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   std::vector<double> candidate_factors{1.0, 1.5, 2.0, 2.5};
   std::vector<double> lawnmower_factors{1.0, 1.5, 2.0, 2.5, 3.0};
   int steps = 10;
+  std::string rule = "front-aware";
   adaptseg::examples::CommonOptions common;
   adaptseg::examples::SegmenterOptions segmenter;  // the backend the missions will use
   app.add_option("--field", field_dir, "training field directory (with ground truth)")->required();
@@ -35,6 +36,11 @@ int main(int argc, char** argv) {
   app.add_option("--lawnmower-factors", lawnmower_factors,
                  "GSDs of the training lawnmower curve, multiples of the field's GSD")
       ->delimiter(',')
+      ->capture_default_str();
+  app.add_option("--rule", rule,
+                 "decision rule: front-aware (descend while descents beat the lawnmower curve; no threshold) or "
+                 "threshold (the paper's utility with the threshold calibrated on the training field)")
+      ->check(CLI::IsMember({"front-aware", "threshold"}))
       ->capture_default_str();
   app.add_option("--threshold-steps", steps, "utility thresholds tried per weighting")->capture_default_str();
   common.add_to(app);
@@ -53,10 +59,11 @@ int main(int argc, char** argv) {
     for (double f : candidate_factors) options.adaptive.candidate_gsd_cm.push_back(f * g0);
     for (double f : lawnmower_factors) options.lawnmower_gsd_cm.push_back(f * g0);
     options.threshold_steps = steps;
+    options.front_aware = rule == "front-aware";
     std::fprintf(stderr, "calibrating on %s (%dx%d px, %.2f cm/px) with %s ...\n", field.name().c_str(),
                  field.width_px(), field.height_px(), g0, segmenter.name.c_str());
     const auto [cal, model] = segmenter.with_backend(field, mission.camera, [&](auto& backend) {
-      adaptseg::CalibrationResult c = adaptseg::calibrate(field, backend, options);
+      adaptseg::CalibrationResult c = adaptseg::examples::calibrate_cached(field, backend, options);
       adaptseg::DecisionModel m = adaptseg::make_decision_model(field, backend.name(), options, c);
       return std::pair{std::move(c), std::move(m)};
     });
@@ -65,11 +72,12 @@ int main(int argc, char** argv) {
 
     std::printf("training lawnmower curve (time s, mIoU interest):");
     for (const auto& p : cal.lawnmower_curve) std::printf(" (%.1f, %.4f)", p.time_s, p.miou);
-    std::printf("\nthreshold trials (chosen first): weight_by_sigma relative min_utility -> time_s miou front_margin "
-                "worst_margin descents\n");
+    std::printf("\nthreshold trials (chosen first): weight_by_sigma relative front_aware min_utility -> time_s miou "
+                "front_margin worst_margin descents\n");
     for (const auto& t : cal.trials)
-      std::printf("  %d %d %.6g -> %.1f %.4f %+.4f %+.4f %d\n", t.params.weight_by_sigma ? 1 : 0,
-                  t.params.relative_utility ? 1 : 0, t.params.min_utility, t.time_s, t.miou_interest, t.front_margin,
+      std::printf("  %d %d %d %.6g -> %.1f %.4f %+.4f %+.4f %d\n", t.params.weight_by_sigma ? 1 : 0,
+                  t.params.relative_utility ? 1 : 0, t.params.front_aware ? 1 : 0, t.params.min_utility, t.time_s,
+                  t.miou_interest, t.front_margin,
                   t.worst_margin, t.descents);
     std::printf("%zu region samples; linear sigma range [%.4f, %.4f]; model -> %s\n", cal.samples.size(),
                 cal.linear.sigma_low, cal.linear.sigma_high, out_file.string().c_str());

@@ -6,6 +6,8 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
+
 using namespace adaptseg;
 namespace t = adaptseg::test;
 
@@ -44,7 +46,9 @@ TEST_CASE("calibration: region samples pair every region with every candidate") 
 TEST_CASE("calibration: the chosen thresholds never fall below the training lawnmower curve") {
   const Field f = t::blob_field(2600, 2000, 1.0, 4, 30);
   OracleSegmenter oracle(f.num_classes());
-  const CalibrationResult cal = calibrate(f, oracle, small_options());
+  CalibrationOptions options = small_options();
+  options.front_aware = false;  // the paper's rule with a calibrated threshold
+  const CalibrationResult cal = calibrate(f, oracle, options);
   CHECK(cal.samples.size() == 2u * 2u * 2u);
   CHECK(cal.lawnmower_curve.size() == 3);
   REQUIRE_FALSE(cal.trials.empty());
@@ -59,6 +63,33 @@ TEST_CASE("calibration: the chosen thresholds never fall below the training lawn
   CHECK(model.candidate_gsd_cm == std::vector<double>{1.0, 2.0});
   CHECK(model.train_front_margin == cal.trials.front().front_margin);
   model.check_compatible(f, f.interest());
+}
+
+TEST_CASE("calibration: by default the front-aware rule is chosen, with the training curve as its reference") {
+  const Field f = t::blob_field(2600, 2000, 1.0, 4, 30);
+  OracleSegmenter oracle(f.num_classes());
+  const CalibrationOptions options = small_options();
+  REQUIRE(options.front_aware);
+  const CalibrationResult cal = calibrate(f, oracle, options);
+  CHECK(cal.decision_function.params().front_aware);
+  CHECK(cal.trials.front().params.front_aware);
+  CHECK_FALSE(cal.decision_function.params().relative_utility);
+  // Its reference: the training lawnmower's mIoU at each lawnmower GSD.
+  const auto& reference = cal.decision_function.reference_lawnmower();
+  REQUIRE(reference.size() == options.lawnmower_gsd_cm.size());
+  for (std::size_t k = 0; k < reference.size(); ++k) {
+    CHECK(reference[k].gsd_cm == options.lawnmower_gsd_cm[k]);
+    CHECK(reference[k].miou == cal.lawnmower_curve[k].miou);
+  }
+  // The threshold settings are still flown and reported.
+  CHECK(std::count_if(cal.trials.begin(), cal.trials.end(),
+                      [](const ThresholdTrial& tr) { return !tr.params.front_aware; }) > 5);
+  // The model file keeps the rule and its reference.
+  t::TempDir tmp;
+  make_decision_model(f, oracle.name(), options, cal).save(tmp.path() / "model.yaml");
+  const DecisionModel back = DecisionModel::load(tmp.path() / "model.yaml");
+  CHECK(back.decision_function.params().front_aware);
+  CHECK(back.decision_function.reference_lawnmower().size() == reference.size());
 }
 
 TEST_CASE("decision model: file round trip and compatibility checks") {

@@ -1,4 +1,5 @@
 #include <adaptseg/decision_function.hpp>
+#include <adaptseg/lawnmower_curve.hpp>
 #include <adaptseg/linear_decision.hpp>
 
 #include <doctest/doctest.h>
@@ -144,6 +145,79 @@ TEST_CASE("decision function: save and load give the same decisions and broken f
   std::istringstream empty("");
   CHECK_THROWS_AS((void)DecisionFunction::load(empty), std::invalid_argument);
   CHECK_THROWS_AS((void)DecisionFunction::initialize({}, {}), std::invalid_argument);
+}
+
+TEST_CASE("decision function: the front-aware rule descends while descents beat the lawnmower curve") {
+  auto df = DecisionFunction::initialize(samples(), {.weight_by_sigma = false, .front_aware = true});
+  // Training lawnmower by GSD, and this field's lawnmower times at the same GSDs.
+  df.set_reference_lawnmower({{1.0, 1.0}, {1.5, 0.85}, {2.0, 0.82}, {2.5, 0.77}, {3.0, 0.75}});
+  const std::vector<LawnmowerForecast> lawnmowers{{1.0, 185.0}, {1.5, 107.0}, {2.0, 101.0}, {2.5, 96.0}, {3.0, 40.0}};
+  const std::vector<CurvePoint> curve{{185.0, 1.0}, {107.0, 0.85}, {101.0, 0.82}, {96.0, 0.77}, {40.0, 0.75}};
+  const auto c = candidates();
+  DecisionContext ctx{.sigma = 0.2, .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5,
+                      .candidates = c, .elapsed_s = 5.7, .rest_s = 34.3, .region_share = 1.0 / 7.0,
+                      .lawnmowers = lawnmowers};
+  // First region: the mission's end point is the top-level lawnmower's (40 s, 0.75), margin 0.
+  // Re-mapping the region (1/7 of the field) from 1.0 cm/px gains about 0.275 / 7 = 0.039 for
+  // 40 s: (80 s, 0.789) lies above the curve (0.764 there).
+  const Decision first = df.decide(ctx);
+  REQUIRE(first.descend);
+  double best = -1.0;
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    const auto& s = first.scores[k];
+    // The predicted margin is the forecast end point against the curve, from the region's gain.
+    const double expected = front_margin(curve, 40.0 + c[k].extra_time_s, 0.75 - s.predicted_delta_miou / 7.0);
+    CHECK(s.predicted_front_margin == doctest::Approx(expected).epsilon(1e-9));
+    best = std::max(best, s.predicted_front_margin);
+  }
+  CHECK(best > 0.015);
+  for (std::size_t k = 0; k < c.size(); ++k)
+    if (first.scores[k].predicted_front_margin == best) CHECK(first.gsd_cm == c[k].gsd_cm);
+  // A later region, after that descent (end point now about 85 s): another descent would end
+  // in the curve's steep part (2.5 -> 1.5 cm/px costs only 11 s there), below it: continue.
+  DecisionContext next = ctx;
+  next.elapsed_s = 5.7 + 40.0 + 5.7;
+  next.rest_s = 33.6;
+  const Decision second = df.decide(next);
+  CHECK_FALSE(second.descend);
+  for (const auto& s : second.scores) CHECK(s.predicted_front_margin < 0.0);
+  // A new mission forgets the forecast: the first region descends again.
+  df.reset_mission();
+  CHECK(df.decide(ctx).descend);
+  // The rule needs the forecasts and the reference; it excludes the relative threshold.
+  df.reset_mission();
+  DecisionContext blind = ctx;
+  blind.lawnmowers = {};
+  CHECK_THROWS_WITH_AS((void)df.decide(blind), doctest::Contains("lawnmower forecasts"), std::invalid_argument);
+  auto no_reference = DecisionFunction::initialize(samples(), {.front_aware = true});
+  CHECK_THROWS_WITH_AS((void)no_reference.decide(ctx), doctest::Contains("reference lawnmower"),
+                       std::invalid_argument);
+  CHECK_THROWS_AS(df.set_params({.relative_utility = true, .front_aware = true}), std::invalid_argument);
+  CHECK_THROWS_AS(df.set_reference_lawnmower({{0.0, 0.5}}), std::invalid_argument);
+  // Saved and loaded with its reference.
+  std::stringstream ss;
+  df.save(ss);
+  auto back = DecisionFunction::load(ss);
+  CHECK(back.params().front_aware);
+  REQUIRE(back.reference_lawnmower().size() == 5);
+  CHECK(back.reference_lawnmower()[3].miou == 0.77);
+  CHECK(back.decide(ctx).gsd_cm == first.gsd_cm);
+}
+
+TEST_CASE("decision function: files of format version 1 still load") {
+  const auto df = DecisionFunction::initialize(samples(), {.min_utility = 1e-4});
+  std::stringstream ss;
+  df.save(ss);
+  std::string text = ss.str();
+  // Version 1 had no front_aware and no reference_lawnmower lines.
+  text.replace(text.find(" 2\n"), 3, " 1\n");
+  const auto a = text.find("front_aware");
+  text.erase(a, text.find("reference_lawnmower 0\n") + std::string("reference_lawnmower 0\n").size() - a);
+  std::istringstream v1(text);
+  const auto back = DecisionFunction::load(v1);
+  CHECK_FALSE(back.params().front_aware);
+  CHECK(back.params().min_utility == 1e-4);
+  CHECK(back.reference_lawnmower().empty());
 }
 
 TEST_CASE("linear decision: altitude falls linearly with σ to the nearest candidate") {

@@ -110,7 +110,7 @@ inline nlohmann::json result_json(const Field& field, const MissionResult& r, co
                  {"planning", r.planning_s}};
   // Coverage: share of valid field pixels that received a label.
   const cv::Mat observed = (r.fused_labels != field.ignore_label()) & field.valid_mask();
-  const int valid = cv::countNonZero(field.valid_mask());
+  const int valid = field.valid_pixels();
   j["coverage"] = valid > 0 ? static_cast<double>(cv::countNonZero(observed)) / valid : 0.0;
   json wps = json::array();
   for (const auto& w : r.waypoints) {
@@ -145,6 +145,7 @@ inline nlohmann::json result_json(const Field& field, const MissionResult& r, co
           cj["predicted_delta_miou"] = sc.predicted_delta_miou;
           cj["predicted_delta_miou_std"] = sc.predicted_delta_miou_std;
           cj["utility"] = std::isfinite(sc.utility) ? json(sc.utility) : json(nullptr);
+          if (std::isfinite(sc.predicted_front_margin)) cj["predicted_front_margin"] = sc.predicted_front_margin;
         }
         cands.push_back(cj);
       }

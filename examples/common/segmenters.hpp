@@ -2,19 +2,92 @@
 // Choosing the segmentation backend by name (--segmenter oracle|erfnet --model-file PATH) for
 // the example programs. Not part of the library.
 
+#include <adaptseg/calibration.hpp>
 #include <adaptseg/camera.hpp>
 #include <adaptseg/erfnet_segmenter.hpp>
 #include <adaptseg/field.hpp>
+#include <adaptseg/lawnmower_planner.hpp>
 #include <adaptseg/oracle_segmenter.hpp>
+#include <adaptseg/segmentation_backend.hpp>
+#include <adaptseg/simulated_sensor.hpp>
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdio>
 #include <filesystem>
+#include <map>
+#include <tuple>
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace adaptseg::examples {
+
+/// Memoises a deterministic backend: a simulated image is identified by its footprint, its
+/// size and its RGB sums. For calibration, which flies the same waypoints many times, and only
+/// with a fixed segmentation time per image (a cache hit takes no time, so a measured time
+/// would be wrong).
+template <SegmentationBackend Backend>
+class CachedBackend {
+ public:
+  explicit CachedBackend(Backend& inner) : inner_(inner) {}
+  [[nodiscard]] std::string name() const { return inner_.name(); }
+  [[nodiscard]] cv::Mat segment(const Image& image) {
+    const cv::Scalar sum = image.rgb.empty() ? cv::Scalar() : cv::sum(image.rgb);
+    const Key key{image.footprint_px.x, image.footprint_px.y, image.footprint_px.width,
+                  image.footprint_px.height, image.width_px, image.height_px, sum[0], sum[1], sum[2]};
+    const auto it = cache_.find(key);
+    if (it != cache_.end()) return it->second.clone();
+    cv::Mat labels = inner_.segment(image);
+    cache_.emplace(key, labels.clone());
+    return labels;
+  }
+
+ private:
+  using Key = std::tuple<int, int, int, int, int, int, double, double, double>;
+  Backend& inner_;
+  std::map<Key, cv::Mat> cache_;
+};
+
+/// Median wall time [s] of `backend` on up to `count` images of a lawnmower over `field` at
+/// `gsd_cm` (a fixed per-image cost for runs that must be deterministic or cached).
+template <SegmentationBackend Backend>
+double measure_segmentation_s(const Field& field, const CameraModel& camera, Backend& backend, double gsd_cm,
+                              int count = 7) {
+  const auto plan = LawnmowerPlanner(camera).plan(field.area(), gsd_cm, {0.0, 0.0},
+                                                  [&](const Area& a) { return field.has_valid(a); });
+  const SimulatedSensor sensor(field, camera);
+  std::vector<double> times;
+  for (std::size_t k = 0; k < plan.size() && static_cast<int>(times.size()) < count; ++k) {
+    const Image image = sensor.capture(plan[k]);
+    const auto t0 = std::chrono::steady_clock::now();
+    (void)backend.segment(image);
+    times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  if (times.empty()) return 0.0;
+  std::nth_element(times.begin(), times.begin() + static_cast<std::ptrdiff_t>(times.size() / 2), times.end());
+  return times[times.size() / 2];
+}
+
+/// adaptseg::calibrate with a per-image segmentation time fixed (the options', else the
+/// backend's median measured on the training field's top-level images) and `backend` cached:
+/// calibration flies the same waypoints many times, and a network backend is the slow part.
+template <SegmentationBackend Backend>
+CalibrationResult calibrate_cached(const Field& train, Backend& backend, CalibrationOptions options) {
+  auto& fixed = options.adaptive.mission.fixed_segmentation_time_s;
+  if (!fixed) {
+    fixed = measure_segmentation_s(train, CameraModel(options.adaptive.mission.camera), backend,
+                                   options.adaptive.top_gsd_cm);
+    std::fprintf(stderr, "calibration: %s takes %.4f s per image (median, measured on %s); used as a fixed cost\n",
+                 backend.name().c_str(), *fixed, train.name().c_str());
+  }
+  CachedBackend<Backend> cached(backend);
+  return calibrate(train, cached, options);
+}
 
 /// The backend options shared by adaptseg_mission, adaptseg_calibrate and adaptseg_evaluate.
 struct SegmenterOptions {

@@ -59,13 +59,12 @@ inline double map_sigma(const SemanticMap& map, const cv::Rect& rect, const std:
   return semantic_ratio(map.labels()(in), interest, map.unknown_label());
 }
 
-/// Share of the ground under `a` that lies inside the field (valid pixels).
-inline double valid_fraction(const Field& field, const Area& a) {
-  const cv::Rect rect = field.pixel_rect(a);
-  const cv::Rect in = rect & cv::Rect(0, 0, field.width_px(), field.height_px());
-  if (rect.area() <= 0 || in.area() == 0) return 0.0;
-  return static_cast<double>(cv::countNonZero(field.valid_mask()(in))) / static_cast<double>(rect.area());
-}
+/// A fixed-altitude lawnmower over the whole field, as a front-aware policy sees it.
+struct LawnmowerPlanCost {
+  double gsd_cm = 0.0;
+  double flight_s = 0.0;  ///< velocity-ramp flight time along the plan
+  std::size_t images = 0;
+};
 
 }  // namespace detail
 
@@ -105,7 +104,7 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
   const auto keep = [&](const Area& a) { return field.has_valid(a); };
   const auto t_plan = std::chrono::steady_clock::now();
   const auto top = planner.plan(field.area(), options.top_gsd_cm, {0.0, 0.0}, keep);
-  double pending_planning = Mission<Backend>::seconds_since(t_plan);
+  double pending_planning = 0.0;  // charged at the first waypoint (set below)
 
   // Estimates of the per-image cost of work not yet done.
   double slowest_segmentation = 0.0;
@@ -127,7 +126,22 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
                     *options.budget_s);
   }
 
+  // The field's lawnmowers at the top and candidate GSDs (what the mission could fly instead),
+  // planned exactly as run_lawnmower_mission plans them; their times use the current per-image
+  // estimates at each decision.
+  std::vector<detail::LawnmowerPlanCost> lawnmowers;
+  for (double g : candidates) lawnmowers.push_back({g, 0.0, 0});
+  lawnmowers.push_back({options.top_gsd_cm, 0.0, 0});
+  for (auto& l : lawnmowers) {
+    const auto plan = planner.plan(field.area(), l.gsd_cm, {0.0, 0.0}, keep);
+    for (std::size_t k = 1; k < plan.size(); ++k) l.flight_s += timing.segment_time_s(plan[k - 1].position, plan[k].position);
+    l.images = plan.size();
+  }
+  const double field_valid_px = static_cast<double>(field.valid_pixels());
+  pending_planning = Mission<Backend>::seconds_since(t_plan);  // the top plan and the forecasts
+
   std::vector<DecisionRecord> decisions;
+  std::vector<LawnmowerForecast> forecasts(lawnmowers.size());
   for (std::size_t i = 0; i < top.size(); ++i) {
     mission.charge_planning(pending_planning);
     const auto visit = mission.visit(top[i], 0);
@@ -163,12 +177,20 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
       rec.candidates.push_back(c);
       sub_plans.push_back(std::move(sub));
     }
+    const double region_px = static_cast<double>(field.valid_pixels(top[i].footprint));
+    for (std::size_t k = 0; k < lawnmowers.size(); ++k)
+      forecasts[k] = {lawnmowers[k].gsd_cm, lawnmowers[k].flight_s + static_cast<double>(lawnmowers[k].images) *
+                                                                         (seg_estimate() + plan_estimate())};
     DecisionContext ctx;
     ctx.sigma = rec.sigma;
-    ctx.valid_fraction = detail::valid_fraction(field, top[i].footprint);
+    ctx.valid_fraction = region_px / static_cast<double>(std::max(1, field.pixel_rect(top[i].footprint).area()));
     ctx.top_gsd_cm = options.top_gsd_cm;
     ctx.top_altitude_m = here.z();
     ctx.candidates = rec.candidates;
+    ctx.elapsed_s = mission.elapsed_s();
+    ctx.rest_s = rest;
+    ctx.region_share = field_valid_px > 0.0 ? region_px / field_valid_px : 0.0;
+    ctx.lawnmowers = forecasts;
     rec.decision = policy.decide(ctx);
     pending_planning = Mission<Backend>::seconds_since(t0);
 

@@ -30,6 +30,12 @@ struct CalibrationOptions {
   /// (split across the longer image axis) instead of the whole field's margin alone: a
   /// threshold must work on more than one layout to be chosen.
   bool robust = true;
+  /// Choose the front-aware rule (DecisionFunction::Params::front_aware, which needs no
+  /// threshold: it stops descending when descents no longer beat the training lawnmower
+  /// curve mapped onto the field's geometry) instead of the best threshold trial of the
+  /// paper's utility rule. The trials are flown and reported either way. `base.weight_by_sigma`
+  /// selects its σ weighting.
+  bool front_aware = true;
 };
 
 /// One threshold setting tried on the training field.
@@ -57,8 +63,11 @@ struct CalibrationResult {
 /// 2. O and I fitted (DecisionFunction::initialize).
 /// 3. The training field's lawnmower curve at `lawnmower_gsd_cm`.
 /// 4. One adaptive mission on `train` with no threshold gives the utilities the policy sees;
-///    thresholds at their quantiles (and σ weighting on/off) are each flown on `train`; the
-///    setting with the largest front margin wins (ties: shorter time).
+///    thresholds at their quantiles (absolute and relative, σ weighting on/off), the
+///    front-aware rule (its reference lawnmower: the training curve by GSD) and "never
+///    descend" are each flown on `train`. With `front_aware` (default) the front-aware rule is
+///    chosen; otherwise the threshold setting with the largest worst-case front margin over
+///    the layouts (ties: larger whole-field margin, then shorter time).
 /// 5. The linear baseline's σ range: the 5th and 95th percentiles of σ at h_max.
 /// @throws std::invalid_argument for invalid options (see run_adaptive_mission and
 ///         collect_region_samples).
@@ -95,6 +104,9 @@ template <SegmentationBackend Backend>
   probe.min_sigma = 0.0;
   probe.min_utility = -std::numeric_limits<double>::max();
   DecisionFunction fitted = DecisionFunction::initialize(samples, probe, options.restarts);
+  std::vector<GsdPoint> reference;  // the training lawnmower by GSD, for the front-aware rule
+  for (std::size_t k = 0; k < curve.size(); ++k) reference.push_back({options.lawnmower_gsd_cm[k], curve[k].miou});
+  fitted.set_reference_lawnmower(reference);
 
   const auto fly = [&](const DecisionFunction::Params& p) {
     ThresholdTrial t;
@@ -140,6 +152,10 @@ template <SegmentationBackend Backend>
       p.min_utility = utilities[static_cast<std::size_t>(q * static_cast<double>(utilities.size() - 1))];
       trials.push_back(fly(p).first);
     }
+    // The front-aware rule (descend while the forecast front margin rises; no threshold).
+    DecisionFunction::Params front = probe;
+    front.front_aware = true;
+    trials.push_back(fly(front).first);
     // Relative thresholds: a region's best utility over the mission's running mean.
     for (int k = 0; k < options.threshold_steps; ++k) {
       DecisionFunction::Params p = probe;
@@ -159,6 +175,13 @@ template <SegmentationBackend Backend>
     if (a.params.relative_utility != b.params.relative_utility) return a.params.relative_utility;
     return a.time_s < b.time_s;
   });
+  if (options.front_aware) {  // the rule is chosen, not its threshold: put it first
+    const auto chosen = std::find_if(trials.begin(), trials.end(), [&](const ThresholdTrial& t) {
+      return t.params.front_aware && t.params.weight_by_sigma == options.base.weight_by_sigma;
+    });
+    ADAPTSEG_ASSERT(chosen != trials.end());
+    std::rotate(trials.begin(), chosen, chosen + 1);
+  }
   fitted.set_params(trials.front().params);
 
   std::vector<double> sig;

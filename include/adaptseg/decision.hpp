@@ -4,6 +4,7 @@
 /// the `DecisionPolicy` concept that the adaptive planner is templated on.
 
 #include <concepts>
+#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -31,6 +32,13 @@ struct Candidate {
   double extra_time_s = 0.0;  ///< mission time added by the sub-lawnmower [s] (flight, segmentation, planning)
 };
 
+/// What a fixed-altitude lawnmower over the whole field at one GSD would take, known from the
+/// geometry before flying (a front-aware policy's yardstick; see DecisionFunction).
+struct LawnmowerForecast {
+  double gsd_cm = 0.0;  ///< GSD of the lawnmower [cm/px]
+  double time_s = 0.0;  ///< its mission time [s]: flight plus per-image segmentation and planning estimates
+};
+
 /// The situation at a top-level waypoint, after its image has been segmented.
 struct DecisionContext {
   double sigma = 0.0;             ///< semantic ratio σ of the current image (paper Eq. `eq:vr`)
@@ -38,6 +46,11 @@ struct DecisionContext {
   double top_gsd_cm = 0.0;        ///< GSD at h_max [cm/px]
   double top_altitude_m = 0.0;    ///< h_max [m]
   std::span<const Candidate> candidates;  ///< affordable lower altitudes (may be empty)
+  // The mission so far and ahead (used by front-aware policies; the paper's rule ignores it).
+  double elapsed_s = 0.0;         ///< mission time so far, this image included [s]
+  double rest_s = 0.0;            ///< time to finish the top-level coverage from here without descending [s]
+  double region_share = 0.0;      ///< the region's ground inside the field / the field's (0..1]
+  std::span<const LawnmowerForecast> lawnmowers{};  ///< this field's lawnmowers at the top and candidate GSDs
 };
 
 /// A policy's assessment of one candidate.
@@ -46,7 +59,10 @@ struct CandidateScore {
   double predicted_delta_sigma = 0.0;  ///< μ_O: σ_{h_max} − σ_{h'}
   double predicted_delta_miou = 0.0;   ///< μ_I(μ_O): mIoU_{h_max} − mIoU_{h'} (< 0: lower is better)
   double predicted_delta_miou_std = 0.0;  ///< predictive standard deviation of the latter
-  double utility = 0.0;                ///< what the policy maximises
+  double utility = 0.0;                ///< gain per second of extra time
+  /// Front-aware policies: the predicted front margin of the mission if it descends here
+  /// (NaN otherwise; see DecisionFunction::Params::front_aware).
+  double predicted_front_margin = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// The outcome of a decision: continue (`descend == false`) or re-map the region from `gsd_cm`.

@@ -7,6 +7,7 @@
 #include <adaptseg/decision.hpp>
 #include <adaptseg/error.hpp>
 #include <adaptseg/gaussian_process.hpp>
+#include <adaptseg/lawnmower_curve.hpp>
 
 #include <Eigen/Core>
 
@@ -15,10 +16,12 @@
 #include <cstdint>
 #include <istream>
 #include <limits>
+#include <optional>
 #include <ostream>
 #include <sstream>
 #include <span>
 #include <string>
+#include <vector>
 
 namespace adaptseg {
 
@@ -38,6 +41,19 @@ namespace adaptseg {
 ///   `relative_utility` the threshold applies to U divided by the mean best utility of the
 ///   top-level images seen so far in this mission (current one included): a scale-free rule
 ///   that transfers between fields whose σ levels differ (a departure from the paper).
+/// - Front-aware rule (`front_aware`, beyond the paper): the paper's utility ignores what
+///   the UAV could have done instead. This rule compares with that alternative directly: the
+///   field's lawnmowers at the top and candidate GSDs take times known from the geometry
+///   (DecisionContext::lawnmowers) and reach about the training field's lawnmower mIoU at
+///   the same GSD (`reference_lawnmower`), which gives a predicted lawnmower curve for the
+///   field being flown. The mission's own end point is forecast as (elapsed + rest of the
+///   top-level coverage, training mIoU at the top GSD + the field-level gains of the descents
+///   taken so far), a region's field-level gain being its predicted gain G (unweighted) times
+///   its share of the field's ground (DecisionContext::region_share), times σ / mean σ of the
+///   top-level images so far if `weight_by_sigma`. The UAV descends to the candidate whose
+///   forecast lies furthest above the predicted curve, if that is above the forecast without
+///   descending (and σ >= `min_sigma`, U >= `min_utility` still apply): it descends while
+///   descents beat flying lower everywhere, and stops when they no longer do.
 /// - Online adaptation (§3.2.3): after a descent, (Δh', σ_{h_max}) → Δσ' joins O by an
 ///   O(n²) Cholesky extension; O's hyperparameters are re-optimised every `refit_every`
 ///   updates (0: never). `online = false` gives the paper's "non-adaptive" baseline.
@@ -60,6 +76,7 @@ class DecisionFunction {
     bool online = true;          ///< update O after each descent (false: non-adaptive)
     int refit_every = 0;         ///< re-optimise O's hyperparameters every k updates (0: never)
     bool relative_utility = false;  ///< threshold on U / mean best U so far (see class comment)
+    bool front_aware = false;    ///< descend only where the predicted front margin rises (see class comment)
 
     /// @throws std::invalid_argument naming the field.
     void validate() const {
@@ -70,6 +87,9 @@ class DecisionFunction {
       detail::require(std::isfinite(exploration) && exploration >= 0.0,
                       "DecisionFunction::Params::exploration must be finite and >= 0", exploration);
       detail::require(refit_every >= 0, "DecisionFunction::Params::refit_every must be >= 0", refit_every);
+      detail::require(!(front_aware && relative_utility),
+                      "DecisionFunction::Params: front_aware and relative_utility exclude each other; relative_utility",
+                      relative_utility);
     }
   };
 
@@ -133,6 +153,17 @@ class DecisionFunction {
   [[nodiscard]] const IModel& i_model() const noexcept { return i_; }
   [[nodiscard]] int online_updates() const noexcept { return updates_; }
 
+  /// The training field's lawnmower mIoU by GSD, the front-aware rule's expectation of what a
+  /// lawnmower reaches on the field being flown (see the class comment).
+  /// @throws std::invalid_argument for non-finite values or a GSD <= 0.
+  void set_reference_lawnmower(std::vector<GsdPoint> points) {
+    for (const auto& p : points)
+      detail::require(std::isfinite(p.gsd_cm) && p.gsd_cm > 0.0 && std::isfinite(p.miou),
+                      "DecisionFunction::set_reference_lawnmower: GSD must be > 0 and mIoU finite; GSD", p.gsd_cm);
+    reference_ = std::move(points);
+  }
+  [[nodiscard]] const std::vector<GsdPoint>& reference_lawnmower() const noexcept { return reference_; }
+
   /// Predicted Δσ, ΔmIoU and its standard deviation, gain and utility of one candidate.
   [[nodiscard]] CandidateScore score(const DecisionContext& ctx, const Candidate& c) const {
     const double sigma = ctx.sigma;
@@ -149,7 +180,10 @@ class DecisionFunction {
   }
 
   /// The decision at a top-level waypoint (see the class comment).
+  /// @throws std::invalid_argument with `front_aware` if the context has no lawnmower
+  ///         forecasts or the model no reference lawnmower.
   [[nodiscard]] Decision decide(const DecisionContext& c) {
+    if (params_.front_aware) return decide_front_aware(c);
     Decision d;
     double best = -std::numeric_limits<double>::infinity();
     std::size_t best_index = 0;
@@ -181,6 +215,9 @@ class DecisionFunction {
   void reset_mission() noexcept {
     utility_sum_ = 0.0;
     utility_count_ = 0;
+    sigma_sum_ = 0.0;
+    sigma_count_ = 0;
+    forecast_miou_.reset();
   }
 
   /// Online update of O after a descent (no-op unless `online`).
@@ -195,11 +232,14 @@ class DecisionFunction {
 
   /// Writes params, O and I as text (embeddable; read back by `load`).
   void save(std::ostream& os) const {
-    os << "adaptseg.decision_function 1\n";
+    os << "adaptseg.decision_function 2\n";
     os << "min_sigma " << fmt(params_.min_sigma) << "\nmin_utility " << fmt(params_.min_utility)
        << "\nexploration " << fmt(params_.exploration) << "\nweight_by_sigma " << params_.weight_by_sigma
        << "\nonline " << params_.online << "\nrefit_every " << params_.refit_every
-       << "\nrelative_utility " << params_.relative_utility << '\n';
+       << "\nrelative_utility " << params_.relative_utility << "\nfront_aware " << params_.front_aware
+       << "\nreference_lawnmower " << reference_.size();
+    for (const auto& p : reference_) os << ' ' << fmt(p.gsd_cm) << ' ' << fmt(p.miou);
+    os << '\n';
     o_.save(os);
     i_.save(os);
     os << "end adaptseg.decision_function\n";
@@ -218,9 +258,7 @@ class DecisionFunction {
       const std::string t = token("'" + key + "'");
       detail::require(t == key, "DecisionFunction::load: expected '" + key + "', found", t);
     };
-    const auto number = [&](const std::string& key) {
-      expect(key);
-      const std::string t = token("the value of '" + key + "'");
+    const auto parse = [&](const std::string& t, const std::string& what) {
       std::size_t used = 0;
       double v = 0.0;
       try {
@@ -228,12 +266,16 @@ class DecisionFunction {
       } catch (const std::exception&) {
         used = 0;
       }
-      detail::require(used == t.size() && std::isfinite(v), "DecisionFunction::load: bad number for '" + key + "'", t);
+      detail::require(used == t.size() && std::isfinite(v), "DecisionFunction::load: bad number for " + what, t);
       return v;
+    };
+    const auto number = [&](const std::string& key) {
+      expect(key);
+      return parse(token("the value of '" + key + "'"), "'" + key + "'");
     };
     expect("adaptseg.decision_function");
     const std::string version = token("the format version");
-    detail::require(version == "1", "DecisionFunction::load: unsupported format version", version);
+    detail::require(version == "1" || version == "2", "DecisionFunction::load: unsupported format version", version);
     Params p;
     p.min_sigma = number("min_sigma");
     p.min_utility = number("min_utility");
@@ -242,16 +284,75 @@ class DecisionFunction {
     p.online = number("online") != 0.0;
     p.refit_every = static_cast<int>(number("refit_every"));
     p.relative_utility = number("relative_utility") != 0.0;
+    std::vector<GsdPoint> reference;
+    if (version == "2") {  // version 1 had neither
+      p.front_aware = number("front_aware") != 0.0;
+      const double n = number("reference_lawnmower");
+      detail::require(n >= 0.0 && n <= 1000.0 && n == std::floor(n),
+                      "DecisionFunction::load: bad point count for 'reference_lawnmower'", n);
+      const auto value = [&](const char* what) {
+        const std::string name = std::string("a reference_lawnmower ") + what;
+        return parse(token(name), name);
+      };
+      for (int k = 0; k < static_cast<int>(n); ++k) {
+        const double g = value("GSD");
+        reference.push_back({g, value("mIoU")});
+      }
+    }
     is >> std::ws;
     OModel o = OModel::load(is);
     is >> std::ws;
     IModel i = IModel::load(is);
     expect("end");
     expect("adaptseg.decision_function");
-    return DecisionFunction(std::move(o), std::move(i), p);
+    DecisionFunction df(std::move(o), std::move(i), p);
+    df.set_reference_lawnmower(std::move(reference));
+    return df;
   }
 
  private:
+  /// The front-aware rule (see the class comment).
+  [[nodiscard]] Decision decide_front_aware(const DecisionContext& c) {
+    detail::require(!c.lawnmowers.empty(),
+                    "DecisionFunction::decide: front_aware needs the context's lawnmower forecasts; count",
+                    c.lawnmowers.size());
+    detail::require(!reference_.empty(),
+                    "DecisionFunction::decide: front_aware needs a reference lawnmower (set_reference_lawnmower); count",
+                    reference_.size());
+    std::vector<CurvePoint> curve;
+    for (const auto& f : c.lawnmowers) curve.push_back({f.time_s, miou_at_gsd(reference_, f.gsd_cm)});
+    if (!forecast_miou_) forecast_miou_ = miou_at_gsd(reference_, c.top_gsd_cm);
+    sigma_sum_ += c.sigma;
+    ++sigma_count_;
+    const double mean_sigma = sigma_sum_ / static_cast<double>(sigma_count_);
+    const double weight = c.region_share * (params_.weight_by_sigma && mean_sigma > 0.0 ? c.sigma / mean_sigma : 1.0);
+    const double t_end = c.elapsed_s + c.rest_s;
+    const double stay = front_margin(curve, t_end, *forecast_miou_);
+
+    Decision d;
+    double best = stay;
+    std::optional<std::size_t> best_index;
+    std::vector<double> field_gain;
+    for (std::size_t k = 0; k < c.candidates.size(); ++k) {
+      CandidateScore s = score(c, c.candidates[k]);
+      const double g = -s.predicted_delta_miou + params_.exploration * s.predicted_delta_miou_std;
+      field_gain.push_back(g * weight);
+      s.predicted_front_margin =
+          front_margin(curve, t_end + c.candidates[k].extra_time_s, *forecast_miou_ + field_gain.back());
+      if (g > 0.0 && s.utility >= params_.min_utility && s.predicted_front_margin > best) {
+        best = s.predicted_front_margin;
+        best_index = k;
+      }
+      d.scores.push_back(s);
+    }
+    if (best_index && c.sigma >= params_.min_sigma) {
+      d.descend = true;
+      d.gsd_cm = c.candidates[*best_index].gsd_cm;
+      *forecast_miou_ += field_gain[*best_index];
+    }
+    return d;
+  }
+
   [[nodiscard]] double gain_of(const CandidateScore& s, const DecisionContext& c) const {
     const double g = -s.predicted_delta_miou + params_.exploration * s.predicted_delta_miou_std;
     return params_.weight_by_sigma ? g * c.sigma * c.valid_fraction : g;
@@ -269,6 +370,10 @@ class DecisionFunction {
   int updates_ = 0;
   double utility_sum_ = 0.0;
   std::size_t utility_count_ = 0;
+  std::vector<GsdPoint> reference_;        ///< training lawnmower mIoU by GSD (front-aware rule)
+  double sigma_sum_ = 0.0;                 ///< σ of this mission's top-level images (front-aware rule)
+  std::size_t sigma_count_ = 0;
+  std::optional<double> forecast_miou_;    ///< this mission's forecast end mIoU (front-aware rule)
 };
 
 static_assert(DecisionPolicy<DecisionFunction>);

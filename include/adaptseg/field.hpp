@@ -105,11 +105,16 @@ class Field {
     return {c0, r0, c1 - c0, r1 - r0};
   }
 
-  /// True if any valid (non-ignore) pixel lies under `a`.
-  [[nodiscard]] bool has_valid(const Area& a) const {
+  /// Number of valid (non-ignore) pixels under `a` (the part of `a` outside the raster has none).
+  [[nodiscard]] int valid_pixels(const Area& a) const {
     const cv::Rect r = pixel_rect(a) & cv::Rect(0, 0, width_px(), height_px());
-    return r.area() > 0 && cv::countNonZero(valid_(r)) > 0;
+    return r.area() > 0 ? cv::countNonZero(valid_(r)) : 0;
   }
+  /// Number of valid (non-ignore) pixels of the whole field.
+  [[nodiscard]] int valid_pixels() const { return cv::countNonZero(valid_); }
+
+  /// True if any valid (non-ignore) pixel lies under `a`.
+  [[nodiscard]] bool has_valid(const Area& a) const { return valid_pixels(a) > 0; }
 
   /// Index of the class called `class_name`, if any.
   [[nodiscard]] std::optional<int> class_index(std::string_view class_name) const {

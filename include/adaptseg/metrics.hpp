@@ -3,6 +3,7 @@
 /// Segmentation metrics (method.md §3): semantic ratio (paper Eq. `eq:vr`), per-class IoU and
 /// mIoU (paper Eq. `eq:iou`) over a class set, per image and over the fused field.
 
+#include <adaptseg/lawnmower_curve.hpp>
 #include <adaptseg/simulated_sensor.hpp>
 
 #include <opencv2/core.hpp>
@@ -148,37 +149,6 @@ class ConfusionMatrix {
   ConfusionMatrix cm(num_classes);
   cm.add(image.ground_truth, up, image.ignore_label);
   return cm;
-}
-
-}  // namespace adaptseg
-
-namespace adaptseg {
-
-/// One point of a fixed-altitude lawnmower curve: execution time [s] and field mIoU.
-struct CurvePoint {
-  double time_s = 0.0;
-  double miou = 0.0;
-};
-
-/// Front margin (paper §5, method.md §5): `miou` minus the lawnmower curve's mIoU linearly
-/// interpolated at `time_s`; the curve is flat beyond its ends. Positive: the strategy lies
-/// above the curve (more accuracy for its time than flying one altitude everywhere).
-/// @throws std::invalid_argument for an empty curve or non-finite values.
-[[nodiscard]] inline double front_margin(std::vector<CurvePoint> curve, double time_s, double miou) {
-  detail::require(!curve.empty(), "front_margin: the lawnmower curve is empty", 0);
-  detail::require(std::isfinite(time_s) && std::isfinite(miou), "front_margin: time and mIoU must be finite", time_s);
-  std::sort(curve.begin(), curve.end(), [](const CurvePoint& a, const CurvePoint& b) { return a.time_s < b.time_s; });
-  if (time_s <= curve.front().time_s) return miou - curve.front().miou;
-  if (time_s >= curve.back().time_s) return miou - curve.back().miou;
-  for (std::size_t k = 1; k < curve.size(); ++k) {
-    if (time_s <= curve[k].time_s) {
-      const CurvePoint& a = curve[k - 1];
-      const CurvePoint& b = curve[k];
-      const double t = b.time_s > a.time_s ? (time_s - a.time_s) / (b.time_s - a.time_s) : 1.0;
-      return miou - (a.miou + t * (b.miou - a.miou));
-    }
-  }
-  return miou - curve.back().miou;  // unreachable
 }
 
 }  // namespace adaptseg
