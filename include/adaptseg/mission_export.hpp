@@ -64,7 +64,7 @@ struct ExportWaypoint {
 
 /// A path in WGS84, ready to export: built from field-frame waypoints by make_export_path().
 struct ExportPath {
-  std::string name;                        ///< written into the files (plan-free formats ignore it)
+  std::string name;                        ///< the GeoJSON's name (the .plan and WPL formats have no place for it)
   GeoPoint home;                           ///< take-off: the field frame's origin on the field plane
   std::vector<ExportWaypoint> waypoints;   ///< in visiting order
 };
