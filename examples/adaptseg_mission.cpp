@@ -6,8 +6,10 @@
 //                    --segmenter erfnet --model-file examples/models/erfnet-dubai --out out/erfnet-15
 //   adaptseg_mission --field DIR --strategy adaptive --model model.yaml --out OUT [--budget-s 900]
 //
-// Writes OUT/result.json (scores, time, waypoints, decisions), OUT/path.png and OUT/map.png.
+// Writes OUT/result.json (scores, time, waypoints, decisions), OUT/path.png and OUT/map.png;
+// with --export plan,wpl,geojson also OUT/mission.{plan,waypoints,geojson}.
 
+#include "common/export.hpp"
 #include "common/segmenters.hpp"
 #include "common/strategies.hpp"
 
@@ -38,10 +40,12 @@ int main(int argc, char** argv) {
   app.add_option("--out", out_dir, "output directory")->required();
   common.add_to(app);
   segmenter.add_to(app);
+  adaptseg::examples::ExportCli exports;
+  exports.add_to(app);
   CLI11_PARSE(app, argc, argv);
 
   try {
-    const adaptseg::Field field = adaptseg::examples::load_field_spec(field_spec);
+    const adaptseg::Field field = exports.load_field(field_spec);
     adaptseg::MissionOptions options = common.resolve(field);
     std::optional<adaptseg::DecisionModel> model;
     if (!model_file.empty()) model = adaptseg::DecisionModel::load(model_file);
@@ -62,6 +66,7 @@ int main(int argc, char** argv) {
     if (strategy == "lawnmower") json["gsd_cm"] = gsd_cm;
     if (budget_s) json["budget_s"] = *budget_s;
     adaptseg::examples::write_text(out_dir / "result.json", json.dump(2) + "\n");
+    exports.write(field, result, options, out_dir);
     std::vector<adaptseg::Waypoint> path;
     for (const auto& w : result.waypoints) path.push_back(w.waypoint);
     const std::string what = strategy == "lawnmower" ? strategy + " at " + adaptseg::examples::fmt(gsd_cm, 2) + " cm/px"

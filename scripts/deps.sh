@@ -1,20 +1,22 @@
 #!/usr/bin/env bash
 # Installs the Debian packages adaptseg needs, or says which are missing.
 #   scripts/deps.sh build   compiler, CMake and the C++ libraries (library, examples, tests)
-#   scripts/deps.sh test    build + what the test suite runs (Python for the data converters)
+#   scripts/deps.sh test    build + what the test suite runs (Python for the data converters,
+#                           GDAL's ogrinfo to read the exported GeoJSON)
 #   scripts/deps.sh bench   test + what the benchmarks compare against (scikit-learn)
 #   scripts/deps.sh plots   build + matplotlib for the evaluation figures
 # As root it runs apt-get; otherwise it prints the command to run and fails if anything is missing.
 set -euo pipefail
 
 # libopencv-dev: the only package that ships OpenCV's CMake config (OpenCVConfig.cmake).
+# libgeographiclib-dev: geo-reference and mission export (adaptseg::geo).
 build=(cmake g++ make pkg-config libeigen3-dev libopencv-dev doctest-dev liblbfgspp-dev
-       libyaml-cpp-dev nlohmann-json3-dev libcli11-dev)
+       libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libgeographiclib-dev)
 python=(python3 python3-numpy python3-opencv python3-yaml python3-pil)
 case "${1:-build}" in
   build) want=("${build[@]}") ;;
-  test) want=("${build[@]}" "${python[@]}") ;;
-  bench) want=("${build[@]}" "${python[@]}" python3-sklearn) ;;
+  test) want=("${build[@]}" "${python[@]}" gdal-bin) ;;
+  bench) want=("${build[@]}" "${python[@]}" gdal-bin python3-sklearn) ;;
   plots) want=("${build[@]}" "${python[@]}" python3-matplotlib) ;;
   *) echo "usage: $0 [build|test|bench|plots]" >&2; exit 2 ;;
 esac

@@ -7,6 +7,7 @@
 #include <adaptseg/decision_model.hpp>
 #include <adaptseg/linear_decision.hpp>
 
+#include <array>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -16,28 +17,41 @@ namespace adaptseg::examples {
 
 inline const std::vector<std::string> kStrategies{"lawnmower", "adaptive", "nonadaptive", "linear"};
 
+/// "a,b,c,d" -> four numbers; `what` describes the expected text in the error.
+/// @throws std::invalid_argument for anything else.
+inline std::array<double, 4> parse_four_numbers(const std::string& text, const std::string& what) {
+  std::istringstream is(text);
+  std::array<double, 4> v{};
+  char comma = 0;
+  bool ok = static_cast<bool>(is >> v[0]);
+  for (std::size_t k = 1; k < 4 && ok; ++k) ok = (is >> comma) && comma == ',' && (is >> v[k]);
+  ok = ok && (is >> std::ws).eof();
+  if (!ok) throw std::invalid_argument("'" + text + "' is not " + what);
+  return v;
+}
+
 /// "x0,y0,x1,y1" -> FieldRegion (fractions along the image axes).
 /// @throws std::invalid_argument for anything else.
 inline FieldRegion parse_region(const std::string& text) {
-  std::istringstream is(text);
-  double v[4];
-  char comma = 0;
-  bool ok = static_cast<bool>(is >> v[0]);
-  for (int k = 1; k < 4 && ok; ++k) ok = (is >> comma) && comma == ',' && (is >> v[k]);
-  ok = ok && (is >> std::ws).eof();
-  if (!ok) throw std::invalid_argument("region '" + text + "' is not x0,y0,x1,y1 (fractions 0..1)");
+  const auto v = parse_four_numbers(text, "a region x0,y0,x1,y1 (fractions 0..1)");
   return {v[0], v[1], v[2], v[3]};
 }
 
-/// A field directory with an optional region: "DIR" or "DIR:x0,y0,x1,y1".
-inline Field load_field_spec(const std::string& spec) {
+/// A field directory with an optional region: "DIR" or "DIR:x0,y0,x1,y1". `geo`, if set,
+/// replaces the directory's geo-reference (before the region is cut out, so it refers to
+/// the whole field's frame, like field.yaml's `geo:` section).
+inline Field load_field_spec(const std::string& spec, const std::optional<FieldGeo>& geo = std::nullopt) {
+  const auto load = [&](const std::string& dir) {
+    const Field f = Field::load(dir);
+    return geo ? f.with_geo(geo) : f;
+  };
   const auto colon = spec.rfind(':');
   if (colon != std::string::npos && colon + 1 < spec.size()) {
     const std::string tail = spec.substr(colon + 1);
     if (std::count(tail.begin(), tail.end(), ',') == 3 && tail.find('/') == std::string::npos)
-      return Field::load(spec.substr(0, colon)).sub_field(parse_region(tail));
+      return load(spec.substr(0, colon)).sub_field(parse_region(tail));
   }
-  return Field::load(spec);
+  return load(spec);
 }
 
 /// One flown strategy: the mission, and the decisions for the model-based ones.

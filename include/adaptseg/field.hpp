@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <iterator>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -30,6 +31,45 @@ struct ClassInfo {
   std::string name;
   std::array<std::uint8_t, 3> color_rgb{0, 0, 0};
 };
+
+/// Where a field lies on the Earth: the optional `geo:` section of `field.yaml`
+/// (docs/data_format.md). Plain data; the conversions live in `<adaptseg/geo.hpp>`
+/// (adaptseg::geo, GeographicLib).
+///
+/// The anchor point (`anchor_x_m`, `anchor_y_m`) of the field frame is at (`latitude_deg`,
+/// `longitude_deg`) on the field plane, whose height is `altitude_m`. The field's +x axis
+/// points to the compass bearing `heading_deg` (degrees clockwise from north), +y 90 degrees
+/// counter-clockwise from it seen from above (the frame is right-handed with z up): heading
+/// 90 puts +x east and +y north, heading 0 puts +x north and +y west.
+struct FieldGeo {
+  double latitude_deg = 0.0;   ///< WGS84 latitude of the anchor [deg], in [-90, 90]
+  double longitude_deg = 0.0;  ///< WGS84 longitude of the anchor [deg], in [-180, 180]
+  double altitude_m = 0.0;     ///< height of the field plane above the WGS84 ellipsoid [m]
+  double heading_deg = 90.0;   ///< compass bearing of the field's +x axis [deg clockwise from north]
+  /// Field-frame position of the anchor [m]: (0, 0), the frame origin, for a loaded field;
+  /// Field::sub_field moves the frame origin and shifts the anchor accordingly.
+  double anchor_x_m = 0.0;
+  double anchor_y_m = 0.0;  ///< see anchor_x_m
+
+  friend bool operator==(const FieldGeo&, const FieldGeo&) = default;
+};
+
+namespace detail {
+
+/// Checks a FieldGeo; `where` prefixes the message (e.g. "geo").
+/// @throws std::invalid_argument naming the member and its value.
+inline void validate_field_geo(const FieldGeo& g, const std::string& where) {
+  require(std::isfinite(g.latitude_deg) && g.latitude_deg >= -90.0 && g.latitude_deg <= 90.0,
+          where + ".latitude_deg must be in [-90, 90]", g.latitude_deg);
+  require(std::isfinite(g.longitude_deg) && g.longitude_deg >= -180.0 && g.longitude_deg <= 180.0,
+          where + ".longitude_deg must be in [-180, 180]", g.longitude_deg);
+  require_finite(g.altitude_m, where + ".altitude_m");
+  require_finite(g.heading_deg, where + ".heading_deg");
+  require_finite(g.anchor_x_m, where + ".anchor_x_m");
+  require_finite(g.anchor_y_m, where + ".anchor_y_m");
+}
+
+}  // namespace detail
 
 /// Fraction rectangle of a field along the image axes: `x` along columns (left to right),
 /// `y` along rows (top to bottom), each in [0, 1]. `{0, 0, 0.5, 1}` is the left half.
@@ -67,7 +107,8 @@ class Field {
   /// Loads a field directory: `field.yaml`, the label PNG it names and the optional image.
   /// @throws std::invalid_argument naming the file and the problem (missing file, YAML
   ///         syntax error, missing or mistyped key, unknown key, unknown class of interest,
-  ///         wrong image type, size mismatch, out-of-range label value).
+  ///         wrong image type, size mismatch, out-of-range label value, a `geo:` section
+  ///         with a missing, unknown, mistyped or out-of-range key).
   static Field load(const std::filesystem::path& dir);
 
   [[nodiscard]] const std::string& name() const noexcept { return name_; }
@@ -85,6 +126,17 @@ class Field {
   /// Default labels of interest L (class indices, ascending).
   [[nodiscard]] const std::vector<int>& interest() const noexcept { return interest_; }
   [[nodiscard]] int ignore_label() const noexcept { return ignore_label_; }
+  /// Where the field lies on the Earth, if known (`geo:` in field.yaml, or with_geo()).
+  [[nodiscard]] const std::optional<FieldGeo>& geo() const noexcept { return geo_; }
+  /// A copy of this field with `geo` as its geo-reference (nullopt: none).
+  /// @throws std::invalid_argument for a latitude outside [-90, 90], a longitude outside
+  ///         [-180, 180], or a non-finite altitude, heading or anchor.
+  [[nodiscard]] Field with_geo(std::optional<FieldGeo> geo) const {
+    if (geo) detail::validate_field_geo(*geo, "Field '" + name_ + "': geo");
+    Field out = *this;
+    out.geo_ = std::move(geo);
+    return out;
+  }
   [[nodiscard]] int width_px() const noexcept { return labels_.cols; }
   [[nodiscard]] int height_px() const noexcept { return labels_.rows; }
 
@@ -142,6 +194,8 @@ class Field {
 
   /// The part of the field inside `region` (fractions along the image axes) as a field of
   /// its own, named "<name>[x0,y0,x1,y1]"; pixel edges are rounded to the nearest pixel.
+  /// Its frame origin is the region's bottom-left corner; a geo-reference is kept, its
+  /// anchor shifted into the new frame, so every ground point keeps its WGS84 position.
   /// @throws std::invalid_argument unless 0 <= x0 < x1 <= 1 and 0 <= y0 < y1 <= 1 and the
   ///         region holds at least one pixel.
   [[nodiscard]] Field sub_field(const FieldRegion& region) const {
@@ -158,8 +212,15 @@ class Field {
     const int r1 = static_cast<int>(std::lround(region.y1 * height_px()));
     detail::require(c1 > c0 && r1 > r0, "Field::sub_field: region holds no pixel", desc.str());
     const cv::Rect roi(c0, r0, c1 - c0, r1 - r0);
-    return Field(name_ + "[" + desc.str() + "]", gsd_cm_, labels_(roi).clone(), classes_, interest_,
-                 ignore_label_, image_.empty() ? cv::Mat() : image_(roi).clone());
+    Field out(name_ + "[" + desc.str() + "]", gsd_cm_, labels_(roi).clone(), classes_, interest_, ignore_label_,
+              image_.empty() ? cv::Mat() : image_(roi).clone());
+    if (geo_) {
+      // The new origin, the region's bottom-left corner, lies at (c0, height - r1) pixels in this frame.
+      out.geo_ = geo_;
+      out.geo_->anchor_x_m -= c0 * gsd_cm_ / 100.0;
+      out.geo_->anchor_y_m -= (height_px() - r1) * gsd_cm_ / 100.0;
+    }
+    return out;
   }
 
  private:
@@ -219,6 +280,7 @@ class Field {
   std::vector<int> interest_;
   int ignore_label_;
   cv::Mat valid_;
+  std::optional<FieldGeo> geo_;
 };
 
 namespace detail {
@@ -242,6 +304,32 @@ T field_scalar(const YAML::Node& n, const char* what, const std::filesystem::pat
   } catch (const YAML::Exception&) {
     field_error(file, std::string("'") + what + "' has the wrong type (value '" + n.Scalar() + "')");
   }
+}
+
+/// The `geo:` section of field.yaml: a mapping of exactly latitude_deg, longitude_deg,
+/// altitude_m and heading_deg (numbers).
+inline FieldGeo field_read_geo(const YAML::Node& n, const std::filesystem::path& file) {
+  if (!n.IsMap())
+    field_error(file, "'geo' must be a mapping {latitude_deg, longitude_deg, altitude_m, heading_deg}");
+  static const char* const kGeoKeys[] = {"latitude_deg", "longitude_deg", "altitude_m", "heading_deg"};
+  for (const auto& kv : n) {
+    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "<non-scalar>";
+    if (std::none_of(std::begin(kGeoKeys), std::end(kGeoKeys), [&](const char* k) { return key == k; }))
+      field_error(file, "geo: unknown key '" + key + "' (known: latitude_deg, longitude_deg, altitude_m, heading_deg)");
+  }
+  double v[4];
+  for (int k = 0; k < 4; ++k) {
+    const std::string what = std::string("geo.") + kGeoKeys[k];
+    if (!n[kGeoKeys[k]]) field_error(file, "missing key '" + what + "'");
+    v[k] = field_scalar<double>(n[kGeoKeys[k]], what.c_str(), file);
+  }
+  const FieldGeo g{v[0], v[1], v[2], v[3]};
+  try {
+    validate_field_geo(g, "geo");
+  } catch (const std::invalid_argument& e) {
+    field_error(file, e.what());
+  }
+  return g;
 }
 
 inline cv::Mat field_read_image(const std::filesystem::path& file, int flags,
@@ -268,14 +356,14 @@ inline Field Field::load(const std::filesystem::path& dir) {
     detail::field_error(yaml, std::string("YAML error: ") + e.what());
   }
   if (!root.IsMap()) detail::field_error(yaml, "the document must be a mapping");
-  static const std::set<std::string> kKeys{"name", "gsd_cm", "labels", "image",
-                                           "ignore_label", "classes", "interest"};
+  static const std::set<std::string> kKeys{"name", "gsd_cm", "labels", "image", "ignore_label",
+                                           "classes", "interest", "geo"};
   for (const auto& kv : root) {
     const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "<non-scalar>";
     if (!kKeys.count(key))
       detail::field_error(yaml, "unknown key '" + key +
                                     "' (known: name, gsd_cm, labels, image, ignore_label, "
-                                    "classes, interest)");
+                                    "classes, interest, geo)");
   }
   const auto name = detail::field_scalar<std::string>(detail::field_key(root, "name", yaml), "name", yaml);
   const auto gsd = detail::field_scalar<double>(detail::field_key(root, "gsd_cm", yaml), "gsd_cm", yaml);
@@ -345,6 +433,9 @@ inline Field Field::load(const std::filesystem::path& dir) {
   std::sort(interest.begin(), interest.end());
   interest.erase(std::unique(interest.begin(), interest.end()), interest.end());
 
+  std::optional<FieldGeo> geo;
+  if (root["geo"]) geo = detail::field_read_geo(root["geo"], yaml);
+
   cv::Mat labels = detail::field_read_image(dir / labels_file, cv::IMREAD_UNCHANGED, yaml);
   if (labels.type() != CV_8UC1)
     detail::field_error(yaml, "'" + labels_file + "' must be an 8-bit single-channel PNG (got " +
@@ -357,7 +448,8 @@ inline Field Field::load(const std::filesystem::path& dir) {
   }
   try {
     return Field(name, gsd, std::move(labels), std::move(classes), std::move(interest), ignore,
-                 std::move(image));
+                 std::move(image))
+        .with_geo(geo);
   } catch (const std::invalid_argument& e) {
     detail::field_error(yaml, e.what());
   }

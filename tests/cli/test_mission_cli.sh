@@ -5,21 +5,8 @@
 #   test_mission_cli.sh MISSION_BINARY EXAMPLES_DIR PYTHON CASE
 set -uo pipefail
 mission=$1 examples=$2 python=$3 case=$4
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+source "$(dirname "$0")/cli_common.sh"
 field="$examples/data/weedmap-000"
-fail() { echo "FAIL: $*" >&2; exit 1; }
-
-# expect_error FRAGMENT ARGS...: exit code 2, exactly one stderr line containing FRAGMENT.
-expect_error() {
-  local fragment=$1; shift
-  "$mission" "$@" >"$work/out" 2>"$work/err"
-  local rc=$?
-  [ "$rc" -eq 2 ] || fail "exit code $rc (want 2) for: $* ($(cat "$work/err"))"
-  [ "$(wc -l <"$work/err")" -eq 1 ] || fail "want one error line for: $*, got: $(cat "$work/err")"
-  grep -qF -- "$fragment" "$work/err" || fail "error for: $* lacks '$fragment': $(cat "$work/err")"
-  echo "ok: $(cat "$work/err")"
-}
 
 case "$case" in
 bad_inputs)

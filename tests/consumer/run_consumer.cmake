@@ -16,7 +16,7 @@ execute_process(COMMAND "${CMAKE_COMMAND}" --build "${WORK_DIR}/build" RESULT_VA
 if(rc)
   message(FATAL_ERROR "building the consumer failed: ${rc}")
 endif()
-foreach(exe consumer consumer_core)
+foreach(exe consumer consumer_core consumer_geo)
   execute_process(COMMAND "${WORK_DIR}/build/${exe}" RESULT_VARIABLE rc)
   if(rc)
     message(FATAL_ERROR "${exe} failed: ${rc}")

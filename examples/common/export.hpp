@@ -1,0 +1,78 @@
+#pragma once
+// `--export FORMAT` of adaptseg_mission: the geo-reference of the flown field (field.yaml's
+// `geo:` section or --geo-origin) and the mission files of the flown path. Not part of the
+// library; the formats are adaptseg/mission_export.hpp's.
+
+#include "strategies.hpp"
+
+#include <adaptseg/mission_export.hpp>
+
+#include <CLI/CLI.hpp>
+
+#include <filesystem>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace adaptseg::examples {
+
+/// The export options and what they need of the field.
+struct ExportCli {
+  std::vector<std::string> formats;
+  std::string geo_origin;
+  ExportOptions file_options;
+
+  void add_to(CLI::App& app) {
+    app.add_option("--export", formats,
+                   "write the flown path as OUT/mission.plan (plan: QGroundControl), OUT/mission.waypoints "
+                   "(wpl: QGC WPL 110), OUT/mission.geojson (geojson); repeat or comma-separate; needs a "
+                   "geo-reference")
+        ->delimiter(',')
+        ->check(CLI::IsMember({"plan", "wpl", "geojson"}));
+    app.add_option("--geo-origin", geo_origin,
+                   "LAT,LON,ALT,HEADING: WGS84 position [deg] and ellipsoidal height [m] of the field "
+                   "directory's frame origin, and the compass bearing [deg] of its +x axis; replaces "
+                   "field.yaml's geo section");
+    app.add_option("--hold-s", file_options.hold_s, "hold time at every exported waypoint [s]")
+        ->capture_default_str();
+  }
+
+  /// --geo-origin as a FieldGeo, if given.
+  /// @throws std::invalid_argument for a malformed or out-of-range value.
+  [[nodiscard]] std::optional<FieldGeo> geo_override() const {
+    if (geo_origin.empty()) return std::nullopt;
+    const auto v = parse_four_numbers(geo_origin, "--geo-origin LAT,LON,ALT,HEADING");
+    const FieldGeo g{v[0], v[1], v[2], v[3]};
+    detail::validate_field_geo(g, "--geo-origin");
+    return g;
+  }
+
+  /// Loads the field of `spec` with --geo-origin applied; when exporting, checks before the
+  /// mission flies that the field has a geo-reference.
+  /// @throws std::invalid_argument for a bad field, a bad --geo-origin, or none at all.
+  [[nodiscard]] Field load_field(const std::string& spec) const {
+    Field field = load_field_spec(spec, geo_override());
+    if (!formats.empty() && !field.geo())
+      throw std::invalid_argument("--export needs a geo-reference: field '" + field.name() +
+                                  "' has no 'geo:' section in field.yaml; pass --geo-origin LAT,LON,ALT,HEADING");
+    file_options.validate();
+    return field;
+  }
+
+  /// Writes one file per requested format into `out_dir`; hover speed from the mission's timing.
+  void write(const Field& field, const MissionResult& result, const MissionOptions& options,
+             const std::filesystem::path& out_dir) const {
+    if (formats.empty()) return;
+    ExportOptions opt = file_options;
+    opt.hover_speed_mps = options.timing.max_speed_mps;
+    const ExportPath path = make_export_path(result, GeoReference(field));
+    for (const std::string& name : std::set<std::string>(formats.begin(), formats.end())) {
+      const ExportFormat format = parse_export_format(name);
+      write_text(out_dir / export_file_name(format), write_mission(format, path, opt));
+    }
+  }
+};
+
+}  // namespace adaptseg::examples

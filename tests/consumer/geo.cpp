@@ -1,0 +1,15 @@
+// adaptseg::geo from the installed package: GeographicLib and nlohmann-json found through it.
+#include <adaptseg/mission_export.hpp>
+
+#include <cstdio>
+
+int main() {
+  const adaptseg::GeoReference geo(adaptseg::FieldGeo{47.4, 8.5, 500.0, 90.0});
+  adaptseg::Waypoint w;
+  w.position = {100.0, 0.0, 20.0};
+  const auto path = adaptseg::make_export_path({w}, geo, "consumer");
+  const auto back = adaptseg::read_wpl(adaptseg::write_wpl(path));
+  std::printf("geo consumer: %zu items, first at %.7f, %.7f\n", back.items.size(), back.items[0].params[4],
+              back.items[0].params[5]);
+  return back.items.size() == 2 && back.items[0].params[5] > 8.5 ? 0 : 1;
+}
