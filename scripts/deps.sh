@@ -4,6 +4,7 @@
 #   scripts/deps.sh test    build + what the test suite runs (Python for the data converters)
 #   scripts/deps.sh bench   test + what the benchmarks compare against (scikit-learn)
 #   scripts/deps.sh plots   build + matplotlib for the evaluation figures
+#   scripts/deps.sh fuzz    build + clang with libFuzzer (scripts/fuzz.sh)
 # As root it runs apt-get; otherwise it prints the command to run and fails if anything is missing.
 set -euo pipefail
 
@@ -16,7 +17,9 @@ case "${1:-build}" in
   test) want=("${build[@]}" "${python[@]}") ;;
   bench) want=("${build[@]}" "${python[@]}" python3-sklearn) ;;
   plots) want=("${build[@]}" "${python[@]}" python3-matplotlib) ;;
-  *) echo "usage: $0 [build|test|bench|plots]" >&2; exit 2 ;;
+  # clang: the compiler; libclang-rt-14-dev: libFuzzer and the sanitizer runtimes for it.
+  fuzz) want=("${build[@]}" clang libclang-rt-14-dev) ;;
+  *) echo "usage: $0 [build|test|bench|plots|fuzz]" >&2; exit 2 ;;
 esac
 
 missing=()
