@@ -5,6 +5,7 @@
 #                           GDAL's ogrinfo to read the exported GeoJSON)
 #   scripts/deps.sh bench   test + what the benchmarks compare against (scikit-learn)
 #   scripts/deps.sh plots   build + matplotlib for the evaluation figures
+#   scripts/deps.sh fuzz    build + clang with libFuzzer (scripts/fuzz.sh)
 # As root it runs apt-get; otherwise it prints the command to run and fails if anything is missing.
 set -euo pipefail
 
@@ -18,7 +19,9 @@ case "${1:-build}" in
   test) want=("${build[@]}" "${python[@]}" gdal-bin) ;;
   bench) want=("${build[@]}" "${python[@]}" gdal-bin python3-sklearn) ;;
   plots) want=("${build[@]}" "${python[@]}" python3-matplotlib) ;;
-  *) echo "usage: $0 [build|test|bench|plots]" >&2; exit 2 ;;
+  # clang: the compiler; libclang-rt-14-dev: libFuzzer and the sanitizer runtimes for it.
+  fuzz) want=("${build[@]}" clang libclang-rt-14-dev) ;;
+  *) echo "usage: $0 [build|test|bench|plots|fuzz]" >&2; exit 2 ;;
 esac
 
 missing=()

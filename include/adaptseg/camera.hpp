@@ -4,6 +4,8 @@
 
 #include <adaptseg/error.hpp>
 
+#include <string>
+
 namespace adaptseg {
 
 /// Ground extent of one image [m]: `width_m` along the image's x axis (its columns).
@@ -33,12 +35,21 @@ class CameraModel {
  public:
   using Params = CameraParams;
 
-  /// @throws std::invalid_argument if a value is not finite and positive.
+  /// Largest image a CameraModel accepts [px] (2^28, 268 Mpx): images are materialised in
+  /// memory, and width x height must not overflow `int` pixel counts.
+  static constexpr long long kMaxImagePixels = 1LL << 28;
+
+  /// @throws std::invalid_argument if a value is not finite and positive, or the image has
+  ///         more than kMaxImagePixels pixels.
   explicit CameraModel(Params params = {}) : params_(params) {
     detail::require(params_.image_width_px > 0, "CameraModel: image_width_px must be > 0",
                     params_.image_width_px);
     detail::require(params_.image_height_px > 0, "CameraModel: image_height_px must be > 0",
                     params_.image_height_px);
+    detail::require(static_cast<long long>(params_.image_width_px) * params_.image_height_px <= kMaxImagePixels,
+                    "CameraModel: the image has too many pixels (image_width_px x image_height_px must be "
+                    "<= 2^28)",
+                    std::to_string(params_.image_width_px) + "x" + std::to_string(params_.image_height_px));
     detail::require_positive(params_.sensor_width_mm, "CameraModel: sensor_width_mm");
     detail::require_positive(params_.focal_length_mm, "CameraModel: focal_length_mm");
   }

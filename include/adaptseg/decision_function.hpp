@@ -282,7 +282,10 @@ class DecisionFunction {
     p.exploration = number("exploration");
     p.weight_by_sigma = number("weight_by_sigma") != 0.0;
     p.online = number("online") != 0.0;
-    p.refit_every = static_cast<int>(number("refit_every"));
+    const double refit_every = number("refit_every");  // range-checked before the cast (UB otherwise)
+    detail::require(refit_every >= 0.0 && refit_every <= 1e9 && refit_every == std::floor(refit_every),
+                    "DecisionFunction::load: refit_every must be an integer in [0, 1e9]", refit_every);
+    p.refit_every = static_cast<int>(refit_every);
     p.relative_utility = number("relative_utility") != 0.0;
     std::vector<GsdPoint> reference;
     if (version == "2") {  // version 1 had neither

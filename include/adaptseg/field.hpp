@@ -150,10 +150,16 @@ class Field {
   /// beyond the orthomosaic.
   [[nodiscard]] cv::Rect pixel_rect(const Area& a) const {
     const double s = 100.0 / gsd_cm_;
-    const int c0 = static_cast<int>(std::lround(a.x_min_m * s));
-    const int c1 = static_cast<int>(std::lround(a.x_max_m * s));
-    const int r0 = static_cast<int>(std::lround(height_px() - a.y_max_m * s));
-    const int r1 = static_cast<int>(std::lround(height_px() - a.y_min_m * s));
+    // Clamped to +-2^29 px so that absurd areas cannot overflow `int` (they would wrap and
+    // miss the field); the rectangle still covers everything it should.
+    const auto px = [](double v) {
+      constexpr double kLimit = 536870912.0;
+      return static_cast<int>(std::lround(std::clamp(v, -kLimit, kLimit)));
+    };
+    const int c0 = px(a.x_min_m * s);
+    const int c1 = px(a.x_max_m * s);
+    const int r0 = px(height_px() - a.y_max_m * s);
+    const int r1 = px(height_px() - a.y_min_m * s);
     return {c0, r0, c1 - c0, r1 - r0};
   }
 

@@ -1120,23 +1120,29 @@ class GaussianProcess {
     detail::require(samples >= 0 && samples <= 100'000'000, r.where() + "samples must be in [0, 1e8]", samples);
     detail::require(dimension >= (samples > 0 ? 1 : 0) && dimension <= 1'000'000,
                     r.where() + "dimension must be in [1, 1e6] (0 allowed without samples)", dimension);
+    // The announced sizes are not trusted for allocation: the dimension must be the kernel's,
+    // and the samples are stored as their lines arrive (memory bounded by the input's size).
+    detail::require(dimension == 0 || kernel.accepts_dimension(static_cast<Eigen::Index>(dimension)),
+                    r.where() + "the kernel does not accept dimension", dimension);
     GaussianProcess gp(std::move(kernel), options);
     gp.y_mean_ = mean;
     gp.y_std_ = stddev;
     const Eigen::Index n = static_cast<Eigen::Index>(samples);
     const Eigen::Index dims = static_cast<Eigen::Index>(dimension);
-    Eigen::MatrixXd x(n, dims);
-    Eigen::VectorXd y(n);
+    std::vector<double> values;  // row-major, dims + 1 per sample
     for (Eigen::Index i = 0; i < n; ++i) {
       const auto tokens = r.next("sample " + std::to_string(i + 1) + " of " + std::to_string(n));
       detail::require(static_cast<Eigen::Index>(tokens.size()) == dims + 1,
                       r.where() + "a sample line needs " + std::to_string(dims + 1) + " numbers, found",
                       tokens.size());
-      for (Eigen::Index d = 0; d < dims; ++d) x(i, d) = r.parse_real(tokens[static_cast<std::size_t>(d)]);
-      y(i) = r.parse_real(tokens.back());
+      for (const auto& token : tokens) values.push_back(r.parse_real(token));
     }
     r.expect("end", 1);
     if (n > 0) {
+      const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> rows(
+          values.data(), n, dims + 1);
+      const Eigen::MatrixXd x = rows.leftCols(dims);
+      const Eigen::VectorXd y = rows.col(dims);
       gp.condition(x, y);
     } else {
       gp.dimension_ = dims;

@@ -184,7 +184,7 @@ template <SegmentationBackend Backend>
 [[nodiscard]] MissionResult run_lawnmower_mission(const Field& field, double gsd_cm, Backend& backend,
                                                   const MissionOptions& options) {
   detail::require(std::isfinite(gsd_cm) && gsd_cm >= field.gsd_cm() * (1.0 - 1e-9),
-                  "run_lawnmower_mission: gsd_cm must not be finer than the field's " +
+                  "run_lawnmower_mission: gsd_cm must be finite and not finer than the field's " +
                       std::to_string(field.gsd_cm()) + " cm/px",
                   gsd_cm);
   Mission<Backend> mission(field, backend, options, "lawnmower");

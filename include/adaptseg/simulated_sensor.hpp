@@ -12,6 +12,8 @@
 
 #include <Eigen/Core>
 
+#include <cmath>
+
 namespace adaptseg {
 
 /// One camera frame, as a segmentation backend receives it.
@@ -40,6 +42,9 @@ struct Image {
 /// the oracle and the metrics). Parts outside the orthomosaic are black / ignore.
 class SimulatedSensor {
  public:
+  /// Largest footprint capture() renders [orthomosaic pixels] (2^28).
+  static constexpr double kMaxFootprintPixels = 268435456.0;
+
   /// @throws std::invalid_argument via CameraModel for an invalid camera.
   SimulatedSensor(Field field, CameraModel camera) : field_(std::move(field)), camera_(camera) {}
 
@@ -48,11 +53,20 @@ class SimulatedSensor {
 
   /// The image taken at waypoint `w`.
   /// @throws std::invalid_argument if the waypoint's GSD is finer than the orthomosaic's
-  ///         (the simulator would have to invent detail) or its footprint is empty.
+  ///         (the simulator would have to invent detail), its footprint is empty, or the
+  ///         footprint exceeds kMaxFootprintPixels.
   [[nodiscard]] Image capture(const Waypoint& w) const {
     detail::require(w.gsd_cm >= field_.gsd_cm() * (1.0 - 1e-9),
                     "SimulatedSensor::capture: waypoint GSD [cm/px] is finer than the field's " +
                         std::to_string(field_.gsd_cm()) + " cm/px",
+                    w.gsd_cm);
+    // The footprint is cut out of the orthomosaic at its resolution: bound it before
+    // allocating (an absurd altitude must be an error, not a terabyte allocation).
+    const double fp_px = (w.footprint.width_m() * 100.0 / field_.gsd_cm()) *
+                         (w.footprint.height_m() * 100.0 / field_.gsd_cm());
+    detail::require(std::isfinite(fp_px) && fp_px <= kMaxFootprintPixels,
+                    "SimulatedSensor::capture: the footprint is too large to simulate (more than 2^28 "
+                    "orthomosaic pixels: lower the altitude), waypoint gsd_cm",
                     w.gsd_cm);
     Image img;
     img.position = w.position;

@@ -2,9 +2,9 @@
 # Black-box tests of adaptseg_mission: bad input gives one clear error line and exit code 2
 # (never a crash); good input writes result.json with the documented keys and the figures;
 # on the bundled WeedMap field the GSD sweep behaves as the issue demands.
-#   test_mission_cli.sh MISSION_BINARY EXAMPLES_DIR PYTHON CASE
+#   test_mission_cli.sh MISSION_BINARY EXAMPLES_DIR PYTHON CASE [CALIBRATE_BINARY]
 set -uo pipefail
-mission=$1 examples=$2 python=$3 case=$4
+mission=$1 examples=$2 python=$3 case=$4 calibrate=${5:-}
 source "$(dirname "$0")/cli_common.sh"
 field="$examples/data/weedmap-000"
 
@@ -87,6 +87,35 @@ print("miou_all 5 cm/px", fine["miou_all"], "15 cm/px", coarse["miou_all"])
 assert fine["miou_all"] > coarse["miou_all"] + 0.02, "finer GSD must segment better"
 assert 0.3 < fine["miou_all"] < 1.0, "ERFNet is not the oracle, and not useless"
 PY
+  ;;
+determinism)
+  # Issue 6 item 5: the same inputs and seed give byte-identical outputs (times fixed by
+  # --seg-time-s and --plan-time-s): the calibrated model, result.json and the figures, for a
+  # lawnmower, an adaptive and a linear mission, each flown twice into its own directory.
+  [ -x "$calibrate" ] || fail "determinism needs the adaptseg_calibrate binary as 5th argument"
+  test="$field:0.5,0,1,0.2"
+  fixed=(--seg-time-s 0.1 --plan-time-s 0.01)
+  for run in a b; do
+    "$calibrate" --field "$field" --region 0,0,0.5,0.2 --segmenter oracle --threshold-steps 2 "${fixed[@]}" \
+      --out "$work/$run/model.yaml" >/dev/null 2>&1 || fail "calibration $run failed"
+    "$mission" --field "$test" --strategy lawnmower --gsd 2 --segmenter oracle "${fixed[@]}" \
+      --out "$work/$run/lawnmower" >/dev/null || fail "lawnmower $run failed"
+    for s in adaptive linear; do
+      "$mission" --field "$test" --strategy "$s" --model "$work/$run/model.yaml" --segmenter oracle "${fixed[@]}" \
+        --out "$work/$run/$s" >/dev/null || fail "$s $run failed"
+    done
+  done
+  cmp "$work/a/model.yaml" "$work/b/model.yaml" || fail "model.yaml differs between two calibrations"
+  for s in lawnmower adaptive linear; do
+    for f in result.json path.png map.png; do
+      cmp "$work/a/$s/$f" "$work/b/$s/$f" || fail "$s/$f differs between two runs"
+    done
+  done
+  # The adaptive result holds the GPs' predictions for every candidate; the linear mission
+  # descends, so sub-lawnmowers and map fusion are covered too.
+  grep -q '"predicted_delta_miou"' "$work/a/adaptive/result.json" || fail "the adaptive mission scored no candidate"
+  grep -q '"action": "descend"' "$work/a/linear/result.json" || fail "the linear mission never descended"
+  echo "identical: model.yaml, {lawnmower,adaptive,linear}/{result.json,path.png,map.png}"
   ;;
 *) fail "unknown case $case" ;;
 esac
