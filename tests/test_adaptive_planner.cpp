@@ -149,3 +149,219 @@ TEST_CASE("adaptive planner: bad options are refused") {
   for (const auto& d : r.decisions)
     for (const auto& c : d.candidates) CHECK(c.gsd_cm == 3.0);
 }
+
+// --- AdaptivePlanner driven step by step, as a UAV's companion computer would ---
+
+namespace {
+using Planner = AdaptivePlanner<OracleSegmenter, Scripted>;
+
+AdaptiveOptions weedmap_options(const Field& f) {
+  AdaptiveOptions o = options();
+  o.mission.interest = f.interest();
+  return o;
+}
+
+// Flies `planner` with a simulated camera: next() -> capture -> report(), as a caller would.
+// With `report_elapsed`, the caller keeps the mission time itself (flight by the timing model,
+// the fixed per-image and per-waypoint times) and reports it with each image.
+std::vector<PlannerStep> fly(Planner& planner, const Field& f, bool report_elapsed = false) {
+  const SimulatedSensor sensor(f, planner.camera());
+  const auto& mo = planner.options().mission;
+  std::vector<PlannerStep> steps;
+  std::optional<Eigen::Vector3d> at;
+  double clock = 0.0;
+  while (const auto w = planner.next()) {
+    if (at) clock += planner.timing().segment_time_s(*at, w->waypoint.position);
+    at = w->waypoint.position;
+    clock += *mo.fixed_segmentation_time_s + *mo.fixed_planning_time_s;
+    steps.push_back(report_elapsed ? planner.report(sensor.capture(w->waypoint), clock)
+                                   : planner.report(sensor.capture(w->waypoint)));
+  }
+  return steps;
+}
+}  // namespace
+
+TEST_CASE("AdaptivePlanner: stepping by hand over WeedMap gives run_adaptive_mission's path, decisions and map") {
+  const Field f = Field::load(t::example_field("weedmap-000"));
+  OracleSegmenter oracle(f.num_classes());
+  double unlimited_s = 0.0;
+  for (const bool budget : {false, true}) {
+    for (const bool report_elapsed : {false, true}) {
+      CAPTURE(budget);
+      CAPTURE(report_elapsed);
+      AdaptiveOptions o = weedmap_options(f);
+      if (budget) o.budget_s = unlimited_s - 1.0;  // at least one descent less
+      Scripted sim_policy{.gsd = 1.5, .which = {0, 2, 3, 5, 8, 9, 11}};
+      const AdaptiveResult sim = run_adaptive_mission(f, oracle, sim_policy, o, "scripted");
+      Scripted live_policy = Scripted{.gsd = 1.5, .which = {0, 2, 3, 5, 8, 9, 11}};
+      Planner planner(SurveyArea::of(f), oracle, live_policy, o);
+      const auto steps = fly(planner, f, report_elapsed);
+
+      REQUIRE(sim.descents() >= 2);
+      if (!budget) unlimited_s = sim.mission.total_s();
+      if (budget) CHECK(sim.descents() < 7);
+      REQUIRE(steps.size() == sim.mission.waypoints.size());
+      REQUIRE(planner.path().size() == steps.size());
+      for (std::size_t k = 0; k < steps.size(); ++k) {
+        const auto& w = sim.mission.waypoints[k];
+        CHECK(steps[k].waypoint.index == k);
+        CHECK(steps[k].waypoint.level == w.level);
+        CHECK(steps[k].waypoint.waypoint.position == w.waypoint.position);
+        CHECK(steps[k].sigma == w.semantic_ratio);
+      }
+      REQUIRE(planner.decisions().size() == sim.decisions.size());
+      for (std::size_t k = 0; k < sim.decisions.size(); ++k) {
+        const auto& a = planner.decisions()[k];
+        const auto& b = sim.decisions[k];
+        CHECK(a.waypoint_index == b.waypoint_index);
+        CHECK(a.sigma == b.sigma);
+        CHECK(a.decision.descend == b.decision.descend);
+        CHECK(a.decision.gsd_cm == b.decision.gsd_cm);
+        CHECK(a.budget_limited == b.budget_limited);
+        REQUIRE(a.candidates.size() == b.candidates.size());
+        for (std::size_t c = 0; c < a.candidates.size(); ++c)
+          CHECK(a.candidates[c].extra_time_s == b.candidates[c].extra_time_s);
+        REQUIRE(a.outcome.has_value() == b.outcome.has_value());
+        if (a.outcome) CHECK(a.outcome->sigma_sub == b.outcome->sigma_sub);
+      }
+      CHECK(live_policy.observed == sim_policy.observed);
+      CHECK(cv::countNonZero(planner.map().labels() != sim.mission.fused_labels) == 0);
+      CHECK(planner.elapsed_s() == doctest::Approx(sim.mission.total_s()).epsilon(1e-12));
+      if (budget) CHECK(planner.elapsed_s() <= *o.budget_s + 1e-9);
+      // The step results carry the decisions and outcomes as they happen.
+      int decided = 0, outcomes = 0;
+      for (const auto& s : steps) {
+        decided += s.decision ? 1 : 0;
+        outcomes += s.outcome ? 1 : 0;
+        CHECK(s.decision.has_value() == (s.waypoint.level == 0));
+      }
+      CHECK(decided == static_cast<int>(sim.decisions.size()));
+      CHECK(outcomes == sim.descents());
+    }
+  }
+}
+
+TEST_CASE("AdaptivePlanner: next() repeats the pending waypoint and is nullopt once done") {
+  const Field f = t::blob_field(1500, 1100, 1.0, 5, 40);
+  OracleSegmenter oracle(f.num_classes());
+  Scripted one{.gsd = 2.0, .which = {0}};
+  Planner planner(SurveyArea::of(f), oracle, one, weedmap_options(f));
+  CHECK_FALSE(planner.done());
+  const auto a = planner.next();
+  const auto b = planner.next();
+  REQUIRE(a.has_value());
+  REQUIRE(b.has_value());
+  CHECK(a->index == b->index);
+  CHECK(planner.path().size() == 1);
+  CHECK(planner.pending().has_value());
+  const auto steps = fly(planner, f);
+  CHECK(planner.done());
+  CHECK_FALSE(planner.pending().has_value());
+  CHECK_FALSE(planner.next().has_value());
+  CHECK_FALSE(planner.next().has_value());
+  // The first region was re-mapped at 2 cm/px right after its top-level image.
+  REQUIRE(steps.size() > planner.top_level().size());
+  CHECK(steps[1].waypoint.level == 1);
+  CHECK(steps[1].waypoint.top_index == 0);
+  CHECK(steps[1].waypoint.waypoint.gsd_cm == 2.0);
+  CHECK(one.observed == 1);
+  // Every waypoint flown is one the planner announced as reachable.
+  const auto reachable = planner.reachable_waypoints();
+  for (const auto& p : planner.path())
+    CHECK(std::any_of(reachable.begin(), reachable.end(),
+                      [&](const Waypoint& r) { return r.position == p.waypoint.position; }));
+}
+
+TEST_CASE("AdaptivePlanner: report() refuses a missing, repeated or malformed image") {
+  const Field f = t::blob_field(1500, 1100, 1.0, 5, 40);
+  OracleSegmenter oracle(f.num_classes());
+  Scripted never{.gsd = 0.5};
+  Planner planner(SurveyArea::of(f), oracle, never, weedmap_options(f));
+  const SimulatedSensor sensor(f, planner.camera());
+  const Image first = sensor.capture(planner.top_level().front());
+  CHECK_THROWS_WITH_AS((void)planner.report(first), doctest::Contains("no waypoint is waiting for an image"),
+                       std::invalid_argument);
+  const auto w = planner.next();
+  REQUIRE(w.has_value());
+  Image small = first;
+  small.width_px = 320;
+  CHECK_THROWS_WITH_AS((void)planner.report(small), doctest::Contains("the image must have the camera's size 480x360"),
+                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)planner.report(first, cv::Mat(10, 10, CV_8UC1), 0.1),
+                       doctest::Contains("labels must be CV_8UC1 of the image's size"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)planner.report(first, -1.0), doctest::Contains("elapsed_s"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)planner.image_at(w->waypoint.position, cv::Mat(10, 10, CV_8UC3)),
+                       doctest::Contains("rgb must be CV_8UC3 of the camera's size"), std::invalid_argument);
+  // A refused report changes nothing: the waypoint is still pending.
+  CHECK(planner.pending().has_value());
+  const PlannerStep step = planner.report(first);
+  CHECK(step.waypoint.index == 0);
+  REQUIRE(step.decision.has_value());
+  CHECK_FALSE(step.decision->decision.descend);
+  CHECK_THROWS_WITH_AS((void)planner.report(first), doctest::Contains("each waypoint takes one image"),
+                       std::invalid_argument);
+}
+
+TEST_CASE("AdaptivePlanner: the elapsed time the caller reports drives the budget") {
+  const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
+  OracleSegmenter oracle(f.num_classes());
+  Scripted never{.gsd = 0.5};
+  const double coverage = run_adaptive_mission(f, oracle, never, options(), "never").mission.total_s();
+  AdaptiveOptions o = weedmap_options(f);
+  o.budget_s = coverage + 200.0;
+  // Reporting the same mission time as the simulation gives the same budget-limited mission.
+  Scripted greedy{.gsd = 1.0};
+  const AdaptiveResult sim = run_adaptive_mission(f, oracle, greedy, o, "greedy");
+  Scripted greedy_live{.gsd = 1.0};
+  Planner planner(SurveyArea::of(f), oracle, greedy_live, o);
+  (void)fly(planner, f, true);
+  CHECK(planner.elapsed_s() == doctest::Approx(sim.mission.total_s()).epsilon(1e-12));
+  CHECK(planner.elapsed_s() <= *o.budget_s + 1e-9);
+  CHECK(planner.path().size() == sim.mission.waypoints.size());
+  CHECK(sim.descents() > 0);
+  // A caller whose clock says the budget is spent gets no descent, whatever the policy wants.
+  Scripted late{.gsd = 1.0};
+  Planner spent(SurveyArea::of(f), oracle, late, o);
+  const SimulatedSensor sensor(f, spent.camera());
+  while (const auto w = spent.next()) (void)spent.report(sensor.capture(w->waypoint), *o.budget_s);
+  CHECK(spent.elapsed_s() == *o.budget_s);
+  CHECK(spent.path().size() == spent.top_level().size());
+  for (const auto& d : spent.decisions()) {
+    CHECK(d.budget_limited);
+    CHECK(d.candidates.empty());
+    CHECK_FALSE(d.decision.descend);
+  }
+}
+
+TEST_CASE("AdaptivePlanner: live images made from poses land where the simulator puts them") {
+  const Field f = Field::load(t::example_field("weedmap-000"));
+  OracleSegmenter oracle(f.num_classes());
+  Scripted never{.gsd = 0.5};
+  Planner planner(SurveyArea::of(f), oracle, never, weedmap_options(f));
+  const SimulatedSensor sensor(f, planner.camera());
+  const auto reachable = planner.reachable_waypoints();
+  CHECK(reachable.size() > planner.top_level().size() * 4);
+  for (const auto& w : reachable) {
+    const Image live = planner.image_at(w.position);
+    const Image sim = sensor.capture(w);
+    CHECK(live.footprint_px == sim.footprint_px);
+    CHECK(live.gsd_cm == doctest::Approx(sim.gsd_cm));
+  }
+}
+
+TEST_CASE("AdaptivePlanner: a survey area without a mask covers the rectangle") {
+  const Field f = t::blob_field(1500, 1100, 1.0, 5, 40);
+  OracleSegmenter oracle(f.num_classes());
+  Scripted never{.gsd = 0.5};
+  SurveyArea area{.area = {0.0, 0.0, 15.0, 11.0}, .map_gsd_cm = 1.0};
+  Planner planner(area, oracle, never, weedmap_options(f));
+  CHECK(planner.map().labels().size() == cv::Size(1500, 1100));
+  CHECK(planner.valid_fraction(planner.top_level().front().footprint) == 1.0);
+  CHECK(planner.top_level().size() == LawnmowerPlanner(CameraModel{}).plan(area.area, 3.0).size());
+  AdaptiveOptions no_interest = options();
+  CHECK_THROWS_WITH_AS(Planner(area, oracle, never, no_interest), doctest::Contains("no labels of interest"),
+                       std::invalid_argument);
+  area.area.x_min_m = -1.0;
+  CHECK_THROWS_WITH_AS(Planner(area, oracle, never, weedmap_options(f)), doctest::Contains("SurveyArea: area"),
+                       std::invalid_argument);
+}

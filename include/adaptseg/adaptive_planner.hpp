@@ -4,22 +4,40 @@
 /// segment each image, ask a DecisionPolicy whether to re-map the region from a lower
 /// altitude, insert that sub-lawnmower before the next top-level waypoint, fuse, and feed the
 /// outcome back to the policy. Optionally never exceeds a mission-time budget.
+///
+/// `AdaptivePlanner` is the planner itself, run step by step by whoever flies the UAV: ask
+/// `next()` for a waypoint, fly there, take the image, `report()` it, repeat (live use: no
+/// simulator, no ground truth). `run_adaptive_mission` drives it in simulation.
 
+#include <adaptseg/camera.hpp>
 #include <adaptseg/decision.hpp>
+#include <adaptseg/field.hpp>
 #include <adaptseg/lawnmower_planner.hpp>
 #include <adaptseg/metrics.hpp>
 #include <adaptseg/mission.hpp>
+#include <adaptseg/segmentation_backend.hpp>
+#include <adaptseg/semantic_map.hpp>
+#include <adaptseg/simulated_sensor.hpp>
+#include <adaptseg/timing.hpp>
+
+#include <opencv2/core.hpp>
+
+#include <Eigen/Core>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace adaptseg {
 
 /// Settings of an adaptive mission.
 struct AdaptiveOptions {
+  /// Camera, timing, labels of interest, fixed per-image/waypoint times. AdaptivePlanner needs
+  /// `interest` set; run_adaptive_mission fills an empty one from the field.
   MissionOptions mission{};
   double top_gsd_cm = 3.0;                ///< GSD at h_max [cm/px]
   std::vector<double> candidate_gsd_cm{}; ///< lower GSDs a sub-lawnmower may fly [cm/px]
@@ -32,7 +50,7 @@ struct AdaptiveOptions {
 
 /// The decision taken at one top-level waypoint.
 struct DecisionRecord {
-  std::size_t waypoint_index = 0;  ///< index into MissionResult::waypoints
+  std::size_t waypoint_index = 0;  ///< index into the path (= MissionResult::waypoints in simulation)
   double sigma = 0.0;              ///< σ of the top-level image
   Decision decision;
   std::vector<Candidate> candidates;  ///< what was affordable, with exact costs
@@ -50,176 +68,523 @@ struct AdaptiveResult {
   }
 };
 
-namespace detail {
+/// The ground a mission covers, as a real mission knows it: no labels, only where the field is.
+///
+/// The map grid is the field frame's (docs/data_format.md): origin at the grid's bottom-left
+/// corner, x along its columns, y up its rows, `map_gsd_cm` per pixel; it is what the planner
+/// fuses segmentations into and what `valid_mask` is drawn on.
+struct SurveyArea {
+  Area area{};               ///< the rectangle to cover [m], x_min, y_min >= 0
+  double map_gsd_cm = 1.0;   ///< resolution of the fused map (and of `valid_mask`) [cm/px]
+  /// Optional CV_8UC1 over the map grid, non-zero where there is field; its size sets the
+  /// grid's. Empty: every pixel under `area` is field, and the grid just covers `area`.
+  cv::Mat valid_mask{};
+  int ignore_label = 255;    ///< "no class" in segmentations and in the map (0..255)
 
-/// σ of the map's labels inside `rect` (pixels never observed left out).
-inline double map_sigma(const SemanticMap& map, const cv::Rect& rect, const std::vector<int>& interest) {
-  const cv::Rect in = rect & cv::Rect(0, 0, map.labels().cols, map.labels().rows);
-  if (in.area() == 0) return 0.0;
-  return semantic_ratio(map.labels()(in), interest, map.unknown_label());
-}
-
-/// A fixed-altitude lawnmower over the whole field, as a front-aware policy sees it.
-struct LawnmowerPlanCost {
-  double gsd_cm = 0.0;
-  double flight_s = 0.0;  ///< velocity-ramp flight time along the plan
-  std::size_t images = 0;
+  /// A Field's area, GSD, valid mask and ignore label (what the simulation knows).
+  [[nodiscard]] static SurveyArea of(const Field& field) {
+    return {field.area(), field.gsd_cm(), field.valid_mask(), field.ignore_label()};
+  }
 };
 
-}  // namespace detail
+/// One waypoint the planner asks the UAV to fly to and take an image at.
+struct PlannedWaypoint {
+  Waypoint waypoint;
+  int level = 0;              ///< 0: top-level lawnmower W^{h_max}; 1: sub-lawnmower W^{h'} (a descent)
+  std::size_t index = 0;      ///< visiting order: 0, 1, ... over the whole path
+  std::size_t top_index = 0;  ///< the top-level waypoint whose region it maps
+};
 
-/// Runs the adaptive strategy with `policy` over `field`.
+/// What the planner made of one reported image.
+struct PlannerStep {
+  PlannedWaypoint waypoint;  ///< the waypoint the image was reported for
+  double sigma = 0.0;        ///< semantic ratio σ of the image's segmentation (paper Eq. `eq:vr`)
+  /// At a top-level waypoint: the decision taken (descend or continue).
+  std::optional<DecisionRecord> decision;
+  /// After the last image of a descent: what the region showed, fed back to the policy.
+  std::optional<DescentOutcome> outcome;
+};
+
+/// The adaptive planner run step by step (paper §3.2, Fig. workflow), for a caller that flies
+/// the UAV and takes the images: a companion computer, or the simulation driver
+/// run_adaptive_mission.
 ///
-/// At top-level waypoint i (GSD `top_gsd_cm`): segment, σ from the segmentation; for each
-/// candidate GSD finer than the top and not finer than the field, plan the sub-lawnmower over
-/// the region (starting in the corner nearest the UAV, cells without valid pixels skipped)
-/// and compute its exact extra time: the flight i → sub-lawnmower → i+1 minus the flight
-/// i → i+1, plus the per-image segmentation and per-waypoint planning estimates. Candidates
-/// that would break the budget are dropped. The policy decides; after a descent the region's
-/// σ at h' (from the fused map) goes back to the policy.
+/// Protocol: `next()` gives the waypoint to fly to (nullopt when the mission is complete);
+/// the caller flies there, takes the image and calls `report()` with it, once. The planner
+/// segments it with the backend (or takes the caller's labels), fuses it into its map, and at
+/// a top-level waypoint i (GSD `top_gsd_cm`) decides: for each candidate GSD finer than the
+/// top and not finer than the map, it plans the sub-lawnmower over the region (starting in the
+/// corner nearest the UAV, cells without field skipped) and computes its exact extra time: the
+/// flight i → sub-lawnmower → i+1 minus the flight i → i+1, plus the per-image segmentation
+/// and per-waypoint planning estimates. Candidates that would break the budget are dropped; the
+/// policy decides; a descent's waypoints come next. After a descent's last image, the region's
+/// σ at h' (from the fused map) goes back to the policy (paper §3.2.3).
 ///
-/// Holds references to `backend` and `policy` for the call's duration only.
-/// @throws std::invalid_argument for a top GSD finer than the field's, candidates that are not
-///         finer than the top, and a budget too small for the top-level coverage alone.
+/// Time: the budget check uses the elapsed mission time the caller reports with each image,
+/// or, if it reports none, the planner's own account (flight by the timing model along the
+/// planned waypoints; segmentation and planning measured, or fixed per image / waypoint).
+///
+/// Holds references to `backend` and `policy`, which must outlive the planner.
+///
+/// @code
+/// adaptseg::AdaptivePlanner planner(area, backend, policy, options);
+/// while (const auto w = planner.next()) {
+///   const cv::Mat rgb = fly_and_shoot(w->waypoint.position);         // the UAV's part
+///   const auto step = planner.report(planner.image_at(measured_pose(), rgb));
+///   if (step.decision && step.decision->decision.descend) { /* a sub-lawnmower comes next */ }
+/// }
+/// const adaptseg::SemanticMap& map = planner.map();
+/// @endcode
 template <SegmentationBackend Backend, DecisionPolicy Policy>
-[[nodiscard]] AdaptiveResult run_adaptive_mission(const Field& field, Backend& backend, Policy& policy,
-                                                  const AdaptiveOptions& options, std::string strategy) {
-  detail::require(std::isfinite(options.top_gsd_cm) && options.top_gsd_cm >= field.gsd_cm() * (1.0 - 1e-9),
-                  "run_adaptive_mission: top_gsd_cm must not be finer than the field's " +
-                      std::to_string(field.gsd_cm()) + " cm/px",
-                  options.top_gsd_cm);
-  std::vector<double> candidates;
-  for (double g : options.candidate_gsd_cm) {
-    detail::require(std::isfinite(g) && g > 0.0 && g < options.top_gsd_cm,
-                    "run_adaptive_mission: candidate GSDs must be positive and finer than top_gsd_cm", g);
-    if (g >= field.gsd_cm() * (1.0 - 1e-9)) candidates.push_back(g);  // finer than the data: skip
-  }
-  if (options.budget_s)
-    detail::require(std::isfinite(*options.budget_s) && *options.budget_s > 0.0,
-                    "run_adaptive_mission: budget_s must be finite and > 0", *options.budget_s);
-
-  Mission<Backend> mission(field, backend, options.mission, std::move(strategy));
-  const MissionOptions& mo = mission.options();
-  const LawnmowerPlanner planner(mission.camera());
-  const auto keep = [&](const Area& a) { return field.has_valid(a); };
-  const auto t_plan = std::chrono::steady_clock::now();
-  const auto top = planner.plan(field.area(), options.top_gsd_cm, {0.0, 0.0}, keep);
-  double pending_planning = 0.0;  // charged at the first waypoint (set below)
-
-  // Estimates of the per-image cost of work not yet done.
-  double slowest_segmentation = 0.0;
-  const auto seg_estimate = [&] {
-    return mo.fixed_segmentation_time_s ? *mo.fixed_segmentation_time_s : 1.25 * slowest_segmentation;
-  };
-  const auto plan_estimate = [&] { return mo.fixed_planning_time_s.value_or(0.0); };
-  const TimingModel& timing = mission.timing();
-  // Flight time of the top-level plan from waypoint i on.
-  std::vector<double> flight_after(top.size() + 1, 0.0);
-  for (std::size_t i = top.size(); i-- > 1;)
-    flight_after[i - 1] = flight_after[i] + timing.segment_time_s(top[i - 1].position, top[i].position);
-
-  if (options.budget_s) {
-    const double coverage = flight_after[0] + static_cast<double>(top.size()) * (seg_estimate() + plan_estimate());
-    detail::require(coverage <= *options.budget_s,
-                    "run_adaptive_mission: budget_s [s] is too small for the top-level coverage, which needs " +
-                        std::to_string(coverage) + " s",
-                    *options.budget_s);
-  }
-
-  // The field's lawnmowers at the top and candidate GSDs (what the mission could fly instead),
-  // planned exactly as run_lawnmower_mission plans them; their times use the current per-image
-  // estimates at each decision.
-  std::vector<detail::LawnmowerPlanCost> lawnmowers;
-  for (double g : candidates) lawnmowers.push_back({g, 0.0, 0});
-  lawnmowers.push_back({options.top_gsd_cm, 0.0, 0});
-  for (auto& l : lawnmowers) {
-    const auto plan = planner.plan(field.area(), l.gsd_cm, {0.0, 0.0}, keep);
-    for (std::size_t k = 1; k < plan.size(); ++k) l.flight_s += timing.segment_time_s(plan[k - 1].position, plan[k].position);
-    l.images = plan.size();
-  }
-  const double field_valid_px = static_cast<double>(field.valid_pixels());
-  pending_planning = Mission<Backend>::seconds_since(t_plan);  // the top plan and the forecasts
-
-  std::vector<DecisionRecord> decisions;
-  std::vector<LawnmowerForecast> forecasts(lawnmowers.size());
-  for (std::size_t i = 0; i < top.size(); ++i) {
-    mission.charge_planning(pending_planning);
-    const auto visit = mission.visit(top[i], 0);
-    slowest_segmentation = std::max(slowest_segmentation, visit.record->segmentation_s);
+class AdaptivePlanner {
+ public:
+  /// Plans the top-level lawnmower over `area` (cells without field skipped).
+  /// @throws std::invalid_argument for an invalid area, camera or timing, no labels of
+  ///         interest (or one that is the ignore label), a top GSD finer than the map's,
+  ///         candidates that are not finer than the top, a budget that is not positive, or
+  ///         one too small for the top-level coverage alone.
+  AdaptivePlanner(SurveyArea area, Backend& backend, Policy& policy, AdaptiveOptions options)
+      : camera_(options.mission.camera),
+        timing_(options.mission.timing),
+        area_(std::move(area)),
+        map_(grid_size(area_), area_.ignore_label),
+        backend_(backend),
+        policy_(policy),
+        options_(std::move(options)) {
     const auto t0 = std::chrono::steady_clock::now();
+    if (area_.valid_mask.empty()) {
+      area_.valid_mask = cv::Mat(map_.labels().size(), CV_8UC1, cv::Scalar(0));
+      area_.valid_mask(pixel_rect(area_.area) & grid()).setTo(255);
+    }
+    detail::check_fixed_times(options_.mission);
+    const auto& interest = options_.mission.interest;
+    detail::require(!interest.empty(), "AdaptivePlanner: no labels of interest (options.mission.interest)", 0);
+    for (int c : interest)
+      detail::require(c >= 0 && c <= 255 && c != area_.ignore_label,
+                      "AdaptivePlanner: a label of interest is out of 0..255 or the ignore label", c);
+    const double map_gsd = area_.map_gsd_cm;
+    detail::require(std::isfinite(options_.top_gsd_cm) && options_.top_gsd_cm >= map_gsd * (1.0 - 1e-9),
+                    "AdaptivePlanner: top_gsd_cm must not be finer than the map's " + std::to_string(map_gsd) +
+                        " cm/px",
+                    options_.top_gsd_cm);
+    for (double g : options_.candidate_gsd_cm) {
+      detail::require(std::isfinite(g) && g > 0.0 && g < options_.top_gsd_cm,
+                      "AdaptivePlanner: candidate GSDs must be positive and finer than top_gsd_cm", g);
+      if (g >= map_gsd * (1.0 - 1e-9)) candidates_.push_back(g);  // finer than the map: skip
+    }
+    if (options_.budget_s)
+      detail::require(std::isfinite(*options_.budget_s) && *options_.budget_s > 0.0,
+                      "AdaptivePlanner: budget_s must be finite and > 0", *options_.budget_s);
 
+    top_ = LawnmowerPlanner(camera_).plan(area_.area, options_.top_gsd_cm,
+                                          Eigen::Vector2d(area_.area.x_min_m, area_.area.y_min_m), keep());
+    // The area's lawnmowers at the candidate and top GSDs (what the mission could fly instead;
+    // planned as run_lawnmower_mission plans them), for front-aware policies.
+    for (double g : candidates_) lawnmowers_.push_back({g, 0.0, 0});
+    lawnmowers_.push_back({options_.top_gsd_cm, 0.0, 0});
+    for (LawnmowerCost& l : lawnmowers_) {
+      const auto plan = LawnmowerPlanner(camera_).plan(area_.area, l.gsd_cm,
+                                                       Eigen::Vector2d(area_.area.x_min_m, area_.area.y_min_m), keep());
+      for (std::size_t k = 1; k < plan.size(); ++k)
+        l.flight_s += timing_.segment_time_s(plan[k - 1].position, plan[k].position);
+      l.images = plan.size();
+    }
+    valid_px_ = cv::countNonZero(area_.valid_mask);
+    charge_measured_planning(seconds_since(t0));
+    flight_after_.assign(top_.size() + 1, 0.0);
+    for (std::size_t i = top_.size(); i-- > 1;)
+      flight_after_[i - 1] = flight_after_[i] + timing_.segment_time_s(top_[i - 1].position, top_[i].position);
+    if (options_.budget_s) {
+      const double coverage =
+          flight_after_[0] + static_cast<double>(top_.size()) * (segmentation_estimate() + planning_estimate());
+      detail::require(coverage <= *options_.budget_s,
+                      "AdaptivePlanner: budget_s [s] is too small for the top-level coverage, which needs " +
+                          std::to_string(coverage) + " s",
+                      *options_.budget_s);
+    }
+  }
+
+  /// The next waypoint to fly to and take an image at; the same one again while its image has
+  /// not been reported; nullopt once the mission is complete.
+  [[nodiscard]] std::optional<PlannedWaypoint> next() {
+    if (pending_) return path_.back();
+    PlannedWaypoint p;
+    if (sub_next_ < sub_.size()) {
+      p.waypoint = sub_[sub_next_++];
+      p.level = 1;
+      p.top_index = top_next_ - 1;
+    } else if (top_next_ < top_.size()) {
+      p.waypoint = top_[top_next_];
+      p.top_index = top_next_++;
+    } else {
+      return std::nullopt;
+    }
+    p.index = path_.size();
+    path_.push_back(p);
+    pending_ = true;
+    if (options_.mission.fixed_planning_time_s) planning_s_ += *options_.mission.fixed_planning_time_s;
+    return p;
+  }
+
+  /// Reports the image taken at the pending waypoint; the planner segments it with the backend
+  /// (the time it takes is the image's segmentation time) and goes on as the other overload.
+  /// @throws std::invalid_argument as the other overload, and whatever the backend throws.
+  PlannerStep report(const Image& image, std::optional<double> elapsed_s = std::nullopt) {
+    check_report(image, elapsed_s);
+    const auto t0 = std::chrono::steady_clock::now();
+    cv::Mat labels = backend_.segment(image);
+    return report(image, labels, seconds_since(t0), elapsed_s);
+  }
+
+  /// Reports the image taken at the pending waypoint with its segmentation `labels`, which
+  /// took `segmentation_s` [s] (ignored when the options fix a segmentation time). The image's
+  /// pose (`position`, `footprint_px`) is what gets fused: the waypoint's, or the one the UAV
+  /// measured (see image_at()). `elapsed_s`: the mission time [s] the caller measured up to
+  /// now (flight, segmentation, planning), used for the budget instead of the planner's own
+  /// account. Nothing changes when it throws: the waypoint stays pending.
+  /// @throws std::invalid_argument if no waypoint is pending (next() not called, or its image
+  ///         already reported), for an image that is not of the camera's size or has no
+  ///         footprint, labels that are not CV_8UC1 of the image's size, or a time that is
+  ///         negative or not finite.
+  PlannerStep report(const Image& image, const cv::Mat& labels, double segmentation_s,
+                     std::optional<double> elapsed_s = std::nullopt) {
+    check_report(image, elapsed_s);
+    detail::require(labels.type() == CV_8UC1 && labels.cols == image.width_px && labels.rows == image.height_px,
+                    "AdaptivePlanner::report: labels must be CV_8UC1 of the image's size",
+                    std::to_string(labels.cols) + "x" + std::to_string(labels.rows));
+    detail::require(std::isfinite(segmentation_s) && segmentation_s >= 0.0,
+                    "AdaptivePlanner::report: segmentation_s must be finite and >= 0", segmentation_s);
+    pending_ = false;
+    reported_elapsed_s_ = elapsed_s;
+    const PlannedWaypoint& p = path_.back();
+    if (p.index > 0) flight_s_ += timing_.segment_time_s(path_[p.index - 1].waypoint.position, p.waypoint.position);
+    const double seg = options_.mission.fixed_segmentation_time_s.value_or(segmentation_s);
+    segmentation_s_ += seg;
+    slowest_segmentation_s_ = std::max(slowest_segmentation_s_, seg);
+    map_.fuse(image, labels);
+
+    PlannerStep step;
+    step.waypoint = p;
+    step.sigma = semantic_ratio(labels, options_.mission.interest, image.ignore_label);
+    if (p.level == 0)
+      step.decision = decide(p, step.sigma);
+    else if (sub_next_ == sub_.size())
+      step.outcome = finish_descent();
+    return step;
+  }
+
+  /// The Image of a camera frame `rgb` (CV_8UC3 of the camera's size, or empty) taken at
+  /// `pose`: x, y [m] in the field frame, z the altitude above ground [m]. Nadir camera with
+  /// its image x axis along the field's x axis (the plan's yaw); the GSD follows from the
+  /// altitude, the footprint is centred under the camera and snapped to map pixels, as
+  /// SimulatedSensor does.
+  /// @throws std::invalid_argument for a pose that is not finite or an altitude <= 0, and an
+  ///         RGB image of another size or type.
+  [[nodiscard]] Image image_at(const Eigen::Vector3d& pose, cv::Mat rgb = {}) const {
+    detail::require(pose.allFinite(), "AdaptivePlanner::image_at: the pose must be finite", pose.transpose());
+    detail::require(rgb.empty() || (rgb.type() == CV_8UC3 && rgb.cols == camera_.width_px() &&
+                                    rgb.rows == camera_.height_px()),
+                    "AdaptivePlanner::image_at: rgb must be CV_8UC3 of the camera's size " +
+                        std::to_string(camera_.width_px()) + "x" + std::to_string(camera_.height_px()),
+                    std::to_string(rgb.cols) + "x" + std::to_string(rgb.rows));
+    Image img;
+    img.rgb = std::move(rgb);
+    img.position = pose;
+    img.gsd_cm = camera_.gsd_cm(pose.z());
+    img.width_px = camera_.width_px();
+    img.height_px = camera_.height_px();
+    img.ignore_label = area_.ignore_label;
+    const Extent fp = camera_.footprint_at_gsd(img.gsd_cm);
+    img.footprint_px = pixel_rect({pose.x() - 0.5 * fp.width_m, pose.y() - 0.5 * fp.height_m,
+                                   pose.x() + 0.5 * fp.width_m, pose.y() + 0.5 * fp.height_m});
+    return img;
+  }
+
+  /// The sub-lawnmower that re-maps the region of top-level waypoint `top_index` at `gsd_cm`
+  /// (paper §3.2.1 W^{h'}): from the corner nearest that waypoint, cells without field skipped.
+  /// @throws std::invalid_argument for an index out of range or a GSD that is not positive.
+  [[nodiscard]] std::vector<Waypoint> sub_plan(std::size_t top_index, double gsd_cm) const {
+    detail::require(top_index < top_.size(), "AdaptivePlanner::sub_plan: top_index out of range", top_index);
+    const Waypoint& t = top_[top_index];
+    return LawnmowerPlanner(camera_).plan(t.footprint, gsd_cm, Eigen::Vector2d(t.position.x(), t.position.y()),
+                                          keep());
+  }
+
+  /// The top-level lawnmower W^{h_max}.
+  [[nodiscard]] const std::vector<Waypoint>& top_level() const noexcept { return top_; }
+  /// The candidate GSDs a descent may fly [cm/px] (those not finer than the map).
+  [[nodiscard]] const std::vector<double>& candidate_gsd_cm() const noexcept { return candidates_; }
+  /// Every waypoint next() may hand out: the top level and, per region, every candidate's
+  /// sub-lawnmower (what a pre-recorded image set must cover).
+  [[nodiscard]] std::vector<Waypoint> reachable_waypoints() const {
+    std::vector<Waypoint> out = top_;
+    for (std::size_t i = 0; i < top_.size(); ++i)
+      for (double g : candidates_) {
+        const auto sub = sub_plan(i, g);
+        out.insert(out.end(), sub.begin(), sub.end());
+      }
+    return out;
+  }
+
+  /// True once every waypoint has been handed out and reported.
+  [[nodiscard]] bool done() const noexcept {
+    return !pending_ && sub_next_ >= sub_.size() && top_next_ >= top_.size();
+  }
+  /// The waypoint whose image is awaited, if any.
+  [[nodiscard]] std::optional<PlannedWaypoint> pending() const {
+    return pending_ ? std::optional<PlannedWaypoint>(path_.back()) : std::nullopt;
+  }
+  /// The fused segmentations (paper §3.1: the finest GSD wins), over the map grid.
+  [[nodiscard]] const SemanticMap& map() const noexcept { return map_; }
+  /// One record per top-level image reported so far.
+  [[nodiscard]] const std::vector<DecisionRecord>& decisions() const noexcept { return decisions_; }
+  /// Every waypoint handed out so far, in visiting order (the last may be pending).
+  [[nodiscard]] const std::vector<PlannedWaypoint>& path() const noexcept { return path_; }
+  [[nodiscard]] const SurveyArea& area() const noexcept { return area_; }
+  [[nodiscard]] const CameraModel& camera() const noexcept { return camera_; }
+  [[nodiscard]] const TimingModel& timing() const noexcept { return timing_; }
+  [[nodiscard]] const AdaptiveOptions& options() const noexcept { return options_; }
+
+  /// Mission time so far [s]: what the caller reported with the last image if it did,
+  /// otherwise the planner's own account (flight + segmentation + planning).
+  [[nodiscard]] double elapsed_s() const noexcept {
+    return reported_elapsed_s_.value_or(flight_s_ + segmentation_s_ + planning_s_);
+  }
+
+  /// Measured planner computation [s] since the last call (planning the top level, decisions,
+  /// online updates): what a caller keeping its own time account charges as planning time.
+  [[nodiscard]] double take_planning_s() noexcept { return std::exchange(untaken_planning_s_, 0.0); }
+
+  /// The pixels of the map grid under `a` (edges rounded to the nearest pixel boundary, as
+  /// Field::pixel_rect); may extend beyond the grid.
+  [[nodiscard]] cv::Rect pixel_rect(const Area& a) const {
+    const double s = 100.0 / area_.map_gsd_cm;
+    const int c0 = static_cast<int>(std::lround(a.x_min_m * s));
+    const int c1 = static_cast<int>(std::lround(a.x_max_m * s));
+    const int r0 = static_cast<int>(std::lround(map_.labels().rows - a.y_max_m * s));
+    const int r1 = static_cast<int>(std::lround(map_.labels().rows - a.y_min_m * s));
+    return {c0, r0, c1 - c0, r1 - r0};
+  }
+
+  /// Field pixels of the map grid under `a`.
+  [[nodiscard]] int valid_pixels(const Area& a) const {
+    const cv::Rect in = pixel_rect(a) & grid();
+    return in.area() > 0 ? cv::countNonZero(area_.valid_mask(in)) : 0;
+  }
+
+  /// Share of the ground under `a` that is field (paper: DecisionContext::valid_fraction).
+  [[nodiscard]] double valid_fraction(const Area& a) const {
+    const cv::Rect rect = pixel_rect(a);
+    if (rect.area() <= 0) return 0.0;
+    return static_cast<double>(valid_pixels(a)) / static_cast<double>(rect.area());
+  }
+
+ private:
+  static double seconds_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+
+  /// The map grid's size: the mask's, or just enough to cover the area.
+  static cv::Size grid_size(const SurveyArea& a) {
+    const Area& r = a.area;
+    detail::require_positive(a.map_gsd_cm, "SurveyArea: map_gsd_cm");
+    detail::require(std::isfinite(r.x_min_m) && std::isfinite(r.y_min_m) && r.x_min_m >= 0.0 && r.y_min_m >= 0.0 &&
+                        std::isfinite(r.width_m()) && r.width_m() > 0.0 && std::isfinite(r.height_m()) &&
+                        r.height_m() > 0.0,
+                    "SurveyArea: area must be finite with x_min, y_min >= 0 and a positive size [m]",
+                    r.width_m() * r.height_m());
+    detail::require(a.ignore_label >= 0 && a.ignore_label <= 255, "SurveyArea: ignore_label must be in 0..255",
+                    a.ignore_label);
+    const double s = 100.0 / a.map_gsd_cm;
+    if (a.valid_mask.empty())
+      return {static_cast<int>(std::ceil(r.x_max_m * s - 1e-6)), static_cast<int>(std::ceil(r.y_max_m * s - 1e-6))};
+    detail::require(a.valid_mask.type() == CV_8UC1, "SurveyArea: valid_mask must be CV_8UC1",
+                    a.valid_mask.type());
+    detail::require(r.x_max_m * s <= a.valid_mask.cols + 0.5 && r.y_max_m * s <= a.valid_mask.rows + 0.5,
+                    "SurveyArea: area must lie inside the valid mask's grid",
+                    std::to_string(a.valid_mask.cols) + "x" + std::to_string(a.valid_mask.rows) + " px");
+    return a.valid_mask.size();
+  }
+
+  [[nodiscard]] cv::Rect grid() const { return {0, 0, map_.labels().cols, map_.labels().rows}; }
+
+  /// Which lawnmower cells to fly: those with any field under them.
+  [[nodiscard]] auto keep() const {
+    return [this](const Area& a) { return valid_pixels(a) > 0; };
+  }
+
+  [[nodiscard]] double segmentation_estimate() const {
+    return options_.mission.fixed_segmentation_time_s.value_or(1.25 * slowest_segmentation_s_);
+  }
+  [[nodiscard]] double planning_estimate() const { return options_.mission.fixed_planning_time_s.value_or(0.0); }
+
+  void charge_measured_planning(double s) {
+    untaken_planning_s_ += s;
+    if (!options_.mission.fixed_planning_time_s) planning_s_ += s;
+  }
+
+  void check_report(const Image& image, std::optional<double> elapsed_s) const {
+    detail::require(pending_,
+                    "AdaptivePlanner::report: no waypoint is waiting for an image (call next() first; "
+                    "each waypoint takes one image)",
+                    path_.size());
+    detail::require(image.width_px == camera_.width_px() && image.height_px == camera_.height_px(),
+                    "AdaptivePlanner::report: the image must have the camera's size " +
+                        std::to_string(camera_.width_px()) + "x" + std::to_string(camera_.height_px()),
+                    std::to_string(image.width_px) + "x" + std::to_string(image.height_px));
+    detail::require(image.rgb.empty() || image.rgb.size() == cv::Size(image.width_px, image.height_px),
+                    "AdaptivePlanner::report: the image's rgb must be of its size",
+                    std::to_string(image.rgb.cols) + "x" + std::to_string(image.rgb.rows));
+    detail::require(image.footprint_px.width > 0 && image.footprint_px.height > 0 && image.gsd_cm > 0.0,
+                    "AdaptivePlanner::report: the image has no footprint (make it with image_at())",
+                    image.gsd_cm);
+    if (elapsed_s)
+      detail::require(std::isfinite(*elapsed_s) && *elapsed_s >= 0.0,
+                      "AdaptivePlanner::report: elapsed_s must be finite and >= 0", *elapsed_s);
+  }
+
+  /// The decision at top-level waypoint `p` (paper §3.2.2), its candidates with exact costs.
+  DecisionRecord decide(const PlannedWaypoint& p, double sigma) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::size_t i = p.top_index;
     DecisionRecord rec;
-    rec.waypoint_index = mission.records().size() - 1;
-    rec.sigma = visit.record->semantic_ratio;
-    const Eigen::Vector3d here = top[i].position;
-    const bool last = i + 1 == top.size();
-    const double direct = last ? 0.0 : timing.segment_time_s(here, top[i + 1].position);
+    rec.waypoint_index = p.index;
+    rec.sigma = sigma;
+    const Eigen::Vector3d here = top_[i].position;
+    const bool last = i + 1 == top_.size();
+    const double direct = last ? 0.0 : timing_.segment_time_s(here, top_[i + 1].position);
     // Time still needed after this waypoint's decision to finish the top-level coverage.
-    const double rest = (last ? 0.0 : direct + flight_after[i + 1]) +
-                        static_cast<double>(top.size() - i - 1) * (seg_estimate() + plan_estimate());
+    const double rest = (last ? 0.0 : direct + flight_after_[i + 1]) +
+                        static_cast<double>(top_.size() - i - 1) * (segmentation_estimate() + planning_estimate());
+    const double elapsed = elapsed_s();
     std::vector<std::vector<Waypoint>> sub_plans;
-    for (double g : candidates) {
-      auto sub = planner.plan(top[i].footprint, g, Eigen::Vector2d(here.x(), here.y()), keep);
+    for (double g : candidates_) {
+      auto sub = sub_plan(i, g);
       if (sub.empty()) continue;
-      double flight = timing.segment_time_s(here, sub.front().position);
-      for (std::size_t k = 1; k < sub.size(); ++k) flight += timing.segment_time_s(sub[k - 1].position, sub[k].position);
-      if (!last) flight += timing.segment_time_s(sub.back().position, top[i + 1].position);
+      double flight = timing_.segment_time_s(here, sub.front().position);
+      for (std::size_t k = 1; k < sub.size(); ++k) flight += timing_.segment_time_s(sub[k - 1].position, sub[k].position);
+      if (!last) flight += timing_.segment_time_s(sub.back().position, top_[i + 1].position);
       Candidate c;
       c.gsd_cm = g;
-      c.altitude_m = mission.camera().altitude_m(g);
+      c.altitude_m = camera_.altitude_m(g);
       c.images = static_cast<int>(sub.size());
-      c.extra_time_s = flight - direct + static_cast<double>(sub.size()) * (seg_estimate() + plan_estimate());
+      c.extra_time_s = flight - direct + static_cast<double>(sub.size()) * (segmentation_estimate() + planning_estimate());
       // Descending replaces the direct leg to i+1: elapsed + extra + rest must fit.
-      if (options.budget_s && mission.elapsed_s() + c.extra_time_s + rest > *options.budget_s + 1e-9) {
+      if (options_.budget_s && elapsed + c.extra_time_s + rest > *options_.budget_s + 1e-9) {
         rec.budget_limited = true;
         continue;
       }
       rec.candidates.push_back(c);
       sub_plans.push_back(std::move(sub));
     }
-    const double region_px = static_cast<double>(field.valid_pixels(top[i].footprint));
-    for (std::size_t k = 0; k < lawnmowers.size(); ++k)
-      forecasts[k] = {lawnmowers[k].gsd_cm, lawnmowers[k].flight_s + static_cast<double>(lawnmowers[k].images) *
-                                                                         (seg_estimate() + plan_estimate())};
+    std::vector<LawnmowerForecast> forecasts;
+    for (const auto& l : lawnmowers_)
+      forecasts.push_back(
+          {l.gsd_cm, l.flight_s + static_cast<double>(l.images) * (segmentation_estimate() + planning_estimate())});
     DecisionContext ctx;
     ctx.sigma = rec.sigma;
-    ctx.valid_fraction = region_px / static_cast<double>(std::max(1, field.pixel_rect(top[i].footprint).area()));
-    ctx.top_gsd_cm = options.top_gsd_cm;
+    ctx.valid_fraction = valid_fraction(top_[i].footprint);
+    ctx.top_gsd_cm = options_.top_gsd_cm;
     ctx.top_altitude_m = here.z();
     ctx.candidates = rec.candidates;
-    ctx.elapsed_s = mission.elapsed_s();
+    ctx.elapsed_s = elapsed;
     ctx.rest_s = rest;
-    ctx.region_share = field_valid_px > 0.0 ? region_px / field_valid_px : 0.0;
+    ctx.region_share = valid_px_ > 0 ? static_cast<double>(valid_pixels(top_[i].footprint)) / valid_px_ : 0.0;
     ctx.lawnmowers = forecasts;
-    rec.decision = policy.decide(ctx);
-    pending_planning = Mission<Backend>::seconds_since(t0);
-
+    rec.decision = policy_.decide(ctx);
     if (rec.decision.descend) {
       const auto it = std::find_if(rec.candidates.begin(), rec.candidates.end(),
                                    [&](const Candidate& c) { return c.gsd_cm == rec.decision.gsd_cm; });
       ADAPTSEG_ASSERT(it != rec.candidates.end());
-      const auto& sub = sub_plans[static_cast<std::size_t>(it - rec.candidates.begin())];
-      for (const auto& w : sub) {
-        mission.charge_planning(pending_planning);
-        pending_planning = 0.0;
-        const auto v = mission.visit(w, 1);
-        slowest_segmentation = std::max(slowest_segmentation, v.record->segmentation_s);
-      }
-      const auto t1 = std::chrono::steady_clock::now();
-      DescentOutcome out;
-      out.top_altitude_m = here.z();
-      out.sub_altitude_m = it->altitude_m;
-      out.sigma_top = rec.sigma;
-      out.sigma_sub = detail::map_sigma(mission.map(), field.pixel_rect(top[i].footprint), mission.interest());
-      policy.observe(out);
-      rec.outcome = out;
-      pending_planning += Mission<Backend>::seconds_since(t1);
+      sub_ = std::move(sub_plans[static_cast<std::size_t>(it - rec.candidates.begin())]);
+      sub_next_ = 0;
+      descent_altitude_m_ = it->altitude_m;
     }
-    decisions.push_back(std::move(rec));
+    decisions_.push_back(rec);
+    charge_measured_planning(seconds_since(t0));
+    return rec;
+  }
+
+  /// After a descent's last image: σ of the region at h' from the fused map, to the policy.
+  DescentOutcome finish_descent() {
+    const auto t0 = std::chrono::steady_clock::now();
+    DecisionRecord& rec = decisions_.back();
+    const Waypoint& top = top_[path_[rec.waypoint_index].top_index];
+    DescentOutcome out;
+    out.top_altitude_m = top.position.z();
+    out.sub_altitude_m = descent_altitude_m_;
+    out.sigma_top = rec.sigma;
+    const cv::Rect region = pixel_rect(top.footprint) & grid();
+    out.sigma_sub = region.area() == 0 ? 0.0
+                                       : semantic_ratio(map_.labels()(region), options_.mission.interest,
+                                                        map_.unknown_label());
+    policy_.observe(out);
+    rec.outcome = out;
+    sub_.clear();
+    sub_next_ = 0;
+    charge_measured_planning(seconds_since(t0));
+    return out;
+  }
+
+  CameraModel camera_;
+  TimingModel timing_;
+  SurveyArea area_;
+  SemanticMap map_;
+  Backend& backend_;
+  Policy& policy_;
+  AdaptiveOptions options_;
+  std::vector<double> candidates_;
+  std::vector<Waypoint> top_;
+  std::vector<double> flight_after_;  ///< flight time of the top-level plan from waypoint i on [s]
+  /// A fixed-altitude lawnmower over the area (a front-aware policy's yardstick).
+  struct LawnmowerCost {
+    double gsd_cm = 0.0;
+    double flight_s = 0.0;
+    std::size_t images = 0;
+  };
+  std::vector<LawnmowerCost> lawnmowers_;  ///< at the candidate and top GSDs
+  double valid_px_ = 0.0;                  ///< field pixels of the whole map grid
+
+  std::size_t top_next_ = 0;          ///< next top-level waypoint to hand out
+  std::vector<Waypoint> sub_;         ///< the descent in progress, if any
+  std::size_t sub_next_ = 0;          ///< next waypoint of sub_ to hand out
+  double descent_altitude_m_ = 0.0;
+  bool pending_ = false;              ///< path_.back() awaits its image
+  std::vector<PlannedWaypoint> path_;
+  std::vector<DecisionRecord> decisions_;
+
+  double flight_s_ = 0.0;             ///< the planner's own time account [s]
+  double segmentation_s_ = 0.0;
+  double planning_s_ = 0.0;
+  double slowest_segmentation_s_ = 0.0;
+  double untaken_planning_s_ = 0.0;
+  std::optional<double> reported_elapsed_s_;
+};
+
+/// Runs the adaptive strategy with `policy` over `field` in simulation: AdaptivePlanner
+/// decides, a Mission flies (SimulatedSensor image, segmentation by `backend`, scoring, time
+/// accounting) and reports each image with the mission's elapsed time; the planner's fused
+/// map is the mission's map.
+///
+/// Holds references to `backend` and `policy` for the call's duration only.
+/// @throws std::invalid_argument for a top GSD finer than the field's, candidates that are not
+///         finer than the top, a budget too small for the top-level coverage alone, and the
+///         reasons of Mission's constructor.
+template <SegmentationBackend Backend, DecisionPolicy Policy>
+[[nodiscard]] AdaptiveResult run_adaptive_mission(const Field& field, Backend& backend, Policy& policy,
+                                                  const AdaptiveOptions& options, std::string strategy) {
+  Mission<Backend> mission(field, backend, options.mission, std::move(strategy));
+  AdaptiveOptions planner_options = options;
+  planner_options.mission.interest = mission.interest();
+  AdaptivePlanner<Backend, Policy> planner(SurveyArea::of(field), backend, policy, std::move(planner_options));
+  while (const auto w = planner.next()) {
+    mission.charge_planning(planner.take_planning_s());
+    const auto visit = mission.visit_without_fusion(w->waypoint, w->level);
+    (void)planner.report(visit.image, visit.labels, visit.record->segmentation_s, mission.elapsed_s());
   }
   // The last decision's measured time (a fixed planning time is charged per waypoint only).
-  if (!mo.fixed_planning_time_s) mission.charge_planning(pending_planning);
-  return AdaptiveResult{std::move(mission).finish(), std::move(decisions)};
+  if (!mission.options().fixed_planning_time_s) mission.charge_planning(planner.take_planning_s());
+  return AdaptiveResult{std::move(mission).finish(planner.map()), planner.decisions()};
 }
 
 }  // namespace adaptseg

@@ -60,7 +60,7 @@ namespace adaptseg {
 ///
 /// @code
 /// auto df = adaptseg::DecisionFunction::initialize(samples, {.min_sigma = 0.02});
-/// adaptseg::Decision d = df.decide(context);   // context built by run_adaptive_mission
+/// adaptseg::Decision d = df.decide(context);   // context built by AdaptivePlanner
 /// @endcode
 class DecisionFunction {
  public:

@@ -32,6 +32,20 @@ struct MissionOptions {
   std::optional<double> fixed_planning_time_s{};
 };
 
+namespace detail {
+
+/// Throws unless the fixed segmentation and planning times, where set, are finite and >= 0.
+inline void check_fixed_times(const MissionOptions& options) {
+  if (options.fixed_segmentation_time_s)
+    require(std::isfinite(*options.fixed_segmentation_time_s) && *options.fixed_segmentation_time_s >= 0.0,
+            "MissionOptions: fixed_segmentation_time_s must be finite and >= 0", *options.fixed_segmentation_time_s);
+  if (options.fixed_planning_time_s)
+    require(std::isfinite(*options.fixed_planning_time_s) && *options.fixed_planning_time_s >= 0.0,
+            "MissionOptions: fixed_planning_time_s must be finite and >= 0", *options.fixed_planning_time_s);
+}
+
+}  // namespace detail
+
 /// What happened at one waypoint.
 struct WaypointRecord {
   Waypoint waypoint;
@@ -78,14 +92,7 @@ class Mission {
         map_(field.labels().size(), field.ignore_label()),
         backend_(backend),
         options_(std::move(options)) {
-    if (options_.fixed_segmentation_time_s)
-      detail::require(std::isfinite(*options_.fixed_segmentation_time_s) && *options_.fixed_segmentation_time_s >= 0.0,
-                      "MissionOptions: fixed_segmentation_time_s must be finite and >= 0",
-                      *options_.fixed_segmentation_time_s);
-    if (options_.fixed_planning_time_s)
-      detail::require(std::isfinite(*options_.fixed_planning_time_s) && *options_.fixed_planning_time_s >= 0.0,
-                      "MissionOptions: fixed_planning_time_s must be finite and >= 0",
-                      *options_.fixed_planning_time_s);
+    detail::check_fixed_times(options_);
     result_.field = field.name();
     result_.strategy = std::move(strategy);
     result_.segmenter = backend_.name();
@@ -102,6 +109,7 @@ class Mission {
   [[nodiscard]] const TimingModel& timing() const noexcept { return timing_; }
   [[nodiscard]] const MissionOptions& options() const noexcept { return options_; }
   [[nodiscard]] const std::vector<int>& interest() const noexcept { return result_.interest; }
+  /// The map fused by visit() (visit_without_fusion() leaves it alone).
   [[nodiscard]] const SemanticMap& map() const noexcept { return map_; }
   [[nodiscard]] const std::vector<WaypointRecord>& records() const noexcept { return result_.waypoints; }
   /// Time spent so far [s] (flight + segmentation + planning).
@@ -121,6 +129,14 @@ class Mission {
 
   /// Flies to `w`, takes and segments the image, fuses it into the map and records it.
   Visit visit(const Waypoint& w, int level) {
+    Visit v = visit_without_fusion(w, level);
+    map_.fuse(v.image, v.labels);
+    return v;
+  }
+
+  /// visit() without fusing the image into this mission's map, for a planner that keeps the
+  /// map itself (AdaptivePlanner); score that map with `finish(map)`.
+  Visit visit_without_fusion(const Waypoint& w, int level) {
     if (const auto p = position()) result_.flight_s += timing_.segment_time_s(*p, w.position);
     Visit v{sensor_.capture(w), cv::Mat(), nullptr};
     const auto t0 = std::chrono::steady_clock::now();
@@ -131,7 +147,6 @@ class Mission {
                     "Mission::visit: the backend '" + result_.segmenter +
                         "' returned labels that are not CV_8UC1 of the image's size",
                     std::to_string(v.labels.cols) + "x" + std::to_string(v.labels.rows));
-    map_.fuse(v.image, v.labels);
 
     WaypointRecord rec;
     rec.waypoint = w;
@@ -155,9 +170,16 @@ class Mission {
   }
 
   /// Scores the fused map against the field and returns the result. Call once, at the end.
-  MissionResult finish() && {
-    result_.fused_labels = map_.labels();
-    result_.confusion.add(field().labels(), map_.labels(), field().ignore_label());
+  MissionResult finish() && { return std::move(*this).finish(map_); }
+
+  /// Scores `map` (of the field's size, e.g. a planner's own map) as the mission's fused map.
+  /// Call once, at the end.
+  /// @throws std::invalid_argument if `map` differs in size from the field.
+  MissionResult finish(const SemanticMap& map) && {
+    detail::require(map.labels().size() == field().labels().size(),
+                    "Mission::finish: the map must have the field's size", map.labels().cols);
+    result_.fused_labels = map.labels().clone();  // the map may go on changing
+    result_.confusion.add(field().labels(), map.labels(), field().ignore_label());
     return std::move(result_);
   }
 
