@@ -17,7 +17,7 @@ python=(python3 python3-numpy python3-opencv python3-yaml python3-pil)
 case "${1:-build}" in
   build) want=("${build[@]}") ;;
   test) want=("${build[@]}" "${python[@]}" gdal-bin) ;;
-  bench) want=("${build[@]}" "${python[@]}" gdal-bin python3-sklearn) ;;
+  bench) want=("${build[@]}" "${python[@]}" gdal-bin python3-sklearn python3-torch) ;;
   plots) want=("${build[@]}" "${python[@]}" python3-matplotlib) ;;
   # clang: the compiler; libclang-rt-14-dev: libFuzzer and the sanitizer runtimes for it.
   fuzz) want=("${build[@]}" clang libclang-rt-14-dev) ;;

@@ -430,7 +430,7 @@ TEST_CASE("robustness: adaptive: top GSD finer than the field") {
   o.top_gsd_cm = 0.5;
   LinearDecision policy({0.0, 1.0});
   CHECK_THROWS_WITH_AS((void)run_adaptive_mission(f, oracle, policy, o, "linear"),
-                       Contains("top_gsd_cm must not be finer than the field's"), std::invalid_argument);
+                       Contains("top_gsd_cm must not be finer than the map's"), std::invalid_argument);
 }
 
 TEST_CASE("robustness: adaptive: candidate GSD not finer than the top") {

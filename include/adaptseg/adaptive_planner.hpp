@@ -355,15 +355,10 @@ class AdaptivePlanner {
   /// online updates): what a caller keeping its own time account charges as planning time.
   [[nodiscard]] double take_planning_s() noexcept { return std::exchange(untaken_planning_s_, 0.0); }
 
-  /// The pixels of the map grid under `a` (edges rounded to the nearest pixel boundary, as
-  /// Field::pixel_rect); may extend beyond the grid.
+  /// The pixels of the map grid under `a` (raster_rect, as Field::pixel_rect); may extend
+  /// beyond the grid.
   [[nodiscard]] cv::Rect pixel_rect(const Area& a) const {
-    const double s = 100.0 / area_.map_gsd_cm;
-    const int c0 = static_cast<int>(std::lround(a.x_min_m * s));
-    const int c1 = static_cast<int>(std::lround(a.x_max_m * s));
-    const int r0 = static_cast<int>(std::lround(map_.labels().rows - a.y_max_m * s));
-    const int r1 = static_cast<int>(std::lround(map_.labels().rows - a.y_min_m * s));
-    return {c0, r0, c1 - c0, r1 - r0};
+    return raster_rect(a, area_.map_gsd_cm, map_.labels().rows);
   }
 
   /// Field pixels of the map grid under `a`.

@@ -71,6 +71,24 @@ inline void validate_field_geo(const FieldGeo& g, const std::string& where) {
 
 }  // namespace detail
 
+/// Pixels under `a` of a raster in the field frame (see Field) with `rows` rows at `gsd_cm`,
+/// edges rounded to the nearest pixel boundary, so that areas sharing an edge share it in
+/// pixels too (no gaps, no overlaps). May extend beyond the raster. Coordinates are clamped to
+/// +-2^29 px so that absurd areas cannot overflow `int` (they would wrap and miss the raster);
+/// the rectangle still covers everything it should.
+[[nodiscard]] inline cv::Rect raster_rect(const Area& a, double gsd_cm, int rows) {
+  const double s = 100.0 / gsd_cm;
+  const auto px = [](double v) {
+    constexpr double kLimit = 536870912.0;
+    return static_cast<int>(std::lround(std::clamp(v, -kLimit, kLimit)));
+  };
+  const int c0 = px(a.x_min_m * s);
+  const int c1 = px(a.x_max_m * s);
+  const int r0 = px(rows - a.y_max_m * s);
+  const int r1 = px(rows - a.y_min_m * s);
+  return {c0, r0, c1 - c0, r1 - r0};
+}
+
 /// Fraction rectangle of a field along the image axes: `x` along columns (left to right),
 /// `y` along rows (top to bottom), each in [0, 1]. `{0, 0, 0.5, 1}` is the left half.
 struct FieldRegion {
@@ -145,23 +163,9 @@ class Field {
     return {0.0, 0.0, width_px() * gsd_cm_ / 100.0, height_px() * gsd_cm_ / 100.0};
   }
 
-  /// Orthomosaic pixels under `a`, edges rounded to the nearest pixel boundary, so that
-  /// areas sharing an edge share it in pixels too (no gaps, no overlaps). May extend
-  /// beyond the orthomosaic.
-  [[nodiscard]] cv::Rect pixel_rect(const Area& a) const {
-    const double s = 100.0 / gsd_cm_;
-    // Clamped to +-2^29 px so that absurd areas cannot overflow `int` (they would wrap and
-    // miss the field); the rectangle still covers everything it should.
-    const auto px = [](double v) {
-      constexpr double kLimit = 536870912.0;
-      return static_cast<int>(std::lround(std::clamp(v, -kLimit, kLimit)));
-    };
-    const int c0 = px(a.x_min_m * s);
-    const int c1 = px(a.x_max_m * s);
-    const int r0 = px(height_px() - a.y_max_m * s);
-    const int r1 = px(height_px() - a.y_min_m * s);
-    return {c0, r0, c1 - c0, r1 - r0};
-  }
+  /// Orthomosaic pixels under `a` (raster_rect: edges on pixel boundaries, may extend beyond
+  /// the orthomosaic, clamped against overflow).
+  [[nodiscard]] cv::Rect pixel_rect(const Area& a) const { return raster_rect(a, gsd_cm_, height_px()); }
 
   /// Number of valid (non-ignore) pixels under `a` (the part of `a` outside the raster has none).
   [[nodiscard]] int valid_pixels(const Area& a) const {
