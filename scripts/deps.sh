@@ -2,7 +2,8 @@
 # Installs the Debian packages adaptseg needs, or says which are missing.
 #   scripts/deps.sh build   compiler, CMake and the C++ libraries (library, examples, tests)
 #   scripts/deps.sh test    build + what the test suite runs (Python for the data converters,
-#                           GDAL's ogrinfo to read the exported GeoJSON)
+#                           GDAL's ogrinfo to read the exported GeoJSON, doxygen for docs:doxygen)
+#   scripts/deps.sh docs    doxygen, for the API reference (scripts/docs.sh)
 #   scripts/deps.sh bench   test + what the benchmarks compare against (scikit-learn)
 #   scripts/deps.sh plots   build + matplotlib for the evaluation figures
 #   scripts/deps.sh fuzz    build + clang with libFuzzer (scripts/fuzz.sh)
@@ -16,12 +17,13 @@ build=(cmake g++ make pkg-config libeigen3-dev libopencv-dev doctest-dev liblbfg
 python=(python3 python3-numpy python3-opencv python3-yaml python3-pil)
 case "${1:-build}" in
   build) want=("${build[@]}") ;;
-  test) want=("${build[@]}" "${python[@]}" gdal-bin) ;;
-  bench) want=("${build[@]}" "${python[@]}" gdal-bin python3-sklearn python3-torch) ;;
+  test) want=("${build[@]}" "${python[@]}" gdal-bin doxygen) ;;
+  docs) want=(doxygen) ;;
+  bench) want=("${build[@]}" "${python[@]}" gdal-bin doxygen python3-sklearn python3-torch) ;;
   plots) want=("${build[@]}" "${python[@]}" python3-matplotlib) ;;
   # clang: the compiler; libclang-rt-14-dev: libFuzzer and the sanitizer runtimes for it.
   fuzz) want=("${build[@]}" clang libclang-rt-14-dev) ;;
-  *) echo "usage: $0 [build|test|bench|plots|fuzz]" >&2; exit 2 ;;
+  *) echo "usage: $0 [build|test|docs|bench|plots|fuzz]" >&2; exit 2 ;;
 esac
 
 missing=()

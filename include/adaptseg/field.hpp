@@ -102,8 +102,13 @@ struct FieldRegion {
 /// A Field is immutable; copies are cheap (the cv::Mat buffers are shared).
 class Field {
  public:
+  /// @param name field name (reports, figures).
+  /// @param gsd_cm ground sampling distance of `labels` (and `image`) [cm/px], > 0.
   /// @param labels 8-bit single-channel class indices; `ignore_label` marks pixels outside
   ///        the field or unlabelled.
+  /// @param classes the classes, index order (names unique and non-empty).
+  /// @param interest class indices of the labels of interest L.
+  /// @param ignore_label label value of "no class" (0..255, not a class index).
   /// @param image optional 8-bit 3-channel BGR image of the same size (empty if none).
   /// @throws std::invalid_argument for an empty/mistyped label map, a GSD that is not
   ///         positive, no classes, duplicate or empty class names, an ignore label that is

@@ -786,6 +786,7 @@ class GaussianProcess {
   /// the hyperparameters, and factorises. O(n^3) per LML evaluation.
   /// @param x n x D inputs, one sample per row, n >= 1, finite.
   /// @param y n targets [output units], finite.
+  /// @param fit_options whether and how to optimise the hyperparameters (validated).
   /// @throws std::invalid_argument on bad input or options; NumericalError if K_XX cannot be
   ///         factorised even with jitter at every hyperparameter tried.
   FitSummary fit(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y,
