@@ -16,7 +16,7 @@ TEST_CASE("camera: GSD follows 100 h S_w / (f I_w) for the default camera") {
   CHECK(cam.altitude_m(3.0) == doctest::Approx(16.5).epsilon(1e-12));
 }
 
-TEST_CASE("camera: altitude and GSD are inverse; footprint scales with altitude") {
+TEST_CASE("camera: altitude and GSD are inverse, and the footprint scales with altitude") {
   const CameraModel cam({.image_width_px = 640, .image_height_px = 480, .sensor_width_mm = 6.17,
                          .focal_length_mm = 4.5});
   for (double h : {1.0, 7.3, 30.0, 120.0}) {

@@ -25,7 +25,7 @@ TEST_CASE("timing: velocity ramp below and above the cruise distance v^2/a") {
   }
 }
 
-TEST_CASE("timing: 3-D segments include altitude changes; paths add segments") {
+TEST_CASE("timing: 3-D segments include altitude changes, and paths add segments") {
   const TimingModel t;
   const Eigen::Vector3d a(0, 0, 10), b(3, 4, 10), c(3, 4, 22);
   CHECK(t.segment_time_s(a, b) == doctest::Approx(t.segment_time_s(5.0)));
