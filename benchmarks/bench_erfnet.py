@@ -20,7 +20,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import statistics
 import subprocess
 import sys
@@ -34,6 +33,7 @@ import yaml
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "examples" / "tools"))
 import train_erfnet as te  # noqa: E402
+from bench_common import cpu_model  # noqa: E402
 
 
 def conv_flops(model: torch.nn.Module, x: torch.Tensor) -> tuple[int, list]:
@@ -77,17 +77,6 @@ def time_opencv(binary: str, model_dir: Path, threads: int, iters: int, warmup: 
     if res.returncode != 0:
         raise SystemExit(f"{' '.join(cmd)} failed:\n{res.stderr}")
     return json.loads(res.stdout)
-
-
-def cpu_model() -> str:
-    try:
-        out = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
-        for line in out.splitlines():
-            if line.startswith("Model name:"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
 
 
 def main():

@@ -40,6 +40,8 @@ from sklearn.exceptions import ConvergenceWarning
 from sklearn.gaussian_process import GaussianProcessRegressor
 from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
 
+from bench_common import cpu_model
+
 BOUNDS = {"sf2": (1e-5, 1e5), "ls": (1e-5, 1e5), "sn2": (1e-5, 1e5)}
 INIT = {"sf2": 1.0, "ls": 1.0, "sn2": 0.1}
 
@@ -121,17 +123,6 @@ def blas_description():
         return ("threadpoolctl finds no BLAS pool: numpy/scipy use an unmanaged BLAS "
                 "(here: the reference netlib libblas3, single-threaded); pools: " + ", ".join(others))
     return ", ".join(others)
-
-
-def cpu_model():
-    try:
-        out = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
-        for line in out.splitlines():
-            if line.startswith("Model name:"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
 
 
 def main():
