@@ -338,7 +338,7 @@ class DecisionFunction {
     std::vector<double> field_gain;
     for (std::size_t k = 0; k < c.candidates.size(); ++k) {
       CandidateScore s = score(c, c.candidates[k]);
-      const double g = -s.predicted_delta_miou + params_.exploration * s.predicted_delta_miou_std;
+      const double g = unweighted_gain(s);
       field_gain.push_back(g * weight);
       s.predicted_front_margin =
           front_margin(curve, t_end + c.candidates[k].extra_time_s, *forecast_miou_ + field_gain.back());
@@ -356,8 +356,13 @@ class DecisionFunction {
     return d;
   }
 
+  /// G = −ΔmIoU + κ·sd_I (see the class comment).
+  [[nodiscard]] double unweighted_gain(const CandidateScore& s) const {
+    return -s.predicted_delta_miou + params_.exploration * s.predicted_delta_miou_std;
+  }
+  /// G, weighted by σ · valid fraction if `weight_by_sigma` (the paper's rule).
   [[nodiscard]] double gain_of(const CandidateScore& s, const DecisionContext& c) const {
-    const double g = -s.predicted_delta_miou + params_.exploration * s.predicted_delta_miou_std;
+    const double g = unweighted_gain(s);
     return params_.weight_by_sigma ? g * c.sigma * c.valid_fraction : g;
   }
   static std::string fmt(double v) {
