@@ -22,8 +22,7 @@ int main(int argc, char** argv) {
   double top_factor = 3.0;
   std::vector<double> candidate_factors{1.0, 1.5, 2.0, 2.5};
   std::vector<double> lawnmower_factors{1.0, 1.5, 2.0, 2.5, 3.0};
-  int steps = 10;
-  std::string rule = "front-aware";
+  adaptseg::examples::CalibrationCli calibration;
   adaptseg::examples::CommonOptions common;
   adaptseg::examples::SegmenterOptions segmenter;  // the backend the missions will use
   app.add_option("--field", field_dir, "training field directory (with ground truth)")->required();
@@ -37,12 +36,7 @@ int main(int argc, char** argv) {
                  "GSDs of the training lawnmower curve, multiples of the field's GSD")
       ->delimiter(',')
       ->capture_default_str();
-  app.add_option("--rule", rule,
-                 "decision rule: front-aware (descend while descents beat the lawnmower curve; no threshold) or "
-                 "threshold (the paper's utility with the threshold calibrated on the training field)")
-      ->check(CLI::IsMember({"front-aware", "threshold"}))
-      ->capture_default_str();
-  app.add_option("--threshold-steps", steps, "utility thresholds tried per weighting")->capture_default_str();
+  calibration.add_to(app);
   common.add_to(app);
   segmenter.add_to(app);
   CLI11_PARSE(app, argc, argv);
@@ -58,8 +52,7 @@ int main(int argc, char** argv) {
     options.adaptive.top_gsd_cm = top_factor * g0;
     for (double f : candidate_factors) options.adaptive.candidate_gsd_cm.push_back(f * g0);
     for (double f : lawnmower_factors) options.lawnmower_gsd_cm.push_back(f * g0);
-    options.threshold_steps = steps;
-    options.front_aware = rule == "front-aware";
+    calibration.apply(options);
     std::fprintf(stderr, "calibrating on %s (%dx%d px, %.2f cm/px) with %s ...\n", field.name().c_str(),
                  field.width_px(), field.height_px(), g0, segmenter.name.c_str());
     const auto [cal, model] = segmenter.with_backend(field, mission.camera, [&](auto& backend) {

@@ -46,8 +46,7 @@ int main(int argc, char** argv) {
   std::vector<double> lawnmower_factors{1.0, 1.5, 2.0, 2.5, 3.0};
   std::optional<double> budget_s;
   bool no_plots = false;
-  int steps = 10;
-  std::string rule = "front-aware";
+  adaptseg::examples::CalibrationCli calibration;
   adaptseg::examples::CommonOptions common;
   adaptseg::examples::SegmenterOptions segmenter;
   app.add_option("--train", train_spec, "training field DIR[:x0,y0,x1,y1] (decision-function initialisation)");
@@ -58,12 +57,7 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->capture_default_str();
   app.add_option("--budget-s", budget_s, "mission-time budget [s] for the adaptive strategies");
-  app.add_option("--rule", rule,
-                 "decision rule: front-aware (descend while descents beat the lawnmower curve; no threshold) or "
-                 "threshold (the paper's utility with the threshold calibrated on the training field)")
-      ->check(CLI::IsMember({"front-aware", "threshold"}))
-      ->capture_default_str();
-  app.add_option("--threshold-steps", steps, "utility thresholds tried in calibration")->capture_default_str();
+  calibration.add_to(app);
   app.add_flag("--no-plots", no_plots, "do not run the plotting script");
   common.add_to(app);
   segmenter.add_to(app);
@@ -97,8 +91,7 @@ int main(int argc, char** argv) {
       co.adaptive.top_gsd_cm = lawnmower_factors.back() * g0;
       for (std::size_t k = 0; k + 1 < lawnmower_factors.size(); ++k) co.adaptive.candidate_gsd_cm.push_back(lawnmower_factors[k] * g0);
       for (double f : lawnmower_factors) co.lawnmower_gsd_cm.push_back(f * g0);
-      co.threshold_steps = steps;
-      co.front_aware = rule == "front-aware";
+      calibration.apply(co);
       std::fprintf(stderr, "[%6.1f s] calibrating on %s ...\n", elapsed(), train.name().c_str());
       const auto cal = segmenter.with_backend(train, co.adaptive.mission.camera, [&](auto& backend) {
         adaptseg::CalibrationResult c = adaptseg::examples::calibrate_cached(train, backend, co);

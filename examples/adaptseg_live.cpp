@@ -205,6 +205,7 @@ adaptseg::AdaptiveOptions model_options(const adaptseg::DecisionModel& model, st
   o.mission.interest = std::move(interest);
   o.top_gsd_cm = model.top_gsd_cm;
   o.candidate_gsd_cm = model.candidate_gsd_cm;
+  o.coverage = model.coverage;
   return o;
 }
 

@@ -94,6 +94,44 @@ TEST_CASE("adaptive planner: a candidate's extra time is exactly what the descen
   }
 }
 
+namespace {
+// Two top-level regions (3.0 cm/px over 2880 x 1080 px at 1 cm/px) and one crop patch in the
+// first region's top-left sub-cell (at 1.0 cm/px a region is 3 x 3 sub-cells of 480 x 360 px).
+Field patch_field() {
+  cv::Mat labels(1080, 2880, CV_8UC1, cv::Scalar(0));
+  labels(cv::Rect(50, 50, 100, 100)).setTo(1);
+  return Field("patch", 1.0, labels, t::soil_crop_weed(), {1, 2});
+}
+}  // namespace
+
+TEST_CASE("adaptive planner: coverage 'interest' re-maps only the sub-cells that show a label of interest") {
+  const Field f = patch_field();
+  OracleSegmenter oracle(f.num_classes());
+  AdaptiveOptions o = options();
+  o.candidate_gsd_cm = {1.0};
+  Scripted all{.gsd = 1.0};
+  const AdaptiveResult region = run_adaptive_mission(f, oracle, all, o, "region");
+  o.coverage = DescentCoverage::interest;
+  Scripted all_focused{.gsd = 1.0};
+  const AdaptiveResult focused = run_adaptive_mission(f, oracle, all_focused, o, "interest");
+  REQUIRE(region.decisions.size() == 2);
+  REQUIRE(focused.decisions.size() == 2);
+  CHECK(region.descents() == 2);
+  CHECK(focused.descents() == 1);  // the region without crop offers no descent at all
+  int offered = 0;
+  for (const auto& d : focused.decisions)
+    for (const auto& c : d.candidates) {
+      CHECK(c.images == 1);  // the patch's sub-cell only (a region needs 9)
+      ++offered;
+    }
+  CHECK(offered == 1);
+  // The patch is mapped exactly either way; the focused mission is shorter.
+  CHECK(region.mission.miou_interest().value() == 1.0);
+  CHECK(focused.mission.miou_interest().value() == 1.0);
+  CHECK(focused.mission.total_s() < region.mission.total_s());
+  CHECK(focused.mission.waypoints.size() == 2 + 1);
+}
+
 TEST_CASE("adaptive planner: the budget is never exceeded and the top level is always covered") {
   const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
   OracleSegmenter oracle(f.num_classes());

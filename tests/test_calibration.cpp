@@ -43,6 +43,26 @@ TEST_CASE("calibration: region samples pair every region with every candidate") 
   CHECK_THROWS_AS((void)collect_region_samples(f, oracle, CameraModel{}, 3.0, {1.0}, {}), std::invalid_argument);
 }
 
+TEST_CASE("calibration: with coverage 'interest' a sample re-maps the cells that show a label of interest") {
+  // Two regions, one crop patch in the first (as tests/test_adaptive_planner.cpp's patch field).
+  cv::Mat labels(1080, 2880, CV_8UC1, cv::Scalar(0));
+  labels(cv::Rect(50, 50, 100, 100)).setTo(1);
+  const Field f("patch", 1.0, labels, t::soil_crop_weed(), {1, 2});
+  OracleSegmenter oracle(f.num_classes());
+  const auto all = collect_region_samples(f, oracle, CameraModel{}, 3.0, {1.0, 2.0}, f.interest());
+  const auto focused =
+      collect_region_samples(f, oracle, CameraModel{}, 3.0, {1.0, 2.0}, f.interest(), DescentCoverage::interest);
+  CHECK(all.size() == 4);
+  REQUIRE(focused.size() == 2);  // the region without crop has no cell to re-map
+  for (const auto& s : focused) {
+    CHECK(s.sigma_top > 0.0);
+    // The cells not re-mapped keep their (correct) top-level soil: only the patch's edges
+    // could be wrong, and at the field's GSD they are not.
+    if (s.sub_gsd_cm == 1.0) CHECK(s.miou_sub == 1.0);
+    CHECK(s.miou_sub >= s.miou_top);
+  }
+}
+
 TEST_CASE("calibration: the chosen thresholds never fall below the training lawnmower curve") {
   const Field f = t::blob_field(2600, 2000, 1.0, 4, 30);
   OracleSegmenter oracle(f.num_classes());
@@ -117,7 +137,22 @@ TEST_CASE("decision model: file round trip and compatibility checks") {
   CHECK(back.linear.sigma_high == m.linear.sigma_high);
   CHECK(back.decision_function.params().min_utility == doctest::Approx(1e-3));
   CHECK(back.decision_function.o_model().size() == m.decision_function.o_model().size());
+  CHECK(back.coverage == DescentCoverage::region);
   back.check_compatible(f, {1, 2});
+  {  // coverage is kept; a file without the key (written before it existed) is "region"
+    DecisionModel focused = m;
+    focused.coverage = DescentCoverage::interest;
+    focused.save(tmp.path() / "focused.yaml");
+    CHECK(DecisionModel::load(tmp.path() / "focused.yaml").coverage == DescentCoverage::interest);
+    std::string text = t::read_file(tmp.path() / "focused.yaml");
+    const auto at = text.find("descent_coverage: interest\n");
+    REQUIRE(at != std::string::npos);
+    t::write_file(tmp.path() / "old.yaml", std::string(text).erase(at, std::string("descent_coverage: interest\n").size()));
+    CHECK(DecisionModel::load(tmp.path() / "old.yaml").coverage == DescentCoverage::region);
+    t::write_file(tmp.path() / "bad.yaml", std::string(text).replace(at, 26, "descent_coverage: everywhere"));
+    CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "bad.yaml"), doctest::Contains("'region' or 'interest'"),
+                         std::invalid_argument);
+  }
   CHECK_THROWS_WITH_AS(back.check_compatible(f, {2}), doctest::Contains("labels of interest"), std::invalid_argument);
   const Field other("o", 1.0, f.labels(), {{"a", {0, 0, 0}}, {"b", {1, 1, 1}}, {"c", {2, 2, 2}}}, {1});
   CHECK_THROWS_WITH_AS(back.check_compatible(other, {1}), doctest::Contains("classes"), std::invalid_argument);

@@ -204,20 +204,84 @@ TEST_CASE("decision function: the front-aware rule descends while descents beat 
   CHECK(back.decide(ctx).gsd_cm == first.gsd_cm);
 }
 
-TEST_CASE("decision function: files of format version 1 still load") {
-  const auto df = DecisionFunction::initialize(samples(), {.min_utility = 1e-4});
+namespace {
+// The text a version 1 or 2 file had for `df` (saved as version 3): the old version number,
+// and I's kernel under its old name (those versions had the isotropic kernel type for I).
+std::string old_format_text(const DecisionFunction& df, int version) {
   std::stringstream ss;
   df.save(ss);
   std::string text = ss.str();
-  // Version 1 had no front_aware and no reference_lawnmower lines.
-  text.replace(text.find(" 2\n"), 3, " 1\n");
-  const auto a = text.find("front_aware");
-  text.erase(a, text.find("reference_lawnmower 0\n") + std::string("reference_lawnmower 0\n").size() - a);
-  std::istringstream v1(text);
-  const auto back = DecisionFunction::load(v1);
-  CHECK_FALSE(back.params().front_aware);
-  CHECK(back.params().min_utility == 1e-4);
-  CHECK(back.reference_lawnmower().empty());
+  text.replace(text.find("adaptseg.decision_function 3\n"), 29, "adaptseg.decision_function " + std::to_string(version) + "\n");
+  const std::string ard = "kernel squared_exponential_ard\n";
+  const auto i_kernel = text.find(ard, text.find(ard) + 1);  // the second GP is I
+  REQUIRE(i_kernel != std::string::npos);
+  text.replace(i_kernel, ard.size(), "kernel squared_exponential_isotropic\n");
+  if (version == 1) {  // version 1 had no front_aware and no reference_lawnmower lines
+    const auto a = text.find("front_aware");
+    const std::string ref = "reference_lawnmower 0\n";
+    text.erase(a, text.find(ref) + ref.size() - a);
+  }
+  return text;
+}
+}  // namespace
+
+TEST_CASE("decision function: files of format versions 1 and 2 still load, with the same predictions") {
+  const auto df = DecisionFunction::initialize(samples(), {.min_utility = 1e-4});
+  const auto c = candidates();
+  DecisionContext ctx{.sigma = 0.2, .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5, .candidates = c};
+  for (int version : {1, 2}) {
+    CAPTURE(version);
+    std::istringstream old(old_format_text(df, version));
+    const auto back = DecisionFunction::load(old);
+    CHECK_FALSE(back.params().front_aware);
+    CHECK(back.params().min_utility == 1e-4);
+    CHECK(back.reference_lawnmower().empty());
+    CHECK(back.gain_inputs() == DecisionFunction::GainInputs::delta_sigma);
+    for (const auto& cand : c)
+      CHECK(back.score(ctx, cand).predicted_delta_miou == doctest::Approx(df.score(ctx, cand).predicted_delta_miou).epsilon(1e-12));
+  }
+  // An old file whose I block is cut off says so.
+  std::string cut = old_format_text(df, 2);
+  cut.erase(cut.rfind("end adaptseg.gaussian_process"));
+  std::istringstream truncated(cut);
+  CHECK_THROWS_AS((void)DecisionFunction::load(truncated), std::invalid_argument);
+}
+
+TEST_CASE("decision function: I on (delta sigma, delta h) tells candidate altitudes apart where delta sigma cannot") {
+  // What an oracle backend gives: σ does not change with altitude (Δσ = 0), while the
+  // accuracy gain grows with the descent.
+  std::vector<RegionSample> flat;
+  for (double dh : {2.75, 5.5, 8.25, 11.0})
+    for (double sigma : {0.05, 0.1, 0.2, 0.3}) {
+      RegionSample s;
+      s.top_gsd_cm = 3.0;
+      s.delta_h_m = dh;
+      s.sigma_top = sigma;
+      s.sigma_sub = sigma;
+      s.miou_top = 0.8;
+      s.miou_sub = 0.8 + 0.015 * dh;
+      flat.push_back(s);
+    }
+  const auto c = candidates();
+  DecisionContext ctx{.sigma = 0.2, .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5, .candidates = c};
+  const auto paper = DecisionFunction::initialize(flat, {});
+  CHECK(paper.gain_inputs() == DecisionFunction::GainInputs::delta_sigma);
+  CHECK(paper.score(ctx, c[0]).predicted_delta_miou ==
+        doctest::Approx(paper.score(ctx, c[3]).predicted_delta_miou).epsilon(1e-9));  // blind to Δh
+  const auto by_height =
+      DecisionFunction::initialize(flat, {}, 3, 0, DecisionFunction::GainInputs::delta_sigma_and_height);
+  CHECK(by_height.gain_inputs() == DecisionFunction::GainInputs::delta_sigma_and_height);
+  CHECK(by_height.i_model().dimension() == 2);
+  CHECK(by_height.score(ctx, c[0]).predicted_delta_miou == doctest::Approx(-0.165).epsilon(0.05));  // Δh = 11 m
+  CHECK(by_height.score(ctx, c[3]).predicted_delta_miou == doctest::Approx(-0.041).epsilon(0.1));   // Δh = 2.75 m
+  // Saved as version 3 and read back: the same predictions.
+  std::stringstream ss;
+  by_height.save(ss);
+  CHECK(ss.str().rfind("adaptseg.decision_function 3\n", 0) == 0);
+  const auto back = DecisionFunction::load(ss);
+  CHECK(back.i_model().dimension() == 2);
+  CHECK(back.score(ctx, c[1]).predicted_delta_miou ==
+        doctest::Approx(by_height.score(ctx, c[1]).predicted_delta_miou).epsilon(1e-12));
 }
 
 TEST_CASE("linear decision: altitude falls linearly with σ to the nearest candidate") {

@@ -84,6 +84,44 @@ struct CommonOptions {
   }
 };
 
+/// Calibration choices shared by adaptseg_calibrate and adaptseg_evaluate: the decision rule,
+/// the thresholds tried, and what a descent re-maps.
+struct CalibrationCli {
+  std::string rule = "front-aware";
+  int threshold_steps = 10;
+  std::string coverage = "interest";
+  std::string gain_inputs = "delta-sigma-height";
+
+  void add_to(CLI::App& app) {
+    app.add_option("--rule", rule,
+                   "decision rule: front-aware (descend while descents beat the lawnmower curve; no threshold) or "
+                   "threshold (the paper's utility with the threshold calibrated on the training field)")
+        ->check(CLI::IsMember({"front-aware", "threshold"}))
+        ->capture_default_str();
+    app.add_option("--threshold-steps", threshold_steps, "utility thresholds tried per weighting")
+        ->capture_default_str();
+    app.add_option("--coverage", coverage,
+                   "what a descent re-maps: region (the whole top-level footprint, the paper's) or interest (only "
+                   "the cells where the top-level image shows a label of interest); saved in the model")
+        ->check(CLI::IsMember({"region", "interest"}))
+        ->capture_default_str();
+    app.add_option("--gain-inputs", gain_inputs,
+                   "what the GP I predicts the accuracy gain from: delta-sigma (the paper's) or delta-sigma-height "
+                   "(the change of semantic ratio and of altitude)")
+        ->check(CLI::IsMember({"delta-sigma", "delta-sigma-height"}))
+        ->capture_default_str();
+  }
+
+  /// Sets the rule, the threshold steps and the coverage of `options`.
+  void apply(CalibrationOptions& options) const {
+    options.threshold_steps = threshold_steps;
+    options.front_aware = rule == "front-aware";
+    options.adaptive.coverage = parse_descent_coverage(coverage);
+    options.gain_inputs = gain_inputs == "delta-sigma-height" ? DecisionFunction::GainInputs::delta_sigma_and_height
+                                                              : DecisionFunction::GainInputs::delta_sigma;
+  }
+};
+
 inline nlohmann::json opt_json(const std::optional<double>& v) {
   return v && std::isfinite(*v) ? nlohmann::json(*v) : nlohmann::json(nullptr);
 }

@@ -83,7 +83,7 @@ StrategyRun run_strategy(const Field& field, Backend& backend, const std::string
   model->check_compatible(field, options.interest);
   options.camera = model->camera;
   options.timing = model->timing;
-  AdaptiveOptions ao{options, model->top_gsd_cm, model->candidate_gsd_cm, budget_s};
+  AdaptiveOptions ao{options, model->top_gsd_cm, model->candidate_gsd_cm, budget_s, model->coverage};
   if (strategy == "linear") {
     LinearDecision policy(model->linear);
     auto r = run_adaptive_mission(field, backend, policy, ao, policy.name());

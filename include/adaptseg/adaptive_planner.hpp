@@ -46,6 +46,9 @@ struct AdaptiveOptions {
   /// segmentation and planning times; with measured times the remaining work is estimated
   /// from the slowest image so far plus 25 %.
   std::optional<double> budget_s{};
+  /// What a descent re-maps: the whole region (the paper) or only its cells that show a label
+  /// of interest (DescentCoverage). A decision model must be calibrated with the same.
+  DescentCoverage coverage = DescentCoverage::region;
 };
 
 /// The decision taken at one top-level waypoint.
@@ -310,6 +313,26 @@ class AdaptivePlanner {
                                           keep());
   }
 
+  /// The sub-lawnmower a descent at top-level waypoint `top_index` flies at `gsd_cm` once the
+  /// region's top-level image is fused: sub_plan() with `options().coverage` applied
+  /// (DescentCoverage::interest: only the cells whose ground, grown by one top-level pixel and
+  /// clipped to the region, shows a label of interest in the map; visiting order unchanged).
+  /// @throws std::invalid_argument as sub_plan().
+  [[nodiscard]] std::vector<Waypoint> descent_plan(std::size_t top_index, double gsd_cm) const {
+    if (options_.coverage == DescentCoverage::region) return sub_plan(top_index, gsd_cm);
+    detail::require(top_index < top_.size(), "AdaptivePlanner::descent_plan: top_index out of range", top_index);
+    const Waypoint& t = top_[top_index];
+    const cv::Rect region = pixel_rect(t.footprint) & grid();
+    const cv::Mat labels = map_.labels()(region);
+    const int margin = static_cast<int>(std::ceil(options_.top_gsd_cm / area_.map_gsd_cm - 1e-9));
+    const auto keep_cell = [&](const Area& a) {
+      return valid_pixels(a) > 0 &&
+             shows_interest(labels, pixel_rect(a) - region.tl(), margin, options_.mission.interest);
+    };
+    return LawnmowerPlanner(camera_).plan(t.footprint, gsd_cm, Eigen::Vector2d(t.position.x(), t.position.y()),
+                                          keep_cell);
+  }
+
   /// The top-level lawnmower W^{h_max}.
   [[nodiscard]] const std::vector<Waypoint>& top_level() const noexcept { return top_; }
   /// The candidate GSDs a descent may fly [cm/px] (those not finer than the map).
@@ -454,7 +477,7 @@ class AdaptivePlanner {
     const double elapsed = elapsed_s();
     std::vector<std::vector<Waypoint>> sub_plans;
     for (double g : candidates_) {
-      auto sub = sub_plan(i, g);
+      auto sub = descent_plan(i, g);
       if (sub.empty()) continue;
       double flight = timing_.segment_time_s(here, sub.front().position);
       for (std::size_t k = 1; k < sub.size(); ++k) flight += timing_.segment_time_s(sub[k - 1].position, sub[k].position);

@@ -36,6 +36,11 @@ struct CalibrationOptions {
   /// paper's utility rule. The trials are flown and reported either way. `base.weight_by_sigma`
   /// selects its σ weighting.
   bool front_aware = true;
+  /// What I predicts the accuracy gain from (DecisionFunction::GainInputs); (Δσ, Δh) by
+  /// default, which reduces to the paper's chain where Δσ carries the information (see
+  /// docs/method.md). What a descent covers is `adaptive.coverage` (region by default, as
+  /// AdaptiveOptions; the example programs default to DescentCoverage::interest).
+  DecisionFunction::GainInputs gain_inputs = DecisionFunction::GainInputs::delta_sigma_and_height;
 };
 
 /// One threshold setting tried on the training field.
@@ -80,7 +85,7 @@ template <SegmentationBackend Backend>
   detail::require(!interest.empty(), "calibrate: no labels of interest", 0);
   const CameraModel camera(options.adaptive.mission.camera);
   auto samples = collect_region_samples(train, backend, camera, options.adaptive.top_gsd_cm,
-                                        options.adaptive.candidate_gsd_cm, interest);
+                                        options.adaptive.candidate_gsd_cm, interest, options.adaptive.coverage);
   detail::require(!samples.empty(), "calibrate: the training field gave no region sample", train.name());
 
   // Calibration layouts: the field, and (robust) its halves across the longer axis.
@@ -103,7 +108,7 @@ template <SegmentationBackend Backend>
   DecisionFunction::Params probe = options.base;
   probe.min_sigma = 0.0;
   probe.min_utility = -std::numeric_limits<double>::max();
-  DecisionFunction fitted = DecisionFunction::initialize(samples, probe, options.restarts);
+  DecisionFunction fitted = DecisionFunction::initialize(samples, probe, options.restarts, 0, options.gain_inputs);
   std::vector<GsdPoint> reference;  // the training lawnmower by GSD, for the front-aware rule
   for (std::size_t k = 0; k < curve.size(); ++k) reference.push_back({options.lawnmower_gsd_cm[k], curve[k].miou});
   fitted.set_reference_lawnmower(reference);
@@ -207,6 +212,7 @@ template <SegmentationBackend Backend>
                   .timing = options.adaptive.mission.timing,
                   .top_gsd_cm = options.adaptive.top_gsd_cm,
                   .candidate_gsd_cm = options.adaptive.candidate_gsd_cm,
+                  .coverage = options.adaptive.coverage,
                   .decision_function = calibration.decision_function,
                   .linear = calibration.linear,
                   .samples = calibration.samples.size(),

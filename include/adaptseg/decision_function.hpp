@@ -30,8 +30,12 @@ namespace adaptseg {
 /// - O (paper Eq. `eq:veg2h`, left): a GP of Δσ = σ_{h_max} − σ_{h'} on the inputs
 ///   (Δh = h_max − h' [m], σ_{h_max}); the current image's σ is the only thing the UAV knows
 ///   when it decides, so it is an input (method.md §4). ARD squared-exponential kernel.
-/// - I (Eq. `eq:veg2h`, right): a GP of ΔmIoU = mIoU_{h_max} − mIoU_{h'} on Δσ. Fixed after
-///   initialisation (it needs ground truth).
+/// - I (Eq. `eq:veg2h`, right): a GP of ΔmIoU = mIoU_{h_max} − mIoU_{h'} on Δσ (the paper's,
+///   GainInputs::delta_sigma), or on (Δσ, Δh) (GainInputs::delta_sigma_and_height, beyond the
+///   paper: where the backend keeps σ nearly unchanged across altitudes, e.g. a ground-truth
+///   oracle, Δσ alone predicts the same gain for every candidate altitude, so the cheapest
+///   descent always looks best; Δh tells I how much finer the re-mapping is). Fixed after
+///   initialisation (it needs ground truth). ARD kernel.
 /// - Decision at σ, for each affordable candidate h' with exact extra time T(h'):
 ///   `ΔmIoU(h') = μ_I(μ_O(Δh', σ))`, gain `G = −ΔmIoU + κ·sd_I` (κ = `exploration`: optimism
 ///   under uncertainty), weighted if `weight_by_sigma` by the image's share of labels of
@@ -65,7 +69,13 @@ namespace adaptseg {
 class DecisionFunction {
  public:
   using OModel = GaussianProcess<ArdSquaredExponentialKernel>;
-  using IModel = GaussianProcess<SquaredExponentialKernel>;
+  using IModel = GaussianProcess<ArdSquaredExponentialKernel>;
+
+  /// The inputs of I (see the class comment).
+  enum class GainInputs {
+    delta_sigma,             ///< ΔmIoU from Δσ (the paper's Eq. `eq:veg2h`)
+    delta_sigma_and_height,  ///< ΔmIoU from (Δσ, Δh)
+  };
 
   /// Thresholds and behaviour; validated by the constructor.
   struct Params {
@@ -94,13 +104,16 @@ class DecisionFunction {
   };
 
   /// @throws std::invalid_argument for invalid params or models of the wrong input
-  ///         dimension (O: 2, I: 1) or without data.
+  ///         dimension (O: 2; I: 1 for GainInputs::delta_sigma, 2 for delta_sigma_and_height)
+  ///         or without data.
   DecisionFunction(OModel o, IModel i, Params params) : o_(std::move(o)), i_(std::move(i)), params_(params) {
     params_.validate();
     detail::require(o_.size() > 0 && o_.dimension() == 2,
                     "DecisionFunction: O must hold data with 2 inputs (delta_h, sigma); dimension", o_.dimension());
-    detail::require(i_.size() > 0 && i_.dimension() == 1,
-                    "DecisionFunction: I must hold data with 1 input (delta_sigma); dimension", i_.dimension());
+    detail::require(i_.size() > 0 && (i_.dimension() == 1 || i_.dimension() == 2),
+                    "DecisionFunction: I must hold data with 1 input (delta_sigma) or 2 (delta_sigma, delta_h); "
+                    "dimension",
+                    i_.dimension());
   }
 
   /// Fits O and I to initialisation samples (hyperparameters by maximum marginal likelihood,
@@ -108,10 +121,12 @@ class DecisionFunction {
   /// @throws std::invalid_argument if there is no sample or a sample is not finite;
   ///         NumericalError if a GP cannot be factorised.
   [[nodiscard]] static DecisionFunction initialize(std::span<const RegionSample> samples, Params params,
-                                                   int restarts = 3, std::uint64_t seed = 0) {
+                                                   int restarts = 3, std::uint64_t seed = 0,
+                                                   GainInputs gain_inputs = GainInputs::delta_sigma) {
     detail::require(!samples.empty(), "DecisionFunction::initialize: number of samples must be > 0", 0);
     const auto n = static_cast<Eigen::Index>(samples.size());
-    Eigen::MatrixXd xo(n, 2), xi(n, 1);
+    const bool by_height = gain_inputs == GainInputs::delta_sigma_and_height;
+    Eigen::MatrixXd xo(n, 2), xi(n, by_height ? 2 : 1);
     Eigen::VectorXd yo(n), yi(n);
     for (Eigen::Index k = 0; k < n; ++k) {
       const RegionSample& s = samples[static_cast<std::size_t>(k)];
@@ -119,13 +134,14 @@ class DecisionFunction {
       xo(k, 1) = s.sigma_top;
       yo(k) = s.delta_sigma();
       xi(k, 0) = s.delta_sigma();
+      if (by_height) xi(k, 1) = s.delta_h_m;
       yi(k) = s.delta_miou();
     }
     ArdSquaredExponentialKernel::Bounds ob;
     ob.length_scale = {1e-2, 1e3};
     ob.signal_variance = {1e-4, 1e2};
     ob.noise_variance = {1e-8, 1e1};
-    SquaredExponentialKernel::Bounds ib;
+    ArdSquaredExponentialKernel::Bounds ib;
     ib.length_scale = {1e-3, 1e2};
     ib.signal_variance = {1e-4, 1e2};
     ib.noise_variance = {1e-8, 1e1};
@@ -135,7 +151,10 @@ class DecisionFunction {
     };
     OModel o(ArdSquaredExponentialKernel(Eigen::Vector2d(spread(xo.col(0)), spread(xo.col(1))), 1.0, 0.1, ob),
              {.normalize_y = true});
-    IModel i(SquaredExponentialKernel(std::clamp(spread(xi.col(0)), 1e-3, 1e2), 1.0, 0.1, ib), {.normalize_y = true});
+    Eigen::VectorXd il(xi.cols());
+    il(0) = std::clamp(spread(xi.col(0)), 1e-3, 1e2);
+    if (by_height) il(1) = spread(xi.col(1));
+    IModel i(ArdSquaredExponentialKernel(il, 1.0, 0.1, ib), {.normalize_y = true});
     (void)o.fit(xo, yo, {.restarts = restarts, .seed = seed});
     (void)i.fit(xi, yi, {.restarts = restarts, .seed = seed + 1});
     return DecisionFunction(std::move(o), std::move(i), params);
@@ -151,6 +170,10 @@ class DecisionFunction {
   }
   [[nodiscard]] const OModel& o_model() const noexcept { return o_; }
   [[nodiscard]] const IModel& i_model() const noexcept { return i_; }
+  /// What I predicts from (its input dimension).
+  [[nodiscard]] GainInputs gain_inputs() const noexcept {
+    return i_.dimension() == 2 ? GainInputs::delta_sigma_and_height : GainInputs::delta_sigma;
+  }
   [[nodiscard]] int online_updates() const noexcept { return updates_; }
 
   /// The training field's lawnmower mIoU by GSD, the front-aware rule's expectation of what a
@@ -169,9 +192,12 @@ class DecisionFunction {
     const double sigma = ctx.sigma;
     CandidateScore s;
     s.gsd_cm = c.gsd_cm;
-    Eigen::RowVector2d q(ctx.top_altitude_m - c.altitude_m, sigma);
-    s.predicted_delta_sigma = o_.predict_mean(q)(0);
-    const auto p = i_.predict(Eigen::MatrixXd::Constant(1, 1, s.predicted_delta_sigma));
+    const double delta_h = ctx.top_altitude_m - c.altitude_m;
+    s.predicted_delta_sigma = o_.predict_mean(Eigen::RowVector2d(delta_h, sigma))(0);
+    Eigen::MatrixXd qi(1, i_.dimension());
+    qi(0, 0) = s.predicted_delta_sigma;
+    if (qi.cols() == 2) qi(0, 1) = delta_h;
+    const auto p = i_.predict(qi);
     s.predicted_delta_miou = p.mean(0);
     s.predicted_delta_miou_std = std::sqrt(std::max(0.0, p.variance(0)));
     const double gain = gain_of(s, ctx);
@@ -232,7 +258,7 @@ class DecisionFunction {
 
   /// Writes params, O and I as text (embeddable; read back by `load`).
   void save(std::ostream& os) const {
-    os << "adaptseg.decision_function 2\n";
+    os << "adaptseg.decision_function 3\n";
     os << "min_sigma " << fmt(params_.min_sigma) << "\nmin_utility " << fmt(params_.min_utility)
        << "\nexploration " << fmt(params_.exploration) << "\nweight_by_sigma " << params_.weight_by_sigma
        << "\nonline " << params_.online << "\nrefit_every " << params_.refit_every
@@ -275,7 +301,8 @@ class DecisionFunction {
     };
     expect("adaptseg.decision_function");
     const std::string version = token("the format version");
-    detail::require(version == "1" || version == "2", "DecisionFunction::load: unsupported format version", version);
+    detail::require(version == "1" || version == "2" || version == "3",
+                    "DecisionFunction::load: unsupported format version", version);
     Params p;
     p.min_sigma = number("min_sigma");
     p.min_utility = number("min_utility");
@@ -288,7 +315,7 @@ class DecisionFunction {
     p.refit_every = static_cast<int>(refit_every);
     p.relative_utility = number("relative_utility") != 0.0;
     std::vector<GsdPoint> reference;
-    if (version == "2") {  // version 1 had neither
+    if (version != "1") {  // version 1 had neither
       p.front_aware = number("front_aware") != 0.0;
       const double n = number("reference_lawnmower");
       detail::require(n >= 0.0 && n <= 1000.0 && n == std::floor(n),
@@ -305,7 +332,7 @@ class DecisionFunction {
     is >> std::ws;
     OModel o = OModel::load(is);
     is >> std::ws;
-    IModel i = IModel::load(is);
+    IModel i = version == "3" ? IModel::load(is) : load_isotropic_i(is);
     expect("end");
     expect("adaptseg.decision_function");
     DecisionFunction df(std::move(o), std::move(i), p);
@@ -314,6 +341,29 @@ class DecisionFunction {
   }
 
  private:
+  /// Versions 1-2 stored I with the isotropic kernel, which for its one input is the ARD
+  /// kernel with one length scale (same parameters, same layout): the block is read up to its
+  /// `end` line and parsed as that.
+  static IModel load_isotropic_i(std::istream& is) {
+    std::string block, line;
+    bool ended = false;
+    while (std::getline(is, line)) {
+      if (line.rfind("kernel ", 0) == 0 && line == "kernel " + std::string(SquaredExponentialKernel::kName))
+        line = "kernel " + std::string(ArdSquaredExponentialKernel::kName);
+      block += line + '\n';
+      if (line.rfind("end ", 0) == 0) {
+        ended = true;
+        break;
+      }
+    }
+    detail::require(ended, "DecisionFunction::load: input ends inside I's Gaussian process", "<end of input>");
+    std::istringstream in(block);
+    IModel i = IModel::load(in);
+    detail::require(i.dimension() == 1, "DecisionFunction::load: I of a version 1-2 file must have 1 input; dimension",
+                    i.dimension());
+    return i;
+  }
+
   /// The front-aware rule (see the class comment).
   [[nodiscard]] Decision decide_front_aware(const DecisionContext& c) {
     detail::require(!c.lawnmowers.empty(),

@@ -7,6 +7,7 @@
 #include <adaptseg/camera.hpp>
 #include <adaptseg/decision_function.hpp>
 #include <adaptseg/field.hpp>
+#include <adaptseg/lawnmower_planner.hpp>
 #include <adaptseg/linear_decision.hpp>
 #include <adaptseg/timing.hpp>
 
@@ -31,6 +32,9 @@ struct DecisionModel {
   TimingParams timing{};
   double top_gsd_cm = 0.0;
   std::vector<double> candidate_gsd_cm;
+  /// What the model's descents re-map (its samples were taken so); files without the key
+  /// are `region`, the paper's.
+  DescentCoverage coverage = DescentCoverage::region;
   DecisionFunction decision_function;
   LinearDecision::Params linear{};
   std::size_t samples = 0;                ///< region samples the GPs were fitted to
@@ -74,6 +78,7 @@ struct DecisionModel {
       << YAML::Key << "max_accel_mps2" << YAML::Value << timing.max_accel_mps2 << YAML::EndMap;
     e << YAML::Key << "top_gsd_cm" << YAML::Value << top_gsd_cm;
     e << YAML::Key << "candidate_gsd_cm" << YAML::Value << YAML::Flow << candidate_gsd_cm;
+    e << YAML::Key << "descent_coverage" << YAML::Value << to_string(coverage);
     e << YAML::Key << "linear" << YAML::Value << YAML::Flow << YAML::BeginMap
       << YAML::Key << "sigma_low" << YAML::Value << linear.sigma_low
       << YAML::Key << "sigma_high" << YAML::Value << linear.sigma_high << YAML::EndMap;
@@ -118,6 +123,9 @@ struct DecisionModel {
                       .timing = {},
                       .top_gsd_cm = req("top_gsd_cm").as<double>(),
                       .candidate_gsd_cm = req("candidate_gsd_cm").as<std::vector<double>>(),
+                      .coverage = root["descent_coverage"]
+                                      ? parse_descent_coverage(root["descent_coverage"].as<std::string>())
+                                      : DescentCoverage::region,
                       .decision_function = DecisionFunction::load(df),
                       .linear = {},
                       .samples = req("samples").as<std::size_t>(),

@@ -11,6 +11,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace adaptseg {
@@ -37,6 +39,28 @@ struct Waypoint {
   double gsd_cm = 0.0;                                 ///< GSD of the image taken here [cm/px]
   Area footprint;                                      ///< ground seen from here [m]
 };
+
+/// What a descent's sub-lawnmower W^{h'} covers (AdaptiveOptions::coverage).
+/// - `region`: the whole top-level footprint (paper §3.2.1), cells without field skipped.
+/// - `interest` (beyond the paper): only the cells where the top-level image's segmentation
+///   shows a label of interest within one top-level pixel of the cell. For a spatially
+///   localised class the errors of the top-level map lie on the class's edges, so a descent
+///   that re-maps only those cells buys most of the gain for a fraction of the time. Cells
+///   where a small instance vanished at h_max are not re-mapped.
+enum class DescentCoverage { region, interest };
+
+/// The name used in files and on the command line: "region" or "interest".
+[[nodiscard]] inline const char* to_string(DescentCoverage c) noexcept {
+  return c == DescentCoverage::interest ? "interest" : "region";
+}
+
+/// Parses "region" or "interest".
+/// @throws std::invalid_argument for anything else.
+[[nodiscard]] inline DescentCoverage parse_descent_coverage(const std::string& s) {
+  if (s == "region") return DescentCoverage::region;
+  if (s == "interest") return DescentCoverage::interest;
+  throw std::invalid_argument("descent coverage must be 'region' or 'interest', not '" + s + "'");
+}
 
 /// Lawnmower coverage of a rectangle at one altitude: the rectangle is cut into a grid of
 /// camera footprints (ceil(width / footprint width) by ceil(height / footprint height)),

@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -17,6 +18,16 @@
 #include <vector>
 
 namespace adaptseg {
+
+namespace detail {
+/// lut[v] is true for the label values v in `labels` (values outside 0..255 are ignored).
+[[nodiscard]] inline std::array<bool, 256> label_lut(std::span<const int> labels) {
+  std::array<bool, 256> lut{};
+  for (int c : labels)
+    if (c >= 0 && c < 256) lut[static_cast<std::size_t>(c)] = true;
+  return lut;
+}
+}  // namespace detail
 
 /// Semantic ratio σ of a label image (paper Eq. `eq:vr`): pixels labelled with a class in
 /// `interest` over valid pixels (those not equal to `ignore_label`). The paper divides by all
@@ -27,9 +38,7 @@ namespace adaptseg {
                                            int ignore_label) {
   detail::require(labels.type() == CV_8UC1, "semantic_ratio: labels must be CV_8UC1", labels.type());
   std::int64_t valid = 0, hits = 0;
-  bool lut[256] = {};
-  for (int c : interest)
-    if (c >= 0 && c < 256) lut[c] = true;
+  const auto lut = detail::label_lut(interest);
   for (int r = 0; r < labels.rows; ++r) {
     const auto* row = labels.ptr<std::uint8_t>(r);
     for (int c = 0; c < labels.cols; ++c) {
@@ -39,6 +48,25 @@ namespace adaptseg {
     }
   }
   return valid == 0 ? 0.0 : static_cast<double>(hits) / static_cast<double>(valid);
+}
+
+/// True if some pixel of `labels` inside `rect` grown by `margin_px` on every side (then
+/// clipped to the image) carries a class in `interest`: whether a sub-lawnmower cell shows a
+/// label of interest (DescentCoverage::interest).
+/// @throws std::invalid_argument unless `labels` is CV_8UC1 and `margin_px` >= 0.
+[[nodiscard]] inline bool shows_interest(const cv::Mat& labels, cv::Rect rect, int margin_px,
+                                         std::span<const int> interest) {
+  detail::require(labels.type() == CV_8UC1, "shows_interest: labels must be CV_8UC1", labels.type());
+  detail::require(margin_px >= 0, "shows_interest: margin_px must be >= 0", margin_px);
+  rect = cv::Rect(rect.x - margin_px, rect.y - margin_px, rect.width + 2 * margin_px, rect.height + 2 * margin_px) &
+         cv::Rect(0, 0, labels.cols, labels.rows);
+  const auto lut = detail::label_lut(interest);
+  for (int r = rect.y; r < rect.y + rect.height; ++r) {
+    const auto* row = labels.ptr<std::uint8_t>(r);
+    for (int c = rect.x; c < rect.x + rect.width; ++c)
+      if (lut[row[c]]) return true;
+  }
+  return false;
 }
 
 /// Pixel counts of (true class, predicted class) over valid pixels. A prediction that is

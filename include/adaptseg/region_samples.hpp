@@ -43,14 +43,18 @@ namespace adaptseg {
 
 /// Flies every top-level region of `field` at `top_gsd_cm` and at each of `candidate_gsd_cm`
 /// and returns one RegionSample per (region, candidate). Regions without a valid pixel are
-/// skipped; candidates finer than the field's GSD are skipped.
+/// skipped; candidates finer than the field's GSD are skipped. `coverage`: what each
+/// sub-lawnmower covers, as AdaptivePlanner::descent_plan (with DescentCoverage::interest, a
+/// (region, candidate) whose sub-lawnmower has no cell is skipped: the planner offers no such
+/// descent).
 /// @throws std::invalid_argument for a top GSD finer than the field's or candidates not finer
 ///         than the top, or an empty `interest`.
 template <SegmentationBackend Backend>
 [[nodiscard]] std::vector<RegionSample> collect_region_samples(const Field& field, Backend& backend,
                                                                const CameraModel& camera, double top_gsd_cm,
                                                                const std::vector<double>& candidate_gsd_cm,
-                                                               const std::vector<int>& interest) {
+                                                               const std::vector<int>& interest,
+                                                               DescentCoverage coverage = DescentCoverage::region) {
   detail::require(top_gsd_cm >= field.gsd_cm() * (1.0 - 1e-9),
                   "collect_region_samples: top_gsd_cm is finer than the field's GSD", top_gsd_cm);
   detail::require(!interest.empty(), "collect_region_samples: no labels of interest", 0);
@@ -61,6 +65,7 @@ template <SegmentationBackend Backend>
   const LawnmowerPlanner planner(camera);
   const auto keep = [&](const Area& a) { return field.has_valid(a); };
   const int n = field.num_classes();
+  const int margin = static_cast<int>(std::ceil(top_gsd_cm / field.gsd_cm() - 1e-9));  // one top-level pixel
   std::vector<RegionSample> out;
   for (const auto& top : planner.plan(field.area(), top_gsd_cm, {0.0, 0.0}, keep)) {
     const Image top_image = sensor.capture(top);
@@ -68,11 +73,24 @@ template <SegmentationBackend Backend>
     const ConfusionMatrix top_cm = image_confusion(top_image, top_labels, n);
     const double sigma_top = semantic_ratio(top_labels, interest, top_image.ignore_label);
     const cv::Rect region = top_image.footprint_px;
+    // What the UAV knows when it plans the descent: the top-level segmentation on the map grid.
+    Image top_local = top_image;  // pixel frame shifted to the region
+    top_local.footprint_px -= region.tl();
+    SemanticMap top_map(region.size(), field.ignore_label());
+    top_map.fuse(top_local, top_labels);
+    const auto keep_cell = [&](const Area& a) {
+      return keep(a) && (coverage == DescentCoverage::region ||
+                         shows_interest(top_map.labels(), field.pixel_rect(a) - region.tl(), margin, interest));
+    };
     for (double g : candidate_gsd_cm) {
       if (g < field.gsd_cm() * (1.0 - 1e-9)) continue;
       // Fuse the sub-lawnmower into a map of the region alone (pixel frame shifted).
+      const auto sub = planner.plan(top.footprint, g, Eigen::Vector2d(top.position.x(), top.position.y()), keep_cell);
+      if (sub.empty()) continue;
       SemanticMap local(region.size(), field.ignore_label());
-      for (const auto& w : planner.plan(top.footprint, g, Eigen::Vector2d(top.position.x(), top.position.y()), keep)) {
+      // Cells a focused descent skips keep their top-level labels, as in the mission's map.
+      if (coverage == DescentCoverage::interest) local.fuse(top_local, top_labels);
+      for (const auto& w : sub) {
         Image img = sensor.capture(w);
         const cv::Mat labels = backend.segment(img);
         img.footprint_px -= region.tl();
