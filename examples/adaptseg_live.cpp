@@ -197,16 +197,11 @@ const PosedImage& find_image(const std::vector<PosedImage>& images, const Eigen:
   return *best;
 }
 
-/// The planner's options from the decision model: its camera, speed, top and candidate GSDs.
+/// The planner's options from the decision model: its camera, speed, GSDs and coverage.
 adaptseg::AdaptiveOptions model_options(const adaptseg::DecisionModel& model, std::vector<int> interest) {
-  adaptseg::AdaptiveOptions o;
-  o.mission.camera = model.camera;
-  o.mission.timing = model.timing;
-  o.mission.interest = std::move(interest);
-  o.top_gsd_cm = model.top_gsd_cm;
-  o.candidate_gsd_cm = model.candidate_gsd_cm;
-  o.coverage = model.coverage;
-  return o;
+  adaptseg::MissionOptions mission;
+  mission.interest = std::move(interest);
+  return model.adaptive_options(std::move(mission));
 }
 
 /// The live loop's settings.

@@ -143,7 +143,19 @@ TEST_CASE("decision model: file round trip and compatibility checks") {
     DecisionModel focused = m;
     focused.coverage = DescentCoverage::interest;
     focused.save(tmp.path() / "focused.yaml");
-    CHECK(DecisionModel::load(tmp.path() / "focused.yaml").coverage == DescentCoverage::interest);
+    const DecisionModel focused_back = DecisionModel::load(tmp.path() / "focused.yaml");
+    CHECK(focused_back.coverage == DescentCoverage::interest);
+    // A mission from the model flies its camera, GSDs and coverage.
+    MissionOptions mission;
+    mission.interest = {1};
+    mission.camera.focal_length_mm = 99.0;  // replaced by the model's
+    const AdaptiveOptions ao = focused_back.adaptive_options(mission, 100.0);
+    CHECK(ao.coverage == DescentCoverage::interest);
+    CHECK(ao.top_gsd_cm == 3.0);
+    CHECK(ao.candidate_gsd_cm == m.candidate_gsd_cm);
+    CHECK(ao.mission.camera.focal_length_mm == m.camera.focal_length_mm);
+    CHECK(ao.mission.interest == std::vector<int>{1});
+    CHECK(ao.budget_s == 100.0);
     std::string text = t::read_file(tmp.path() / "focused.yaml");
     const auto at = text.find("descent_coverage: interest\n");
     REQUIRE(at != std::string::npos);

@@ -81,9 +81,7 @@ StrategyRun run_strategy(const Field& field, Backend& backend, const std::string
   // Without --interest, the model's labels of interest (its GPs were fitted for them).
   if (options.interest.empty()) options.interest = field.class_indices(model->interest);
   model->check_compatible(field, options.interest);
-  options.camera = model->camera;
-  options.timing = model->timing;
-  AdaptiveOptions ao{options, model->top_gsd_cm, model->candidate_gsd_cm, budget_s, model->coverage};
+  const AdaptiveOptions ao = model->adaptive_options(std::move(options), budget_s);
   if (strategy == "linear") {
     LinearDecision policy(model->linear);
     auto r = run_adaptive_mission(field, backend, policy, ao, policy.name());

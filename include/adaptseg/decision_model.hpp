@@ -4,6 +4,7 @@
 /// decision function (GPs and thresholds), the linear baseline's parameters, and what they
 /// were calibrated for (class set, labels of interest, camera, GSDs, backend).
 
+#include <adaptseg/adaptive_planner.hpp>
 #include <adaptseg/camera.hpp>
 #include <adaptseg/decision_function.hpp>
 #include <adaptseg/field.hpp>
@@ -18,6 +19,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace adaptseg {
@@ -39,6 +41,15 @@ struct DecisionModel {
   LinearDecision::Params linear{};
   std::size_t samples = 0;                ///< region samples the GPs were fitted to
   double train_front_margin = 0.0;        ///< of the chosen thresholds, on the training field
+
+  /// The planner options of a mission flown with this model: its camera, timing, top and
+  /// candidate GSDs and descent coverage, with `mission`'s labels of interest and fixed times.
+  [[nodiscard]] AdaptiveOptions adaptive_options(MissionOptions mission,
+                                                 std::optional<double> budget_s = std::nullopt) const {
+    mission.camera = camera;
+    mission.timing = timing;
+    return {std::move(mission), top_gsd_cm, candidate_gsd_cm, budget_s, coverage};
+  }
 
   /// Throws unless `field` has the model's class set and `interest` (class indices of
   /// `field`) equals the model's labels of interest.

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Black-box test of adaptseg_evaluate, the paper's experiment on a scene the decision function
+# never saw: initialised on Dubai tile 4, flown on tile 6 with the oracle, L = {road} (0.8 % of
+# tile 6's pixels: a spatially localised class). Checks results.csv's columns, the figures, a
+# positive front margin for the adaptive strategy, and that a budget is never exceeded.
+#   test_evaluate_cli.sh EVALUATE_BINARY EXAMPLES_DIR
+set -uo pipefail
+evaluate=$1 examples=$2
+source "$(dirname "$0")/cli_common.sh"
+fixed=(--seg-time-s 0.1 --plan-time-s 0)
+"$evaluate" --train "$examples/data/dubai-tile-4" --test "$examples/data/dubai-tile-6" --interest road \
+  "${fixed[@]}" --out "$work/e" >"$work/log" 2>&1 || fail "evaluate failed: $(tail -5 "$work/log")"
+for f in results.csv per_image.csv model.yaml miou_vs_time.png per_image_miou.png paths.png maps.png; do
+  [ -s "$work/e/$f" ] || fail "missing $f"
+done
+header=$(head -1 "$work/e/results.csv")
+want="field,strategy,gsd_cm,miou_interest,miou_all,time_total,time_flight,time_segmentation,time_planning,images,front_margin"
+[ "${header#"$want"}" != "$header" ] || fail "results.csv header: $header"
+# adaptive's row: front margin (column 11) > 0
+margin=$(awk -F, '$2 == "adaptive" {print $11}' "$work/e/results.csv")
+[ -n "$margin" ] || fail "no adaptive row"
+awk -v m="$margin" 'BEGIN {exit !(m > 0)}' || fail "adaptive front margin $margin is not positive"
+echo "ok: adaptive front margin on dubai-tile-6 (road) = $margin"
+
+# With a budget between the top-level coverage and what adaptive took without one, no mission
+# exceeds it (and the top level is still covered: evaluate fails otherwise).
+total=$(awk -F, '$2 == "adaptive" {print $6}' "$work/e/results.csv")
+budget=$(awk -F, '$2 == "lawnmower" && $3 == "15.000" {print $6}' "$work/e/results.csv")
+[ -n "$total" ] && [ -n "$budget" ] || fail "missing adaptive or 15 cm/px lawnmower row"
+budget=$(awk -v a="$total" -v b="$budget" 'BEGIN {printf "%.1f", (a + b) / 2}')
+"$evaluate" --model "$work/e/model.yaml" --test "$examples/data/dubai-tile-6" --interest road "${fixed[@]}" \
+  --budget-s "$budget" --no-plots --out "$work/b" >"$work/log" 2>&1 || fail "evaluate with budget failed"
+awk -F, -v b="$budget" 'NR > 1 && $2 != "lawnmower" && $6 > b + 1e-6 {bad = 1; print "over budget: " $0}
+  END {exit bad}' "$work/b/results.csv" || fail "a mission exceeded the budget $budget s"
+echo "ok: budget $budget s kept"
