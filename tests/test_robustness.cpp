@@ -640,6 +640,24 @@ TEST_CASE("robustness: decision model: refit count out of range") {
   CHECK_THROWS_WITH_AS((void)load_model_text(dir, text), Contains("refit_every"), std::invalid_argument);
 }
 
+TEST_CASE("robustness: decision model: unknown descent coverage") {
+  const t::TempDir dir;
+  const std::string text = replaced(model_text(), "descent_coverage: region", "descent_coverage: everywhere");
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, text), Contains("'region' or 'interest'"), std::invalid_argument);
+}
+
+TEST_CASE("robustness: decision model: I with three inputs") {
+  const t::TempDir dir;
+  // I's GP announces dimension 3: its kernel has one length scale per input it was fitted to.
+  std::string text = model_text();
+  const auto i_block = text.rfind("kernel squared_exponential_ard");
+  REQUIRE(i_block != std::string::npos);
+  const auto dim = text.find("dimension 1", i_block);
+  REQUIRE(dim != std::string::npos);
+  text.replace(dim, 11, "dimension 3");
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, text), Contains("does not accept dimension"), std::invalid_argument);
+}
+
 // ---- ERFNet model files ----------------------------------------------------------------------
 
 TEST_CASE("robustness: erfnet: ONNX file missing") {
