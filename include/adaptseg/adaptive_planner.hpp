@@ -117,7 +117,8 @@ struct PlannerStep {
 /// segments it with the backend (or takes the caller's labels), fuses it into its map, and at
 /// a top-level waypoint i (GSD `top_gsd_cm`) decides: for each candidate GSD finer than the
 /// top and not finer than the map, it plans the sub-lawnmower over the region (starting in the
-/// corner nearest the UAV, cells without field skipped) and computes its exact extra time: the
+/// corner nearest the UAV, cells without field skipped; with DescentCoverage::interest only the
+/// cells that show a label of interest, see descent_plan()) and computes its exact extra time: the
 /// flight i → sub-lawnmower → i+1 minus the flight i → i+1, plus the per-image segmentation
 /// and per-waypoint planning estimates. Candidates that would break the budget are dropped; the
 /// policy decides; a descent's waypoints come next. After a descent's last image, the region's
