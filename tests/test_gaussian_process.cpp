@@ -12,6 +12,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -395,6 +396,59 @@ TEST_CASE("squared exponential: value of eq:sqexp and argument checks") {
   CHECK_THROWS_WITH_AS(SquaredExponentialKernel(1.0, 1.0, 1.0, bad), doctest::Contains("bounds.noise_variance.upper"),
                        std::invalid_argument);
   CHECK_THROWS_AS(ArdSquaredExponentialKernel(Eigen::VectorXd(0)), std::invalid_argument);
+}
+
+TEST_CASE("vectorised kernels: baseline and dispatched instruction set against the reference") {
+  using adaptseg::detail::kGpQueryBlock;
+  // sf2 * exp(-r2 / 2), 0 from r2 = 690 on; sizes that leave a tail for every vector width.
+  std::vector<double> r2 = {0.0, 1e-300, 4e-17, 0.5, 689.999, 690.0, 1e3};
+  adaptseg::detail::GpSplitMix64 rng(7);
+  for (int i = 0; i < 2000; ++i) r2.push_back(700.0 * rng.uniform());
+  r2.push_back(3.0);
+  const auto check_exp = [&](const std::vector<double>& got) {
+    for (std::size_t i = 0; i < r2.size(); ++i) {
+      const double ref = r2[i] < 690.0 ? 1.7 * std::exp(-0.5 * r2[i]) : 0.0;
+      if (ref == 0.0) {
+        CHECK(got[i] == 0.0);
+      } else {
+        CHECK(std::abs(got[i] - ref) <= 4.0 * std::numeric_limits<double>::epsilon() * ref);
+      }
+    }
+  };
+  std::vector<double> baseline = r2, dispatched = r2;
+  adaptseg::detail::gp_squared_exponential_body<16>(baseline.data(), static_cast<Eigen::Index>(r2.size()), 1.7);
+  adaptseg::detail::gp_squared_exponential(dispatched.data(), static_cast<Eigen::Index>(r2.size()), 1.7);
+  check_exp(baseline);
+  check_exp(dispatched);
+  CHECK(baseline[0] == 1.7);
+
+  // v = L^-1 k per query, mean = z^T v, ssq = v^T v, for n with and without padding.
+  for (const Eigen::Index n : {Eigen::Index{1}, Eigen::Index{13}, Eigen::Index{72}}) {
+    CAPTURE(n);
+    const Eigen::MatrixXd a = random_inputs(n, n, 11);
+    const Eigen::MatrixXd spd = a * a.transpose() + static_cast<double>(n) * Eigen::MatrixXd::Identity(n, n);
+    const Eigen::MatrixXd l = spd.llt().matrixL();
+    const Eigen::VectorXd z = random_inputs(n, 1, 12, -1.0, 1.0);
+    const adaptseg::detail::GpPackedFactor factor(l, z);
+    Eigen::MatrixXd c = Eigen::MatrixXd::Zero(kGpQueryBlock, factor.n4);
+    c.leftCols(n) = random_inputs(kGpQueryBlock, n, 13);
+    const Eigen::Index lanes = 37;
+    for (const bool dispatch : {false, true}) {
+      Eigen::MatrixXd v = c;
+      Eigen::VectorXd mean(kGpQueryBlock), ssq(kGpQueryBlock);
+      if (dispatch) {
+        adaptseg::detail::gp_lower_solve_block(factor, v.data(), lanes, mean.data(), ssq.data());
+      } else {
+        adaptseg::detail::gp_lower_solve_body<16>(factor, v.data(), lanes, mean.data(), ssq.data());
+      }
+      for (Eigen::Index q = 0; q < lanes; ++q) {
+        const Eigen::VectorXd ref = l.triangularView<Eigen::Lower>().solve(c.row(q).head(n).transpose());
+        CHECK(scaled_error(v.row(q).head(n).transpose(), ref, ref.cwiseAbs().maxCoeff()) < 1e-13);
+        CHECK(mean(q) == doctest::Approx(z.dot(ref)).epsilon(1e-12));
+        CHECK(ssq(q) == doctest::Approx(ref.squaredNorm()).epsilon(1e-12));
+      }
+    }
+  }
 }
 
 // ============================================================================================

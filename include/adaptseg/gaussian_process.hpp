@@ -26,6 +26,7 @@
 #include <concepts>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -41,6 +42,258 @@
 #include <vector>
 
 namespace adaptseg {
+
+// ============================================================================================
+// Vectorised numerical kernels with run-time instruction-set dispatch
+// ============================================================================================
+
+namespace detail {
+
+// The library is header-only, so its code is compiled with the consumer's flags, by default
+// for baseline x86-64 (SSE2, two doubles per instruction). The two hot loops of prediction
+// and fitting (exponentials, and the triangular solve of the predictive variance) are also
+// compiled for AVX2 + FMA and for AVX-512 (GCC/Clang `target` attribute) and chosen once at
+// run time by what the CPU supports; elsewhere (other compilers or architectures, or
+// ADAPTSEG_GP_NO_DISPATCH defined) the portable version runs. Each is written once, on GCC
+// vector types of `Bytes` bytes, and every element goes through the same vector code (tails
+// are padded), so a result does not depend on its position in a batch; different
+// instruction sets may differ in the last bits (FMA rounding).
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__)) && !defined(ADAPTSEG_GP_NO_DISPATCH)
+#define ADAPTSEG_GP_DISPATCH 1
+#endif
+
+/// Instruction set the dispatched kernels use: 0 = baseline, 1 = AVX2 + FMA, 2 = AVX-512F.
+[[nodiscard]] inline int gp_simd_level() {
+#if defined(ADAPTSEG_GP_DISPATCH)
+  static const int level = [] {
+    __builtin_cpu_init();
+    if (__builtin_cpu_supports("avx512f")) return 2;
+    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return 1;
+    return 0;
+  }();
+  return level;
+#else
+  return 0;
+#endif
+}
+
+/// GCC vector types of 16, 32 and 64 bytes (spelled out: the attribute is not applied to a
+/// dependent size).
+template <int Bytes>
+struct GpVector;
+template <>
+struct GpVector<16> {
+  typedef double Double __attribute__((vector_size(16)));
+  typedef unsigned long long Bits __attribute__((vector_size(16)));
+};
+template <>
+struct GpVector<32> {
+  typedef double Double __attribute__((vector_size(32)));
+  typedef unsigned long long Bits __attribute__((vector_size(32)));
+};
+template <>
+struct GpVector<64> {
+  typedef double Double __attribute__((vector_size(64)));
+  typedef unsigned long long Bits __attribute__((vector_size(64)));
+};
+
+/// r2 <- 0 where r2 >= kGpNegligibleR2 (covariance below ~1e-150 sf2: far below rounding of
+/// any sum it enters, and it keeps subnormal numbers out at short length scales).
+inline constexpr double kGpNegligibleR2 = 690.0;
+
+/// r2[i] <- sf2 * exp(-r2[i] / 2) for r2[i] in [0, kGpNegligibleR2), else 0; r2 >= 0 (a
+/// squared distance). exp by Cody-Waite reduction x = k ln2 + r, |r| <= ln2 / 2, and the
+/// degree-13 Taylor polynomial of exp(r) (truncation < 0.03 ulp; total error ~1 ulp).
+template <int Bytes>
+[[gnu::always_inline]] inline void gp_squared_exponential_body(double* r2, Eigen::Index size, double sf2) {
+  using Vd = typename GpVector<Bytes>::Double;
+  using Vu = typename GpVector<Bytes>::Bits;
+  constexpr Eigen::Index kLanes = Bytes / 8;
+  constexpr double kLog2e = 1.4426950408889634074;
+  constexpr double kLn2Hi = 6.93147180369123816490e-01;  // trailing zeros: k * kLn2Hi exact
+  constexpr double kLn2Lo = 1.90821492927058770002e-10;
+  constexpr double kShifter = 0x1.8p52;  // adding it rounds to an integer held in the low bits
+  const auto one = [&](double* p) {
+    Vd q;
+    std::memcpy(&q, p, Bytes);
+    const Vu keep = (Vu)(q < kGpNegligibleR2);
+    const Vd x = -0.5 * (q < kGpNegligibleR2 ? q : kGpNegligibleR2 + Vd{});
+    const Vd kd = x * kLog2e + kShifter;
+    const Vd k = kd - kShifter;
+    const Vd r = (x - k * kLn2Hi) - k * kLn2Lo;
+    Vd e = 1.0 / 6227020800.0 + Vd{};  // 1/13!
+    e = e * r + 1.0 / 479001600.0;
+    e = e * r + 1.0 / 39916800.0;
+    e = e * r + 1.0 / 3628800.0;
+    e = e * r + 1.0 / 362880.0;
+    e = e * r + 1.0 / 40320.0;
+    e = e * r + 1.0 / 5040.0;
+    e = e * r + 1.0 / 720.0;
+    e = e * r + 1.0 / 120.0;
+    e = e * r + 1.0 / 24.0;
+    e = e * r + 1.0 / 6.0;
+    e = e * r + 0.5;
+    e = e * r + 1.0;
+    e = e * r + 1.0;
+    // 2^k: k in [-498, 0] sits in the low bits of kd; move it into the exponent field.
+    const Vu scale = ((Vu)kd << 52) + (1023ULL << 52);
+    const Vd y = sf2 * (e * (Vd)scale);
+    q = (Vd)((Vu)y & keep);
+    std::memcpy(p, &q, Bytes);
+  };
+  Eigen::Index i = 0;
+  for (; i + kLanes <= size; i += kLanes) one(r2 + i);
+  if (i < size) {
+    double pad[kLanes] = {};
+    std::memcpy(pad, r2 + i, static_cast<std::size_t>(size - i) * sizeof(double));
+    one(pad);
+    std::memcpy(r2 + i, pad, static_cast<std::size_t>(size - i) * sizeof(double));
+  }
+}
+
+#if defined(ADAPTSEG_GP_DISPATCH)
+[[gnu::target("avx512f")]] inline void gp_squared_exponential_avx512(double* r2, Eigen::Index size, double sf2) {
+  gp_squared_exponential_body<64>(r2, size, sf2);
+}
+[[gnu::target("avx2,fma")]] inline void gp_squared_exponential_avx2(double* r2, Eigen::Index size, double sf2) {
+  gp_squared_exponential_body<32>(r2, size, sf2);
+}
+#endif
+
+/// Dispatching `gp_squared_exponential_body`: r2[i] <- sf2 * exp(-r2[i] / 2) (0 beyond
+/// kGpNegligibleR2) over a contiguous array.
+inline void gp_squared_exponential(double* r2, Eigen::Index size, double sf2) {
+#if defined(ADAPTSEG_GP_DISPATCH)
+  switch (gp_simd_level()) {
+    case 2: gp_squared_exponential_avx512(r2, size, sf2); return;
+    case 1: gp_squared_exponential_avx2(r2, size, sf2); return;
+    default: break;
+  }
+#endif
+  gp_squared_exponential_body<16>(r2, size, sf2);
+}
+
+/// Queries per block of the predictive-variance kernel (`gp_lower_solve_block`).
+inline constexpr Eigen::Index kGpQueryBlock = 64;
+
+/// The lower Cholesky factor L (n x n) of the training covariance, repacked for
+/// `gp_lower_solve_block`: rows in panels of four, n padded to n4 = 4 ceil(n / 4) with
+/// identity rows. Panel p (rows i0 = 4p .. i0 + 3) holds L(i0 + r, k), k < i0, at
+/// panels[8 p (p - 1) + 4 k + r]; its diagonal block's strictly lower part at
+/// diagonal[4 i0 + 4 r + c] (c < r), and 1 / L(i, i) at inverse_diagonal[i].
+struct GpPackedFactor {
+  Eigen::Index n = 0;
+  Eigen::Index n4 = 0;
+  std::vector<double> panels;
+  std::vector<double> diagonal;
+  std::vector<double> inverse_diagonal;
+  std::vector<double> z;  // L^-1 y, zero-padded to n4
+
+  GpPackedFactor(const Eigen::Ref<const Eigen::MatrixXd>& l, const Eigen::Ref<const Eigen::VectorXd>& zv)
+      : n(l.rows()), n4((l.rows() + 3) / 4 * 4) {
+    const auto un4 = static_cast<std::size_t>(n4);
+    panels.assign(un4 * (un4 - 4) / 2, 0.0);
+    diagonal.assign(4 * un4, 0.0);
+    inverse_diagonal.assign(un4, 1.0);
+    z.assign(un4, 0.0);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Index i0 = i / 4 * 4;
+      const Eigen::Index r = i - i0;
+      double* panel = panels.data() + 2 * i0 * (i0 / 4 - 1) + r;
+      for (Eigen::Index k = 0; k < i0; ++k) panel[4 * k] = l(i, k);
+      for (Eigen::Index c = 0; c < r; ++c) diagonal[static_cast<std::size_t>(4 * i0 + 4 * r + c)] = l(i, i0 + c);
+      inverse_diagonal[static_cast<std::size_t>(i)] = 1.0 / l(i, i);
+      z[static_cast<std::size_t>(i)] = zv(i);
+    }
+  }
+};
+
+/// Forward substitution V = L^-1 K* for a block of kGpQueryBlock queries, with the per-query
+/// sums that prediction needs: mean[q] = z^T v_q, ssq[q] = v_q^T v_q. `c` holds K* transposed
+/// (query q, training point k at c[k * kGpQueryBlock + q], n4 columns, padding zero) and is
+/// overwritten by V^T. Lanes are queries; four rows of L at a time against two vectors of
+/// queries (8 accumulators). Only the first `lanes` queries (rounded up to a vector pair) are
+/// computed.
+template <int Bytes>
+[[gnu::always_inline]] inline void gp_lower_solve_body(const GpPackedFactor& f, double* c, Eigen::Index lanes,
+                                                       double* mean, double* ssq) {
+  using Vd = typename GpVector<Bytes>::Double;
+  constexpr Eigen::Index kWidth = Bytes / 8;
+  constexpr Eigen::Index kGroup = 2 * kWidth;
+  constexpr Eigen::Index kLd = kGpQueryBlock;
+  static_assert(kGpQueryBlock % kGroup == 0);
+  const auto load = [](Vd& v, const double* p) { std::memcpy(&v, p, Bytes); };
+  const auto store = [](double* p, const Vd& v) { std::memcpy(p, &v, Bytes); };
+  for (Eigen::Index g = 0; g < lanes; g += kGroup) {
+    double* cg = c + g;
+    Vd m0{}, m1{}, s0{}, s1{};
+    const double* panel = f.panels.data();
+    for (Eigen::Index i0 = 0; i0 < f.n4; i0 += 4) {
+      Vd a[4][2];
+      for (int r = 0; r < 4; ++r) {
+        load(a[r][0], cg + (i0 + r) * kLd);
+        load(a[r][1], cg + (i0 + r) * kLd + kWidth);
+      }
+      for (Eigen::Index k = 0; k < i0; ++k) {
+        Vd x0, x1;
+        load(x0, cg + k * kLd);
+        load(x1, cg + k * kLd + kWidth);
+        const double* lk = panel + 4 * k;
+        for (int r = 0; r < 4; ++r) {
+          a[r][0] -= lk[r] * x0;
+          a[r][1] -= lk[r] * x1;
+        }
+      }
+      panel += 4 * i0;
+      const double* d = f.diagonal.data() + 4 * i0;
+      for (int r = 0; r < 4; ++r) {
+        for (int q = 0; q < r; ++q) {
+          a[r][0] -= d[4 * r + q] * a[q][0];
+          a[r][1] -= d[4 * r + q] * a[q][1];
+        }
+        const double inv = f.inverse_diagonal[static_cast<std::size_t>(i0 + r)];
+        a[r][0] *= inv;
+        a[r][1] *= inv;
+        store(cg + (i0 + r) * kLd, a[r][0]);
+        store(cg + (i0 + r) * kLd + kWidth, a[r][1]);
+        const double zi = f.z[static_cast<std::size_t>(i0 + r)];
+        m0 += zi * a[r][0];
+        m1 += zi * a[r][1];
+        s0 += a[r][0] * a[r][0];
+        s1 += a[r][1] * a[r][1];
+      }
+    }
+    store(mean + g, m0);
+    store(mean + g + kWidth, m1);
+    store(ssq + g, s0);
+    store(ssq + g + kWidth, s1);
+  }
+}
+
+#if defined(ADAPTSEG_GP_DISPATCH)
+[[gnu::target("avx512f")]] inline void gp_lower_solve_avx512(const GpPackedFactor& f, double* c, Eigen::Index lanes,
+                                                             double* mean, double* ssq) {
+  gp_lower_solve_body<64>(f, c, lanes, mean, ssq);
+}
+[[gnu::target("avx2,fma")]] inline void gp_lower_solve_avx2(const GpPackedFactor& f, double* c, Eigen::Index lanes,
+                                                            double* mean, double* ssq) {
+  gp_lower_solve_body<32>(f, c, lanes, mean, ssq);
+}
+#endif
+
+/// Dispatching `gp_lower_solve_body`.
+inline void gp_lower_solve_block(const GpPackedFactor& f, double* c, Eigen::Index lanes, double* mean, double* ssq) {
+#if defined(ADAPTSEG_GP_DISPATCH)
+  switch (gp_simd_level()) {
+    case 2: gp_lower_solve_avx512(f, c, lanes, mean, ssq); return;
+    case 1: gp_lower_solve_avx2(f, c, lanes, mean, ssq); return;
+    default: break;
+  }
+#endif
+  gp_lower_solve_body<16>(f, c, lanes, mean, ssq);
+}
+
+}  // namespace detail
 
 // ============================================================================================
 // Kernel concept
@@ -243,7 +496,7 @@ class SquaredExponential {
         auto col = k.col(j).tail(n - j).array();
         col = (as.col(0).tail(n - j).array() - as(j, 0)).square();
         for (Eigen::Index d = 1; d < as.cols(); ++d) col += (as.col(d).tail(n - j).array() - as(j, d)).square();
-        squared_exponential_in_place(col, sf2);
+        detail::gp_squared_exponential(col.data(), n - j, sf2);
         k.row(j).tail(n - j - 1) = k.col(j).tail(n - j - 1).transpose();
       }
       return k;
@@ -253,8 +506,8 @@ class SquaredExponential {
       auto col = k.col(j).array();
       col = (as.col(0).array() - bs(j, 0)).square();
       for (Eigen::Index d = 1; d < as.cols(); ++d) col += (as.col(d).array() - bs(j, d)).square();
-      squared_exponential_in_place(col, sf2);
     }
+    detail::gp_squared_exponential(k.data(), k.size(), sf2);
     return k;
   }
 
@@ -291,7 +544,7 @@ class SquaredExponential {
       r = (xs.col(0).tail(m).array() - xs(j, 0)).square();
       for (Eigen::Index d = 1; d < dims; ++d) r += (xs.col(d).tail(m).array() - xs(j, d)).square();
       v = r;
-      squared_exponential_in_place(v, sf2);
+      detail::gp_squared_exponential(v.data(), m, sf2);
       v *= w.col(j).tail(m).array();
       g_sf += 2.0 * v.sum();
       if constexpr (Mode == LengthScales::kIsotropic) {
@@ -337,15 +590,6 @@ class SquaredExponential {
     lower_(nl + 1) = std::log(bounds.noise_variance.lower);
     upper_(nl + 1) = std::log(bounds.noise_variance.upper);
   }
-
-  /// r2 <- sf2 * exp(-r2 / 2), elementwise. Values with r2 >= kNegligibleR2 (below ~1e-150
-  /// sf2) become exactly 0: far below rounding of any sum they enter, and it keeps subnormal
-  /// numbers (100x slower arithmetic) out of the covariance at short length scales.
-  template <typename ArrayExpr>
-  static void squared_exponential_in_place(ArrayExpr&& r2, double sf2) {
-    r2 = (r2 < kNegligibleR2).select(sf2 * (-0.5 * r2.min(kNegligibleR2)).exp(), 0.0);
-  }
-  static constexpr double kNegligibleR2 = 690.0;
 
   static void check_bounds(const HyperparameterBounds& b, const std::string& name) {
     detail::require_positive(b.lower, name + ".lower");
@@ -919,22 +1163,23 @@ class GaussianProcess {
     check_query(xq);
     const detail::GpScopedFlushSubnormals flush;
     const Eigen::Index m = xq.rows();
-    Prediction out{Eigen::VectorXd(m), Eigen::VectorXd(m)};
-    constexpr Eigen::Index kChunk = 512;  // bounds the n x chunk cross-covariance in memory
-    for (Eigen::Index s = 0; s < m; s += kChunk) {
-      const Eigen::Index rows = std::min(kChunk, m - s);
-      const auto q = xq.middleRows(s, rows);
-      Eigen::VectorXd var = kernel_.prior_variance(q);
-      if (n_ > 0) {
-        Eigen::MatrixXd v = kernel_.cross_covariance(x_.topRows(n_), q);  // n x rows
-        l_.topLeftCorner(n_, n_).template triangularView<Eigen::Lower>().solveInPlace(v);
-        out.mean.segment(s, rows).noalias() = v.transpose() * z_.head(n_);  // k*^T K^-1 y
-        var -= v.colwise().squaredNorm().transpose();
-      } else {
-        out.mean.segment(s, rows).setZero();
+    Prediction out{Eigen::VectorXd::Zero(m), kernel_.prior_variance(xq)};
+    if (n_ > 0) {
+      // Per block of queries: K*^T (queries x n), then v = L^-1 k* for each query with
+      // mean = v^T z (= k*^T K^-1 y) and variance = prior - v^T v, all in one pass.
+      constexpr Eigen::Index kBlock = detail::kGpQueryBlock;
+      const detail::GpPackedFactor factor(l_.topLeftCorner(n_, n_), z_.head(n_));
+      Eigen::MatrixXd c = Eigen::MatrixXd::Zero(kBlock, factor.n4);
+      Eigen::Matrix<double, kBlock, 1> mean, ssq;
+      for (Eigen::Index s = 0; s < m; s += kBlock) {
+        const Eigen::Index rows = std::min(kBlock, m - s);
+        c.topLeftCorner(rows, n_) = kernel_.cross_covariance(xq.middleRows(s, rows), x_.topRows(n_));
+        detail::gp_lower_solve_block(factor, c.data(), rows, mean.data(), ssq.data());
+        out.mean.segment(s, rows) = mean.head(rows);
+        out.variance.segment(s, rows) -= ssq.head(rows);
       }
-      out.variance.segment(s, rows) = var.cwiseMax(0.0);
     }
+    out.variance = out.variance.cwiseMax(0.0);
     if (kind == PredictiveVariance::kNoisy) out.variance.array() += kernel_.noise_variance();
     out.mean = out.mean.array() * y_std_ + y_mean_;
     out.variance *= y_std_ * y_std_;
