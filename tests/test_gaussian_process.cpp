@@ -437,7 +437,7 @@ TEST_CASE("vectorised kernels: baseline and dispatched instruction set against t
       Eigen::MatrixXd v = c;
       Eigen::VectorXd mean(kGpQueryBlock), ssq(kGpQueryBlock);
       if (dispatch) {
-        adaptseg::detail::gp_lower_solve_block(factor, v.data(), lanes, mean.data(), ssq.data());
+        adaptseg::detail::gp_lower_solve(factor, v.data(), lanes, mean.data(), ssq.data());
       } else {
         adaptseg::detail::gp_lower_solve_body<16>(factor, v.data(), lanes, mean.data(), ssq.data());
       }
@@ -448,6 +448,39 @@ TEST_CASE("vectorised kernels: baseline and dispatched instruction set against t
         CHECK(ssq(q) == doctest::Approx(ref.squaredNorm()).epsilon(1e-12));
       }
     }
+
+    // Cholesky, L^-1 and K^-1 = L^-T L^-1 on the padded layout of a likelihood evaluation.
+    const Eigen::Index n4 = factor.n4;
+    const Eigen::Index ld = (n4 + 15) / 16 * 16;
+    const Eigen::MatrixXd inverse = spd.llt().solve(Eigen::MatrixXd::Identity(n, n));
+    for (const bool dispatch : {false, true}) {
+      Eigen::MatrixXd m = Eigen::MatrixXd::Zero(ld, n4);
+      Eigen::MatrixXd xt = Eigen::MatrixXd::Zero(ld, n4);
+      m.topLeftCorner(n, n) = spd;
+      m.diagonal().segment(n, n4 - n).setOnes();
+      if (dispatch) {
+        REQUIRE(adaptseg::detail::gp_cholesky(m.data(), n4, ld));
+      } else {
+        REQUIRE(adaptseg::detail::gp_cholesky_body<16>(m.data(), n4, ld));
+      }
+      const Eigen::MatrixXd lm = m.topLeftCorner(n, n).triangularView<Eigen::Lower>();
+      CHECK((lm - l).cwiseAbs().maxCoeff() < 1e-13 * l.cwiseAbs().maxCoeff());
+      if (dispatch) {
+        adaptseg::detail::gp_invert_lower(m.data(), xt.data(), n4, ld);
+        adaptseg::detail::gp_gram(xt.data(), m.data(), n4, ld);
+      } else {
+        adaptseg::detail::gp_invert_lower_body<16>(m.data(), xt.data(), n4, ld);
+        adaptseg::detail::gp_gram_body<16>(xt.data(), m.data(), n4, ld);
+      }
+      const Eigen::MatrixXd got = m.topLeftCorner(n, n).triangularView<Eigen::Lower>();
+      const Eigen::MatrixXd want = inverse.triangularView<Eigen::Lower>();
+      CHECK((got - want).cwiseAbs().maxCoeff() < 1e-13 * want.cwiseAbs().maxCoeff());
+    }
+    // A matrix that is not positive definite is reported, not factorised.
+    Eigen::MatrixXd bad = Eigen::MatrixXd::Zero(ld, n4);
+    bad.diagonal().setOnes();
+    bad(n - 1, n - 1) = -1.0;
+    CHECK_FALSE(adaptseg::detail::gp_cholesky(bad.data(), n4, ld));
   }
 }
 

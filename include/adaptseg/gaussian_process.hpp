@@ -77,6 +77,24 @@ namespace detail {
 #endif
 }
 
+/// Defines `name(params)`, which runs `name##_body<Bytes>(args)` for the widest instruction
+/// set of `gp_simd_level()`, with `name##_avx512` and `name##_avx2` compiled for those.
+#if defined(ADAPTSEG_GP_DISPATCH)
+#define ADAPTSEG_GP_DISPATCHED(ret, name, params, args)                                          \
+  [[gnu::target("avx512f")]] inline ret name##_avx512 params { return name##_body<64> args; } \
+  [[gnu::target("avx2,fma")]] inline ret name##_avx2 params { return name##_body<32> args; }  \
+  inline ret name params {                                                                    \
+    switch (gp_simd_level()) {                                                                \
+      case 2: return name##_avx512 args;                                                      \
+      case 1: return name##_avx2 args;                                                        \
+      default: return name##_body<16> args;                                                   \
+    }                                                                                         \
+  }
+#else
+#define ADAPTSEG_GP_DISPATCHED(ret, name, params, args) \
+  inline ret name params { return name##_body<16> args; }
+#endif
+
 /// GCC vector types of 16, 32 and 64 bytes (spelled out: the attribute is not applied to a
 /// dependent size).
 template <int Bytes>
@@ -151,33 +169,28 @@ template <int Bytes>
   }
 }
 
-#if defined(ADAPTSEG_GP_DISPATCH)
-[[gnu::target("avx512f")]] inline void gp_squared_exponential_avx512(double* r2, Eigen::Index size, double sf2) {
-  gp_squared_exponential_body<64>(r2, size, sf2);
-}
-[[gnu::target("avx2,fma")]] inline void gp_squared_exponential_avx2(double* r2, Eigen::Index size, double sf2) {
-  gp_squared_exponential_body<32>(r2, size, sf2);
-}
-#endif
-
 /// Dispatching `gp_squared_exponential_body`: r2[i] <- sf2 * exp(-r2[i] / 2) (0 beyond
 /// kGpNegligibleR2) over a contiguous array.
-inline void gp_squared_exponential(double* r2, Eigen::Index size, double sf2) {
-#if defined(ADAPTSEG_GP_DISPATCH)
-  switch (gp_simd_level()) {
-    case 2: gp_squared_exponential_avx512(r2, size, sf2); return;
-    case 1: gp_squared_exponential_avx2(r2, size, sf2); return;
-    default: break;
+ADAPTSEG_GP_DISPATCHED(void, gp_squared_exponential, (double* r2, Eigen::Index size, double sf2), (r2, size, sf2))
+
+/// s[r][v] += b[r] * x[v], r < 4, v < 2, for the two vectors x at p: the rank-one step that
+/// all dense kernels below are built on (four broadcasts against two vectors of lanes).
+template <int Bytes>
+[[gnu::always_inline]] inline void gp_rank_one_4x2(typename GpVector<Bytes>::Double (&s)[4][2], const double* b,
+                                                   const double* p) {
+  typename GpVector<Bytes>::Double x[2];
+  std::memcpy(&x, p, 2 * Bytes);
+  for (int r = 0; r < 4; ++r) {
+    s[r][0] += b[r] * x[0];
+    s[r][1] += b[r] * x[1];
   }
-#endif
-  gp_squared_exponential_body<16>(r2, size, sf2);
 }
 
-/// Queries per block of the predictive-variance kernel (`gp_lower_solve_block`).
+/// Queries per block of the predictive-variance kernel (`gp_lower_solve`).
 inline constexpr Eigen::Index kGpQueryBlock = 64;
 
 /// The lower Cholesky factor L (n x n) of the training covariance, repacked for
-/// `gp_lower_solve_block`: rows in panels of four, n padded to n4 = 4 ceil(n / 4) with
+/// `gp_lower_solve`: rows in panels of four, n padded to n4 = 4 ceil(n / 4) with
 /// identity rows. Panel p (rows i0 = 4p .. i0 + 3) holds L(i0 + r, k), k < i0, at
 /// panels[8 p (p - 1) + 4 k + r]; its diagonal block's strictly lower part at
 /// diagonal[4 i0 + 4 r + c] (c < r), and 1 / L(i, i) at inverse_diagonal[i].
@@ -229,20 +242,14 @@ template <int Bytes>
     Vd m0{}, m1{}, s0{}, s1{};
     const double* panel = f.panels.data();
     for (Eigen::Index i0 = 0; i0 < f.n4; i0 += 4) {
+      Vd sum[4][2] = {};
+      for (Eigen::Index k = 0; k < i0; ++k) gp_rank_one_4x2<Bytes>(sum, panel + 4 * k, cg + k * kLd);
       Vd a[4][2];
       for (int r = 0; r < 4; ++r) {
         load(a[r][0], cg + (i0 + r) * kLd);
         load(a[r][1], cg + (i0 + r) * kLd + kWidth);
-      }
-      for (Eigen::Index k = 0; k < i0; ++k) {
-        Vd x0, x1;
-        load(x0, cg + k * kLd);
-        load(x1, cg + k * kLd + kWidth);
-        const double* lk = panel + 4 * k;
-        for (int r = 0; r < 4; ++r) {
-          a[r][0] -= lk[r] * x0;
-          a[r][1] -= lk[r] * x1;
-        }
+        a[r][0] -= sum[r][0];
+        a[r][1] -= sum[r][1];
       }
       panel += 4 * i0;
       const double* d = f.diagonal.data() + 4 * i0;
@@ -270,28 +277,129 @@ template <int Bytes>
   }
 }
 
-#if defined(ADAPTSEG_GP_DISPATCH)
-[[gnu::target("avx512f")]] inline void gp_lower_solve_avx512(const GpPackedFactor& f, double* c, Eigen::Index lanes,
-                                                             double* mean, double* ssq) {
-  gp_lower_solve_body<64>(f, c, lanes, mean, ssq);
-}
-[[gnu::target("avx2,fma")]] inline void gp_lower_solve_avx2(const GpPackedFactor& f, double* c, Eigen::Index lanes,
-                                                            double* mean, double* ssq) {
-  gp_lower_solve_body<32>(f, c, lanes, mean, ssq);
-}
-#endif
-
 /// Dispatching `gp_lower_solve_body`.
-inline void gp_lower_solve_block(const GpPackedFactor& f, double* c, Eigen::Index lanes, double* mean, double* ssq) {
-#if defined(ADAPTSEG_GP_DISPATCH)
-  switch (gp_simd_level()) {
-    case 2: gp_lower_solve_avx512(f, c, lanes, mean, ssq); return;
-    case 1: gp_lower_solve_avx2(f, c, lanes, mean, ssq); return;
-    default: break;
+ADAPTSEG_GP_DISPATCHED(void, gp_lower_solve,
+                       (const GpPackedFactor& f, double* c, Eigen::Index lanes, double* mean, double* ssq),
+                       (f, c, lanes, mean, ssq))
+
+/// Dense kernels of one likelihood evaluation on column-major n4 x n4 matrices (n4 a multiple
+/// of 4) with leading dimension `ld` (a multiple of kGpRowGroup, >= n4); lanes are rows, in
+/// chunks of two vectors that start at a multiple of the chunk size, so that entries above
+/// the diagonal may be overwritten: only the lower triangle (diagonal included) is meaningful.
+inline constexpr Eigen::Index kGpRowGroup = 16;
+
+/// Left-looking Cholesky in place, four columns at a time: lower(a) <- L, L L^T = a.
+/// Returns false on a pivot that is not positive and finite (a is then partly overwritten).
+template <int Bytes>
+[[gnu::always_inline]] inline bool gp_cholesky_body(double* a, Eigen::Index n4, Eigen::Index ld) {
+  using Vd = typename GpVector<Bytes>::Double;
+  constexpr Eigen::Index kWidth = Bytes / 8;
+  for (Eigen::Index j0 = 0; j0 < n4; j0 += 4) {
+    double* col = a + j0 * ld;  // column j0 + c at col + c * ld
+    // a(i, j0 + c) -= sum_{k < j0} a(i, k) a(j0 + c, k), rows i >= j0 (and some above)
+    for (Eigen::Index i = j0 / (2 * kWidth) * (2 * kWidth); i < n4; i += 2 * kWidth) {
+      Vd sum[4][2] = {};
+      for (Eigen::Index k = 0; k < j0; ++k) gp_rank_one_4x2<Bytes>(sum, a + k * ld + j0, a + k * ld + i);
+      for (int c = 0; c < 4; ++c) {
+        Vd s[2];
+        std::memcpy(&s, col + c * ld + i, 2 * Bytes);
+        s[0] -= sum[c][0];
+        s[1] -= sum[c][1];
+        std::memcpy(col + c * ld + i, &s, 2 * Bytes);
+      }
+    }
+    // The 4 x 4 diagonal block, scalar.
+    double l[4][4] = {};
+    for (int c = 0; c < 4; ++c) {
+      for (int r = c; r < 4; ++r) {
+        double v = col[c * ld + j0 + r];
+        for (int q = 0; q < c; ++q) v -= l[r][q] * l[c][q];
+        if (r == c) {
+          if (!(v > 0.0) || !std::isfinite(v)) return false;
+          v = std::sqrt(v);
+        } else {
+          v /= l[c][c];
+        }
+        l[r][c] = v;
+        col[c * ld + j0 + r] = v;
+      }
+    }
+    // Rows below the block: a(i, j0 + c) <- (a(i, j0 + c) - sum_{q < c} L(i, j0 + q)
+    // L(j0 + c, j0 + q)) / L(j0 + c, j0 + c); the chunk holding the block is done in scalars.
+    const Eigen::Index first = (j0 + 4 + kWidth - 1) / kWidth * kWidth;
+    for (Eigen::Index i = j0 + 4; i < std::min(first, n4); ++i) {
+      for (int c = 0; c < 4; ++c) {
+        double v = col[c * ld + i];
+        for (int q = 0; q < c; ++q) v -= l[c][q] * col[q * ld + i];
+        col[c * ld + i] = v / l[c][c];
+      }
+    }
+    for (Eigen::Index i = first; i < n4; i += kWidth) {
+      Vd s[4];
+      for (int c = 0; c < 4; ++c) std::memcpy(&s[c], col + c * ld + i, Bytes);
+      for (int c = 0; c < 4; ++c) {
+        for (int q = 0; q < c; ++q) s[c] -= l[c][q] * s[q];
+        s[c] /= l[c][c];
+        std::memcpy(col + c * ld + i, &s[c], Bytes);
+      }
+    }
   }
-#endif
-  gp_lower_solve_body<16>(f, c, lanes, mean, ssq);
+  return true;
 }
+
+/// xt <- (L^-1)^T for L = lower(a): row i of L^-1 is column i of xt (zero above row i... i.e.
+/// xt(q, i) = 0 for q > i). `xt` (n4 x n4, leading dimension ld) must be zero on entry.
+template <int Bytes>
+[[gnu::always_inline]] inline void gp_invert_lower_body(const double* a, double* xt, Eigen::Index n4, Eigen::Index ld) {
+  using Vd = typename GpVector<Bytes>::Double;
+  constexpr Eigen::Index kWidth = Bytes / 8;
+  for (Eigen::Index i0 = 0; i0 < n4; i0 += 4) {
+    // X(i0 + r, q) = (e_{i0 + r}(q) - sum_{k < i0 + r} L(i0 + r, k) X(k, q)) / L(i0 + r, i0 + r);
+    // X(k, q) = 0 for k < q, so a chunk of q starting at qs needs k >= qs only.
+    for (Eigen::Index qs = 0; qs < i0 + 4; qs += 2 * kWidth) {
+      Vd s[4][2] = {};
+      for (Eigen::Index k = qs; k < i0; ++k) gp_rank_one_4x2<Bytes>(s, a + k * ld + i0, xt + k * ld + qs);
+      for (int r = 0; r < 4; ++r) {
+        double e[2 * kWidth] = {};
+        if (i0 + r >= qs && i0 + r < qs + 2 * kWidth) e[i0 + r - qs] = 1.0;
+        Vd v[2];
+        std::memcpy(&v, e, 2 * Bytes);
+        const double* li = a + i0 + r;  // L(i0 + r, k) at li[k * ld]
+        for (int q = 0; q < r; ++q) {
+          Vd xq[2];
+          std::memcpy(&xq, xt + (i0 + q) * ld + qs, 2 * Bytes);
+          s[r][0] += li[(i0 + q) * ld] * xq[0];
+          s[r][1] += li[(i0 + q) * ld] * xq[1];
+        }
+        const double d = li[(i0 + r) * ld];
+        v[0] = (v[0] - s[r][0]) / d;
+        v[1] = (v[1] - s[r][1]) / d;
+        std::memcpy(xt + (i0 + r) * ld + qs, &v, 2 * Bytes);
+      }
+    }
+  }
+}
+
+/// lower(a) <- lower(X^T X) = lower(K^-1) for X = L^-1 given as xt = X^T (from
+/// `gp_invert_lower_body`): a(p, b) = sum_i X(i, p) X(i, b), i >= max(p, b).
+template <int Bytes>
+[[gnu::always_inline]] inline void gp_gram_body(const double* xt, double* a, Eigen::Index n4, Eigen::Index ld) {
+  using Vd = typename GpVector<Bytes>::Double;
+  constexpr Eigen::Index kWidth = Bytes / 8;
+  for (Eigen::Index b0 = 0; b0 < n4; b0 += 4) {
+    for (Eigen::Index ps = b0 / (2 * kWidth) * (2 * kWidth); ps < n4; ps += 2 * kWidth) {
+      Vd s[4][2] = {};
+      for (Eigen::Index i = std::max(b0, ps); i < n4; ++i) gp_rank_one_4x2<Bytes>(s, xt + i * ld + b0, xt + i * ld + ps);
+      for (int c = 0; c < 4; ++c) std::memcpy(a + (b0 + c) * ld + ps, &s[c], 2 * Bytes);
+    }
+  }
+}
+
+/// Dispatching `gp_cholesky_body`, `gp_invert_lower_body`, `gp_gram_body`.
+ADAPTSEG_GP_DISPATCHED(bool, gp_cholesky, (double* a, Eigen::Index n4, Eigen::Index ld), (a, n4, ld))
+ADAPTSEG_GP_DISPATCHED(void, gp_invert_lower, (const double* a, double* xt, Eigen::Index n4, Eigen::Index ld),
+                       (a, xt, n4, ld))
+ADAPTSEG_GP_DISPATCHED(void, gp_gram, (const double* xt, double* a, Eigen::Index n4, Eigen::Index ld), (xt, a, n4, ld))
 
 }  // namespace detail
 
@@ -630,57 +738,6 @@ static_assert(Kernel<ArdSquaredExponentialKernel>);
 // ============================================================================================
 
 namespace detail {
-
-/// Below this size the triangular kernels run unblocked.
-inline constexpr Eigen::Index kGpTriangularBlock = 48;
-
-/// lower(a) <- L^{-1}, where L = lower(a) is invertible (recursive LAPACK trtri, n^3/3 flops).
-inline void gp_invert_lower_in_place(Eigen::Ref<Eigen::MatrixXd> a) {
-  const Eigen::Index n = a.rows();
-  if (n <= kGpTriangularBlock) {
-    for (Eigen::Index j = n - 1; j >= 0; --j) {
-      a(j, j) = 1.0 / a(j, j);
-      const Eigen::Index m = n - j - 1;
-      if (m > 0) {
-        const Eigen::VectorXd t =
-            a.bottomRightCorner(m, m).template triangularView<Eigen::Lower>() * a.col(j).tail(m);
-        a.col(j).tail(m) = -a(j, j) * t;
-      }
-    }
-    return;
-  }
-  const Eigen::Index n1 = n / 2;
-  const Eigen::Index n2 = n - n1;
-  gp_invert_lower_in_place(a.topLeftCorner(n1, n1));
-  gp_invert_lower_in_place(a.bottomRightCorner(n2, n2));
-  // [A 0; B C]^{-1} = [A^-1 0; -C^-1 B A^-1, C^-1]
-  const Eigen::MatrixXd t =
-      a.bottomLeftCorner(n2, n1) * a.topLeftCorner(n1, n1).template triangularView<Eigen::Lower>();
-  a.bottomLeftCorner(n2, n1).noalias() =
-      -(a.bottomRightCorner(n2, n2).template triangularView<Eigen::Lower>() * t);
-}
-
-/// lower(a) <- lower(L^T L), where L = lower(a) (recursive LAPACK lauum, n^3/3 flops).
-inline void gp_lower_gram_in_place(Eigen::Ref<Eigen::MatrixXd> a) {
-  const Eigen::Index n = a.rows();
-  if (n <= kGpTriangularBlock) {
-    const Eigen::MatrixXd l = a.template triangularView<Eigen::Lower>();
-    const Eigen::MatrixXd g = l.transpose() * l;
-    a.template triangularView<Eigen::Lower>() = g;
-    return;
-  }
-  const Eigen::Index n1 = n / 2;
-  const Eigen::Index n2 = n - n1;
-  // [P 0; Q R]^T [P 0; Q R] = [P^T P + Q^T Q, Q^T R; R^T Q, R^T R]
-  gp_lower_gram_in_place(a.topLeftCorner(n1, n1));
-  a.topLeftCorner(n1, n1).template selfadjointView<Eigen::Lower>().rankUpdate(
-      a.bottomLeftCorner(n2, n1).transpose());
-  const Eigen::MatrixXd t =
-      a.bottomRightCorner(n2, n2).template triangularView<Eigen::Lower>().transpose() *
-      a.bottomLeftCorner(n2, n1);
-  a.bottomLeftCorner(n2, n1) = t;
-  gp_lower_gram_in_place(a.bottomRightCorner(n2, n2));
-}
 
 /// Flushes subnormal results to zero and reads subnormal operands as zero (x86 FTZ/DAZ) for
 /// the current thread while alive, and restores the previous mode on destruction (also when
@@ -1129,7 +1186,9 @@ class GaussianProcess {
   /// doubles for the factor.
   void reserve(Eigen::Index capacity) {
     if (capacity <= x_.rows() && dimension_ == x_.cols()) return;
-    const Eigen::Index cap = std::max(capacity, n_ + std::max<Eigen::Index>(32, n_ / 4));
+    const Eigen::Index wanted = std::max(capacity, n_ + std::max<Eigen::Index>(32, n_ / 4));
+    // A multiple of kGpRowGroup rows: the factor is computed in place by the dense kernels.
+    const Eigen::Index cap = (wanted + detail::kGpRowGroup - 1) / detail::kGpRowGroup * detail::kGpRowGroup;
     Eigen::MatrixXd x(cap, dimension_);
     Eigen::VectorXd y(cap), yn(cap), z(cap), alpha(cap);
     Eigen::MatrixXd l(cap, cap);
@@ -1174,7 +1233,7 @@ class GaussianProcess {
       for (Eigen::Index s = 0; s < m; s += kBlock) {
         const Eigen::Index rows = std::min(kBlock, m - s);
         c.topLeftCorner(rows, n_) = kernel_.cross_covariance(xq.middleRows(s, rows), x_.topRows(n_));
-        detail::gp_lower_solve_block(factor, c.data(), rows, mean.data(), ssq.data());
+        detail::gp_lower_solve(factor, c.data(), rows, mean.data(), ssq.data());
         out.mean.segment(s, rows) = mean.head(rows);
         out.variance.segment(s, rows) -= ssq.head(rows);
       }
@@ -1244,7 +1303,7 @@ class GaussianProcess {
     detail::require(n_ > 0, "GaussianProcess::log_marginal_likelihood: number of training samples must be > 0", n_);
     K kernel = kernel_;
     kernel.set_log_parameters(theta);
-    Eigen::MatrixXd work;
+    Workspace work;
     return evaluate(kernel, gradient, work);
   }
 
@@ -1527,24 +1586,19 @@ class GaussianProcess {
     yn_.head(n_) = (y_.head(n_).array() - y_mean_) / y_std_;
   }
 
-  /// Cholesky of the symmetric matrix `k` (both triangles filled) in place into its lower
-  /// triangle, with jitter retries; returns the jitter used.
-  double cholesky_with_jitter(Eigen::Ref<Eigen::MatrixXd> k) const {
-    const Eigen::Index n = k.rows();
-    const Eigen::VectorXd diag = k.diagonal();
-    const double scale = std::abs(diag.mean());
+  /// Runs `factor()` (true on success); after a failure, `reset(jitter)` restores the matrix
+  /// with `jitter` added to its diagonal and `factor()` runs again, jitter
+  /// `initial_jitter * scale * 10^k`, k = 0..max_jitter_attempts-1. Returns the jitter used.
+  /// @throws NumericalError when the last attempt fails (n: the matrix size, for the message).
+  template <typename Reset, typename Factor>
+  double factor_with_jitter(Eigen::Index n, double scale, Reset&& reset, Factor&& factor) const {
     double jitter = 0.0;
     for (int attempt = 0;; ++attempt) {
       if (attempt > 0) {
-        // LLT overwrote the lower triangle only: restore it from the untouched upper one.
-        for (Eigen::Index j = 0; j + 1 < n; ++j) k.col(j).tail(n - j - 1) = k.row(j).tail(n - j - 1).transpose();
         jitter = options_.initial_jitter * scale * std::pow(10.0, attempt - 1);
-        k.diagonal() = diag.array() + jitter;
+        reset(jitter);
       }
-      Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Lower> llt(k);
-      if (llt.info() == Eigen::Success && k.diagonal().allFinite() && (k.diagonal().array() > 0.0).all()) {
-        return jitter;
-      }
+      if (factor()) return jitter;
       if (attempt >= options_.max_jitter_attempts) {
         std::ostringstream os;
         os << "GaussianProcess: covariance matrix (n = " << n << ") is not positive definite after "
@@ -1556,17 +1610,56 @@ class GaussianProcess {
     }
   }
 
-  /// LML (and gradient) of the normalised training targets for `kernel`; `work` is scratch.
-  double evaluate(const K& kernel, Eigen::VectorXd* gradient, Eigen::MatrixXd& work) const {
+  /// Scratch of `evaluate`, kept across the evaluations of one optimiser run.
+  struct Workspace {
+    Eigen::MatrixXd a;   // K, then L, then K^-1 and the gradient weights (lower triangles)
+    Eigen::MatrixXd xt;  // (L^-1)^T
+  };
+
+  /// Columns n4 = 4 ceil(n / 4) and leading dimension (a multiple of kGpRowGroup) of the
+  /// padded matrices the dense kernels work on.
+  static Eigen::Index padded_columns(Eigen::Index n) { return (n + 3) / 4 * 4; }
+  static Eigen::Index padded_rows(Eigen::Index n) {
+    return (padded_columns(n) + detail::kGpRowGroup - 1) / detail::kGpRowGroup * detail::kGpRowGroup;
+  }
+
+  /// K_XX of the first n_ samples for `kernel` into the top-left of `a` (padded to
+  /// padded_columns(n_) with the identity; a.rows() a multiple of kGpRowGroup, >=
+  /// padded_rows(n_)), factorised in place by the dispatched Cholesky with jitter retries:
+  /// lower(a) = L. Returns the jitter. `fit` (through `evaluate`) and `factorize` share it, so
+  /// the optimiser and the final model agree to the last bit.
+  double factorize_into(const K& kernel, Eigen::MatrixXd& a) const {
+    const Eigen::Index n = n_;
+    const Eigen::Index n4 = padded_columns(n);
+    ADAPTSEG_ASSERT(a.rows() % detail::kGpRowGroup == 0 && a.rows() >= padded_rows(n) && a.cols() >= n4);
+    const auto x = x_.topRows(n);
+    const double noise = kernel.noise_variance();
+    const auto fill = [&](double jitter) {
+      a.leftCols(n4).setZero();
+      a.topLeftCorner(n, n) = kernel.cross_covariance(x, x);
+      a.diagonal().head(n).array() += noise + jitter;
+      a.diagonal().segment(n, n4 - n).setOnes();
+    };
+    fill(0.0);
+    const double scale = std::abs(a.diagonal().head(n).mean());
+    return factor_with_jitter(n, scale, fill, [&] { return detail::gp_cholesky(a.data(), n4, a.rows()); });
+  }
+
+  /// LML (and gradient) of the normalised training targets for `kernel`. The dense work
+  /// (Cholesky, L^-1, K^-1 = L^-T L^-1: n^3 flops in all) runs in the dispatched kernels.
+  double evaluate(const K& kernel, Eigen::VectorXd* gradient, Workspace& ws) const {
     const detail::GpScopedFlushSubnormals flush;
     const Eigen::Index n = n_;
+    const Eigen::Index n4 = padded_columns(n);
+    const Eigen::Index ld = padded_rows(n);
     const auto x = x_.topRows(n);
-    work = kernel.cross_covariance(x, x);
-    work.diagonal().array() += kernel.noise_variance();
-    cholesky_with_jitter(work);
-    const Eigen::VectorXd z = work.template triangularView<Eigen::Lower>().solve(yn_.head(n));
-    const Eigen::VectorXd alpha = work.template triangularView<Eigen::Lower>().transpose().solve(z);
-    const double lml = -0.5 * z.squaredNorm() - work.diagonal().array().log().sum() -
+    Eigen::MatrixXd& a = ws.a;
+    a.resize(ld, n4);
+    factorize_into(kernel, a);
+    const auto l = a.topLeftCorner(n, n);
+    const Eigen::VectorXd z = l.template triangularView<Eigen::Lower>().solve(yn_.head(n));
+    const Eigen::VectorXd alpha = l.template triangularView<Eigen::Lower>().transpose().solve(z);
+    const double lml = -0.5 * z.squaredNorm() - l.diagonal().array().log().sum() -
                        0.5 * static_cast<double>(n) * std::log(2.0 * std::numbers::pi);
     if (!std::isfinite(lml)) {
       std::ostringstream os;
@@ -1575,12 +1668,14 @@ class GaussianProcess {
       throw NumericalError(os.str());
     }
     if (gradient != nullptr) {
-      detail::gp_invert_lower_in_place(work);
-      detail::gp_lower_gram_in_place(work);  // lower(work) = K^-1
+      ws.xt.setZero(ld, n4);
+      detail::gp_invert_lower(a.data(), ws.xt.data(), n4, ld);
+      detail::gp_gram(ws.xt.data(), a.data(), n4, ld);  // lower(a) = K^-1
+      auto w = a.topLeftCorner(n, n);
       for (Eigen::Index j = 0; j < n; ++j) {
-        work.col(j).tail(n - j) = alpha.tail(n - j) * alpha(j) - work.col(j).tail(n - j);
+        w.col(j).tail(n - j) = alpha.tail(n - j) * alpha(j) - w.col(j).tail(n - j);
       }
-      *gradient = 0.5 * kernel.contract_gradient(x, work);
+      *gradient = 0.5 * kernel.contract_gradient(x, w);
     }
     return lml;
   }
@@ -1590,12 +1685,9 @@ class GaussianProcess {
     ADAPTSEG_ASSERT(n_ > 0);
     const detail::GpScopedFlushSubnormals flush;
     const Eigen::Index n = n_;
-    reserve(n);
-    const auto x = x_.topRows(n);
-    auto l = l_.topLeftCorner(n, n);
-    l = kernel_.cross_covariance(x, x);
-    l.diagonal().array() += kernel_.noise_variance();
-    jitter_ = cholesky_with_jitter(l);
+    reserve(padded_rows(n));
+    jitter_ = factorize_into(kernel_, l_);
+    const auto l = l_.topLeftCorner(n, n);
     z_.head(n) = l.template triangularView<Eigen::Lower>().solve(yn_.head(n));
     alpha_.head(n) = l.template triangularView<Eigen::Lower>().transpose().solve(z_.head(n));
     alpha_current_ = true;
@@ -1616,7 +1708,7 @@ class GaussianProcess {
   struct Objective {
     const GaussianProcess* gp;
     K kernel;
-    Eigen::MatrixXd work;
+    Workspace work;
     Eigen::VectorXd best_theta;
     double best_value = std::numeric_limits<double>::infinity();
     int evaluations = 0;
