@@ -14,6 +14,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -481,6 +482,34 @@ TEST_CASE("vectorised kernels: baseline and dispatched instruction set against t
     bad.diagonal().setOnes();
     bad(n - 1, n - 1) = -1.0;
     CHECK_FALSE(adaptseg::detail::gp_cholesky(bad.data(), n4, ld));
+  }
+}
+
+TEST_CASE("likelihood: dispatched kernels and the Eigen path on both sides of the size limit") {
+  const Eigen::Index limit = adaptseg::detail::gp_dense_kernel_limit();
+  for (const Eigen::Index n : {limit, limit + 1}) {
+    CAPTURE(n);
+    const Eigen::MatrixXd x = random_inputs(n, 1, 21, 0.0, 50.0);
+    const Eigen::VectorXd y = smooth_targets(x, 22);
+    const SquaredExponentialKernel kernel(0.5, 1.0, 0.1);
+    GaussianProcess<SquaredExponentialKernel> gp(kernel);
+    gp.fit(x, y, {.optimize = false});
+    Eigen::VectorXd grad;
+    const double lml = gp.log_marginal_likelihood(kernel.log_parameters(), &grad);
+    // The fitted model and the optimiser's objective share the factorisation: equal bits.
+    CHECK(lml == gp.log_marginal_likelihood());
+
+    Eigen::MatrixXd k = kernel.cross_covariance(x, x);
+    k.diagonal().array() += kernel.noise_variance();
+    const Eigen::LLT<Eigen::MatrixXd> llt(k);
+    const Eigen::VectorXd alpha = llt.solve(y);
+    const Eigen::MatrixXd l = llt.matrixL();
+    const double lml_ref = -0.5 * y.dot(alpha) - l.diagonal().array().log().sum() -
+                           0.5 * static_cast<double>(n) * std::log(2.0 * std::numbers::pi);
+    const Eigen::MatrixXd w = alpha * alpha.transpose() - llt.solve(Eigen::MatrixXd::Identity(n, n));
+    const Eigen::VectorXd grad_ref = 0.5 * kernel.contract_gradient(x, w);
+    CHECK(lml == doctest::Approx(lml_ref).epsilon(1e-10));
+    CHECK(scaled_error(grad, grad_ref, std::max(1.0, grad_ref.cwiseAbs().maxCoeff())) < 1e-8);
   }
 }
 
