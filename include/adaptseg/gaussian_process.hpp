@@ -89,10 +89,12 @@ namespace detail {
       case 1: return name##_avx2 args;                                                        \
       default: return name##_body<16> args;                                                   \
     }                                                                                         \
-  }
+  }                                                                                           \
+  static_assert(true, "a use ends with a semicolon")
 #else
-#define ADAPTSEG_GP_DISPATCHED(ret, name, params, args) \
-  inline ret name params { return name##_body<16> args; }
+#define ADAPTSEG_GP_DISPATCHED(ret, name, params, args)    \
+  inline ret name params { return name##_body<16> args; } \
+  static_assert(true, "a use ends with a semicolon")
 #endif
 
 /// GCC vector types of 16, 32 and 64 bytes (spelled out: the attribute is not applied to a
@@ -171,7 +173,7 @@ template <int Bytes>
 
 /// Dispatching `gp_squared_exponential_body`: r2[i] <- sf2 * exp(-r2[i] / 2) (0 beyond
 /// kGpNegligibleR2) over a contiguous array.
-ADAPTSEG_GP_DISPATCHED(void, gp_squared_exponential, (double* r2, Eigen::Index size, double sf2), (r2, size, sf2))
+ADAPTSEG_GP_DISPATCHED(void, gp_squared_exponential, (double* r2, Eigen::Index size, double sf2), (r2, size, sf2));
 
 /// s[r][v] += b[r] * x[v], r < 4, v < 2, for the two vectors x at p: the rank-one step that
 /// all dense kernels below are built on (four broadcasts against two vectors of lanes).
@@ -280,7 +282,7 @@ template <int Bytes>
 /// Dispatching `gp_lower_solve_body`.
 ADAPTSEG_GP_DISPATCHED(void, gp_lower_solve,
                        (const GpPackedFactor& f, double* c, Eigen::Index lanes, double* mean, double* ssq),
-                       (f, c, lanes, mean, ssq))
+                       (f, c, lanes, mean, ssq));
 
 /// Dense kernels of one likelihood evaluation on column-major n4 x n4 matrices (n4 a multiple
 /// of 4) with leading dimension `ld` (a multiple of kGpRowGroup, >= n4); lanes are rows, in
@@ -347,8 +349,9 @@ template <int Bytes>
   return true;
 }
 
-/// xt <- (L^-1)^T for L = lower(a): row i of L^-1 is column i of xt (zero above row i... i.e.
-/// xt(q, i) = 0 for q > i). `xt` (n4 x n4, leading dimension ld) must be zero on entry.
+/// xt <- (L^-1)^T for L = lower(a): row i of L^-1 is column i of xt (L^-1 is lower
+/// triangular, so xt(q, i) = 0 for q > i). `xt` (n4 x n4, leading dimension ld) must be zero
+/// on entry.
 template <int Bytes>
 [[gnu::always_inline]] inline void gp_invert_lower_body(const double* a, double* xt, Eigen::Index n4, Eigen::Index ld) {
   using Vd = typename GpVector<Bytes>::Double;
@@ -396,10 +399,10 @@ template <int Bytes>
 }
 
 /// Dispatching `gp_cholesky_body`, `gp_invert_lower_body`, `gp_gram_body`.
-ADAPTSEG_GP_DISPATCHED(bool, gp_cholesky, (double* a, Eigen::Index n4, Eigen::Index ld), (a, n4, ld))
+ADAPTSEG_GP_DISPATCHED(bool, gp_cholesky, (double* a, Eigen::Index n4, Eigen::Index ld), (a, n4, ld));
 ADAPTSEG_GP_DISPATCHED(void, gp_invert_lower, (const double* a, double* xt, Eigen::Index n4, Eigen::Index ld),
-                       (a, xt, n4, ld))
-ADAPTSEG_GP_DISPATCHED(void, gp_gram, (const double* xt, double* a, Eigen::Index n4, Eigen::Index ld), (xt, a, n4, ld))
+                       (a, xt, n4, ld));
+ADAPTSEG_GP_DISPATCHED(void, gp_gram, (const double* xt, double* a, Eigen::Index n4, Eigen::Index ld), (xt, a, n4, ld));
 
 /// Largest n for which a likelihood evaluation uses the kernels above. They are not blocked
 /// for the cache: each 4-column step streams the triangle once, so beyond a few hundred rows
