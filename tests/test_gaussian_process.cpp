@@ -12,7 +12,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -395,6 +397,120 @@ TEST_CASE("squared exponential: value of eq:sqexp and argument checks") {
   CHECK_THROWS_WITH_AS(SquaredExponentialKernel(1.0, 1.0, 1.0, bad), doctest::Contains("bounds.noise_variance.upper"),
                        std::invalid_argument);
   CHECK_THROWS_AS(ArdSquaredExponentialKernel(Eigen::VectorXd(0)), std::invalid_argument);
+}
+
+TEST_CASE("vectorised kernels: baseline and dispatched instruction set against the reference") {
+  using adaptseg::detail::kGpQueryBlock;
+  // sf2 * exp(-r2 / 2), 0 from r2 = 690 on; sizes that leave a tail for every vector width.
+  std::vector<double> r2 = {0.0, 1e-300, 4e-17, 0.5, 689.999, 690.0, 1e3};
+  adaptseg::detail::GpSplitMix64 rng(7);
+  for (int i = 0; i < 2000; ++i) r2.push_back(700.0 * rng.uniform());
+  r2.push_back(3.0);
+  const auto check_exp = [&](const std::vector<double>& got) {
+    for (std::size_t i = 0; i < r2.size(); ++i) {
+      const double ref = r2[i] < 690.0 ? 1.7 * std::exp(-0.5 * r2[i]) : 0.0;
+      if (ref == 0.0) {
+        CHECK(got[i] == 0.0);
+      } else {
+        CHECK(std::abs(got[i] - ref) <= 4.0 * std::numeric_limits<double>::epsilon() * ref);
+      }
+    }
+  };
+  std::vector<double> baseline = r2, dispatched = r2;
+  adaptseg::detail::gp_squared_exponential_body<16>(baseline.data(), static_cast<Eigen::Index>(r2.size()), 1.7);
+  adaptseg::detail::gp_squared_exponential(dispatched.data(), static_cast<Eigen::Index>(r2.size()), 1.7);
+  check_exp(baseline);
+  check_exp(dispatched);
+  CHECK(baseline[0] == 1.7);
+
+  // v = L^-1 k per query, mean = z^T v, ssq = v^T v, for n with and without padding.
+  for (const Eigen::Index n : {Eigen::Index{1}, Eigen::Index{13}, Eigen::Index{72}}) {
+    CAPTURE(n);
+    const Eigen::MatrixXd a = random_inputs(n, n, 11);
+    const Eigen::MatrixXd spd = a * a.transpose() + static_cast<double>(n) * Eigen::MatrixXd::Identity(n, n);
+    const Eigen::MatrixXd l = spd.llt().matrixL();
+    const Eigen::VectorXd z = random_inputs(n, 1, 12, -1.0, 1.0);
+    const adaptseg::detail::GpPackedFactor factor(l, z);
+    Eigen::MatrixXd c = Eigen::MatrixXd::Zero(kGpQueryBlock, factor.n4);
+    c.leftCols(n) = random_inputs(kGpQueryBlock, n, 13);
+    const Eigen::Index lanes = 37;
+    for (const bool dispatch : {false, true}) {
+      Eigen::MatrixXd v = c;
+      Eigen::VectorXd mean(kGpQueryBlock), ssq(kGpQueryBlock);
+      if (dispatch) {
+        adaptseg::detail::gp_lower_solve(factor, v.data(), lanes, mean.data(), ssq.data());
+      } else {
+        adaptseg::detail::gp_lower_solve_body<16>(factor, v.data(), lanes, mean.data(), ssq.data());
+      }
+      for (Eigen::Index q = 0; q < lanes; ++q) {
+        const Eigen::VectorXd ref = l.triangularView<Eigen::Lower>().solve(c.row(q).head(n).transpose());
+        CHECK(scaled_error(v.row(q).head(n).transpose(), ref, ref.cwiseAbs().maxCoeff()) < 1e-13);
+        CHECK(mean(q) == doctest::Approx(z.dot(ref)).epsilon(1e-12));
+        CHECK(ssq(q) == doctest::Approx(ref.squaredNorm()).epsilon(1e-12));
+      }
+    }
+
+    // Cholesky, L^-1 and K^-1 = L^-T L^-1 on the padded layout of a likelihood evaluation.
+    const Eigen::Index n4 = factor.n4;
+    const Eigen::Index ld = (n4 + 15) / 16 * 16;
+    const Eigen::MatrixXd inverse = spd.llt().solve(Eigen::MatrixXd::Identity(n, n));
+    for (const bool dispatch : {false, true}) {
+      Eigen::MatrixXd m = Eigen::MatrixXd::Zero(ld, n4);
+      Eigen::MatrixXd xt = Eigen::MatrixXd::Zero(ld, n4);
+      m.topLeftCorner(n, n) = spd;
+      m.diagonal().segment(n, n4 - n).setOnes();
+      if (dispatch) {
+        REQUIRE(adaptseg::detail::gp_cholesky(m.data(), n4, ld));
+      } else {
+        REQUIRE(adaptseg::detail::gp_cholesky_body<16>(m.data(), n4, ld));
+      }
+      const Eigen::MatrixXd lm = m.topLeftCorner(n, n).triangularView<Eigen::Lower>();
+      CHECK((lm - l).cwiseAbs().maxCoeff() < 1e-13 * l.cwiseAbs().maxCoeff());
+      if (dispatch) {
+        adaptseg::detail::gp_invert_lower(m.data(), xt.data(), n4, ld);
+        adaptseg::detail::gp_gram(xt.data(), m.data(), n4, ld);
+      } else {
+        adaptseg::detail::gp_invert_lower_body<16>(m.data(), xt.data(), n4, ld);
+        adaptseg::detail::gp_gram_body<16>(xt.data(), m.data(), n4, ld);
+      }
+      const Eigen::MatrixXd got = m.topLeftCorner(n, n).triangularView<Eigen::Lower>();
+      const Eigen::MatrixXd want = inverse.triangularView<Eigen::Lower>();
+      CHECK((got - want).cwiseAbs().maxCoeff() < 1e-13 * want.cwiseAbs().maxCoeff());
+    }
+    // A matrix that is not positive definite is reported, not factorised.
+    Eigen::MatrixXd bad = Eigen::MatrixXd::Zero(ld, n4);
+    bad.diagonal().setOnes();
+    bad(n - 1, n - 1) = -1.0;
+    CHECK_FALSE(adaptseg::detail::gp_cholesky(bad.data(), n4, ld));
+  }
+}
+
+TEST_CASE("likelihood: dispatched kernels and the Eigen path on both sides of the size limit") {
+  const Eigen::Index limit = adaptseg::detail::gp_dense_kernel_limit();
+  for (const Eigen::Index n : {limit, limit + 1}) {
+    CAPTURE(n);
+    const Eigen::MatrixXd x = random_inputs(n, 1, 21, 0.0, 50.0);
+    const Eigen::VectorXd y = smooth_targets(x, 22);
+    const SquaredExponentialKernel kernel(0.5, 1.0, 0.1);
+    GaussianProcess<SquaredExponentialKernel> gp(kernel);
+    gp.fit(x, y, {.optimize = false});
+    Eigen::VectorXd grad;
+    const double lml = gp.log_marginal_likelihood(kernel.log_parameters(), &grad);
+    // The fitted model and the optimiser's objective share the factorisation: equal bits.
+    CHECK(lml == gp.log_marginal_likelihood());
+
+    Eigen::MatrixXd k = kernel.cross_covariance(x, x);
+    k.diagonal().array() += kernel.noise_variance();
+    const Eigen::LLT<Eigen::MatrixXd> llt(k);
+    const Eigen::VectorXd alpha = llt.solve(y);
+    const Eigen::MatrixXd l = llt.matrixL();
+    const double lml_ref = -0.5 * y.dot(alpha) - l.diagonal().array().log().sum() -
+                           0.5 * static_cast<double>(n) * std::log(2.0 * std::numbers::pi);
+    const Eigen::MatrixXd w = alpha * alpha.transpose() - llt.solve(Eigen::MatrixXd::Identity(n, n));
+    const Eigen::VectorXd grad_ref = 0.5 * kernel.contract_gradient(x, w);
+    CHECK(lml == doctest::Approx(lml_ref).epsilon(1e-10));
+    CHECK(scaled_error(grad, grad_ref, std::max(1.0, grad_ref.cwiseAbs().maxCoeff())) < 1e-8);
+  }
 }
 
 // ============================================================================================
