@@ -399,7 +399,29 @@ TEST_CASE("squared exponential: value of eq:sqexp and argument checks") {
   CHECK_THROWS_AS(ArdSquaredExponentialKernel(Eigen::VectorXd(0)), std::invalid_argument);
 }
 
-TEST_CASE("vectorised kernels: baseline and dispatched instruction set against the reference") {
+namespace {
+// The instruction sets this CPU can run: 0 = baseline, 1 = AVX2 + FMA, 2 = AVX-512F. Each
+// compiled variant is called directly, so an AVX-512 machine tests the AVX2 kernels too.
+std::vector<int> runnable_simd_levels() {
+  std::vector<int> out{0};
+#if defined(ADAPTSEG_GP_DISPATCH)
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) out.push_back(1);
+  if (__builtin_cpu_supports("avx512f")) out.push_back(2);
+#endif
+  return out;
+}
+}  // namespace
+
+#if defined(ADAPTSEG_GP_DISPATCH)
+#define GP_AT_LEVEL(level, name, ...)                                                   \
+  ((level) == 2   ? adaptseg::detail::name##_avx512(__VA_ARGS__)                        \
+   : (level) == 1 ? adaptseg::detail::name##_avx2(__VA_ARGS__)                          \
+                  : adaptseg::detail::name##_body<16>(__VA_ARGS__))
+#else
+#define GP_AT_LEVEL(level, name, ...) adaptseg::detail::name##_body<16>(__VA_ARGS__)
+#endif
+
+TEST_CASE("vectorised kernels: every instruction set this CPU runs, and the dispatched one, against the reference") {
   using adaptseg::detail::kGpQueryBlock;
   // sf2 * exp(-r2 / 2), 0 from r2 = 690 on; sizes that leave a tail for every vector width.
   std::vector<double> r2 = {0.0, 1e-300, 4e-17, 0.5, 689.999, 690.0, 1e3};
@@ -416,12 +438,16 @@ TEST_CASE("vectorised kernels: baseline and dispatched instruction set against t
       }
     }
   };
-  std::vector<double> baseline = r2, dispatched = r2;
-  adaptseg::detail::gp_squared_exponential_body<16>(baseline.data(), static_cast<Eigen::Index>(r2.size()), 1.7);
+  std::vector<double> dispatched = r2;
   adaptseg::detail::gp_squared_exponential(dispatched.data(), static_cast<Eigen::Index>(r2.size()), 1.7);
-  check_exp(baseline);
   check_exp(dispatched);
-  CHECK(baseline[0] == 1.7);
+  for (const int level : runnable_simd_levels()) {
+    CAPTURE(level);
+    std::vector<double> got = r2;
+    GP_AT_LEVEL(level, gp_squared_exponential, got.data(), static_cast<Eigen::Index>(r2.size()), 1.7);
+    check_exp(got);
+    CHECK(got[0] == 1.7);
+  }
 
   // v = L^-1 k per query, mean = z^T v, ssq = v^T v, for n with and without padding.
   for (const Eigen::Index n : {Eigen::Index{1}, Eigen::Index{13}, Eigen::Index{72}}) {
@@ -434,14 +460,11 @@ TEST_CASE("vectorised kernels: baseline and dispatched instruction set against t
     Eigen::MatrixXd c = Eigen::MatrixXd::Zero(kGpQueryBlock, factor.n4);
     c.leftCols(n) = random_inputs(kGpQueryBlock, n, 13);
     const Eigen::Index lanes = 37;
-    for (const bool dispatch : {false, true}) {
+    for (const int level : runnable_simd_levels()) {
+      CAPTURE(level);
       Eigen::MatrixXd v = c;
       Eigen::VectorXd mean(kGpQueryBlock), ssq(kGpQueryBlock);
-      if (dispatch) {
-        adaptseg::detail::gp_lower_solve(factor, v.data(), lanes, mean.data(), ssq.data());
-      } else {
-        adaptseg::detail::gp_lower_solve_body<16>(factor, v.data(), lanes, mean.data(), ssq.data());
-      }
+      GP_AT_LEVEL(level, gp_lower_solve, factor, v.data(), lanes, mean.data(), ssq.data());
       for (Eigen::Index q = 0; q < lanes; ++q) {
         const Eigen::VectorXd ref = l.triangularView<Eigen::Lower>().solve(c.row(q).head(n).transpose());
         CHECK(scaled_error(v.row(q).head(n).transpose(), ref, ref.cwiseAbs().maxCoeff()) < 1e-13);
@@ -454,25 +477,17 @@ TEST_CASE("vectorised kernels: baseline and dispatched instruction set against t
     const Eigen::Index n4 = factor.n4;
     const Eigen::Index ld = (n4 + 15) / 16 * 16;
     const Eigen::MatrixXd inverse = spd.llt().solve(Eigen::MatrixXd::Identity(n, n));
-    for (const bool dispatch : {false, true}) {
+    for (const int level : runnable_simd_levels()) {
+      CAPTURE(level);
       Eigen::MatrixXd m = Eigen::MatrixXd::Zero(ld, n4);
       Eigen::MatrixXd xt = Eigen::MatrixXd::Zero(ld, n4);
       m.topLeftCorner(n, n) = spd;
       m.diagonal().segment(n, n4 - n).setOnes();
-      if (dispatch) {
-        REQUIRE(adaptseg::detail::gp_cholesky(m.data(), n4, ld));
-      } else {
-        REQUIRE(adaptseg::detail::gp_cholesky_body<16>(m.data(), n4, ld));
-      }
+      REQUIRE(GP_AT_LEVEL(level, gp_cholesky, m.data(), n4, ld));
       const Eigen::MatrixXd lm = m.topLeftCorner(n, n).triangularView<Eigen::Lower>();
       CHECK((lm - l).cwiseAbs().maxCoeff() < 1e-13 * l.cwiseAbs().maxCoeff());
-      if (dispatch) {
-        adaptseg::detail::gp_invert_lower(m.data(), xt.data(), n4, ld);
-        adaptseg::detail::gp_gram(xt.data(), m.data(), n4, ld);
-      } else {
-        adaptseg::detail::gp_invert_lower_body<16>(m.data(), xt.data(), n4, ld);
-        adaptseg::detail::gp_gram_body<16>(xt.data(), m.data(), n4, ld);
-      }
+      GP_AT_LEVEL(level, gp_invert_lower, m.data(), xt.data(), n4, ld);
+      GP_AT_LEVEL(level, gp_gram, xt.data(), m.data(), n4, ld);
       const Eigen::MatrixXd got = m.topLeftCorner(n, n).triangularView<Eigen::Lower>();
       const Eigen::MatrixXd want = inverse.triangularView<Eigen::Lower>();
       CHECK((got - want).cwiseAbs().maxCoeff() < 1e-13 * want.cwiseAbs().maxCoeff());
