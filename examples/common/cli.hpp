@@ -112,7 +112,7 @@ struct CalibrationCli {
         ->capture_default_str();
   }
 
-  /// Sets the rule, the threshold steps and the coverage of `options`.
+  /// Sets the rule, the threshold steps, the descent coverage and I's inputs of `options`.
   void apply(CalibrationOptions& options) const {
     options.threshold_steps = threshold_steps;
     options.front_aware = rule == "front-aware";
