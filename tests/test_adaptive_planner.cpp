@@ -94,18 +94,8 @@ TEST_CASE("adaptive planner: a candidate's extra time is exactly what the descen
   }
 }
 
-namespace {
-// Two top-level regions (3.0 cm/px over 2880 x 1080 px at 1 cm/px) and one crop patch in the
-// first region's top-left sub-cell (at 1.0 cm/px a region is 3 x 3 sub-cells of 480 x 360 px).
-Field patch_field() {
-  cv::Mat labels(1080, 2880, CV_8UC1, cv::Scalar(0));
-  labels(cv::Rect(50, 50, 100, 100)).setTo(1);
-  return Field("patch", 1.0, labels, t::soil_crop_weed(), {1, 2});
-}
-}  // namespace
-
 TEST_CASE("adaptive planner: coverage 'interest' re-maps only the sub-cells that show a label of interest") {
-  const Field f = patch_field();
+  const Field f = t::patch_field();
   OracleSegmenter oracle(f.num_classes());
   AdaptiveOptions o = options();
   o.candidate_gsd_cm = {1.0};

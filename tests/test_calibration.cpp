@@ -44,10 +44,7 @@ TEST_CASE("calibration: region samples pair every region with every candidate") 
 }
 
 TEST_CASE("calibration: with coverage 'interest' a sample re-maps the cells that show a label of interest") {
-  // Two regions, one crop patch in the first (as tests/test_adaptive_planner.cpp's patch field).
-  cv::Mat labels(1080, 2880, CV_8UC1, cv::Scalar(0));
-  labels(cv::Rect(50, 50, 100, 100)).setTo(1);
-  const Field f("patch", 1.0, labels, t::soil_crop_weed(), {1, 2});
+  const Field f = t::patch_field();  // two regions, one crop patch in the first
   OracleSegmenter oracle(f.num_classes());
   const auto all = collect_region_samples(f, oracle, CameraModel{}, 3.0, {1.0, 2.0}, f.interest());
   const auto focused =

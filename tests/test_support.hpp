@@ -76,6 +76,15 @@ inline Field blob_field(int width, int height, double gsd_cm, unsigned seed = 7,
   return Field("blobs", gsd_cm, labels, soil_crop_weed(), {1, 2});
 }
 
+/// Two top-level regions (3.0 cm/px with the default camera over 2880 x 1080 px at 1 cm/px)
+/// and one crop patch in the first region's top-left sub-cell (at 1.0 cm/px a region is 3 x 3
+/// sub-cells of 480 x 360 px): what DescentCoverage::interest is tested on.
+inline Field patch_field() {
+  cv::Mat labels(1080, 2880, CV_8UC1, cv::Scalar(0));
+  labels(cv::Rect(50, 50, 100, 100)).setTo(1);
+  return Field("patch", 1.0, labels, soil_crop_weed(), {1, 2});
+}
+
 /// Writes `labels` and a field.yaml with `yaml_body` (everything but the labels line) to `dir`.
 inline void write_field(const std::filesystem::path& dir, const cv::Mat& labels, const std::string& yaml) {
   std::filesystem::create_directories(dir);

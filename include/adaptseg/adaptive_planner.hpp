@@ -325,10 +325,9 @@ class AdaptivePlanner {
     const Waypoint& t = top_[top_index];
     const cv::Rect region = pixel_rect(t.footprint) & grid();
     const cv::Mat labels = map_.labels()(region);
-    const int margin = static_cast<int>(std::ceil(options_.top_gsd_cm / area_.map_gsd_cm - 1e-9));
     const auto keep_cell = [&](const Area& a) {
-      return valid_pixels(a) > 0 &&
-             shows_interest(labels, pixel_rect(a) - region.tl(), margin, options_.mission.interest);
+      return valid_pixels(a) > 0 && cell_shows_interest(labels, pixel_rect(a) - region.tl(), options_.top_gsd_cm,
+                                                         area_.map_gsd_cm, options_.mission.interest);
     };
     return LawnmowerPlanner(camera_).plan(t.footprint, gsd_cm, Eigen::Vector2d(t.position.x(), t.position.y()),
                                           keep_cell);

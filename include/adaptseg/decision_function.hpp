@@ -348,7 +348,7 @@ class DecisionFunction {
     std::string block, line;
     bool ended = false;
     while (std::getline(is, line)) {
-      if (line.rfind("kernel ", 0) == 0 && line == "kernel " + std::string(SquaredExponentialKernel::kName))
+      if (line == "kernel " + std::string(SquaredExponentialKernel::kName))
         line = "kernel " + std::string(ArdSquaredExponentialKernel::kName);
       block += line + '\n';
       if (line.rfind("end ", 0) == 0) {

@@ -50,16 +50,20 @@ namespace detail {
   return valid == 0 ? 0.0 : static_cast<double>(hits) / static_cast<double>(valid);
 }
 
-/// True if some pixel of `labels` inside `rect` grown by `margin_px` on every side (then
-/// clipped to the image) carries a class in `interest`: whether a sub-lawnmower cell shows a
-/// label of interest (DescentCoverage::interest).
-/// @throws std::invalid_argument unless `labels` is CV_8UC1 and `margin_px` >= 0.
-[[nodiscard]] inline bool shows_interest(const cv::Mat& labels, cv::Rect rect, int margin_px,
-                                         std::span<const int> interest) {
-  detail::require(labels.type() == CV_8UC1, "shows_interest: labels must be CV_8UC1", labels.type());
-  detail::require(margin_px >= 0, "shows_interest: margin_px must be >= 0", margin_px);
-  rect = cv::Rect(rect.x - margin_px, rect.y - margin_px, rect.width + 2 * margin_px, rect.height + 2 * margin_px) &
-         cv::Rect(0, 0, labels.cols, labels.rows);
+/// The DescentCoverage::interest rule for one sub-lawnmower cell: true if some pixel of
+/// `labels` (the region's top-level segmentation on a grid of `grid_gsd_cm`) inside `cell`,
+/// grown by one top-level pixel (`top_gsd_cm`) on every side and clipped to the image, carries
+/// a class in `interest`. One rule for the planner and for calibration, so that a model's
+/// samples are taken as its missions fly.
+/// @throws std::invalid_argument unless `labels` is CV_8UC1 and both GSDs are finite and > 0.
+[[nodiscard]] inline bool cell_shows_interest(const cv::Mat& labels, cv::Rect cell, double top_gsd_cm,
+                                              double grid_gsd_cm, std::span<const int> interest) {
+  detail::require(labels.type() == CV_8UC1, "cell_shows_interest: labels must be CV_8UC1", labels.type());
+  detail::require(std::isfinite(top_gsd_cm) && top_gsd_cm > 0.0 && std::isfinite(grid_gsd_cm) && grid_gsd_cm > 0.0,
+                  "cell_shows_interest: GSDs must be finite and > 0; top", top_gsd_cm);
+  const int m = static_cast<int>(std::ceil(top_gsd_cm / grid_gsd_cm - 1e-9));  // one top-level pixel
+  const cv::Rect rect =
+      cv::Rect(cell.x - m, cell.y - m, cell.width + 2 * m, cell.height + 2 * m) & cv::Rect(0, 0, labels.cols, labels.rows);
   const auto lut = detail::label_lut(interest);
   for (int r = rect.y; r < rect.y + rect.height; ++r) {
     const auto* row = labels.ptr<std::uint8_t>(r);

@@ -65,7 +65,6 @@ template <SegmentationBackend Backend>
   const LawnmowerPlanner planner(camera);
   const auto keep = [&](const Area& a) { return field.has_valid(a); };
   const int n = field.num_classes();
-  const int margin = static_cast<int>(std::ceil(top_gsd_cm / field.gsd_cm() - 1e-9));  // one top-level pixel
   std::vector<RegionSample> out;
   for (const auto& top : planner.plan(field.area(), top_gsd_cm, {0.0, 0.0}, keep)) {
     const Image top_image = sensor.capture(top);
@@ -80,7 +79,8 @@ template <SegmentationBackend Backend>
     top_map.fuse(top_local, top_labels);
     const auto keep_cell = [&](const Area& a) {
       return keep(a) && (coverage == DescentCoverage::region ||
-                         shows_interest(top_map.labels(), field.pixel_rect(a) - region.tl(), margin, interest));
+                         cell_shows_interest(top_map.labels(), field.pixel_rect(a) - region.tl(), top_gsd_cm,
+                                             field.gsd_cm(), interest));
     };
     for (double g : candidate_gsd_cm) {
       if (g < field.gsd_cm() * (1.0 - 1e-9)) continue;
