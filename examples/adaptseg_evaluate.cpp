@@ -50,7 +50,8 @@ int main(int argc, char** argv) {
   adaptseg::examples::CommonOptions common;
   adaptseg::examples::SegmenterOptions segmenter;
   app.add_option("--train", train_spec, "training field DIR[:x0,y0,x1,y1] (decision-function initialisation)");
-  app.add_option("--model", model_file, "use this decision model instead of calibrating on --train");
+  CLI::Option* model_opt =
+      app.add_option("--model", model_file, "use this decision model instead of calibrating on --train");
   app.add_option("--test", test_specs, "test field DIR[:x0,y0,x1,y1]; repeatable")->required();
   app.add_option("--out", out_dir, "output directory")->required();
   app.add_option("--lawnmower-factors", lawnmower_factors, "lawnmower GSDs as multiples of each field's GSD")
@@ -58,6 +59,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--budget-s", budget_s, "mission-time budget [s] for the adaptive strategies");
   calibration.add_to(app);
+  calibration.exclude(model_opt);  // the model file fixes them
   app.add_flag("--no-plots", no_plots, "do not run the plotting script");
   common.add_to(app);
   segmenter.add_to(app);

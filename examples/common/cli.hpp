@@ -93,23 +93,30 @@ struct CalibrationCli {
   std::string gain_inputs = "delta-sigma-height";
 
   void add_to(CLI::App& app) {
-    app.add_option("--rule", rule,
+    options_.clear();
+    options_.push_back(app.add_option("--rule", rule,
                    "decision rule: front-aware (descend while descents beat the lawnmower curve; no threshold) or "
                    "threshold (the paper's utility with the threshold calibrated on the training field)")
         ->check(CLI::IsMember({"front-aware", "threshold"}))
-        ->capture_default_str();
-    app.add_option("--threshold-steps", threshold_steps, "utility thresholds tried per weighting")
-        ->capture_default_str();
-    app.add_option("--coverage", coverage,
+        ->capture_default_str());
+    options_.push_back(app.add_option("--threshold-steps", threshold_steps, "utility thresholds tried per weighting")
+        ->capture_default_str());
+    options_.push_back(app.add_option("--coverage", coverage,
                    "what a descent re-maps: region (the whole top-level footprint, the paper's) or interest (only "
                    "the cells where the top-level image shows a label of interest); saved in the model")
         ->check(CLI::IsMember({"region", "interest"}))
-        ->capture_default_str();
-    app.add_option("--gain-inputs", gain_inputs,
+        ->capture_default_str());
+    options_.push_back(app.add_option("--gain-inputs", gain_inputs,
                    "what the GP I predicts the accuracy gain from: delta-sigma (the paper's) or delta-sigma-height "
                    "(the change of semantic ratio and of altitude)")
         ->check(CLI::IsMember({"delta-sigma", "delta-sigma-height"}))
-        ->capture_default_str();
+        ->capture_default_str());
+  }
+
+  /// Makes giving any calibration flag together with `other` (e.g. `--model`, which loads a
+  /// calibrated model) a command-line error instead of a silently ignored flag.
+  void exclude(CLI::Option* other) {
+    for (CLI::Option* o : options_) o->excludes(other);
   }
 
   /// Sets the rule, the threshold steps, the descent coverage and I's inputs of `options`.
@@ -120,6 +127,9 @@ struct CalibrationCli {
     options.gain_inputs = gain_inputs == "delta-sigma-height" ? DecisionFunction::GainInputs::delta_sigma_and_height
                                                               : DecisionFunction::GainInputs::delta_sigma;
   }
+
+ private:
+  std::vector<CLI::Option*> options_;
 };
 
 inline nlohmann::json opt_json(const std::optional<double>& v) {

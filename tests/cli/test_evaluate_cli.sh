@@ -33,3 +33,11 @@ budget=$(awk -v a="$total" -v b="$budget" 'BEGIN {printf "%.1f", (a + b) / 2}')
 awk -F, -v b="$budget" 'NR > 1 && $2 != "lawnmower" && $6 > b + 1e-6 {bad = 1; print "over budget: " $0}
   END {exit bad}' "$work/b/results.csv" || fail "a mission exceeded the budget $budget s"
 echo "ok: budget $budget s kept"
+
+# A calibration flag next to --model (which fixes the calibration) is refused, not ignored.
+if "$evaluate" --model "$work/e/model.yaml" --test "$examples/data/dubai-tile-6" --coverage region \
+  --out "$work/x" >"$work/log" 2>&1; then
+  fail "--coverage with --model was accepted"
+fi
+grep -q "excludes" "$work/log" || fail "no clear error for --coverage with --model: $(tail -3 "$work/log")"
+echo "ok: calibration flags with --model refused"
