@@ -506,7 +506,10 @@ def export(model, ckpt, args, model_dir: Path, val_result):
             "train_minutes": round(float(ckpt["train_seconds"]) / 60.0, 1),
             "threads": int(args.threads),
             "seed": int(args.seed),
-            "optimizer": f"Adam lr {args.lr} wd {args.weight_decay}, warm-up then poly(0.9) decay",
+            "optimizer": f"Adam wd {args.weight_decay}; per learning-rate cycle linear warm-up to the "
+                         "peak, then poly(0.9) decay to 0",
+            "lr_cycles": [{k: (float(v) if k == "lr" else int(v)) for k, v in c.items()}
+                          for c in ckpt.get("stages", [])],
             "dropout": [round(0.03 * ckpt["dropout_scale"], 4), round(0.3 * ckpt["dropout_scale"], 4)],
             "augmentation": "random 256x256 crops of camera images, flips, 90-degree rotations, "
                             "contrast x U(0.9, 1.1) and per-channel offset U(-0.1, 0.1) after normalisation",
@@ -568,6 +571,9 @@ def main(argv=None):
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--resume", action="store_true", help="continue from WORK_DIR/checkpoint.pt")
+    ap.add_argument("--extend", type=int, default=0, metavar="STEPS",
+                    help="with --resume of a finished run: train STEPS more steps under a new "
+                         "learning-rate cycle (warm-up to --lr, then poly decay; a warm restart)")
     ap.add_argument("--export-only", action="store_true", help="export WORK_DIR/checkpoint.pt and exit")
     ap.add_argument("--no-export", action="store_true")
     ap.add_argument("--export-graph", choices=("subpixel", "deconv"), default="deconv",
@@ -599,6 +605,8 @@ def main(argv=None):
     print(f"loaded {len(train_fields)} training fields + {val_field.name} in {time.time() - t0:.1f} s; "
           f"classes {classes}", flush=True)
 
+    if args.extend < 0 or (args.extend and not args.resume):
+        raise SystemExit("--extend needs --resume and a step count >= 0")
     resume = (args.resume or args.export_only) and ckpt_path.exists()
     if (args.resume or args.export_only) and not resume:
         if args.export_only:
@@ -640,6 +648,18 @@ def main(argv=None):
         torch.set_rng_state(ckpt["torch_rng"])
         rng.bit_generator.state = ckpt["numpy_rng"]
         print(f"resumed from {ckpt_path} at step {ckpt['step']}", flush=True)
+    # Learning-rate cycles: the first from step 0 to --steps (--lr, --warmup); each --extend
+    # appends one. The checkpoint keeps them, so --resume continues the schedule it was in.
+    stages = ckpt.setdefault("stages", [{"start": 0, "end": args.steps, "lr": args.lr,
+                                         "warmup": args.warmup}])
+    if args.extend:
+        if ckpt["step"] != stages[-1]["end"]:
+            raise SystemExit(f"--extend: the checkpoint is at step {ckpt['step']}, inside its last "
+                             f"learning-rate cycle (ends at {stages[-1]['end']}); finish it with --resume first")
+        stages.append({"start": ckpt["step"], "end": ckpt["step"] + args.extend, "lr": args.lr,
+                       "warmup": args.warmup})
+        print(f"extending by {args.extend} steps: new learning-rate cycle, peak {args.lr:g}", flush=True)
+    total_steps = stages[-1]["end"]
     print(f"ERFNet width {width}: channels {erfnet_channels(width)}, "
           f"{sum(p.numel() for p in model.parameters())} parameters; mean {np.round(mean, 4).tolist()} "
           f"std {np.round(std, 4).tolist()}; class weights {np.round(ckpt['class_weights'], 3).tolist()}",
@@ -666,9 +686,11 @@ def main(argv=None):
                 log.write_text("".join(lines[:1] + [ln for ln in lines[1:] if int(ln.split(",")[0]) <= ckpt["step"]]))
 
     def lr_at(step):
-        if step < args.warmup:
-            return args.lr * (step + 1) / args.warmup
-        return args.lr * (1.0 - (step - args.warmup) / max(1, args.steps - args.warmup)) ** 0.9
+        st = next(c for c in stages if c["start"] <= step < c["end"])
+        i, n, w = step - st["start"], st["end"] - st["start"], st["warmup"]
+        if i < w:
+            return st["lr"] * (i + 1) / w
+        return st["lr"] * (1.0 - (i - w) / max(1, n - w)) ** 0.9
 
     def save_checkpoint():
         ckpt.update({"model": model.state_dict(), "optimizer": opt.state_dict(),
@@ -694,7 +716,7 @@ def main(argv=None):
     model.train()
     step = ckpt["step"]
     run_loss, run_n, t_log = 0.0, 0, time.time()
-    while step < args.steps:
+    while step < total_steps:
         ts = time.time()
         lr = lr_at(step)
         for g in opt.param_groups:
@@ -709,15 +731,15 @@ def main(argv=None):
         ckpt["train_seconds"] += time.time() - ts
         run_loss += float(loss)
         run_n += 1
-        if step % args.log_every == 0 or step == args.steps:
+        if step % args.log_every == 0 or step == total_steps:
             ips = run_n * args.batch / (time.time() - t_log)
             with train_log.open("a") as fh:
                 fh.write(f"{step},{ckpt['train_seconds']:.1f},{run_loss / run_n:.5f},{lr:.3e},{ips:.2f}\n")
-            eta = (args.steps - step) * ckpt["train_seconds"] / max(1, step) / 60
-            print(f"step {step}/{args.steps} loss {run_loss / run_n:.4f} lr {lr:.2e} {ips:.2f} img/s "
+            eta = (total_steps - step) * (time.time() - t_log) / run_n / 60
+            print(f"step {step}/{total_steps} loss {run_loss / run_n:.4f} lr {lr:.2e} {ips:.2f} img/s "
                   f"elapsed {ckpt['train_seconds'] / 60:.1f} min, eta {eta:.1f} min", flush=True)
             run_loss, run_n, t_log = 0.0, 0, time.time()
-        if step % args.val_every == 0 and step < args.steps:
+        if step % args.val_every == 0 and step < total_steps:
             validate(step)
             t_log = time.time()
         if step % args.ckpt_every == 0:
