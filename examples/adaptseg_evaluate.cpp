@@ -109,7 +109,7 @@ int main(int argc, char** argv) {
     std::ofstream results(out_dir / "results.csv"), per_image(out_dir / "per_image.csv");
     results << "field,strategy,gsd_cm,miou_interest,miou_all,time_total,time_flight,time_segmentation,"
                "time_planning,images,front_margin,descents\n";
-    per_image << "field,strategy,gsd_cm,image,level,image_gsd_cm,sigma,image_miou_interest,image_miou_all\n";
+    per_image << "field,strategy,gsd_cm,image,level,image_gsd_cm,sigma,image_miou_interest,image_miou_all,truth_sigma\n";
     const std::size_t total_runs = tests.size() * (lawnmower_factors.size() + 3);
     std::size_t run_index = 0;
     for (const auto& field : tests) {
@@ -157,7 +157,8 @@ int main(int argc, char** argv) {
           const auto& w = m.waypoints[k];
           per_image << csv(field.name()) << ',' << row.strategy << ',' << fmt(row.gsd, 3) << ',' << k << ',' << w.level
                     << ',' << fmt(w.waypoint.gsd_cm, 3) << ',' << fmt(w.semantic_ratio, 6) << ','
-                    << csv(w.image_miou_interest) << ',' << csv(w.image_miou_all) << '\n';
+                    << csv(w.image_miou_interest) << ',' << csv(w.image_miou_all) << ','
+                    << csv(w.truth_ratio) << '\n';
         }
         const std::string name = row.strategy + (row.strategy == "lawnmower" ? "-" + fmt(row.gsd, 2) : "");
         const fs::path dir = field_dir / name;

@@ -46,6 +46,18 @@ TEST_CASE("metrics: classes absent from truth and prediction do not count") {
   CHECK_THROWS_AS(cm.add(truth, cv::Mat(1, 2, CV_8UC1), 255), std::invalid_argument);
 }
 
+TEST_CASE("metrics: truth share counts true labels of interest, whatever was predicted") {
+  const cv::Mat truth = (cv::Mat_<std::uint8_t>(1, 5) << 0, 1, 1, 2, 255);
+  const cv::Mat pred = (cv::Mat_<std::uint8_t>(1, 5) << 1, 1, 0, 1, 1);
+  ConfusionMatrix cm(3);
+  CHECK(cm.truth_share(std::vector<int>{1}) == 0.0);  // nothing counted yet
+  cm.add(truth, pred, 255);
+  CHECK(cm.truth_share(std::vector<int>{1}) == doctest::Approx(2.0 / 4.0));
+  CHECK(cm.truth_share(std::vector<int>{0, 2}) == doctest::Approx(2.0 / 4.0));
+  CHECK(cm.truth_share(std::vector<int>{}) == 0.0);
+  CHECK_THROWS_AS((void)cm.truth_share(std::vector<int>{3}), std::invalid_argument);
+}
+
 TEST_CASE("metrics: per-image confusion compares at the orthomosaic's resolution") {
   Image img;
   img.width_px = 2;

@@ -66,6 +66,21 @@ TEST_CASE("mission: time is flight by the ramp model plus fixed segmentation and
     CHECK(w.level == 0);
     CHECK(w.image_miou_all.has_value());
     CHECK(w.semantic_ratio > 0.0);
+    // Majority voting at 2x the field's GSD drops some of the 1-12 px blobs of L.
+    REQUIRE(w.truth_ratio.has_value());
+    CHECK(*w.truth_ratio > w.semantic_ratio);
+  }
+}
+
+TEST_CASE("mission: at the field's own GSD the oracle's semantic ratio is the truth's") {
+  const Field f = t::blob_field(1200, 900, 1.0, 7, 40);  // with an ignore border
+  OracleSegmenter oracle(f.num_classes());
+  const MissionResult r = run_lawnmower_mission(f, 1.0, oracle, deterministic());
+  REQUIRE(r.waypoints.size() == 9);
+  for (const auto& w : r.waypoints) {
+    REQUIRE(w.truth_ratio.has_value());
+    CHECK(*w.truth_ratio > 0.0);
+    CHECK(*w.truth_ratio == doctest::Approx(w.semantic_ratio).epsilon(1e-12));
   }
 }
 

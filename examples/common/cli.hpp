@@ -170,6 +170,7 @@ inline nlohmann::json result_json(const Field& field, const MissionResult& r, co
                    {"semantic_ratio", w.semantic_ratio},
                    {"image_miou_interest", opt_json(w.image_miou_interest)},
                    {"image_miou_all", opt_json(w.image_miou_all)},
+                   {"truth_ratio", opt_json(w.truth_ratio)},
                    {"segmentation_s", w.segmentation_s}});
   }
   j["waypoints"] = wps;

@@ -117,6 +117,20 @@ class ConfusionMatrix {
     return s;
   }
 
+  /// Share of the counted (valid) truth pixels whose true class is in `classes`: the semantic
+  /// ratio of the ground truth (Eq. `eq:vr` on the truth instead of a segmentation); 0 if
+  /// nothing was counted.
+  /// @throws std::invalid_argument for a class out of range.
+  [[nodiscard]] double truth_share(std::span<const int> classes) const {
+    const std::int64_t all = total();
+    std::int64_t in = 0;
+    for (int c : classes) {
+      detail::require(c >= 0 && c < n_, "ConfusionMatrix::truth_share: class out of range", c);
+      for (int k = 0; k <= n_; ++k) in += count(c, k);
+    }
+    return all == 0 ? 0.0 : static_cast<double>(in) / static_cast<double>(all);
+  }
+
   /// IoU = TP / (TP + FP + FN) of class `c`; nullopt if `c` occurs in neither the truth nor
   /// the prediction.
   /// @throws std::invalid_argument for a class out of range.

@@ -53,6 +53,9 @@ struct WaypointRecord {
   double semantic_ratio = 0.0;  ///< σ of the segmentation over L (paper Eq. `eq:vr`)
   std::optional<double> image_miou_interest;  ///< per-image mIoU over L, if defined
   std::optional<double> image_miou_all;       ///< per-image mIoU over all classes, if defined
+  /// Share of the footprint's valid ground-truth pixels in L (σ of the truth, not of the
+  /// segmentation); set when the image carries ground truth.
+  std::optional<double> truth_ratio;
   double segmentation_s = 0.0;  ///< segmentation time charged [s]
 };
 
@@ -156,6 +159,7 @@ class Mission {
       const ConfusionMatrix cm = image_confusion(v.image, v.labels, field().num_classes());
       rec.image_miou_interest = cm.miou(result_.interest);
       rec.image_miou_all = cm.miou_all();
+      rec.truth_ratio = cm.truth_share(result_.interest);
     }
     rec.segmentation_s = options_.fixed_segmentation_time_s.value_or(measured);
     result_.segmentation_s += rec.segmentation_s;

@@ -21,6 +21,11 @@ margin=$(awk -F, '$2 == "adaptive" {print $11}' "$work/e/results.csv")
 [ -n "$margin" ] || fail "no adaptive row"
 awk -v m="$margin" 'BEGIN {exit !(m > 0)}' || fail "adaptive front margin $margin is not positive"
 echo "ok: adaptive front margin on dubai-tile-6 (road) = $margin"
+# per_image.csv: every image has the truth's share of L, in [0, 1]; road is in some of them
+want="field,strategy,gsd_cm,image,level,image_gsd_cm,sigma,image_miou_interest,image_miou_all,truth_sigma"
+[ "$(head -1 "$work/e/per_image.csv")" = "$want" ] || fail "per_image.csv header: $(head -1 "$work/e/per_image.csv")"
+awk -F, 'NR > 1 {n++; if ($10 == "" || $10 < 0 || $10 > 1) bad++; if ($10 > 0) some++}
+  END {exit !(n > 0 && bad == 0 && some > 0)}' "$work/e/per_image.csv" || fail "per_image.csv truth_sigma out of [0, 1] or never > 0"
 
 # With a budget between the top-level coverage and what adaptive took without one, no mission
 # exceeds it (and the top level is still covered: evaluate fails otherwise).
