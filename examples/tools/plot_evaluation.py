@@ -24,7 +24,7 @@ import matplotlib.image as mpimg  # noqa: E402
 
 # Per-image figure: the lawnmower images are also shown restricted to those whose footprint's
 # ground truth has at least this share of L (per_image.csv column truth_sigma).
-MIN_TRUTH_SIGMA = 0.05
+from per_image_table import MIN_TRUTH_SIGMA  # noqa: E402
 
 STYLE = {
     "adaptive": dict(color="tab:red", marker="*", s=220, label="adaptive"),

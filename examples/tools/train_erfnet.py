@@ -30,6 +30,9 @@ Usage:
   /usr/bin/python3 examples/tools/train_erfnet.py [--work-dir /tmp/erfnet-run] \\
       [--model-dir examples/models/erfnet-dubai]
   ... --resume             continue from WORK_DIR/checkpoint.pt after an interruption
+  ... --resume --extend N --lr LR
+                           train a finished run N steps more under a new learning-rate
+                           cycle (peak LR); an interrupted extension resumes with --resume
   ... --export-only        re-export model.onnx/model.yaml/model.pt from the checkpoint
 """
 

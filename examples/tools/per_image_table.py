@@ -1,0 +1,72 @@
+#!/usr/bin/env python3
+"""Prints a markdown table of per-image mIoU against image GSD from adaptseg_evaluate runs.
+
+Usage: /usr/bin/python3 examples/tools/per_image_table.py [--strategy lawnmower] OUTDIR [OUTDIR ...]
+
+Reads OUTDIR/per_image.csv. One row per run x field x image GSD, over the images of the given
+strategy (default: the lawnmowers, i.e. every GSD of the sweep): mean and standard deviation of
+the per-image mIoU over L (images where it is defined), the same over the images whose
+footprint's ground truth is at least 5 % L (column truth_sigma; the subset the per-image figure
+also draws), and the per-image mIoU over all classes. The last column says whether each mean
+rises as the GSD falls (every finer GSD strictly above the next coarser one).
+"""
+import argparse
+import csv
+import os
+import statistics
+from collections import defaultdict
+
+MIN_TRUTH_SIGMA = 0.05  # also used by plot_evaluation.py
+
+
+def stats(values):
+    if not values:
+        return "–"
+    sd = statistics.pstdev(values) if len(values) > 1 else 0.0
+    return f"{statistics.fmean(values):.3f} ± {sd:.3f} ({len(values)})"
+
+
+def rises(means):
+    """True if the means (ordered by GSD, finest first) fall strictly with GSD."""
+    m = [v for v in means if v is not None]
+    return len(m) >= 2 and all(a > b for a, b in zip(m, m[1:]))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--strategy", default="lawnmower")
+    ap.add_argument("dirs", nargs="+")
+    args = ap.parse_args()
+    print("| run | field | GSD [cm/px] | mIoU L, all images (n) | mIoU L, images with L ≥ 5 % (n) | "
+          "mIoU all classes (n) |")
+    print("| --- | --- | ---: | ---: | ---: | ---: |")
+    summary = []
+    for d in args.dirs:
+        groups = defaultdict(lambda: ([], [], []))
+        with open(os.path.join(d, "per_image.csv"), newline="") as f:
+            for r in csv.DictReader(f):
+                if r["strategy"] != args.strategy:
+                    continue
+                g = groups[(r["field"], round(float(r["image_gsd_cm"]), 3))]
+                if r["image_miou_interest"] != "":
+                    g[0].append(float(r["image_miou_interest"]))
+                    if r.get("truth_sigma", "") != "" and float(r["truth_sigma"]) >= MIN_TRUTH_SIGMA:
+                        g[1].append(float(r["image_miou_interest"]))
+                if r["image_miou_all"] != "":
+                    g[2].append(float(r["image_miou_all"]))
+        run = os.path.basename(os.path.normpath(d))
+        for field in sorted({k[0] for k in groups}):
+            keys = sorted(k for k in groups if k[0] == field)
+            for k in keys:
+                print(f"| {run} | {field} | {k[1]:.2f} | " + " | ".join(stats(v) for v in groups[k]) + " |")
+            cols = [[statistics.fmean(groups[k][i]) if groups[k][i] else None for k in keys] for i in range(3)]
+            summary.append(f"{run} / {field}: rises as GSD falls? L all images: {'yes' if rises(cols[0]) else 'no'}; "
+                           f"L, images with L >= 5 %: {'yes' if rises(cols[1]) else 'no'}; "
+                           f"all classes: {'yes' if rises(cols[2]) else 'no'}")
+    print()
+    for s in summary:
+        print(s)
+
+
+if __name__ == "__main__":
+    main()
