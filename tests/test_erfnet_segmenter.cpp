@@ -107,7 +107,7 @@ TEST_CASE("erfnet: passes the backend conformance suite on the held-out Dubai ti
 TEST_CASE("erfnet: mIoU on held-out tile 6 at the finest GSD is above the floor") {
   // A sub-field of tile 6 (8 images at 1x the orthomosaic GSD, 5 cm/px, to keep the test
   // fast). Measured with PyTorch by tests/tools/make_erfnet_fixture.py (fixture.yaml,
-  // test_field_miou.test_region): mIoU 0.474 over all five classes (whole tile 6 at 1x: 0.558).
+  // test_field_miou.test_region): mIoU 0.448 over all five classes (whole tile 6 at 1x: 0.512).
   // The floor, 0.40, is set below that with margin; it catches a broken pre-processing
   // (channel order, normalisation) or a wrong model, which fall far below it.
   const Field whole = Field::load(t::example_field(kTestField));
@@ -188,12 +188,28 @@ TEST_CASE("erfnet: resize_to_network takes other camera sizes of the same aspect
   const cv::Mat labels = erfnet.segment(big);
   REQUIRE(labels.type() == CV_8UC1);
   REQUIRE(labels.size() == cv::Size(960, 720));
+  // The contract: the network sees the image shrunk with INTER_AREA to its input size, and its
+  // logits come back bilinearly enlarged to the camera size.
+  Image small = native;
+  cv::resize(big.rgb, small.rgb, cv::Size(480, 360), 0, 0, cv::INTER_AREA);
+  ErfnetSegmenter native_net(model_dir());
+  const std::vector<cv::Mat> want = native_net.logits(small);
+  const std::vector<cv::Mat> got = erfnet.logits(big);
+  REQUIRE(got.size() == want.size());
+  for (std::size_t c = 0; c < got.size(); ++c) {
+    REQUIRE(got[c].size() == cv::Size(960, 720));
+    cv::Mat up;
+    cv::resize(want[c], up, got[c].size(), 0, 0, cv::INTER_LINEAR);
+    CHECK(cv::norm(got[c], up, cv::NORM_INF) < 1e-4);
+  }
+  // And the labels stay close to the original image's (INTER_AREA 2x down of a bilinear 2x up
+  // is close to, not equal to, the original; 0.89 for the committed model).
   const cv::Mat torch_labels = cv::imread((fixture_dir() / "labels_torch.png").string(), cv::IMREAD_UNCHANGED);
   cv::Mat up;
   cv::resize(torch_labels, up, labels.size(), 0, 0, cv::INTER_NEAREST);
   const double agree = 1.0 - cv::countNonZero(labels != up) / static_cast<double>(labels.total());
   CAPTURE(agree);
-  CHECK(agree > 0.9);  // INTER_AREA 2x down of a bilinear 2x up is close to, not equal to, the original
+  CHECK(agree > 0.8);
 }
 
 TEST_CASE("erfnet: clear errors for bad models, bad parameters and images without RGB") {

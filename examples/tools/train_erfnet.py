@@ -22,9 +22,10 @@ val_log.csv; at the end (or with --export-only) in --model-dir: model.onnx (fp32
 input 1x3xHxW "input", output 1xCxHxW "logits"), model.yaml (metadata), model.pt (final
 weights, state_dict), train_log.csv, val_log.csv.
 
-The defaults reproduce the committed model (examples/models/erfnet-dubai/README.md):
-train on dubai-tile-1,2,3,5, validate on dubai-tile-4, never read dubai-tile-6 (the test
-field); half width, 1600 steps of 8 crops, one thread (~55-60 min on an idle core).
+The defaults are the first cycle of the committed model (examples/models/erfnet-dubai/
+README.md, which gives both commands): train on dubai-tile-1,2,3,5, validate on dubai-tile-4,
+never read dubai-tile-6 (the test field); half width, 1600 steps of 8 crops, one thread
+(~55-60 min on an idle core); then --resume --extend 2400 --lr 1e-3 --warmup 20 --threads 2.
 
 Usage:
   /usr/bin/python3 examples/tools/train_erfnet.py [--work-dir /tmp/erfnet-run] \\
