@@ -93,24 +93,25 @@ struct CalibrationCli {
   std::string gain_inputs = "delta-sigma-height";
 
   void add_to(CLI::App& app) {
-    options_.clear();
-    options_.push_back(app.add_option("--rule", rule,
-                   "decision rule: front-aware (descend while descents beat the lawnmower curve; no threshold) or "
-                   "threshold (the paper's utility with the threshold calibrated on the training field)")
-        ->check(CLI::IsMember({"front-aware", "threshold"}))
-        ->capture_default_str());
-    options_.push_back(app.add_option("--threshold-steps", threshold_steps, "utility thresholds tried per weighting")
-        ->capture_default_str());
-    options_.push_back(app.add_option("--coverage", coverage,
-                   "what a descent re-maps: region (the whole top-level footprint, the paper's) or interest (only "
-                   "the cells where the top-level image shows a label of interest); saved in the model")
-        ->check(CLI::IsMember({"region", "interest"}))
-        ->capture_default_str());
-    options_.push_back(app.add_option("--gain-inputs", gain_inputs,
-                   "what the GP I predicts the accuracy gain from: delta-sigma (the paper's) or delta-sigma-height "
-                   "(the change of semantic ratio and of altitude)")
-        ->check(CLI::IsMember({"delta-sigma", "delta-sigma-height"}))
-        ->capture_default_str());
+    options_ = {
+        app.add_option("--rule", rule,
+                       "decision rule: front-aware (descend while descents beat the lawnmower curve; no threshold) "
+                       "or threshold (the paper's utility with the threshold calibrated on the training field)")
+            ->check(CLI::IsMember({"front-aware", "threshold"}))
+            ->capture_default_str(),
+        app.add_option("--threshold-steps", threshold_steps, "utility thresholds tried per weighting")
+            ->capture_default_str(),
+        app.add_option("--coverage", coverage,
+                       "what a descent re-maps: region (the whole top-level footprint, the paper's) or interest "
+                       "(only the cells where the top-level image shows a label of interest); saved in the model")
+            ->check(CLI::IsMember({"region", "interest"}))
+            ->capture_default_str(),
+        app.add_option("--gain-inputs", gain_inputs,
+                       "what the GP I predicts the accuracy gain from: delta-sigma (the paper's) or "
+                       "delta-sigma-height (the change of semantic ratio and of altitude)")
+            ->check(CLI::IsMember({"delta-sigma", "delta-sigma-height"}))
+            ->capture_default_str(),
+    };
   }
 
   /// Makes giving any calibration flag together with `other` (e.g. `--model`, which loads a
