@@ -27,7 +27,7 @@ if [ "$part" != erfnet ]; then
   # Dubai with the defaults (I on delta sigma and delta h, descents over the cells showing the
   # class), then the same with the paper's I and sub-lawnmower, and with the paper's
   # sub-lawnmower alone (ablation; no figures).
-  for cls in building land road vegetation water; do
+  for cls in $classes; do
     $eval --train examples/data/dubai-tile-4 "${tests[@]}" --interest "$cls" --out "out/results/dubai-$cls" "${fixed[@]}"
     $eval --train examples/data/dubai-tile-4 "${tests[@]}" --interest "$cls" --out "out/results/ablation-paper/dubai-$cls" \
       "${fixed[@]}" "${paper[@]}" --no-plots

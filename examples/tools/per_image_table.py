@@ -19,6 +19,20 @@ from collections import defaultdict
 MIN_TRUTH_SIGMA = 0.05  # also used by plot_evaluation.py
 
 
+def by_gsd(rows, field, strategy, column="image_miou_interest", min_truth=None):
+    """{image GSD: [values of `column`]} over the per_image.csv rows of `field` flown by
+    `strategy` where the value is defined; with `min_truth`, only the images whose footprint's
+    truth is at least that share L (column truth_sigma). Also used by plot_evaluation.py."""
+    groups = defaultdict(list)
+    for r in rows:
+        if r["field"] != field or r["strategy"] != strategy or r[column] == "":
+            continue
+        if min_truth is not None and (r.get("truth_sigma", "") == "" or float(r["truth_sigma"]) < min_truth):
+            continue
+        groups[round(float(r["image_gsd_cm"]), 3)].append(float(r[column]))
+    return groups
+
+
 def stats(values):
     if not values:
         return "–"
@@ -42,24 +56,17 @@ def main():
     print("| --- | --- | ---: | ---: | ---: | ---: |")
     summary = []
     for d in args.dirs:
-        groups = defaultdict(lambda: ([], [], []))
         with open(os.path.join(d, "per_image.csv"), newline="") as f:
-            for r in csv.DictReader(f):
-                if r["strategy"] != args.strategy:
-                    continue
-                g = groups[(r["field"], round(float(r["image_gsd_cm"]), 3))]
-                if r["image_miou_interest"] != "":
-                    g[0].append(float(r["image_miou_interest"]))
-                    if r.get("truth_sigma", "") != "" and float(r["truth_sigma"]) >= MIN_TRUTH_SIGMA:
-                        g[1].append(float(r["image_miou_interest"]))
-                if r["image_miou_all"] != "":
-                    g[2].append(float(r["image_miou_all"]))
+            rows = [r for r in csv.DictReader(f) if r["strategy"] == args.strategy]
         run = os.path.basename(os.path.normpath(d))
-        for field in sorted({k[0] for k in groups}):
-            keys = sorted(k for k in groups if k[0] == field)
-            for k in keys:
-                print(f"| {run} | {field} | {k[1]:.2f} | " + " | ".join(stats(v) for v in groups[k]) + " |")
-            cols = [[statistics.fmean(groups[k][i]) if groups[k][i] else None for k in keys] for i in range(3)]
+        for field in sorted({r["field"] for r in rows}):
+            gsds = sorted({round(float(r["image_gsd_cm"]), 3) for r in rows if r["field"] == field})
+            series = (by_gsd(rows, field, args.strategy),
+                      by_gsd(rows, field, args.strategy, min_truth=MIN_TRUTH_SIGMA),
+                      by_gsd(rows, field, args.strategy, column="image_miou_all"))
+            for g in gsds:
+                print(f"| {run} | {field} | {g:.2f} | " + " | ".join(stats(s.get(g, [])) for s in series) + " |")
+            cols = [[statistics.fmean(s[g]) if s.get(g) else None for g in gsds] for s in series]
             summary.append(f"{run} / {field}: rises as GSD falls? L all images: {'yes' if rises(cols[0]) else 'no'}; "
                            f"L, images with L >= 5 %: {'yes' if rises(cols[1]) else 'no'}; "
                            f"all classes: {'yes' if rises(cols[2]) else 'no'}")

@@ -14,7 +14,6 @@ import csv
 import os
 import re
 import sys
-from collections import defaultdict
 
 import matplotlib
 
@@ -23,8 +22,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.image as mpimg  # noqa: E402
 
 # Per-image figure: the lawnmower images are also shown restricted to those whose footprint's
-# ground truth has at least this share of L (per_image.csv column truth_sigma).
-from per_image_table import MIN_TRUTH_SIGMA  # noqa: E402
+# ground truth has at least MIN_TRUTH_SIGMA of L (per_image.csv column truth_sigma).
+from per_image_table import MIN_TRUTH_SIGMA, by_gsd  # noqa: E402
 
 STYLE = {
     "adaptive": dict(color="tab:red", marker="*", s=220, label="adaptive"),
@@ -89,13 +88,7 @@ def main(out):
                   ("lawnmower", "tab:green", "s--", 0.09, MIN_TRUTH_SIGMA,
                    f"lawnmowers (images with L >= {MIN_TRUTH_SIGMA:.0%} of the truth)"))
         for strategy, color, fmt, offset, min_truth, label in series:
-            groups = defaultdict(list)
-            for r in per:
-                if r["field"] != field or r["strategy"] != strategy or r["image_miou_interest"] == "":
-                    continue
-                if min_truth is not None and (r.get("truth_sigma", "") == "" or num(r["truth_sigma"]) < min_truth):
-                    continue
-                groups[round(num(r["image_gsd_cm"]), 3)].append(num(r["image_miou_interest"]))
+            groups = by_gsd(per, field, strategy, min_truth=min_truth)
             if not groups:
                 continue
             g = sorted(groups)
