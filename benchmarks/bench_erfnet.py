@@ -32,7 +32,7 @@ import yaml
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "examples" / "tools"))
-import train_erfnet as te  # noqa: E402
+import train_segnet as te  # noqa: E402
 from bench_common import cpu_model  # noqa: E402
 
 
@@ -92,10 +92,7 @@ def main():
     args = ap.parse_args()
 
     model_dir = Path(args.model_dir)
-    meta = yaml.safe_load((model_dir / "model.yaml").read_text())
-    model = te.ERFNet(len(meta["classes"]), meta["width"])
-    model.load_state_dict(torch.load(model_dir / "model.pt", map_location="cpu"))
-    model.eval()
+    model, _, meta = te.load_exported(model_dir)
     h, w = meta["input"]["height"], meta["input"]["width"]
     x = torch.from_numpy(np.random.default_rng(0).standard_normal((1, 3, h, w)).astype(np.float32))
     flops, _ = conv_flops(model, x)

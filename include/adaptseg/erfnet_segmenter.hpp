@@ -4,9 +4,12 @@
 /// at several altitudes) run through OpenCV DNN. Link `adaptseg::erfnet`; this header is kept
 /// out of the umbrella `planner.hpp` so that users without OpenCV DNN pay nothing for it.
 ///
-/// A model is an ONNX file (fp32, input `1x3xHxW`, output `1xCxHxW` logits) plus a metadata
-/// YAML written by `examples/tools/train_erfnet.py`: class names in label-index order, input
-/// size, channel order and the per-channel normalisation `(v / 255 - mean) / std`.
+/// A model is an ONNX file (fp32, input `1x3xHxW`, output `1xCx(H/s)x(W/s)` logits at output
+/// stride s) plus a metadata YAML written by `examples/tools/train_segnet.py`: class names in
+/// label-index order, input size, channel order, the per-channel normalisation
+/// `(v / 255 - mean) / std` and the output stride. Any network of that form runs here: the
+/// bundled models are an ERFNet (`examples/models/erfnet-dubai`, stride 1) and a MobileNetV2
+/// with a light decoder (`examples/models/mobilenetv2-dubai`, stride 4).
 
 #include <adaptseg/camera.hpp>
 #include <adaptseg/error.hpp>
@@ -36,7 +39,8 @@ struct ErfnetModelInfo {
   bool rgb_order = true;             ///< true: the network takes RGB; false: BGR
   std::array<float, 3> mean{};       ///< per input channel, in the network's channel order, on v/255
   std::array<float, 3> std{};        ///< per input channel, > 0
-  double width_multiplier = 0.0;     ///< informational (1.0 = the paper's 16/64/128 channels)
+  int output_stride = 1;             ///< logits are input / output_stride per side (`output.stride`, default 1)
+  double width_multiplier = 0.0;     ///< informational (ERFNet; 1.0 = the paper's 16/64/128 channels)
 };
 
 /// Options of ErfnetSegmenter, validated once by its constructor.
@@ -50,8 +54,9 @@ struct ErfnetParams {
   int camera_height_px = 0;
   /// What to do with images whose size differs from the network input. false: refuse (the
   /// constructor throws for a differing camera size, `segment` for a differing image). true:
-  /// resample the RGB to the input size (INTER_AREA shrinking, INTER_LINEAR enlarging) and the
-  /// logits back to the image size (bilinear) before softmax / argmax. The aspect ratios must
+  /// resample the RGB to the input size (INTER_AREA shrinking, INTER_LINEAR enlarging). The
+  /// logits are resampled bilinearly to the image size whenever their size differs from it
+  /// (a network with an output stride > 1 always). The aspect ratios must
   /// agree within 1 % either way: a stretched image has another GSD than the network learnt.
   bool resize_to_network = false;
   /// Camera pixels that are exactly black (0, 0, 0), which is how SimulatedSensor fills
@@ -69,7 +74,8 @@ struct ErfnetParams {
   std::string name = "erfnet";
 };
 
-/// Semantic segmentation with an ERFNet through OpenCV DNN; a `SegmentationBackend`.
+/// Semantic segmentation with an ONNX network (ERFNet, MobileNetV2 + decoder, or any model of
+/// the metadata format above) through OpenCV DNN; a `SegmentationBackend`.
 ///
 /// Per image: BGR -> the network's channel order, `(v / 255 - mean) / std` per channel
 /// (exactly the training normalisation, from the metadata), forward, then argmax over the
@@ -152,6 +158,10 @@ class ErfnetSegmenter {
   [[nodiscard]] cv::Size input_size() const noexcept {
     return {info_.input_width_px, info_.input_height_px};
   }
+  /// The size of the network's logits [px]: the input size / the output stride.
+  [[nodiscard]] cv::Size output_size() const noexcept {
+    return {info_.input_width_px / info_.output_stride, info_.input_height_px / info_.output_stride};
+  }
 
   /// Labels: CV_8UC1, `image.height_px x image.width_px`, argmax of the logits (ties to the
   /// lower index); `image.ignore_label` on pixels without RGB content (see ErfnetParams).
@@ -212,7 +222,7 @@ class ErfnetSegmenter {
   }
 
   /// The raw network output: one CV_32FC1 plane of logits per class at the image's size
-  /// (resampled bilinearly if the image size differs from the input size). No masking.
+  /// (resampled bilinearly where the network's output size differs from it). No masking.
   /// @throws std::invalid_argument as segment().
   [[nodiscard]] std::vector<cv::Mat> logits(const Image& image) {
     check_image(image);
@@ -225,13 +235,14 @@ class ErfnetSegmenter {
     }
     net_.setInput(to_blob(rgb));
     cv::Mat out = net_.forward();
-    ADAPTSEG_ASSERT(out.dims == 4 && out.size[1] == num_classes() && out.size[2] == in.height &&
-                    out.size[3] == in.width);
+    const cv::Size net_out = output_size();
+    ADAPTSEG_ASSERT(out.dims == 4 && out.size[1] == num_classes() && out.size[2] == net_out.height &&
+                    out.size[3] == net_out.width);
     std::vector<cv::Mat> planes(static_cast<std::size_t>(num_classes()));
     for (int c = 0; c < num_classes(); ++c) {
       // Wraps the network's buffer; copied (or resampled) before the next forward.
-      const cv::Mat view(in, CV_32F, out.ptr<float>(0, c));
-      if (out_size == in)
+      const cv::Mat view(net_out, CV_32F, out.ptr<float>(0, c));
+      if (out_size == net_out)
         planes[static_cast<std::size_t>(c)] = view.clone();
       else
         cv::resize(view, planes[static_cast<std::size_t>(c)], out_size, 0, 0, cv::INTER_LINEAR);
@@ -312,6 +323,13 @@ class ErfnetSegmenter {
           (std::string(key) == "mean" ? info.mean : info.std)[k] = static_cast<float>(x);
         }
       }
+      if (const YAML::Node output = root["output"]; output && output["stride"]) {
+        info.output_stride = output["stride"].as<int>();
+        if (info.output_stride < 1 || info.output_stride > 32 ||
+            info.input_width_px % info.output_stride != 0 || info.input_height_px % info.output_stride != 0)
+          meta_error(file, "output.stride must be 1..32 and divide the input width and height (got " +
+                               std::to_string(info.output_stride) + ")");
+      }
       if (root["width"]) info.width_multiplier = root["width"].as<double>();
     } catch (const YAML::Exception& e) {
       meta_error(file, std::string("malformed value: ") + e.what());
@@ -390,7 +408,8 @@ class ErfnetSegmenter {
                                   " does not take a 1x3x" + std::to_string(info_.input_height_px) +
                                   "x" + std::to_string(info_.input_width_px) + " input: " + e.what());
     }
-    const cv::dnn::MatShape expected{1, num_classes(), info_.input_height_px, info_.input_width_px};
+    const cv::Size net_out = output_size();
+    const cv::dnn::MatShape expected{1, num_classes(), net_out.height, net_out.width};
     if (out_shape != expected) {
       std::string got;
       for (int d : out_shape) {
@@ -399,9 +418,8 @@ class ErfnetSegmenter {
       }
       throw std::invalid_argument("ErfnetSegmenter: ONNX model " + onnx_file.string() +
                                   " outputs " + got + ", expected 1x" + std::to_string(num_classes()) +
-                                  "x" + std::to_string(info_.input_height_px) + "x" +
-                                  std::to_string(info_.input_width_px) +
-                                  " (classes x input size from the metadata)");
+                                  "x" + std::to_string(net_out.height) + "x" + std::to_string(net_out.width) +
+                                  " (classes x input size / output stride from the metadata)");
     }
   }
 

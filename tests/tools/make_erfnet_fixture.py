@@ -31,19 +31,11 @@ import yaml
 
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO / "examples" / "tools"))
-import train_erfnet as te  # noqa: E402
+import train_segnet as te  # noqa: E402
 
 # The sub-field of the test field on which tests/test_erfnet_segmenter.cpp checks the mIoU at
 # the finest GSD (fractions x0, y0, x1, y1; Field::sub_field). Kept small: 8 images.
 TEST_REGION = (0.0, 0.0, 0.37, 0.57)
-
-
-def load_model(model_dir: Path):
-    meta = yaml.safe_load((model_dir / "model.yaml").read_text())
-    model = te.ERFNet(len(meta["classes"]), meta["width"])
-    model.load_state_dict(torch.load(model_dir / "model.pt", map_location="cpu"))
-    model.eval()
-    return model, meta
 
 
 def sub_field(f: te.FieldData, region) -> te.FieldData:
@@ -68,14 +60,12 @@ def main():
     cv2.setNumThreads(1)
 
     model_dir = Path(args.model_dir)
-    model, meta = load_model(model_dir)
+    model, spec, meta = te.load_exported(model_dir)
     field = te.load_field(Path(args.field))
     if field.classes != meta["classes"]:
         raise SystemExit(f"classes differ: field {field.classes} vs model {meta['classes']}")
     nc = len(meta["classes"])
-    cam = (meta["input"]["width"], meta["input"]["height"])
-    mean = np.array(meta["input"]["mean"])
-    std = np.array(meta["input"]["std"])
+    cam = spec.camera_wh
     field_dir = Path(args.field).resolve().name
     if field_dir in meta["training"]["fields"] or field_dir == meta["training"]["validation_field"]:
         raise SystemExit(f"{field_dir} was used in training or validation; it is not a test field")
@@ -98,15 +88,18 @@ def main():
     if best is None:
         raise SystemExit("no lawnmower image lies fully inside the field")
     _, index, rect, rgb = best
-    x = torch.from_numpy(te.to_tensor(rgb, mean, std))[None]
+    # What the backend computes: the network on its input size, logits resampled to the camera's.
+    x = torch.from_numpy(te.to_tensor(te.to_network_size(rgb, spec.input_wh), spec.mean, spec.std))[None]
     with torch.no_grad():
-        logits = model(x)[0].numpy().astype(np.float32)
+        net_logits = model(x)
+        logits = te.logits_to(net_logits, (cam[1], cam[0]))[0].numpy().astype(np.float32)
     labels = logits.argmax(0).astype(np.uint8)
 
     net = cv2.dnn.readNetFromONNX(str(model_dir / "model.onnx"))
     net.setInput(x.numpy())
-    cv_logits = net.forward()[0]
-    cv_diff = float(np.abs(cv_logits - logits).max())
+    cv_net_logits = net.forward()
+    cv_diff = float(np.abs(cv_net_logits - net_logits.numpy()).max())
+    cv_logits = te.logits_to(torch.from_numpy(cv_net_logits), (cam[1], cam[0]))[0].numpy()
     cv_agree = float((cv_logits.argmax(0) == labels).mean())
     margin = np.sort(logits, axis=0)
     min_margin = float((margin[-1] - margin[-2]).min())
@@ -120,9 +113,9 @@ def main():
 
     # --- test-field metrics with PyTorch (= OpenCV DNN up to ~1e-5 in the logits)
     bands = [float(v) for v in args.bands.split(",")]
-    full = te.evaluate(model, field, bands, cam, mean, std, nc)
+    full = te.evaluate(model, field, bands, spec)
     region = sub_field(field, TEST_REGION)
-    test_region = te.evaluate(model, region, [1.0], cam, mean, std, nc)[1.0]
+    test_region = te.evaluate(model, region, [1.0], spec)[1.0]
 
     fixture = {
         "description": "ERFNet backend fixture: one camera image of the held-out test field and "
