@@ -1,9 +1,11 @@
-// adaptseg_calibrate: initialise the decision function on a training field with ground truth
-// (paper §3.2.2) and choose its thresholds there; writes the model for adaptseg_mission and
+// adaptseg_calibrate: initialise the decision function on training fields with ground truth
+// (paper §3.2.2) and choose its settings there; writes the model for adaptseg_mission and
 // adaptseg_evaluate.
 //
 //   adaptseg_calibrate --field examples/data/weedmap-000 --region 0,0,0.5,1 --segmenter oracle
 //                      --out model.yaml
+//   adaptseg_calibrate --train examples/data/dubai-tile-1 --train examples/data/dubai-tile-2:0,0,1,0.5
+//                      --interest road --out roads.yaml
 //   adaptseg_calibrate --field examples/data/dubai-tile-4 --segmenter erfnet
 //                      --model-file examples/models/erfnet-dubai --out erfnet-model.yaml
 
@@ -12,28 +14,35 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <sstream>
 #include <utility>
 
 int main(int argc, char** argv) {
   namespace fs = std::filesystem;
-  CLI::App app{"Initialise the adaptive decision function on a training field and save it."};
-  fs::path field_dir, out_file;
+  CLI::App app{"Initialise the adaptive decision function on training fields and save it."};
+  fs::path field_dir, out_file, samples_csv;
   std::string region_text;
+  std::vector<std::string> train_specs;
   double top_factor = 3.0;
   std::vector<double> candidate_factors{1.0, 1.5, 2.0, 2.5};
   std::vector<double> lawnmower_factors{1.0, 1.5, 2.0, 2.5, 3.0};
   adaptseg::examples::CalibrationCli calibration;
   adaptseg::examples::CommonOptions common;
   adaptseg::examples::SegmenterOptions segmenter;  // the backend the missions will use
-  app.add_option("--field", field_dir, "training field directory (with ground truth)")->required();
-  app.add_option("--region", region_text, "part of the field to use: x0,y0,x1,y1 in fractions along the image axes");
+  CLI::Option* field_opt = app.add_option("--field", field_dir, "training field directory (with ground truth)");
+  app.add_option("--region", region_text, "part of --field to use: x0,y0,x1,y1 in fractions along the image axes")
+      ->needs(field_opt);
+  app.add_option("--train", train_specs,
+                 "training field DIR[:x0,y0,x1,y1]; repeatable (samples pooled, every field's lawnmower curve kept)")
+      ->excludes(field_opt);
   app.add_option("--out", out_file, "model file to write (YAML)")->required();
+  app.add_option("--samples-csv", samples_csv, "also write the region samples (one per region and candidate) here");
   app.add_option("--top-factor", top_factor, "top-level GSD as a multiple of the field's GSD")->capture_default_str();
   app.add_option("--candidate-factors", candidate_factors, "candidate lower GSDs, multiples of the field's GSD")
       ->delimiter(',')
       ->capture_default_str();
   app.add_option("--lawnmower-factors", lawnmower_factors,
-                 "GSDs of the training lawnmower curve, multiples of the field's GSD")
+                 "GSDs of the training lawnmower curves, multiples of the field's GSD")
       ->delimiter(',')
       ->capture_default_str();
   calibration.add_to(app);
@@ -42,36 +51,60 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   try {
-    adaptseg::Field field = adaptseg::Field::load(field_dir);
-    if (!region_text.empty()) field = field.sub_field(adaptseg::examples::parse_region(region_text));
+    std::vector<adaptseg::Field> fields;
+    if (!field_dir.empty()) {
+      fields.push_back(adaptseg::Field::load(field_dir));
+      if (!region_text.empty()) fields.back() = fields.back().sub_field(adaptseg::examples::parse_region(region_text));
+    }
+    for (const auto& spec : train_specs) fields.push_back(adaptseg::examples::load_field_spec(spec));
+    if (fields.empty()) throw std::invalid_argument("give a training field: --field DIR or --train DIR (repeatable)");
+    const adaptseg::Field& field = fields.front();
     const adaptseg::MissionOptions mission = common.resolve(field);
     const double g0 = field.gsd_cm();
+    for (const auto& f : fields)
+      if (f.gsd_cm() != g0)
+        throw std::invalid_argument("training fields must share one GSD (the factors multiply it): '" + f.name() +
+                                    "' has " + std::to_string(f.gsd_cm()) + " cm/px, '" + field.name() + "' " +
+                                    std::to_string(g0));
     adaptseg::CalibrationOptions options;
     options.adaptive.mission = mission;
     if (options.adaptive.mission.interest.empty()) options.adaptive.mission.interest = field.interest();
     options.adaptive.top_gsd_cm = top_factor * g0;
     for (double f : candidate_factors) options.adaptive.candidate_gsd_cm.push_back(f * g0);
     for (double f : lawnmower_factors) options.lawnmower_gsd_cm.push_back(f * g0);
-    calibration.apply(options);
-    std::fprintf(stderr, "calibrating on %s (%dx%d px, %.2f cm/px) with %s ...\n", field.name().c_str(),
-                 field.width_px(), field.height_px(), g0, segmenter.name.c_str());
+    calibration.apply(options, common);
+    for (const auto& f : fields)
+      std::fprintf(stderr, "calibrating on %s (%dx%d px, %.2f cm/px) with %s ...\n", f.name().c_str(), f.width_px(),
+                   f.height_px(), g0, segmenter.name.c_str());
     const auto [cal, model] = segmenter.with_backend(field, mission.camera, [&](auto& backend) {
-      adaptseg::CalibrationResult c = adaptseg::examples::calibrate_cached(field, backend, options);
-      adaptseg::DecisionModel m = adaptseg::make_decision_model(field, backend.name(), options, c);
+      adaptseg::CalibrationResult c = adaptseg::examples::calibrate_cached(fields, backend, options);
+      adaptseg::DecisionModel m = adaptseg::make_decision_model(fields, backend.name(), options, c);
       return std::pair{std::move(c), std::move(m)};
     });
     if (out_file.has_parent_path()) fs::create_directories(out_file.parent_path());
     model.save(out_file);
+    if (!samples_csv.empty()) {
+      std::ostringstream os;
+      os << "field,top_gsd_cm,sub_gsd_cm,delta_h_m,sigma_top,sigma_sub,miou_top,miou_sub,relabelled,"
+            "relabelled_interest,region_share,field_sigma,field_gain\n";
+      for (const auto& s : cal.samples)
+        os << fields[s.field].name() << ',' << s.top_gsd_cm << ',' << s.sub_gsd_cm << ',' << s.delta_h_m << ','
+           << s.sigma_top << ',' << s.sigma_sub << ',' << s.miou_top << ',' << s.miou_sub << ','
+           << s.relabelled.share << ',' << s.relabelled.interest_share << ',' << s.region_share << ','
+           << s.field_sigma << ',' << s.field_gain << '\n';
+      adaptseg::examples::write_text(samples_csv, os.str());
+    }
 
-    std::printf("training lawnmower curve (time s, mIoU interest):");
-    for (const auto& p : cal.lawnmower_curve) std::printf(" (%.1f, %.4f)", p.time_s, p.miou);
-    std::printf("\nthreshold trials (chosen first): weight_by_sigma relative front_aware min_utility -> time_s miou "
-                "front_margin worst_margin descents\n");
+    for (std::size_t k = 0; k < fields.size(); ++k) {
+      std::printf("lawnmower curve of %s (time s, mIoU interest):", fields[k].name().c_str());
+      for (const auto& p : cal.lawnmower_curves[k]) std::printf(" (%.1f, %.4f)", p.time_s, p.miou);
+      std::printf("\n");
+    }
+    std::printf("settings tried on the training fields (chosen first): mean time_s, mean mIoU, mean front margin, "
+                "worst front margin, descents\n");
     for (const auto& t : cal.trials)
-      std::printf("  %d %d %d %.6g -> %.1f %.4f %+.4f %+.4f %d\n", t.params.weight_by_sigma ? 1 : 0,
-                  t.params.relative_utility ? 1 : 0, t.params.front_aware ? 1 : 0, t.params.min_utility, t.time_s,
-                  t.miou_interest, t.front_margin,
-                  t.worst_margin, t.descents);
+      std::printf("  %-48s %8.1f %.4f %+.4f %+.4f %d\n", t.description.c_str(), t.time_s, t.miou_interest,
+                  t.front_margin, t.worst_margin, t.descents);
     std::printf("%zu region samples; linear sigma range [%.4f, %.4f]; model -> %s\n", cal.samples.size(),
                 cal.linear.sigma_low, cal.linear.sigma_high, out_file.string().c_str());
     return 0;

@@ -30,6 +30,56 @@ std::string csv(const std::string& s) {
 
 std::string csv(const std::optional<double>& v) { return v ? fmt(*v, 6) : ""; }
 
+std::string csv_finite(double v) { return std::isfinite(v) ? fmt(v, 6) : ""; }
+
+/// One row per decision: what was forecast for the chosen candidate (or for the best-scored one
+/// when continuing), what the descent changed, and, in simulation, what it gained.
+void write_decisions(std::ostream& os, const std::string& field, const std::string& strategy,
+                     const std::vector<adaptseg::DecisionRecord>& decisions,
+                     const std::vector<adaptseg::RealisedDescent>& realised) {
+  std::size_t next_realised = 0;
+  for (std::size_t k = 0; k < decisions.size(); ++k) {
+    const auto& d = decisions[k];
+    // The candidate the row describes: the chosen one, else the one with the best forecast.
+    std::optional<std::size_t> c;
+    for (std::size_t i = 0; i < d.candidates.size(); ++i) {
+      if (d.decision.descend) {
+        if (d.candidates[i].gsd_cm == d.decision.gsd_cm) c = i;
+      } else if (i < d.decision.scores.size() &&
+                 (!c || d.decision.scores[i].predicted_delta_miou < d.decision.scores[*c].predicted_delta_miou)) {
+        c = i;
+      }
+    }
+    const adaptseg::RealisedDescent* r = nullptr;
+    if (next_realised < realised.size() && realised[next_realised].decision == k) r = &realised[next_realised++];
+    os << csv(field) << ',' << strategy << ',' << k << ',' << d.waypoint_index << ',' << fmt(d.sigma, 6) << ','
+       << (d.decision.descend ? "descend" : "continue") << ',';
+    if (c) {
+      const auto& cand = d.candidates[*c];
+      os << fmt(cand.gsd_cm, 3) << ',' << cand.images << ',' << fmt(cand.extra_time_s, 3) << ',';
+      if (*c < d.decision.scores.size()) {
+        const auto& s = d.decision.scores[*c];
+        os << fmt(s.predicted_delta_sigma, 6) << ',' << fmt(s.predicted_delta_miou, 6) << ','
+           << fmt(s.predicted_delta_miou_std, 6) << ',' << csv_finite(s.predicted_relabelled) << ','
+           << csv_finite(s.predicted_field_gain) << ',' << csv_finite(s.predicted_front_margin) << ',';
+      } else {
+        os << ",,,,,,";
+      }
+    } else {
+      os << ",,,,,,,,,";
+    }
+    if (d.outcome)
+      os << fmt(d.outcome->sigma_sub, 6) << ',' << fmt(d.outcome->relabelled.share, 6) << ','
+         << fmt(d.outcome->relabelled.interest_share, 6) << ',';
+    else
+      os << ",,,";
+    if (r)
+      os << fmt(r->region_delta_miou(), 6) << ',' << fmt(r->field_gain, 6) << '\n';
+    else
+      os << ",\n";
+  }
+}
+
 std::string slug(const std::string& s) {
   std::string out;
   for (char c : s) out += std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' ? c : '_';
@@ -40,7 +90,7 @@ std::string slug(const std::string& s) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Run every strategy on test fields and write the paper's tables and figures."};
-  std::string train_spec;
+  std::vector<std::string> train_specs;
   std::vector<std::string> test_specs;
   fs::path out_dir, model_file;
   std::vector<double> lawnmower_factors{1.0, 1.5, 2.0, 2.5, 3.0};
@@ -49,7 +99,8 @@ int main(int argc, char** argv) {
   adaptseg::examples::CalibrationCli calibration;
   adaptseg::examples::CommonOptions common;
   adaptseg::examples::SegmenterOptions segmenter;
-  app.add_option("--train", train_spec, "training field DIR[:x0,y0,x1,y1] (decision-function initialisation)");
+  app.add_option("--train", train_specs,
+                 "training field DIR[:x0,y0,x1,y1] (decision-function initialisation); repeatable");
   CLI::Option* model_opt =
       app.add_option("--model", model_file, "use this decision model instead of calibrating on --train");
   app.add_option("--test", test_specs, "test field DIR[:x0,y0,x1,y1]; repeatable")->required();
@@ -66,7 +117,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   try {
-    if (train_spec.empty() == model_file.empty())
+    if (train_specs.empty() == model_file.empty())
       throw std::invalid_argument("give exactly one of --train (calibrate) and --model (load)");
     std::vector<adaptseg::Field> tests;
     for (const auto& spec : test_specs) tests.push_back(adaptseg::examples::load_field_spec(spec));
@@ -86,30 +137,40 @@ int main(int argc, char** argv) {
     if (!model_file.empty()) {
       loaded = adaptseg::DecisionModel::load(model_file);
     } else {
-      const adaptseg::Field train = adaptseg::examples::load_field_spec(train_spec);
+      std::vector<adaptseg::Field> trains;
+      for (const auto& spec : train_specs) trains.push_back(adaptseg::examples::load_field_spec(spec));
+      const adaptseg::Field& train = trains.front();
       adaptseg::CalibrationOptions co;
       co.adaptive.mission = common.resolve(train);
       const double g0 = train.gsd_cm();
       co.adaptive.top_gsd_cm = lawnmower_factors.back() * g0;
       for (std::size_t k = 0; k + 1 < lawnmower_factors.size(); ++k) co.adaptive.candidate_gsd_cm.push_back(lawnmower_factors[k] * g0);
       for (double f : lawnmower_factors) co.lawnmower_gsd_cm.push_back(f * g0);
-      calibration.apply(co);
-      std::fprintf(stderr, "[%6.1f s] calibrating on %s ...\n", elapsed(), train.name().c_str());
+      calibration.apply(co, common);
+      std::string names;
+      for (const auto& f : trains) names += (names.empty() ? "" : ", ") + f.name();
+      std::fprintf(stderr, "[%6.1f s] calibrating on %s ...\n", elapsed(), names.c_str());
       const auto cal = segmenter.with_backend(train, co.adaptive.mission.camera, [&](auto& backend) {
-        adaptseg::CalibrationResult c = adaptseg::examples::calibrate_cached(train, backend, co);
-        loaded = adaptseg::make_decision_model(train, backend.name(), co, c);
+        adaptseg::CalibrationResult c = adaptseg::examples::calibrate_cached(trains, backend, co);
+        loaded = adaptseg::make_decision_model(trains, backend.name(), co, c);
         return c;
       });
-      std::fprintf(stderr, "[%6.1f s] calibrated: %zu samples, train front margin %+.4f, %d descents\n", elapsed(),
-                   cal.samples.size(), loaded->train_front_margin, cal.trials.front().descents);
+      std::fprintf(stderr, "[%6.1f s] calibrated: %zu samples, %s, train front margin %+.4f, %d descents\n",
+                   elapsed(), cal.samples.size(), cal.trials.front().description.c_str(), loaded->train_front_margin,
+                   cal.trials.front().descents);
     }
     const adaptseg::DecisionModel& model = *loaded;
     model.save(out_dir / "model.yaml");
 
-    std::ofstream results(out_dir / "results.csv"), per_image(out_dir / "per_image.csv");
+    std::ofstream results(out_dir / "results.csv"), per_image(out_dir / "per_image.csv"),
+        decisions_csv(out_dir / "decisions.csv");
     results << "field,strategy,gsd_cm,miou_interest,miou_all,time_total,time_flight,time_segmentation,"
                "time_planning,images,front_margin,descents\n";
     per_image << "field,strategy,gsd_cm,image,level,image_gsd_cm,sigma,image_miou_interest,image_miou_all,truth_sigma\n";
+    decisions_csv << "field,strategy,decision,image,sigma,action,gsd_cm,images,extra_time_s,forecast_delta_sigma,"
+                     "forecast_delta_miou,forecast_delta_miou_std,forecast_relabelled_interest,forecast_field_gain,forecast_front_margin,"
+                     "observed_sigma_sub,observed_relabelled,observed_relabelled_interest,realised_region_delta_miou,"
+                     "realised_field_gain\n";
     const std::size_t total_runs = tests.size() * (lawnmower_factors.size() + 3);
     std::size_t run_index = 0;
     for (const auto& field : tests) {
@@ -160,6 +221,8 @@ int main(int argc, char** argv) {
                     << csv(w.image_miou_interest) << ',' << csv(w.image_miou_all) << ','
                     << csv(w.truth_ratio) << '\n';
         }
+        if (row.run.decisions)
+          write_decisions(decisions_csv, field.name(), row.strategy, *row.run.decisions, row.run.realised);
         const std::string name = row.strategy + (row.strategy == "lawnmower" ? "-" + fmt(row.gsd, 2) : "");
         const fs::path dir = field_dir / name;
         fs::create_directories(dir);
@@ -183,11 +246,15 @@ int main(int argc, char** argv) {
       }
       results.flush();
       per_image.flush();
+      decisions_csv.flush();
     }
-    if (!results || !per_image) throw std::runtime_error("error writing the CSV files in " + out_dir.string());
+    if (!results || !per_image || !decisions_csv)
+      throw std::runtime_error("error writing the CSV files in " + out_dir.string());
     results.close();
     per_image.close();
-    std::fprintf(stderr, "[%6.1f s] wrote %s/results.csv, per_image.csv and per-mission results\n", elapsed(),
+    decisions_csv.close();
+    std::fprintf(stderr, "[%6.1f s] wrote %s/results.csv, per_image.csv, decisions.csv and per-mission results\n",
+                 elapsed(),
                  out_dir.string().c_str());
     if (!no_plots) {
       const std::string cmd = "/usr/bin/python3 '" + std::string(ADAPTSEG_PLOT_SCRIPT) + "' '" + out_dir.string() + "'";

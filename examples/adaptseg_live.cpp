@@ -310,9 +310,7 @@ void fly_strategy(const std::string& strategy, const adaptseg::DecisionModel& mo
     return;
   }
   adaptseg::DecisionFunction df = model.decision_function;
-  auto p = df.params();
-  p.online = strategy == "adaptive";
-  df.set_params(p);
+  df.set_online(strategy == "adaptive");
   fly(info, images, backend, df, options, s);
 }
 

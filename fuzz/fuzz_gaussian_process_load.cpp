@@ -1,9 +1,9 @@
 // Fuzz target: the text loaders of the Gaussian processes (both kernels) and of the
-// decision function that embeds them, from memory.
+// decision function of format-1 model files that embeds them, from memory.
 
 #include "fuzz_support.hpp"
 
-#include <adaptseg/decision_function.hpp>
+#include <adaptseg/decision_model.hpp>
 #include <adaptseg/gaussian_process.hpp>
 
 #include <cstddef>
@@ -24,7 +24,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   });
   fuzz::expect_clean([&] {
     std::istringstream is(text);
-    (void)DecisionFunction::load(is);
+    (void)detail::read_legacy_decision_function(is, "fuzz");
   });
   return 0;
 }

@@ -1,59 +1,98 @@
 #!/usr/bin/env bash
-# Reproduces docs/results.md: the paper's experiment with the ground-truth oracle on the
-# bundled WeedMap field (train on one half, test on the other, then swapped) and on the Dubai
-# tiles (decision function initialised on tile 4, tested on tiles 1, 2, 3, 5, 6; one target
-# class at a time). Deterministic: fixed segmentation (0.1 s/image) and planning (0 s) times.
-# Then the ERFNet experiment (measured segmentation times, so its times vary from run to run).
-# Outputs under out/results/; prints the tables. About 25 minutes on 2 cores.
-#   bash scripts/results.sh [all|oracle|erfnet]   (default all; erfnet alone: ~4 minutes)
+# Reproduces docs/results.md.
+#   bash scripts/results.sh [all|oracle|network] [JOBS]   (default: all, one job per core)
+#
+# oracle: the paper's experiment with the ground-truth oracle, deterministic (fixed 0.1 s per
+#   image and 0 s per waypoint), in two configurations: the defaults, and the paper's (utility
+#   threshold, I on delta sigma, descents over the whole region). Runs:
+#   - WeedMap field 000: decision function initialised on one half, flown on the other, and
+#     swapped (L = crop, weed);
+#   - Dubai tiles 1-6, leave one tile out: initialised on the other five, flown on the sixth,
+#     for each of building, road, vegetation, water.
+#   About 10 minutes on 2 cores (independent runs in parallel).
+# network: the same with the bundled networks (measured segmentation times) on the tiles they
+#   never trained on: initialised on tile 4, flown on tile 6, and the reverse.
+# Outputs: out/results/<configuration>/<run>/ (adaptseg_evaluate's files); prints the tables.
 set -euo pipefail
 part=${1:-all}
-case "$part" in all | oracle | erfnet) ;; *) echo "usage: $0 [all|oracle|erfnet]" >&2; exit 2 ;; esac
+jobs=${2:-$(nproc 2>/dev/null || echo 2)}
+case "$part" in all | oracle | network) ;; *) echo "usage: $0 [all|oracle|network] [JOBS]" >&2; exit 2 ;; esac
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh plots
-cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release
-cmake --build build/release -j"$(nproc 2>/dev/null || echo 2)" --target adaptseg_evaluate
-eval=build/release/examples/adaptseg_evaluate
+cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build/release -j"$jobs" --target adaptseg_evaluate
+eval_bin=build/release/examples/adaptseg_evaluate
+root=out/results
+classes="building road vegetation water"
 fixed=(--seg-time-s 0.1 --plan-time-s 0)
-paper=(--gain-inputs delta-sigma --coverage region)
-height=(--gain-inputs delta-sigma-height --coverage region)
-classes="building land road vegetation water"
-if [ "$part" != erfnet ]; then
-  w=examples/data/weedmap-000
-  $eval --train "$w:0,0,0.5,1" --test "$w:0.5,0,1,1" --out out/results/weedmap-train-left "${fixed[@]}"
-  $eval --train "$w:0.5,0,1,1" --test "$w:0,0,0.5,1" --out out/results/weedmap-train-right "${fixed[@]}"
-  tests=()
-  for t in 1 2 3 5 6; do tests+=(--test examples/data/dubai-tile-$t); done
-  # Dubai with the defaults (I on delta sigma and delta h, descents over the cells showing the
-  # class), then the same with the paper's I and sub-lawnmower, and with the paper's
-  # sub-lawnmower alone (ablation; no figures).
-  for cls in $classes; do
-    $eval --train examples/data/dubai-tile-4 "${tests[@]}" --interest "$cls" --out "out/results/dubai-$cls" "${fixed[@]}"
-    $eval --train examples/data/dubai-tile-4 "${tests[@]}" --interest "$cls" --out "out/results/ablation-paper/dubai-$cls" \
-      "${fixed[@]}" "${paper[@]}" --no-plots
-    $eval --train examples/data/dubai-tile-4 "${tests[@]}" --interest "$cls" --out "out/results/ablation-height/dubai-$cls" \
-      "${fixed[@]}" "${height[@]}" --no-plots
+paper=(--rule threshold --gain-inputs delta-sigma --coverage region --no-plots)
+
+# One adaptseg_evaluate run: CONFIG RUN ARGS... -> $root/CONFIG/RUN (log: RUN.log beside it).
+running=0
+launched=()
+run() {
+  local config=$1 name=$2
+  shift 2
+  mkdir -p "$root/$config"
+  launched+=("$config/$name")
+  "$eval_bin" "$@" --out "$root/$config/$name" >"$root/$config/$name.log" 2>&1 &
+  running=$((running + 1))
+  if [ "$running" -ge "$jobs" ]; then
+    wait -n || true
+    running=$((running - 1))
+  fi
+}
+dubai() { echo examples/data/dubai-tile-$1; }
+# After `wait`: every launched run must have written its results.
+check() {
+  local bad=0
+  for r in "${launched[@]}"; do
+    [ -s "$root/$r/results.csv" ] || { echo "FAILED: $r (see $root/$r.log)" >&2; bad=1; }
   done
-  /usr/bin/python3 examples/tools/results_table.py out/results/weedmap-train-left out/results/weedmap-train-right
-  /usr/bin/python3 examples/tools/results_table.py out/results/dubai-*
-  /usr/bin/python3 examples/tools/margin_table.py \
-    "paper: I(Δσ), whole region=$(for c in $classes; do printf 'out/results/ablation-paper/dubai-%s,' "$c"; done | sed 's/,$//')" \
-    "I(Δσ, Δh), whole region=$(for c in $classes; do printf 'out/results/ablation-height/dubai-%s,' "$c"; done | sed 's/,$//')" \
-    "I(Δσ, Δh), cells of interest (default)=$(for c in $classes; do printf 'out/results/dubai-%s,' "$c"; done | sed 's/,$//')"
-  /usr/bin/python3 examples/tools/per_image_table.py out/results/weedmap-train-left out/results/weedmap-train-right
+  [ "$bad" = 0 ] || exit 1
+}
+
+if [ "$part" != network ]; then
+  rm -rf "$root/oracle-default" "$root/oracle-paper"
+  w=examples/data/weedmap-000
+  for config in oracle-default oracle-paper; do
+    extra=("${fixed[@]}")
+    [ "$config" = oracle-paper ] && extra+=("${paper[@]}")
+    run "$config" weedmap-train-left --train "$w:0,0,0.5,1" --test "$w:0.5,0,1,1" "${extra[@]}"
+    run "$config" weedmap-train-right --train "$w:0.5,0,1,1" --test "$w:0,0,0.5,1" "${extra[@]}"
+    for cls in $classes; do
+      for t in 1 2 3 4 5 6; do
+        train=()
+        for k in 1 2 3 4 5 6; do [ "$k" != "$t" ] && train+=(--train "$(dubai "$k")"); done
+        run "$config" "dubai-$cls-tile-$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" "${extra[@]}"
+      done
+    done
+  done
+  wait
+  check
+  runs() { ls -d "$root/$1"/*/ | sed 's:/$::' | paste -sd, -; }
+  /usr/bin/python3 examples/tools/sweep_table.py "defaults=$(runs oracle-default)" "paper=$(runs oracle-paper)"
+  /usr/bin/python3 examples/tools/per_image_table.py "$root/oracle-default/weedmap-train-left" \
+    "$root/oracle-default/weedmap-train-right"
 fi
+
 if [ "$part" != oracle ]; then
-  # The ERFNet backend (measured segmentation times): initialised on tile 4, flown on tile 6;
-  # the defaults, then the paper's I and sub-lawnmower.
-  $eval --train examples/data/dubai-tile-4 --test examples/data/dubai-tile-6 --segmenter erfnet \
-    --model-file examples/models/erfnet-dubai --threads 2 --out out/results/erfnet-veg
-  $eval --train examples/data/dubai-tile-4 --test examples/data/dubai-tile-6 --segmenter erfnet \
-    --model-file examples/models/erfnet-dubai --threads 2 --out out/results/ablation-paper/erfnet-veg "${paper[@]}" --no-plots
-  /usr/bin/python3 examples/tools/results_table.py out/results/erfnet-veg
-  /usr/bin/python3 examples/tools/margin_table.py "paper=out/results/ablation-paper/erfnet-veg" "default=out/results/erfnet-veg"
-  # Per-image mIoU by GSD also on the calibration tile 4 (the network's validation tile): its
-  # lawnmower rows (the adaptive rows there fly the tile the model was calibrated on).
-  $eval --model out/results/erfnet-veg/model.yaml --test examples/data/dubai-tile-4 --interest vegetation \
-    --segmenter erfnet --model-file examples/models/erfnet-dubai --threads 2 --out out/results/erfnet-tile4 --no-plots
-  /usr/bin/python3 examples/tools/per_image_table.py out/results/erfnet-veg out/results/erfnet-tile4
+  rm -rf "$root/network"
+  for net in erfnet-dubai mobilenetv2-dubai; do
+    for cls in $classes; do
+      run network "$net-$cls-init4-fly6" --train "$(dubai 4)" --test "$(dubai 6)" --interest "$cls" \
+        --segmenter erfnet --model-file "examples/models/$net" --threads 1
+      run network "$net-$cls-init6-fly4" --train "$(dubai 6)" --test "$(dubai 4)" --interest "$cls" \
+        --segmenter erfnet --model-file "examples/models/$net" --threads 1
+    done
+  done
+  wait
+  check
+  for net in erfnet-dubai mobilenetv2-dubai; do
+    echo
+    echo "## $net"
+    /usr/bin/python3 examples/tools/sweep_table.py "$net=$(ls -d "$root/network/$net"-*/ | sed 's:/$::' | paste -sd, -)"
+    /usr/bin/python3 examples/tools/per_image_table.py "$root/network/$net-vegetation-init4-fly6" \
+      "$root/network/$net-vegetation-init6-fly4"
+  done
 fi

@@ -27,6 +27,7 @@ struct Scripted {
       }
     return d;
   }
+  void begin_mission() { seen = 0; }
   void observe(const DescentOutcome&) { ++observed; }
 };
 static_assert(DecisionPolicy<Scripted>);
@@ -69,7 +70,24 @@ TEST_CASE("adaptive planner: descending everywhere to the field's GSD maps it ex
     REQUIRE(d.outcome.has_value());
     CHECK(d.outcome->sub_altitude_m == doctest::Approx(5.5));
     CHECK(d.candidates.size() == 4);
+    // What each descent relabelled, seen in flight: the oracle's coarse errors it corrected.
+    CHECK(d.outcome->relabelled.interest_share <= d.outcome->relabelled.share);
   }
+  // In simulation, what each descent gained: every region corrected to the truth, and the
+  // gains add up to the mission's gain over the top-level lawnmower (but for IoU's ratio).
+  REQUIRE(a.realised.size() == a.decisions.size());
+  const MissionResult top = run_lawnmower_mission(f, 3.0, oracle, options().mission);
+  double sum = 0.0;
+  for (std::size_t k = 0; k < a.realised.size(); ++k) {
+    const RealisedDescent& r = a.realised[k];
+    CHECK(r.decision == k);
+    CHECK(r.region_miou_after == doctest::Approx(1.0));
+    CHECK(r.region_miou_before <= r.region_miou_after);
+    CHECK(r.field_gain >= 0.0);
+    if (r.region_delta_miou() < 0.0) CHECK(a.decisions[k].outcome->relabelled.interest_share > 0.0);
+    sum += r.field_gain;
+  }
+  CHECK(sum == doctest::Approx(1.0 - top.miou_interest().value()).epsilon(0.15));
 }
 
 TEST_CASE("adaptive planner: a candidate's extra time is exactly what the descent adds") {

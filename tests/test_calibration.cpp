@@ -7,6 +7,12 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <locale>
+#include <sstream>
+#include <string>
+#include <variant>
 
 using namespace adaptseg;
 namespace t = adaptseg::test;
@@ -20,7 +26,7 @@ CalibrationOptions small_options() {
   o.adaptive.candidate_gsd_cm = {1.0, 2.0};
   o.lawnmower_gsd_cm = {1.0, 2.0, 3.0};
   o.threshold_steps = 3;
-  o.restarts = 1;
+  o.fit.restarts = 1;
   return o;
 }
 }  // namespace
@@ -60,68 +66,161 @@ TEST_CASE("calibration: with coverage 'interest' a sample re-maps the cells that
   }
 }
 
-TEST_CASE("calibration: the chosen thresholds never fall below the training lawnmower curve") {
+TEST_CASE("calibration: region samples carry what the descent relabelled and what it adds to the field") {
+  const Field f = t::blob_field(2000, 1500, 1.0, 9, 30);
+  OracleSegmenter oracle(f.num_classes());
+  const auto samples = collect_region_samples(f, oracle, CameraModel{}, 3.0, {1.0, 2.0}, f.interest(),
+                                              DescentCoverage::region, 3);
+  REQUIRE(samples.size() == 8);
+  double share = 0.0;
+  for (const auto& s : samples) {
+    CHECK(s.field == 3);
+    CHECK(s.relabelled.interest_share >= 0.0);
+    CHECK(s.relabelled.interest_share <= s.relabelled.share + 1e-12);
+    CHECK(s.region_share > 0.0);
+    CHECK(s.field_sigma == samples.front().field_sigma);
+    // The oracle at the field's GSD relabels only to correct: never a loss.
+    if (s.sub_gsd_cm == 1.0) {
+      CHECK(s.field_gain >= -1e-12);
+      share += s.region_share;
+    }
+    // A region that relabels nothing gains nothing.
+    if (s.relabelled.share == 0.0) CHECK(s.field_gain == doctest::Approx(0.0));
+  }
+  CHECK(share == doctest::Approx(1.0));  // the regions tile the field
+  // Descending everywhere to the field's GSD: the region gains add up to about the field's
+  // lawnmower gain (exactly, but for IoU's ratio).
+  MissionOptions mo;
+  mo.fixed_segmentation_time_s = 0.1;
+  const double lawnmower_gain = run_lawnmower_mission(f, 1.0, oracle, mo).miou_interest().value() -
+                                run_lawnmower_mission(f, 3.0, oracle, mo).miou_interest().value();
+  double sum = 0.0;
+  for (const auto& s : samples)
+    if (s.sub_gsd_cm == 1.0) sum += s.field_gain;
+  CHECK(sum == doctest::Approx(lawnmower_gain).epsilon(0.1));
+}
+
+TEST_CASE("calibration: the paper's rule takes the threshold with the best worst-case training margin") {
   const Field f = t::blob_field(2600, 2000, 1.0, 4, 30);
   OracleSegmenter oracle(f.num_classes());
   CalibrationOptions options = small_options();
-  options.front_aware = false;  // the paper's rule with a calibrated threshold
+  options.rule = CalibrationOptions::Rule::utility;
   const CalibrationResult cal = calibrate(f, oracle, options);
   CHECK(cal.samples.size() == 2u * 2u * 2u);
-  CHECK(cal.lawnmower_curve.size() == 3);
+  REQUIRE(cal.lawnmower_curves.size() == 1);
+  CHECK(cal.lawnmower_curves.front().size() == 3);
   REQUIRE_FALSE(cal.trials.empty());
+  REQUIRE_FALSE(cal.decision_function.front_aware());
   // "Never descend" is always tried, so the best worst-case margin is at least 0.
   CHECK(cal.trials.front().worst_margin >= 0.0);
+  CHECK(cal.trials.front().margins.size() == 3);  // the field and its halves
   for (const auto& trial : cal.trials) CHECK(trial.worst_margin <= cal.trials.front().worst_margin);
-  CHECK(cal.decision_function.params().min_utility == cal.trials.front().params.min_utility);
   CHECK(cal.linear.sigma_high > cal.linear.sigma_low);
   const DecisionModel model = make_decision_model(f, oracle.name(), small_options(), cal);
   CHECK(model.classes == std::vector<std::string>{"soil", "crop", "weed"});
   CHECK(model.interest == std::vector<std::string>{"crop", "weed"});
   CHECK(model.candidate_gsd_cm == std::vector<double>{1.0, 2.0});
   CHECK(model.train_front_margin == cal.trials.front().front_margin);
+  CHECK(model.calibration_segmentation_time_s == 0.1);
   model.check_compatible(f, f.interest());
 }
 
-TEST_CASE("calibration: by default the front-aware rule is chosen, with the training curve as its reference") {
+TEST_CASE("calibration: by default the front-aware rule, its confidence chosen on the training field") {
   const Field f = t::blob_field(2600, 2000, 1.0, 4, 30);
   OracleSegmenter oracle(f.num_classes());
   const CalibrationOptions options = small_options();
-  REQUIRE(options.front_aware);
+  REQUIRE(options.rule == CalibrationOptions::Rule::front_aware);
   const CalibrationResult cal = calibrate(f, oracle, options);
-  CHECK(cal.decision_function.params().front_aware);
-  CHECK(cal.trials.front().params.front_aware);
-  CHECK_FALSE(cal.decision_function.params().relative_utility);
-  // Its reference: the training lawnmower's mIoU at each lawnmower GSD.
-  const auto& reference = cal.decision_function.reference_lawnmower();
-  REQUIRE(reference.size() == options.lawnmower_gsd_cm.size());
-  for (std::size_t k = 0; k < reference.size(); ++k) {
-    CHECK(reference[k].gsd_cm == options.lawnmower_gsd_cm[k]);
-    CHECK(reference[k].miou == cal.lawnmower_curve[k].miou);
+  REQUIRE(cal.decision_function.front_aware());
+  const auto& rule = std::get<FrontAwarePolicy>(cal.decision_function.rule());
+  // One trial per confidence level; the chosen one first, with the best mean margin.
+  REQUIRE(cal.trials.size() == options.confidences.size());
+  for (const auto& trial : cal.trials) CHECK(trial.front_margin <= cal.trials.front().front_margin);
+  CHECK(cal.trials.front().description == "front-aware z=" + std::string(adaptseg::detail::format_number(rule.params().confidence)));
+  // Its reference: the training lawnmower's mIoU at each lawnmower GSD, and the field's σ.
+  REQUIRE(rule.reference().size() == 1);
+  const auto& reference = rule.reference().front();
+  REQUIRE(reference.points.size() == options.lawnmower_gsd_cm.size());
+  for (std::size_t k = 0; k < reference.points.size(); ++k) {
+    CHECK(reference.points[k].gsd_cm == options.lawnmower_gsd_cm[k]);
+    CHECK(reference.points[k].miou == cal.lawnmower_curves.front()[k].miou);
   }
-  // The threshold settings are still flown and reported.
-  CHECK(std::count_if(cal.trials.begin(), cal.trials.end(),
-                      [](const ThresholdTrial& tr) { return !tr.params.front_aware; }) > 5);
-  // The model file keeps the rule and its reference.
+  CHECK(reference.field_sigma == cal.samples.front().field_sigma);
+  CHECK(rule.model().c_model().has_value());
+  // The model file keeps the rule, its settings and its reference, and predicts the same.
   t::TempDir tmp;
   make_decision_model(f, oracle.name(), options, cal).save(tmp.path() / "model.yaml");
   const DecisionModel back = DecisionModel::load(tmp.path() / "model.yaml");
-  CHECK(back.decision_function.params().front_aware);
-  CHECK(back.decision_function.reference_lawnmower().size() == reference.size());
+  REQUIRE(back.decision_function.front_aware());
+  const auto& back_rule = std::get<FrontAwarePolicy>(back.decision_function.rule());
+  CHECK(back_rule.params().confidence == rule.params().confidence);
+  CHECK(back_rule.params().scale_prior_sd == rule.params().scale_prior_sd);
+  CHECK(back_rule.reference().front().points.size() == reference.points.size());
+  CHECK(back_rule.reference().front().field_sigma == reference.field_sigma);
+  for (double sigma : {0.0, 0.05, 0.2})
+    for (double dh : {5.5, 11.0}) {
+      const GainForecast a = rule.model().forecast(dh, sigma), b = back_rule.model().forecast(dh, sigma);
+      CHECK(a.delta_miou == b.delta_miou);
+      CHECK(a.relabelled == b.relabelled);
+      CHECK(rule.model().efficiency(dh) == back_rule.model().efficiency(dh));
+    }
+}
+
+TEST_CASE("calibration: several training fields pool their samples and keep every field's curve") {
+  const Field a = t::blob_field(2600, 2000, 1.0, 4, 30);
+  const Field b = t::blob_field(2000, 2600, 1.0, 11, 30).sub_field({0, 0, 1, 0.8});
+  OracleSegmenter oracle(a.num_classes());
+  const std::vector<Field> fields{a, b};
+  const CalibrationOptions options = small_options();
+  const CalibrationResult cal = calibrate(fields, oracle, options);
+  const auto only_a = collect_region_samples(a, oracle, CameraModel{}, 3.0, {1.0, 2.0}, a.interest(),
+                                             DescentCoverage::region, 0);
+  const auto only_b = collect_region_samples(b, oracle, CameraModel{}, 3.0, {1.0, 2.0}, b.interest(),
+                                             DescentCoverage::region, 1);
+  CHECK(cal.samples.size() == only_a.size() + only_b.size());
+  CHECK(std::count_if(cal.samples.begin(), cal.samples.end(), [](const RegionSample& s) { return s.field == 1; }) ==
+        static_cast<long>(only_b.size()));
+  REQUIRE(cal.lawnmower_curves.size() == 2);
+  const auto& rule = std::get<FrontAwarePolicy>(cal.decision_function.rule());
+  REQUIRE(rule.reference().size() == 2);
+  CHECK(rule.reference()[1].field == b.name());
+  // Each trial flew each field once, with a model fitted without it.
+  for (const auto& trial : cal.trials) CHECK(trial.margins.size() == 2);
+  const DecisionModel model = make_decision_model(fields, oracle.name(), options, cal);
+  CHECK(model.calibration_fields == std::vector<std::string>{a.name(), b.name()});
+  // Fields of another class set are refused.
+  const Field other("o", 1.0, a.labels(), {{"a", {0, 0, 0}}, {"b", {1, 1, 1}}, {"c", {2, 2, 2}}}, {1});
+  const std::vector<Field> mixed{a, other};
+  CHECK_THROWS_WITH_AS((void)calibrate(mixed, oracle, options), doctest::Contains("classes"), std::invalid_argument);
+}
+
+TEST_CASE("calibration: the model is a function of its inputs (a declared time per image)") {
+  const Field f = t::blob_field(2000, 1500, 1.0, 9, 30);
+  OracleSegmenter oracle(f.num_classes());
+  CalibrationOptions options = small_options();
+  options.adaptive.mission.fixed_segmentation_time_s.reset();  // replaced by the declared time
+  t::TempDir tmp;
+  make_decision_model(f, oracle.name(), options, calibrate(f, oracle, options)).save(tmp.path() / "a.yaml");
+  make_decision_model(f, oracle.name(), options, calibrate(f, oracle, options)).save(tmp.path() / "b.yaml");
+  CHECK(t::read_file(tmp.path() / "a.yaml") == t::read_file(tmp.path() / "b.yaml"));
+  CHECK(t::read_file(tmp.path() / "a.yaml").find("segmentation_time_s: 0.1\n") != std::string::npos);
 }
 
 TEST_CASE("decision model: file round trip and compatibility checks") {
   const Field f = t::blob_field(2000, 1500, 1.0, 9, 30);
   OracleSegmenter oracle(f.num_classes());
   const auto samples = collect_region_samples(f, oracle, CameraModel{}, 3.0, {1.0, 2.0}, f.interest());
-  DecisionModel m{.calibration_field = f.name(),
+  DecisionModel m{.calibration_fields = {f.name()},
                   .segmenter = "oracle",
+                  .calibration_segmentation_time_s = 0.1,
                   .classes = {"soil", "crop", "weed"},
                   .interest = {"crop", "weed"},
                   .camera = {},
                   .timing = {},
                   .top_gsd_cm = 3.0,
                   .candidate_gsd_cm = {1.0, 2.0},
-                  .decision_function = DecisionFunction::initialize(samples, {.min_utility = 1e-3}, 1),
+                  .decision_function = DecisionFunction(UtilityPolicy(GainModel::fit(samples, {.restarts = 1}),
+                                                                      {.min_utility = 1e-3})),
                   .linear = {0.01, 0.2},
                   .samples = samples.size(),
                   .train_front_margin = 0.01};
@@ -132,8 +231,9 @@ TEST_CASE("decision model: file round trip and compatibility checks") {
   CHECK(back.interest == m.interest);
   CHECK(back.candidate_gsd_cm == m.candidate_gsd_cm);
   CHECK(back.linear.sigma_high == m.linear.sigma_high);
-  CHECK(back.decision_function.params().min_utility == doctest::Approx(1e-3));
-  CHECK(back.decision_function.o_model().size() == m.decision_function.o_model().size());
+  CHECK(std::get<UtilityPolicy>(back.decision_function.rule()).params().min_utility == 1e-3);
+  CHECK(back.decision_function.model().o_model().size() == m.decision_function.model().o_model().size());
+  CHECK(back.calibration_fields == m.calibration_fields);
   CHECK(back.coverage == DescentCoverage::region);
   back.check_compatible(f, {1, 2});
   {  // coverage is kept; a file without the key (written before it existed) is "region"
@@ -177,4 +277,131 @@ TEST_CASE("decision model: file round trip and compatibility checks") {
                        std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "missing.yaml"), doctest::Contains("not found"),
                        std::invalid_argument);
+}
+
+namespace {
+/// The rows of an *.expected.csv of tests/data/decision_model_v1 (README there).
+struct OldRow {
+  double sigma, gsd_cm, delta_sigma, delta_miou, delta_miou_std, utility, front_margin;
+  bool descend;
+  double chosen;
+};
+std::vector<OldRow> read_expected(const std::filesystem::path& p) {
+  std::ifstream is(p);
+  std::string line;
+  std::getline(is, line);  // header
+  std::vector<OldRow> rows;
+  while (std::getline(is, line)) {
+    std::vector<double> v;
+    std::istringstream ls(line);
+    for (std::string cell; std::getline(ls, cell, ',');) v.push_back(std::stod(cell));  // "nan" included
+    REQUIRE(v.size() == 9);
+    rows.push_back({v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7] != 0.0, v[8]});
+  }
+  return rows;
+}
+}  // namespace
+
+TEST_CASE("decision model: files of format 1 load with the forecasts and decisions of adaptseg 0.1") {
+  const std::filesystem::path dir = std::filesystem::path(ADAPTSEG_TEST_DATA_DIR) / "decision_model_v1";
+  for (const char* name : {"weedmap_utility_v1", "dubai_road_front_aware_v3"}) {
+    CAPTURE(name);
+    const DecisionModel m = DecisionModel::load(dir / (std::string(name) + ".yaml"));
+    CHECK(m.calibration_fields.size() == 1);
+    CHECK_FALSE(m.decision_function.model().c_model().has_value());
+    const auto rows = read_expected(dir / (std::string(name) + ".expected.csv"));
+    REQUIRE(rows.size() == 8 * m.candidate_gsd_cm.size());
+    // The contexts dump_old.cpp.txt decided on, in its order.
+    DecisionFunction df = m.decision_function;
+    df.begin_mission();
+    const CameraModel camera(m.camera);
+    std::vector<Candidate> cands;
+    for (double g : m.candidate_gsd_cm) cands.push_back({g, camera.altitude_m(g), 4, 30.0 + 10.0 * g});
+    std::vector<LawnmowerForecast> lm;
+    for (double g : m.candidate_gsd_cm) lm.push_back({g, 400.0 / g});
+    lm.push_back({m.top_gsd_cm, 400.0 / m.top_gsd_cm});
+    for (int k = 0; k < 8; ++k) {
+      const double sigma = 0.01 + 0.07 * k;
+      const DecisionContext c{.sigma = sigma, .valid_fraction = 0.9, .top_gsd_cm = m.top_gsd_cm,
+                              .top_altitude_m = camera.altitude_m(m.top_gsd_cm), .candidates = cands,
+                              .elapsed_s = 10.0 + 20.0 * k, .rest_s = 200.0 - 20.0 * k, .region_share = 0.1,
+                              .lawnmowers = lm};
+      const Decision d = df.decide(c);
+      for (std::size_t i = 0; i < cands.size(); ++i) {
+        const OldRow& r = rows[static_cast<std::size_t>(k) * cands.size() + i];
+        const CandidateScore& s = d.scores[i];
+        CHECK(r.sigma == doctest::Approx(sigma));
+        CHECK(s.predicted_delta_sigma == doctest::Approx(r.delta_sigma).epsilon(1e-12));
+        CHECK(s.predicted_delta_miou == doctest::Approx(r.delta_miou).epsilon(1e-12));
+        CHECK(s.predicted_delta_miou_std == doctest::Approx(r.delta_miou_std).epsilon(1e-12));
+        // The front-aware rule reports its field-level gain per second as the utility (0.1:
+        // the paper's σ-weighted one, which that rule did not use).
+        if (!m.decision_function.front_aware()) CHECK(s.utility == doctest::Approx(r.utility).epsilon(1e-12));
+        if (std::isfinite(r.front_margin)) CHECK(s.predicted_front_margin == doctest::Approx(r.front_margin).epsilon(1e-12));
+        CHECK(d.descend == r.descend);
+        if (r.descend) CHECK(d.gsd_cm == r.chosen);
+      }
+    }
+  }
+  // A format-1 file whose I block (decision-function text of version 1: isotropic I) is cut
+  // before its end line says so.
+  std::string text = t::read_file(dir / "weedmap_utility_v1.yaml");
+  const auto i_end = text.rfind("end adaptseg.gaussian_process");
+  REQUIRE(i_end != std::string::npos);
+  t::TempDir tmp;
+  t::write_file(tmp.path() / "cut.yaml", text.erase(i_end));
+  CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "cut.yaml"),
+                       doctest::Contains("input ends inside I's Gaussian process"), std::invalid_argument);
+}
+
+TEST_CASE("decision model: a plain YAML file, every fitted number a key, written and read under any locale") {
+  const Field f = t::blob_field(2000, 1500, 1.0, 9, 30);
+  OracleSegmenter oracle(f.num_classes());
+  CalibrationOptions options = small_options();
+  options.confidences = {0.5};
+  const CalibrationResult cal = calibrate(f, oracle, options);
+  const DecisionModel m = make_decision_model(f, oracle.name(), options, cal);
+  t::TempDir tmp;
+  m.save(tmp.path() / "model.yaml");
+  // Any YAML reader sees the fitted state: the GPs' data and hyperparameters, the rule.
+  const YAML::Node root = YAML::LoadFile((tmp.path() / "model.yaml").string());
+  CHECK(root["format"].as<std::string>() == "adaptseg.decision_model/2");
+  const YAML::Node o = root["gain_model"]["O"];
+  REQUIRE(o.IsMap());
+  CHECK(o["targets"].size() == cal.samples.size());
+  CHECK(o["inputs"].size() == cal.samples.size());
+  CHECK(o["inputs"][0].size() == 2);
+  CHECK(o["log_parameters"].size() == 4);
+  CHECK(root["gain_model"]["C"]["kernel"].as<std::string>() == "squared_exponential_ard");
+  CHECK(root["gain_model"]["efficiency"]["eta"].size() == 2);
+  CHECK(root["rule"]["kind"].as<std::string>() == "front-aware");
+  CHECK(root["rule"]["confidence"].as<std::string>() == "0.5");
+  CHECK(root["rule"]["reference"][0]["miou"].size() == 3);
+
+  // A global locale whose decimal separator is a comma and that groups thousands.
+  struct Comma : std::numpunct<char> {
+    char do_decimal_point() const override { return ','; }
+    char do_thousands_sep() const override { return '.'; }
+    std::string do_grouping() const override { return "\3"; }
+  };
+  const std::locale previous = std::locale::global(std::locale(std::locale::classic(), new Comma));
+  try {
+    m.save(tmp.path() / "comma.yaml");
+    const DecisionModel back = DecisionModel::load(tmp.path() / "comma.yaml");
+    const DecisionModel plain = DecisionModel::load(tmp.path() / "model.yaml");
+    std::locale::global(previous);
+    CHECK(t::read_file(tmp.path() / "comma.yaml") == t::read_file(tmp.path() / "model.yaml"));
+    for (const DecisionModel* b : {&back, &plain})
+      for (double sigma : {0.01, 0.1, 0.3}) {
+        const GainForecast x = m.decision_function.model().forecast(11.0, sigma);
+        const GainForecast y = b->decision_function.model().forecast(11.0, sigma);
+        CHECK(x.delta_sigma == y.delta_sigma);
+        CHECK(x.delta_miou == y.delta_miou);
+        CHECK(x.relabelled == y.relabelled);
+      }
+    CHECK(back.camera.image_width_px == m.camera.image_width_px);
+  } catch (...) {
+    std::locale::global(previous);
+    throw;
+  }
 }

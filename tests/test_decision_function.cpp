@@ -1,18 +1,28 @@
+// The decision layer: the gain model (gain_model.hpp), the paper's rule (utility_policy.hpp),
+// the front-aware rule (front_aware_policy.hpp), the model-file wrapper (decision_function.hpp),
+// the linear baseline, and the conformance suite on each policy.
+
+#include "policy_conformance.hpp"
+
 #include <adaptseg/decision_function.hpp>
+#include <adaptseg/front_aware_policy.hpp>
+#include <adaptseg/gain_model.hpp>
 #include <adaptseg/lawnmower_curve.hpp>
 #include <adaptseg/linear_decision.hpp>
+#include <adaptseg/utility_policy.hpp>
 
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <sstream>
+#include <string>
 #include <vector>
 
 using namespace adaptseg;
 
 namespace {
 // Synthetic initialisation data: descending further (larger Δh) loses more σ and gains more
-// accuracy; denser regions (larger σ) gain more.
+// accuracy; a descent relabels ρ = 0.125 of σ(1 − σ); its field gain per relabelled share is Δh / 11.
 std::vector<RegionSample> samples() {
   std::vector<RegionSample> out;
   for (double dh : {2.75, 5.5, 8.25, 11.0})
@@ -24,6 +34,10 @@ std::vector<RegionSample> samples() {
       s.sigma_sub = sigma + 0.02 * dh * sigma;
       s.miou_top = 0.7;
       s.miou_sub = 0.7 + 0.025 * dh;
+      s.relabelled = {0.15 * sigma * (1.0 - sigma), 0.125 * sigma * (1.0 - sigma)};
+      s.region_share = 0.1;
+      s.field_sigma = 0.1;
+      s.field_gain = (dh / 11.0) * s.relabelled.interest_share * s.region_share / s.field_sigma;
       out.push_back(s);
     }
   return out;
@@ -33,221 +47,57 @@ std::vector<Candidate> candidates() {
   // 1.0, 1.5, 2.0, 2.5 cm/px below 3.0 cm/px with the default camera (h = 5.5 * gsd).
   return {{1.0, 5.5, 9, 40.0}, {1.5, 8.25, 4, 20.0}, {2.0, 11.0, 4, 20.0}, {2.5, 13.75, 4, 20.0}};
 }
+
+const GainModel& fitted() {
+  static const GainModel m = GainModel::fit(samples());
+  return m;
+}
+
+/// `m` without C (what a file of format 1 holds).
+GainModel without_c(const GainModel& m) { return GainModel(m.o_model(), m.i_model()); }
+
+DecisionContext context(std::span<const Candidate> c, double sigma = 0.2) {
+  return {.sigma = sigma, .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5, .candidates = c};
+}
 }  // namespace
 
+static_assert(DecisionPolicy<UtilityPolicy>);
+static_assert(DecisionPolicy<FrontAwarePolicy>);
 static_assert(DecisionPolicy<DecisionFunction>);
 static_assert(DecisionPolicy<LinearDecision>);
 static_assert(!DecisionPolicy<int>);
 
-TEST_CASE("decision function: initialised GPs reproduce the training trends") {
-  const auto df = DecisionFunction::initialize(samples(), {});
-  CHECK(df.o_model().size() == 20);
-  CHECK(df.i_model().size() == 20);
-  const auto c = candidates();
-  DecisionContext ctx{.sigma = 0.2, .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5, .candidates = c};
-  const auto far = df.score(ctx, c[0]);   // Δh = 11 m
-  const auto near = df.score(ctx, c[3]);  // Δh = 2.75 m
-  CHECK(far.predicted_delta_sigma < near.predicted_delta_sigma);  // more σ recovered lower down
-  CHECK(far.predicted_delta_miou == doctest::Approx(-0.275).epsilon(0.1));
-  CHECK(near.predicted_delta_miou == doctest::Approx(-0.069).epsilon(0.2));
-  CHECK(far.predicted_delta_miou_std >= 0.0);
+// ---------------------------------------------------------------------------------------------
+// GainModel
+// ---------------------------------------------------------------------------------------------
+TEST_CASE("gain model: initialised GPs reproduce the training trends") {
+  const GainModel& m = fitted();
+  CHECK(m.o_model().size() == 20);
+  CHECK(m.i_model().size() == 20);
+  CHECK(m.gain_inputs() == GainModel::GainInputs::delta_sigma_and_height);
+  const GainForecast far = m.forecast(11.0, 0.2);
+  const GainForecast near = m.forecast(2.75, 0.2);
+  CHECK(far.delta_sigma < near.delta_sigma);  // more σ recovered lower down
+  CHECK(far.delta_miou == doctest::Approx(-0.275).epsilon(0.1));
+  CHECK(near.delta_miou == doctest::Approx(-0.069).epsilon(0.2));
+  CHECK(far.delta_miou_std >= 0.0);
+  // C: χ = σ(1 − σ) · ρ with ρ = 0.125, and 0 where nothing of L, or nothing else, is seen.
+  CHECK(far.relabelled == doctest::Approx(0.02).epsilon(0.02));
+  CHECK(m.forecast(5.5, 0.05).relabelled == doctest::Approx(0.125 * 0.05 * 0.95).epsilon(0.02));
+  CHECK(m.forecast(5.5, 0.0).relabelled == 0.0);
+  CHECK(m.forecast(5.5, 1.0).relabelled == 0.0);
+  CHECK(far.relabelled_noisy_std >= far.relabelled_std);
+  // η: the field gain per relabelled share at each descent height, linear in between.
+  REQUIRE(m.efficiency_points().size() == 4);
+  CHECK(m.efficiency(11.0) == doctest::Approx(1.0));
+  CHECK(m.efficiency(2.75) == doctest::Approx(0.25));
+  CHECK(m.efficiency(6.875) == doctest::Approx(0.625));
+  CHECK(m.efficiency(20.0) == doctest::Approx(1.0));  // constant beyond the ends
+  CHECK(m.efficiency(1.0) == doctest::Approx(0.25));
+  CHECK_THROWS_AS((void)GainModel::fit({}), std::invalid_argument);
 }
 
-TEST_CASE("decision function: thresholds, σ weighting and the best utility") {
-  auto df = DecisionFunction::initialize(samples(), {});
-  const auto c = candidates();
-  DecisionContext ctx{.sigma = 0.2, .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5, .candidates = c};
-  Decision d = df.decide(ctx);
-  REQUIRE(d.scores.size() == 4);
-  REQUIRE(d.descend);
-  double best = 0.0;
-  for (const auto& s : d.scores) best = std::max(best, s.utility);
-  for (std::size_t k = 0; k < c.size(); ++k)
-    if (d.scores[k].utility == best) CHECK(d.gsd_cm == c[k].gsd_cm);
-  // σ weighting: half the σ, half the utility (same predictions up to the σ input of O).
-  DecisionContext half_valid = ctx;
-  half_valid.valid_fraction = 0.5;
-  CHECK(df.decide(half_valid).scores[0].utility == doctest::Approx(d.scores[0].utility * 0.5));
-  // Thresholds.
-  auto p = df.params();
-  p.min_sigma = 0.25;
-  df.set_params(p);
-  CHECK_FALSE(df.decide(ctx).descend);
-  p.min_sigma = 0.0;
-  p.min_utility = best * 1.01;
-  df.set_params(p);
-  CHECK_FALSE(df.decide(ctx).descend);
-  p.min_utility = best * 0.99;
-  df.set_params(p);
-  CHECK(df.decide(ctx).descend);
-  // No affordable candidate: continue.
-  DecisionContext none = ctx;
-  none.candidates = {};
-  CHECK_FALSE(df.decide(none).descend);
-  CHECK_THROWS_AS(df.set_params({.min_sigma = 2.0}), std::invalid_argument);
-  CHECK_THROWS_AS(df.set_params({.exploration = -1.0}), std::invalid_argument);
-}
-
-TEST_CASE("decision function: relative utility compares with the mission's running mean") {
-  auto df = DecisionFunction::initialize(samples(), {.min_utility = 1.2, .relative_utility = true});
-  const auto c = candidates();
-  DecisionContext low{.sigma = 0.05, .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5, .candidates = c};
-  DecisionContext high = low;
-  high.sigma = 0.3;
-  CHECK_FALSE(df.decide(low).descend);  // first image: ratio 1 < 1.2
-  CHECK_FALSE(df.decide(low).descend);
-  CHECK(df.decide(high).descend);       // well above the running mean
-  df.reset_mission();
-  CHECK_FALSE(df.decide(high).descend);  // alone again: ratio 1
-}
-
-TEST_CASE("decision function: online updates extend O only when adaptive") {
-  auto adaptive = DecisionFunction::initialize(samples(), {.online = true});
-  auto refitting = DecisionFunction::initialize(samples(), {.online = true, .refit_every = 1});
-  auto fixed = DecisionFunction::initialize(samples(), {.online = false});
-  CHECK(adaptive.name() == "adaptive");
-  CHECK(fixed.name() == "nonadaptive");
-  const DescentOutcome out{.top_altitude_m = 16.5, .sub_altitude_m = 5.5, .sigma_top = 0.1, .sigma_sub = 0.3};
-  adaptive.observe(out);
-  adaptive.observe(out);
-  fixed.observe(out);
-  refitting.observe(out);
-  CHECK(refitting.o_model().size() == 21);
-  CHECK(adaptive.o_model().size() == 22);
-  CHECK(adaptive.online_updates() == 2);
-  CHECK(fixed.o_model().size() == 20);
-  // The observed, much larger σ recovery (Δσ = -0.2) pulls O's prediction towards it.
-  const auto c = candidates();
-  DecisionContext ctx{.sigma = 0.1, .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5, .candidates = c};
-  const double before = fixed.score(ctx, c[0]).predicted_delta_sigma;
-  const double after = adaptive.score(ctx, c[0]).predicted_delta_sigma;
-  CHECK(std::abs(after - (-0.2)) < 0.5 * std::abs(before - (-0.2)));
-}
-
-TEST_CASE("decision function: save and load give the same decisions and broken files are refused") {
-  auto df = DecisionFunction::initialize(samples(), {.min_sigma = 0.01, .min_utility = 1e-4, .exploration = 0.5});
-  std::stringstream ss;
-  df.save(ss);
-  const std::string text = ss.str();
-  auto back = DecisionFunction::load(ss);
-  CHECK(back.params().min_sigma == df.params().min_sigma);
-  CHECK(back.params().exploration == df.params().exploration);
-  const auto c = candidates();
-  DecisionContext ctx{.sigma = 0.17, .valid_fraction = 0.9, .top_gsd_cm = 3.0, .top_altitude_m = 16.5, .candidates = c};
-  const Decision a = df.decide(ctx), b = back.decide(ctx);
-  CHECK(a.descend == b.descend);
-  for (std::size_t k = 0; k < c.size(); ++k)
-    CHECK(a.scores[k].utility == doctest::Approx(b.scores[k].utility).epsilon(1e-9));
-  std::istringstream truncated(text.substr(0, text.size() / 2));
-  CHECK_THROWS_AS((void)DecisionFunction::load(truncated), std::invalid_argument);
-  std::istringstream wrong("adaptseg.decision_function 7\n");
-  CHECK_THROWS_WITH_AS((void)DecisionFunction::load(wrong), doctest::Contains("version"), std::invalid_argument);
-  std::istringstream empty("");
-  CHECK_THROWS_AS((void)DecisionFunction::load(empty), std::invalid_argument);
-  CHECK_THROWS_AS((void)DecisionFunction::initialize({}, {}), std::invalid_argument);
-}
-
-TEST_CASE("decision function: the front-aware rule descends while descents beat the lawnmower curve") {
-  auto df = DecisionFunction::initialize(samples(), {.weight_by_sigma = false, .front_aware = true});
-  // Training lawnmower by GSD, and this field's lawnmower times at the same GSDs.
-  df.set_reference_lawnmower({{1.0, 1.0}, {1.5, 0.85}, {2.0, 0.82}, {2.5, 0.77}, {3.0, 0.75}});
-  const std::vector<LawnmowerForecast> lawnmowers{{1.0, 185.0}, {1.5, 107.0}, {2.0, 101.0}, {2.5, 96.0}, {3.0, 40.0}};
-  const std::vector<CurvePoint> curve{{185.0, 1.0}, {107.0, 0.85}, {101.0, 0.82}, {96.0, 0.77}, {40.0, 0.75}};
-  const auto c = candidates();
-  DecisionContext ctx{.sigma = 0.2, .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5,
-                      .candidates = c, .elapsed_s = 5.7, .rest_s = 34.3, .region_share = 1.0 / 7.0,
-                      .lawnmowers = lawnmowers};
-  // First region: the mission's end point is the top-level lawnmower's (40 s, 0.75), margin 0.
-  // Re-mapping the region (1/7 of the field) from 1.0 cm/px gains about 0.275 / 7 = 0.039 for
-  // 40 s: (80 s, 0.789) lies above the curve (0.764 there).
-  const Decision first = df.decide(ctx);
-  REQUIRE(first.descend);
-  double best = -1.0;
-  for (std::size_t k = 0; k < c.size(); ++k) {
-    const auto& s = first.scores[k];
-    // The predicted margin is the forecast end point against the curve, from the region's gain.
-    const double expected = front_margin(curve, 40.0 + c[k].extra_time_s, 0.75 - s.predicted_delta_miou / 7.0);
-    CHECK(s.predicted_front_margin == doctest::Approx(expected).epsilon(1e-9));
-    best = std::max(best, s.predicted_front_margin);
-  }
-  CHECK(best > 0.015);
-  for (std::size_t k = 0; k < c.size(); ++k)
-    if (first.scores[k].predicted_front_margin == best) CHECK(first.gsd_cm == c[k].gsd_cm);
-  // A later region, after that descent (end point now about 85 s): another descent would end
-  // in the curve's steep part (2.5 -> 1.5 cm/px costs only 11 s there), below it: continue.
-  DecisionContext next = ctx;
-  next.elapsed_s = 5.7 + 40.0 + 5.7;
-  next.rest_s = 33.6;
-  const Decision second = df.decide(next);
-  CHECK_FALSE(second.descend);
-  for (const auto& s : second.scores) CHECK(s.predicted_front_margin < 0.0);
-  // A new mission forgets the forecast: the first region descends again.
-  df.reset_mission();
-  CHECK(df.decide(ctx).descend);
-  // The rule needs the forecasts and the reference; it excludes the relative threshold.
-  df.reset_mission();
-  DecisionContext blind = ctx;
-  blind.lawnmowers = {};
-  CHECK_THROWS_WITH_AS((void)df.decide(blind), doctest::Contains("lawnmower forecasts"), std::invalid_argument);
-  auto no_reference = DecisionFunction::initialize(samples(), {.front_aware = true});
-  CHECK_THROWS_WITH_AS((void)no_reference.decide(ctx), doctest::Contains("reference lawnmower"),
-                       std::invalid_argument);
-  CHECK_THROWS_AS(df.set_params({.relative_utility = true, .front_aware = true}), std::invalid_argument);
-  CHECK_THROWS_AS(df.set_reference_lawnmower({{0.0, 0.5}}), std::invalid_argument);
-  // Saved and loaded with its reference.
-  std::stringstream ss;
-  df.save(ss);
-  auto back = DecisionFunction::load(ss);
-  CHECK(back.params().front_aware);
-  REQUIRE(back.reference_lawnmower().size() == 5);
-  CHECK(back.reference_lawnmower()[3].miou == 0.77);
-  CHECK(back.decide(ctx).gsd_cm == first.gsd_cm);
-}
-
-namespace {
-// The text a version 1 or 2 file had for `df` (saved as version 3): the old version number,
-// and I's kernel under its old name (those versions had the isotropic kernel type for I).
-std::string old_format_text(const DecisionFunction& df, int version) {
-  std::stringstream ss;
-  df.save(ss);
-  std::string text = ss.str();
-  text.replace(text.find("adaptseg.decision_function 3\n"), 29, "adaptseg.decision_function " + std::to_string(version) + "\n");
-  const std::string ard = "kernel squared_exponential_ard\n";
-  const auto i_kernel = text.find(ard, text.find(ard) + 1);  // the second GP is I
-  REQUIRE(i_kernel != std::string::npos);
-  text.replace(i_kernel, ard.size(), "kernel squared_exponential_isotropic\n");
-  if (version == 1) {  // version 1 had no front_aware and no reference_lawnmower lines
-    const auto a = text.find("front_aware");
-    const std::string ref = "reference_lawnmower 0\n";
-    text.erase(a, text.find(ref) + ref.size() - a);
-  }
-  return text;
-}
-}  // namespace
-
-TEST_CASE("decision function: files of format versions 1 and 2 still load, with the same predictions") {
-  const auto df = DecisionFunction::initialize(samples(), {.min_utility = 1e-4});
-  const auto c = candidates();
-  DecisionContext ctx{.sigma = 0.2, .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5, .candidates = c};
-  for (int version : {1, 2}) {
-    CAPTURE(version);
-    std::istringstream old(old_format_text(df, version));
-    const auto back = DecisionFunction::load(old);
-    CHECK_FALSE(back.params().front_aware);
-    CHECK(back.params().min_utility == 1e-4);
-    CHECK(back.reference_lawnmower().empty());
-    CHECK(back.gain_inputs() == DecisionFunction::GainInputs::delta_sigma);
-    for (const auto& cand : c)
-      CHECK(back.score(ctx, cand).predicted_delta_miou == doctest::Approx(df.score(ctx, cand).predicted_delta_miou).epsilon(1e-12));
-  }
-  // An old file whose I block is cut off says so.
-  std::string cut = old_format_text(df, 2);
-  cut.erase(cut.rfind("end adaptseg.gaussian_process"));
-  std::istringstream truncated(cut);
-  CHECK_THROWS_AS((void)DecisionFunction::load(truncated), std::invalid_argument);
-}
-
-TEST_CASE("decision function: I on (delta sigma, delta h) tells candidate altitudes apart where delta sigma cannot") {
+TEST_CASE("gain model: the paper's I on delta sigma alone cannot tell candidate altitudes apart where (delta sigma, delta h) can") {
   // What an oracle backend gives: σ does not change with altitude (Δσ = 0), while the
   // accuracy gain grows with the descent.
   std::vector<RegionSample> flat;
@@ -262,32 +112,287 @@ TEST_CASE("decision function: I on (delta sigma, delta h) tells candidate altitu
       s.miou_sub = 0.8 + 0.015 * dh;
       flat.push_back(s);
     }
-  const auto c = candidates();
-  DecisionContext ctx{.sigma = 0.2, .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5, .candidates = c};
-  const auto paper = DecisionFunction::initialize(flat, {});
-  CHECK(paper.gain_inputs() == DecisionFunction::GainInputs::delta_sigma);
-  CHECK(paper.score(ctx, c[0]).predicted_delta_miou ==
-        doctest::Approx(paper.score(ctx, c[3]).predicted_delta_miou).epsilon(1e-9));  // blind to Δh
-  const auto by_height =
-      DecisionFunction::initialize(flat, {}, 3, 0, DecisionFunction::GainInputs::delta_sigma_and_height);
-  CHECK(by_height.gain_inputs() == DecisionFunction::GainInputs::delta_sigma_and_height);
+  const auto paper = GainModel::fit(flat, {.gain_inputs = GainModel::GainInputs::delta_sigma});
+  CHECK(paper.gain_inputs() == GainModel::GainInputs::delta_sigma);
+  CHECK(paper.forecast(11.0, 0.2).delta_miou == doctest::Approx(paper.forecast(2.75, 0.2).delta_miou).epsilon(1e-9));
+  const auto by_height = GainModel::fit(flat);
   CHECK(by_height.i_model().dimension() == 2);
-  CHECK(by_height.score(ctx, c[0]).predicted_delta_miou == doctest::Approx(-0.165).epsilon(0.05));  // Δh = 11 m
-  CHECK(by_height.score(ctx, c[3]).predicted_delta_miou == doctest::Approx(-0.041).epsilon(0.1));   // Δh = 2.75 m
-  // Saved as version 3 and read back: the same predictions.
-  std::stringstream ss;
-  by_height.save(ss);
-  CHECK(ss.str().rfind("adaptseg.decision_function 3\n", 0) == 0);
-  const auto back = DecisionFunction::load(ss);
-  CHECK(back.i_model().dimension() == 2);
-  CHECK(back.score(ctx, c[1]).predicted_delta_miou ==
-        doctest::Approx(by_height.score(ctx, c[1]).predicted_delta_miou).epsilon(1e-12));
+  CHECK(by_height.forecast(11.0, 0.2).delta_miou == doctest::Approx(-0.165).epsilon(0.05));
+  CHECK(by_height.forecast(2.75, 0.2).delta_miou == doctest::Approx(-0.041).epsilon(0.1));
+}
+
+TEST_CASE("gain model: the online update extends O") {
+  GainModel m = fitted();
+  GainModel refitting = fitted();
+  refitting.set_refit_every(1);
+  const DescentOutcome out{.top_altitude_m = 16.5, .sub_altitude_m = 5.5, .sigma_top = 0.1, .sigma_sub = 0.3};
+  const double before = m.forecast(11.0, 0.1).delta_sigma;
+  m.update(out);
+  m.update(out);
+  refitting.update(out);
+  CHECK(m.o_model().size() == 22);
+  CHECK(m.updates() == 2);
+  CHECK(refitting.o_model().size() == 21);
+  CHECK(m.i_model().size() == 20);  // I needs ground truth: fixed
+  // The observed, much larger σ recovery (Δσ = -0.2) pulls O's prediction towards it.
+  CHECK(std::abs(m.forecast(11.0, 0.1).delta_sigma + 0.2) < 0.5 * std::abs(before + 0.2));
+  CHECK_THROWS_AS(m.set_refit_every(-1), std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------------------------
+// UtilityPolicy (the paper's rule)
+// ---------------------------------------------------------------------------------------------
+TEST_CASE("utility policy: thresholds, σ weighting and the best utility") {
+  UtilityPolicy policy(fitted(), {});
+  const auto c = candidates();
+  const DecisionContext ctx = context(c);
+  Decision d = policy.decide(ctx);
+  REQUIRE(d.scores.size() == 4);
+  REQUIRE(d.descend);
+  double best = 0.0;
+  for (const auto& s : d.scores) best = std::max(best, s.utility);
+  for (std::size_t k = 0; k < c.size(); ++k)
+    if (d.scores[k].utility == best) CHECK(d.gsd_cm == c[k].gsd_cm);
+  // σ weighting: half the valid fraction, half the utility.
+  DecisionContext half_valid = ctx;
+  half_valid.valid_fraction = 0.5;
+  CHECK(policy.decide(half_valid).scores[0].utility == doctest::Approx(d.scores[0].utility * 0.5));
+  // Thresholds.
+  auto p = policy.params();
+  p.min_sigma = 0.25;
+  policy.set_params(p);
+  CHECK_FALSE(policy.decide(ctx).descend);
+  p.min_sigma = 0.0;
+  p.min_utility = best * 1.01;
+  policy.set_params(p);
+  CHECK_FALSE(policy.decide(ctx).descend);
+  p.min_utility = best * 0.99;
+  policy.set_params(p);
+  CHECK(policy.decide(ctx).descend);
+  // No affordable candidate: continue.
+  CHECK_FALSE(policy.decide(context({})).descend);
+  CHECK_THROWS_AS(policy.set_params({.min_sigma = 2.0}), std::invalid_argument);
+  CHECK_THROWS_AS(policy.set_params({.exploration = -1.0}), std::invalid_argument);
+}
+
+TEST_CASE("utility policy: relative utility compares with the mission's running mean") {
+  UtilityPolicy policy(fitted(), {.min_utility = 1.2, .relative_utility = true});
+  const auto c = candidates();
+  const DecisionContext low = context(c, 0.05);
+  const DecisionContext high = context(c, 0.3);
+  CHECK_FALSE(policy.decide(low).descend);  // first image: ratio 1 < 1.2
+  CHECK_FALSE(policy.decide(low).descend);
+  CHECK(policy.decide(high).descend);  // well above the running mean
+  policy.begin_mission();
+  CHECK_FALSE(policy.decide(high).descend);  // alone again: ratio 1
+}
+
+TEST_CASE("utility policy: online updates extend O only when adaptive, and a new mission starts from the initial model") {
+  UtilityPolicy adaptive(fitted(), {.online = true});
+  UtilityPolicy fixed(fitted(), {.online = false});
+  CHECK(adaptive.name() == "adaptive");
+  CHECK(fixed.name() == "nonadaptive");
+  const DescentOutcome out{.top_altitude_m = 16.5, .sub_altitude_m = 5.5, .sigma_top = 0.1, .sigma_sub = 0.3};
+  adaptive.observe(out);
+  fixed.observe(out);
+  CHECK(adaptive.model().o_model().size() == 21);
+  CHECK(fixed.model().o_model().size() == 20);
+  adaptive.begin_mission();
+  CHECK(adaptive.model().o_model().size() == 20);
+  CHECK(adaptive.initial_model().o_model().size() == 20);
+}
+
+// ---------------------------------------------------------------------------------------------
+// FrontAwarePolicy
+// ---------------------------------------------------------------------------------------------
+TEST_CASE("front-aware policy: a model without C descends while descents beat the lawnmower curve (adaptseg 0.1)") {
+  // Training lawnmower by GSD, and this field's lawnmower times at the same GSDs.
+  const std::vector<ReferenceCurve> reference{
+      {"train", {{1.0, 1.0}, {1.5, 0.85}, {2.0, 0.82}, {2.5, 0.77}, {3.0, 0.75}}, 0.0}};
+  FrontAwarePolicy policy(without_c(fitted()), reference, {.weight_by_sigma = false});
+  const std::vector<LawnmowerForecast> lawnmowers{{1.0, 185.0}, {1.5, 107.0}, {2.0, 101.0}, {2.5, 96.0}, {3.0, 40.0}};
+  const std::vector<CurvePoint> curve{{185.0, 1.0}, {107.0, 0.85}, {101.0, 0.82}, {96.0, 0.77}, {40.0, 0.75}};
+  const auto c = candidates();
+  DecisionContext ctx = context(c);
+  ctx.elapsed_s = 5.7;
+  ctx.rest_s = 34.3;
+  ctx.region_share = 1.0 / 7.0;
+  ctx.lawnmowers = lawnmowers;
+  // First region: the mission's end point is the top-level lawnmower's (40 s, 0.75), margin 0.
+  // Re-mapping the region (1/7 of the field) from 1.0 cm/px gains about 0.275 / 7 = 0.039 for
+  // 40 s: (80 s, 0.789) lies above the curve (0.764 there).
+  const Decision first = policy.decide(ctx);
+  REQUIRE(first.descend);
+  double best = -1.0;
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    const auto& s = first.scores[k];
+    const double expected = front_margin(curve, 40.0 + c[k].extra_time_s, 0.75 - s.predicted_delta_miou / 7.0);
+    CHECK(s.predicted_front_margin == doctest::Approx(expected).epsilon(1e-9));
+    CHECK(s.predicted_field_gain == doctest::Approx(-s.predicted_delta_miou / 7.0).epsilon(1e-12));
+    CHECK(std::isnan(s.predicted_relabelled));
+    best = std::max(best, s.predicted_front_margin);
+  }
+  CHECK(best > 0.015);
+  for (std::size_t k = 0; k < c.size(); ++k)
+    if (first.scores[k].predicted_front_margin == best) CHECK(first.gsd_cm == c[k].gsd_cm);
+  // A later region, after that descent (end point now about 85 s): another descent would end
+  // in the curve's steep part (2.5 -> 1.5 cm/px costs only 11 s there), below it: continue.
+  DecisionContext next = ctx;
+  next.elapsed_s = 5.7 + 40.0 + 5.7;
+  next.rest_s = 33.6;
+  const Decision second = policy.decide(next);
+  CHECK_FALSE(second.descend);
+  for (const auto& s : second.scores) CHECK(s.predicted_front_margin < 0.0);
+  // A new mission forgets the forecast: the first region descends again.
+  policy.begin_mission();
+  CHECK(policy.decide(ctx).descend);
+  // The rule needs the forecasts and a valid reference.
+  DecisionContext blind = ctx;
+  blind.lawnmowers = {};
+  CHECK_THROWS_WITH_AS((void)policy.decide(blind), doctest::Contains("lawnmower forecasts"), std::invalid_argument);
+  CHECK_THROWS_AS(FrontAwarePolicy(fitted(), {}, {}), std::invalid_argument);
+  CHECK_THROWS_AS(FrontAwarePolicy(fitted(), {{"x", {{0.0, 0.5}}, 0.1}}, {}), std::invalid_argument);
+  CHECK_THROWS_AS(FrontAwarePolicy(fitted(), reference, {.confidence = -1.0}), std::invalid_argument);
+}
+
+namespace {
+// One candidate 1.0 cm/px (Δh = 11 m, η = 1) for 40 s; the field's lawnmowers at 3.0 cm/px
+// (40 s) and 1.0 cm/px (185 s); regions of 1/7 of the field; the training fields' σ 0.2. With
+// C's ρ = 0.125 a region of σ = 0.2 is forecast to relabel 0.02 of its pixels, a field gain of
+// 0.02 · (1/7) / 0.2 = 0.0143.
+struct Scenario {
+  std::vector<Candidate> one{{1.0, 5.5, 9, 40.0}};
+  std::vector<Candidate> cheap{{1.0, 5.5, 2, 10.0}};  // the same descent over a few cells
+  std::vector<LawnmowerForecast> lawnmowers{{1.0, 185.0}, {3.0, 40.0}};
+
+  /// Reference curves whose rise over 40 s (linear from 40 to 185 s) is `rise`, and a second
+  /// one rising by `rise2` (the spread of the training fields).
+  std::vector<ReferenceCurve> reference(double rise, std::optional<double> rise2 = std::nullopt) const {
+    std::vector<ReferenceCurve> r{{"a", {{1.0, 0.75 + rise * 145.0 / 40.0}, {3.0, 0.75}}, 0.2}};
+    if (rise2) r.push_back({"b", {{1.0, 0.75 + *rise2 * 145.0 / 40.0}, {3.0, 0.75}}, 0.2});
+    return r;
+  }
+  /// The k-th region (k = 0, 1, ...), after k descents.
+  DecisionContext region(int k, double sigma = 0.2, bool is_cheap = false) const {
+    DecisionContext c{.sigma = sigma, .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5,
+                      .candidates = is_cheap ? cheap : one};
+    c.elapsed_s = 5.7 * (k + 1) + 40.0 * k;
+    c.rest_s = 40.0 - 5.7 * (k + 1);
+    c.region_share = 1.0 / 7.0;
+    c.lawnmowers = lawnmowers;
+    return c;
+  }
+  /// A descent at region 0 that relabelled `factor` times what C forecast.
+  static DescentOutcome outcome(double factor) {
+    return {.top_altitude_m = 16.5, .sub_altitude_m = 5.5, .sigma_top = 0.2, .sigma_sub = 0.2,
+            .relabelled = {0.024 * factor, 0.02 * factor}};
+  }
+};
+}  // namespace
+
+TEST_CASE("front-aware policy: the field gain comes from C's relabelling, η and the field's estimated σ") {
+  const Scenario s;
+  FrontAwarePolicy policy(fitted(), s.reference(0.0), {.confidence = 0.0});
+  const Decision d = policy.decide(s.region(0));
+  REQUIRE(d.scores.size() == 1);
+  CHECK(d.scores[0].predicted_relabelled == doctest::Approx(0.02).epsilon(0.02));
+  CHECK(d.scores[0].predicted_field_gain == doctest::Approx(0.02 / 7.0 / 0.2).epsilon(0.02));
+  CHECK(d.descend);  // a flat curve: any gain beats it
+  // A field that shows less of L than the training fields so far: σ̂ is pulled towards what
+  // it shows, so the same relabelled share is worth more of the field's mIoU.
+  FrontAwarePolicy sparse(fitted(), s.reference(0.0), {});
+  (void)sparse.decide(s.region(0, 0.02));
+  const Decision d2 = sparse.decide(s.region(1, 0.2));
+  CHECK(d2.scores[0].predicted_field_gain > d.scores[0].predicted_field_gain);
+}
+
+TEST_CASE("front-aware policy: what a descent relabelled changes a later decision when online, not otherwise") {
+  const Scenario s;
+  const double gain = 0.02 / 7.0 / 0.2;
+  SUBCASE("a descent that changes less than forecast stops the descents") {
+    // The curve rises by 0.6 of the forecast gain over a descent's time: worth descending.
+    const auto reference = s.reference(0.6 * gain);
+    FrontAwarePolicy adaptive(fitted(), reference, {.online = true});
+    FrontAwarePolicy fixed(fitted(), reference, {.online = false});
+    for (FrontAwarePolicy* p : {&adaptive, &fixed}) {
+      REQUIRE(p->decide(s.region(0)).descend);
+      p->observe(Scenario::outcome(0.25));
+    }
+    CHECK(adaptive.field_scale() < 0.5);
+    CHECK(fixed.field_scale() == 1.0);
+    CHECK_FALSE(adaptive.decide(s.region(1)).descend);
+    CHECK(fixed.decide(s.region(1)).descend);
+  }
+  SUBCASE("a descent that changes more than forecast makes a later, costlier one worth it") {
+    const auto reference = s.reference(1.5 * gain);
+    FrontAwarePolicy adaptive(fitted(), reference, {.online = true});
+    FrontAwarePolicy fixed(fitted(), reference, {.online = false});
+    // A dense first region, cheap to re-map: worth descending for both.
+    for (FrontAwarePolicy* p : {&adaptive, &fixed}) {
+      REQUIRE(p->decide(s.region(0, 0.6, true)).descend);
+      p->observe(Scenario::outcome(4.0 * 1.2));  // four times the relabelling C forecast at σ 0.6
+    }
+    CHECK(adaptive.field_scale() > 3.0);
+    CHECK(adaptive.decide(s.region(1)).descend);
+    CHECK_FALSE(fixed.decide(s.region(1)).descend);
+  }
+  SUBCASE("a new mission forgets what the last one learnt") {
+    FrontAwarePolicy adaptive(fitted(), s.reference(0.6 * gain), {.online = true});
+    (void)adaptive.decide(s.region(0));
+    adaptive.observe(Scenario::outcome(0.25));
+    adaptive.begin_mission();
+    CHECK(adaptive.field_scale() == 1.0);
+    CHECK(adaptive.field_scale_sd() == doctest::Approx(0.5));
+    CHECK(adaptive.model().o_model().size() == fitted().o_model().size());
+  }
+}
+
+TEST_CASE("front-aware policy: pessimistic when unsure, from the field factor and the spread of the training curves") {
+  const Scenario s;
+  const double gain = 0.02 / 7.0 / 0.2;
+  // Two training curves rising by 0.2 and 0.6 of the gain over a descent: mean 0.4.
+  const auto reference = s.reference(0.2 * gain, 0.6 * gain);
+  FrontAwarePolicy bold(fitted(), reference, {.confidence = 0.0});
+  FrontAwarePolicy careful(fitted(), reference, {.confidence = 3.0});
+  CHECK(bold.decide(s.region(0)).descend);
+  CHECK_FALSE(careful.decide(s.region(0)).descend);
+  // After a descent whose relabelling matched the forecast, the field factor is surer: the
+  // lower bound rises.
+  FrontAwarePolicy moderate(fitted(), s.reference(0.3 * gain), {.confidence = 1.2});
+  FrontAwarePolicy moderate_fixed(fitted(), s.reference(0.3 * gain), {.online = false, .confidence = 1.2});
+  for (FrontAwarePolicy* p : {&moderate, &moderate_fixed}) {
+    (void)p->decide(s.region(0, 0.6));
+    p->observe(Scenario::outcome(3.0));
+  }
+  CHECK(moderate.field_scale_sd() < 0.5 * moderate_fixed.field_scale_sd());
+  CHECK(moderate.decide(s.region(1)).descend);
+  CHECK_FALSE(moderate_fixed.decide(s.region(1)).descend);
+}
+
+// ---------------------------------------------------------------------------------------------
+// DecisionFunction, LinearDecision, conformance
+// ---------------------------------------------------------------------------------------------
+TEST_CASE("decision function: forwards to its rule; online on and off") {
+  const Scenario s;
+  DecisionFunction df(FrontAwarePolicy(fitted(), s.reference(0.0), {}));
+  CHECK(df.front_aware());
+  CHECK(df.name() == "adaptive");
+  df.set_online(false);
+  CHECK_FALSE(df.online());
+  CHECK(df.name() == "nonadaptive");
+  CHECK(df.model().o_model().size() == 20);
+  df.begin_mission();
+  CHECK(df.decide(s.region(0)).descend);
+  DecisionFunction paper(UtilityPolicy(fitted(), {.min_utility = 1e9}));
+  CHECK_FALSE(paper.front_aware());
+  const auto c = candidates();
+  CHECK_FALSE(paper.decide(context(c)).descend);
 }
 
 TEST_CASE("linear decision: altitude falls linearly with σ to the nearest candidate") {
   const LinearDecision lin({.sigma_low = 0.1, .sigma_high = 0.3});
   const auto c = candidates();
-  DecisionContext ctx{.sigma = 0.05, .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5, .candidates = c};
+  DecisionContext ctx = context(c, 0.05);
   CHECK_FALSE(lin.decide(ctx).descend);  // below sigma_low: stay at h_max
   ctx.sigma = 0.3;
   CHECK(lin.decide(ctx).gsd_cm == 1.0);  // at sigma_high: the lowest altitude
@@ -296,4 +401,36 @@ TEST_CASE("linear decision: altitude falls linearly with σ to the nearest candi
   ctx.sigma = 0.11;                       // 16.5 - 0.55 m: nearer h_max than any candidate
   CHECK_FALSE(lin.decide(ctx).descend);
   CHECK_THROWS_AS(LinearDecision({.sigma_low = 0.3, .sigma_high = 0.3}), std::invalid_argument);
+}
+
+TEST_CASE("decision policies: every policy passes the conformance suite") {
+  const Scenario s;
+  const auto c = candidates();
+  // A mission of five regions: varied σ, all candidates, then none affordable.
+  std::vector<DecisionContext> mission;
+  for (int k = 0; k < 5; ++k) {
+    DecisionContext ctx = s.region(k, 0.05 + 0.1 * k);
+    ctx.candidates = k == 4 ? std::span<const Candidate>() : std::span<const Candidate>(c);
+    mission.push_back(ctx);
+  }
+  const DescentOutcome outcome = Scenario::outcome(0.5);
+  SUBCASE("utility") { test::check_policy_conformance(UtilityPolicy(fitted(), {}), mission, outcome); }
+  SUBCASE("utility, relative") {
+    test::check_policy_conformance(UtilityPolicy(fitted(), {.min_utility = 1.1, .relative_utility = true}), mission,
+                                   outcome);
+  }
+  SUBCASE("front-aware") {
+    test::check_policy_conformance(FrontAwarePolicy(fitted(), s.reference(0.001, 0.002), {.confidence = 0.5}),
+                                   mission, outcome);
+  }
+  SUBCASE("front-aware without C") {
+    test::check_policy_conformance(FrontAwarePolicy(without_c(fitted()), s.reference(0.001), {}), mission, outcome);
+  }
+  SUBCASE("decision function") {
+    test::check_policy_conformance(DecisionFunction(FrontAwarePolicy(fitted(), s.reference(0.0), {})), mission,
+                                   outcome);
+  }
+  SUBCASE("linear") {
+    test::check_policy_conformance(LinearDecision({.sigma_low = 0.1, .sigma_high = 0.4}), mission, outcome);
+  }
 }

@@ -91,15 +91,16 @@ DecisionModel small_model() {
   const auto samples = collect_region_samples(f, oracle, CameraModel({.image_width_px = 48, .image_height_px = 36}),
                                               3.0, {1.0, 2.0}, f.interest());
   REQUIRE(samples.size() >= 4);
-  DecisionModel m{.calibration_field = f.name(),
+  DecisionModel m{.calibration_fields = {f.name()},
                   .segmenter = "oracle",
+                  .calibration_segmentation_time_s = 0.1,
                   .classes = {"soil", "crop", "weed"},
                   .interest = {"crop", "weed"},
                   .camera = {.image_width_px = 48, .image_height_px = 36},
                   .timing = {},
                   .top_gsd_cm = 3.0,
                   .candidate_gsd_cm = {1.0, 2.0},
-                  .decision_function = DecisionFunction::initialize(samples, {}, 0),
+                  .decision_function = DecisionFunction(UtilityPolicy(GainModel::fit(samples, {.restarts = 0}), {})),
                   .linear = {0.1, 0.5},
                   .samples = samples.size(),
                   .train_front_margin = 0.0};
@@ -536,29 +537,50 @@ TEST_CASE("robustness: GP file: huge announced sizes") {
   CHECK_THROWS_WITH_AS(load_gp(many), Contains("unexpected end of input"), std::invalid_argument);
   // An ARD kernel has as many length scales as inputs: another dimension is refused up front.
   std::ostringstream ard;
-  small_model().decision_function.o_model().save(ard);
+  small_model().decision_function.model().o_model().save(ard);
   std::istringstream is(replaced(ard.str(), "dimension 2", "dimension 1000000"));
   CHECK_THROWS_WITH_AS((void)GaussianProcess<ArdSquaredExponentialKernel>::load(is),
                        Contains("the kernel does not accept dimension"), std::invalid_argument);
 }
 
 TEST_CASE("robustness: decision function: no samples or a NaN sample") {
-  CHECK_THROWS_WITH_AS((void)DecisionFunction::initialize({}, {}), Contains("number of samples must be > 0"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)GainModel::fit({}), Contains("number of samples must be > 0"), std::invalid_argument);
   std::vector<RegionSample> samples(4);
   for (std::size_t k = 0; k < samples.size(); ++k) {
     samples[k] = {3.0, 1.0, 10.0, 0.1 * static_cast<double>(k), 0.05, 0.5, 0.6};
   }
   samples[2].sigma_top = kNaN;
-  CHECK_THROWS_WITH_AS((void)DecisionFunction::initialize(samples, {}, 0), Contains("must be finite"),
+  CHECK_THROWS_WITH_AS((void)GainModel::fit(samples, {.restarts = 0}), Contains("must be finite"),
                        std::invalid_argument);
 }
 
 TEST_CASE("robustness: decision function: threshold out of range") {
-  CHECK_THROWS_WITH_AS(DecisionFunction::Params{.min_sigma = 1.5}.validate(), Contains("min_sigma must be in [0, 1]"),
+  CHECK_THROWS_WITH_AS(UtilityPolicy::Params{.min_sigma = 1.5}.validate(), Contains("min_sigma must be in [0, 1]"),
                        std::invalid_argument);
-  CHECK_THROWS_WITH_AS(DecisionFunction::Params{.exploration = -1.0}.validate(),
+  CHECK_THROWS_WITH_AS(UtilityPolicy::Params{.exploration = -1.0}.validate(),
                        Contains("exploration must be finite and >= 0"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(FrontAwarePolicy::Params{.confidence = kNaN}.validate(),
+                       Contains("confidence must be finite and >= 0"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(FrontAwarePolicy::Params{.scale_prior_sd = 0.0}.validate(),
+                       Contains("scale_prior_sd must be finite and > 0"), std::invalid_argument);
+}
+
+TEST_CASE("robustness: decision function: a policy that descends to a GSD it was not offered") {
+  const Field f = weedmap_field();
+  OracleSegmenter oracle(f.num_classes());
+  struct Rogue {  // descends to 1.7 cm/px, which is no candidate
+    std::string name() const { return "rogue"; }
+    void begin_mission() {}
+    Decision decide(const DecisionContext&) { return {.descend = true, .gsd_cm = 1.7, .scores = {}}; }
+    void observe(const DescentOutcome&) {}
+  } rogue;
+  AdaptiveOptions o;
+  o.mission = fixed_times();
+  o.mission.camera = {.image_width_px = 48, .image_height_px = 36};
+  o.top_gsd_cm = 3.0;
+  o.candidate_gsd_cm = {1.0, 2.0};
+  CHECK_THROWS_WITH_AS((void)run_adaptive_mission(f, oracle, rogue, o, "rogue"),
+                       Contains("decision policy 'rogue' descends to 1.7"), std::logic_error);
 }
 
 // ---- decision model files --------------------------------------------------------------------
@@ -572,13 +594,30 @@ TEST_CASE("robustness: decision model: file missing") {
 TEST_CASE("robustness: decision model: truncated file") {
   const t::TempDir dir;
   const std::string& text = model_text();
-  // Cut inside the embedded decision function (the last key).
-  const std::string cut = text.substr(0, text.size() - 40);
-  CHECK_THROWS_WITH_AS((void)load_model_text(dir, cut), Contains("DecisionFunction::load: input ends before"),
+  // Cut inside the rule (the last key).
+  const std::string cut = text.substr(0, text.find("  relative_utility:"));
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, cut), Contains("missing key 'rule.relative_utility'"),
                        std::invalid_argument);
-  // Cut before the decision function: a key is missing.
-  const std::string head = text.substr(0, text.find("decision_function:"));
-  CHECK_THROWS_WITH_AS((void)load_model_text(dir, head), Contains("missing key 'decision_function'"),
+  // Cut before the gain model: a key is missing.
+  const std::string head = text.substr(0, text.find("gain_model:"));
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, head), Contains("missing key 'gain_model'"), std::invalid_argument);
+}
+
+TEST_CASE("robustness: decision model: a number that is none, or a GP whose data do not fit") {
+  const t::TempDir dir;
+  const std::string& text = model_text();
+  const auto y_mean = text.find("    y_mean: ");
+  REQUIRE(y_mean != std::string::npos);
+  const auto eol = text.find('\n', y_mean);
+  std::string bad = text;
+  bad.replace(y_mean, eol - y_mean, "    y_mean: 0,25");
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, bad), Contains("'gain_model.O.y_mean' must be a finite number (got '0,25')"),
+                       std::invalid_argument);
+  const auto targets = text.find("    targets: [");
+  REQUIRE(targets != std::string::npos);
+  bad = text;
+  bad.insert(targets + std::string("    targets: [").size(), "0.5, ");
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, bad), Contains("as many input rows as 'targets' has values"),
                        std::invalid_argument);
 }
 
@@ -622,22 +661,23 @@ TEST_CASE("robustness: decision model: candidate GSD not finer than top") {
 TEST_CASE("robustness: decision model: invalid camera") {
   const t::TempDir dir;
   const std::string text = replaced(model_text(), "image_width_px: 48", "image_width_px: 0");
-  CHECK_THROWS_WITH_AS((void)load_model_text(dir, text), Contains("image_width_px must be > 0"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, text),
+                       Contains("'camera.image_width_px' must be an integer in [1, 1000000]"), std::invalid_argument);
 }
 
 TEST_CASE("robustness: decision model: mistyped value") {
   const t::TempDir dir;
   CHECK_THROWS_WITH_AS((void)load_model_text(dir, replaced(model_text(), "top_gsd_cm: 3", "top_gsd_cm: high")),
-                       Contains("bad value"), std::invalid_argument);
+                       Contains("'top_gsd_cm' must be a finite number (got 'high')"), std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)load_model_text(dir, replaced(model_text(), "samples: ", "samples: -")),
-                       Contains("bad value"), std::invalid_argument);
+                       Contains("'calibration.samples' must be an integer"), std::invalid_argument);
 }
 
 TEST_CASE("robustness: decision model: refit count out of range") {
   const t::TempDir dir;
-  const std::string text = replaced(model_text(), "refit_every 0", "refit_every 1e300");
-  CHECK_THROWS_WITH_AS((void)load_model_text(dir, text), Contains("refit_every"), std::invalid_argument);
+  const std::string text = replaced(model_text(), "refit_every: 0", "refit_every: 1e300");
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, text), Contains("'gain_model.refit_every' must be an integer"),
+                       std::invalid_argument);
 }
 
 TEST_CASE("robustness: decision model: unknown descent coverage") {
@@ -648,14 +688,15 @@ TEST_CASE("robustness: decision model: unknown descent coverage") {
 
 TEST_CASE("robustness: decision model: I with three inputs") {
   const t::TempDir dir;
-  // I's GP announces dimension 3: its kernel has one length scale per input it was fitted to.
+  // I's inputs get a third column: I takes (Δσ, Δh).
   std::string text = model_text();
-  const auto i_block = text.rfind("kernel squared_exponential_ard");
+  const auto i_block = text.find("\n  I:\n");
   REQUIRE(i_block != std::string::npos);
-  const auto dim = text.find("dimension 1", i_block);
-  REQUIRE(dim != std::string::npos);
-  text.replace(dim, 11, "dimension 3");
-  CHECK_THROWS_WITH_AS((void)load_model_text(dir, text), Contains("does not accept dimension"), std::invalid_argument);
+  const auto row = text.find("]", text.find("    inputs:", i_block));
+  REQUIRE(row != std::string::npos);
+  text.insert(row, ", 3");
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, text), Contains("'gain_model.I.inputs' rows must have 2 values"),
+                       std::invalid_argument);
 }
 
 // ---- ERFNet model files ----------------------------------------------------------------------
@@ -712,12 +753,10 @@ TEST_CASE("robustness: erfnet: field without RGB") {
 // ---- determinism (issue 6 item 5) --------------------------------------------------------------
 
 TEST_CASE("determinism: the same samples and seed give the same decision function") {
-  const DecisionModel a = small_model();
-  const DecisionModel b = small_model();
-  std::ostringstream sa, sb;
-  a.decision_function.save(sa);
-  b.decision_function.save(sb);
-  CHECK(sa.str() == sb.str());
+  const t::TempDir dir;
+  small_model().save(dir.path() / "a.yaml");
+  small_model().save(dir.path() / "b.yaml");
+  CHECK(read_text(dir.path() / "a.yaml") == read_text(dir.path() / "b.yaml"));
 }
 
 TEST_CASE("determinism: two adaptive missions give identical records") {
@@ -730,11 +769,11 @@ TEST_CASE("determinism: two adaptive missions give identical records") {
   o.candidate_gsd_cm = {1.0, 2.0};
   const DecisionModel model = small_model();
   const auto run = [&] {
-    DecisionFunction df = model.decision_function;
-    auto p = df.params();
+    UtilityPolicy policy = std::get<UtilityPolicy>(model.decision_function.rule());
+    auto p = policy.params();
     p.min_utility = -1.0;  // descend wherever the predicted gain is positive
-    df.set_params(p);
-    return run_adaptive_mission(f, oracle, df, o, df.name());
+    policy.set_params(p);
+    return run_adaptive_mission(f, oracle, policy, o, policy.name());
   };
   const AdaptiveResult a = run();
   const AdaptiveResult b = run();

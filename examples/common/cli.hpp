@@ -85,12 +85,14 @@ struct CommonOptions {
 };
 
 /// Calibration choices shared by adaptseg_calibrate and adaptseg_evaluate: the decision rule,
-/// the thresholds tried, and what a descent re-maps.
+/// the settings tried, what a descent re-maps, and the time charged per image.
 struct CalibrationCli {
   std::string rule = "front-aware";
   int threshold_steps = 10;
   std::string coverage = "interest";
   std::string gain_inputs = "delta-sigma-height";
+  std::vector<double> confidences = kDefaultConfidences;
+  std::optional<double> segmentation_time_s;
 
   void add_to(CLI::App& app) {
     options_ = {
@@ -111,6 +113,16 @@ struct CalibrationCli {
                        "delta-sigma-height (the change of semantic ratio and of altitude)")
             ->check(CLI::IsMember({"delta-sigma", "delta-sigma-height"}))
             ->capture_default_str(),
+        app.add_option("--confidence", confidences,
+                       "front-aware rule: confidence levels z tried on the training fields (a descent must beat "
+                       "the curve by z standard deviations); the best is saved in the model")
+            ->delimiter(',')
+            ->check(CLI::NonNegativeNumber)
+            ->capture_default_str(),
+        app.add_option("--calibration-seg-time-s", segmentation_time_s,
+                       "segmentation time charged per image during calibration [s], recorded in the model "
+                       "(default: --seg-time-s if given, else 0.1)")
+            ->check(CLI::NonNegativeNumber),
     };
   }
 
@@ -120,13 +132,17 @@ struct CalibrationCli {
     for (CLI::Option* o : options_) o->excludes(other);
   }
 
-  /// Sets the rule, the threshold steps, the descent coverage and I's inputs of `options`.
-  void apply(CalibrationOptions& options) const {
+  /// Sets the rule and the settings it tries, the descent coverage, I's inputs and the time
+  /// charged per image of `options` (`common`: the programs' --seg-time-s and --plan-time-s).
+  void apply(CalibrationOptions& options, const CommonOptions& common) const {
     options.threshold_steps = threshold_steps;
-    options.front_aware = rule == "front-aware";
+    options.rule = rule == "front-aware" ? CalibrationOptions::Rule::front_aware : CalibrationOptions::Rule::utility;
+    options.confidences = confidences;
     options.adaptive.coverage = parse_descent_coverage(coverage);
-    options.gain_inputs = gain_inputs == "delta-sigma-height" ? DecisionFunction::GainInputs::delta_sigma_and_height
-                                                              : DecisionFunction::GainInputs::delta_sigma;
+    options.fit.gain_inputs = gain_inputs == "delta-sigma-height" ? GainModel::GainInputs::delta_sigma_and_height
+                                                                  : GainModel::GainInputs::delta_sigma;
+    options.segmentation_time_s = segmentation_time_s.value_or(common.seg_time_s.value_or(0.1));
+    options.planning_time_s = common.plan_time_s.value_or(0.0);
   }
 
  private:

@@ -53,40 +53,13 @@ class CachedBackend {
   std::map<Key, cv::Mat> cache_;
 };
 
-/// Median wall time [s] of `backend` on up to `count` images of a lawnmower over `field` at
-/// `gsd_cm` (a fixed per-image cost for runs that must be deterministic or cached).
+/// adaptseg::calibrate with `backend` cached: calibration flies the same waypoints many times
+/// (at its declared per-image time, so a cache hit changes no number), and a network backend
+/// is the slow part.
 template <SegmentationBackend Backend>
-double measure_segmentation_s(const Field& field, const CameraModel& camera, Backend& backend, double gsd_cm,
-                              int count = 7) {
-  const auto plan = LawnmowerPlanner(camera).plan(field.area(), gsd_cm, {0.0, 0.0},
-                                                  [&](const Area& a) { return field.has_valid(a); });
-  const SimulatedSensor sensor(field, camera);
-  std::vector<double> times;
-  for (std::size_t k = 0; k < plan.size() && static_cast<int>(times.size()) < count; ++k) {
-    const Image image = sensor.capture(plan[k]);
-    const auto t0 = std::chrono::steady_clock::now();
-    (void)backend.segment(image);
-    times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  }
-  if (times.empty()) return 0.0;
-  std::nth_element(times.begin(), times.begin() + static_cast<std::ptrdiff_t>(times.size() / 2), times.end());
-  return times[times.size() / 2];
-}
-
-/// adaptseg::calibrate with a per-image segmentation time fixed (the options', else the
-/// backend's median measured on the training field's top-level images) and `backend` cached:
-/// calibration flies the same waypoints many times, and a network backend is the slow part.
-template <SegmentationBackend Backend>
-CalibrationResult calibrate_cached(const Field& train, Backend& backend, CalibrationOptions options) {
-  auto& fixed = options.adaptive.mission.fixed_segmentation_time_s;
-  if (!fixed) {
-    fixed = measure_segmentation_s(train, CameraModel(options.adaptive.mission.camera), backend,
-                                   options.adaptive.top_gsd_cm);
-    std::fprintf(stderr, "calibration: %s takes %.4f s per image (median, measured on %s); used as a fixed cost\n",
-                 backend.name().c_str(), *fixed, train.name().c_str());
-  }
+CalibrationResult calibrate_cached(std::span<const Field> fields, Backend& backend, const CalibrationOptions& options) {
   CachedBackend<Backend> cached(backend);
-  return calibrate(train, cached, options);
+  return calibrate(fields, cached, options);
 }
 
 /// The backend options shared by adaptseg_mission, adaptseg_calibrate and adaptseg_evaluate.

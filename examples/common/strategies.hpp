@@ -58,6 +58,7 @@ inline Field load_field_spec(const std::string& spec, const std::optional<FieldG
 struct StrategyRun {
   MissionResult mission;
   std::optional<std::vector<DecisionRecord>> decisions;
+  std::vector<RealisedDescent> realised{};  ///< simulation: what each descent gained
 };
 
 /// Flies `strategy` over `field`. Lawnmower: at `gsd_cm`. Others: from `model`'s top GSD
@@ -85,16 +86,14 @@ StrategyRun run_strategy(const Field& field, Backend& backend, const std::string
   if (strategy == "linear") {
     LinearDecision policy(model->linear);
     auto r = run_adaptive_mission(field, backend, policy, ao, policy.name());
-    return {std::move(r.mission), std::move(r.decisions)};
+    return {std::move(r.mission), std::move(r.decisions), std::move(r.realised)};
   }
   if (strategy != "adaptive" && strategy != "nonadaptive")
     throw std::invalid_argument("unknown strategy '" + strategy + "'");
   DecisionFunction df = model->decision_function;
-  auto p = df.params();
-  p.online = strategy == "adaptive";
-  df.set_params(p);
+  df.set_online(strategy == "adaptive");
   auto r = run_adaptive_mission(field, backend, df, ao, df.name());
-  return {std::move(r.mission), std::move(r.decisions)};
+  return {std::move(r.mission), std::move(r.decisions), std::move(r.realised)};
 }
 
 }  // namespace adaptseg::examples

@@ -3,10 +3,11 @@
 
 Usage: /usr/bin/python3 examples/tools/plot_evaluation.py OUTDIR
 
-Reads OUTDIR/results.csv and OUTDIR/per_image.csv (written by adaptseg_evaluate) and writes
+Reads OUTDIR/results.csv, per_image.csv and decisions.csv (written by adaptseg_evaluate) and writes
   OUTDIR/miou_vs_time.png       field mIoU over the labels of interest vs execution time
   OUTDIR/per_image_miou.png     per-image mIoU vs image GSD, mean and standard deviation
-  OUTDIR/paths.png              top views of the paths (lawnmower, non-adaptive, adaptive, linear)
+  OUTDIR/decisions.png          per descent: forecast vs realised field gain (simulation)
+  OUTDIR/paths.png              top views of the paths (lawnmower, non-adaptive, adaptive, linear), 2 x 2
   OUTDIR/maps.png               fused maps vs ground truth (coarsest lawnmower, adaptive)
 Needs matplotlib (Debian: python3-matplotlib).
 """
@@ -105,6 +106,43 @@ def main(out):
     fig.savefig(os.path.join(out, "per_image_miou.png"), dpi=110)
     plt.close(fig)
 
+    # Per descent: the forecast field gain the decision was taken on, against what the descent
+    # realised (simulation: the field mIoU with and without its re-mapping).
+    path = os.path.join(out, "decisions.csv")
+    decisions = read_csv(path) if os.path.exists(path) else []
+    decisions = [d for d in decisions if d["action"] == "descend" and d["forecast_field_gain"] != ""
+                 and d["realised_field_gain"] != ""]
+    if decisions:
+        fig, axes = plt.subplots(1, len(fields), figsize=(5.5 * len(fields), 5), squeeze=False)
+        for ax, field in zip(axes[0], fields):
+            lim = 0.0
+            for strategy in ("nonadaptive", "adaptive"):
+                sel = [d for d in decisions if d["field"] == field and d["strategy"] == strategy]
+                if not sel:
+                    continue
+                f = [num(d["forecast_field_gain"]) for d in sel]
+                r = [num(d["realised_field_gain"]) for d in sel]
+                lim = max(lim, max(f), max(r))
+                st = STYLE[strategy]
+                ax.scatter(f, r, color=st["color"], marker=st["marker"], s=st["s"] * 0.5,
+                           facecolors="none" if strategy == "nonadaptive" else st["color"],
+                           label=f"{st['label']} ({len(sel)} descents)")
+                for x, y, d in zip(f, r, sel):
+                    ax.annotate(f"{num(d['gsd_cm']):g}", (x, y), textcoords="offset points", xytext=(5, 3),
+                                fontsize=7, color=st["color"])
+            lim = lim * 1.1 if lim > 0 else 1.0
+            ax.plot([0, lim], [0, lim], "--", color="0.5", label="realised = forecast")
+            ax.set_xlim(min(0.0, ax.get_xlim()[0]), lim)
+            ax.set_xlabel("forecast field gain (field mIoU over L)")
+            ax.set_ylabel("realised field gain")
+            ax.set_title(f"{field}\n(label: descent GSD [cm/px])", fontsize=10)
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=8, loc="upper left")
+        fig.suptitle("Each descent: the gain it was forecast to add to the field mIoU, and what it added", fontsize=11)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out, "decisions.png"), dpi=110)
+        plt.close(fig)
+
     # Paths and maps: montages of the per-mission pictures.
     for name, picks in (("paths.png", ["path"]), ("maps.png", ["map"])):
         panels = []
@@ -119,9 +157,9 @@ def main(out):
                     panels.append(p)
         if not panels:
             continue
-        cols = 4 if name == "paths.png" else 2
+        cols = 2
         rows_n = (len(panels) + cols - 1) // cols
-        fig, axes = plt.subplots(rows_n, cols, figsize=(6 * cols, 5 * rows_n), squeeze=False)
+        fig, axes = plt.subplots(rows_n, cols, figsize=(8 * cols, 6.5 * rows_n), squeeze=False)
         for ax in axes.flat:
             ax.axis("off")
         for ax, p in zip(axes.flat, panels):

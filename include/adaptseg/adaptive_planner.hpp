@@ -29,6 +29,7 @@
 #include <cmath>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -61,10 +62,24 @@ struct DecisionRecord {
   bool budget_limited = false;     ///< some candidate was dropped because of the budget
 };
 
+/// What a descent gained, measured against the ground truth (simulation only).
+struct RealisedDescent {
+  std::size_t decision = 0;      ///< index into AdaptiveResult::decisions
+  double region_miou_before = 0.0;  ///< mIoU over L of the region's map before the descent (paired_miou)
+  double region_miou_after = 0.0;   ///< ... after it
+  /// Field mIoU over L at the end of the mission minus the same with the pixels this descent
+  /// mapped last (also beyond its region, where its images overhang) labelled as the top-level
+  /// images labelled them: the descent's contribution to the mission's result.
+  double field_gain = 0.0;
+  /// Region ΔmIoU in the sense of the decision function's I: before − after (< 0: it helped).
+  [[nodiscard]] double region_delta_miou() const noexcept { return region_miou_before - region_miou_after; }
+};
+
 /// An adaptive mission's result: the mission plus every decision.
 struct AdaptiveResult {
   MissionResult mission;
   std::vector<DecisionRecord> decisions;
+  std::vector<RealisedDescent> realised;  ///< one per descent, in order (simulation)
   [[nodiscard]] int descents() const {
     return static_cast<int>(std::count_if(decisions.begin(), decisions.end(),
                                            [](const DecisionRecord& d) { return d.decision.descend; }));
@@ -156,6 +171,7 @@ class AdaptivePlanner {
         policy_(policy),
         options_(std::move(options)) {
     const auto t0 = std::chrono::steady_clock::now();
+    policy_.begin_mission();
     if (area_.valid_mask.empty()) {
       area_.valid_mask = cv::Mat(map_.labels().size(), CV_8UC1, cv::Scalar(0));
       area_.valid_mask(pixel_rect(area_.area) & grid()).setTo(255);
@@ -323,7 +339,7 @@ class AdaptivePlanner {
     if (options_.coverage == DescentCoverage::region) return sub_plan(top_index, gsd_cm);
     detail::require(top_index < top_.size(), "AdaptivePlanner::descent_plan: top_index out of range", top_index);
     const Waypoint& t = top_[top_index];
-    const cv::Rect region = pixel_rect(t.footprint) & grid();
+    const cv::Rect region = region_rect(top_index);
     const cv::Mat labels = map_.labels()(region);
     const auto keep_cell = [&](const Area& a) {
       return valid_pixels(a) > 0 && cell_shows_interest(labels, pixel_rect(a) - region.tl(), options_.top_gsd_cm,
@@ -332,6 +348,17 @@ class AdaptivePlanner {
     return LawnmowerPlanner(camera_).plan(t.footprint, gsd_cm, Eigen::Vector2d(t.position.x(), t.position.y()),
                                           keep_cell);
   }
+
+  /// The map pixels of top-level waypoint `top_index`'s region: its footprint, clipped to the
+  /// map grid.
+  /// @throws std::out_of_range for an index out of range.
+  [[nodiscard]] cv::Rect region_rect(std::size_t top_index) const {
+    return pixel_rect(top_.at(top_index).footprint) & grid();
+  }
+
+  /// The waypoints of the descent in progress (decided at the last top-level image), in
+  /// visiting order; empty when none is in progress.
+  [[nodiscard]] const std::vector<Waypoint>& descent() const noexcept { return sub_; }
 
   /// The top-level lawnmower W^{h_max}.
   [[nodiscard]] const std::vector<Waypoint>& top_level() const noexcept { return top_; }
@@ -511,12 +538,11 @@ class AdaptivePlanner {
     ctx.lawnmowers = forecasts;
     rec.decision = policy_.decide(ctx);
     if (rec.decision.descend) {
-      const auto it = std::find_if(rec.candidates.begin(), rec.candidates.end(),
-                                   [&](const Candidate& c) { return c.gsd_cm == rec.decision.gsd_cm; });
-      ADAPTSEG_ASSERT(it != rec.candidates.end());
-      sub_ = std::move(sub_plans[static_cast<std::size_t>(it - rec.candidates.begin())]);
+      const std::size_t k = chosen_candidate(rec.decision, rec.candidates, policy_.name());
+      sub_ = std::move(sub_plans[k]);
       sub_next_ = 0;
-      descent_altitude_m_ = it->altitude_m;
+      descent_altitude_m_ = rec.candidates[k].altitude_m;
+      descent_before_ = map_.labels()(region_rect(i)).clone();
     }
     decisions_.push_back(rec);
     charge_measured_planning(seconds_since(t0));
@@ -527,15 +553,18 @@ class AdaptivePlanner {
   DescentOutcome finish_descent() {
     const auto t0 = std::chrono::steady_clock::now();
     DecisionRecord& rec = decisions_.back();
-    const Waypoint& top = top_[path_[rec.waypoint_index].top_index];
+    const std::size_t top_index = path_[rec.waypoint_index].top_index;
     DescentOutcome out;
-    out.top_altitude_m = top.position.z();
+    out.top_altitude_m = top_[top_index].position.z();
     out.sub_altitude_m = descent_altitude_m_;
     out.sigma_top = rec.sigma;
-    const cv::Rect region = pixel_rect(top.footprint) & grid();
+    const cv::Rect region = region_rect(top_index);
     out.sigma_sub = region.area() == 0 ? 0.0
                                        : semantic_ratio(map_.labels()(region), options_.mission.interest,
                                                         map_.unknown_label());
+    if (region.area() > 0)
+      out.relabelled = relabelling(descent_before_, map_.labels()(region), area_.valid_mask(region),
+                                   options_.mission.interest);
     policy_.observe(out);
     rec.outcome = out;
     sub_.clear();
@@ -567,6 +596,7 @@ class AdaptivePlanner {
   std::vector<Waypoint> sub_;         ///< the descent in progress, if any
   std::size_t sub_next_ = 0;          ///< next waypoint of sub_ to hand out
   double descent_altitude_m_ = 0.0;
+  cv::Mat descent_before_;            ///< the region's map when the descent in progress was decided
   bool pending_ = false;              ///< path_.back() awaits its image
   std::vector<PlannedWaypoint> path_;
   std::vector<DecisionRecord> decisions_;
@@ -595,14 +625,59 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
   AdaptiveOptions planner_options = options;
   planner_options.mission.interest = mission.interest();
   AdaptivePlanner<Backend, Policy> planner(SurveyArea::of(field), backend, policy, std::move(planner_options));
+  // What each descent gained is scored at the end against the ground truth: its region's map
+  // before it, the map pixels its images covered, and the top-level images alone.
+  struct Pending {
+    std::size_t decision;
+    cv::Rect region;
+    cv::Mat before;
+    cv::Rect covered;  ///< bounding box of the descent's footprints on the map
+    double gsd_cm;
+  };
+  std::vector<Pending> descents;
+  SemanticMap top_only(field.labels().size(), field.ignore_label());
   while (const auto w = planner.next()) {
     mission.charge_planning(planner.take_planning_s());
     const auto visit = mission.visit_without_fusion(w->waypoint, w->level);
-    (void)planner.report(visit.image, visit.labels, visit.record->segmentation_s, mission.elapsed_s());
+    const PlannerStep step = planner.report(visit.image, visit.labels, visit.record->segmentation_s, mission.elapsed_s());
+    if (w->level == 0) top_only.fuse(visit.image, visit.labels);
+    if (step.decision && step.decision->decision.descend) {
+      const cv::Rect region = planner.region_rect(w->top_index);
+      cv::Rect covered;
+      for (const Waypoint& s : planner.descent()) covered |= planner.pixel_rect(s.footprint);
+      descents.push_back({planner.decisions().size() - 1, region, planner.map().labels()(region).clone(),
+                          covered & cv::Rect(0, 0, field.width_px(), field.height_px()),
+                          step.decision->decision.gsd_cm});
+    }
   }
   // The last decision's measured time (a fixed planning time is charged per waypoint only).
   if (!mission.options().fixed_planning_time_s) mission.charge_planning(planner.take_planning_s());
-  return AdaptiveResult{std::move(mission).finish(planner.map()), planner.decisions()};
+  AdaptiveResult result{std::move(mission).finish(planner.map()), planner.decisions(), {}};
+  const auto& interest = result.mission.interest;
+  const int n = field.num_classes();
+  const auto region_confusion = [&](const cv::Rect& region, const cv::Mat& labels) {
+    ConfusionMatrix cm(n);
+    cm.add(field.labels()(region), labels, field.ignore_label());
+    return cm;
+  };
+  const double final_miou = result.mission.miou_interest().value_or(0.0);
+  const cv::Mat& final_labels = result.mission.fused_labels;
+  for (const Pending& d : descents) {
+    RealisedDescent r;
+    r.decision = d.decision;
+    std::tie(r.region_miou_before, r.region_miou_after) =
+        paired_miou(region_confusion(d.region, d.before), region_confusion(d.region, final_labels(d.region)), interest);
+    // The pixels this descent mapped last: covered by it and still holding its GSD.
+    const cv::Mat owned = planner.map().gsd_cm()(d.covered) == static_cast<float>(d.gsd_cm);
+    cv::Mat reverted = final_labels(d.covered).clone();
+    top_only.labels()(d.covered).copyTo(reverted, owned);
+    ConfusionMatrix without = result.mission.confusion;
+    without -= region_confusion(d.covered, final_labels(d.covered));
+    without += region_confusion(d.covered, reverted);
+    r.field_gain = final_miou - without.miou(interest).value_or(0.0);
+    result.realised.push_back(r);
+  }
+  return result;
 }
 
 }  // namespace adaptseg

@@ -1,8 +1,8 @@
 #pragma once
 /// @file
-/// Offline initialisation on a training field (paper §3.2.2; method.md §4): collect the O and
-/// I samples, fit the decision function, and choose its thresholds on the training field
-/// only, by the front margin over the training field's own lawnmower curve.
+/// Offline initialisation on training fields (paper §3.2.2; method.md §4): collect the O, I and
+/// C samples, fit the gain model, and choose the decision rule's settings on the training
+/// fields only, by the front margin over each field's own lawnmower curve.
 
 #include <adaptseg/adaptive_planner.hpp>
 #include <adaptseg/decision_function.hpp>
@@ -15,179 +15,312 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
+#include <string>
 #include <vector>
 
 namespace adaptseg {
 
+/// The confidence levels z the front-aware rule's calibration tries by default.
+inline const std::vector<double> kDefaultConfidences{0.0, 0.5, 1.0, 1.5, 2.0};
+
 /// How to calibrate.
 struct CalibrationOptions {
-  AdaptiveOptions adaptive{};            ///< camera, timing, labels of interest, top and candidate GSDs
-  std::vector<double> lawnmower_gsd_cm{};///< GSDs of the training field's lawnmower curve
-  DecisionFunction::Params base{};       ///< exploration, refit schedule; thresholds are searched
-  int threshold_steps = 10;              ///< utility thresholds tried (quantiles of observed utility)
-  int restarts = 3;                      ///< GP hyperparameter restarts
-  /// Score thresholds by their worst front margin over the training field and its two halves
-  /// (split across the longer image axis) instead of the whole field's margin alone: a
-  /// threshold must work on more than one layout to be chosen.
-  bool robust = true;
-  /// Choose the front-aware rule (DecisionFunction::Params::front_aware, which needs no
-  /// threshold: it stops descending when descents no longer beat the training lawnmower
-  /// curve mapped onto the field's geometry) instead of the best threshold trial of the
-  /// paper's utility rule. The trials are flown and reported either way. `base.weight_by_sigma`
-  /// selects its σ weighting.
-  bool front_aware = true;
-  /// What I predicts the accuracy gain from (DecisionFunction::GainInputs); (Δσ, Δh) by
-  /// default, which reduces to the paper's chain where Δσ carries the information (see
-  /// docs/method.md). What a descent covers is `adaptive.coverage` (region by default, as
-  /// AdaptiveOptions; the example programs default to DescentCoverage::interest).
-  DecisionFunction::GainInputs gain_inputs = DecisionFunction::GainInputs::delta_sigma_and_height;
+  /// Camera, timing, labels of interest (empty: the first field's), top and candidate GSDs,
+  /// descent coverage. Its fixed segmentation and planning times are replaced by the two below.
+  AdaptiveOptions adaptive{};
+  std::vector<double> lawnmower_gsd_cm{};  ///< GSDs of the training fields' lawnmower curves
+  /// Segmentation time charged per image during calibration [s]: declared, not measured, so
+  /// that the same inputs give the same model on any machine (recorded in the model file).
+  double segmentation_time_s = 0.1;
+  double planning_time_s = 0.0;            ///< planning time charged per waypoint [s]
+  GainModel::FitOptions fit{};             ///< what I predicts from, hyperparameter restarts
+  int refit_every = 0;                     ///< O's scheduled re-optimisation (GainModel)
+
+  /// Which rule the model holds: the FrontAwarePolicy (default; its confidence level z is
+  /// chosen below) or the paper's UtilityPolicy (its threshold chosen below).
+  enum class Rule { front_aware, utility };
+  Rule rule = Rule::front_aware;
+
+  /// Front-aware rule: `min_sigma`, `weight_by_sigma` and `scale_prior_sd` as given (with
+  /// several fields `scale_prior_sd` is estimated from their spread instead); `confidence`
+  /// chosen among `confidences` by the mean front margin over the training fields, each flown
+  /// with a model fitted without it (one field: the field and its halves, with the model of
+  /// the whole field). Ties (e.g. where no setting descends on the training fields) go to the
+  /// smaller z: the training fields give no evidence against descending.
+  FrontAwarePolicy::Params front_aware{};
+  std::vector<double> confidences = kDefaultConfidences;
+
+  /// Utility rule: `exploration` and `min_sigma` as given; thresholds searched (quantiles of
+  /// the utilities seen, absolute and relative, σ weighting on and off, "never descend"), each
+  /// flown over every layout (the fields; one field: the field and its halves) and scored by
+  /// its worst front margin (ties: larger mean margin, then the relative rule, then shorter time).
+  UtilityPolicy::Params utility{};
+  int threshold_steps = 10;                ///< utility thresholds tried per weighting
 };
 
-/// One threshold setting tried on the training field.
-struct ThresholdTrial {
-  DecisionFunction::Params params;
-  double time_s = 0.0;          ///< on the whole training field
-  double miou_interest = 0.0;   ///< on the whole training field
-  double front_margin = 0.0;    ///< on the whole training field
-  double worst_margin = 0.0;    ///< smallest margin over the calibration layouts (the score)
-  int descents = 0;             ///< on the whole training field
+/// One setting of the rule tried on the training fields.
+struct RuleTrial {
+  std::string description;      ///< e.g. "front-aware z=1" or "utility weight=1 relative=0 min_utility=..."
+  double time_s = 0.0;          ///< mean over the layouts
+  double miou_interest = 0.0;   ///< mean over the layouts
+  double front_margin = 0.0;    ///< mean over the layouts
+  double worst_margin = 0.0;    ///< smallest over the layouts
+  int descents = 0;             ///< total over the layouts
+  std::vector<double> margins;  ///< per layout
 };
 
 /// Everything calibration produced.
 struct CalibrationResult {
-  std::vector<RegionSample> samples;
-  DecisionFunction decision_function;   ///< fitted, with the chosen thresholds
-  LinearDecision::Params linear{};      ///< σ range of the training field's top-level images
-  std::vector<CurvePoint> lawnmower_curve;  ///< on the training field
-  std::vector<ThresholdTrial> trials;   ///< every setting tried, the chosen one first
+  std::vector<RegionSample> samples;               ///< pooled over the fields (RegionSample::field)
+  DecisionFunction decision_function;              ///< fitted, with the chosen rule and settings
+  LinearDecision::Params linear{};                 ///< σ range of the training fields' top-level images
+  std::vector<std::vector<CurvePoint>> lawnmower_curves;  ///< per training field, at lawnmower_gsd_cm
+  std::vector<RuleTrial> trials;                   ///< every setting tried, the chosen one first
 };
 
-/// Calibrates on `train` with `backend` (the backend the missions will use).
+namespace detail {
+
+/// An adaptive mission of `policy` over `field`, scored against `curve`.
+template <SegmentationBackend Backend, DecisionPolicy Policy>
+AdaptiveResult fly_scored(const Field& field, Backend& backend, Policy& policy, const AdaptiveOptions& options,
+                          const std::vector<CurvePoint>& curve, double& margin) {
+  AdaptiveResult r = run_adaptive_mission(field, backend, policy, options, policy.name());
+  margin = front_margin(curve, r.mission.total_s(), r.mission.miou_interest().value_or(0.0));
+  return r;
+}
+
+/// Adds one layout's run to a trial.
+inline void add_to_trial(RuleTrial& t, const AdaptiveResult& r, double margin) {
+  const double k = static_cast<double>(t.margins.size());
+  t.time_s = (t.time_s * k + r.mission.total_s()) / (k + 1.0);
+  t.miou_interest = (t.miou_interest * k + r.mission.miou_interest().value_or(0.0)) / (k + 1.0);
+  t.front_margin = (t.front_margin * k + margin) / (k + 1.0);
+  t.worst_margin = t.margins.empty() ? margin : std::min(t.worst_margin, margin);
+  t.descents += r.descents();
+  t.margins.push_back(margin);
+}
+
+inline std::string z_text(double z) {
+  std::string s = format_number(z);
+  return "front-aware z=" + s;
+}
+
+}  // namespace detail
+
+/// Calibrates on the training `fields` with `backend` (the backend the missions will use).
 ///
-/// 1. Region samples at every top-level region × candidate GSD (collect_region_samples).
-/// 2. O and I fitted (DecisionFunction::initialize).
-/// 3. The training field's lawnmower curve at `lawnmower_gsd_cm`.
-/// 4. One adaptive mission on `train` with no threshold gives the utilities the policy sees;
-///    thresholds at their quantiles (absolute and relative, σ weighting on/off), the
-///    front-aware rule (its reference lawnmower: the training curve by GSD) and "never
-///    descend" are each flown on `train`. With `front_aware` (default) the front-aware rule is
-///    chosen; otherwise the threshold setting with the largest worst-case front margin over
-///    the layouts (ties: larger whole-field margin, then shorter time).
+/// 1. Region samples at every top-level region × candidate GSD of every field, pooled
+///    (collect_region_samples).
+/// 2. The gain model fitted to them (GainModel::fit).
+/// 3. Each field's lawnmower curve at `lawnmower_gsd_cm`: the front-aware rule's reference curves.
+/// 4. The rule's settings chosen on the training fields (CalibrationOptions::rule).
 /// 5. The linear baseline's σ range: the 5th and 95th percentiles of σ at h_max.
-/// @throws std::invalid_argument for invalid options (see run_adaptive_mission and
-///         collect_region_samples).
+/// @throws std::invalid_argument for no field, fields with other class sets, invalid options
+///         (see run_adaptive_mission and collect_region_samples), or fields without a sample.
 template <SegmentationBackend Backend>
-[[nodiscard]] CalibrationResult calibrate(const Field& train, Backend& backend, const CalibrationOptions& options) {
+[[nodiscard]] CalibrationResult calibrate(std::span<const Field> fields, Backend& backend,
+                                          const CalibrationOptions& options) {
+  detail::require(!fields.empty(), "calibrate: at least one training field is needed; count", fields.size());
   detail::require(!options.lawnmower_gsd_cm.empty(), "calibrate: lawnmower_gsd_cm must not be empty", 0);
   detail::require(options.threshold_steps >= 1, "calibrate: threshold_steps must be >= 1", options.threshold_steps);
-  const std::vector<int> interest =
-      options.adaptive.mission.interest.empty() ? train.interest() : options.adaptive.mission.interest;
-  detail::require(!interest.empty(), "calibrate: no labels of interest", 0);
-  const CameraModel camera(options.adaptive.mission.camera);
-  auto samples = collect_region_samples(train, backend, camera, options.adaptive.top_gsd_cm,
-                                        options.adaptive.candidate_gsd_cm, interest, options.adaptive.coverage);
-  detail::require(!samples.empty(), "calibrate: the training field gave no region sample", train.name());
+  detail::require(std::isfinite(options.segmentation_time_s) && options.segmentation_time_s >= 0.0,
+                  "calibrate: segmentation_time_s must be finite and >= 0", options.segmentation_time_s);
+  detail::require(!options.confidences.empty(), "calibrate: confidences must not be empty", 0);
+  const auto names = [](const Field& f) {
+    std::vector<std::string> v;
+    for (const auto& c : f.classes()) v.push_back(c.name);
+    return v;
+  };
+  for (const Field& f : fields)
+    detail::require(names(f) == names(fields.front()),
+                    "calibrate: every training field must have the first field's classes; field", f.name());
+  AdaptiveOptions adaptive = options.adaptive;
+  if (adaptive.mission.interest.empty()) adaptive.mission.interest = fields.front().interest();
+  detail::require(!adaptive.mission.interest.empty(), "calibrate: no labels of interest", 0);
+  adaptive.mission.fixed_segmentation_time_s = options.segmentation_time_s;
+  adaptive.mission.fixed_planning_time_s = options.planning_time_s;
+  const std::vector<int>& interest = adaptive.mission.interest;
+  const CameraModel camera(adaptive.mission.camera);
 
-  // Calibration layouts: the field, and (robust) its halves across the longer axis.
-  std::vector<Field> layouts{train};
-  if (options.robust) {
-    const bool wide = train.width_px() >= train.height_px();
-    layouts.push_back(train.sub_field(wide ? FieldRegion{0, 0, 0.5, 1} : FieldRegion{0, 0, 1, 0.5}));
-    layouts.push_back(train.sub_field(wide ? FieldRegion{0.5, 0, 1, 1} : FieldRegion{0, 0.5, 1, 1}));
+  std::vector<RegionSample> samples;
+  std::vector<std::vector<RegionSample>> by_field;
+  for (std::size_t k = 0; k < fields.size(); ++k) {
+    by_field.push_back(collect_region_samples(fields[k], backend, camera, adaptive.top_gsd_cm,
+                                              adaptive.candidate_gsd_cm, interest, adaptive.coverage, k));
+    detail::require(!by_field.back().empty(), "calibrate: the training field gave no region sample", fields[k].name());
+    samples.insert(samples.end(), by_field.back().begin(), by_field.back().end());
   }
-  std::vector<std::vector<CurvePoint>> curves;
-  for (const Field& f : layouts) {
-    curves.emplace_back();
+  const auto curve_of = [&](const Field& f) {
+    std::vector<CurvePoint> c;
     for (double g : options.lawnmower_gsd_cm) {
-      const MissionResult r = run_lawnmower_mission(f, g, backend, options.adaptive.mission);
-      curves.back().push_back({r.total_s(), r.miou_interest().value_or(0.0)});
+      const MissionResult r = run_lawnmower_mission(f, g, backend, adaptive.mission);
+      c.push_back({r.total_s(), r.miou_interest().value_or(0.0)});
     }
+    return c;
+  };
+  std::vector<std::vector<CurvePoint>> curves;
+  std::vector<ReferenceCurve> reference;
+  for (std::size_t f = 0; f < fields.size(); ++f) {
+    curves.push_back(curve_of(fields[f]));
+    ReferenceCurve r{fields[f].name(), {}, by_field[f].front().field_sigma};
+    for (std::size_t k = 0; k < options.lawnmower_gsd_cm.size(); ++k)
+      r.points.push_back({options.lawnmower_gsd_cm[k], curves.back()[k].miou});
+    reference.push_back(std::move(r));
   }
-  const std::vector<CurvePoint>& curve = curves.front();
+  GainModel::FitOptions fit = options.fit;
+  GainModel model = GainModel::fit(samples, fit);
+  model.set_refit_every(options.refit_every);
 
-  DecisionFunction::Params probe = options.base;
-  probe.min_sigma = 0.0;
-  probe.min_utility = -std::numeric_limits<double>::max();
-  DecisionFunction fitted = DecisionFunction::initialize(samples, probe, options.restarts, 0, options.gain_inputs);
-  std::vector<GsdPoint> reference;  // the training lawnmower by GSD, for the front-aware rule
-  for (std::size_t k = 0; k < curve.size(); ++k) reference.push_back({options.lawnmower_gsd_cm[k], curve[k].miou});
-  fitted.set_reference_lawnmower(reference);
+  // Layouts of a single field: the field and its halves across the longer axis.
+  std::vector<Field> halves;
+  std::vector<std::vector<CurvePoint>> half_curves;
+  if (fields.size() == 1) {
+    const Field& f = fields.front();
+    const bool wide = f.width_px() >= f.height_px();
+    halves.push_back(f.sub_field(wide ? FieldRegion{0, 0, 0.5, 1} : FieldRegion{0, 0, 1, 0.5}));
+    halves.push_back(f.sub_field(wide ? FieldRegion{0.5, 0, 1, 1} : FieldRegion{0, 0.5, 1, 1}));
+    for (const Field& h : halves) half_curves.push_back(curve_of(h));
+  }
 
-  const auto fly = [&](const DecisionFunction::Params& p) {
-    ThresholdTrial t;
-    t.params = p;
-    t.worst_margin = std::numeric_limits<double>::infinity();
-    AdaptiveResult whole;
-    for (std::size_t k = 0; k < layouts.size(); ++k) {
-      DecisionFunction df = fitted;
-      df.set_params(p);
-      AdaptiveResult r = run_adaptive_mission(layouts[k], backend, df, options.adaptive, df.name());
-      const double margin = front_margin(curves[k], r.mission.total_s(), r.mission.miou_interest().value_or(0.0));
-      t.worst_margin = std::min(t.worst_margin, margin);
-      if (k == 0) {
-        t.time_s = r.mission.total_s();
-        t.miou_interest = r.mission.miou_interest().value_or(0.0);
-        t.front_margin = margin;
-        t.descents = r.descents();
-        whole = std::move(r);
+  std::vector<RuleTrial> trials;
+  std::optional<DecisionFunction> chosen;
+  if (options.rule == CalibrationOptions::Rule::front_aware) {
+    FrontAwarePolicy::Params base = options.front_aware;
+    base.online = true;
+    // One fold per training field, its model fitted without it (one field: its layouts, the
+    // whole field's model).
+    struct Fold {
+      const Field* field;
+      const std::vector<CurvePoint>* curve;
+      GainModel model;
+      std::vector<ReferenceCurve> reference;
+    };
+    std::vector<Fold> folds;
+    std::vector<double> field_scales;
+    if (fields.size() == 1) {
+      folds.push_back({&fields.front(), &curves.front(), model, reference});
+      for (std::size_t k = 0; k < halves.size(); ++k) folds.push_back({&halves[k], &half_curves[k], model, reference});
+    } else {
+      for (std::size_t k = 0; k < fields.size(); ++k) {
+        std::vector<RegionSample> rest;
+        std::vector<ReferenceCurve> rest_reference;
+        for (std::size_t j = 0; j < fields.size(); ++j)
+          if (j != k) {
+            rest.insert(rest.end(), by_field[j].begin(), by_field[j].end());
+            rest_reference.push_back(reference[j]);
+          }
+        GainModel m = GainModel::fit(rest, fit);
+        m.set_refit_every(options.refit_every);
+        // The field factor s of this field under the model that did not see it: the least-squares
+        // scale of C's forecasts onto what its descents relabelled.
+        double num = 0.0, den = 0.0;
+        for (const RegionSample& s : by_field[k]) {
+          const GainForecast f = m.forecast(s.delta_h_m, s.sigma_top);
+          num += f.relabelled * s.relabelled.interest_share;
+          den += f.relabelled * f.relabelled;
+        }
+        if (den > 0.0) field_scales.push_back(num / den);
+        folds.push_back({&fields[k], &curves[k], std::move(m), std::move(rest_reference)});
       }
     }
-    return std::make_pair(t, std::move(whole));
-  };
-
-  std::vector<ThresholdTrial> trials;
-  for (bool weight : {true, false}) {
-    probe.weight_by_sigma = weight;
-    probe.relative_utility = false;
-    auto [open, open_run] = fly(probe);  // descends wherever the predicted gain is positive
-    std::vector<double> utilities;
-    for (const auto& d : open_run.decisions)
-      for (const auto& s : d.decision.scores)
-        if (std::isfinite(s.utility) && s.utility > 0.0) utilities.push_back(s.utility);
-    std::sort(utilities.begin(), utilities.end());
-    trials.push_back(open);
-    // Absolute thresholds: quantiles spread evenly, plus the top tail where only the best
-    // regions qualify.
-    std::vector<double> quantiles;
-    for (int k = 0; k < options.threshold_steps; ++k) quantiles.push_back(static_cast<double>(k) / options.threshold_steps);
-    for (double q : {0.93, 0.96, 0.99}) quantiles.push_back(q);
-    for (double q : quantiles) {
-      if (utilities.empty()) break;
-      DecisionFunction::Params p = probe;
-      p.min_utility = utilities[static_cast<std::size_t>(q * static_cast<double>(utilities.size() - 1))];
-      trials.push_back(fly(p).first);
+    if (field_scales.size() >= 2) {  // ω: the spread of s about 1 over the training fields
+      double ss = 0.0;
+      for (double s : field_scales) ss += (s - 1.0) * (s - 1.0);
+      base.scale_prior_sd = std::max(0.1, std::sqrt(ss / static_cast<double>(field_scales.size())));
     }
-    // The front-aware rule (descend while the forecast front margin rises; no threshold).
-    DecisionFunction::Params front = probe;
-    front.front_aware = true;
-    trials.push_back(fly(front).first);
-    // Relative thresholds: a region's best utility over the mission's running mean.
-    for (int k = 0; k < options.threshold_steps; ++k) {
-      DecisionFunction::Params p = probe;
-      p.relative_utility = true;
-      p.min_utility = 1.0 + 2.0 * static_cast<double>(k) / options.threshold_steps;
-      trials.push_back(fly(p).first);
+    for (double z : options.confidences) {
+      RuleTrial t;
+      t.description = detail::z_text(z);
+      FrontAwarePolicy::Params p = base;
+      p.confidence = z;
+      for (const Fold& fold : folds) {
+        FrontAwarePolicy policy(fold.model, fold.reference, p);
+        double margin = 0.0;
+        const AdaptiveResult r = detail::fly_scored(*fold.field, backend, policy, adaptive, *fold.curve, margin);
+        detail::add_to_trial(t, r, margin);
+      }
+      trials.push_back(std::move(t));
     }
-    DecisionFunction::Params never = probe;  // the top-level lawnmower alone
-    never.min_utility = std::numeric_limits<double>::max();
-    trials.push_back(fly(never).first);
-  }
-  std::stable_sort(trials.begin(), trials.end(), [](const ThresholdTrial& a, const ThresholdTrial& b) {
-    if (a.worst_margin != b.worst_margin) return a.worst_margin > b.worst_margin;
-    if (a.front_margin != b.front_margin) return a.front_margin > b.front_margin;
-    // Equal on the training field: prefer the scale-free rule, which transfers to fields
-    // whose σ levels differ.
-    if (a.params.relative_utility != b.params.relative_utility) return a.params.relative_utility;
-    return a.time_s < b.time_s;
-  });
-  if (options.front_aware) {  // the rule is chosen, not its threshold: put it first
-    const auto chosen = std::find_if(trials.begin(), trials.end(), [&](const ThresholdTrial& t) {
-      return t.params.front_aware && t.params.weight_by_sigma == options.base.weight_by_sigma;
+    std::size_t best = 0;
+    for (std::size_t k = 1; k < trials.size(); ++k)
+      if (trials[k].front_margin > trials[best].front_margin ||
+          (trials[k].front_margin == trials[best].front_margin && options.confidences[k] < options.confidences[best]))
+        best = k;
+    base.confidence = options.confidences[best];
+    chosen = DecisionFunction(FrontAwarePolicy(model, reference, base));
+    std::rotate(trials.begin(), trials.begin() + static_cast<std::ptrdiff_t>(best),
+                trials.begin() + static_cast<std::ptrdiff_t>(best) + 1);
+  } else {
+    std::vector<const Field*> layouts;
+    std::vector<const std::vector<CurvePoint>*> layout_curves;
+    for (std::size_t k = 0; k < fields.size(); ++k) layouts.push_back(&fields[k]), layout_curves.push_back(&curves[k]);
+    for (std::size_t k = 0; k < halves.size(); ++k) layouts.push_back(&halves[k]), layout_curves.push_back(&half_curves[k]);
+    struct Tried {
+      RuleTrial trial;
+      UtilityPolicy::Params params;
+    };
+    std::vector<Tried> tried;
+    const auto fly = [&](const UtilityPolicy::Params& p, std::vector<double>* utilities) {
+      Tried c{{}, p};
+      c.trial.description = "utility weight=" + std::to_string(p.weight_by_sigma ? 1 : 0) +
+                            " relative=" + std::to_string(p.relative_utility ? 1 : 0) +
+                            " min_utility=" + detail::format_number(p.min_utility);
+      for (std::size_t k = 0; k < layouts.size(); ++k) {
+        UtilityPolicy policy(model, p);
+        double margin = 0.0;
+        const AdaptiveResult r = detail::fly_scored(*layouts[k], backend, policy, adaptive, *layout_curves[k], margin);
+        if (utilities && k == 0)
+          for (const auto& d : r.decisions)
+            for (const auto& s : d.decision.scores)
+              if (std::isfinite(s.utility) && s.utility > 0.0) utilities->push_back(s.utility);
+        detail::add_to_trial(c.trial, r, margin);
+      }
+      tried.push_back(std::move(c));
+    };
+    UtilityPolicy::Params probe = options.utility;
+    probe.online = true;
+    probe.min_utility = -std::numeric_limits<double>::max();
+    for (bool weight : {true, false}) {
+      probe.weight_by_sigma = weight;
+      probe.relative_utility = false;
+      std::vector<double> utilities;
+      fly(probe, &utilities);  // descends wherever the predicted gain is positive
+      std::sort(utilities.begin(), utilities.end());
+      // Absolute thresholds: quantiles spread evenly, plus the top tail where only the best
+      // regions qualify.
+      std::vector<double> quantiles;
+      for (int k = 0; k < options.threshold_steps; ++k)
+        quantiles.push_back(static_cast<double>(k) / options.threshold_steps);
+      for (double q : {0.93, 0.96, 0.99}) quantiles.push_back(q);
+      for (double q : quantiles) {
+        if (utilities.empty()) break;
+        UtilityPolicy::Params p = probe;
+        p.min_utility = utilities[static_cast<std::size_t>(q * static_cast<double>(utilities.size() - 1))];
+        fly(p, nullptr);
+      }
+      // Relative thresholds: a region's best utility over the mission's running mean.
+      for (int k = 0; k < options.threshold_steps; ++k) {
+        UtilityPolicy::Params p = probe;
+        p.relative_utility = true;
+        p.min_utility = 1.0 + 2.0 * static_cast<double>(k) / options.threshold_steps;
+        fly(p, nullptr);
+      }
+      UtilityPolicy::Params never = probe;  // the top-level lawnmower alone
+      never.min_utility = std::numeric_limits<double>::max();
+      fly(never, nullptr);
+    }
+    std::stable_sort(tried.begin(), tried.end(), [](const Tried& a, const Tried& b) {
+      if (a.trial.worst_margin != b.trial.worst_margin) return a.trial.worst_margin > b.trial.worst_margin;
+      if (a.trial.front_margin != b.trial.front_margin) return a.trial.front_margin > b.trial.front_margin;
+      // Equal on the training fields: prefer the scale-free rule, which transfers to fields
+      // whose σ levels differ.
+      if (a.params.relative_utility != b.params.relative_utility) return a.params.relative_utility;
+      return a.trial.time_s < b.trial.time_s;
     });
-    ADAPTSEG_ASSERT(chosen != trials.end());
-    std::rotate(trials.begin(), chosen, chosen + 1);
+    chosen = DecisionFunction(UtilityPolicy(model, tried.front().params));
+    for (auto& c : tried) trials.push_back(std::move(c.trial));
   }
-  fitted.set_params(trials.front().params);
 
   std::vector<double> sig;
   for (const auto& s : samples) sig.push_back(s.sigma_top);
@@ -196,16 +329,23 @@ template <SegmentationBackend Backend>
   LinearDecision::Params linear{pct(0.05), pct(0.95)};
   if (!(linear.sigma_high > linear.sigma_low)) linear = {0.0, std::max(1e-6, sig.back())};
   linear.sigma_high = std::min(1.0, linear.sigma_high);
-  return CalibrationResult{std::move(samples), std::move(fitted), linear, std::move(curve), std::move(trials)};
+  return CalibrationResult{std::move(samples), std::move(*chosen), linear, std::move(curves), std::move(trials)};
 }
 
-/// The model file's content for a calibration on `train` with the backend named `segmenter`:
+/// The single-field case (the paper's).
+template <SegmentationBackend Backend>
+[[nodiscard]] CalibrationResult calibrate(const Field& train, Backend& backend, const CalibrationOptions& options) {
+  return calibrate(std::span<const Field>(&train, 1), backend, options);
+}
+
+/// The model file's content for a calibration on `fields` with the backend named `segmenter`:
 /// the fitted decision function, the linear baseline, and what they were calibrated for.
-[[nodiscard]] inline DecisionModel make_decision_model(const Field& train, const std::string& segmenter,
+[[nodiscard]] inline DecisionModel make_decision_model(std::span<const Field> fields, const std::string& segmenter,
                                                        const CalibrationOptions& options,
                                                        const CalibrationResult& calibration) {
-  DecisionModel m{.calibration_field = train.name(),
+  DecisionModel m{.calibration_fields = {},
                   .segmenter = segmenter,
+                  .calibration_segmentation_time_s = options.segmentation_time_s,
                   .classes = {},
                   .interest = {},
                   .camera = options.adaptive.mission.camera,
@@ -217,10 +357,19 @@ template <SegmentationBackend Backend>
                   .linear = calibration.linear,
                   .samples = calibration.samples.size(),
                   .train_front_margin = calibration.trials.empty() ? 0.0 : calibration.trials.front().front_margin};
-  for (const auto& c : train.classes()) m.classes.push_back(c.name);
-  const auto& interest = options.adaptive.mission.interest.empty() ? train.interest() : options.adaptive.mission.interest;
-  for (int i : interest) m.interest.push_back(train.classes().at(static_cast<std::size_t>(i)).name);
+  const Field& first = fields.front();
+  for (const Field& f : fields) m.calibration_fields.push_back(f.name());
+  for (const auto& c : first.classes()) m.classes.push_back(c.name);
+  const auto& interest = options.adaptive.mission.interest.empty() ? first.interest() : options.adaptive.mission.interest;
+  for (int i : interest) m.interest.push_back(first.classes().at(static_cast<std::size_t>(i)).name);
   return m;
+}
+
+/// The single-field case.
+[[nodiscard]] inline DecisionModel make_decision_model(const Field& train, const std::string& segmenter,
+                                                       const CalibrationOptions& options,
+                                                       const CalibrationResult& calibration) {
+  return make_decision_model(std::span<const Field>(&train, 1), segmenter, options, calibration);
 }
 
 }  // namespace adaptseg

@@ -2,14 +2,30 @@
 /// @file
 /// What a decision policy sees and says at a top-level waypoint (paper §3.2.2-3.2.3), and
 /// the `DecisionPolicy` concept that the adaptive planner is templated on.
+///
+/// Models of the concept: UtilityPolicy (the paper's rule), FrontAwarePolicy (beyond the
+/// paper), LinearDecision (the conference version's), and DecisionFunction (whichever of the
+/// first two a calibrated model file holds). Each passes the conformance suite in
+/// tests/policy_conformance.hpp.
 
 #include <concepts>
+#include <cstddef>
 #include <limits>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace adaptseg {
+
+/// What a re-mapping changed in a map region, seen without ground truth (`relabelling()` in
+/// metrics.hpp measures it): the share of the region's field pixels whose label differs before
+/// and after, and the share whose label changed with a label of interest on either side (a
+/// change into, out of, or within L).
+struct Relabelling {
+  double share = 0.0;           ///< label changed [0, 1]
+  double interest_share = 0.0;  ///< label changed, old or new label in L [0, 1]
+};
 
 /// One region seen from h_max and from h' (paper Eq. `eq:veg2h`: a row of O and of I).
 struct RegionSample {
@@ -20,6 +36,20 @@ struct RegionSample {
   double sigma_sub = 0.0;    ///< σ_{h'} (fused sub-lawnmower images over the region)
   double miou_top = 0.0;     ///< mIoU_{h_max} over L on the region
   double miou_sub = 0.0;     ///< mIoU_{h'} over L on the region
+  /// What the descent changed in the region's map (a row of C; observable in flight).
+  Relabelling relabelled{};
+  // The sample in field terms (calibration knows the whole field's top-level map and truth):
+  double region_share = 0.0;  ///< the region's field pixels / the field's
+  double field_sigma = 0.0;   ///< σ of the field's top-level map (share of L over its field pixels)
+  /// Field mIoU over L of the top-level map with this region re-mapped, minus without: what
+  /// this descent alone adds to a top-level lawnmower's result.
+  double field_gain = 0.0;
+  std::size_t field = 0;      ///< which calibration field it comes from (index)
+  /// The field gain per unit of region share and per unit of the field's σ:
+  /// field_gain · field_sigma / region_share (≈ the share of the region's pixels corrected).
+  [[nodiscard]] double normalized_field_gain() const noexcept {
+    return region_share > 0.0 ? field_gain * field_sigma / region_share : 0.0;
+  }
   [[nodiscard]] double delta_sigma() const noexcept { return sigma_top - sigma_sub; }
   [[nodiscard]] double delta_miou() const noexcept { return miou_top - miou_sub; }
 };
@@ -60,6 +90,12 @@ struct CandidateScore {
   double predicted_delta_miou = 0.0;   ///< μ_I(μ_O): mIoU_{h_max} − mIoU_{h'} (< 0: lower is better)
   double predicted_delta_miou_std = 0.0;  ///< predictive standard deviation of the latter
   double utility = 0.0;                ///< gain per second of extra time
+  /// The policy's forecast of the descent's gain in field mIoU over L (NaN where the policy
+  /// makes none; see FrontAwarePolicy).
+  double predicted_field_gain = std::numeric_limits<double>::quiet_NaN();
+  /// The policy's forecast of the share of the region's field pixels the descent relabels with
+  /// a label of interest involved (compare DescentOutcome::relabelled; NaN where none is made).
+  double predicted_relabelled = std::numeric_limits<double>::quiet_NaN();
   /// Front-aware policies: the predicted front margin of the mission if it descends here
   /// (NaN otherwise; see DecisionFunction::Params::front_aware).
   double predicted_front_margin = std::numeric_limits<double>::quiet_NaN();
@@ -78,17 +114,42 @@ struct DescentOutcome {
   double sub_altitude_m = 0.0;  ///< h' [m]
   double sigma_top = 0.0;       ///< σ_{h_max} of the region
   double sigma_sub = 0.0;       ///< σ_{h'} of the region (fused sub-lawnmower images)
+  /// What the descent changed in the region's map (field pixels; no ground truth needed).
+  Relabelling relabelled{};
 };
 
-/// Decides at each top-level waypoint: `decide(context)` returns a Decision whose `gsd_cm`,
-/// when descending, is one of the context's candidates; `observe(outcome)` is called after
-/// every descent (a policy that does not adapt ignores it); `name()` names the strategy.
-/// Rationale: the planner owns geometry and time, the policy only weighs gain against cost.
+/// Decides at each top-level waypoint. Rationale: the planner owns geometry and time, the
+/// policy only weighs gain against cost.
+///
+/// Lifecycle and laws, for one mission:
+/// - `begin_mission()` first (AdaptivePlanner's constructor calls it): it forgets whatever the
+///   policy learnt or kept during a previous mission, so one object can fly many missions and
+///   two missions given the same contexts take the same decisions;
+/// - `decide(context)` at every top-level image, in flight order: a Decision that, when
+///   descending, names one of `context.candidates` by its `gsd_cm` (the planner checks it and
+///   throws std::logic_error otherwise); never descending without candidates; `scores` one
+///   per candidate, in order;
+/// - `observe(outcome)` after every descent, before the next `decide` (a policy that does not
+///   adapt ignores it);
+/// - `name()` names the strategy (e.g. in results).
 template <typename P>
 concept DecisionPolicy = requires(P& policy, const DecisionContext& context, const DescentOutcome& outcome) {
+  policy.begin_mission();
   { policy.decide(context) } -> std::same_as<Decision>;
   policy.observe(outcome);
   { policy.name() } -> std::convertible_to<std::string>;
 };
+
+/// The index of the candidate a descending `decision` names (its `gsd_cm`), checked.
+/// @throws std::logic_error naming `policy` if the decision descends to a GSD that is not one
+///         of `candidates` (a policy breaking the DecisionPolicy contract).
+[[nodiscard]] inline std::size_t chosen_candidate(const Decision& decision, std::span<const Candidate> candidates,
+                                                  const std::string& policy) {
+  for (std::size_t k = 0; k < candidates.size(); ++k)
+    if (candidates[k].gsd_cm == decision.gsd_cm) return k;
+  throw std::logic_error("decision policy '" + policy + "' descends to " + std::to_string(decision.gsd_cm) +
+                         " cm/px, which is not one of the " + std::to_string(candidates.size()) +
+                         " candidates it was offered");
+}
 
 }  // namespace adaptseg

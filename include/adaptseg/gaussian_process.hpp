@@ -1424,6 +1424,42 @@ class GaussianProcess {
 
   // ---- persistence --------------------------------------------------------------------------
 
+  /// Everything that defines a fitted model: what a file format stores to restore it exactly.
+  struct State {
+    K kernel;                 ///< hyperparameters and their bounds
+    Options options;
+    double y_mean = 0.0;      ///< frozen target normalisation (0 and 1 without normalize_y)
+    double y_std = 1.0;
+    Eigen::MatrixXd inputs;   ///< n x D training inputs (online additions included)
+    Eigen::VectorXd targets;  ///< n training targets [output units]
+  };
+
+  /// The model's state (see State); `from_state(state())` predicts exactly as this model.
+  [[nodiscard]] State state() const {
+    return State{kernel_, options_, y_mean_, y_std_, training_inputs(), training_targets()};
+  }
+
+  /// Restores a model from its state and factorises it.
+  /// @throws std::invalid_argument for invalid options, a y_std that is not finite and > 0, a
+  ///         y_mean that is not finite, inputs and targets of different lengths, non-finite
+  ///         data, or a dimension the kernel does not accept; NumericalError.
+  [[nodiscard]] static GaussianProcess from_state(State s) {
+    detail::require(std::isfinite(s.y_std) && s.y_std > 0.0, "GaussianProcess::from_state: y_std must be finite and > 0",
+                    s.y_std);
+    detail::require_finite(s.y_mean, "GaussianProcess::from_state: y_mean");
+    GaussianProcess gp(std::move(s.kernel), s.options);
+    gp.y_mean_ = s.y_mean;
+    gp.y_std_ = s.y_std;
+    if (s.inputs.rows() > 0 || s.targets.size() > 0) {
+      detail::require(gp.kernel_.accepts_dimension(s.inputs.cols()),
+                      "GaussianProcess::from_state: the kernel does not accept dimension", s.inputs.cols());
+      gp.condition(s.inputs, s.targets);
+    } else {
+      gp.dimension_ = s.inputs.cols();
+    }
+    return gp;
+  }
+
   /// Writes the model as text (format in `load`); leaves `os`'s formatting state unchanged.
   /// @throws std::invalid_argument if the stream fails.
   void save(std::ostream& os) const {

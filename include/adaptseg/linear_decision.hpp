@@ -59,6 +59,7 @@ class LinearDecision {
     return d;
   }
 
+  void begin_mission() const noexcept {}  ///< nothing to forget: the rule has no state
   void observe(const DescentOutcome&) const noexcept {}
 
  private:

@@ -3,6 +3,7 @@
 /// Segmentation metrics (method.md §3): semantic ratio (paper Eq. `eq:vr`), per-class IoU and
 /// mIoU (paper Eq. `eq:iou`) over a class set, per image and over the fused field.
 
+#include <adaptseg/decision.hpp>
 #include <adaptseg/lawnmower_curve.hpp>
 #include <adaptseg/simulated_sensor.hpp>
 
@@ -15,6 +16,8 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace adaptseg {
@@ -175,10 +178,70 @@ class ConfusionMatrix {
     return *this;
   }
 
+  /// Removes counts added before (e.g. one region's, to score a map without it).
+  /// @throws std::invalid_argument if the class counts differ or a count would become negative.
+  ConfusionMatrix& operator-=(const ConfusionMatrix& other) {
+    detail::require(other.n_ == n_, "ConfusionMatrix::operator-=: class counts differ", other.n_);
+    for (std::size_t i = 0; i < counts_.size(); ++i)
+      detail::require(counts_[i] >= other.counts_[i], "ConfusionMatrix::operator-=: a count would become negative",
+                      other.counts_[i]);
+    for (std::size_t i = 0; i < counts_.size(); ++i) counts_[i] -= other.counts_[i];
+    return *this;
+  }
+
  private:
   int n_;
   std::vector<std::int64_t> counts_;
 };
+
+/// mIoU over `classes` of two predictions of the same region, on a common class set: the
+/// classes that occur in the truth or in either prediction. A class absent from the truth and
+/// from one prediction scores 1 for that prediction (nothing to get wrong); a region where no
+/// class of the set occurs anywhere scores 1 for both.
+/// @return {mIoU of a, mIoU of b}
+[[nodiscard]] inline std::pair<double, double> paired_miou(const ConfusionMatrix& a, const ConfusionMatrix& b,
+                                                           std::span<const int> classes) {
+  double sa = 0.0, sb = 0.0;
+  int n = 0;
+  for (int c : classes) {
+    const auto ia = a.iou(c);
+    const auto ib = b.iou(c);
+    if (!ia && !ib) continue;
+    sa += ia.value_or(1.0);
+    sb += ib.value_or(1.0);
+    ++n;
+  }
+  if (n == 0) return {1.0, 1.0};
+  return {sa / n, sb / n};
+}
+
+/// Relabelling (decision.hpp) between two label maps of one region, over the pixels where `field_mask` is
+/// non-zero (all pixels if it is empty); 0 for a region without field pixels.
+/// @throws std::invalid_argument unless the maps (and a non-empty mask) are CV_8UC1 of one size.
+[[nodiscard]] inline Relabelling relabelling(const cv::Mat& before, const cv::Mat& after, const cv::Mat& field_mask,
+                                             std::span<const int> interest) {
+  detail::require(before.type() == CV_8UC1 && after.type() == CV_8UC1 && before.size() == after.size() &&
+                      (field_mask.empty() || (field_mask.type() == CV_8UC1 && field_mask.size() == before.size())),
+                  "relabelling: before, after (and the mask) must be CV_8UC1 of one size",
+                  std::to_string(before.cols) + "x" + std::to_string(before.rows) + " vs " +
+                      std::to_string(after.cols) + "x" + std::to_string(after.rows));
+  const auto lut = detail::label_lut(interest);
+  std::int64_t n = 0, changed = 0, changed_l = 0;
+  for (int r = 0; r < before.rows; ++r) {
+    const auto* b = before.ptr<std::uint8_t>(r);
+    const auto* a = after.ptr<std::uint8_t>(r);
+    const auto* m = field_mask.empty() ? nullptr : field_mask.ptr<std::uint8_t>(r);
+    for (int c = 0; c < before.cols; ++c) {
+      if (m != nullptr && m[c] == 0) continue;
+      ++n;
+      if (a[c] == b[c]) continue;
+      ++changed;
+      changed_l += lut[a[c]] || lut[b[c]] ? 1 : 0;
+    }
+  }
+  if (n == 0) return {};
+  return {static_cast<double>(changed) / static_cast<double>(n), static_cast<double>(changed_l) / static_cast<double>(n)};
+}
 
 /// Confusion of one image's segmentation against its ground truth at the orthomosaic's
 /// resolution (each camera pixel spread over the orthomosaic pixels it covers).

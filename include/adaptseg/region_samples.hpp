@@ -20,33 +20,12 @@
 
 namespace adaptseg {
 
-/// mIoU over `classes` of two predictions of the same region, on a common class set: the
-/// classes that occur in the truth or in either prediction. A class absent from the truth and
-/// from one prediction scores 1 for that prediction (nothing to get wrong); a region where no
-/// class of the set occurs anywhere scores 1 for both.
-/// @return {mIoU of a, mIoU of b}
-[[nodiscard]] inline std::pair<double, double> paired_miou(const ConfusionMatrix& a, const ConfusionMatrix& b,
-                                                           std::span<const int> classes) {
-  double sa = 0.0, sb = 0.0;
-  int n = 0;
-  for (int c : classes) {
-    const auto ia = a.iou(c);
-    const auto ib = b.iou(c);
-    if (!ia && !ib) continue;
-    sa += ia.value_or(1.0);
-    sb += ib.value_or(1.0);
-    ++n;
-  }
-  if (n == 0) return {1.0, 1.0};
-  return {sa / n, sb / n};
-}
-
 /// Flies every top-level region of `field` at `top_gsd_cm` and at each of `candidate_gsd_cm`
 /// and returns one RegionSample per (region, candidate). Regions without a valid pixel are
 /// skipped; candidates finer than the field's GSD are skipped. `coverage`: what each
 /// sub-lawnmower covers, as AdaptivePlanner::descent_plan (with DescentCoverage::interest, a
 /// (region, candidate) whose sub-lawnmower has no cell is skipped: the planner offers no such
-/// descent).
+/// descent). Each sample's `field` is `field_index`.
 /// @throws std::invalid_argument for a top GSD finer than the field's or candidates not finer
 ///         than the top, or an empty `interest`.
 template <SegmentationBackend Backend>
@@ -54,7 +33,8 @@ template <SegmentationBackend Backend>
                                                                const CameraModel& camera, double top_gsd_cm,
                                                                const std::vector<double>& candidate_gsd_cm,
                                                                const std::vector<int>& interest,
-                                                               DescentCoverage coverage = DescentCoverage::region) {
+                                                               DescentCoverage coverage = DescentCoverage::region,
+                                                               std::size_t field_index = 0) {
   detail::require(top_gsd_cm >= field.gsd_cm() * (1.0 - 1e-9),
                   "collect_region_samples: top_gsd_cm is finer than the field's GSD", top_gsd_cm);
   detail::require(!interest.empty(), "collect_region_samples: no labels of interest", 0);
@@ -65,10 +45,28 @@ template <SegmentationBackend Backend>
   const LawnmowerPlanner planner(camera);
   const auto keep = [&](const Area& a) { return field.has_valid(a); };
   const int n = field.num_classes();
+  // The top-level lawnmower over the whole field: every sample's field terms are measured
+  // against its map.
+  const auto tops = planner.plan(field.area(), top_gsd_cm, {0.0, 0.0}, keep);
+  std::vector<Image> top_images;
+  std::vector<cv::Mat> top_segmentations;
+  SemanticMap field_map(field.labels().size(), field.ignore_label());
+  for (const auto& top : tops) {
+    top_images.push_back(sensor.capture(top));
+    top_segmentations.push_back(backend.segment(top_images.back()));
+    field_map.fuse(top_images.back(), top_segmentations.back());
+  }
+  ConfusionMatrix field_cm(n);
+  field_cm.add(field.labels(), field_map.labels(), field.ignore_label());
+  const double field_miou = field_cm.miou(interest).value_or(0.0);
+  const double field_sigma = semantic_ratio(field_map.labels(), interest, field.ignore_label());
+  const double field_px_total = std::max(1, field.valid_pixels());
+  const cv::Rect grid(0, 0, field.width_px(), field.height_px());
   std::vector<RegionSample> out;
-  for (const auto& top : planner.plan(field.area(), top_gsd_cm, {0.0, 0.0}, keep)) {
-    const Image top_image = sensor.capture(top);
-    const cv::Mat top_labels = backend.segment(top_image);
+  for (std::size_t t = 0; t < tops.size(); ++t) {
+    const Waypoint& top = tops[t];
+    const Image& top_image = top_images[t];
+    const cv::Mat& top_labels = top_segmentations[t];
     const ConfusionMatrix top_cm = image_confusion(top_image, top_labels, n);
     const double sigma_top = semantic_ratio(top_labels, interest, top_image.ignore_label);
     const cv::Rect region = top_image.footprint_px;
@@ -77,6 +75,17 @@ template <SegmentationBackend Backend>
     top_local.footprint_px -= region.tl();
     SemanticMap top_map(region.size(), field.ignore_label());
     top_map.fuse(top_local, top_labels);
+    // The region's field pixels: where relabelling is counted.
+    cv::Mat field_px(region.size(), CV_8UC1, cv::Scalar(0));
+    const cv::Rect inside = region & grid;
+    field.valid_mask()(inside).copyTo(field_px(inside - region.tl()));
+    // The field's confusion without this region's top-level map, for the field gain.
+    ConfusionMatrix field_without_region = field_cm;
+    {
+      ConfusionMatrix here(n);
+      here.add(field.labels()(inside), field_map.labels()(inside), field.ignore_label());
+      field_without_region -= here;
+    }
     const auto keep_cell = [&](const Area& a) {
       return keep(a) && (coverage == DescentCoverage::region ||
                          cell_shows_interest(top_map.labels(), field.pixel_rect(a) - region.tl(), top_gsd_cm,
@@ -98,7 +107,18 @@ template <SegmentationBackend Backend>
       }
       ConfusionMatrix sub_cm(n);
       sub_cm.add(top_image.ground_truth, local.labels(), field.ignore_label());
+      // What the descent changed in the mission's map (where the sub-lawnmower wrote nothing,
+      // the map keeps the top-level labels): C's target.
+      cv::Mat after = top_map.labels().clone();
+      local.labels().copyTo(after, local.labels() != field.ignore_label());
       RegionSample s;
+      s.field = field_index;
+      s.relabelled = relabelling(top_map.labels(), after, field_px, interest);
+      s.region_share = cv::countNonZero(field_px) / field_px_total;
+      s.field_sigma = field_sigma;
+      ConfusionMatrix with = field_without_region;
+      with.add(field.labels()(inside), after(inside - region.tl()), field.ignore_label());
+      s.field_gain = with.miou(interest).value_or(0.0) - field_miou;
       s.top_gsd_cm = top_gsd_cm;
       s.sub_gsd_cm = g;
       s.delta_h_m = camera.altitude_m(top_gsd_cm) - camera.altitude_m(g);

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Black-box test of adaptseg_evaluate, the paper's experiment on a scene the decision function
 # never saw: initialised on Dubai tile 4, flown on tile 6 with the oracle, L = {road} (0.8 % of
-# tile 6's pixels: a spatially localised class). Checks results.csv's columns, the figures, a
-# positive front margin for the adaptive strategy, and that a budget is never exceeded.
+# tile 6's pixels: a spatially localised class). Checks results.csv's and decisions.csv's
+# columns, the figures, a positive front margin for the adaptive strategy, and that a budget is
+# never exceeded.
 #   test_evaluate_cli.sh EVALUATE_BINARY EXAMPLES_DIR
 set -uo pipefail
 evaluate=$1 examples=$2
@@ -10,7 +11,8 @@ source "$(dirname "$0")/cli_common.sh"
 fixed=(--seg-time-s 0.1 --plan-time-s 0)
 "$evaluate" --train "$examples/data/dubai-tile-4" --test "$examples/data/dubai-tile-6" --interest road \
   "${fixed[@]}" --out "$work/e" >"$work/log" 2>&1 || fail "evaluate failed: $(tail -5 "$work/log")"
-for f in results.csv per_image.csv model.yaml miou_vs_time.png per_image_miou.png paths.png maps.png; do
+for f in results.csv per_image.csv decisions.csv model.yaml miou_vs_time.png per_image_miou.png decisions.png paths.png \
+  maps.png; do
   [ -s "$work/e/$f" ] || fail "missing $f"
 done
 header=$(head -1 "$work/e/results.csv")
@@ -21,6 +23,18 @@ margin=$(awk -F, '$2 == "adaptive" {print $11}' "$work/e/results.csv")
 [ -n "$margin" ] || fail "no adaptive row"
 awk -v m="$margin" 'BEGIN {exit !(m > 0)}' || fail "adaptive front margin $margin is not positive"
 echo "ok: adaptive front margin on dubai-tile-6 (road) = $margin"
+# decisions.csv: one row per top-level decision of each model-based strategy; every descent of
+# adaptive carries its forecast, what it relabelled (no truth needed) and what it realised.
+want="field,strategy,decision,image,sigma,action,gsd_cm,images,extra_time_s,forecast_delta_sigma,forecast_delta_miou,"
+want+="forecast_delta_miou_std,forecast_relabelled_interest,forecast_field_gain,forecast_front_margin,observed_sigma_sub,"
+want+="observed_relabelled,observed_relabelled_interest,realised_region_delta_miou,realised_field_gain"
+[ "$(head -1 "$work/e/decisions.csv")" = "$want" ] || fail "decisions.csv header: $(head -1 "$work/e/decisions.csv")"
+descents=$(awk -F, '$2 == "adaptive" {print $12}' "$work/e/results.csv")
+awk -F, -v n="$descents" '$2 == "adaptive" {rows++} $2 == "adaptive" && $6 == "descend" {
+    d++; if ($13 == "" || $14 == "" || $18 == "" || $20 == "" || $14 <= 0 || $20 <= 0) bad++ }
+  END {exit !(rows > 0 && d == n && d > 0 && bad == 0)}' "$work/e/decisions.csv" ||
+  fail "decisions.csv: adaptive's $descents descents not all recorded with forecast, observation and realised gain"
+echo "ok: decisions.csv records adaptive's $descents descents"
 # per_image.csv: every image has the truth's share of L, in [0, 1]; road is in some of them
 want="field,strategy,gsd_cm,image,level,image_gsd_cm,sigma,image_miou_interest,image_miou_all,truth_sigma"
 [ "$(head -1 "$work/e/per_image.csv")" = "$want" ] || fail "per_image.csv header: $(head -1 "$work/e/per_image.csv")"

@@ -1,0 +1,291 @@
+#pragma once
+/// @file
+/// The front-aware decision rule (beyond the paper; docs/method.md): descend where a descent's
+/// forecast gain beats what flying the whole field lower would have gained in the same time,
+/// with the forecasts corrected in flight from what the descents actually changed.
+
+#include <adaptseg/decision.hpp>
+#include <adaptseg/error.hpp>
+#include <adaptseg/gain_model.hpp>
+#include <adaptseg/lawnmower_curve.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace adaptseg {
+
+/// A training field's fixed-altitude lawnmower curve by GSD: the front-aware rule's yardstick.
+struct ReferenceCurve {
+  std::string field;              ///< the training field's name
+  std::vector<GsdPoint> points;   ///< field mIoU over L by lawnmower GSD
+  /// σ of the field's top-level map (its share of L as the UAV sees it); 0: unknown (files of
+  /// format 1). The mean over the reference curves is the prior of a new field's σ.
+  double field_sigma = 0.0;
+};
+
+/// The front-aware rule over a GainModel; a DecisionPolicy.
+///
+/// The paper's utility G / T says nothing about what else the UAV could have done with the
+/// time. This rule measures a descent against exactly that: the fixed-altitude lawnmowers over
+/// the field being flown, at the top and candidate GSDs (DecisionContext::lawnmowers: times
+/// known from the geometry before flying). Their accuracy comes from the training fields'
+/// lawnmower curves at the same GSD (GSD transfers between fields of one kind, time does not):
+/// each training field gives a predicted lawnmower curve for the field being flown.
+///
+/// At a top-level image of σ over a region whose share of the field's ground is a:
+/// - T0 = elapsed + rest of the top-level coverage: the mission's end if it descends no more;
+/// - per candidate, the descent's field-level gain ĝ = η · s · μ_C · a / σ̂ (GainModel: μ_C the
+///   share of the region's pixels the descent relabels, η the field gain per relabelled share;
+///   s the field correction below), with variance (η·a/σ̂)²·(s²·sd_C² + Var(s)·μ_C²). Field
+///   mIoU counts a class's pixels over the whole field, so a corrected pixel is worth 1 / (the
+///   field's pixels of L): σ̂ estimates the field's σ from the top-level images so far (area
+///   weighted), the part not yet seen taken at their σ shrunk towards the training fields' mean
+///   σ with a weight of `sigma_prior_weight` fields;
+/// - the curve's rise ΔD over the descent's extra time, [T0, T0 + T], on each training field's
+///   predicted curve: mean ΔD̄ and spread sd_D over the training fields;
+/// - the descent is worth its time if its lower bound (ĝ − ΔD̄) − z·sqrt(Var ĝ + sd_D²) > 0
+///   (z = `confidence`, chosen on training fields; 0: the forecasts' means). The UAV descends
+///   to the candidate of largest lower bound, if σ >= `min_sigma`. Since ΔD̄ grows with T0, it
+///   descends while descents beat flying lower everywhere, and stops when they no longer do.
+///
+/// Field correction (`online`; beyond the paper, §3.2.3's idea applied to what is observable):
+/// a descent's relabelled share χ (Relabelling::interest_share, the region's field pixels whose
+/// label changed with a label of interest involved) needs no ground truth. C forecasts it; on
+/// this field the truth is taken to be χ = s·μ_C + ε with one field factor s (prior N(1, ω²),
+/// ω = `scale_prior_sd`; ε ~ N(0, sd_C²), C's predictive spread of one region) and the same
+/// factor on the gains, the gain being paid by the relabelled pixels. After each descent s's
+/// posterior is updated (conjugate Gaussian): descents that change less than forecast lower
+/// ĝ and the UAV stops earlier; descents that change more raise it; each observation narrows
+/// Var(s), so the lower bound rises as evidence accrues. Also the paper's update of O.
+/// `online = false` (non-adaptive) keeps s = 1, Var(s) = ω² and O as initialised. Models
+/// without C (files of format 1) keep s = 1, Var(s) = 0.
+///
+/// Models without C (files of format 1) forecast the gain as adaptseg 0.1 did: ĝ = (−μ_I) · a · w,
+/// w = σ / mean σ of this mission's top-level images if `weight_by_sigma`, else 1; with one
+/// reference curve and z = 0 the rule is then exactly that version's.
+class FrontAwarePolicy {
+ public:
+  /// Behaviour; validated by the constructor.
+  struct Params {
+    double min_sigma = 0.0;         ///< σ below which the UAV never descends
+    bool weight_by_sigma = true;    ///< models without C: gain weighted by σ / mean σ (see class comment)
+    bool online = true;             ///< field correction and O's update (false: non-adaptive)
+    double confidence = 0.0;        ///< z >= 0 of the lower bound (see class comment)
+    double scale_prior_sd = 0.5;    ///< ω > 0, prior spread of the field factor s
+    double sigma_prior_weight = 0.25;  ///< > 0: weight of the training fields' σ in σ̂ [fields]
+
+    /// @throws std::invalid_argument naming the field.
+    void validate() const {
+      detail::require(std::isfinite(min_sigma) && min_sigma >= 0.0 && min_sigma <= 1.0,
+                      "FrontAwarePolicy::Params::min_sigma must be in [0, 1]", min_sigma);
+      detail::require(std::isfinite(confidence) && confidence >= 0.0,
+                      "FrontAwarePolicy::Params::confidence must be finite and >= 0", confidence);
+      detail::require(std::isfinite(scale_prior_sd) && scale_prior_sd > 0.0,
+                      "FrontAwarePolicy::Params::scale_prior_sd must be finite and > 0", scale_prior_sd);
+      detail::require(std::isfinite(sigma_prior_weight) && sigma_prior_weight > 0.0,
+                      "FrontAwarePolicy::Params::sigma_prior_weight must be finite and > 0", sigma_prior_weight);
+    }
+  };
+
+  /// @throws std::invalid_argument for invalid params, no reference curve, a curve without
+  ///         points, or a point with a GSD <= 0 or a non-finite value.
+  FrontAwarePolicy(GainModel model, std::vector<ReferenceCurve> reference, Params params)
+      : initial_(std::move(model)), model_(initial_), reference_(std::move(reference)), params_(params) {
+    params_.validate();
+    std::size_t with_sigma = 0;
+    detail::require(!reference_.empty(), "FrontAwarePolicy: at least one reference lawnmower curve is needed; count",
+                    reference_.size());
+    for (const auto& r : reference_) {
+      detail::require(!r.points.empty(), "FrontAwarePolicy: reference curve '" + r.field + "' has no point; count",
+                      r.points.size());
+      for (const auto& p : r.points)
+        detail::require(std::isfinite(p.gsd_cm) && p.gsd_cm > 0.0 && std::isfinite(p.miou),
+                        "FrontAwarePolicy: reference curve '" + r.field + "' needs GSD > 0 and finite mIoU; GSD",
+                        p.gsd_cm);
+      detail::require(std::isfinite(r.field_sigma) && r.field_sigma >= 0.0 && r.field_sigma <= 1.0,
+                      "FrontAwarePolicy: reference curve '" + r.field + "' needs field_sigma in [0, 1]",
+                      r.field_sigma);
+      if (r.field_sigma > 0.0) {
+        prior_sigma_ += r.field_sigma / static_cast<double>(reference_.size());
+        ++with_sigma;
+      }
+    }
+    if (with_sigma != reference_.size()) prior_sigma_ = 0.0;  // unknown for some: the running mean of σ
+    begin_mission();
+  }
+
+  [[nodiscard]] std::string name() const { return params_.online ? "adaptive" : "nonadaptive"; }
+  [[nodiscard]] const Params& params() const noexcept { return params_; }
+  /// @throws std::invalid_argument for invalid params.
+  void set_params(const Params& p) {
+    p.validate();
+    params_ = p;
+  }
+  [[nodiscard]] const std::vector<ReferenceCurve>& reference() const noexcept { return reference_; }
+  /// The model as updated during the current mission.
+  [[nodiscard]] const GainModel& model() const noexcept { return model_; }
+  /// The model as given (what begin_mission restores).
+  [[nodiscard]] const GainModel& initial_model() const noexcept { return initial_; }
+  /// The field factor s: posterior mean and standard deviation so far in this mission.
+  [[nodiscard]] double field_scale() const noexcept { return scale_mean_; }
+  [[nodiscard]] double field_scale_sd() const noexcept { return std::sqrt(scale_var_); }
+
+  void begin_mission() {
+    model_ = initial_;
+    sigma_sum_ = 0.0;
+    sigma_count_ = 0;
+    seen_share_ = 0.0;
+    seen_interest_ = 0.0;
+    forecast_gain_ = 0.0;
+    pending_relabelled_.reset();
+    scale_mean_ = 1.0;
+    scale_var_ = model_.c_model() ? params_.scale_prior_sd * params_.scale_prior_sd : 0.0;
+    scale_precision_sum_ = 0.0;
+    scale_evidence_sum_ = 0.0;
+  }
+
+  /// @throws std::invalid_argument if the context has no lawnmower forecasts.
+  [[nodiscard]] Decision decide(const DecisionContext& c) {
+    detail::require(!c.lawnmowers.empty(),
+                    "FrontAwarePolicy::decide: the context needs the field's lawnmower forecasts; count",
+                    c.lawnmowers.size());
+    // Each training field's lawnmower accuracy, placed at this field's lawnmower times.
+    std::vector<std::vector<CurvePoint>> curves;
+    for (const auto& r : reference_) {
+      curves.emplace_back();
+      for (const auto& f : c.lawnmowers) curves.back().push_back({f.time_s, miou_at_gsd(r.points, f.gsd_cm)});
+    }
+    sigma_sum_ += c.sigma;
+    ++sigma_count_;
+    seen_share_ += c.region_share;
+    seen_interest_ += c.region_share * c.sigma;
+    const bool by_relabelling = model_.c_model().has_value();
+    const double weight = by_relabelling ? gain_weight(c) : legacy_gain_weight(c);
+    const double t0 = c.elapsed_s + c.rest_s;
+
+    Decision d;
+    std::optional<std::size_t> best_index;
+    double best = 0.0;
+    std::vector<double> gains;
+    std::vector<GainForecast> forecasts;
+    for (std::size_t k = 0; k < c.candidates.size(); ++k) {
+      const Candidate& cand = c.candidates[k];
+      const double delta_h = c.top_altitude_m - cand.altitude_m;
+      const GainForecast f = model_.forecast(delta_h, c.sigma);
+      CandidateScore s = scored(cand, f);
+      const double eta = by_relabelling ? model_.efficiency(delta_h) : 1.0;
+      const double base = (by_relabelling ? f.relabelled : -f.delta_miou) * eta * weight;
+      const double base_sd = (by_relabelling ? f.relabelled_std : f.delta_miou_std) * eta * weight;
+      const double gain = scale_mean_ * base;
+      const double gain_var = scale_mean_ * scale_mean_ * base_sd * base_sd + scale_var_ * base * base;
+      s.predicted_field_gain = gain;
+      if (by_relabelling) s.predicted_relabelled = scale_mean_ * f.relabelled;
+      s.utility = utility(gain, cand.extra_time_s);
+      // The curve's rise over the descent's extra time, on every training field's curve.
+      double rise_sum = 0.0, rise_sq = 0.0;
+      for (const auto& curve : curves) {
+        const double rise = curve_miou(curve, t0 + cand.extra_time_s) - curve_miou(curve, t0);
+        rise_sum += rise;
+        rise_sq += rise * rise;
+      }
+      const double n = static_cast<double>(curves.size());
+      const double rise = rise_sum / n;
+      const double rise_var = curves.size() > 1 ? std::max(0.0, (rise_sq - n * rise * rise) / (n - 1.0)) : 0.0;
+      const double lower = gain - rise - params_.confidence * std::sqrt(gain_var + rise_var);
+      s.predicted_front_margin = mean_top_miou(c) + forecast_gain_ + gain - mean_curve_miou(curves, t0 + cand.extra_time_s);
+      if (gain > 0.0 && lower > best) {
+        best = lower;
+        best_index = k;
+      }
+      d.scores.push_back(s);
+      gains.push_back(gain);
+      forecasts.push_back(f);
+    }
+    if (best_index && c.sigma >= params_.min_sigma) {
+      d.descend = true;
+      d.gsd_cm = c.candidates[*best_index].gsd_cm;
+      forecast_gain_ += gains[*best_index];
+      pending_relabelled_ = forecasts[*best_index];
+    }
+    return d;
+  }
+
+  /// After a descent: the paper's update of O and the field correction (no-op unless `online`).
+  void observe(const DescentOutcome& out) {
+    const std::optional<GainForecast> f = std::exchange(pending_relabelled_, std::nullopt);
+    if (!params_.online) return;
+    model_.update(out);
+    if (!f || !std::isfinite(f->relabelled) || !model_.c_model()) return;
+    // Conjugate update of s in χ_obs = s·μ_C + ε, ε ~ N(0, sd_C²), prior s ~ N(1, ω²).
+    const double noise = std::max(f->relabelled_noisy_std * f->relabelled_noisy_std, 1e-12);
+    scale_precision_sum_ += f->relabelled * f->relabelled / noise;
+    scale_evidence_sum_ += f->relabelled * out.relabelled.interest_share / noise;
+    const double prior_precision = 1.0 / (params_.scale_prior_sd * params_.scale_prior_sd);
+    const double precision = prior_precision + scale_precision_sum_;
+    scale_mean_ = std::max(0.0, (prior_precision + scale_evidence_sum_) / precision);
+    scale_var_ = 1.0 / precision;
+  }
+
+ private:
+  /// a / σ̂: a relabelled share of the region, times η, as a field-level gain (see the class comment).
+  [[nodiscard]] double gain_weight(const DecisionContext& c) const {
+    double sigma = 0.0;
+    if (prior_sigma_ > 0.0) {
+      const double k = params_.sigma_prior_weight;
+      const double rest = (seen_interest_ + k * prior_sigma_) / (seen_share_ + k);
+      sigma = seen_interest_ + std::max(0.0, 1.0 - seen_share_) * rest;
+    } else {
+      sigma = sigma_sum_ / static_cast<double>(sigma_count_);
+    }
+    return sigma > 0.0 ? c.region_share / sigma : 0.0;
+  }
+
+  /// a · w of adaptseg 0.1 (models without C).
+  [[nodiscard]] double legacy_gain_weight(const DecisionContext& c) const {
+    const double mean_sigma = sigma_sum_ / static_cast<double>(sigma_count_);
+    return c.region_share * (params_.weight_by_sigma && mean_sigma > 0.0 ? c.sigma / mean_sigma : 1.0);
+  }
+
+  /// mIoU of a predicted curve at time t: linear between its points, flat beyond its ends.
+  static double curve_miou(const std::vector<CurvePoint>& curve, double t) { return -front_margin(curve, t, 0.0); }
+
+  static double mean_curve_miou(const std::vector<std::vector<CurvePoint>>& curves, double t) {
+    double s = 0.0;
+    for (const auto& c : curves) s += curve_miou(c, t);
+    return s / static_cast<double>(curves.size());
+  }
+
+  /// The training fields' mean lawnmower mIoU at the top GSD: where the forecast end point
+  /// starts (reported as CandidateScore::predicted_front_margin only).
+  [[nodiscard]] double mean_top_miou(const DecisionContext& c) const {
+    double s = 0.0;
+    for (const auto& r : reference_) s += miou_at_gsd(r.points, c.top_gsd_cm);
+    return s / static_cast<double>(reference_.size());
+  }
+
+  GainModel initial_;
+  GainModel model_;
+  std::vector<ReferenceCurve> reference_;
+  Params params_;
+  double prior_sigma_ = 0.0;        ///< mean σ of the training fields (0: unknown)
+  // Per mission (reset by begin_mission):
+  double sigma_sum_ = 0.0;          ///< σ of the top-level images so far
+  std::size_t sigma_count_ = 0;
+  double seen_share_ = 0.0;         ///< field share of the top-level regions seen so far
+  double seen_interest_ = 0.0;      ///< ... and Σ share · σ over them
+  double forecast_gain_ = 0.0;      ///< forecast field-level gain of the descents taken
+  std::optional<GainForecast> pending_relabelled_;  ///< the forecast of the descent in progress
+  double scale_mean_ = 1.0;         ///< field factor s: posterior mean
+  double scale_var_ = 0.0;          ///< ... and variance
+  double scale_precision_sum_ = 0.0;
+  double scale_evidence_sum_ = 0.0;
+};
+
+static_assert(DecisionPolicy<FrontAwarePolicy>);
+
+}  // namespace adaptseg
