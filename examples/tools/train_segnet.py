@@ -694,6 +694,9 @@ def main(argv=None):
         if "arch" not in ckpt:
             raise SystemExit(f"{ckpt_path}: a checkpoint of the former train_erfnet.py (its data sampling "
                              "differs); start a new run")
+        if isinstance(ckpt["optimizer"], dict):  # checkpoints before 2026-11-23 kept the state under this key
+            ckpt["optimizer_state"] = ckpt["optimizer"]
+            ckpt["optimizer"] = "Adam" if ckpt["arch"] == "erfnet" else "AdamW"
     else:
         camera_wh = parse_wh(args.camera, "--camera")
         erf = args.arch == "erfnet"
@@ -760,7 +763,7 @@ def main(argv=None):
         lr_scales = [1.0, float(ckpt["encoder_lr_scale"])]
     if resume:
         model.load_state_dict(ckpt["model"])
-        opt.load_state_dict(ckpt["optimizer"])
+        opt.load_state_dict(ckpt["optimizer_state"])
         torch.set_rng_state(ckpt["torch_rng"])
         if cuda and ckpt.get("cuda_rng") is not None:
             torch.cuda.set_rng_state(ckpt["cuda_rng"])
@@ -812,7 +815,7 @@ def main(argv=None):
 
     def save_checkpoint():
         ckpt.update({"model": {k: v.detach().cpu() for k, v in model.state_dict().items()},
-                     "optimizer": opt.state_dict(), "torch_rng": torch.get_rng_state(),
+                     "optimizer_state": opt.state_dict(), "torch_rng": torch.get_rng_state(),
                      "cuda_rng": torch.cuda.get_rng_state() if cuda else None})
         tmp = ckpt_path.with_suffix(".tmp")
         torch.save(ckpt, tmp)

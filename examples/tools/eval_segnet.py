@@ -1,0 +1,142 @@
+#!/usr/bin/python3
+"""Acceptance tables of a bundled segmentation network: per-class IoU and mIoU per GSD band,
+field-level and per image, on the fields given (default: dubai-tile-4, the validation tile, and
+dubai-tile-6, the test tile).
+
+Every band is a whole-field lawnmower at that GSD (footprints as adaptseg's LawnmowerPlanner
+places them, images rendered as its SimulatedSensor renders them); the network runs on the path
+of the C++ backend (resampled to its input size, logits back to the camera size, argmax) in
+PyTorch on the weights model.onnx was exported from. Labels are scored against the
+orthomosaic labels at orthomosaic resolution (adaptseg::image_confusion):
+
+- field: the confusion matrix summed over the band's images; IoU per class, and mIoU over the
+  classes present in truth or prediction (ConfusionMatrix::miou_all);
+- per image: for each class, the mean IoU of that class over the images whose valid ground is
+  at least --min-share that class (the images that contain it; IoU over L = {class}, as
+  adaptseg_evaluate's per-image mIoU over L), with the image count.
+
+Prints markdown tables; --json also writes the numbers.
+
+Usage:
+  /usr/bin/python3 examples/tools/eval_segnet.py --model-dir examples/models/mobilenetv2-dubai \\
+      [--fields examples/data/dubai-tile-4,examples/data/dubai-tile-6] [--bands 1,1.5,2,2.5,3] \\
+      [--json out.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import torch
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import train_segnet as te  # noqa: E402
+
+REPO = Path(__file__).resolve().parent.parent.parent
+
+
+def class_iou(cm: np.ndarray, c: int) -> float | None:
+    """IoU of class c from an nc x (nc+1) confusion matrix; None if absent from truth and prediction."""
+    tp = cm[c, c]
+    fn = cm[c].sum() - tp
+    fp = cm[:, c].sum() - tp
+    den = tp + fn + fp
+    return None if den == 0 else float(tp / den)
+
+
+def evaluate_field(model, spec, field: te.FieldData, bands, min_share: float):
+    nc = len(field.classes)
+    out = {}
+    for fac in bands:
+        gsd = field.gsd_cm * fac
+        cm = np.zeros((nc, nc + 1), np.int64)
+        per_image = [[] for _ in range(nc)]
+        images = 0
+        for (c0, r0, fw, fh) in te.lawnmower_rects(field, gsd, spec.camera_wh):
+            rgb, _, gt = te.capture(field, c0, r0, fw, fh, spec.camera_wh)
+            valid = gt != te.IGNORE
+            if valid.sum() == 0:
+                continue
+            with torch.no_grad():
+                pred = te.predict_labels(model, rgb, spec, "cpu")
+            up = cv2.resize(pred, (fw, fh), interpolation=cv2.INTER_NEAREST_EXACT)
+            icm = te.confusion(gt, up, nc)
+            cm += icm
+            images += 1
+            counts = np.bincount(gt[valid].astype(np.int64), minlength=nc)
+            for c in range(nc):
+                if counts[c] >= min_share * valid.sum():
+                    per_image[c].append(class_iou(icm, c))
+        m, _ = te.miou(cm)
+        out[fac] = {
+            "gsd_cm": gsd, "images": images, "miou": m,
+            "iou": [class_iou(cm, c) for c in range(nc)],
+            "per_image_iou_mean": [float(np.mean(v)) if v else None for v in per_image],
+            "per_image_count": [len(v) for v in per_image],
+        }
+    return out
+
+
+def fmt(v) -> str:
+    return "–" if v is None else f"{v:.3f}"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--model-dir", required=True)
+    ap.add_argument("--fields", default=",".join(str(REPO / "examples" / "data" / f"dubai-tile-{k}") for k in (4, 6)))
+    ap.add_argument("--bands", default="1,1.5,2,2.5,3", help="GSD factors of the fields' GSD")
+    ap.add_argument("--min-share", type=float, default=0.05,
+                    help="per-image IoU of a class over the images whose valid ground is at least this share of it")
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--json")
+    args = ap.parse_args()
+    torch.set_num_threads(args.threads)
+    cv2.setNumThreads(1)
+
+    model, spec, meta = te.load_exported(Path(args.model_dir))
+    bands = [float(v) for v in args.bands.split(",")]
+    results = {}
+    for fdir in args.fields.split(","):
+        field = te.load_field(Path(fdir))
+        if field.classes != meta["classes"]:
+            raise SystemExit(f"{fdir}: classes {field.classes} differ from the model's {meta['classes']}")
+        role = ("training" if Path(fdir).name in meta["training"]["fields"] else
+                "validation" if Path(fdir).name == meta["training"]["validation_field"] else "test")
+        results[field.name] = {"role": role, "bands": evaluate_field(model, spec, field, bands, args.min_share)}
+
+    classes = meta["classes"]
+    print(f"model {Path(args.model_dir).name}; per-image IoU over images with >= {args.min_share:.0%} of the class")
+    for name, r in results.items():
+        print(f"\n**{name}** ({r['role']}), field level: IoU per class and mIoU\n")
+        print("| GSD [cm/px] | images | " + " | ".join(classes) + " | mIoU |")
+        print("| ---: | ---: | " + " | ".join("---:" for _ in classes) + " | ---: |")
+        for b in r["bands"].values():
+            print(f"| {b['gsd_cm']:.1f} | {b['images']} | " + " | ".join(fmt(v) for v in b["iou"]) +
+                  f" | **{b['miou']:.3f}** |")
+        print(f"\n**{name}** ({r['role']}), per image: mean IoU of each class over the images that contain it (n)\n")
+        print("| GSD [cm/px] | " + " | ".join(classes) + " |")
+        print("| ---: | " + " | ".join("---:" for _ in classes) + " |")
+        for b in r["bands"].values():
+            cells = [f"{fmt(m)} ({n})" for m, n in zip(b["per_image_iou_mean"], b["per_image_count"])]
+            print(f"| {b['gsd_cm']:.1f} | " + " | ".join(cells) + " |")
+        # Which classes gain from altitude: per-image IoU at the finest band above the coarsest.
+        first, last = r["bands"][bands[0]], r["bands"][bands[-1]]
+        rising = [c for k, c in enumerate(classes)
+                  if first["per_image_iou_mean"][k] is not None and last["per_image_iou_mean"][k] is not None
+                  and first["per_image_iou_mean"][k] > last["per_image_iou_mean"][k]]
+        print(f"\nper-image IoU higher at {first['gsd_cm']:.1f} than at {last['gsd_cm']:.1f} cm/px: "
+              f"{len(rising)} of {len(classes)} classes ({', '.join(rising) or 'none'}); "
+              f"field mIoU {first['miou']:.3f} vs {last['miou']:.3f} ({first['miou'] - last['miou']:+.3f})")
+    if args.json:
+        Path(args.json).write_text(json.dumps({"model": str(args.model_dir), "min_share": args.min_share,
+                                               "classes": classes, "fields": results}, indent=2) + "\n")
+
+
+if __name__ == "__main__":
+    main()
