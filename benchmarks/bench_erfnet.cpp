@@ -1,12 +1,14 @@
-// Times the ERFNet backend (OpenCV DNN) on one camera image: the network's forward pass
-// alone and the whole ErfnetSegmenter::segment (normalisation + forward + argmax).
+// Times the ONNX backend (OpenCV DNN) on one camera image: the network's forward pass alone
+// (at its input size) and the whole ErfnetSegmenter::segment (resampling to the input size if
+// the camera's differs, normalisation, forward, logits resampled to the camera size, argmax).
 // Driven by benchmarks/bench_erfnet.py, which runs PyTorch on the same weights side by side.
 //
 //   bench_erfnet MODEL_DIR [--threads N] [--iters K] [--warmup W] [--image PNG]
-//                [--no-fusion]
+//                [--camera WxH] [--no-fusion]
 //
-// Prints one JSON object: {"threads": N, "iters": K, "forward_ms": {"median", "min", "max"},
-// "segment_ms": {...}, "opencv": "4.6.0"}.
+// --camera: size of the random camera image (default: the network's input size).
+// Prints one JSON object: {"threads": N, "iters": K, "input": [H, W], "camera": [H, W],
+// "forward_ms": {"median", "min", "max"}, "segment_ms": {...}, "opencv": "4.6.0"}.
 
 #include <adaptseg/erfnet_segmenter.hpp>
 
@@ -54,7 +56,8 @@ void print_stats(const char* key, const Stats& s) {
 }
 
 int usage() {
-  std::cerr << "usage: bench_erfnet MODEL_DIR [--threads N] [--iters K] [--warmup W] [--image PNG] [--no-fusion]\n";
+  std::cerr << "usage: bench_erfnet MODEL_DIR [--threads N] [--iters K] [--warmup W] [--image PNG] [--camera WxH] "
+               "[--no-fusion]\n";
   return 2;
 }
 
@@ -66,6 +69,7 @@ int main(int argc, char** argv) {
   int threads = 1, iters = 30, warmup = 5;
   bool fusion = true;
   std::string image_file;
+  cv::Size camera;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
     const auto next = [&]() -> std::string {
@@ -77,7 +81,12 @@ int main(int argc, char** argv) {
       else if (a == "--iters") iters = std::stoi(next());
       else if (a == "--warmup") warmup = std::stoi(next());
       else if (a == "--image") image_file = next();
-      else if (a == "--no-fusion") fusion = false;
+      else if (a == "--camera") {
+        const std::string v = next();
+        const auto x = v.find('x');
+        if (x == std::string::npos) throw std::invalid_argument("--camera expects WxH, got " + v);
+        camera = {std::stoi(v.substr(0, x)), std::stoi(v.substr(x + 1))};
+      } else if (a == "--no-fusion") fusion = false;
       else return usage();
     } catch (const std::exception& e) {
       std::cerr << "bench_erfnet: " << e.what() << '\n';
@@ -88,15 +97,17 @@ int main(int argc, char** argv) {
   try {
     adaptseg::ErfnetParams params;
     params.num_threads = threads;
+    params.resize_to_network = true;
     adaptseg::ErfnetSegmenter erfnet(model_dir, params);
     const cv::Size in = erfnet.input_size();
+    if (camera.width <= 0 || camera.height <= 0) camera = in;
 
     adaptseg::Image image;
     if (!image_file.empty()) {
       image.rgb = cv::imread(image_file, cv::IMREAD_COLOR);
       if (image.rgb.empty()) throw std::invalid_argument("cannot read image " + image_file);
     } else {
-      image.rgb.create(in, CV_8UC3);
+      image.rgb.create(camera, CV_8UC3);
       cv::randu(image.rgb, 0, 256);
     }
     image.width_px = image.rgb.cols;
@@ -120,8 +131,10 @@ int main(int argc, char** argv) {
         warmup, iters));
     const Stats seg = stats(time_ms([&] { (void)erfnet.segment(image); }, warmup, iters));
 
-    std::printf("{\"threads\": %d, \"cv_threads\": %d, \"iters\": %d, \"fusion\": %s, \"input\": [%d, %d], ",
-                threads, cv::getNumThreads(), iters, fusion ? "true" : "false", in.height, in.width);
+    std::printf("{\"threads\": %d, \"cv_threads\": %d, \"iters\": %d, \"fusion\": %s, \"input\": [%d, %d], "
+                "\"camera\": [%d, %d], ",
+                threads, cv::getNumThreads(), iters, fusion ? "true" : "false", in.height, in.width,
+                image.rgb.rows, image.rgb.cols);
     print_stats("forward_ms", fwd);
     std::printf(", ");
     print_stats("segment_ms", seg);

@@ -1,9 +1,12 @@
 #!/usr/bin/python3
-"""ERFNet inference: PyTorch vs OpenCV DNN (adaptseg::ErfnetSegmenter) side by side.
+"""Network inference: PyTorch vs OpenCV DNN (adaptseg::ErfnetSegmenter, the ONNX backend) side
+by side, for any bundled model (ERFNet, MobileNetV2).
 
 Runs PyTorch on the checkpoint the ONNX model was exported from (model.pt next to
 model.onnx) and the C++ timing binary bench_erfnet (benchmarks/bench_erfnet.cpp) on the ONNX
-model, on the same input size (the model's, 360x480) and the same thread counts. To be fair on
+model, on the same input size (the network's: 480x360 for ERFNet, 512x384 for MobileNetV2) and
+the same thread counts. OpenCV's segment() takes a camera image of the size the model was
+trained for (480x360), resampled to the input size where that differs. To be fair on
 a shared machine the two are interleaved: --rounds rounds, each timing --iters forward passes
 of PyTorch, then of OpenCV; the median is over all rounds. Also reports the FLOPs per image
 (convolutions and transposed convolutions counted per layer with forward hooks; 1 MAC = 2
@@ -71,8 +74,9 @@ def time_torch(model, x, iters: int, warmup: int) -> list[float]:
     return out
 
 
-def time_opencv(binary: str, model_dir: Path, threads: int, iters: int, warmup: int, extra) -> dict:
-    cmd = [binary, str(model_dir), "--threads", str(threads), "--iters", str(iters), "--warmup", str(warmup)] + extra
+def time_opencv(binary: str, model_dir: Path, threads: int, iters: int, warmup: int, camera, extra) -> dict:
+    cmd = [binary, str(model_dir), "--threads", str(threads), "--iters", str(iters), "--warmup", str(warmup),
+           "--camera", f"{camera[0]}x{camera[1]}"] + extra
     res = subprocess.run(cmd, capture_output=True, text=True, check=False)
     if res.returncode != 0:
         raise SystemExit(f"{' '.join(cmd)} failed:\n{res.stderr}")
@@ -94,6 +98,7 @@ def main():
     model_dir = Path(args.model_dir)
     model, _, meta = te.load_exported(model_dir)
     h, w = meta["input"]["height"], meta["input"]["width"]
+    camera = meta["training"]["camera"]
     x = torch.from_numpy(np.random.default_rng(0).standard_normal((1, 3, h, w)).astype(np.float32))
     flops, _ = conv_flops(model, x)
     params = sum(p.numel() for p in model.parameters())
@@ -106,7 +111,7 @@ def main():
         pt, cv_fwd, cv_seg = [], [], []
         for _ in range(args.rounds):
             pt += time_torch(model, x, args.iters, args.warmup)
-            r = time_opencv(args.bench_bin, model_dir, n, args.iters, args.warmup, extra)
+            r = time_opencv(args.bench_bin, model_dir, n, args.iters, args.warmup, camera, extra)
             cv_fwd.append(r["forward_ms"]["median"])
             cv_seg.append(r["segment_ms"]["median"])
         row = {"threads": n, "pytorch_ms": statistics.median(pt),
@@ -118,7 +123,9 @@ def main():
         results.append(row)
     load_after = os.getloadavg()
 
-    print(f"ERFNet width {meta['width']} ({params} parameters), input 1x3x{h}x{w}, "
+    arch = meta.get("arch", "erfnet")
+    name = f"ERFNet width {meta['width']}" if arch == "erfnet" else "MobileNetV2 + decoder"
+    print(f"{model_dir.name}: {name} ({params} parameters), input 1x3x{h}x{w}, camera {camera[0]}x{camera[1]}, "
           f"{flops / 1e9:.2f} GFLOP per image (conv + transposed conv, 2 FLOP per MAC)")
     print(f"CPU: {cpu_model()}, {os.cpu_count()} logical CPUs; torch {torch.__version__}, "
           f"OpenCV {r['opencv']}; load average before {load_before[0]:.2f}, after {load_after[0]:.2f}")

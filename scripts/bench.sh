@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds in Release, and runs the benchmarks:
-#   GaussianProcess vs scikit-learn, the per-waypoint decision time, and the ERFNet backend
-#   (OpenCV DNN vs PyTorch). Results: docs/benchmarks.md.
+#   GaussianProcess vs scikit-learn, the per-waypoint decision time, and each bundled network
+#   through the ONNX backend (OpenCV DNN vs PyTorch). Results: docs/benchmarks.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh bench
@@ -9,4 +9,7 @@ cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release
 cmake --build build/release -j"$(nproc 2>/dev/null || echo 2)" --target bench_gaussian_process bench_decision bench_erfnet
 /usr/bin/python3 benchmarks/bench_gaussian_process.py build/release/benchmarks/bench_gaussian_process
 build/release/benchmarks/bench_decision
-/usr/bin/python3 benchmarks/bench_erfnet.py --bench-bin build/release/benchmarks/bench_erfnet --rounds 5 --iters 10
+for m in erfnet-dubai mobilenetv2-dubai; do
+  /usr/bin/python3 benchmarks/bench_erfnet.py --model-dir "examples/models/$m" \
+      --bench-bin build/release/benchmarks/bench_erfnet --rounds 5 --iters 10
+done

@@ -1,8 +1,10 @@
-// Tests of the ERFNet backend (include/adaptseg/erfnet_segmenter.hpp) with the committed model
-// examples/models/erfnet-dubai and the fixture tests/data/erfnet (written by
+// Tests of the ONNX backend (include/adaptseg/erfnet_segmenter.hpp) with every bundled model:
+// examples/models/erfnet-dubai (ERFNet, input = camera size, stride 1) and
+// examples/models/mobilenetv2-dubai (MobileNetV2 + decoder, input 512x384 for the 480x360
+// camera, logits at stride 4), each with its fixture in tests/data/<fixture> (written by
 // tests/tools/make_erfnet_fixture.py from the PyTorch weights the ONNX file was exported from).
 // Models are loaded inside test cases only: doctest_discover_tests runs this binary at build
-// time. About 30 forward passes in all (18 of them in the conformance suite).
+// time. About 30 forward passes per model (18 of them in the conformance suite).
 
 #include "backend_conformance.hpp"
 #include "test_support.hpp"
@@ -36,14 +38,29 @@ static_assert(std::is_move_constructible_v<ErfnetSegmenter>);
 
 namespace {
 
-fs::path model_dir() { return fs::path(ADAPTSEG_EXAMPLES_DIR) / "models" / "erfnet-dubai"; }
-fs::path fixture_dir() { return fs::path(ADAPTSEG_TEST_DATA_DIR) / "erfnet"; }
+/// A bundled model and what its tests expect of it.
+struct BundledModel {
+  const char* dir;      ///< examples/models/<dir>
+  const char* fixture;  ///< tests/data/<fixture>
+  /// mIoU floor on the tile-6 test region at 5 cm/px (see the floor test): the value measured
+  /// with PyTorch (the fixture's test_field_miou.test_region) minus a margin.
+  double floor;
+  fs::path model_dir() const { return fs::path(ADAPTSEG_EXAMPLES_DIR) / "models" / dir; }
+  fs::path fixture_dir() const { return fs::path(ADAPTSEG_TEST_DATA_DIR) / fixture; }
+};
+
+// Measured (fixture.yaml): erfnet-dubai 0.448, mobilenetv2-dubai 0.521; floors 0.05 below or more.
+const BundledModel kModels[] = {{"erfnet-dubai", "erfnet", 0.40}, {"mobilenetv2-dubai", "mobilenetv2", 0.47}};
+
+// The ERFNet model, for the tests of errors and options that need one model only.
+fs::path model_dir() { return kModels[0].model_dir(); }
+fs::path fixture_dir() { return kModels[0].fixture_dir(); }
 const char* kTestField = "dubai-tile-6";  // held out of training and validation
 
 /// The fixture's camera image as the sensor would hand it over.
-Image fixture_image() {
+Image fixture_image(const BundledModel& m = kModels[0]) {
   Image img;
-  img.rgb = cv::imread((fixture_dir() / "camera.png").string(), cv::IMREAD_COLOR);
+  img.rgb = cv::imread((m.fixture_dir() / "camera.png").string(), cv::IMREAD_COLOR);
   REQUIRE_FALSE(img.rgb.empty());
   img.width_px = img.rgb.cols;
   img.height_px = img.rgb.rows;
@@ -52,88 +69,97 @@ Image fixture_image() {
 
 }  // namespace
 
-TEST_CASE("erfnet: the committed model reproduces PyTorch's logits and labels on the fixture") {
-  const YAML::Node fx = YAML::LoadFile((fixture_dir() / "fixture.yaml").string());
-  const std::vector<int> shape = fx["logits"]["shape"].as<std::vector<int>>();
-  const int stride = fx["logits"]["stride"].as<int>();
-  REQUIRE(shape.size() == 3);
-  const Image img = fixture_image();
-  // The fixture image has RGB content everywhere, so no pixel is masked as no-data.
-  cv::Mat black;
-  cv::inRange(img.rgb, cv::Scalar(0, 0, 0), cv::Scalar(0, 0, 0), black);
-  REQUIRE(cv::countNonZero(black) == 0);
+TEST_CASE("erfnet: each bundled model reproduces PyTorch's logits and labels on its fixture") {
+  for (const BundledModel& m : kModels) {
+    CAPTURE(m.dir);
+    const YAML::Node fx = YAML::LoadFile((m.fixture_dir() / "fixture.yaml").string());
+    const std::vector<int> shape = fx["logits"]["shape"].as<std::vector<int>>();
+    const int stride = fx["logits"]["stride"].as<int>();
+    REQUIRE(shape.size() == 3);
+    const Image img = fixture_image(m);
+    // The fixture image has RGB content everywhere, so no pixel is masked as no-data.
+    cv::Mat black;
+    cv::inRange(img.rgb, cv::Scalar(0, 0, 0), cv::Scalar(0, 0, 0), black);
+    REQUIRE(cv::countNonZero(black) == 0);
 
-  ErfnetSegmenter erfnet(model_dir(), ErfnetParams{.num_threads = 2});
-  REQUIRE(erfnet.num_classes() == shape[0]);
+    ErfnetSegmenter erfnet(m.model_dir(), ErfnetParams{.camera_width_px = img.width_px, .camera_height_px = img.height_px,
+                                                     .resize_to_network = true, .num_threads = 2});
+    REQUIRE(erfnet.num_classes() == shape[0]);
 
-  std::vector<float> ref(static_cast<std::size_t>(shape[0]) * static_cast<std::size_t>(shape[1]) *
-                         static_cast<std::size_t>(shape[2]));
-  std::ifstream in(fixture_dir() / "logits_stride4.f32", std::ios::binary);
-  in.read(reinterpret_cast<char*>(ref.data()), static_cast<std::streamsize>(ref.size() * sizeof(float)));
-  REQUIRE(in.gcount() == static_cast<std::streamsize>(ref.size() * sizeof(float)));
+    std::vector<float> ref(static_cast<std::size_t>(shape[0]) * static_cast<std::size_t>(shape[1]) *
+                           static_cast<std::size_t>(shape[2]));
+    std::ifstream in(m.fixture_dir() / "logits_stride4.f32", std::ios::binary);
+    in.read(reinterpret_cast<char*>(ref.data()), static_cast<std::streamsize>(ref.size() * sizeof(float)));
+    REQUIRE(in.gcount() == static_cast<std::streamsize>(ref.size() * sizeof(float)));
 
-  // Logits: OpenCV DNN vs PyTorch (float32 both; measured max |diff| ~1e-5 on logits of
-  // magnitude ~10). Tolerance 1e-3 absolute.
-  const std::vector<cv::Mat> logits = erfnet.logits(img);
-  REQUIRE(logits.size() == static_cast<std::size_t>(shape[0]));
-  double max_diff = 0.0;
-  std::size_t k = 0;
-  for (int c = 0; c < shape[0]; ++c)
-    for (int i = 0; i < shape[1]; ++i)
-      for (int j = 0; j < shape[2]; ++j, ++k)
-        max_diff = std::max(max_diff, std::abs(static_cast<double>(logits[static_cast<std::size_t>(c)].at<float>(i * stride, j * stride)) -
-                                               static_cast<double>(ref[k])));
-  CAPTURE(max_diff);
-  CHECK(max_diff < 1e-3);
+    // Logits: OpenCV DNN vs PyTorch (float32 both; measured max |diff| ~1e-5 on logits of
+    // magnitude ~10). Tolerance 1e-3 absolute.
+    const std::vector<cv::Mat> logits = erfnet.logits(img);
+    REQUIRE(logits.size() == static_cast<std::size_t>(shape[0]));
+    double max_diff = 0.0;
+    std::size_t k = 0;
+    for (int c = 0; c < shape[0]; ++c)
+      for (int i = 0; i < shape[1]; ++i)
+        for (int j = 0; j < shape[2]; ++j, ++k)
+          max_diff = std::max(max_diff, std::abs(static_cast<double>(logits[static_cast<std::size_t>(c)].at<float>(i * stride, j * stride)) -
+                                                 static_cast<double>(ref[k])));
+    CAPTURE(max_diff);
+    CHECK(max_diff < 1e-3);
 
-  // Labels: argmax agrees with PyTorch's on >= 99.9 % of the pixels (near-ties may flip).
-  const cv::Mat torch_labels = cv::imread((fixture_dir() / "labels_torch.png").string(), cv::IMREAD_UNCHANGED);
-  REQUIRE(torch_labels.type() == CV_8UC1);
-  const cv::Mat labels = erfnet.segment(img);
-  REQUIRE(labels.size() == torch_labels.size());
-  const double agree = 1.0 - cv::countNonZero(labels != torch_labels) / static_cast<double>(labels.total());
-  CAPTURE(agree);
-  CHECK(agree >= 0.999);
+    // Labels: argmax agrees with PyTorch's on >= 99.9 % of the pixels (near-ties may flip).
+    const cv::Mat torch_labels = cv::imread((m.fixture_dir() / "labels_torch.png").string(), cv::IMREAD_UNCHANGED);
+    REQUIRE(torch_labels.type() == CV_8UC1);
+    const cv::Mat labels = erfnet.segment(img);
+    REQUIRE(labels.size() == torch_labels.size());
+    const double agree = 1.0 - cv::countNonZero(labels != torch_labels) / static_cast<double>(labels.total());
+    CAPTURE(agree);
+    CHECK(agree >= 0.999);
+  }
 }
 
-TEST_CASE("erfnet: passes the backend conformance suite on the held-out Dubai tile 6") {
+TEST_CASE("erfnet: each bundled model passes the backend conformance suite on the held-out Dubai tile 6") {
   const Field f = Field::load(t::example_field(kTestField));
   const CameraModel camera;
-  ErfnetSegmenter erfnet(model_dir(), f, camera, ErfnetParams{.num_threads = 2});
-  CHECK(erfnet.name() == "erfnet");
-  t::check_backend_conformance(erfnet, SimulatedSensor(f, camera), f.num_classes());
+  for (const BundledModel& m : kModels) {
+    CAPTURE(m.dir);
+    ErfnetSegmenter erfnet(m.model_dir(), f, camera, ErfnetParams{.resize_to_network = true, .num_threads = 2});
+    CHECK(erfnet.name() == "erfnet");
+    t::check_backend_conformance(erfnet, SimulatedSensor(f, camera), f.num_classes());
+  }
 }
 
-TEST_CASE("erfnet: mIoU on held-out tile 6 at the finest GSD is above the floor") {
+TEST_CASE("erfnet: mIoU of each bundled model on held-out tile 6 at the finest GSD is above its floor") {
   // A sub-field of tile 6 (8 images at 1x the orthomosaic GSD, 5 cm/px, to keep the test
   // fast). Measured with PyTorch by tests/tools/make_erfnet_fixture.py (fixture.yaml,
-  // test_field_miou.test_region): mIoU 0.448 over all five classes (whole tile 6 at 1x: 0.512).
-  // The floor, 0.40, is set below that with margin; it catches a broken pre-processing
-  // (channel order, normalisation) or a wrong model, which fall far below it.
+  // test_field_miou.test_region); the floor is set below that with margin (kModels); it catches
+  // a broken pre-processing (channel order, normalisation, resampling) or a wrong model, which
+  // fall far below it.
   const Field whole = Field::load(t::example_field(kTestField));
   const Field f = whole.sub_field({0.0, 0.0, 0.37, 0.57});
   const CameraModel camera;
-  ErfnetSegmenter erfnet(model_dir(), f, camera, ErfnetParams{.num_threads = 2});
   const SimulatedSensor sensor(f, camera);
   const auto plan = LawnmowerPlanner(camera).plan(f.area(), f.gsd_cm());
   CHECK(plan.size() == 8);
-  ConfusionMatrix erf(f.num_classes()), oracle_cm(f.num_classes());
-  OracleSegmenter oracle(f.num_classes());
-  for (const auto& w : plan) {
-    const Image img = sensor.capture(w);
-    erf += image_confusion(img, erfnet.segment(img), f.num_classes());
-    oracle_cm += image_confusion(img, oracle.segment(img), f.num_classes());
+  for (const BundledModel& m : kModels) {
+    CAPTURE(m.dir);
+    ErfnetSegmenter erfnet(m.model_dir(), f, camera, ErfnetParams{.resize_to_network = true, .num_threads = 2});
+    ConfusionMatrix erf(f.num_classes()), oracle_cm(f.num_classes());
+    OracleSegmenter oracle(f.num_classes());
+    for (const auto& w : plan) {
+      const Image img = sensor.capture(w);
+      erf += image_confusion(img, erfnet.segment(img), f.num_classes());
+      oracle_cm += image_confusion(img, oracle.segment(img), f.num_classes());
+    }
+    const double miou = erf.miou_all().value();
+    const double measured = YAML::LoadFile((m.fixture_dir() / "fixture.yaml").string())["test_field_miou"]
+                                ["test_region"]["miou_ortho"].as<double>();
+    CAPTURE(miou);
+    CAPTURE(measured);
+    CHECK(miou > m.floor);
+    // The C++ path computes the same number as the Python measurement (up to argmax near-ties).
+    CHECK(miou == doctest::Approx(measured).epsilon(0.01));
+    CHECK(oracle_cm.miou_all().value() == doctest::Approx(1.0));  // oracle at g0: exact
   }
-  const double miou = erf.miou_all().value();
-  const double measured = YAML::LoadFile((fixture_dir() / "fixture.yaml").string())["test_field_miou"]
-                              ["test_region"]["miou_ortho"].as<double>();
-  CAPTURE(miou);
-  CAPTURE(measured);
-  constexpr double kFloor = 0.40;
-  CHECK(miou > kFloor);
-  // The C++ path computes the same number as the Python measurement (up to argmax near-ties).
-  CHECK(miou == doctest::Approx(measured).epsilon(0.01));
-  CHECK(oracle_cm.miou_all().value() == doctest::Approx(1.0));  // oracle at g0: exact
 }
 
 TEST_CASE("erfnet: probabilities are the softmax of the logits and black pixels are no-data") {

@@ -74,8 +74,9 @@ struct SegmenterOptions {
         ->check(CLI::IsMember({"oracle", "erfnet"}))
         ->capture_default_str();
     app.add_option("--model-file", model_file,
-                   "ERFNet model: a directory with model.onnx + model.yaml, or an .onnx file with its .yaml "
-                   "next to it (e.g. examples/models/erfnet-dubai)");
+                   "network of --segmenter erfnet (the ONNX backend): a directory with model.onnx + model.yaml, "
+                   "or an .onnx file with its .yaml next to it (examples/models/erfnet-dubai, "
+                   "examples/models/mobilenetv2-dubai)");
     app.add_option("--threads", threads, "ERFNet: OpenCV threads (0: OpenCV's default)")
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
@@ -90,7 +91,9 @@ struct SegmenterOptions {
   }
 
   /// Calls `f(backend)` with the chosen backend built for `field` seen by `camera` (the
-  /// ERFNet's classes must be the field's and its input size the camera's).
+  /// network's classes must be the field's; a camera image of another size than the network's
+  /// input, with the same aspect ratio, is resampled to it, as the MobileNetV2 model's 512x384
+  /// input needs for the 480x360 camera).
   template <class F>
   decltype(auto) with_backend(const Field& field, const CameraModel::Params& camera, F&& f) const {
     validate();
@@ -100,6 +103,7 @@ struct SegmenterOptions {
     }
     ErfnetParams p = ErfnetSegmenter::for_field(field, CameraModel(camera));
     p.num_threads = threads;
+    p.resize_to_network = true;
     const bool dir = std::filesystem::is_directory(model_file);
     const std::filesystem::path onnx = dir ? model_file / "model.onnx" : model_file;
     std::filesystem::path metadata = onnx;
