@@ -138,7 +138,7 @@ def main(out):
             ax.set_title(f"{field}\n(label: descent GSD [cm/px])", fontsize=10)
             ax.grid(alpha=0.3)
             ax.legend(fontsize=8, loc="upper left")
-        fig.suptitle("Each descent: the gain it was forecast to add to the field mIoU, and what it added", fontsize=11)
+        fig.suptitle("Each descent: the gain it was forecast\nto add to the field mIoU, and what it added", fontsize=11)
         fig.tight_layout()
         fig.savefig(os.path.join(out, "decisions.png"), dpi=110)
         plt.close(fig)
