@@ -49,6 +49,8 @@ Usage:
                            train a finished run N steps more under a new learning-rate
                            cycle (peak LR); an interrupted extension resumes with --resume
   ... --export-only        re-export model.onnx/model.yaml/model.pt from the checkpoint
+  ... --init-weights DIR   a new run from the weights of an exported model (DIR/model.pt), e.g. a
+                           bundled model trained further in a later session
 """
 
 from __future__ import annotations
@@ -521,6 +523,8 @@ def export(model, ckpt, args, model_dir: Path, val_result):
             "train_minutes": round(float(ckpt["train_seconds"]) / 60.0, 1),
             "devices": sorted(set(ckpt.get("devices", []))),
             "seed": int(ckpt["seed"]),
+            "initialised_from": ckpt.get("init_weights", "ImageNet encoder" if ckpt["arch"] == "mobilenetv2"
+                                         else "random"),
             "optimizer": f"{ckpt['optimizer']} wd {ckpt['weight_decay']}; per learning-rate cycle linear "
                          "warm-up to the peak, then poly(0.9) decay to 0",
             "lr_cycles": [{k: (float(v) if k == "lr" else int(v)) for k, v in c.items()}
@@ -605,6 +609,10 @@ def main(argv=None):
     ap.add_argument("--width", type=float, default=0.5, help="ERFNet width multiplier")
     ap.add_argument("--encoder-weights", default="",
                     help="MobileNetV2 encoder state_dict from mobilenet_v2.py (default: import with npm)")
+    ap.add_argument("--init-weights", default="", metavar="MODEL_DIR",
+                    help="start a new run from an exported model's weights (MODEL_DIR/model.pt, same "
+                         "architecture and options), e.g. to train a bundled model further once its "
+                         "checkpoint is gone; the optimizer and the learning-rate cycle start afresh")
     ap.add_argument("--frozen-blocks", type=int, default=4,
                     help="MobileNetV2: stem + first blocks kept at ImageNet weights (4: up to block_2)")
     ap.add_argument("--no-image-pooling", action="store_true",
@@ -625,7 +633,7 @@ def main(argv=None):
     ap.add_argument("--gsd-min-factor", type=float, default=1.0)
     ap.add_argument("--gsd-max-factor", type=float, default=3.0)
     ap.add_argument("--val-factors", default="1,1.5,2,2.5,3")
-    ap.add_argument("--val-every", type=int, default=400)
+    ap.add_argument("--val-every", type=int, default=400, help="validate every N steps (0: at the end only)")
     ap.add_argument("--val-max-images", type=int, default=0, help="0 = all images of a band")
     ap.add_argument("--ckpt-every", type=int, default=50)
     ap.add_argument("--log-every", type=int, default=10)
@@ -742,7 +750,16 @@ def main(argv=None):
                         encoder_lr_scale=args.encoder_lr_scale, image_pooling=not args.no_image_pooling)
     spec = net_spec(ckpt)
     model = build_model(ckpt, nc)
-    if not resume and ckpt["arch"] == "mobilenetv2":
+    if not resume and args.init_weights:
+        src = Path(args.init_weights) / "model.pt"
+        try:
+            model.load_state_dict(torch.load(src, map_location="cpu"))
+        except (OSError, RuntimeError) as e:
+            raise SystemExit(f"--init-weights: cannot load {src} into this network ({args.arch} with these "
+                             f"options): {e}")
+        ckpt["init_weights"] = str(args.init_weights)
+        print(f"initialised from {src}", flush=True)
+    elif not resume and ckpt["arch"] == "mobilenetv2":
         enc = (torch.load(args.encoder_weights, map_location="cpu") if args.encoder_weights
                else mobilenet_v2.import_weights(None))
         model.encoder.load_state_dict(enc)
@@ -875,7 +892,7 @@ def main(argv=None):
             print(f"step {step}/{total_steps} loss {run_loss / run_n:.4f} lr {lr:.2e} {ips:.2f} img/s "
                   f"elapsed {ckpt['train_seconds'] / 60:.1f} min, eta {eta:.1f} min", flush=True)
             run_loss, run_n, t_log = 0.0, 0, time.time()
-        if step % args.val_every == 0 and step < total_steps:
+        if args.val_every > 0 and step % args.val_every == 0 and step < total_steps:
             validate(step)
             set_train_mode(model, ckpt)
             t_log = time.time()
