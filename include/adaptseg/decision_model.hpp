@@ -494,23 +494,36 @@ struct DecisionModel {
     (void)LinearDecision(m.linear);
   }
 
+  /// A model of what a reader parsed first (the calibration record and the decision function),
+  /// the rest default until read_common fills it in.
+  static DecisionModel parsed(std::vector<std::string> fields, std::string segmenter, double segmentation_time_s,
+                              DecisionFunction function, std::size_t samples, double train_front_margin) {
+    return {.calibration_fields = std::move(fields),
+            .segmenter = std::move(segmenter),
+            .calibration_segmentation_time_s = segmentation_time_s,
+            .classes = {},
+            .interest = {},
+            .camera = {},
+            .timing = {},
+            .top_gsd_cm = 0.0,
+            .candidate_gsd_cm = {},
+            .coverage = DescentCoverage::region,
+            .decision_function = std::move(function),
+            .linear = {},
+            .samples = samples,
+            .train_front_margin = train_front_margin};
+  }
+
+  // Both readers read keys in the order of the model's members: a file with several faults
+  // reports the first in that order.
   static DecisionModel read_v1(const detail::ModelReader& r) {
     const std::string field = r.text("calibration_field");
     std::istringstream df(r.text("decision_function"));
-    DecisionModel m{.calibration_fields = {field},
-                    .segmenter = r.text("segmenter"),
-                    .calibration_segmentation_time_s = 0.0,
-                    .classes = {},
-                    .interest = {},
-                    .camera = {},
-                    .timing = {},
-                    .top_gsd_cm = 0.0,
-                    .candidate_gsd_cm = {},
-                    .coverage = DescentCoverage::region,
-                    .decision_function = detail::read_legacy_decision_function(df, field),
-                    .linear = {},
-                    .samples = static_cast<std::size_t>(r.integer("samples", 0, 1'000'000'000)),
-                    .train_front_margin = r.number("train_front_margin")};
+    std::string segmenter = r.text("segmenter");
+    DecisionFunction function = detail::read_legacy_decision_function(df, field);
+    const auto samples = static_cast<std::size_t>(r.integer("samples", 0, 1'000'000'000));
+    DecisionModel m = parsed({field}, std::move(segmenter), 0.0, std::move(function), samples,
+                             r.number("train_front_margin"));
     read_common(r, m);
     return m;
   }
@@ -573,20 +586,13 @@ struct DecisionModel {
                                                                  .relative_utility = rule.flag("relative_utility")}));
       detail::model_error(r.where(), "'rule.kind' must be front-aware or utility (got '" + kind + "')");
     };
-    DecisionModel m{.calibration_fields = cal.texts("fields"),
-                    .segmenter = cal.text("segmenter"),
-                    .calibration_segmentation_time_s = cal.number("segmentation_time_s"),
-                    .classes = {},
-                    .interest = {},
-                    .camera = {},
-                    .timing = {},
-                    .top_gsd_cm = 0.0,
-                    .candidate_gsd_cm = {},
-                    .coverage = DescentCoverage::region,
-                    .decision_function = make_function(),
-                    .linear = {},
-                    .samples = static_cast<std::size_t>(cal.integer("samples", 0, 1'000'000'000)),
-                    .train_front_margin = cal.number("train_front_margin")};
+    std::vector<std::string> fields = cal.texts("fields");
+    std::string segmenter = cal.text("segmenter");
+    const double segmentation_time_s = cal.number("segmentation_time_s");
+    DecisionFunction function = make_function();
+    const auto samples = static_cast<std::size_t>(cal.integer("samples", 0, 1'000'000'000));
+    DecisionModel m = parsed(std::move(fields), std::move(segmenter), segmentation_time_s, std::move(function),
+                             samples, cal.number("train_front_margin"));
     read_common(r, m);
     return m;
   }
