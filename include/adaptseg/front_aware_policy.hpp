@@ -5,6 +5,7 @@
 /// with the forecasts corrected in flight from what the descents actually changed.
 
 #include <adaptseg/decision.hpp>
+#include <adaptseg/detail/interpolate.hpp>
 #include <adaptseg/error.hpp>
 #include <adaptseg/gain_model.hpp>
 #include <adaptseg/lawnmower_curve.hpp>
@@ -154,11 +155,13 @@ class FrontAwarePolicy {
     detail::require(!c.lawnmowers.empty(),
                     "FrontAwarePolicy::decide: the context needs the field's lawnmower forecasts; count",
                     c.lawnmowers.size());
-    // Each training field's lawnmower accuracy, placed at this field's lawnmower times.
+    // Each training field's lawnmower accuracy, placed at this field's lawnmower times, in time
+    // order (curve_miou reads them there).
     std::vector<std::vector<CurvePoint>> curves;
     for (const auto& r : reference_) {
-      curves.emplace_back();
-      for (const auto& f : c.lawnmowers) curves.back().push_back({f.time_s, miou_at_gsd(r.points, f.gsd_cm)});
+      auto& curve = curves.emplace_back();
+      for (const auto& f : c.lawnmowers) curve.push_back({f.time_s, miou_at_gsd(r.points, f.gsd_cm)});
+      std::sort(curve.begin(), curve.end(), [](const CurvePoint& a, const CurvePoint& b) { return a.time_s < b.time_s; });
     }
     sigma_sum_ += c.sigma;
     ++sigma_count_;
@@ -251,8 +254,11 @@ class FrontAwarePolicy {
     return c.region_share * (params_.weight_by_sigma && mean_sigma > 0.0 ? c.sigma / mean_sigma : 1.0);
   }
 
-  /// mIoU of a predicted curve at time t: linear between its points, flat beyond its ends.
-  static double curve_miou(const std::vector<CurvePoint>& curve, double t) { return -front_margin(curve, t, 0.0); }
+  /// mIoU of a predicted curve (sorted by time) at time t: linear between its points, flat
+  /// beyond its ends, as front_margin reads the curve.
+  static double curve_miou(const std::vector<CurvePoint>& curve, double t) {
+    return detail::interpolate_flat(curve, t, &CurvePoint::time_s, &CurvePoint::miou);
+  }
 
   static double mean_curve_miou(const std::vector<std::vector<CurvePoint>>& curves, double t) {
     double s = 0.0;

@@ -6,6 +6,7 @@
 /// against time are separate types (UtilityPolicy, FrontAwarePolicy).
 
 #include <adaptseg/decision.hpp>
+#include <adaptseg/detail/interpolate.hpp>
 #include <adaptseg/error.hpp>
 #include <adaptseg/gaussian_process.hpp>
 
@@ -253,13 +254,7 @@ class GainModel {
   /// η at `delta_h_m` [m] (see the class comment); 0 for a model without C.
   [[nodiscard]] double efficiency(double delta_h_m) const noexcept {
     if (efficiency_.empty()) return 0.0;
-    if (delta_h_m <= efficiency_.front().delta_h_m) return efficiency_.front().efficiency;
-    if (delta_h_m >= efficiency_.back().delta_h_m) return efficiency_.back().efficiency;
-    std::size_t k = 1;
-    while (delta_h_m > efficiency_[k].delta_h_m) ++k;
-    const auto& a = efficiency_[k - 1];
-    const auto& b = efficiency_[k];
-    return a.efficiency + (delta_h_m - a.delta_h_m) / (b.delta_h_m - a.delta_h_m) * (b.efficiency - a.efficiency);
+    return detail::interpolate_flat(efficiency_, delta_h_m, &EfficiencyPoint::delta_h_m, &EfficiencyPoint::efficiency);
   }
   /// η's points (empty for a model without C).
   [[nodiscard]] const std::vector<EfficiencyPoint>& efficiency_points() const noexcept { return efficiency_; }

@@ -4,6 +4,7 @@
 /// mIoU against execution time of lawnmowers flown at several GSDs, and the front margin of a
 /// strategy over it (method.md §5). Eigen- and OpenCV-free: the decision function uses it too.
 
+#include <adaptseg/detail/interpolate.hpp>
 #include <adaptseg/error.hpp>
 
 #include <algorithm>
@@ -26,17 +27,7 @@ struct CurvePoint {
   detail::require(!curve.empty(), "front_margin: the lawnmower curve is empty", 0);
   detail::require(std::isfinite(time_s) && std::isfinite(miou), "front_margin: time and mIoU must be finite", time_s);
   std::sort(curve.begin(), curve.end(), [](const CurvePoint& a, const CurvePoint& b) { return a.time_s < b.time_s; });
-  if (time_s <= curve.front().time_s) return miou - curve.front().miou;
-  if (time_s >= curve.back().time_s) return miou - curve.back().miou;
-  for (std::size_t k = 1; k < curve.size(); ++k) {
-    if (time_s <= curve[k].time_s) {
-      const CurvePoint& a = curve[k - 1];
-      const CurvePoint& b = curve[k];
-      const double t = b.time_s > a.time_s ? (time_s - a.time_s) / (b.time_s - a.time_s) : 1.0;
-      return miou - (a.miou + t * (b.miou - a.miou));
-    }
-  }
-  return miou - curve.back().miou;  // unreachable
+  return miou - detail::interpolate_flat(curve, time_s, &CurvePoint::time_s, &CurvePoint::miou);
 }
 
 /// Field mIoU of a fixed-altitude lawnmower at one GSD (a training field's curve, indexed by
@@ -52,14 +43,7 @@ struct GsdPoint {
   detail::require(!points.empty(), "miou_at_gsd: no points", 0);
   detail::require(std::isfinite(gsd_cm), "miou_at_gsd: gsd_cm must be finite", gsd_cm);
   std::sort(points.begin(), points.end(), [](const GsdPoint& a, const GsdPoint& b) { return a.gsd_cm < b.gsd_cm; });
-  if (gsd_cm <= points.front().gsd_cm) return points.front().miou;
-  if (gsd_cm >= points.back().gsd_cm) return points.back().miou;
-  std::size_t k = 1;
-  while (gsd_cm > points[k].gsd_cm) ++k;
-  const GsdPoint& a = points[k - 1];
-  const GsdPoint& b = points[k];
-  const double t = b.gsd_cm > a.gsd_cm ? (gsd_cm - a.gsd_cm) / (b.gsd_cm - a.gsd_cm) : 1.0;
-  return a.miou + t * (b.miou - a.miou);
+  return detail::interpolate_flat(points, gsd_cm, &GsdPoint::gsd_cm, &GsdPoint::miou);
 }
 
 }  // namespace adaptseg
