@@ -40,46 +40,25 @@ import train_segnet as te  # noqa: E402
 REPO = Path(__file__).resolve().parent.parent.parent
 
 
-def class_iou(cm: np.ndarray, c: int) -> float | None:
-    """IoU of class c from an nc x (nc+1) confusion matrix; None if absent from truth and prediction."""
-    tp = cm[c, c]
-    fn = cm[c].sum() - tp
-    fp = cm[:, c].sum() - tp
-    den = tp + fn + fp
-    return None if den == 0 else float(tp / den)
-
-
 def evaluate_field(model, spec, field: te.FieldData, bands, min_share: float):
+    """train_segnet.evaluate's field-level numbers per band, and per class the IoU of each image
+    whose valid ground is at least `min_share` that class."""
     nc = len(field.classes)
-    out = {}
-    for fac in bands:
-        gsd = field.gsd_cm * fac
-        cm = np.zeros((nc, nc + 1), np.int64)
-        per_image = [[] for _ in range(nc)]
-        images = 0
-        for (c0, r0, fw, fh) in te.lawnmower_rects(field, gsd, spec.camera_wh):
-            rgb, _, gt = te.capture(field, c0, r0, fw, fh, spec.camera_wh)
-            valid = gt != te.IGNORE
-            if valid.sum() == 0:
-                continue
-            with torch.no_grad():
-                pred = te.predict_labels(model, rgb, spec, "cpu")
-            up = cv2.resize(pred, (fw, fh), interpolation=cv2.INTER_NEAREST_EXACT)
-            icm = te.confusion(gt, up, nc)
-            cm += icm
-            images += 1
-            counts = np.bincount(gt[valid].astype(np.int64), minlength=nc)
-            for c in range(nc):
-                if counts[c] >= min_share * valid.sum():
-                    per_image[c].append(class_iou(icm, c))
-        m, _ = te.miou(cm)
-        out[fac] = {
-            "gsd_cm": gsd, "images": images, "miou": m,
-            "iou": [class_iou(cm, c) for c in range(nc)],
-            "per_image_iou_mean": [float(np.mean(v)) if v else None for v in per_image],
-            "per_image_count": [len(v) for v in per_image],
-        }
-    return out
+    per_image = {fac: [[] for _ in range(nc)] for fac in bands}
+
+    def on_image(fac, gt, image_cm):
+        valid = gt != te.IGNORE
+        counts = np.bincount(gt[valid].astype(np.int64), minlength=nc)
+        _, iou = te.miou(image_cm)
+        for c in range(nc):
+            if counts[c] >= min_share * valid.sum():
+                per_image[fac][c].append(iou[c])
+
+    bands_result = te.evaluate(model, field, bands, spec, on_image=on_image)
+    return {fac: {"gsd_cm": r["gsd_cm"], "images": r["images"], "miou": r["miou_ortho"], "iou": r["iou_ortho"],
+                  "per_image_iou_mean": [float(np.mean(v)) if v else None for v in per_image[fac]],
+                  "per_image_count": [len(v) for v in per_image[fac]]}
+            for fac, r in bands_result.items()}
 
 
 def fmt(v) -> str:

@@ -387,9 +387,11 @@ def miou(cm: np.ndarray) -> tuple[float, list]:
 
 
 @torch.no_grad()
-def evaluate(model, field: FieldData, factors, spec: NetSpec, max_images=None, device="cpu"):
+def evaluate(model, field: FieldData, factors, spec: NetSpec, max_images=None, device="cpu", on_image=None):
     """Per band: mIoU vs the oracle at camera resolution, and vs the orthomosaic labels at
-    orthomosaic resolution (adaptseg::image_confusion). Returns {factor: {...}}."""
+    orthomosaic resolution (adaptseg::image_confusion). Returns {factor: {...}}. With
+    `on_image`, also calls on_image(factor, gt, confusion) for every image scored: its
+    orthomosaic labels and its confusion matrix against them."""
     was_training = model.training
     model.eval()
     nc = len(field.classes)
@@ -408,7 +410,10 @@ def evaluate(model, field: FieldData, factors, spec: NetSpec, max_images=None, d
             pred = predict_labels(model, rgb, spec, device)
             cm_cam += confusion(target, pred, nc)
             up = cv2.resize(pred, (fw, fh), interpolation=cv2.INTER_NEAREST_EXACT)
-            cm_ortho += confusion(gt, up, nc)
+            image_cm = confusion(gt, up, nc)
+            cm_ortho += image_cm
+            if on_image is not None:
+                on_image(fac, gt, image_cm)
             n_img += 1
         m_cam, iou_cam = miou(cm_cam)
         m_ortho, iou_ortho = miou(cm_ortho)
