@@ -37,6 +37,13 @@ def slug(name):
     return re.sub(r"[^A-Za-z0-9.\-]", "_", name)
 
 
+def save(fig, path, dpi=110):
+    """Lays out, writes and closes a figure."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+
+
 def read_csv(path):
     with open(path, newline="") as f:
         return list(csv.DictReader(f))
@@ -72,9 +79,7 @@ def main(out):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="lower right")
     fig.suptitle("Field mIoU vs execution time (above the lawnmower curve: front margin > 0)", fontsize=11)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "miou_vs_time.png"), dpi=110)
-    plt.close(fig)
+    save(fig, os.path.join(out, "miou_vs_time.png"))
 
     # Per-image mIoU vs GSD (paper Fig. iouvsh).
     per = read_csv(os.path.join(out, "per_image.csv"))
@@ -102,9 +107,7 @@ def main(out):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
     fig.suptitle("Per-image mIoU vs GSD: mean and standard deviation over the images taken")
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "per_image_miou.png"), dpi=110)
-    plt.close(fig)
+    save(fig, os.path.join(out, "per_image_miou.png"))
 
     # Per descent: the forecast field gain the decision was taken on, against what the descent
     # realised (simulation: the field mIoU with and without its re-mapping).
@@ -139,9 +142,7 @@ def main(out):
             ax.grid(alpha=0.3)
             ax.legend(fontsize=8, loc="upper left")
         fig.suptitle("Each descent: the gain it was forecast\nto add to the field mIoU, and what it added", fontsize=11)
-        fig.tight_layout()
-        fig.savefig(os.path.join(out, "decisions.png"), dpi=110)
-        plt.close(fig)
+        save(fig, os.path.join(out, "decisions.png"))
 
     # Paths and maps: montages of the per-mission pictures.
     for name, picks in (("paths.png", ["path"]), ("maps.png", ["map"])):
@@ -164,9 +165,7 @@ def main(out):
             ax.axis("off")
         for ax, p in zip(axes.flat, panels):
             ax.imshow(mpimg.imread(p))
-        fig.tight_layout()
-        fig.savefig(os.path.join(out, name), dpi=100)
-        plt.close(fig)
+        save(fig, os.path.join(out, name), dpi=100)
     print(f"plots written to {out}")
 
 
