@@ -137,6 +137,7 @@ ImageSetInfo read_image_set_info(const fs::path& dir) {
                               {static_cast<std::uint8_t>(rgb[0]), static_cast<std::uint8_t>(rgb[1]),
                                static_cast<std::uint8_t>(rgb[2])}});
     }
+    info.area.num_classes = static_cast<int>(info.classes.size());
     info.interest = root["interest"].as<std::vector<std::string>>();
     const YAML::Node cam = root["camera"];
     info.camera = {cam["image_width_px"].as<int>(), cam["image_height_px"].as<int>(),

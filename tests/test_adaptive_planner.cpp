@@ -334,7 +334,7 @@ TEST_CASE("AdaptivePlanner: report() refuses a missing, repeated or malformed im
   CHECK_THROWS_WITH_AS((void)planner.report(small), doctest::Contains("the image must have the camera's size 480x360"),
                        std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)planner.report(first, cv::Mat(10, 10, CV_8UC1), 0.1),
-                       doctest::Contains("labels must be CV_8UC1 of the image's size"), std::invalid_argument);
+                       doctest::Contains("labels must have the image's size 480x360"), std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)planner.report(first, -1.0), doctest::Contains("elapsed_s"), std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)planner.image_at(w->waypoint.position, cv::Mat(10, 10, CV_8UC3)),
                        doctest::Contains("rgb must be CV_8UC3 of the camera's size"), std::invalid_argument);
@@ -399,7 +399,7 @@ TEST_CASE("AdaptivePlanner: a survey area without a mask covers the rectangle") 
   const Field f = t::blob_field(1500, 1100, 1.0, 5, 40);
   OracleSegmenter oracle(f.num_classes());
   Scripted never{.gsd = 0.5};
-  SurveyArea area{.area = {0.0, 0.0, 15.0, 11.0}, .map_gsd_cm = 1.0};
+  SurveyArea area{.area = {0.0, 0.0, 15.0, 11.0}, .map_gsd_cm = 1.0, .num_classes = f.num_classes()};
   Planner planner(area, oracle, never, weedmap_options(f));
   CHECK(planner.map().labels().size() == cv::Size(1500, 1100));
   CHECK(planner.valid_fraction(planner.top_level().front().footprint) == 1.0);

@@ -3,6 +3,7 @@
 
 #include <adaptseg/metrics.hpp>
 #include <adaptseg/oracle_segmenter.hpp>
+#include <adaptseg/simulated_sensor.hpp>
 
 #include <doctest/doctest.h>
 

@@ -144,11 +144,36 @@ GaussianProcess<SquaredExponentialKernel> load_gp(const std::string& text) {
 fs::path erfnet_dir() { return fs::path(ADAPTSEG_EXAMPLES_DIR) / "models" / "erfnet-dubai"; }
 
 /// A backend that breaks the SegmentationBackend contract: a 1 x 1 label map.
-struct WrongSizeBackend {
-  [[nodiscard]] std::string name() const { return "wrong-size"; }
-  [[nodiscard]] cv::Mat segment(const Image&) const { return cv::Mat(1, 1, CV_8UC1, cv::Scalar(0)); }
+/// A backend that breaks the segmentation contract (segmentation_backend.hpp) one way.
+struct ContractBreaker {
+  enum class Fault { size, type, label };
+  Fault fault = Fault::label;
+  [[nodiscard]] std::string name() const { return "breaker"; }
+  [[nodiscard]] cv::Mat segment(const Image& image) const {
+    switch (fault) {
+      case Fault::size:
+        return cv::Mat(1, 1, CV_8UC1, cv::Scalar(0));
+      case Fault::type:
+        return cv::Mat(image.height_px, image.width_px, CV_16UC1, cv::Scalar(0));
+      case Fault::label:
+        break;
+    }
+    cv::Mat labels(image.height_px, image.width_px, CV_8UC1, cv::Scalar(0));
+    labels.at<unsigned char>(5, 7) = 7;  // row 5, column 7: not a class of a 3-class field
+    return labels;
+  }
 };
-static_assert(SegmentationBackend<WrongSizeBackend>);
+static_assert(SegmentationBackend<ContractBreaker>);
+
+/// A live planner's options over `f`: top level 3 cm/px, one candidate, fixed times.
+AdaptiveOptions live_options(const Field& f) {
+  AdaptiveOptions o;
+  o.mission = fixed_times();
+  o.mission.interest = f.interest();
+  o.top_gsd_cm = 3.0;
+  o.candidate_gsd_cm = {1.0};
+  return o;
+}
 
 }  // namespace
 
@@ -417,9 +442,74 @@ TEST_CASE("robustness: mission: negative fixed segmentation time") {
 
 TEST_CASE("robustness: mission: backend returns labels of the wrong size") {
   const Field f = weedmap_field();
-  WrongSizeBackend backend;
+  ContractBreaker backend{ContractBreaker::Fault::size};
   CHECK_THROWS_WITH_AS((void)run_lawnmower_mission(f, 3.0, backend, fixed_times()),
-                       Contains("the backend 'wrong-size' returned labels that are not CV_8UC1"),
+                       Contains("segmentation backend 'breaker' broke the segmentation contract: labels must have "
+                                "the image's size 480x360 (got 1x1)"),
+                       std::invalid_argument);
+}
+
+TEST_CASE("robustness: mission: backend returns labels of the wrong type") {
+  const Field f = weedmap_field();
+  ContractBreaker backend{ContractBreaker::Fault::type};
+  CHECK_THROWS_WITH_AS((void)run_lawnmower_mission(f, 3.0, backend, fixed_times()),
+                       Contains("segmentation backend 'breaker' broke the segmentation contract: labels must be "
+                                "CV_8UC1 (8-bit, one channel) (got type CV_16UC1)"),
+                       std::invalid_argument);
+}
+
+TEST_CASE("robustness: mission: backend returns a label outside the class set") {
+  const Field f = weedmap_field();
+  REQUIRE(f.num_classes() == 3);
+  ContractBreaker backend{ContractBreaker::Fault::label};
+  CHECK_THROWS_WITH_AS((void)run_lawnmower_mission(f, 3.0, backend, fixed_times()),
+                       Contains("segmentation backend 'breaker' broke the segmentation contract: label 7 at pixel "
+                                "(x 7, y 5) is neither a class index 0..2 nor the ignore label 255"),
+                       std::invalid_argument);
+}
+
+TEST_CASE("robustness: calibration: backend returns a label outside the class set") {
+  const Field f = weedmap_field();
+  ContractBreaker backend{ContractBreaker::Fault::label};
+  CHECK_THROWS_WITH_AS((void)collect_region_samples(f, backend, CameraModel{}, 3.0, {1.0}, f.interest()),
+                       Contains("segmentation backend 'breaker' broke the segmentation contract: label 7"),
+                       std::invalid_argument);
+}
+
+TEST_CASE("robustness: live planner: labels outside the class set, from the backend or the caller") {
+  const Field f = weedmap_field();
+  ContractBreaker backend{ContractBreaker::Fault::label};
+  LinearDecision never({0.0, 1.0});
+  AdaptivePlanner planner(SurveyArea::of(f), backend, never, live_options(f));
+  const auto w = planner.next();
+  REQUIRE(w.has_value());
+  const Image image = SimulatedSensor(f, planner.camera()).capture(w->waypoint);
+  CHECK_THROWS_WITH_AS((void)planner.report(image),
+                       Contains("segmentation backend 'breaker' broke the segmentation contract: label 7 at pixel "
+                                "(x 7, y 5)"),
+                       std::invalid_argument);
+  cv::Mat labels(image.height_px, image.width_px, CV_8UC1, cv::Scalar(1));
+  labels.at<unsigned char>(359, 479) = 3;
+  CHECK_THROWS_WITH_AS((void)planner.report(image, labels, 0.1),
+                       Contains("AdaptivePlanner::report: the labels reported broke the segmentation contract: "
+                                "label 3 at pixel (x 479, y 359)"),
+                       std::invalid_argument);
+  labels.at<unsigned char>(359, 479) = 255;  // the ignore label is allowed
+  CHECK(planner.report(image, labels, 0.1).waypoint.index == 0);
+}
+
+TEST_CASE("robustness: live planner: survey area without its class count") {
+  const Field f = weedmap_field();
+  OracleSegmenter oracle(f.num_classes());
+  LinearDecision never({0.0, 1.0});
+  const AdaptiveOptions o = live_options(f);
+  SurveyArea area = SurveyArea::of(f);
+  area.num_classes = 0;
+  CHECK_THROWS_WITH_AS(AdaptivePlanner(area, oracle, never, o),
+                       Contains("SurveyArea: num_classes must be the size of the backend's class set, 1..255"),
+                       std::invalid_argument);
+  area.num_classes = 1;  // interest is class 1 or 2 of the WeedMap crop: not a class any more
+  CHECK_THROWS_WITH_AS(AdaptivePlanner(area, oracle, never, o), Contains("a label of interest is not a class index 0..0"),
                        std::invalid_argument);
 }
 

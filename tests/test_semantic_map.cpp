@@ -2,6 +2,7 @@
 
 #include <adaptseg/oracle_segmenter.hpp>
 #include <adaptseg/semantic_map.hpp>
+#include <adaptseg/simulated_sensor.hpp>
 
 #include <doctest/doctest.h>
 

@@ -98,10 +98,14 @@ struct SurveyArea {
   /// grid's. Empty: every pixel under `area` is field, and the grid just covers `area`.
   cv::Mat valid_mask{};
   int ignore_label = 255;    ///< "no class" in segmentations and in the map (0..255)
+  /// Size of the class set the backend labels with (1..255; labels 0 .. num_classes - 1).
+  /// Required: every segmentation reported to the planner is checked against it
+  /// (check_segmentation()); 0, the default, is rejected by the planner with a message.
+  int num_classes = 0;
 
-  /// A Field's area, GSD, valid mask and ignore label (what the simulation knows).
+  /// A Field's area, GSD, valid mask, ignore label and class count (what the simulation knows).
   [[nodiscard]] static SurveyArea of(const Field& field) {
-    return {field.area(), field.gsd_cm(), field.valid_mask(), field.ignore_label()};
+    return {field.area(), field.gsd_cm(), field.valid_mask(), field.ignore_label(), field.num_classes()};
   }
 };
 
@@ -158,10 +162,10 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
 class AdaptivePlanner {
  public:
   /// Plans the top-level lawnmower over `area` (cells without field skipped).
-  /// @throws std::invalid_argument for an invalid area, camera or timing, no labels of
-  ///         interest (or one that is the ignore label), a top GSD finer than the map's,
-  ///         candidates that are not finer than the top, a budget that is not positive, or
-  ///         one too small for the top-level coverage alone.
+  /// @throws std::invalid_argument for an invalid area (num_classes not set included), camera
+  ///         or timing, no labels of interest (or one that is not a class index), a top GSD
+  ///         finer than the map's, candidates that are not finer than the top, a budget that
+  ///         is not positive, or one too small for the top-level coverage alone.
   AdaptivePlanner(SurveyArea area, Backend& backend, Policy& policy, AdaptiveOptions options)
       : camera_(options.mission.camera),
         timing_(options.mission.timing),
@@ -180,8 +184,10 @@ class AdaptivePlanner {
     const auto& interest = options_.mission.interest;
     detail::require(!interest.empty(), "AdaptivePlanner: no labels of interest (options.mission.interest)", 0);
     for (int c : interest)
-      detail::require(c >= 0 && c <= 255 && c != area_.ignore_label,
-                      "AdaptivePlanner: a label of interest is out of 0..255 or the ignore label", c);
+      detail::require(c >= 0 && c < area_.num_classes,
+                      "AdaptivePlanner: a label of interest is not a class index 0.." +
+                          std::to_string(area_.num_classes - 1),
+                      c);
     const double map_gsd = area_.map_gsd_cm;
     detail::require(std::isfinite(options_.top_gsd_cm) && options_.top_gsd_cm >= map_gsd * (1.0 - 1e-9),
                     "AdaptivePlanner: top_gsd_cm must not be finer than the map's " + std::to_string(map_gsd) +
@@ -252,7 +258,7 @@ class AdaptivePlanner {
   PlannerStep report(const Image& image, std::optional<double> elapsed_s = std::nullopt) {
     check_report(image, elapsed_s);
     const auto t0 = std::chrono::steady_clock::now();
-    cv::Mat labels = backend_.segment(image);
+    cv::Mat labels = segment_checked(backend_, image, area_.num_classes);
     return report(image, labels, seconds_since(t0), elapsed_s);
   }
 
@@ -264,14 +270,12 @@ class AdaptivePlanner {
   /// account. Nothing changes when it throws: the waypoint stays pending.
   /// @throws std::invalid_argument if no waypoint is pending (next() not called, or its image
   ///         already reported), for an image that is not of the camera's size or has no
-  ///         footprint, labels that are not CV_8UC1 of the image's size, or a time that is
-  ///         negative or not finite.
+  ///         footprint, labels that break the segmentation contract (check_segmentation()),
+  ///         or a time that is negative or not finite.
   PlannerStep report(const Image& image, const cv::Mat& labels, double segmentation_s,
                      std::optional<double> elapsed_s = std::nullopt) {
     check_report(image, elapsed_s);
-    detail::require(labels.type() == CV_8UC1 && labels.cols == image.width_px && labels.rows == image.height_px,
-                    "AdaptivePlanner::report: labels must be CV_8UC1 of the image's size",
-                    std::to_string(labels.cols) + "x" + std::to_string(labels.rows));
+    check_segmentation(labels, image, area_.num_classes, "AdaptivePlanner::report: the labels reported");
     detail::require(std::isfinite(segmentation_s) && segmentation_s >= 0.0,
                     "AdaptivePlanner::report: segmentation_s must be finite and >= 0", segmentation_s);
     pending_ = false;
@@ -438,8 +442,12 @@ class AdaptivePlanner {
                         r.height_m() > 0.0,
                     "SurveyArea: area must be finite with x_min, y_min >= 0 and a positive size [m]",
                     r.width_m() * r.height_m());
-    detail::require(a.ignore_label >= 0 && a.ignore_label <= 255, "SurveyArea: ignore_label must be in 0..255",
-                    a.ignore_label);
+    detail::require(a.num_classes >= 1 && a.num_classes <= 255,
+                    "SurveyArea: num_classes must be the size of the backend's class set, 1..255 "
+                    "(SurveyArea::of(field) sets it)",
+                    a.num_classes);
+    detail::require(a.ignore_label >= a.num_classes && a.ignore_label <= 255,
+                    "SurveyArea: ignore_label must be in num_classes..255, not a class index", a.ignore_label);
     const double s = 100.0 / a.map_gsd_cm;
     if (a.valid_mask.empty())
       return {static_cast<int>(std::ceil(r.x_max_m * s - 1e-6)), static_cast<int>(std::ceil(r.y_max_m * s - 1e-6))};

@@ -4,8 +4,8 @@
 /// mIoU (paper Eq. `eq:iou`) over a class set, per image and over the fused field.
 
 #include <adaptseg/decision.hpp>
+#include <adaptseg/image.hpp>
 #include <adaptseg/lawnmower_curve.hpp>
-#include <adaptseg/simulated_sensor.hpp>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>

@@ -145,11 +145,8 @@ class Mission {
     const auto t0 = std::chrono::steady_clock::now();
     v.labels = backend_.segment(v.image);
     const double measured = seconds_since(t0);
-    detail::require(v.labels.type() == CV_8UC1 && v.labels.cols == v.image.width_px &&
-                        v.labels.rows == v.image.height_px,
-                    "Mission::visit: the backend '" + result_.segmenter +
-                        "' returned labels that are not CV_8UC1 of the image's size",
-                    std::to_string(v.labels.cols) + "x" + std::to_string(v.labels.rows));
+    check_segmentation(v.labels, v.image, sensor_.field().num_classes(),
+                       "segmentation backend '" + result_.segmenter + "'");
 
     WaypointRecord rec;
     rec.waypoint = w;

@@ -53,7 +53,7 @@ template <SegmentationBackend Backend>
   SemanticMap field_map(field.labels().size(), field.ignore_label());
   for (const auto& top : tops) {
     top_images.push_back(sensor.capture(top));
-    top_segmentations.push_back(backend.segment(top_images.back()));
+    top_segmentations.push_back(segment_checked(backend, top_images.back(), n));
     field_map.fuse(top_images.back(), top_segmentations.back());
   }
   ConfusionMatrix field_cm(n);
@@ -101,7 +101,7 @@ template <SegmentationBackend Backend>
       if (coverage == DescentCoverage::interest) local.fuse(top_local, top_labels);
       for (const auto& w : sub) {
         Image img = sensor.capture(w);
-        const cv::Mat labels = backend.segment(img);
+        const cv::Mat labels = segment_checked(backend, img, n);
         img.footprint_px -= region.tl();
         local.fuse(img, labels);
       }

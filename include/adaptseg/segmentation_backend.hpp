@@ -2,7 +2,7 @@
 /// @file
 /// The plug point for semantic segmentation: the `SegmentationBackend` concept.
 
-#include <adaptseg/simulated_sensor.hpp>
+#include <adaptseg/image.hpp>
 
 #include <opencv2/core.hpp>
 
@@ -33,10 +33,24 @@ concept NamedBackend = requires(const B& backend) {
 /// - It does not modify `image` and does not keep references to it after returning.
 /// - It may keep state between calls (caches, a network) but its output depends only on
 ///   the image: the same image gives the same labels.
+/// - The library enforces the first point on every image it segments, in every build
+///   (segment_checked(), check_segmentation()): a violation is a `std::invalid_argument`
+///   naming the backend, the value and the pixel.
 /// - `segment` may throw `std::invalid_argument` for an image it cannot handle (e.g. the
 ///   ERFNet backend given an image without RGB), naming what is missing.
 /// - Thread safety: none is required; a planner calls one backend from one thread.
 template <typename B>
 concept SegmentationBackend = SegmentsImages<B> && NamedBackend<B>;
+
+/// `backend.segment(image)`, checked against the contract (check_segmentation()) for a class
+/// set of `num_classes` classes; what every planner and calibration of the library calls.
+/// @throws std::invalid_argument naming the backend if its labels break the contract, and
+///         whatever `segment` throws.
+template <SegmentationBackend B>
+[[nodiscard]] cv::Mat segment_checked(B& backend, const Image& image, int num_classes) {
+  cv::Mat labels = backend.segment(image);
+  check_segmentation(labels, image, num_classes, "segmentation backend '" + std::string(backend.name()) + "'");
+  return labels;
+}
 
 }  // namespace adaptseg

@@ -2,7 +2,7 @@
 /// @file
 /// The field map built from segmented images: finest GSD wins (paper §3.1, method.md §3).
 
-#include <adaptseg/simulated_sensor.hpp>
+#include <adaptseg/image.hpp>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>

@@ -5,6 +5,7 @@
 
 #include <adaptseg/camera.hpp>
 #include <adaptseg/field.hpp>
+#include <adaptseg/image.hpp>
 #include <adaptseg/lawnmower_planner.hpp>
 
 #include <opencv2/core.hpp>
@@ -15,24 +16,6 @@
 #include <cmath>
 
 namespace adaptseg {
-
-/// One camera frame, as a segmentation backend receives it.
-struct Image {
-  /// The camera image, I_h x I_w, CV_8UC3 BGR; empty when the field has no RGB.
-  cv::Mat rgb;
-  /// Simulation only: the orthomosaic's labels under the footprint at the orthomosaic's
-  /// resolution (CV_8UC1, ignore label outside the orthomosaic); empty in live use.
-  cv::Mat ground_truth;
-  /// Orthomosaic pixels seen by the camera (may extend beyond the orthomosaic): camera
-  /// pixel (u, v) covers the part (u, v) of a uniform I_w x I_h grid over this rectangle.
-  cv::Rect footprint_px;
-  /// Where the image was taken: x, y [m] field frame, z altitude [m].
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  double gsd_cm = 0.0;    ///< [cm/px]
-  int width_px = 0;       ///< I_w
-  int height_px = 0;      ///< I_h
-  int ignore_label = 255; ///< label for "no class" in ground_truth and in segmentations
-};
 
 /// Renders camera images of a Field.
 ///
