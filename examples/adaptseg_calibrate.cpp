@@ -19,7 +19,7 @@
 
 int main(int argc, char** argv) {
   namespace fs = std::filesystem;
-  CLI::App app{"Initialise the adaptive decision function on training fields and save it."};
+  CLI::App app{"Initialise the adaptive decision function on training fields and save it.", "adaptseg_calibrate"};
   fs::path field_dir, out_file, samples_csv;
   std::string region_text;
   std::vector<std::string> train_specs;
@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
   calibration.add_to(app);
   common.add_to(app);
   segmenter.add_to(app);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = adaptseg::examples::parse_command_line(app, argc, argv)) return *code;
 
   try {
     std::vector<adaptseg::Field> fields;
@@ -66,6 +66,14 @@ int main(int argc, char** argv) {
         throw std::invalid_argument("training fields must share one GSD (the factors multiply it): '" + f.name() +
                                     "' has " + std::to_string(f.gsd_cm()) + " cm/px, '" + field.name() + "' " +
                                     std::to_string(g0));
+    namespace ex = adaptseg::examples;
+    ex::check_gsd_factors({top_factor}, "--top-factor");
+    ex::check_gsd_factors(candidate_factors, "--candidate-factors");
+    ex::check_gsd_factors(lawnmower_factors, "--lawnmower-factors");
+    for (double f : candidate_factors)
+      if (f >= top_factor)
+        throw std::invalid_argument("--candidate-factors " + ex::fmt(f, 3) + " is not finer than --top-factor " +
+                                    ex::fmt(top_factor, 3) + ": a descent must fly lower than the top level");
     adaptseg::CalibrationOptions options;
     options.adaptive.mission = mission;
     if (options.adaptive.mission.interest.empty()) options.adaptive.mission.interest = field.interest();
@@ -100,10 +108,12 @@ int main(int argc, char** argv) {
       for (const auto& p : cal.lawnmower_curves[k]) std::printf(" (%.1f, %.4f)", p.time_s, p.miou);
       std::printf("\n");
     }
-    std::printf("settings tried on the training fields (chosen first): mean time_s, mean mIoU, mean front margin, "
-                "worst front margin, descents\n");
+    std::printf("settings tried on the training fields, the chosen one first (time, mIoU and front margin: "
+                "means over the fields flown; descents: all of them):\n");
+    std::printf("  %-52s %9s %8s %13s %13s %8s\n", "setting", "time [s]", "mIoU", "front margin", "worst margin",
+                "descents");
     for (const auto& t : cal.trials)
-      std::printf("  %-48s %8.1f %.4f %+.4f %+.4f %d\n", t.description.c_str(), t.time_s, t.miou_interest,
+      std::printf("  %-52s %9.1f %8.4f %+13.4f %+13.4f %8d\n", t.description.c_str(), t.time_s, t.miou_interest,
                   t.front_margin, t.worst_margin, t.descents);
     std::printf("%zu region samples; linear sigma range [%.4f, %.4f]; model -> %s\n", cal.samples.size(),
                 cal.linear.sigma_low, cal.linear.sigma_high, out_file.string().c_str());

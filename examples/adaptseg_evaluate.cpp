@@ -10,6 +10,7 @@
 #include "common/segmenters.hpp"
 #include "common/strategies.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -80,16 +81,26 @@ void write_decisions(std::ostream& os, const std::string& field, const std::stri
   }
 }
 
+/// A field's name as a folder name: "weedmap-rededge-000[0.5,0,1,1]" (a region of a field)
+/// -> "weedmap-rededge-000_region_0.5-0-1-1"; other characters than letters, digits, '-' and
+/// '.' -> '_'. examples/tools/plot_evaluation.py's slug() is the same function.
 std::string slug(const std::string& s) {
   std::string out;
-  for (char c : s) out += std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' ? c : '_';
+  for (char c : s) {
+    if (c == '[')
+      out += "_region_";
+    else if (c == ',')
+      out += '-';
+    else if (c != ']')
+      out += std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' ? c : '_';
+  }
   return out;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Run every strategy on test fields and write the paper's tables and figures."};
+  CLI::App app{"Run every strategy on test fields and write the paper's tables and figures.", "adaptseg_evaluate"};
   std::vector<std::string> train_specs;
   std::vector<std::string> test_specs;
   fs::path out_dir, model_file;
@@ -114,11 +125,18 @@ int main(int argc, char** argv) {
   app.add_flag("--no-plots", no_plots, "do not run the plotting script");
   common.add_to(app);
   segmenter.add_to(app);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = adaptseg::examples::parse_command_line(app, argc, argv)) return *code;
 
+  bool progress_open = false;  // a progress line on stderr waits for its end
   try {
     if (train_specs.empty() == model_file.empty())
       throw std::invalid_argument("give exactly one of --train (calibrate) and --model (load)");
+    adaptseg::examples::check_gsd_factors(lawnmower_factors, "--lawnmower-factors");
+    if (lawnmower_factors.size() < 2 || !std::is_sorted(lawnmower_factors.begin(), lawnmower_factors.end()) ||
+        std::adjacent_find(lawnmower_factors.begin(), lawnmower_factors.end()) != lawnmower_factors.end())
+      throw std::invalid_argument(
+          "--lawnmower-factors needs at least two factors in increasing order (the last is the adaptive top level, "
+          "the others its candidates)");
     std::vector<adaptseg::Field> tests;
     for (const auto& spec : test_specs) tests.push_back(adaptseg::examples::load_field_spec(spec));
     // Labels of interest: --interest, else the first test field's default.
@@ -136,6 +154,7 @@ int main(int argc, char** argv) {
     std::optional<adaptseg::DecisionModel> loaded;
     if (!model_file.empty()) {
       loaded = adaptseg::DecisionModel::load(model_file);
+      for (const auto& t : tests) loaded->check_classes(t);
     } else {
       std::vector<adaptseg::Field> trains;
       for (const auto& spec : train_specs) trains.push_back(adaptseg::examples::load_field_spec(spec));
@@ -186,6 +205,7 @@ int main(int argc, char** argv) {
         ++run_index;
         std::fprintf(stderr, "[%6.1f s] (%zu/%zu) %s: %s%s ...", elapsed(), run_index, total_runs, field.name().c_str(),
                      strategy.c_str(), strategy == "lawnmower" ? (" " + fmt(gsd, 2) + " cm/px").c_str() : "");
+        progress_open = true;
         auto run = segmenter.with_backend(field, strategy == "lawnmower" ? mo.camera : model.camera,
                                           [&](auto& backend) {
                                             return adaptseg::examples::run_strategy(
@@ -194,6 +214,7 @@ int main(int argc, char** argv) {
                                           });
         std::fprintf(stderr, " %zu images, %.1f s, mIoU %.4f\n", run.mission.waypoints.size(), run.mission.total_s(),
                      run.mission.miou_interest().value_or(NAN));
+        progress_open = false;
         rows.push_back({strategy, gsd, std::move(run)});
       };
       for (double f : lawnmower_factors) {
@@ -263,7 +284,7 @@ int main(int argc, char** argv) {
     }
     return 0;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "\nadaptseg_evaluate: error: %s\n", e.what());
+    std::fprintf(stderr, "%sadaptseg_evaluate: error: %s\n", progress_open ? "\n" : "", e.what());
     return 2;
   }
 }

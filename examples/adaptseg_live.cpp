@@ -318,7 +318,8 @@ void fly_strategy(const std::string& strategy, const adaptseg::DecisionModel& mo
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Run the adaptive planner step by step over a folder of posed images, as a UAV would."};
+  CLI::App app{"Run the adaptive planner step by step over a folder of posed images, as a UAV would.",
+               "adaptseg_live"};
   LiveSettings s;
   fs::path model_file, erfnet_dir;
   std::string record_from, strategy = "adaptive", segmenter = "oracle";
@@ -341,12 +342,13 @@ int main(int argc, char** argv) {
   app.add_option("--seg-time-s", seg_time_s, "fixed segmentation time per image [s] (default: measured)");
   app.add_option("--plan-time-s", plan_time_s, "fixed planning time per waypoint [s] (default: measured)");
   app.add_option("--out", s.out, "output directory for result.json and map.png");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = adaptseg::examples::parse_command_line(app, argc, argv)) return *code;
 
   try {
     const adaptseg::DecisionModel model = adaptseg::DecisionModel::load(model_file);
     if (!record_from.empty()) {
       const adaptseg::Field field = ex::load_field_spec(record_from);
+      model.check_classes(field);
       const std::vector<int> interest = field.class_indices(model.interest);
       model.check_compatible(field, interest);
       const adaptseg::AdaptiveOptions o = model_options(model, interest);

@@ -21,7 +21,7 @@
 
 int main(int argc, char** argv) {
   namespace fs = std::filesystem;
-  CLI::App app{"Fly one UAV mapping mission over a field (simulated) and score it."};
+  CLI::App app{"Fly one UAV mapping mission over a field (simulated) and score it.", "adaptseg_mission"};
   std::string field_spec;
   fs::path out_dir, model_file;
   std::string strategy = "lawnmower";
@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
   segmenter.add_to(app);
   adaptseg::examples::ExportCli exports;
   exports.add_to(app);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto code = adaptseg::examples::parse_command_line(app, argc, argv)) return *code;
 
   try {
     const adaptseg::Field field = exports.load_field(field_spec);

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -25,6 +26,71 @@ inline std::string fmt(double v, int digits) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.*f", digits, v);
   return buf;
+}
+
+/// The flag of `app` nearest to `word` by edit distance, if within 2 edits ("" otherwise).
+inline std::string nearest_flag(const CLI::App& app, const std::string& word) {
+  const auto distance = [](const std::string& a, const std::string& b) {
+    std::vector<std::size_t> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+      std::size_t diagonal = row[0];
+      row[0] = i;
+      for (std::size_t j = 1; j <= b.size(); ++j) {
+        const std::size_t up = row[j];
+        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+        diagonal = up;
+      }
+    }
+    return row[b.size()];
+  };
+  std::string best;
+  std::size_t best_distance = 3;
+  for (const CLI::Option* o : app.get_options())
+    for (const std::string& name : o->get_lnames())
+      if (const std::size_t d = distance(word, "--" + name); d < best_distance) best = "--" + name, best_distance = d;
+  return best;
+}
+
+/// Parses the command line of `program`. Returns nullopt to go on, else the exit code: 0 after
+/// --help, 2 after a command-line mistake (unknown or misspelt flag, missing or malformed
+/// value), with one error line on stderr naming the flag, as for every other bad input.
+inline std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+    return std::nullopt;
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::string what = e.what();
+    for (char& c : what)
+      if (c == '\n') c = ' ';
+    // A misspelt flag: name the one that was probably meant.
+    for (int k = 1; k < argc; ++k) {
+      const std::string word = std::string(argv[k]).substr(0, std::string(argv[k]).find('='));
+      if (word.rfind("--", 0) != 0 || word.size() < 3) continue;
+      const std::string near = nearest_flag(app, word);
+      if (!near.empty() && near != word) {
+        what += "; did you mean " + near + "?";
+        break;
+      }
+    }
+    std::fprintf(stderr, "%s: error: %s (run %s --help for the options)\n", app.get_name().c_str(), what.c_str(),
+                 app.get_name().c_str());
+    return 2;
+  }
+}
+
+/// Throws unless every GSD factor of `flag` is finite and >= 1: the factors multiply the
+/// field's GSD, and the simulator cannot fly finer than its orthomosaic.
+inline void check_gsd_factors(const std::vector<double>& factors, const std::string& flag) {
+  if (factors.empty()) throw std::invalid_argument(flag + " needs at least one factor");
+  for (double f : factors)
+    if (!std::isfinite(f) || f < 1.0)
+      throw std::invalid_argument(flag + " " + fmt(f, 3) +
+                                  " is finer than the field: GSD factors multiply the field's GSD and must be >= 1");
 }
 
 /// Camera, speed and timing options shared by every program.

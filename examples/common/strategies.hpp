@@ -8,6 +8,7 @@
 #include <adaptseg/linear_decision.hpp>
 
 #include <array>
+#include <filesystem>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -45,11 +46,22 @@ inline Field load_field_spec(const std::string& spec, const std::optional<FieldG
     const Field f = Field::load(dir);
     return geo ? f.with_geo(geo) : f;
   };
+  // "DIR:tail" where the tail looks like numbers is a region (a malformed one is an error that
+  // says so), unless the whole spec is a directory.
   const auto colon = spec.rfind(':');
-  if (colon != std::string::npos && colon + 1 < spec.size()) {
+  if (colon != std::string::npos && colon + 1 < spec.size() && !std::filesystem::is_directory(spec)) {
     const std::string tail = spec.substr(colon + 1);
-    if (std::count(tail.begin(), tail.end(), ',') == 3 && tail.find('/') == std::string::npos)
-      return load(spec.substr(0, colon)).sub_field(parse_region(tail));
+    const bool numeric = tail.find_first_not_of("0123456789.,+-eE ") == std::string::npos &&
+                         tail.find_first_of("0123456789") != std::string::npos;
+    if (numeric) {
+      FieldRegion region{};
+      try {
+        region = parse_region(tail);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument("field '" + spec + "': " + e.what() + "; write DIR:x0,y0,x1,y1");
+      }
+      return load(spec.substr(0, colon)).sub_field(region);
+    }
   }
   return load(spec);
 }
@@ -80,6 +92,7 @@ StrategyRun run_strategy(const Field& field, Backend& backend, const std::string
                                 "' but the mission uses '" + backend.name() +
                                 "': calibrate with the backend the mission flies (adaptseg_calibrate --segmenter)");
   // Without --interest, the model's labels of interest (its GPs were fitted for them).
+  model->check_classes(field);
   if (options.interest.empty()) options.interest = field.class_indices(model->interest);
   model->check_compatible(field, options.interest);
   const AdaptiveOptions ao = model->adaptive_options(std::move(options), budget_s);

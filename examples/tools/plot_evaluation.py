@@ -34,6 +34,9 @@ STYLE = {
 
 
 def slug(name):
+    """A field's name as adaptseg_evaluate names its folder (slug() in adaptseg_evaluate.cpp):
+    "weedmap-rededge-000[0.5,0,1,1]" -> "weedmap-rededge-000_region_0.5-0-1-1"."""
+    name = name.replace("[", "_region_").replace(",", "-").replace("]", "")
     return re.sub(r"[^A-Za-z0-9.\-]", "_", name)
 
 

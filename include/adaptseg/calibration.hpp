@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <span>
 #include <string>
@@ -99,6 +100,16 @@ inline void add_to_trial(RuleTrial& t, const AdaptiveResult& r, double margin) {
   t.worst_margin = t.margins.empty() ? margin : std::min(t.worst_margin, margin);
   t.descents += r.descents();
   t.margins.push_back(margin);
+}
+
+/// A utility threshold for people: 4 significant digits; the lowest and highest doubles,
+/// which stand for "descend whenever the rule can" and "never descend", by name.
+inline std::string threshold_text(double t) {
+  if (t <= std::numeric_limits<double>::lowest()) return "-inf (always)";
+  if (t >= std::numeric_limits<double>::max()) return "+inf (never)";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", t);
+  return buf;
 }
 
 inline std::string z_text(double z) {
@@ -265,7 +276,7 @@ template <SegmentationBackend Backend>
       Tried c{{}, p};
       c.trial.description = "utility weight=" + std::to_string(p.weight_by_sigma ? 1 : 0) +
                             " relative=" + std::to_string(p.relative_utility ? 1 : 0) +
-                            " min_utility=" + detail::format_number(p.min_utility);
+                            " min_utility=" + detail::threshold_text(p.min_utility);
       for (std::size_t k = 0; k < layouts.size(); ++k) {
         UtilityPolicy policy(model, p);
         double margin = 0.0;

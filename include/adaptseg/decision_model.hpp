@@ -323,15 +323,25 @@ struct DecisionModel {
     return {std::move(mission), top_gsd_cm, candidate_gsd_cm, budget_s, coverage};
   }
 
-  /// Throws unless `field` has the model's class set and `interest` (class indices of
-  /// `field`) equals the model's labels of interest.
-  /// @throws std::invalid_argument naming the mismatch.
-  void check_compatible(const Field& field, const std::vector<int>& interest_indices) const {
+  /// The model's class set is the field's (same names, same order): a model calibrated on
+  /// one class set cannot score or fly another.
+  /// @throws std::invalid_argument naming both class sets.
+  void check_classes(const Field& field) const {
     std::vector<std::string> names;
     for (const auto& c : field.classes()) names.push_back(c.name);
     if (names != classes)
       throw std::invalid_argument("decision model was calibrated for classes [" + join(classes) +
-                                  "] but field '" + field.name() + "' has [" + join(names) + "]");
+                                  "] but field '" + field.name() + "' has [" + join(names) +
+                                  "]: calibrate a model on a field with the same classes");
+  }
+
+  /// Throws unless `field` has the model's class set and `interest` (class indices of
+  /// `field`) equals the model's labels of interest.
+  /// @throws std::invalid_argument naming the mismatch.
+  void check_compatible(const Field& field, const std::vector<int>& interest_indices) const {
+    check_classes(field);
+    std::vector<std::string> names;
+    for (const auto& c : field.classes()) names.push_back(c.name);
     std::vector<std::string> in;
     for (int i : interest_indices) in.push_back(names.at(static_cast<std::size_t>(i)));
     if (in != interest)

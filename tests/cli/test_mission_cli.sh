@@ -31,9 +31,17 @@ bad_inputs)
   # The bundled ERFNet knows the Dubai classes, not WeedMap's.
   expect_error "classes" --field "$field" --gsd 3 --segmenter erfnet --model-file "$examples/models/erfnet-dubai" \
     --out "$work/o"
-  # Command-line syntax errors are CLI11's: non-zero exit, message on stderr, no crash.
-  "$mission" --field "$field" --gsd abc --out "$work/o" >/dev/null 2>&1
-  rc=$?; [ "$rc" -ne 0 ] && [ "$rc" -lt 128 ] || fail "--gsd abc: exit code $rc"
+  # A decision model of another class set (WeedMap's, flown on Dubai).
+  expect_error "decision model was calibrated for classes [soil, crop, weed] but field 'dubai-tile-1' has" \
+    --field "$examples/data/dubai-tile-1" --strategy adaptive \
+    --model "$examples/../tests/data/decision_model_v1/weedmap_utility_v1.yaml" --out "$work/o"
+  expect_error "'0.5,0,1' is not a region x0,y0,x1,y1 (fractions 0..1); write DIR:x0,y0,x1,y1" \
+    --field "$field:0.5,0,1" --gsd 3 --out "$work/o"
+  # Command-line syntax errors (CLI11's): the same one line and exit code 2.
+  expect_error "Could not convert: --gsd = abc" --field "$field" --gsd abc --out "$work/o"
+  expect_error "The following argument was not expected: --bogus" --field "$field" --gsd 3 --out "$work/o" --bogus
+  expect_error "did you mean --gsd?" --field "$field" --gds 3 --out "$work/o"
+  expect_error "--out is required" --field "$field" --gsd 3
   ;;
 weedmap_sweep)
   for gsd in 1.0 1.5 2.0 2.5 3.0; do

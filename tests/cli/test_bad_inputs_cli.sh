@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# Black-box tests of the command-line mistakes of adaptseg_calibrate, adaptseg_evaluate and
+# adaptseg_live: each gives exit code 2 and one stderr line naming the flag or the file and
+# the fix (adaptseg_mission's are in test_mission_cli.sh). CLI11's own parse errors (unknown
+# or misspelt flags, missing values) included.
+#   test_bad_inputs_cli.sh PROGRAM_BINARY EXAMPLES_DIR PROGRAM
+set -uo pipefail
+mission=$1 examples=$2 program=$3
+source "$(dirname "$0")/cli_common.sh"
+weedmap="$examples/data/weedmap-000"
+dubai="$examples/data/dubai-tile-1"
+weedmap_model="$examples/../tests/data/decision_model_v1/weedmap_utility_v1.yaml"
+
+# CLI11's errors: an unknown flag, a misspelt one (the likely flag is named), a missing value.
+common_parse_errors() {
+  expect_error "The following argument was not expected: --bogus" "$@" --bogus
+  expect_error "run $program --help for the options" "$@" --bogus
+}
+
+case "$program" in
+adaptseg_calibrate)
+  common_parse_errors --field "$weedmap" --out "$work/m.yaml"
+  expect_error "did you mean --candidate-factors?" --field "$weedmap" --out "$work/m.yaml" --candidate-factor 1
+  expect_error "--top-factor" --field "$weedmap" --out "$work/m.yaml" --top-factor
+  expect_error "give a training field" --out "$work/m.yaml"
+  expect_error "--lawnmower-factors 0.500 is finer than the field" --field "$weedmap" --out "$work/m.yaml" \
+    --lawnmower-factors 0.5,1
+  expect_error "--candidate-factors 0.500 is finer than the field" --field "$weedmap" --out "$work/m.yaml" \
+    --candidate-factors 0.5,1
+  expect_error "--top-factor 0.500 is finer than the field" --field "$weedmap" --out "$work/m.yaml" --top-factor 0.5
+  expect_error "--candidate-factors 3.000 is not finer than --top-factor 3.000" --field "$weedmap" \
+    --out "$work/m.yaml" --candidate-factors 1,3
+  expect_error "is not a region x0,y0,x1,y1 (fractions 0..1); write DIR:x0,y0,x1,y1" --train "$weedmap:0.5,0,1" \
+    --out "$work/m.yaml"
+  expect_error "field directory not found" --train "$work/none" --out "$work/m.yaml"
+  # None of them wrote a model.
+  [ ! -e "$work/m.yaml" ] || fail "a refused calibration wrote $work/m.yaml"
+  ;;
+adaptseg_evaluate)
+  common_parse_errors --test "$dubai" --model "$weedmap_model" --out "$work/o" --no-plots
+  expect_error "did you mean --no-plots?" --test "$dubai" --model "$weedmap_model" --out "$work/o" --no-plot
+  expect_error "decision model was calibrated for classes [soil, crop, weed] but field 'dubai-tile-1' has" \
+    --test "$dubai" --model "$weedmap_model" --out "$work/o" --no-plots
+  expect_error "--lawnmower-factors needs at least two factors in increasing order" --test "$weedmap" \
+    --model "$weedmap_model" --out "$work/o" --no-plots --lawnmower-factors 3,1
+  expect_error "--lawnmower-factors 0.500 is finer than the field" --test "$weedmap" --model "$weedmap_model" \
+    --out "$work/o" --no-plots --lawnmower-factors 0.5,1
+  expect_error "write DIR:x0,y0,x1,y1" --test "$weedmap:0,0,1" --model "$weedmap_model" --out "$work/o" --no-plots
+  expect_error "give exactly one of --train (calibrate) and --model (load)" --test "$weedmap" --out "$work/o"
+  ;;
+adaptseg_live)
+  common_parse_errors --images "$work/images" --model "$weedmap_model" --record-from "$weedmap"
+  expect_error "did you mean --record-from?" --images "$work/images" --model "$weedmap_model" --record-for "$weedmap"
+  expect_error "--model is required" --images "$work/images"
+  expect_error "decision model was calibrated for classes [soil, crop, weed] but field 'dubai-tile-1' has" \
+    --images "$work/images" --model "$weedmap_model" --record-from "$dubai"
+  expect_error "area.yaml" --images "$work/none" --model "$weedmap_model"
+  ;;
+*)
+  fail "unknown program $program"
+  ;;
+esac
+echo "ok: $program bad inputs"
