@@ -553,6 +553,7 @@ TEST_CASE("robustness: adaptive: budget negative or NaN") {
   OracleSegmenter oracle(f.num_classes());
   AdaptiveOptions o;
   o.mission = fixed_times();
+  o.candidate_gsd_cm = {1.0};
   LinearDecision policy({0.0, 1.0});
   for (double b : {-10.0, 0.0, kNaN}) {
     CAPTURE(b);
@@ -560,6 +561,16 @@ TEST_CASE("robustness: adaptive: budget negative or NaN") {
     CHECK_THROWS_WITH_AS((void)run_adaptive_mission(f, oracle, policy, o, "linear"),
                          Contains("budget_s must be finite and > 0"), std::invalid_argument);
   }
+}
+
+TEST_CASE("robustness: adaptive: no candidate GSD to descend to") {
+  const Field f = weedmap_field();
+  OracleSegmenter oracle(f.num_classes());
+  AdaptiveOptions o;
+  o.mission = fixed_times();
+  LinearDecision policy({0.0, 1.0});
+  CHECK_THROWS_WITH_AS((void)run_adaptive_mission(f, oracle, policy, o, "linear"),
+                       Contains("AdaptivePlanner: no candidate GSD to descend to"), std::invalid_argument);
 }
 
 TEST_CASE("robustness: linear decision: sigma range reversed") {

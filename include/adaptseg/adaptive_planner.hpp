@@ -41,7 +41,9 @@ struct AdaptiveOptions {
   /// `interest` set; run_adaptive_mission fills an empty one from the field.
   MissionOptions mission{};
   double top_gsd_cm = 3.0;                ///< GSD at h_max [cm/px]
-  std::vector<double> candidate_gsd_cm{}; ///< lower GSDs a sub-lawnmower may fly [cm/px]
+  /// Lower GSDs a sub-lawnmower may fly [cm/px]; at least one not finer than the map is
+  /// required (AdaptivePlanner rejects an empty list: it could never descend).
+  std::vector<double> candidate_gsd_cm{};
   /// Mission-time budget [s] (flight + segmentation + planning). The planner only descends
   /// when the descent and the rest of the top-level coverage still fit. Exact with fixed
   /// segmentation and planning times; with measured times the remaining work is estimated
@@ -164,8 +166,9 @@ class AdaptivePlanner {
   /// Plans the top-level lawnmower over `area` (cells without field skipped).
   /// @throws std::invalid_argument for an invalid area (num_classes not set included), camera
   ///         or timing, no labels of interest (or one that is not a class index), a top GSD
-  ///         finer than the map's, candidates that are not finer than the top, a budget that
-  ///         is not positive, or one too small for the top-level coverage alone.
+  ///         finer than the map's, candidates that are not finer than the top (or none to
+  ///         descend to), a budget that is not positive, or one too small for the top-level
+  ///         coverage alone.
   AdaptivePlanner(SurveyArea area, Backend& backend, Policy& policy, AdaptiveOptions options)
       : camera_(options.mission.camera),
         timing_(options.mission.timing),
@@ -198,6 +201,13 @@ class AdaptivePlanner {
                       "AdaptivePlanner: candidate GSDs must be positive and finer than top_gsd_cm", g);
       if (g >= map_gsd * (1.0 - 1e-9)) candidates_.push_back(g);  // finer than the map: skip
     }
+    // Without a candidate the planner could never descend: say so instead of flying a lawnmower.
+    detail::require(!candidates_.empty(),
+                    "AdaptivePlanner: no candidate GSD to descend to (options.candidate_gsd_cm is empty or every "
+                    "one is finer than the map's " +
+                        std::to_string(map_gsd) +
+                        " cm/px); DecisionModel::adaptive_options sets the candidates a model was calibrated for",
+                    options_.candidate_gsd_cm.size());
     if (options_.budget_s)
       detail::require(std::isfinite(*options_.budget_s) && *options_.budget_s > 0.0,
                       "AdaptivePlanner: budget_s must be finite and > 0", *options_.budget_s);

@@ -30,11 +30,24 @@ struct CalibrationOptions {
   /// Camera, timing, labels of interest (empty: the first field's), top and candidate GSDs,
   /// descent coverage. Its fixed segmentation and planning times are replaced by the two below.
   AdaptiveOptions adaptive{};
-  std::vector<double> lawnmower_gsd_cm{};  ///< GSDs of the training fields' lawnmower curves
+  /// GSDs of the training fields' lawnmower curves; empty: the candidate GSDs and the top GSD
+  /// (lawnmower_gsds()), the curve the adaptive mission is compared with.
+  std::vector<double> lawnmower_gsd_cm{};
   /// Segmentation time charged per image during calibration [s]: declared, not measured, so
   /// that the same inputs give the same model on any machine (recorded in the model file).
   double segmentation_time_s = 0.1;
   double planning_time_s = 0.0;            ///< planning time charged per waypoint [s]
+
+  /// The lawnmower curve's GSDs: `lawnmower_gsd_cm`, or if it is empty the candidate GSDs
+  /// and the top GSD, ascending.
+  [[nodiscard]] std::vector<double> lawnmower_gsds() const {
+    if (!lawnmower_gsd_cm.empty()) return lawnmower_gsd_cm;
+    std::vector<double> g = adaptive.candidate_gsd_cm;
+    g.push_back(adaptive.top_gsd_cm);
+    std::sort(g.begin(), g.end());
+    g.erase(std::unique(g.begin(), g.end()), g.end());
+    return g;
+  }
   GainModel::FitOptions fit{};             ///< what I predicts from, hyperparameter restarts
   int refit_every = 0;                     ///< O's scheduled re-optimisation (GainModel)
 
@@ -76,7 +89,7 @@ struct CalibrationResult {
   std::vector<RegionSample> samples;               ///< pooled over the fields (RegionSample::field)
   DecisionFunction decision_function;              ///< fitted, with the chosen rule and settings
   LinearDecision::Params linear{};                 ///< σ range of the training fields' top-level images
-  std::vector<std::vector<CurvePoint>> lawnmower_curves;  ///< per training field, at lawnmower_gsd_cm
+  std::vector<std::vector<CurvePoint>> lawnmower_curves;  ///< per training field, at lawnmower_gsds()
   std::vector<RuleTrial> trials;                   ///< every setting tried, the chosen one first
 };
 
@@ -124,7 +137,7 @@ inline std::string z_text(double z) {
 /// 1. Region samples at every top-level region × candidate GSD of every field, pooled
 ///    (collect_region_samples).
 /// 2. The gain model fitted to them (GainModel::fit).
-/// 3. Each field's lawnmower curve at `lawnmower_gsd_cm`: the front-aware rule's reference curves.
+/// 3. Each field's lawnmower curve at `lawnmower_gsds()`: the front-aware rule's reference curves.
 /// 4. The rule's settings chosen on the training fields (CalibrationOptions::rule).
 /// 5. The linear baseline's σ range: the 5th and 95th percentiles of σ at h_max.
 /// @throws std::invalid_argument for no field, fields with other class sets, invalid options
@@ -133,7 +146,7 @@ template <SegmentationBackend Backend>
 [[nodiscard]] CalibrationResult calibrate(std::span<const Field> fields, Backend& backend,
                                           const CalibrationOptions& options) {
   detail::require(!fields.empty(), "calibrate: at least one training field is needed; count", fields.size());
-  detail::require(!options.lawnmower_gsd_cm.empty(), "calibrate: lawnmower_gsd_cm must not be empty", 0);
+  const std::vector<double> lawnmower_gsd = options.lawnmower_gsds();
   detail::require(options.threshold_steps >= 1, "calibrate: threshold_steps must be >= 1", options.threshold_steps);
   detail::require(std::isfinite(options.segmentation_time_s) && options.segmentation_time_s >= 0.0,
                   "calibrate: segmentation_time_s must be finite and >= 0", options.segmentation_time_s);
@@ -164,7 +177,7 @@ template <SegmentationBackend Backend>
   }
   const auto curve_of = [&](const Field& f) {
     std::vector<CurvePoint> c;
-    for (double g : options.lawnmower_gsd_cm) {
+    for (double g : lawnmower_gsd) {
       const MissionResult r = run_lawnmower_mission(f, g, backend, adaptive.mission);
       c.push_back({r.total_s(), r.miou_interest().value_or(0.0)});
     }
@@ -175,8 +188,8 @@ template <SegmentationBackend Backend>
   for (std::size_t f = 0; f < fields.size(); ++f) {
     curves.push_back(curve_of(fields[f]));
     ReferenceCurve r{fields[f].name(), {}, by_field[f].front().field_sigma};
-    for (std::size_t k = 0; k < options.lawnmower_gsd_cm.size(); ++k)
-      r.points.push_back({options.lawnmower_gsd_cm[k], curves.back()[k].miou});
+    for (std::size_t k = 0; k < lawnmower_gsd.size(); ++k)
+      r.points.push_back({lawnmower_gsd[k], curves.back()[k].miou});
     reference.push_back(std::move(r));
   }
   GainModel::FitOptions fit = options.fit;

@@ -323,6 +323,18 @@ struct DecisionModel {
     return {std::move(mission), top_gsd_cm, candidate_gsd_cm, budget_s, coverage};
   }
 
+  /// The labels of interest as class indices of the model's class set (the labels the
+  /// backend it was calibrated with gives): what MissionOptions::interest takes.
+  [[nodiscard]] std::vector<int> interest_indices() const {
+    std::vector<int> out;
+    for (const auto& n : interest) {
+      const auto it = std::find(classes.begin(), classes.end(), n);
+      detail::require(it != classes.end(), "DecisionModel: a label of interest is not one of its classes", n);
+      out.push_back(static_cast<int>(it - classes.begin()));
+    }
+    return out;
+  }
+
   /// The model's class set is the field's (same names, same order): a model calibrated on
   /// one class set cannot score or fly another.
   /// @throws std::invalid_argument naming both class sets.
