@@ -297,7 +297,11 @@ void fly(const ImageSetInfo& info, const std::vector<PosedImage>& images, Backen
                    {"adaptseg_version", adaptseg::kVersion}};
   if (options.budget_s) j["budget_s"] = *options.budget_s;
   ex::write_text(s.out / "result.json", j.dump(2) + "\n");
-  ex::write_png(s.out / "map.png", adaptseg::colorize_labels(planner.map().labels(), info.classes));
+  ex::write_png(s.out / "map.png",
+                adaptseg::render_map(planner.map().labels(), info.classes,
+                                     info.name + ": " + std::string(policy.name()) + ", " +
+                                         std::to_string(planner.path().size()) + " images, " +
+                                         ex::fmt(planner.elapsed_s(), 0) + " s (live)"));
 }
 
 /// Runs the loop with the policy of `strategy` from `model`.

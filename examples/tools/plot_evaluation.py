@@ -28,7 +28,8 @@ from per_image_table import MIN_TRUTH_SIGMA, by_gsd  # noqa: E402
 
 STYLE = {
     "adaptive": dict(color="tab:red", marker="*", s=220, label="adaptive"),
-    "nonadaptive": dict(color="tab:blue", marker="s", s=90, label="non-adaptive"),
+    # Hollow and drawn over the adaptive star: both stay visible when the two coincide.
+    "nonadaptive": dict(color="tab:blue", marker="s", s=260, label="non-adaptive"),
     "linear": dict(color="tab:green", marker="^", s=110, label="linear (ECMR 2021)"),
 }
 
@@ -73,9 +74,11 @@ def main(out):
         for r in fr:
             if r["strategy"] in STYLE:
                 st = STYLE[r["strategy"]]
-                ax.scatter([num(r["time_total"])], [num(r["miou_interest"])], zorder=3,
-                           label=f"{st['label']} (margin {num(r['front_margin']):+.3f})",
-                           **{k: v for k, v in st.items() if k != "label"})
+                hollow = r["strategy"] == "nonadaptive"
+                ax.scatter([num(r["time_total"])], [num(r["miou_interest"])], zorder=4 if hollow else 3,
+                           label=f"{st['label']} (margin {num(r['front_margin']):+.3f})", marker=st["marker"],
+                           s=st["s"], facecolors="none" if hollow else st["color"], edgecolors=st["color"],
+                           linewidths=2 if hollow else 1)
         ax.set_xlabel("mission execution time [s] (flight + segmentation + planning)")
         ax.set_ylabel("field mIoU over the labels of interest")
         ax.set_title(field, fontsize=10)
@@ -161,14 +164,23 @@ def main(out):
                     panels.append(p)
         if not panels:
             continue
-        cols = 2
+        # A grid at the pictures' own resolution (each panel as large as the largest picture),
+        # so no label or map is shrunk: paths two per row, maps (three panels each) one per row.
+        images = [mpimg.imread(p) for p in panels]
+        cols = 2 if name == "paths.png" else 1
         rows_n = (len(panels) + cols - 1) // cols
-        fig, axes = plt.subplots(rows_n, cols, figsize=(8 * cols, 6.5 * rows_n), squeeze=False)
+        cell_w = max(im.shape[1] for im in images)
+        cell_h = max(im.shape[0] for im in images)
+        dpi = 100
+        fig, axes = plt.subplots(rows_n, cols, figsize=(cell_w * cols / dpi, cell_h * rows_n / dpi), dpi=dpi,
+                                 squeeze=False)
+        fig.subplots_adjust(left=0, right=1, bottom=0, top=1, wspace=0, hspace=0)
         for ax in axes.flat:
             ax.axis("off")
-        for ax, p in zip(axes.flat, panels):
-            ax.imshow(mpimg.imread(p))
-        save(fig, os.path.join(out, name), dpi=100)
+        for ax, im in zip(axes.flat, images):
+            ax.imshow(im, interpolation="nearest")
+        fig.savefig(os.path.join(out, name), dpi=dpi)
+        plt.close(fig)
     print(f"plots written to {out}")
 
 

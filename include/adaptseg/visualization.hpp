@@ -1,7 +1,8 @@
 #pragma once
 /// @file
 /// Pictures a person can judge: class-coloured label maps, the flown path over the field
-/// coloured by altitude, and the fused map beside the ground truth.
+/// coloured by altitude, the fused map beside the ground truth and its errors, and a map
+/// with its legend.
 
 #include <adaptseg/field.hpp>
 #include <adaptseg/lawnmower_planner.hpp>
@@ -13,6 +14,7 @@
 #include <cstdio>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace adaptseg {
@@ -123,6 +125,8 @@ inline cv::Mat class_legend(const std::vector<ClassInfo>& classes, int width, co
     const auto v = ramp_bgr.at<cv::Vec3b>(0, static_cast<int>(std::lround(t * 255.0)));
     return cv::Scalar(v[0], v[1], v[2]);
   };
+  // Footprints: a dark outline under the altitude colour, visible on white and on any class colour.
+  for (const auto& w : path) cv::rectangle(base, rect_px(w.footprint), cv::Scalar(40, 40, 40), 3);
   for (const auto& w : path) cv::rectangle(base, rect_px(w.footprint), color_of(w.position.z()), 1);
   for (std::size_t i = 1; i < path.size(); ++i)
     cv::line(base, to_px(path[i - 1].position), to_px(path[i].position), cv::Scalar(60, 60, 60), 1, cv::LINE_AA);
@@ -161,24 +165,66 @@ inline cv::Mat class_legend(const std::vector<ClassInfo>& classes, int width, co
   return detail::with_title(out, title);
 }
 
-/// The fused map (left) beside the ground truth (right), in class colours, with a legend;
-/// pixels never observed are drawn grey ("not observed / outside").
+/// A label map in class colours beside its legend, under `title`, scaled (nearest neighbour)
+/// so that its longer side is `side` px: what a live mission, which has no ground truth, shows.
+[[nodiscard]] inline cv::Mat render_map(const cv::Mat& labels, const std::vector<ClassInfo>& classes,
+                                        const std::string& title, int side = 700) {
+  const double s = static_cast<double>(side) / std::max(labels.cols, labels.rows);
+  cv::Mat a;
+  cv::resize(colorize_labels(labels, classes), a, cv::Size(), s, s, cv::INTER_NEAREST);
+  const cv::Mat legend_src = detail::class_legend(classes, 260, "not observed / outside");
+  cv::Mat legend(std::max(a.rows, legend_src.rows), 260, CV_8UC3, cv::Scalar(255, 255, 255));
+  legend_src.copyTo(legend(cv::Rect(0, 0, 260, legend_src.rows)));
+  cv::Mat column(legend.rows, a.cols, CV_8UC3, cv::Scalar(255, 255, 255));
+  a.copyTo(column(cv::Rect(0, 0, a.cols, a.rows)));
+  cv::Mat out;
+  cv::hconcat(std::vector<cv::Mat>{column, legend}, out);
+  return detail::with_title(out, title);
+}
+
+/// The fused map, the ground truth and the errors side by side, each scaled (nearest
+/// neighbour) so that its longer side is `side` px, with a legend. Never-observed pixels are
+/// grey ("not observed / outside"); in the error panel wrong pixels are red, right ones light
+/// grey, pixels never observed or without truth dark grey.
 [[nodiscard]] inline cv::Mat render_map_comparison(const Field& field, const cv::Mat& fused,
-                                                   const std::string& title, int max_side = 800) {
-  const double s = detail::display_scale(field.labels().size(), max_side);
-  cv::Mat a, b;
+                                                   const std::string& title, int side = 700) {
+  detail::require(fused.type() == CV_8UC1 && fused.size() == field.labels().size(),
+                  "render_map_comparison: the map must be CV_8UC1 of the field's size", fused.cols);
+  const double s = static_cast<double>(side) / std::max(field.width_px(), field.height_px());
+  const int ignore = field.ignore_label();
+  const cv::Mat truth = field.labels();
+  const cv::Mat known = (truth != ignore) & (fused != ignore);
+  cv::Mat errors(fused.size(), CV_8UC3, cv::Scalar(90, 90, 90));
+  errors.setTo(cv::Scalar(225, 225, 225), known & (fused == truth));
+  errors.setTo(cv::Scalar(0, 0, 220), known & (fused != truth));
+  const double wrong = cv::countNonZero(known & (fused != truth)) / std::max(1.0, 1.0 * cv::countNonZero(known));
+  cv::Mat a, b, c;
   cv::resize(colorize_labels(fused, field.classes()), a, cv::Size(), s, s, cv::INTER_NEAREST);
-  cv::resize(colorize_labels(field.labels(), field.classes()), b, cv::Size(), s, s, cv::INTER_NEAREST);
-  a = detail::with_title(a, "fused segmentation map");
+  cv::resize(colorize_labels(truth, field.classes()), b, cv::Size(), s, s, cv::INTER_NEAREST);
+  cv::resize(errors, c, cv::Size(), s, s, cv::INTER_NEAREST);
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "errors: %.1f %% wrong", 100.0 * wrong);
+  a = detail::with_title(a, "fused map");
   b = detail::with_title(b, "ground truth");
+  c = detail::with_title(c, buf);
   const cv::Mat gap(a.rows, 12, CV_8UC3, cv::Scalar(255, 255, 255));
   const cv::Mat legend_src = detail::class_legend(field.classes(), 260, "not observed / outside");
   cv::Mat legend(a.rows, 260, CV_8UC3, cv::Scalar(255, 255, 255));
   const int legend_h = std::min(legend_src.rows, a.rows - 36);
-  if (legend_h > 0)
-    legend_src(cv::Rect(0, 0, 260, legend_h)).copyTo(legend(cv::Rect(0, 36, 260, legend_h)));
+  if (legend_h > 0) legend_src(cv::Rect(0, 0, 260, legend_h)).copyTo(legend(cv::Rect(0, 36, 260, legend_h)));
+  const int errors_y = 36 + legend_h + 16;
+  if (errors_y + 60 <= legend.rows) {
+    const std::pair<cv::Scalar, const char*> keys[] = {{{0, 0, 220}, "error panel: wrong"},
+                                                       {{225, 225, 225}, "error panel: right"}};
+    for (int k = 0; k < 2; ++k) {
+      const int y = errors_y + 24 * k;
+      cv::rectangle(legend, cv::Rect(8, y + 2, 30, 18), keys[k].first, cv::FILLED);
+      cv::rectangle(legend, cv::Rect(8, y + 2, 30, 18), cv::Scalar(0, 0, 0), 1);
+      detail::put_text(legend, keys[k].second, {46, y + 17}, 0.55);
+    }
+  }
   cv::Mat out;
-  cv::hconcat(std::vector<cv::Mat>{a, gap, b, gap, legend}, out);
+  cv::hconcat(std::vector<cv::Mat>{a, gap, b, gap, c, gap, legend}, out);
   return detail::with_title(out, title);
 }
 
