@@ -1,3 +1,4 @@
+#include "comma_locale.hpp"
 #include "test_support.hpp"
 
 #include <adaptseg/calibration.hpp>
@@ -9,7 +10,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
-#include <locale>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <variant>
@@ -378,20 +379,16 @@ TEST_CASE("decision model: a plain YAML file, every fitted number a key, written
   CHECK(root["rule"]["confidence"].as<std::string>() == "0.5");
   CHECK(root["rule"]["reference"][0]["miou"].size() == 3);
 
-  // A global locale whose decimal separator is a comma and that groups thousands.
-  struct Comma : std::numpunct<char> {
-    char do_decimal_point() const override { return ','; }
-    char do_thousands_sep() const override { return '.'; }
-    std::string do_grouping() const override { return "\3"; }
-  };
-  const std::locale previous = std::locale::global(std::locale(std::locale::classic(), new Comma));
-  try {
-    m.save(tmp.path() / "comma.yaml");
-    const DecisionModel back = DecisionModel::load(tmp.path() / "comma.yaml");
-    const DecisionModel plain = DecisionModel::load(tmp.path() / "model.yaml");
-    std::locale::global(previous);
+  {
+    std::optional<DecisionModel> back, plain;
+    {
+      const t::CommaLocale comma;
+      m.save(tmp.path() / "comma.yaml");
+      back = DecisionModel::load(tmp.path() / "comma.yaml");
+      plain = DecisionModel::load(tmp.path() / "model.yaml");
+    }
     CHECK(t::read_file(tmp.path() / "comma.yaml") == t::read_file(tmp.path() / "model.yaml"));
-    for (const DecisionModel* b : {&back, &plain})
+    for (const DecisionModel* b : {&*back, &*plain})
       for (double sigma : {0.01, 0.1, 0.3}) {
         const GainForecast x = m.decision_function.model().forecast(11.0, sigma);
         const GainForecast y = b->decision_function.model().forecast(11.0, sigma);
@@ -399,9 +396,6 @@ TEST_CASE("decision model: a plain YAML file, every fitted number a key, written
         CHECK(x.delta_miou == y.delta_miou);
         CHECK(x.relabelled == y.relabelled);
       }
-    CHECK(back.camera.image_width_px == m.camera.image_width_px);
-  } catch (...) {
-    std::locale::global(previous);
-    throw;
+    CHECK(back->camera.image_width_px == m.camera.image_width_px);
   }
 }

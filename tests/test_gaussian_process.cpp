@@ -1,6 +1,8 @@
 // Tests for adaptseg/gaussian_process.hpp: kernel concept, a conformance suite run on every
 // kernel model, agreement with scikit-learn (fixtures from tests/tools/make_gp_fixtures.py),
 // and properties (gradient, online updates, degenerate data, persistence).
+#include "comma_locale.hpp"
+
 #include <adaptseg/gaussian_process.hpp>
 
 #include <doctest/doctest.h>
@@ -899,6 +901,22 @@ TEST_CASE("persistence: save and load round trip, file and embedded stream") {
   empty.save(es);
   const auto e2 = GaussianProcess<SquaredExponentialKernel>::load(es);
   CHECK(e2.size() == 0);
+}
+
+TEST_CASE("persistence: a model saved under a comma-decimal global locale loads with the same predictions") {
+  const auto gp = fitted_ard_model();
+  std::stringstream plain;
+  gp.save(plain);
+  std::stringstream comma;
+  {
+    const adaptseg::test::CommaLocale guard;
+    gp.save(comma);
+  }
+  CHECK(comma.str() == plain.str());
+  const Eigen::MatrixXd xq = random_inputs(5, 2, 7);
+  const auto back = GaussianProcess<ArdSquaredExponentialKernel>::load(comma);
+  const auto a = gp.predict(xq);
+  CHECK(scaled_error(a.mean, back.predict(xq).mean, a.mean.cwiseAbs().maxCoeff()) < 1e-12);  // as a plain round trip
 }
 
 TEST_CASE("persistence: truncated, garbled and mismatched files are rejected") {

@@ -32,6 +32,7 @@
 #include <fstream>
 #include <istream>
 #include <limits>
+#include <locale>
 #include <numbers>
 #include <ostream>
 #include <sstream>
@@ -1461,9 +1462,12 @@ class GaussianProcess {
   }
 
   /// Writes the model as text (format in `load`); leaves `os`'s formatting state unchanged.
+  /// Numbers are written in the classic "C" locale whatever the global one (load reads them
+  /// with `std::from_chars`, which knows no other).
   /// @throws std::invalid_argument if the stream fails.
   void save(std::ostream& os) const {
     std::ostringstream s;
+    s.imbue(std::locale::classic());
     s.precision(std::numeric_limits<double>::max_digits10);
     const auto vec = [&s](std::string_view key, const Eigen::VectorXd& v) {
       s << key << ' ' << v.size();
