@@ -52,7 +52,7 @@ inline std::string nearest_flag(const CLI::App& app, const std::string& word) {
   return best;
 }
 
-/// Parses the command line of `program`. Returns nullopt to go on, else the exit code: 0 after
+/// Parses the command line into `app`. Returns nullopt to go on, else the exit code: 0 after
 /// --help, 2 after a command-line mistake (unknown or misspelt flag, missing or malformed
 /// value), with one error line on stderr naming the flag, as for every other bad input.
 inline std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
