@@ -4,16 +4,17 @@
 /// eq:sqexp, eq:gp), hyperparameters by maximising the log marginal likelihood, online
 /// updates by extending the Cholesky factor, and a line-based text format for fitted models.
 ///
-/// Self-contained: needs Eigen 3.4, LBFGSpp (header-only) and adaptseg/error.hpp only.
+/// Self-contained: needs Eigen 3.4, LBFGSpp (header-only, reached only through
+/// detail/lbfgs.hpp) and adaptseg/error.hpp only.
 /// Conventions follow scikit-learn's `GaussianProcessRegressor` with the kernel
 /// `ConstantKernel(sf2) * RBF(length_scale) + WhiteKernel(sn2)` and `alpha = 0`, so that
 /// results can be checked against it (see tests/tools/make_gp_fixtures.py).
 
+#include <adaptseg/detail/lbfgs.hpp>
 #include <adaptseg/error.hpp>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
-#include <LBFGSB.h>
 
 #if defined(__SSE2__) || defined(_M_X64)
 #include <xmmintrin.h>
@@ -874,105 +875,7 @@ class GpSplitMix64 {
   std::uint64_t state_;
 };
 
-/// Strong-Wolfe line search (Nocedal & Wright, Algorithms 3.5 and 3.6: bracketing with 4x
-/// extrapolation, then zoom by safeguarded cubic interpolation), as the `LineSearch` policy of
-/// `LBFGSpp::LBFGSBSolver`. LBFGSpp 0.1.0's More-Thuente search extrapolates by 1.1x and can
-/// re-evaluate one point until its budget is spent; this one needs about half the evaluations
-/// on GP likelihoods. Steps never exceed `step_max` (the distance to the box). If the budget
-/// runs out, the best point with sufficient decrease is accepted; without one it throws
-/// `std::runtime_error`, which the caller treats as a failed line search.
-template <typename Scalar>
-class GpLineSearch {
-  using Vector = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
-
- public:
-  template <typename Objective>
-  static void LineSearch(Objective& f, Scalar& fx, Vector& x, Vector& grad, Scalar& step, const Scalar& step_max,
-                         const Vector& drt, const Vector& xp, const LBFGSpp::LBFGSBParam<Scalar>& param) {
-    const Scalar f0 = fx;
-    const Scalar d0 = grad.dot(drt);
-    if (!(d0 < 0) || !(step_max > 0)) throw std::runtime_error("GpLineSearch: not a descent direction");
-    const Scalar c1 = param.ftol;
-    const Scalar c2 = param.wolfe;
-    // lo: best point so far with sufficient decrease (0 = start); hi: other end of the bracket.
-    Point lo{Scalar(0), f0, d0, xp, grad};
-    Point hi{};
-    bool bracketed = false;
-    Scalar t = std::min(step, step_max);
-    for (int it = 0; it < param.max_linesearch; ++it) {
-      x.noalias() = xp + t * drt;
-      const Scalar ft = f(x, grad);
-      const Scalar dt = grad.dot(drt);
-      if (!std::isfinite(ft) || ft > f0 + c1 * t * d0 || ft >= lo.f) {
-        hi = Point{t, ft, dt, {}, {}};
-        bracketed = true;
-      } else {
-        if (std::abs(dt) <= -c2 * d0) {  // strong Wolfe: accept
-          fx = ft;
-          step = t;
-          return;
-        }
-        const Point previous = lo;
-        lo = Point{t, ft, dt, x, grad};
-        if (bracketed && dt * (hi.t - t) >= 0) {
-          hi = previous;
-        } else if (!bracketed && dt >= 0) {
-          hi = previous;
-          bracketed = true;
-        }
-      }
-      if (!bracketed) {
-        if (t >= step_max) break;  // still descending at the box: take the boundary step
-        t = std::min(step_max, Scalar(4) * t);
-        continue;
-      }
-      t = interpolate(lo, hi);
-      if (!(std::abs(hi.t - lo.t) > std::numeric_limits<Scalar>::epsilon() * std::max(Scalar(1), lo.t))) break;
-    }
-    if (lo.t > 0) {
-      x = lo.x;
-      grad = lo.g;
-      fx = lo.f;
-      step = lo.t;
-      return;
-    }
-    x = xp;
-    grad = lo.g;
-    throw std::runtime_error("GpLineSearch: no step with sufficient decrease");
-  }
-
- private:
-  struct Point {
-    Scalar t = 0;
-    Scalar f = 0;
-    Scalar d = 0;  // directional derivative
-    Vector x;
-    Vector g;
-  };
-
-  /// Minimiser of the cubic through both ends, kept in the middle 80% of the bracket.
-  static Scalar interpolate(const Point& a, const Point& b) {
-    const Scalar lo = std::min(a.t, b.t);
-    const Scalar hi = std::max(a.t, b.t);
-    const Scalar margin = Scalar(0.1) * (hi - lo);
-    Scalar t = Scalar(0.5) * (a.t + b.t);
-    if (std::isfinite(a.f) && std::isfinite(b.f) && std::isfinite(b.d)) {
-      const Scalar d1 = a.d + b.d - Scalar(3) * (a.f - b.f) / (a.t - b.t);
-      const Scalar disc = d1 * d1 - a.d * b.d;
-      if (disc >= 0) {
-        const Scalar d2 = std::copysign(std::sqrt(disc), b.t - a.t);
-        const Scalar den = b.d - a.d + Scalar(2) * d2;
-        if (den != 0) {
-          const Scalar c = b.t - (b.t - a.t) * (b.d + d2 - d1) / den;
-          if (std::isfinite(c)) t = c;
-        }
-      }
-    }
-    return std::clamp(t, lo + margin, hi - margin);
-  }
-};
-
-/// Thrown by the objective to leave LBFGSpp; carries the real exception.
+/// Thrown by the objective to leave the minimiser; carries the real exception.
 struct GpObjectiveAborted {
   std::exception_ptr cause;
 };
@@ -1854,7 +1757,7 @@ class GaussianProcess {
     return summary;
   }
 
-  /// Objective for LBFGSpp: -LML and its gradient; remembers the best point seen.
+  /// Objective of the bounded minimiser: -LML and its gradient; remembers the best point seen.
   struct Objective {
     const GaussianProcess* gp;
     K kernel;
@@ -1885,13 +1788,10 @@ class GaussianProcess {
     const Eigen::VectorXd lower = kernel_.log_lower_bounds();
     const Eigen::VectorXd upper = kernel_.log_upper_bounds();
     detail::GpSplitMix64 rng(fo.seed);
-    LBFGSpp::LBFGSBParam<double> param;  // outlives the solver, which keeps a reference
-    param.m = fo.history;
-    param.epsilon = fo.gradient_tolerance;
-    param.epsilon_rel = 0.0;
-    param.past = 1;
-    param.delta = fo.relative_tolerance;
-    param.max_iterations = fo.max_iterations;
+    detail::BoxMinimizerSettings settings{.history = fo.history,
+                                          .gradient_tolerance = fo.gradient_tolerance,
+                                          .relative_tolerance = fo.relative_tolerance,
+                                          .max_iterations = fo.max_iterations};
     double best = std::numeric_limits<double>::infinity();
     for (int r = 0; r <= fo.restarts; ++r) {
       StartSummary start;
@@ -1902,17 +1802,15 @@ class GaussianProcess {
       theta = theta.cwiseMax(lower).cwiseMin(upper);
       start.initial_log_parameters = theta;
       Objective objective{this, kernel_, {}, {}, std::numeric_limits<double>::infinity(), 0};
-      // LBFGSpp signals a failed line search (or a non-descent direction from its subspace
-      // minimisation) by an exception. Like scipy's driver, restart from the best point seen
-      // with a fresh quasi-Newton memory while that still improves the objective.
+      // The minimiser signals a failed line search (or a non-descent direction from its
+      // subspace minimisation) by an exception. Like scipy's driver, restart from the best
+      // point seen with a fresh quasi-Newton memory while that still improves the objective.
       int runs = 0;
       while (true) {
         const double before = objective.best_value;
-        param.max_iterations = std::max(1, fo.max_iterations - start.iterations);
-        LBFGSpp::LBFGSBSolver<double, detail::GpLineSearch> solver(param);
-        double fx = 0.0;
+        settings.max_iterations = std::max(1, fo.max_iterations - start.iterations);
         try {
-          start.iterations += solver.minimize(objective, theta, fx, lower, upper);
+          start.iterations += detail::minimize_in_box(objective, theta, lower, upper, settings);
           start.status = start.iterations >= fo.max_iterations ? FitStatus::kMaxIterations : FitStatus::kConverged;
           break;
         } catch (const detail::GpObjectiveAborted& aborted) {
