@@ -1,24 +1,38 @@
-# Installs the build tree into a scratch prefix, then configures, builds and runs the
-# consumer project against it. Called by CTest with BUILD_DIR, SOURCE_DIR and WORK_DIR.
-file(REMOVE_RECURSE "${WORK_DIR}")
-execute_process(COMMAND "${CMAKE_COMMAND}" --install "${BUILD_DIR}" --prefix "${WORK_DIR}/prefix"
-                RESULT_VARIABLE rc)
-if(rc)
-  message(FATAL_ERROR "install failed: ${rc}")
-endif()
-execute_process(COMMAND "${CMAKE_COMMAND}" -S "${SOURCE_DIR}" -B "${WORK_DIR}/build"
-                        "-DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix" -DCMAKE_BUILD_TYPE=Release
-                RESULT_VARIABLE rc)
-if(rc)
-  message(FATAL_ERROR "configuring the consumer failed: ${rc}")
-endif()
-execute_process(COMMAND "${CMAKE_COMMAND}" --build "${WORK_DIR}/build" RESULT_VARIABLE rc)
-if(rc)
-  message(FATAL_ERROR "building the consumer failed: ${rc}")
-endif()
-foreach(exe consumer consumer_core consumer_geo)
-  execute_process(COMMAND "${WORK_DIR}/build/${exe}" RESULT_VARIABLE rc)
+# Installs the build tree into a scratch prefix, then configures, builds and runs the consumer
+# projects against it. Called by CTest with BUILD_DIR, SOURCE_DIR and WORK_DIR.
+#   - SOURCE_DIR: every component (vision, erfnet, geo) asked for and used;
+#   - SOURCE_DIR/core: the core alone with OpenCV, yaml-cpp, nlohmann_json and GeographicLib
+#     hidden (a GP fitted); asking for vision there must fail, naming OpenCV.
+
+# step(WHAT ARGS...): runs ARGS as a command; stops the test naming WHAT if it fails.
+function(step what)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc)
   if(rc)
-    message(FATAL_ERROR "${exe} failed: ${rc}")
+    message(FATAL_ERROR "${what} failed: ${rc}")
   endif()
+endfunction()
+
+file(REMOVE_RECURSE "${WORK_DIR}")
+set(prefix "-DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix")
+step("install" "${CMAKE_COMMAND}" --install "${BUILD_DIR}" --prefix "${WORK_DIR}/prefix")
+
+step("configuring the consumer" "${CMAKE_COMMAND}" -S "${SOURCE_DIR}" -B "${WORK_DIR}/build" ${prefix}
+     -DCMAKE_BUILD_TYPE=Release)
+step("building the consumer" "${CMAKE_COMMAND}" --build "${WORK_DIR}/build")
+foreach(exe consumer consumer_core consumer_geo consumer_erfnet)
+  step("${exe}" "${WORK_DIR}/build/${exe}")
 endforeach()
+
+set(hidden -DCMAKE_DISABLE_FIND_PACKAGE_OpenCV=ON -DCMAKE_DISABLE_FIND_PACKAGE_yaml-cpp=ON
+           -DCMAKE_DISABLE_FIND_PACKAGE_nlohmann_json=ON -DCMAKE_DISABLE_FIND_PACKAGE_GeographicLib=ON)
+step("configuring the core consumer with the other dependencies hidden" "${CMAKE_COMMAND}" -S "${SOURCE_DIR}/core"
+     -B "${WORK_DIR}/core" ${prefix} -DCMAKE_BUILD_TYPE=Release ${hidden})
+step("building the core consumer" "${CMAKE_COMMAND}" --build "${WORK_DIR}/core")
+step("gp_only" "${WORK_DIR}/core/gp_only")
+
+execute_process(COMMAND "${CMAKE_COMMAND}" -S "${SOURCE_DIR}/core" -B "${WORK_DIR}/core-vision" ${prefix}
+                        -DASK_VISION=ON ${hidden}
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc OR NOT err MATCHES "adaptseg::vision needs OpenCV 4")
+  message(FATAL_ERROR "asking for vision without OpenCV: rc ${rc}, want a failure naming OpenCV; got:\n${err}")
+endif()

@@ -1,0 +1,12 @@
+// The network backend component: its header and target from the installed package.
+#include <adaptseg/erfnet_segmenter.hpp>
+
+#include <cstdio>
+
+int main() {
+  static_assert(adaptseg::SegmentationBackend<adaptseg::ErfnetSegmenter>);
+  const adaptseg::ErfnetParams params;
+  std::printf("erfnet consumer: the backend's contract holds; resize_to_network %d\n",
+              params.resize_to_network ? 1 : 0);
+  return 0;
+}
