@@ -7,7 +7,15 @@ cd "$(dirname "$0")/.."
 bash scripts/deps.sh bench
 cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release
 cmake --build build/release -j"$(nproc 2>/dev/null || echo 2)" --target bench_gaussian_process bench_decision bench_erfnet
-/usr/bin/python3 benchmarks/bench_gaussian_process.py build/release/benchmarks/bench_gaussian_process
+# GaussianProcess vs scikit-learn twice, side by side: numpy/scipy on Debian's reference BLAS and
+# LAPACK (single-threaded), then on OpenBLAS (multi-threaded; what a pip user's numpy brings).
+# The loader picks the BLAS by LD_LIBRARY_PATH; adaptseg's own code uses Eigen, not BLAS.
+lib=/usr/lib/$(gcc -print-multiarch 2>/dev/null || echo x86_64-linux-gnu)
+for blas in "reference:$lib/blas:$lib/lapack" "openblas:$lib/openblas-pthread"; do
+  echo "## scikit-learn on the ${blas%%:*} BLAS"
+  LD_LIBRARY_PATH="${blas#*:}" /usr/bin/python3 benchmarks/bench_gaussian_process.py \
+      build/release/benchmarks/bench_gaussian_process "$@"
+done
 build/release/benchmarks/bench_decision
 for m in erfnet-dubai mobilenetv2-dubai; do
   /usr/bin/python3 benchmarks/bench_erfnet.py --model-dir "examples/models/$m" \

@@ -4,7 +4,8 @@
 #   scripts/deps.sh test    build + what the test suite runs (Python for the data converters,
 #                           GDAL's ogrinfo to read the exported GeoJSON, doxygen for docs:doxygen)
 #   scripts/deps.sh docs    doxygen, for the API reference (scripts/docs.sh)
-#   scripts/deps.sh bench   test + what the benchmarks compare against (scikit-learn)
+#   scripts/deps.sh bench   test + what the benchmarks compare against (scikit-learn, with
+#                           OpenBLAS as well as the reference BLAS)
 #   scripts/deps.sh plots   build + matplotlib for the evaluation figures
 #   scripts/deps.sh fuzz    build + clang with libFuzzer (scripts/fuzz.sh)
 # As root it runs apt-get; otherwise it prints the command to run and fails if anything is missing.
@@ -19,7 +20,7 @@ case "${1:-build}" in
   build) want=("${build[@]}") ;;
   test) want=("${build[@]}" "${python[@]}" gdal-bin doxygen) ;;
   docs) want=(doxygen) ;;
-  bench) want=("${build[@]}" "${python[@]}" gdal-bin doxygen python3-sklearn python3-torch) ;;
+  bench) want=("${build[@]}" "${python[@]}" gdal-bin doxygen python3-sklearn python3-torch libopenblas0-pthread) ;;
   plots) want=("${build[@]}" "${python[@]}" python3-matplotlib) ;;
   # clang: the compiler; libclang-rt-14-dev: libFuzzer and the sanitizer runtimes for it.
   fuzz) want=("${build[@]}" clang libclang-rt-14-dev) ;;
