@@ -306,6 +306,28 @@ TEST_CASE("front-aware policy: the field gain comes from C's relabelling, η and
   CHECK(d2.scores[0].predicted_field_gain > d.scores[0].predicted_field_gain);
 }
 
+TEST_CASE("front-aware policy: beyond the finest lawnmower's time a descent must still beat the curve's last slope") {
+  const Scenario s;
+  // The mission already ends after the finest lawnmower (185 s): T0 = 205 s. The curve rises
+  // 0.02 per 40 s up to 185 s; a descent of 40 s is forecast to gain 0.0143.
+  DecisionContext late = s.region(0);
+  late.elapsed_s = 200.0;
+  late.rest_s = 5.0;
+  FrontAwarePolicy steep(fitted(), s.reference(0.02), {.confidence = 0.0});
+  const Decision d = steep.decide(late);
+  CHECK_FALSE(d.descend);  // read flat beyond 185 s, any positive gain would have descended
+  REQUIRE(d.scores.size() == 1);
+  CHECK(d.scores[0].predicted_field_gain == doctest::Approx(0.0143).epsilon(0.03));
+  FrontAwarePolicy gentle(fitted(), s.reference(0.01), {.confidence = 0.0});
+  CHECK(gentle.decide(late).descend);  // 0.0143 beats 0.01 per 40 s
+  // The extension itself: the last segment goes on; flat before the first point.
+  const std::vector<CurvePoint> curve{{40.0, 0.75}, {185.0, 0.8}};
+  CHECK(detail::interpolate_extend(curve, 330.0, &CurvePoint::time_s, &CurvePoint::miou) == doctest::Approx(0.85));
+  CHECK(detail::interpolate_extend(curve, 100.0, &CurvePoint::time_s, &CurvePoint::miou) ==
+        detail::interpolate_flat(curve, 100.0, &CurvePoint::time_s, &CurvePoint::miou));
+  CHECK(detail::interpolate_extend(curve, 0.0, &CurvePoint::time_s, &CurvePoint::miou) == 0.75);
+}
+
 TEST_CASE("front-aware policy: what a descent relabelled changes a later decision when online, not otherwise") {
   const Scenario s;
   const double gain = 0.02 / 7.0 / 0.2;

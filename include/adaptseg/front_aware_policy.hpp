@@ -48,7 +48,8 @@ struct ReferenceCurve {
 ///   weighted), the part not yet seen taken at their σ shrunk towards the training fields' mean
 ///   σ with a weight of `sigma_prior_weight` fields;
 /// - the curve's rise ΔD over the descent's extra time, [T0, T0 + T], on each training field's
-///   predicted curve: mean ΔD̄ and spread sd_D over the training fields;
+///   predicted curve: mean ΔD̄ and spread sd_D over the training fields; beyond the curve's
+///   last point its last segment goes on (rising_curve_miou);
 /// - the descent is worth its time if its lower bound (ĝ − ΔD̄) − z·sqrt(Var ĝ + sd_D²) > 0
 ///   (z = `confidence`, chosen on training fields; 0: the forecasts' means). The UAV descends
 ///   to the candidate of largest lower bound, if σ >= `min_sigma`. Since ΔD̄ grows with T0, it
@@ -156,7 +157,7 @@ class FrontAwarePolicy {
                     "FrontAwarePolicy::decide: the context needs the field's lawnmower forecasts; count",
                     c.lawnmowers.size());
     // Each training field's lawnmower accuracy, placed at this field's lawnmower times, in time
-    // order (curve_miou reads them there).
+    // order (curve_miou and rising_curve_miou read them there).
     std::vector<std::vector<CurvePoint>> curves;
     for (const auto& r : reference_) {
       auto& curve = curves.emplace_back();
@@ -192,7 +193,7 @@ class FrontAwarePolicy {
       // The curve's rise over the descent's extra time, on every training field's curve.
       double rise_sum = 0.0, rise_sq = 0.0;
       for (const auto& curve : curves) {
-        const double rise = curve_miou(curve, t0 + cand.extra_time_s) - curve_miou(curve, t0);
+        const double rise = rising_curve_miou(curve, t0 + cand.extra_time_s) - rising_curve_miou(curve, t0);
         rise_sum += rise;
         rise_sq += rise * rise;
       }
@@ -258,6 +259,17 @@ class FrontAwarePolicy {
   /// beyond its ends, as front_margin reads the curve.
   static double curve_miou(const std::vector<CurvePoint>& curve, double t) {
     return detail::interpolate_flat(curve, t, &CurvePoint::time_s, &CurvePoint::miou);
+  }
+
+  /// The curve a descent's gain is compared with: as curve_miou, but beyond the last point (a
+  /// mission slower than the finest lawnmower) the last segment goes on if it rises (never
+  /// below the last point: the finest lawnmower can always be flown), capped at 1. There a
+  /// descent must still beat what the finest lawnmowers bought per second; read flat, any
+  /// positive gain would beat it however long the descent.
+  static double rising_curve_miou(const std::vector<CurvePoint>& curve, double t) {
+    const double flat = curve_miou(curve, t);
+    const double extended = detail::interpolate_extend(curve, t, &CurvePoint::time_s, &CurvePoint::miou);
+    return std::min(1.0, std::max(flat, extended));
   }
 
   static double mean_curve_miou(const std::vector<std::vector<CurvePoint>>& curves, double t) {

@@ -1,7 +1,9 @@
 #pragma once
 /// @file
 /// Piecewise-linear interpolation through sorted points, flat beyond the ends: the lawnmower
-/// curve by time (front_margin) and by GSD (miou_at_gsd), and η by descent height (GainModel).
+/// curve by time (front_margin) and by GSD (miou_at_gsd), and η by descent height (GainModel);
+/// extended beyond the last point along the last segment: the curve a decision compares a
+/// descent with (FrontAwarePolicy).
 
 #include <cstddef>
 #include <functional>
@@ -24,6 +26,21 @@ template <class Point, class X, class Y>
   const Point& b = points[k];
   const double t = px(b) > px(a) ? (x - px(a)) / (px(b) - px(a)) : 1.0;
   return py(a) + t * (py(b) - py(a));
+}
+
+/// As interpolate_flat, but beyond the last point the line through the last two points goes on
+/// (flat before the first point, and flat beyond the last if there is only one or the last two
+/// share an x).
+template <class Point, class X, class Y>
+[[nodiscard]] double interpolate_extend(const std::vector<Point>& points, double x, X x_of, Y y_of) {
+  const auto px = [&](const Point& p) { return static_cast<double>(std::invoke(x_of, p)); };
+  const auto py = [&](const Point& p) { return static_cast<double>(std::invoke(y_of, p)); };
+  const std::size_t n = points.size();
+  if (n < 2 || x <= px(points.back())) return interpolate_flat(points, x, x_of, y_of);
+  const Point& a = points[n - 2];
+  const Point& b = points[n - 1];
+  if (!(px(b) > px(a))) return py(b);
+  return py(b) + (x - px(b)) * (py(b) - py(a)) / (px(b) - px(a));
 }
 
 }  // namespace adaptseg::detail
