@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reproduces docs/results.md.
-#   bash scripts/results.sh [all|oracle|network] [JOBS]   (default: all, one job per core)
+#   bash scripts/results.sh [all|oracle|oracle-default|network] [JOBS]   (default: all, one job per core)
 #
 # oracle: the paper's experiment with the ground-truth oracle, deterministic (fixed 0.1 s per
 #   image and 0 s per waypoint), in two configurations: the defaults, and the paper's (utility
@@ -18,7 +18,9 @@
 set -euo pipefail
 part=${1:-all}
 jobs=${2:-$(nproc 2>/dev/null || echo 2)}
-case "$part" in all | oracle | network) ;; *) echo "usage: $0 [all|oracle|network] [JOBS]" >&2; exit 2 ;; esac
+case "$part" in all | oracle | oracle-default | network) ;;
+  *) echo "usage: $0 [all|oracle|oracle-default|network] [JOBS]" >&2; exit 2 ;;
+esac
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh plots
 cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release >/dev/null
@@ -55,9 +57,11 @@ check() {
 }
 
 if [ "$part" != network ]; then
-  rm -rf "$root/oracle-default" "$root/oracle-paper"
+  configs=(oracle-default oracle-paper)
+  [ "$part" = oracle-default ] && configs=(oracle-default)
+  for config in "${configs[@]}"; do rm -rf "${root:?}/$config"; done
   w=examples/data/weedmap-000
-  for config in oracle-default oracle-paper; do
+  for config in "${configs[@]}"; do
     extra=("${fixed[@]}")
     [ "$config" = oracle-paper ] && extra+=("${paper[@]}")
     run "$config" weedmap-train-left --train "$w:0,0,0.5,1" --test "$w:0.5,0,1,1" "${extra[@]}"
@@ -73,12 +77,16 @@ if [ "$part" != network ]; then
   wait
   check
   runs() { ls -d "$root/$1"/*/ | sed 's:/$::' | paste -sd, -; }
-  /usr/bin/python3 examples/tools/sweep_table.py "defaults=$(runs oracle-default)" "paper=$(runs oracle-paper)"
+  if [ "$part" = oracle-default ]; then
+    /usr/bin/python3 examples/tools/sweep_table.py "defaults=$(runs oracle-default)"
+  else
+    /usr/bin/python3 examples/tools/sweep_table.py "defaults=$(runs oracle-default)" "paper=$(runs oracle-paper)"
+  fi
   /usr/bin/python3 examples/tools/per_image_table.py "$root/oracle-default/weedmap-train-left" \
     "$root/oracle-default/weedmap-train-right"
 fi
 
-if [ "$part" != oracle ]; then
+if [ "$part" = all ] || [ "$part" = network ]; then
   rm -rf "$root/network"
   for net in erfnet-dubai mobilenetv2-dubai; do
     for cls in $classes; do
