@@ -268,8 +268,11 @@ class AdaptivePlanner {
   PlannerStep report(const Image& image, std::optional<double> elapsed_s = std::nullopt) {
     check_report(image, elapsed_s);
     const auto t0 = std::chrono::steady_clock::now();
-    cv::Mat labels = segment_checked(backend_, image, area_.num_classes);
-    return report(image, labels, seconds_since(t0), elapsed_s);
+    const cv::Mat labels = backend_.segment(image);
+    const double segmentation_s = seconds_since(t0);  // the network's time, as Mission measures it
+    check_segmentation(labels, image, area_.num_classes,
+                       "segmentation backend '" + std::string(backend_.name()) + "'");
+    return accept(image, labels, segmentation_s, elapsed_s);
   }
 
   /// Reports the image taken at the pending waypoint with its segmentation `labels`, which
@@ -288,23 +291,7 @@ class AdaptivePlanner {
     check_segmentation(labels, image, area_.num_classes, "AdaptivePlanner::report: the labels reported");
     detail::require(std::isfinite(segmentation_s) && segmentation_s >= 0.0,
                     "AdaptivePlanner::report: segmentation_s must be finite and >= 0", segmentation_s);
-    pending_ = false;
-    reported_elapsed_s_ = elapsed_s;
-    const PlannedWaypoint& p = path_.back();
-    if (p.index > 0) flight_s_ += timing_.segment_time_s(path_[p.index - 1].waypoint.position, p.waypoint.position);
-    const double seg = options_.mission.fixed_segmentation_time_s.value_or(segmentation_s);
-    segmentation_s_ += seg;
-    slowest_segmentation_s_ = std::max(slowest_segmentation_s_, seg);
-    map_.fuse(image, labels);
-
-    PlannerStep step;
-    step.waypoint = p;
-    step.sigma = semantic_ratio(labels, options_.mission.interest, image.ignore_label);
-    if (p.level == 0)
-      step.decision = decide(p, step.sigma);
-    else if (sub_next_ == sub_.size())
-      step.outcome = finish_descent();
-    return step;
+    return accept(image, labels, segmentation_s, elapsed_s);
   }
 
   /// The Image of a camera frame `rgb` (CV_8UC3 of the camera's size, or empty) taken at
@@ -439,6 +426,29 @@ class AdaptivePlanner {
   }
 
  private:
+  /// A reported image and its checked labels: the time account, the fused map, and at a
+  /// top-level waypoint the decision, after a descent's last image its outcome.
+  PlannerStep accept(const Image& image, const cv::Mat& labels, double segmentation_s,
+                     std::optional<double> elapsed_s) {
+    pending_ = false;
+    reported_elapsed_s_ = elapsed_s;
+    const PlannedWaypoint& p = path_.back();
+    if (p.index > 0) flight_s_ += timing_.segment_time_s(path_[p.index - 1].waypoint.position, p.waypoint.position);
+    const double seg = options_.mission.fixed_segmentation_time_s.value_or(segmentation_s);
+    segmentation_s_ += seg;
+    slowest_segmentation_s_ = std::max(slowest_segmentation_s_, seg);
+    map_.fuse(image, labels);
+
+    PlannerStep step;
+    step.waypoint = p;
+    step.sigma = semantic_ratio(labels, options_.mission.interest, image.ignore_label);
+    if (p.level == 0)
+      step.decision = decide(p, step.sigma);
+    else if (sub_next_ == sub_.size())
+      step.outcome = finish_descent();
+    return step;
+  }
+
   static double seconds_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
