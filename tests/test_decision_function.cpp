@@ -326,6 +326,8 @@ TEST_CASE("front-aware policy: beyond the finest lawnmower's time a descent must
   CHECK(detail::interpolate_extend(curve, 100.0, &CurvePoint::time_s, &CurvePoint::miou) ==
         detail::interpolate_flat(curve, 100.0, &CurvePoint::time_s, &CurvePoint::miou));
   CHECK(detail::interpolate_extend(curve, 0.0, &CurvePoint::time_s, &CurvePoint::miou) == 0.75);
+  const std::vector<CurvePoint> falling{{40.0, 0.8}, {185.0, 0.75}};  // never extended downwards
+  CHECK(detail::interpolate_extend(falling, 330.0, &CurvePoint::time_s, &CurvePoint::miou) == 0.75);
 }
 
 TEST_CASE("front-aware policy: what a descent relabelled changes a later decision when online, not otherwise") {

@@ -41,9 +41,10 @@ def slug(name):
     return re.sub(r"[^A-Za-z0-9.\-]", "_", name)
 
 
-def save(fig, path, dpi=110):
-    """Lays out, writes and closes a figure."""
-    fig.tight_layout()
+def save(fig, path, dpi=110, tight=True):
+    """Lays out (unless the caller placed the axes: tight=False), writes and closes a figure."""
+    if tight:
+        fig.tight_layout()
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
 
@@ -179,8 +180,7 @@ def main(out):
             ax.axis("off")
         for ax, im in zip(axes.flat, images):
             ax.imshow(im, interpolation="nearest")
-        fig.savefig(os.path.join(out, name), dpi=dpi)
-        plt.close(fig)
+        save(fig, os.path.join(out, name), dpi=dpi, tight=False)
     print(f"plots written to {out}")
 
 

@@ -267,9 +267,7 @@ class FrontAwarePolicy {
   /// descent must still beat what the finest lawnmowers bought per second; read flat, any
   /// positive gain would beat it however long the descent.
   static double rising_curve_miou(const std::vector<CurvePoint>& curve, double t) {
-    const double flat = curve_miou(curve, t);
-    const double extended = detail::interpolate_extend(curve, t, &CurvePoint::time_s, &CurvePoint::miou);
-    return std::min(1.0, std::max(flat, extended));
+    return std::min(1.0, detail::interpolate_extend(curve, t, &CurvePoint::time_s, &CurvePoint::miou));
   }
 
   static double mean_curve_miou(const std::vector<std::vector<CurvePoint>>& curves, double t) {

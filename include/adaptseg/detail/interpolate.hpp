@@ -2,7 +2,7 @@
 /// @file
 /// Piecewise-linear interpolation through sorted points, flat beyond the ends: the lawnmower
 /// curve by time (front_margin) and by GSD (miou_at_gsd), and η by descent height (GainModel);
-/// extended beyond the last point along the last segment: the curve a decision compares a
+/// extended beyond the last point along a rising last segment: the curve a decision compares a
 /// descent with (FrontAwarePolicy).
 
 #include <cstddef>
@@ -29,8 +29,8 @@ template <class Point, class X, class Y>
 }
 
 /// As interpolate_flat, but beyond the last point the line through the last two points goes on
-/// (flat before the first point, and flat beyond the last if there is only one or the last two
-/// share an x).
+/// if it rises (flat if it falls, or if there is only one point or the last two share an x):
+/// never below the last point.
 template <class Point, class X, class Y>
 [[nodiscard]] double interpolate_extend(const std::vector<Point>& points, double x, X x_of, Y y_of) {
   const auto px = [&](const Point& p) { return static_cast<double>(std::invoke(x_of, p)); };
@@ -39,7 +39,7 @@ template <class Point, class X, class Y>
   if (n < 2 || x <= px(points.back())) return interpolate_flat(points, x, x_of, y_of);
   const Point& a = points[n - 2];
   const Point& b = points[n - 1];
-  if (!(px(b) > px(a))) return py(b);
+  if (!(px(b) > px(a)) || !(py(b) > py(a))) return py(b);
   return py(b) + (x - px(b)) * (py(b) - py(a)) / (px(b) - px(a));
 }
 
