@@ -1,5 +1,6 @@
 #include "test_support.hpp"
 
+#include <adaptseg/adaptive_mission.hpp>
 #include <adaptseg/adaptive_planner.hpp>
 #include <adaptseg/oracle_segmenter.hpp>
 
@@ -27,8 +28,12 @@ struct Scripted {
       }
     return d;
   }
+  std::vector<std::size_t> outcomes{};  // DescentOutcome::descent, in the order observed
   void begin_mission() { seen = 0; }
-  void observe(const DescentOutcome&) { ++observed; }
+  void observe(const DescentOutcome& o) {
+    ++observed;
+    outcomes.push_back(o.descent);
+  }
 };
 static_assert(DecisionPolicy<Scripted>);
 
@@ -168,6 +173,83 @@ TEST_CASE("adaptive planner: the budget is never exceeded and the top level is a
   Scripted greedy{.gsd = 1.0};
   CHECK_THROWS_WITH_AS((void)run_adaptive_mission(f, oracle, greedy, tiny, "greedy"),
                        doctest::Contains("too small for the top-level coverage"), std::invalid_argument);
+}
+
+TEST_CASE("adaptive planner (tour): each descent flown at once or after the survey, as costed, never slower") {
+  const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
+  OracleSegmenter oracle(f.num_classes());
+  for (double top : {3.0, 6.0}) {
+    AdaptiveOptions o = options();
+    o.top_gsd_cm = top;
+    o.candidate_gsd_cm = {1.0};
+    Scripted never{.gsd = 0.5};
+    const double coverage = run_adaptive_mission(f, oracle, never, o, "never").mission.total_s();
+    Scripted at_once{.gsd = 1.0};
+    const AdaptiveResult immediate = run_adaptive_mission(f, oracle, at_once, o, "immediate");
+    o.schedule = DescentSchedule::tour;
+    Scripted all{.gsd = 1.0};
+    const AdaptiveResult tour = run_adaptive_mission(f, oracle, all, o, "tour");
+    CAPTURE(top);
+    REQUIRE(tour.descents() == static_cast<int>(tour.decisions.size()));
+    CHECK(tour.mission.miou_all().value() == 1.0);
+    // Each descent's cost is the cheaper of the two ways; the tour is never longer than charged.
+    double charged = 0.0;
+    std::size_t deferred = 0;
+    for (std::size_t k = 0; k < tour.decisions.size(); ++k) {
+      const Candidate& c = tour.decisions[k].candidates.at(0);
+      const Candidate& now = immediate.decisions[k].candidates.at(0);
+      CHECK(!now.deferred);
+      CHECK(c.extra_time_s <= now.extra_time_s + 1e-9);
+      CHECK(c.deferred == (c.extra_time_s < now.extra_time_s));
+      charged += c.extra_time_s;
+      deferred += c.deferred ? 1 : 0;
+    }
+    CHECK(tour.mission.total_s() <= coverage + charged + 1e-9);
+    CHECK(tour.mission.total_s() <= immediate.mission.total_s() + 1e-9);
+    if (top == 6.0) {  // Δh = 27.5 m: climbing back costs more than flying on to the next region
+      CHECK(deferred >= 2);
+      CHECK(tour.mission.total_s() < immediate.mission.total_s() - 5.0);
+    }
+    // Path: the top level, with the at-once descents after their waypoint, then the tour.
+    const auto& w = tour.mission.waypoints;
+    const auto last_top = std::find_if(w.rbegin(), w.rend(), [](const WaypointRecord& r) { return r.level == 0; });
+    const std::size_t tour_start = static_cast<std::size_t>(w.rend() - last_top);
+    std::size_t after = 0;
+    for (std::size_t k = tour_start; k < w.size(); ++k) after += w[k].level == 1 ? 1 : 0;
+    std::size_t deferred_images = 0;
+    for (const auto& d : tour.decisions)
+      if (d.candidates.at(0).deferred) deferred_images += static_cast<std::size_t>(d.candidates[0].images);
+    const auto& last_decision = tour.decisions.back();
+    CHECK(after == deferred_images + (last_decision.candidates[0].deferred ? 0 : last_decision.candidates[0].images));
+    // Outcomes name their descent; the simulation's realised gains come in decision order.
+    CHECK(all.outcomes.size() == tour.decisions.size());
+    for (std::size_t k = 0; k < tour.decisions.size(); ++k) {
+      REQUIRE(tour.decisions[k].outcome.has_value());
+      CHECK(tour.decisions[k].outcome->descent == k);
+      CHECK(tour.realised.at(k).decision == k);
+    }
+  }
+}
+
+TEST_CASE("adaptive planner (tour): the budget is never exceeded") {
+  const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
+  OracleSegmenter oracle(f.num_classes());
+  AdaptiveOptions o = options();
+  o.top_gsd_cm = 6.0;
+  o.schedule = DescentSchedule::tour;
+  Scripted never{.gsd = 0.5};
+  const double coverage = run_adaptive_mission(f, oracle, never, o, "never").mission.total_s();
+  Scripted all{.gsd = 1.0};
+  const double everything = run_adaptive_mission(f, oracle, all, o, "all").mission.total_s();
+  REQUIRE(everything > coverage + 100.0);
+  for (double budget : {coverage + 1.0, coverage + 60.0, 0.5 * (coverage + everything), everything - 1.0}) {
+    o.budget_s = budget;
+    Scripted greedy{.gsd = 1.0};
+    const AdaptiveResult r = run_adaptive_mission(f, oracle, greedy, o, "greedy");
+    CAPTURE(budget);
+    CHECK(r.mission.total_s() <= budget + 1e-9);
+    CHECK(greedy.observed == r.descents());
+  }
 }
 
 TEST_CASE("adaptive planner: bad options are refused") {

@@ -360,6 +360,26 @@ TEST_CASE("front-aware policy: what a descent relabelled changes a later decisio
     CHECK(adaptive.decide(s.region(1)).descend);
     CHECK_FALSE(fixed.decide(s.region(1)).descend);
   }
+  SUBCASE("outcomes reported after all the decisions (a tour) are weighed against their own forecast") {
+    FrontAwarePolicy adaptive(fitted(), s.reference(0.0), {.online = true});
+    const Decision dense = adaptive.decide(s.region(0, 0.6));
+    const Decision sparse = adaptive.decide(s.region(1, 0.2));
+    REQUIRE(dense.descend);
+    REQUIRE(sparse.descend);
+    REQUIRE(dense.scores[0].predicted_relabelled > 1.4 * sparse.scores[0].predicted_relabelled);
+    // The second descent, flown first, relabels exactly what was forecast for it: s stays 1.
+    DescentOutcome second = Scenario::outcome(1.0);
+    second.descent = 1;
+    second.relabelled.interest_share = sparse.scores[0].predicted_relabelled;
+    adaptive.observe(second);
+    CHECK(adaptive.field_scale() == doctest::Approx(1.0));
+    CHECK(adaptive.field_scale_sd() < 0.5);
+    // The first, the same share where far more was forecast: s falls.
+    DescentOutcome first = second;
+    first.descent = 0;
+    adaptive.observe(first);
+    CHECK(adaptive.field_scale() < 0.9);
+  }
   SUBCASE("a new mission forgets what the last one learnt") {
     FrontAwarePolicy adaptive(fitted(), s.reference(0.6 * gain), {.online = true});
     (void)adaptive.decide(s.region(0));

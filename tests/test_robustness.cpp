@@ -6,7 +6,7 @@
 
 #include "test_support.hpp"
 
-#include <adaptseg/adaptive_planner.hpp>
+#include <adaptseg/adaptive_mission.hpp>
 #include <adaptseg/decision_function.hpp>
 #include <adaptseg/decision_model.hpp>
 #include <adaptseg/erfnet_segmenter.hpp>

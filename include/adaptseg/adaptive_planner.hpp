@@ -7,17 +7,18 @@
 ///
 /// `AdaptivePlanner` is the planner itself, run step by step by whoever flies the UAV: ask
 /// `next()` for a waypoint, fly there, take the image, `report()` it, repeat (live use: no
-/// simulator, no ground truth). `run_adaptive_mission` drives it in simulation.
+/// simulator, no ground truth). `run_adaptive_mission` (adaptive_mission.hpp) drives it in
+/// simulation.
 
 #include <adaptseg/camera.hpp>
 #include <adaptseg/decision.hpp>
 #include <adaptseg/field.hpp>
+#include <adaptseg/inspection_tour.hpp>
 #include <adaptseg/lawnmower_planner.hpp>
 #include <adaptseg/metrics.hpp>
-#include <adaptseg/mission.hpp>
+#include <adaptseg/mission_options.hpp>
 #include <adaptseg/segmentation_backend.hpp>
 #include <adaptseg/semantic_map.hpp>
-#include <adaptseg/simulated_sensor.hpp>
 #include <adaptseg/timing.hpp>
 
 #include <opencv2/core.hpp>
@@ -29,11 +30,30 @@
 #include <cmath>
 #include <optional>
 #include <string>
-#include <tuple>
 #include <utility>
 #include <vector>
 
 namespace adaptseg {
+
+/// When the chosen descents are flown.
+enum class DescentSchedule {
+  /// At once (the paper): down from the region's top-level waypoint, the sub-lawnmower, back up
+  /// to the next top-level waypoint: two altitude changes per descent (one for the last region's).
+  immediate,
+  /// Inspect at once or after the survey, whichever is cheaper (beyond the paper): each region
+  /// is decided as it is seen; a chosen descent is flown at once if that adds less time, else
+  /// deferred to a tour flown after the whole top-level lawnmower, every deferred sub-lawnmower
+  /// back to back at low altitude in the order that takes least time (inspection_tour.hpp: one
+  /// descent for all of them, no climb back). A deferred descent is charged what it adds to the
+  /// tour chosen so far (cheapest insertion); the tour is reordered once the survey is flown,
+  /// never longer, so the budget holds. Candidate::deferred says which way each was costed.
+  tour,
+};
+
+/// The name used in results and on the command line: "immediate" or "tour".
+[[nodiscard]] inline const char* to_string(DescentSchedule s) noexcept {
+  return s == DescentSchedule::tour ? "tour" : "immediate";
+}
 
 /// Settings of an adaptive mission.
 struct AdaptiveOptions {
@@ -52,6 +72,8 @@ struct AdaptiveOptions {
   /// What a descent re-maps: the whole region (the paper) or only its cells that show a label
   /// of interest (DescentCoverage). A decision model must be calibrated with the same.
   DescentCoverage coverage = DescentCoverage::region;
+  /// When the chosen descents are flown: at once (the paper) or as one tour after the survey.
+  DescentSchedule schedule = DescentSchedule::immediate;
 };
 
 /// The decision taken at one top-level waypoint.
@@ -62,30 +84,6 @@ struct DecisionRecord {
   std::vector<Candidate> candidates;  ///< what was affordable, with exact costs
   std::optional<DescentOutcome> outcome;  ///< after a descent
   bool budget_limited = false;     ///< some candidate was dropped because of the budget
-};
-
-/// What a descent gained, measured against the ground truth (simulation only).
-struct RealisedDescent {
-  std::size_t decision = 0;      ///< index into AdaptiveResult::decisions
-  double region_miou_before = 0.0;  ///< mIoU over L of the region's map before the descent (paired_miou)
-  double region_miou_after = 0.0;   ///< ... after it
-  /// Field mIoU over L at the end of the mission minus the same with the pixels this descent
-  /// mapped last (also beyond its region, where its images overhang) labelled as the top-level
-  /// images labelled them: the descent's contribution to the mission's result.
-  double field_gain = 0.0;
-  /// Region ΔmIoU in the sense of the decision function's I: before − after (< 0: it helped).
-  [[nodiscard]] double region_delta_miou() const noexcept { return region_miou_before - region_miou_after; }
-};
-
-/// An adaptive mission's result: the mission plus every decision.
-struct AdaptiveResult {
-  MissionResult mission;
-  std::vector<DecisionRecord> decisions;
-  std::vector<RealisedDescent> realised;  ///< one per descent, in order (simulation)
-  [[nodiscard]] int descents() const {
-    return static_cast<int>(std::count_if(decisions.begin(), decisions.end(),
-                                           [](const DecisionRecord& d) { return d.decision.descend; }));
-  }
 };
 
 /// The ground a mission covers, as a real mission knows it: no labels, only where the field is.
@@ -117,6 +115,10 @@ struct PlannedWaypoint {
   int level = 0;              ///< 0: top-level lawnmower W^{h_max}; 1: sub-lawnmower W^{h'} (a descent)
   std::size_t index = 0;      ///< visiting order: 0, 1, ... over the whole path
   std::size_t top_index = 0;  ///< the top-level waypoint whose region it maps
+  /// Level 1: the index of the decision (AdaptivePlanner::decisions()) whose descent it flies,
+  /// and its place in that descent's sub-lawnmower (0: the first waypoint).
+  std::size_t decision = 0;
+  std::size_t step = 0;
 };
 
 /// What the planner made of one reported image.
@@ -142,8 +144,10 @@ struct PlannerStep {
 /// cells that show a label of interest, see descent_plan()) and computes its exact extra time: the
 /// flight i → sub-lawnmower → i+1 minus the flight i → i+1, plus the per-image segmentation
 /// and per-waypoint planning estimates. Candidates that would break the budget are dropped; the
-/// policy decides; a descent's waypoints come next. After a descent's last image, the region's
-/// σ at h' (from the fused map) goes back to the policy (paper §3.2.3).
+/// policy decides; a descent's waypoints come next (DescentSchedule::tour: next, or after the
+/// last top-level image, as one tour with the other deferred descents, as each was costed).
+/// After a descent's last image, the region's σ at h' and what it relabelled (from the fused
+/// map) go back to the policy (paper §3.2.3).
 ///
 /// Time: the budget check uses the elapsed mission time the caller reports with each image,
 /// or, if it reports none, the planner's own account (flight by the timing model along the
@@ -156,7 +160,7 @@ struct PlannerStep {
 /// while (const auto w = planner.next()) {
 ///   const cv::Mat rgb = fly_and_shoot(w->waypoint.position);         // the UAV's part
 ///   const auto step = planner.report(planner.image_at(measured_pose(), rgb));
-///   if (step.decision && step.decision->decision.descend) { /* a sub-lawnmower comes next */ }
+///   if (step.decision && step.decision->decision.descend) { /* a sub-lawnmower comes (next) */ }
 /// }
 /// const adaptseg::SemanticMap& map = planner.map();
 /// @endcode
@@ -244,11 +248,14 @@ class AdaptivePlanner {
   /// not been reported; nullopt once the mission is complete.
   [[nodiscard]] std::optional<PlannedWaypoint> next() {
     if (pending_) return path_.back();
+    if (sub_next_ >= sub_.size() && top_next_ >= top_.size() && tour_next_ < tour_order_.size()) start_inspection();
     PlannedWaypoint p;
     if (sub_next_ < sub_.size()) {
-      p.waypoint = sub_[sub_next_++];
+      p.waypoint = sub_[sub_next_];
       p.level = 1;
-      p.top_index = top_next_ - 1;
+      p.top_index = current_.top_index;
+      p.decision = current_.decision;
+      p.step = sub_next_++;
     } else if (top_next_ < top_.size()) {
       p.waypoint = top_[top_next_];
       p.top_index = top_next_++;
@@ -357,8 +364,9 @@ class AdaptivePlanner {
     return pixel_rect(top_.at(top_index).footprint) & grid();
   }
 
-  /// The waypoints of the descent in progress (decided at the last top-level image), in
-  /// visiting order; empty when none is in progress.
+  /// The waypoints of the descent in progress, in visiting order: decided at the last
+  /// top-level image, or (DescentSchedule::tour) the inspection being flown; empty when none is
+  /// in progress or decided.
   [[nodiscard]] const std::vector<Waypoint>& descent() const noexcept { return sub_; }
 
   /// The top-level lawnmower W^{h_max}.
@@ -379,7 +387,7 @@ class AdaptivePlanner {
 
   /// True once every waypoint has been handed out and reported.
   [[nodiscard]] bool done() const noexcept {
-    return !pending_ && sub_next_ >= sub_.size() && top_next_ >= top_.size();
+    return !pending_ && sub_next_ >= sub_.size() && top_next_ >= top_.size() && tour_next_ >= tour_order_.size();
   }
   /// The waypoint whose image is awaited, if any.
   [[nodiscard]] std::optional<PlannedWaypoint> pending() const {
@@ -426,6 +434,15 @@ class AdaptivePlanner {
   }
 
  private:
+  /// A descent the policy chose.
+  struct ChosenDescent {
+    std::size_t decision = 0;   ///< index into decisions_
+    std::size_t top_index = 0;  ///< its region's top-level waypoint
+    double altitude_m = 0.0;    ///< h'
+    std::size_t ordinal = 0;    ///< 0, 1, ... in the order chosen (DescentOutcome::descent)
+    std::vector<Waypoint> plan;
+  };
+
   /// A reported image and its checked labels: the time account, the fused map, and at a
   /// top-level waypoint the decision, after a descent's last image its outcome.
   PlannerStep accept(const Image& image, const cv::Mat& labels, double segmentation_s,
@@ -437,6 +454,8 @@ class AdaptivePlanner {
     const double seg = options_.mission.fixed_segmentation_time_s.value_or(segmentation_s);
     segmentation_s_ += seg;
     slowest_segmentation_s_ = std::max(slowest_segmentation_s_, seg);
+    // A descent's first image: the region's map before the descent (what its outcome compares).
+    if (p.level == 1 && p.step == 0) descent_before_ = map_.labels()(region_rect(p.top_index)).clone();
     map_.fuse(image, labels);
 
     PlannerStep step;
@@ -525,23 +544,39 @@ class AdaptivePlanner {
     rec.sigma = sigma;
     const Eigen::Vector3d here = top_[i].position;
     const bool last = i + 1 == top_.size();
+    const bool tour = options_.schedule == DescentSchedule::tour;
+    const double per_image = segmentation_estimate() + planning_estimate();
     const double direct = last ? 0.0 : timing_.segment_time_s(here, top_[i + 1].position);
-    // Time still needed after this waypoint's decision to finish the top-level coverage.
-    const double rest = (last ? 0.0 : direct + flight_after_[i + 1]) +
-                        static_cast<double>(top_.size() - i - 1) * (segmentation_estimate() + planning_estimate());
+    // Time still needed after this waypoint's decision to finish the top-level coverage (and
+    // the tour chosen so far).
+    double rest = (last ? 0.0 : direct + flight_after_[i + 1]) + static_cast<double>(top_.size() - i - 1) * per_image;
+    if (tour) rest += tour_flight_s(timing_, tour_start(), tour_stops_, tour_order_) + static_cast<double>(tour_images_) * per_image;
     const double elapsed = elapsed_s();
     std::vector<std::vector<Waypoint>> sub_plans;
+    std::vector<TourInsertion> insertions;
     for (double g : candidates_) {
       auto sub = descent_plan(i, g);
       if (sub.empty()) continue;
-      double flight = timing_.segment_time_s(here, sub.front().position);
-      for (std::size_t k = 1; k < sub.size(); ++k) flight += timing_.segment_time_s(sub[k - 1].position, sub[k].position);
+      double inner = 0.0;
+      for (std::size_t k = 1; k < sub.size(); ++k) inner += timing_.segment_time_s(sub[k - 1].position, sub[k].position);
+      // What descending adds to the flight: at once, down and back up to the next waypoint ...
+      double flight = timing_.segment_time_s(here, sub.front().position) + inner - direct;
       if (!last) flight += timing_.segment_time_s(sub.back().position, top_[i + 1].position);
+      // ... or, on a tour, inserted where it adds least (if that is less).
+      TourInsertion insertion;
+      bool deferred = false;
+      if (tour) {
+        const TourStop stop{sub.front().position, sub.back().position, inner};
+        insertion = cheapest_insertion(timing_, tour_start(), tour_stops_, tour_order_, stop);
+        deferred = insertion.added_s < flight;
+        if (deferred) flight = insertion.added_s;
+      }
       Candidate c;
+      c.deferred = deferred;
       c.gsd_cm = g;
       c.altitude_m = camera_.altitude_m(g);
       c.images = static_cast<int>(sub.size());
-      c.extra_time_s = flight - direct + static_cast<double>(sub.size()) * (segmentation_estimate() + planning_estimate());
+      c.extra_time_s = flight + static_cast<double>(sub.size()) * per_image;
       // Descending replaces the direct leg to i+1: elapsed + extra + rest must fit.
       if (options_.budget_s && elapsed + c.extra_time_s + rest > *options_.budget_s + 1e-9) {
         rec.budget_limited = true;
@@ -549,6 +584,7 @@ class AdaptivePlanner {
       }
       rec.candidates.push_back(c);
       sub_plans.push_back(std::move(sub));
+      insertions.push_back(insertion);
     }
     std::vector<LawnmowerForecast> forecasts;
     for (const auto& l : lawnmowers_)
@@ -567,24 +603,52 @@ class AdaptivePlanner {
     rec.decision = policy_.decide(ctx);
     if (rec.decision.descend) {
       const std::size_t k = chosen_candidate(rec.decision, rec.candidates, policy_.name());
-      sub_ = std::move(sub_plans[k]);
-      sub_next_ = 0;
-      descent_altitude_m_ = rec.candidates[k].altitude_m;
-      descent_before_ = map_.labels()(region_rect(i)).clone();
+      ChosenDescent chosen{decisions_.size(), i, rec.candidates[k].altitude_m, descents_chosen_++, std::move(sub_plans[k])};
+      if (rec.candidates[k].deferred) {
+        const auto& sub = chosen.plan;
+        double inner = 0.0;
+        for (std::size_t m = 1; m < sub.size(); ++m) inner += timing_.segment_time_s(sub[m - 1].position, sub[m].position);
+        tour_stops_.push_back({sub.front().position, sub.back().position, inner});
+        tour_order_.insert(tour_order_.begin() + static_cast<std::ptrdiff_t>(insertions[k].position), queued_.size());
+        tour_images_ += sub.size();
+        queued_.push_back(std::move(chosen));
+      } else {
+        start_descent(std::move(chosen));
+      }
     }
     decisions_.push_back(rec);
     charge_measured_planning(seconds_since(t0));
     return rec;
   }
 
+  /// The descent chosen at a top-level waypoint: its waypoints come next.
+  void start_descent(ChosenDescent d) {
+    sub_ = std::move(d.plan);
+    sub_next_ = 0;
+    current_ = std::move(d);
+  }
+
+  /// Tour: the next inspection of the tour comes next. Before the first, the tour is reordered
+  /// (plan_tour_order: never longer than the order the decisions were charged for).
+  void start_inspection() {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (tour_next_ == 0) tour_order_ = plan_tour_order(timing_, tour_start(), tour_stops_, std::move(tour_order_));
+    start_descent(queued_[tour_order_[tour_next_++]]);
+    charge_measured_planning(seconds_since(t0));
+  }
+
+  /// Where a tour starts: the last top-level waypoint.
+  [[nodiscard]] Eigen::Vector3d tour_start() const { return top_.back().position; }
+
   /// After a descent's last image: σ of the region at h' from the fused map, to the policy.
   DescentOutcome finish_descent() {
     const auto t0 = std::chrono::steady_clock::now();
-    DecisionRecord& rec = decisions_.back();
-    const std::size_t top_index = path_[rec.waypoint_index].top_index;
+    DecisionRecord& rec = decisions_[current_.decision];
+    const std::size_t top_index = current_.top_index;
     DescentOutcome out;
     out.top_altitude_m = top_[top_index].position.z();
-    out.sub_altitude_m = descent_altitude_m_;
+    out.sub_altitude_m = current_.altitude_m;
+    out.descent = current_.ordinal;
     out.sigma_top = rec.sigma;
     const cv::Rect region = region_rect(top_index);
     out.sigma_sub = region.area() == 0 ? 0.0
@@ -623,8 +687,15 @@ class AdaptivePlanner {
   std::size_t top_next_ = 0;          ///< next top-level waypoint to hand out
   std::vector<Waypoint> sub_;         ///< the descent in progress, if any
   std::size_t sub_next_ = 0;          ///< next waypoint of sub_ to hand out
-  double descent_altitude_m_ = 0.0;
-  cv::Mat descent_before_;            ///< the region's map when the descent in progress was decided
+  ChosenDescent current_;             ///< the descent in progress (its plan moved to sub_)
+  std::size_t descents_chosen_ = 0;
+  cv::Mat descent_before_;            ///< the region's map before the descent in progress
+  // DescentSchedule::tour:
+  std::vector<ChosenDescent> queued_;     ///< every descent chosen during the survey, in decision order
+  std::vector<TourStop> tour_stops_;      ///< ... as tour stops (same order)
+  std::vector<std::size_t> tour_order_;   ///< indices into queued_, in flight order
+  std::size_t tour_next_ = 0;             ///< next of tour_order_ to fly
+  std::size_t tour_images_ = 0;           ///< images of the queued descents
   bool pending_ = false;              ///< path_.back() awaits its image
   std::vector<PlannedWaypoint> path_;
   std::vector<DecisionRecord> decisions_;
@@ -636,76 +707,5 @@ class AdaptivePlanner {
   double untaken_planning_s_ = 0.0;
   std::optional<double> reported_elapsed_s_;
 };
-
-/// Runs the adaptive strategy with `policy` over `field` in simulation: AdaptivePlanner
-/// decides, a Mission flies (SimulatedSensor image, segmentation by `backend`, scoring, time
-/// accounting) and reports each image with the mission's elapsed time; the planner's fused
-/// map is the mission's map.
-///
-/// Holds references to `backend` and `policy` for the call's duration only.
-/// @throws std::invalid_argument for a top GSD finer than the field's, candidates that are not
-///         finer than the top, a budget too small for the top-level coverage alone, and the
-///         reasons of Mission's constructor.
-template <SegmentationBackend Backend, DecisionPolicy Policy>
-[[nodiscard]] AdaptiveResult run_adaptive_mission(const Field& field, Backend& backend, Policy& policy,
-                                                  const AdaptiveOptions& options, std::string strategy) {
-  Mission<Backend> mission(field, backend, options.mission, std::move(strategy));
-  AdaptiveOptions planner_options = options;
-  planner_options.mission.interest = mission.interest();
-  AdaptivePlanner<Backend, Policy> planner(SurveyArea::of(field), backend, policy, std::move(planner_options));
-  // What each descent gained is scored at the end against the ground truth: its region's map
-  // before it, the map pixels its images covered, and the top-level images alone.
-  struct Pending {
-    std::size_t decision;
-    cv::Rect region;
-    cv::Mat before;
-    cv::Rect covered;  ///< bounding box of the descent's footprints on the map
-    double gsd_cm;
-  };
-  std::vector<Pending> descents;
-  SemanticMap top_only(field.labels().size(), field.ignore_label());
-  while (const auto w = planner.next()) {
-    mission.charge_planning(planner.take_planning_s());
-    const auto visit = mission.visit_without_fusion(w->waypoint, w->level);
-    const PlannerStep step = planner.report(visit.image, visit.labels, visit.record->segmentation_s, mission.elapsed_s());
-    if (w->level == 0) top_only.fuse(visit.image, visit.labels);
-    if (step.decision && step.decision->decision.descend) {
-      const cv::Rect region = planner.region_rect(w->top_index);
-      cv::Rect covered;
-      for (const Waypoint& s : planner.descent()) covered |= planner.pixel_rect(s.footprint);
-      descents.push_back({planner.decisions().size() - 1, region, planner.map().labels()(region).clone(),
-                          covered & cv::Rect(0, 0, field.width_px(), field.height_px()),
-                          step.decision->decision.gsd_cm});
-    }
-  }
-  // The last decision's measured time (a fixed planning time is charged per waypoint only).
-  if (!mission.options().fixed_planning_time_s) mission.charge_planning(planner.take_planning_s());
-  AdaptiveResult result{std::move(mission).finish(planner.map()), planner.decisions(), {}};
-  const auto& interest = result.mission.interest;
-  const int n = field.num_classes();
-  const auto region_confusion = [&](const cv::Rect& region, const cv::Mat& labels) {
-    ConfusionMatrix cm(n);
-    cm.add(field.labels()(region), labels, field.ignore_label());
-    return cm;
-  };
-  const double final_miou = result.mission.miou_interest().value_or(0.0);
-  const cv::Mat& final_labels = result.mission.fused_labels;
-  for (const Pending& d : descents) {
-    RealisedDescent r;
-    r.decision = d.decision;
-    std::tie(r.region_miou_before, r.region_miou_after) =
-        paired_miou(region_confusion(d.region, d.before), region_confusion(d.region, final_labels(d.region)), interest);
-    // The pixels this descent mapped last: covered by it and still holding its GSD.
-    const cv::Mat owned = planner.map().gsd_cm()(d.covered) == static_cast<float>(d.gsd_cm);
-    cv::Mat reverted = final_labels(d.covered).clone();
-    top_only.labels()(d.covered).copyTo(reverted, owned);
-    ConfusionMatrix without = result.mission.confusion;
-    without -= region_confusion(d.covered, final_labels(d.covered));
-    without += region_confusion(d.covered, reverted);
-    r.field_gain = final_miou - without.miou(interest).value_or(0.0);
-    result.realised.push_back(r);
-  }
-  return result;
-}
 
 }  // namespace adaptseg

@@ -4,7 +4,7 @@
 /// C samples, fit the gain model, and choose the decision rule's settings on the training
 /// fields only, by the front margin over each field's own lawnmower curve.
 
-#include <adaptseg/adaptive_planner.hpp>
+#include <adaptseg/adaptive_mission.hpp>
 #include <adaptseg/decision_function.hpp>
 #include <adaptseg/decision_model.hpp>
 #include <adaptseg/linear_decision.hpp>

@@ -144,7 +144,7 @@ class FrontAwarePolicy {
     seen_share_ = 0.0;
     seen_interest_ = 0.0;
     forecast_gain_ = 0.0;
-    pending_relabelled_.reset();
+    chosen_.clear();
     scale_mean_ = 1.0;
     scale_var_ = model_.c_model() ? params_.scale_prior_sd * params_.scale_prior_sd : 0.0;
     scale_precision_sum_ = 0.0;
@@ -214,16 +214,17 @@ class FrontAwarePolicy {
       d.descend = true;
       d.gsd_cm = c.candidates[*best_index].gsd_cm;
       forecast_gain_ += gains[*best_index];
-      pending_relabelled_ = forecasts[*best_index];
+      chosen_.push_back(forecasts[*best_index]);
     }
     return d;
   }
 
   /// After a descent: the paper's update of O and the field correction (no-op unless `online`).
   void observe(const DescentOutcome& out) {
-    const std::optional<GainForecast> f = std::exchange(pending_relabelled_, std::nullopt);
     if (!params_.online) return;
     model_.update(out);
+    const std::optional<GainForecast> f =
+        out.descent < chosen_.size() ? std::optional<GainForecast>(chosen_[out.descent]) : std::nullopt;
     if (!f || !std::isfinite(f->relabelled) || !model_.c_model()) return;
     // Conjugate update of s in χ_obs = s·μ_C + ε, ε ~ N(0, sd_C²), prior s ~ N(1, ω²).
     const double noise = std::max(f->relabelled_noisy_std * f->relabelled_noisy_std, 1e-12);
@@ -295,7 +296,7 @@ class FrontAwarePolicy {
   double seen_share_ = 0.0;         ///< field share of the top-level regions seen so far
   double seen_interest_ = 0.0;      ///< ... and Σ share · σ over them
   double forecast_gain_ = 0.0;      ///< forecast field-level gain of the descents taken
-  std::optional<GainForecast> pending_relabelled_;  ///< the forecast of the descent in progress
+  std::vector<GainForecast> chosen_;  ///< the forecast of each descent chosen (DescentOutcome::descent)
   double scale_mean_ = 1.0;         ///< field factor s: posterior mean
   double scale_var_ = 0.0;          ///< ... and variance
   double scale_precision_sum_ = 0.0;

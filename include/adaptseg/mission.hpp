@@ -7,6 +7,7 @@
 #include <adaptseg/field.hpp>
 #include <adaptseg/lawnmower_planner.hpp>
 #include <adaptseg/metrics.hpp>
+#include <adaptseg/mission_options.hpp>
 #include <adaptseg/segmentation_backend.hpp>
 #include <adaptseg/semantic_map.hpp>
 #include <adaptseg/simulated_sensor.hpp>
@@ -18,33 +19,6 @@
 #include <vector>
 
 namespace adaptseg {
-
-/// Settings common to every mission.
-struct MissionOptions {
-  CameraModel::Params camera{};
-  TimingModel::Params timing{};
-  /// Labels of interest L; empty: the field's default (`Field::interest()`).
-  std::vector<int> interest{};
-  /// If set, every image costs this segmentation time [s] instead of the measured one
-  /// (deterministic runs: tests, reference results).
-  std::optional<double> fixed_segmentation_time_s{};
-  /// If set, every waypoint costs this planning time [s] instead of the measured one.
-  std::optional<double> fixed_planning_time_s{};
-};
-
-namespace detail {
-
-/// Throws unless the fixed segmentation and planning times, where set, are finite and >= 0.
-inline void check_fixed_times(const MissionOptions& options) {
-  if (options.fixed_segmentation_time_s)
-    require(std::isfinite(*options.fixed_segmentation_time_s) && *options.fixed_segmentation_time_s >= 0.0,
-            "MissionOptions: fixed_segmentation_time_s must be finite and >= 0", *options.fixed_segmentation_time_s);
-  if (options.fixed_planning_time_s)
-    require(std::isfinite(*options.fixed_planning_time_s) && *options.fixed_planning_time_s >= 0.0,
-            "MissionOptions: fixed_planning_time_s must be finite and >= 0", *options.fixed_planning_time_s);
-}
-
-}  // namespace detail
 
 /// What happened at one waypoint.
 struct WaypointRecord {
