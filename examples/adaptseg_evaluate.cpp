@@ -75,10 +75,22 @@ void write_decisions(std::ostream& os, const std::string& field, const std::stri
     else
       os << ",,,";
     if (r)
-      os << fmt(r->region_delta_miou(), 6) << ',' << fmt(r->field_gain, 6) << '\n';
+      os << fmt(r->region_delta_miou(), 6) << ',' << fmt(r->field_gain, 6) << ',';
     else
-      os << ",\n";
+      os << ",,";
+    if (c)
+      os << (d.candidates[*c].deferred ? "tour" : "now") << '\n';
+    else
+      os << '\n';
   }
+}
+
+/// Legs of the mission between waypoints at different altitudes (climbs and descents).
+int altitude_changes(const adaptseg::MissionResult& m) {
+  int n = 0;
+  for (std::size_t k = 1; k < m.waypoints.size(); ++k)
+    n += m.waypoints[k].waypoint.position.z() != m.waypoints[k - 1].waypoint.position.z() ? 1 : 0;
+  return n;
 }
 
 /// A field's name as a folder name: "weedmap-rededge-000[0.5,0,1,1]" (a region of a field)
@@ -184,13 +196,13 @@ int main(int argc, char** argv) {
     std::ofstream results(out_dir / "results.csv"), per_image(out_dir / "per_image.csv"),
         decisions_csv(out_dir / "decisions.csv");
     results << "field,strategy,gsd_cm,miou_interest,miou_all,time_total,time_flight,time_segmentation,"
-               "time_planning,images,front_margin,descents\n";
+               "time_planning,images,front_margin,descents,altitude_changes\n";
     per_image << "field,strategy,gsd_cm,image,level,image_gsd_cm,sigma,image_miou_interest,image_miou_all,truth_sigma\n";
     decisions_csv << "field,strategy,decision,image,sigma,action,gsd_cm,images,extra_time_s,forecast_delta_sigma,"
                      "forecast_delta_miou,forecast_delta_miou_std,forecast_relabelled_interest,forecast_field_gain,forecast_front_margin,"
                      "observed_sigma_sub,observed_relabelled,observed_relabelled_interest,realised_region_delta_miou,"
-                     "realised_field_gain\n";
-    const std::size_t total_runs = tests.size() * (lawnmower_factors.size() + 3);
+                     "realised_field_gain,flown\n";
+    const std::size_t total_runs = tests.size() * (lawnmower_factors.size() + 4);
     std::size_t run_index = 0;
     for (const auto& field : tests) {
       const adaptseg::MissionOptions mo = common.resolve(field);
@@ -221,7 +233,7 @@ int main(int argc, char** argv) {
         fly("lawnmower", f * field.gsd_cm());
         curve.push_back({rows.back().run.mission.total_s(), rows.back().run.mission.miou_interest().value_or(0.0)});
       }
-      for (const char* s : {"nonadaptive", "adaptive", "linear"}) fly(s, model.top_gsd_cm);
+      for (const char* s : {"nonadaptive", "adaptive", "tour", "linear"}) fly(s, model.top_gsd_cm);
 
       const fs::path field_dir = out_dir / slug(field.name());
       for (const auto& row : rows) {
@@ -234,7 +246,7 @@ int main(int argc, char** argv) {
         results << csv(field.name()) << ',' << row.strategy << ',' << fmt(row.gsd, 3) << ',' << csv(m.miou_interest())
                 << ',' << csv(m.miou_all()) << ',' << fmt(m.total_s(), 3) << ',' << fmt(m.flight_s, 3) << ','
                 << fmt(m.segmentation_s, 4) << ',' << fmt(m.planning_s, 4) << ',' << m.waypoints.size() << ','
-                << fmt(margin, 6) << ',' << descents << '\n';
+                << fmt(margin, 6) << ',' << descents << ',' << altitude_changes(m) << '\n';
         for (std::size_t k = 0; k < m.waypoints.size(); ++k) {
           const auto& w = m.waypoints[k];
           per_image << csv(field.name()) << ',' << row.strategy << ',' << fmt(row.gsd, 3) << ',' << k << ',' << w.level

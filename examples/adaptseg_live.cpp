@@ -221,7 +221,8 @@ void fly(const ImageSetInfo& info, const std::vector<PosedImage>& images, Backen
   std::printf("%s: %zu top-level waypoints at %.2f cm/px, candidates", info.name.c_str(),
               planner.top_level().size(), options.top_gsd_cm);
   for (double g : planner.candidate_gsd_cm()) std::printf(" %.2f", g);
-  std::printf(" cm/px, policy %s, segmenter %s\n", std::string(policy.name()).c_str(),
+  std::printf(" cm/px, policy %s, descents %s, segmenter %s\n", std::string(policy.name()).c_str(),
+              options.schedule == adaptseg::DescentSchedule::tour ? "at once or toured" : "at once",
               std::string(backend.name()).c_str());
 
   nlohmann::json wps = nlohmann::json::array();
@@ -286,6 +287,7 @@ void fly(const ImageSetInfo& info, const std::vector<PosedImage>& images, Backen
   fs::create_directories(s.out);
   nlohmann::json j{{"field", info.name},
                    {"strategy", std::string(policy.name())},
+                   {"schedule", adaptseg::to_string(options.schedule)},
                    {"segmenter", std::string(backend.name())},
                    {"images", planner.path().size()},
                    {"time_s", {{"total", planner.elapsed_s()}}},
@@ -315,8 +317,10 @@ void fly_strategy(const std::string& strategy, const adaptseg::DecisionModel& mo
     return;
   }
   adaptseg::DecisionFunction df = model.decision_function;
-  df.set_online(strategy == "adaptive");
-  fly(info, images, backend, df, options, s);
+  df.set_online(strategy != "nonadaptive");
+  adaptseg::AdaptiveOptions o = options;
+  if (strategy == "tour") o.schedule = adaptseg::DescentSchedule::tour;
+  fly(info, images, backend, df, o, s);
 }
 
 }  // namespace
@@ -334,7 +338,7 @@ int main(int argc, char** argv) {
                  "instead of flying: capture, in simulation, every waypoint the planner may ask for over this "
                  "field (DIR or DIR:x0,y0,x1,y1) into --images");
   app.add_option("--strategy", strategy, "decision policy")
-      ->check(CLI::IsMember({"adaptive", "nonadaptive", "linear"}))
+      ->check(CLI::IsMember({"adaptive", "nonadaptive", "tour", "linear"}))
       ->capture_default_str();
   app.add_option("--segmenter", segmenter, "oracle: ground-truth labels/ of the folder; erfnet: its RGB images")
       ->check(CLI::IsMember({"oracle", "erfnet"}))

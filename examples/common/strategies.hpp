@@ -3,7 +3,7 @@
 
 #include "cli.hpp"
 
-#include <adaptseg/adaptive_planner.hpp>
+#include <adaptseg/adaptive_mission.hpp>
 #include <adaptseg/decision_model.hpp>
 #include <adaptseg/linear_decision.hpp>
 
@@ -16,7 +16,11 @@
 
 namespace adaptseg::examples {
 
-inline const std::vector<std::string> kStrategies{"lawnmower", "adaptive", "nonadaptive", "linear"};
+/// lawnmower: one fixed GSD; adaptive / nonadaptive: the decision model with online updates on /
+/// off, descents flown at once (the paper); tour: adaptive, but the whole top level first and the
+/// chosen descents after it as one low-altitude tour (DescentSchedule::tour); linear: the
+/// conference version's rule.
+inline const std::vector<std::string> kStrategies{"lawnmower", "adaptive", "nonadaptive", "tour", "linear"};
 
 /// "a,b,c,d" -> four numbers; `what` describes the expected text in the error.
 /// @throws std::invalid_argument for anything else.
@@ -95,17 +99,18 @@ StrategyRun run_strategy(const Field& field, Backend& backend, const std::string
   model->check_classes(field);
   if (options.interest.empty()) options.interest = field.class_indices(model->interest);
   model->check_compatible(field, options.interest);
-  const AdaptiveOptions ao = model->adaptive_options(std::move(options), budget_s);
+  AdaptiveOptions ao = model->adaptive_options(std::move(options), budget_s);
   if (strategy == "linear") {
     LinearDecision policy(model->linear);
     auto r = run_adaptive_mission(field, backend, policy, ao, policy.name());
     return {std::move(r.mission), std::move(r.decisions), std::move(r.realised)};
   }
-  if (strategy != "adaptive" && strategy != "nonadaptive")
+  if (strategy != "adaptive" && strategy != "nonadaptive" && strategy != "tour")
     throw std::invalid_argument("unknown strategy '" + strategy + "'");
   DecisionFunction df = model->decision_function;
-  df.set_online(strategy == "adaptive");
-  auto r = run_adaptive_mission(field, backend, df, ao, df.name());
+  df.set_online(strategy != "nonadaptive");
+  if (strategy == "tour") ao.schedule = DescentSchedule::tour;
+  auto r = run_adaptive_mission(field, backend, df, ao, strategy);
   return {std::move(r.mission), std::move(r.decisions), std::move(r.realised)};
 }
 

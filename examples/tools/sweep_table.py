@@ -7,13 +7,15 @@ Each LABEL names a configuration; its OUTDIRs are adaptseg_evaluate output direc
 alike across configurations (the run's name is the directory's path below the common root,
 e.g. out/results/loo/road/dubai-tile-3 and out/results/loo-paper/road/dubai-tile-3 are one run).
 Prints, as Markdown:
-  1. per run and test field: the front margin (and descents) of adaptive, non-adaptive and
-     linear in the first configuration, and of adaptive in the others;
+  1. per run and test field: the front margin (and descents) of adaptive, non-adaptive, tour
+     and linear in the first configuration, and of adaptive in the others;
   2. per configuration: runs with margin > 0 and >= -0.002, median and mean margin, and the
      share of positive runs among those where some strategy flown in any configuration beat
      the lawnmower curve (margin > 0);
   3. the runs where adaptive and non-adaptive differ, and by how much;
-  4. per descent (decisions.csv), forecast against realised field gain, by descent GSD.
+  4. per descent (decisions.csv), forecast against realised field gain, by descent GSD;
+  5. when descents are flown (adaptive: at once; tour: at once or after the survey): margins,
+     mission time, altitude changes, descents deferred to the tour, runs where tour differs.
 """
 import csv
 import os
@@ -31,7 +33,7 @@ def run_name(directory, root):
 
 
 def load(dirs):
-    """{(run, field): {strategy: (margin, descents)}} and the decision rows, for `dirs`."""
+    """{(run, field): {strategy: (margin, descents, time, altitude changes)}} and the decision rows."""
     root = os.path.commonpath([os.path.normpath(d) for d in dirs]) if len(dirs) > 1 else os.path.dirname(
         os.path.normpath(dirs[0]))
     runs, decisions = {}, []
@@ -39,7 +41,9 @@ def load(dirs):
         name = run_name(d, root)
         for r in read_csv(os.path.join(d, "results.csv")):
             if r["strategy"] != "lawnmower":
-                runs.setdefault((name, r["field"]), {})[r["strategy"]] = (float(r["front_margin"]), int(r["descents"]))
+                runs.setdefault((name, r["field"]), {})[r["strategy"]] = (
+                    float(r["front_margin"]), int(r["descents"]), float(r["time_total"]),
+                    int(r["altitude_changes"]) if r.get("altitude_changes") else None)
         path = os.path.join(d, "decisions.csv")
         if os.path.exists(path):
             decisions += [dict(r, run=name) for r in read_csv(path)]
@@ -69,13 +73,14 @@ def main(args):
     keys = sorted({k for _, runs, _ in configs for k in runs})
     first_label, first, _ = configs[0]
 
-    print(f"| run | field | adaptive | non-adaptive | linear |" + "".join(f" adaptive, {c[0]} |" for c in configs[1:]))
-    print("| --- | --- | ---: | ---: | ---: |" + " ---: |" * (len(configs) - 1))
+    print(f"| run | field | adaptive | non-adaptive | tour | linear |" +
+          "".join(f" adaptive, {c[0]} |" for c in configs[1:]))
+    print("| --- | --- | ---: | ---: | ---: | ---: |" + " ---: |" * (len(configs) - 1))
     for run, field in keys:
         row = first.get((run, field), {})
         others = "".join(f" {cell(c[1].get((run, field), {}).get('adaptive'))} |" for c in configs[1:])
         print(f"| {run} | {field} | {cell(row.get('adaptive'))} | {cell(row.get('nonadaptive'))} | "
-              f"{cell(row.get('linear'))} |{others}")
+              f"{cell(row.get('tour'))} | {cell(row.get('linear'))} |{others}")
 
     # Runs where some strategy, in some configuration, beat the curve.
     beatable = {k for k in keys for _, runs, _ in configs for v in runs.get(k, {}).values() if v[0] > 0}
@@ -98,7 +103,7 @@ def main(args):
     for label, runs, _ in configs:
         for k in keys:
             r = runs.get(k, {})
-            if "adaptive" in r and "nonadaptive" in r and r["adaptive"] != r["nonadaptive"]:
+            if "adaptive" in r and "nonadaptive" in r and r["adaptive"][:2] != r["nonadaptive"][:2]:
                 differ += 1
                 print(f"| {label} | {k[0]} | {k[1]} | {cell(r['adaptive'])} | {cell(r['nonadaptive'])} | "
                       f"{r['adaptive'][0] - r['nonadaptive'][0]:+.4f} |")
@@ -123,6 +128,29 @@ def main(args):
                 ob = [float(d["observed_relabelled_interest"]) for d in sel if d["forecast_relabelled_interest"] != ""]
                 print(f"| {label} | {strategy} | {g} | {len(sel)} | {sum(f):.4f} | {sum(r):.4f} | "
                       f"{correlation(f, r):.2f} | {sum(fr):.4f} | {sum(ob):.4f} |")
+    schedule_table(configs, keys)
+
+
+def schedule_table(configs, keys):
+    """Table 5: the paper's immediate descents against the tour strategy, per configuration."""
+    print()
+    print("| configuration | strategy | runs | median margin | mean margin | mission time (sum) [s] | "
+          "altitude changes (sum) | descents | deferred to the tour | runs where tour differs |")
+    print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for label, runs, decisions in configs:
+        both = [k for k in keys if k in runs and "adaptive" in runs[k] and "tour" in runs[k]]
+        if not both:
+            continue
+        for strategy in ("adaptive", "tour"):
+            v = [runs[k][strategy] for k in both]
+            deferred = sum(1 for d in decisions if d["strategy"] == strategy and d["action"] == "descend"
+                           and d.get("flown") == "tour")
+            differ = sum(1 for k in both if runs[k]["tour"][:3] != runs[k]["adaptive"][:3])
+            changes = [x[3] for x in v if x[3] is not None]
+            print(f"| {label} | {strategy} | {len(v)} | {statistics.median(x[0] for x in v):+.4f} | "
+                  f"{statistics.mean(x[0] for x in v):+.4f} | {sum(x[2] for x in v):.0f} | "
+                  f"{sum(changes) if changes else '—'} | {sum(x[1] for x in v)} | {deferred} | "
+                  f"{differ if strategy == 'tour' else ''} |")
 
 
 if __name__ == "__main__":

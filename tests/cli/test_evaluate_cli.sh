@@ -2,7 +2,7 @@
 # Black-box test of adaptseg_evaluate, the paper's experiment on a scene the decision function
 # never saw: initialised on Dubai tile 4, flown on tile 6 with the oracle, L = {road} (0.8 % of
 # tile 6's pixels: a spatially localised class). Checks results.csv's and decisions.csv's
-# columns, the figures, a positive front margin for the adaptive strategy, and that a budget is
+# columns, the figures (and the tour strategy's rows), a positive front margin for the adaptive strategy, and that a budget is
 # never exceeded.
 #   test_evaluate_cli.sh EVALUATE_BINARY EXAMPLES_DIR
 set -uo pipefail
@@ -27,7 +27,7 @@ echo "ok: adaptive front margin on dubai-tile-6 (road) = $margin"
 # adaptive carries its forecast, what it relabelled (no truth needed) and what it realised.
 want="field,strategy,decision,image,sigma,action,gsd_cm,images,extra_time_s,forecast_delta_sigma,forecast_delta_miou,"
 want+="forecast_delta_miou_std,forecast_relabelled_interest,forecast_field_gain,forecast_front_margin,observed_sigma_sub,"
-want+="observed_relabelled,observed_relabelled_interest,realised_region_delta_miou,realised_field_gain"
+want+="observed_relabelled,observed_relabelled_interest,realised_region_delta_miou,realised_field_gain,flown"
 [ "$(head -1 "$work/e/decisions.csv")" = "$want" ] || fail "decisions.csv header: $(head -1 "$work/e/decisions.csv")"
 descents=$(awk -F, '$2 == "adaptive" {print $12}' "$work/e/results.csv")
 awk -F, -v n="$descents" '$2 == "adaptive" {rows++} $2 == "adaptive" && $6 == "descend" {
@@ -35,6 +35,14 @@ awk -F, -v n="$descents" '$2 == "adaptive" {rows++} $2 == "adaptive" && $6 == "d
   END {exit !(rows > 0 && d == n && d > 0 && bad == 0)}' "$work/e/decisions.csv" ||
   fail "decisions.csv: adaptive's $descents descents not all recorded with forecast, observation and realised gain"
 echo "ok: decisions.csv records adaptive's $descents descents"
+# How each descent was flown: adaptive always at once; tour at once or in the tour. Adaptive's
+# altitude changes (results.csv column 13): one or two per descent.
+awk -F, '$6 == "descend" && !(($2 == "tour" && ($21 == "now" || $21 == "tour")) || ($2 != "tour" && $21 == "now")) {bad++}
+  $2 == "tour" {tour++} END {exit !(bad == 0 && tour > 0)}' "$work/e/decisions.csv" ||
+  fail "decisions.csv: column flown is not now/tour as the strategy allows, or no tour rows"
+awk -F, -v n="$descents" '$2 == "adaptive" {exit !($13 >= n && $13 <= 2 * n)}' "$work/e/results.csv" ||
+  fail "results.csv: adaptive's altitude_changes is not between its descents and twice them"
+echo "ok: decisions.csv says how each descent was flown"
 # per_image.csv: every image has the truth's share of L, in [0, 1]; road is in some of them
 want="field,strategy,gsd_cm,image,level,image_gsd_cm,sigma,image_miou_interest,image_miou_all,truth_sigma"
 [ "$(head -1 "$work/e/per_image.csv")" = "$want" ] || fail "per_image.csv header: $(head -1 "$work/e/per_image.csv")"
