@@ -145,7 +145,11 @@ def schedule_table(configs, keys):
             v = [runs[k][strategy] for k in both]
             deferred = sum(1 for d in decisions if d["strategy"] == strategy and d["action"] == "descend"
                            and d.get("flown") == "tour")
-            differ = sum(1 for k in both if runs[k]["tour"][:3] != runs[k]["adaptive"][:3])
+            # A different mission: a descent deferred, or other descents (times alone move with
+            # measured segmentation times).
+            deferred_runs = {d["run"] for d in decisions if d["strategy"] == "tour" and d["action"] == "descend"
+                             and d.get("flown") == "tour"}
+            differ = sum(1 for k in both if k[0] in deferred_runs or runs[k]["tour"][1] != runs[k]["adaptive"][1])
             changes = [x[3] for x in v if x[3] is not None]
             print(f"| {label} | {strategy} | {len(v)} | {statistics.median(x[0] for x in v):+.4f} | "
                   f"{statistics.mean(x[0] for x in v):+.4f} | {sum(x[2] for x in v):.0f} | "
