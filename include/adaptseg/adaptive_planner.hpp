@@ -12,7 +12,6 @@
 
 #include <adaptseg/camera.hpp>
 #include <adaptseg/decision.hpp>
-#include <adaptseg/field.hpp>
 #include <adaptseg/inspection_tour.hpp>
 #include <adaptseg/lawnmower_planner.hpp>
 #include <adaptseg/metrics.hpp>
@@ -103,8 +102,11 @@ struct SurveyArea {
   /// (check_segmentation()); 0, the default, is rejected by the planner with a message.
   int num_classes = 0;
 
-  /// A Field's area, GSD, valid mask, ignore label and class count (what the simulation knows).
-  [[nodiscard]] static SurveyArea of(const Field& field) {
+  /// A Field's area, GSD, valid mask, ignore label and class count (what the simulation
+  /// knows). A template so that the live planner does not depend on field.hpp (and its YAML
+  /// and image-file readers): any type with Field's five accessors will do.
+  template <typename FieldLike>
+  [[nodiscard]] static SurveyArea of(const FieldLike& field) {
     return {field.area(), field.gsd_cm(), field.valid_mask(), field.ignore_label(), field.num_classes()};
   }
 };

@@ -4,6 +4,7 @@
 /// GSD and class set, loaded from the project's field directory format (docs/data_format.md).
 
 #include <adaptseg/error.hpp>
+#include <adaptseg/image.hpp>
 #include <adaptseg/lawnmower_planner.hpp>
 
 #include <opencv2/core.hpp>
@@ -70,24 +71,6 @@ inline void validate_field_geo(const FieldGeo& g, const std::string& where) {
 }
 
 }  // namespace detail
-
-/// Pixels under `a` of a raster in the field frame (see Field) with `rows` rows at `gsd_cm`,
-/// edges rounded to the nearest pixel boundary, so that areas sharing an edge share it in
-/// pixels too (no gaps, no overlaps). May extend beyond the raster. Coordinates are clamped to
-/// +-2^29 px so that absurd areas cannot overflow `int` (they would wrap and miss the raster);
-/// the rectangle still covers everything it should.
-[[nodiscard]] inline cv::Rect raster_rect(const Area& a, double gsd_cm, int rows) {
-  const double s = 100.0 / gsd_cm;
-  const auto px = [](double v) {
-    constexpr double kLimit = 536870912.0;
-    return static_cast<int>(std::lround(std::clamp(v, -kLimit, kLimit)));
-  };
-  const int c0 = px(a.x_min_m * s);
-  const int c1 = px(a.x_max_m * s);
-  const int r0 = px(rows - a.y_max_m * s);
-  const int r1 = px(rows - a.y_min_m * s);
-  return {c0, r0, c1 - c0, r1 - r0};
-}
 
 /// Fraction rectangle of a field along the image axes: `x` along columns (left to right),
 /// `y` along rows (top to bottom), each in [0, 1]. `{0, 0, 0.5, 1}` is the left half.

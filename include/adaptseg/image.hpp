@@ -1,19 +1,42 @@
 #pragma once
 /// @file
 /// One camera frame as a segmentation backend receives it (`Image`), and the check of what a
-/// backend gives back (`check_segmentation`). OpenCV core and Eigen only: the segmentation
-/// contract (segmentation_backend.hpp) needs nothing else.
+/// backend gives back (`check_segmentation`), and the pixels of a raster under an area of the
+/// field frame (`raster_rect`). OpenCV core and Eigen only: the segmentation contract
+/// (segmentation_backend.hpp) and the live planner need nothing else.
 
 #include <adaptseg/error.hpp>
+#include <adaptseg/lawnmower_planner.hpp>
 
 #include <opencv2/core.hpp>
 
 #include <Eigen/Core>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <string_view>
 
 namespace adaptseg {
+
+/// Pixels under `a` of a raster in the field frame (origin at the raster's bottom-left
+/// corner, x along its columns, y up its rows; docs/data_format.md) with `rows` rows at `gsd_cm`,
+/// edges rounded to the nearest pixel boundary, so that areas sharing an edge share it in
+/// pixels too (no gaps, no overlaps). May extend beyond the raster. Coordinates are clamped to
+/// +-2^29 px so that absurd areas cannot overflow `int` (they would wrap and miss the raster);
+/// the rectangle still covers everything it should.
+[[nodiscard]] inline cv::Rect raster_rect(const Area& a, double gsd_cm, int rows) {
+  const double s = 100.0 / gsd_cm;
+  const auto px = [](double v) {
+    constexpr double kLimit = 536870912.0;
+    return static_cast<int>(std::lround(std::clamp(v, -kLimit, kLimit)));
+  };
+  const int c0 = px(a.x_min_m * s);
+  const int c1 = px(a.x_max_m * s);
+  const int r0 = px(rows - a.y_max_m * s);
+  const int r1 = px(rows - a.y_min_m * s);
+  return {c0, r0, c1 - c0, r1 - r0};
+}
 
 /// One camera frame, as a segmentation backend receives it.
 struct Image {
