@@ -175,7 +175,7 @@ TEST_CASE("adaptive planner: the budget is never exceeded and the top level is a
                        doctest::Contains("too small for the top-level coverage"), std::invalid_argument);
 }
 
-TEST_CASE("adaptive planner (tour): each descent flown at once or after the survey, as costed, never slower") {
+TEST_CASE("adaptive planner (tour): each descent flown at once or after the survey, as costed") {
   const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
   OracleSegmenter oracle(f.num_classes());
   for (double top : {3.0, 6.0}) {
@@ -199,8 +199,12 @@ TEST_CASE("adaptive planner (tour): each descent flown at once or after the surv
       const Candidate& c = tour.decisions[k].candidates.at(0);
       const Candidate& now = immediate.decisions[k].candidates.at(0);
       CHECK(!now.deferred);
-      CHECK(c.extra_time_s <= now.extra_time_s + 1e-9);
-      CHECK(c.deferred == (c.extra_time_s < now.extra_time_s));
+      if (k + 1 < tour.decisions.size() || deferred == 0) {
+        CHECK(c.extra_time_s <= now.extra_time_s + 1e-9);
+        CHECK(c.deferred == (c.extra_time_s < now.extra_time_s));
+      } else {
+        CHECK(c.deferred);  // where a chosen tour starts, it prices even "at once"
+      }
       charged += c.extra_time_s;
       deferred += c.deferred ? 1 : 0;
     }

@@ -564,13 +564,16 @@ class AdaptivePlanner {
       // What descending adds to the flight: at once, down and back up to the next waypoint ...
       double flight = timing_.segment_time_s(here, sub.front().position) + inner - direct;
       if (!last) flight += timing_.segment_time_s(sub.back().position, top_[i + 1].position);
-      // ... or, on a tour, inserted where it adds least (if that is less).
+      // ... or, on a tour, inserted where it adds least (if that is less). At the last
+      // top-level waypoint, where a tour already chosen starts, flying it at once is the
+      // insertion at the tour's head, so the tour prices it (the at-once cost above would
+      // ignore that the tour then starts from the descent's end).
       TourInsertion insertion;
       bool deferred = false;
       if (tour) {
         const TourStop stop{sub.front().position, sub.back().position, inner};
         insertion = cheapest_insertion(timing_, tour_start(), tour_stops_, tour_order_, stop);
-        deferred = insertion.added_s < flight;
+        deferred = (last && !tour_order_.empty()) || insertion.added_s < flight;
         if (deferred) flight = insertion.added_s;
       }
       Candidate c;
