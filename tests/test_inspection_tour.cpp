@@ -25,14 +25,19 @@ std::vector<TourStop> random_stops(std::mt19937& rng, std::size_t n) {
   return s;
 }
 
-// Each stop inserted where it adds least, in the order chosen; then the local search.
-std::vector<std::size_t> heuristic(const Eigen::Vector3d& start, const std::vector<TourStop>& stops) {
+// Each stop inserted where it adds least, in the order chosen (as the planner builds a tour).
+std::vector<std::size_t> insertion_order(const Eigen::Vector3d& start, const std::vector<TourStop>& stops) {
   std::vector<std::size_t> order;
   for (std::size_t k = 0; k < stops.size(); ++k) {
     const TourInsertion ins = cheapest_insertion(timing, start, stops, order, stops[k]);
     order.insert(order.begin() + static_cast<std::ptrdiff_t>(ins.position), k);
   }
-  return improve_tour_order(timing, start, stops, order);
+  return order;
+}
+
+// The insertion order improved by the local search.
+std::vector<std::size_t> heuristic(const Eigen::Vector3d& start, const std::vector<TourStop>& stops) {
+  return improve_tour_order(timing, start, stops, insertion_order(start, stops));
 }
 }  // namespace
 
@@ -132,11 +137,7 @@ TEST_CASE("inspection tour: the planned order is never longer than the insertion
   const Eigen::Vector3d start(0, 0, 82.5);
   for (std::size_t n : {std::size_t{1}, std::size_t{5}, kExactTourStops, std::size_t{20}, std::size_t{40}}) {
     const auto stops = random_stops(rng, n);
-    std::vector<std::size_t> inserted;
-    for (std::size_t k = 0; k < n; ++k) {
-      const TourInsertion ins = cheapest_insertion(timing, start, stops, inserted, stops[k]);
-      inserted.insert(inserted.begin() + static_cast<std::ptrdiff_t>(ins.position), k);
-    }
+    const auto inserted = insertion_order(start, stops);
     const auto planned = plan_tour_order(timing, start, stops, inserted);
     CAPTURE(n);
     CHECK(planned.size() == n);

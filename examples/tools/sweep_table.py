@@ -141,15 +141,15 @@ def schedule_table(configs, keys):
         both = [k for k in keys if k in runs and "adaptive" in runs[k] and "tour" in runs[k]]
         if not both:
             continue
+        # A different mission: a descent deferred, or other descents (times alone move with
+        # measured segmentation times).
+        deferred_runs = {d["run"] for d in decisions if d["strategy"] == "tour" and d["action"] == "descend"
+                         and d.get("flown") == "tour"}
+        differ = sum(1 for k in both if k[0] in deferred_runs or runs[k]["tour"][1] != runs[k]["adaptive"][1])
         for strategy in ("adaptive", "tour"):
             v = [runs[k][strategy] for k in both]
             deferred = sum(1 for d in decisions if d["strategy"] == strategy and d["action"] == "descend"
                            and d.get("flown") == "tour")
-            # A different mission: a descent deferred, or other descents (times alone move with
-            # measured segmentation times).
-            deferred_runs = {d["run"] for d in decisions if d["strategy"] == "tour" and d["action"] == "descend"
-                             and d.get("flown") == "tour"}
-            differ = sum(1 for k in both if k[0] in deferred_runs or runs[k]["tour"][1] != runs[k]["adaptive"][1])
             changes = [x[3] for x in v if x[3] is not None]
             print(f"| {label} | {strategy} | {len(v)} | {statistics.median(x[0] for x in v):+.4f} | "
                   f"{statistics.mean(x[0] for x in v):+.4f} | {sum(x[2] for x in v):.0f} | "

@@ -555,7 +555,7 @@ class AdaptivePlanner {
     if (tour) rest += tour_flight_s(timing_, tour_start(), tour_stops_, tour_order_) + static_cast<double>(tour_images_) * per_image;
     const double elapsed = elapsed_s();
     std::vector<std::vector<Waypoint>> sub_plans;
-    std::vector<TourInsertion> insertions;
+    std::vector<std::pair<TourStop, TourInsertion>> stops;  // per candidate, for a deferred descent
     for (double g : candidates_) {
       auto sub = descent_plan(i, g);
       if (sub.empty()) continue;
@@ -568,10 +568,10 @@ class AdaptivePlanner {
       // top-level waypoint, where a tour already chosen starts, flying it at once is the
       // insertion at the tour's head, so the tour prices it (the at-once cost above would
       // ignore that the tour then starts from the descent's end).
+      const TourStop stop{sub.front().position, sub.back().position, inner};
       TourInsertion insertion;
       bool deferred = false;
       if (tour) {
-        const TourStop stop{sub.front().position, sub.back().position, inner};
         insertion = cheapest_insertion(timing_, tour_start(), tour_stops_, tour_order_, stop);
         deferred = (last && !tour_order_.empty()) || insertion.added_s < flight;
         if (deferred) flight = insertion.added_s;
@@ -589,12 +589,12 @@ class AdaptivePlanner {
       }
       rec.candidates.push_back(c);
       sub_plans.push_back(std::move(sub));
-      insertions.push_back(insertion);
+      stops.emplace_back(stop, insertion);
     }
     std::vector<LawnmowerForecast> forecasts;
     for (const auto& l : lawnmowers_)
       forecasts.push_back(
-          {l.gsd_cm, l.flight_s + static_cast<double>(l.images) * (segmentation_estimate() + planning_estimate())});
+          {l.gsd_cm, l.flight_s + static_cast<double>(l.images) * per_image});
     DecisionContext ctx;
     ctx.sigma = rec.sigma;
     ctx.valid_fraction = valid_fraction(top_[i].footprint);
@@ -610,12 +610,9 @@ class AdaptivePlanner {
       const std::size_t k = chosen_candidate(rec.decision, rec.candidates, policy_.name());
       ChosenDescent chosen{decisions_.size(), i, rec.candidates[k].altitude_m, descents_chosen_++, std::move(sub_plans[k])};
       if (rec.candidates[k].deferred) {
-        const auto& sub = chosen.plan;
-        double inner = 0.0;
-        for (std::size_t m = 1; m < sub.size(); ++m) inner += timing_.segment_time_s(sub[m - 1].position, sub[m].position);
-        tour_stops_.push_back({sub.front().position, sub.back().position, inner});
-        tour_order_.insert(tour_order_.begin() + static_cast<std::ptrdiff_t>(insertions[k].position), queued_.size());
-        tour_images_ += sub.size();
+        tour_stops_.push_back(stops[k].first);
+        tour_order_.insert(tour_order_.begin() + static_cast<std::ptrdiff_t>(stops[k].second.position), queued_.size());
+        tour_images_ += chosen.plan.size();
         queued_.push_back(std::move(chosen));
       } else {
         start_descent(std::move(chosen));
