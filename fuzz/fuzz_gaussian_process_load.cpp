@@ -1,10 +1,12 @@
-// Fuzz target: the text loaders of the Gaussian processes (both kernels) and of the
-// decision function of format-1 model files that embeds them, from memory.
+// Fuzz target: the file readers of the Gaussian processes (both kernels; YAML and adaptseg
+// 0.1's text format) and of the decision function of format-1 model files that embeds them,
+// from memory.
 
 #include "fuzz_support.hpp"
 
 #include <adaptseg/decision_model.hpp>
 #include <adaptseg/gaussian_process.hpp>
+#include <adaptseg/gp_io.hpp>
 
 #include <cstddef>
 #include <cstdint>
@@ -16,11 +18,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   using namespace adaptseg;
   fuzz::expect_clean([&] {
     std::istringstream is(text);
-    (void)GaussianProcess<SquaredExponentialKernel>::load(is);
+    (void)load_gaussian_process<SquaredExponentialKernel>(is);
   });
   fuzz::expect_clean([&] {
     std::istringstream is(text);
-    (void)GaussianProcess<ArdSquaredExponentialKernel>::load(is);
+    (void)load_gaussian_process<ArdSquaredExponentialKernel>(is);
   });
   fuzz::expect_clean([&] {
     std::istringstream is(text);

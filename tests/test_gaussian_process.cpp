@@ -1,7 +1,6 @@
 // Tests for adaptseg/gaussian_process.hpp: kernel concept, a conformance suite run on every
 // kernel model, agreement with scikit-learn (fixtures from tests/tools/make_gp_fixtures.py),
 // and properties (gradient, online updates, degenerate data, persistence).
-#include "comma_locale.hpp"
 
 #include <adaptseg/gaussian_process.hpp>
 
@@ -12,7 +11,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -844,130 +842,4 @@ TEST_CASE("errors: non-finite input, shapes, options, numerical failure") {
   CHECK_NOTHROW(lenient.fit(xd, Eigen::Vector3d(1.0, 2.0, 3.0), {.optimize = false}));
 }
 
-// ============================================================================================
-// Persistence
-// ============================================================================================
-
-namespace {
-GaussianProcess<ArdSquaredExponentialKernel> fitted_ard_model() {
-  const Eigen::MatrixXd x = random_inputs(20, 2, 81);
-  const Eigen::VectorXd y = 50.0 * smooth_targets(x, 82);
-  GaussianProcess<ArdSquaredExponentialKernel> gp(conformance_kernel<ArdSquaredExponentialKernel>(2),
-                                                  {.normalize_y = true});
-  gp.fit(x, y, {.restarts = 1});
-  gp.add_observation(Eigen::Vector2d(1.0, 2.0), 160.0);  // normalisation stays frozen
-  return gp;
-}
-}  // namespace
-
-TEST_CASE("persistence: save and load round trip, file and embedded stream") {
-  const auto gp = fitted_ard_model();
-  const Eigen::MatrixXd xq = random_inputs(7, 2, 83);
-
-  std::stringstream ss;
-  ss << "header of a larger file\n";
-  gp.save(ss);
-  ss << "trailer\n";
-  std::string first;
-  std::getline(ss, first);
-  auto loaded = GaussianProcess<ArdSquaredExponentialKernel>::load(ss);
-  std::string rest;
-  std::getline(ss, rest);
-  CHECK(rest == "trailer");  // load stops after its own 'end' line
-
-  CHECK(loaded.size() == gp.size());
-  CHECK(loaded.kernel().log_parameters() == gp.kernel().log_parameters());
-  CHECK(loaded.y_mean() == gp.y_mean());
-  CHECK(loaded.y_std() == gp.y_std());
-  CHECK(loaded.options().normalize_y);
-  CHECK(loaded.training_inputs() == gp.training_inputs());
-  CHECK(loaded.training_targets() == gp.training_targets());
-  const auto a = gp.predict(xq);
-  const auto b = loaded.predict(xq);
-  CHECK(scaled_error(a.mean, b.mean, a.mean.cwiseAbs().maxCoeff()) < 1e-12);
-  CHECK(scaled_error(a.variance, b.variance, gp.y_std() * gp.y_std()) < 1e-12);
-
-  const auto path = std::filesystem::temp_directory_path() / "adaptseg_test_gp_roundtrip.gp";
-  gp.save(path);
-  const auto from_file = GaussianProcess<ArdSquaredExponentialKernel>::load(path);
-  CHECK(from_file.log_marginal_likelihood() == doctest::Approx(gp.log_marginal_likelihood()).epsilon(1e-12));
-  std::filesystem::remove(path);
-  CHECK_THROWS_WITH_AS((void)GaussianProcess<ArdSquaredExponentialKernel>::load(path), doctest::Contains("cannot open"),
-                       std::invalid_argument);
-
-  // An empty model round-trips too.
-  GaussianProcess<SquaredExponentialKernel> empty(SquaredExponentialKernel(0.5));
-  std::stringstream es;
-  empty.save(es);
-  const auto e2 = GaussianProcess<SquaredExponentialKernel>::load(es);
-  CHECK(e2.size() == 0);
-}
-
-TEST_CASE("persistence: a model saved under a comma-decimal global locale loads with the same predictions") {
-  const auto gp = fitted_ard_model();
-  std::stringstream plain;
-  gp.save(plain);
-  std::stringstream comma;
-  {
-    const adaptseg::test::CommaLocale guard;
-    gp.save(comma);
-  }
-  CHECK(comma.str() == plain.str());
-  const Eigen::MatrixXd xq = random_inputs(5, 2, 7);
-  const auto back = GaussianProcess<ArdSquaredExponentialKernel>::load(comma);
-  const auto a = gp.predict(xq);
-  CHECK(scaled_error(a.mean, back.predict(xq).mean, a.mean.cwiseAbs().maxCoeff()) < 1e-12);  // as a plain round trip
-}
-
-TEST_CASE("persistence: truncated, garbled and mismatched files are rejected") {
-  const auto gp = fitted_ard_model();
-  std::stringstream ss;
-  gp.save(ss);
-  const std::string text = ss.str();
-  using Ard = GaussianProcess<ArdSquaredExponentialKernel>;
-  const auto load_text = [](const std::string& t) {
-    std::istringstream is(t);
-    return Ard::load(is);
-  };
-  CHECK_NOTHROW((void)load_text(text));
-
-  // Every truncation at a line boundary, and a few inside lines.
-  std::vector<std::size_t> cuts;
-  for (std::size_t i = 0; i < text.size(); ++i)
-    if (text[i] == '\n' && i + 1 < text.size()) cuts.push_back(i + 1);
-  cuts.push_back(text.size() / 2);
-  cuts.push_back(0);
-  for (const std::size_t cut : cuts) {
-    CAPTURE(cut);
-    CHECK_THROWS_AS((void)load_text(text.substr(0, cut)), std::invalid_argument);
-  }
-  CHECK_THROWS_WITH_AS((void)load_text(text.substr(0, text.size() / 2)), doctest::Contains("line"),
-                       std::invalid_argument);
-
-  const auto replace = [&](const std::string& from, const std::string& to) {
-    std::string t = text;
-    const auto pos = t.find(from);
-    REQUIRE(pos != std::string::npos);
-    t.replace(pos, from.size(), to);
-    return t;
-  };
-  CHECK_THROWS_WITH_AS((void)load_text(replace("adaptseg.gaussian_process 1", "adaptseg.gaussian_process 2")),
-                       doctest::Contains("version"), std::invalid_argument);
-  CHECK_THROWS_WITH_AS((void)load_text(replace("squared_exponential_ard", "squared_exponential_isotropic")),
-                       doctest::Contains("kernel"), std::invalid_argument);
-  CHECK_THROWS_WITH_AS((void)load_text(replace("dimension 2", "dimension two")), doctest::Contains("integer"),
-                       std::invalid_argument);
-  CHECK_THROWS_WITH_AS((void)load_text(replace("normalize_y 1", "normalise_y 1")), doctest::Contains("normalize_y"),
-                       std::invalid_argument);
-  CHECK_THROWS_AS((void)load_text(replace("log_parameters 4", "log_parameters 5")), std::invalid_argument);
-  CHECK_THROWS_AS((void)load_text(replace("y_std ", "y_std -")), std::invalid_argument);
-  CHECK_THROWS_AS((void)load_text(replace("samples 21", "samples 22")), std::invalid_argument);
-  CHECK_THROWS_AS((void)load_text(replace("samples 21", "samples 20")), std::invalid_argument);
-  CHECK_THROWS_AS((void)load_text(replace("\nend ", "\nnan ")), std::invalid_argument);
-  // A sample with a garbled number.
-  const auto sample_line = text.find('\n', text.find("samples 21")) + 1;
-  const std::string garbled = text.substr(0, sample_line) + std::string(1, 'x') + text.substr(sample_line);
-  CHECK_THROWS_WITH_AS((void)load_text(garbled), doctest::Contains("finite number"), std::invalid_argument);
-  // Comments and blank lines are allowed (hand-annotated files).
-  CHECK_NOTHROW((void)load_text("# decision-function model\n\n" + text));
-}
+// Persistence (the model's State as a YAML file): tests/test_gp_io.cpp.

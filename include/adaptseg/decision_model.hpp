@@ -12,7 +12,9 @@
 #include <adaptseg/camera.hpp>
 #include <adaptseg/decision_function.hpp>
 #include <adaptseg/detail/number_text.hpp>
+#include <adaptseg/detail/yaml_io.hpp>
 #include <adaptseg/field.hpp>
+#include <adaptseg/gp_io.hpp>
 #include <adaptseg/lawnmower_planner.hpp>
 #include <adaptseg/linear_decision.hpp>
 #include <adaptseg/timing.hpp>
@@ -38,159 +40,6 @@ namespace adaptseg {
 namespace detail {
 
 using ModelGp = GainModel::Gp;
-
-/// Throws std::invalid_argument("<where>: <what>").
-[[noreturn]] inline void model_error(const std::string& where, const std::string& what) {
-  throw std::invalid_argument(where + ": " + what);
-}
-
-/// The decision-model YAML reader: every value read through the number codec, every error
-/// naming the key.
-class ModelReader {
- public:
-  ModelReader(YAML::Node node, std::string where) : node_(std::move(node)), where_(std::move(where)) {}
-
-  [[nodiscard]] bool has(const char* key) const { return static_cast<bool>(node_[key]); }
-  [[nodiscard]] YAML::Node node(const char* key) const {
-    const YAML::Node n = node_[key];
-    if (!n) model_error(where_, std::string("missing key '") + path(key) + "'");
-    return n;
-  }
-  [[nodiscard]] ModelReader map(const char* key) const {
-    const YAML::Node n = node(key);
-    if (!n.IsMap()) model_error(where_, "'" + path(key) + "' must be a mapping");
-    return ModelReader(n, where_, path(key));
-  }
-  [[nodiscard]] std::string text(const char* key) const {
-    const YAML::Node n = node(key);
-    if (!n.IsScalar()) model_error(where_, "'" + path(key) + "' must be a scalar");
-    return n.Scalar();
-  }
-  [[nodiscard]] double number(const char* key) const { return number_of(node(key), path(key)); }
-  [[nodiscard]] long long integer(const char* key, long long lo, long long hi) const {
-    const YAML::Node n = node(key);
-    const auto v = n.IsScalar() ? parse_integer(n.Scalar(), lo, hi) : std::nullopt;
-    if (!v)
-      model_error(where_, "'" + path(key) + "' must be an integer in [" + std::to_string(lo) + ", " +
-                              std::to_string(hi) + "]");
-    return *v;
-  }
-  [[nodiscard]] bool flag(const char* key) const {
-    const std::string t = text(key);
-    if (t != "true" && t != "false") model_error(where_, "'" + path(key) + "' must be true or false (got '" + t + "')");
-    return t == "true";
-  }
-  [[nodiscard]] std::vector<double> numbers(const char* key) const {
-    const YAML::Node n = node(key);
-    if (!n.IsSequence()) model_error(where_, "'" + path(key) + "' must be a list of numbers");
-    std::vector<double> out;
-    for (std::size_t k = 0; k < n.size(); ++k) out.push_back(number_of(n[k], path(key) + "[" + std::to_string(k) + "]"));
-    return out;
-  }
-  [[nodiscard]] std::vector<std::string> texts(const char* key) const {
-    const YAML::Node n = node(key);
-    if (!n.IsSequence()) model_error(where_, "'" + path(key) + "' must be a list");
-    std::vector<std::string> out;
-    for (const auto& v : n) {
-      if (!v.IsScalar()) model_error(where_, "'" + path(key) + "' must be a list of names");
-      out.push_back(v.Scalar());
-    }
-    return out;
-  }
-  [[nodiscard]] const std::string& where() const noexcept { return where_; }
-  [[nodiscard]] std::string path(const char* key) const { return prefix_.empty() ? key : prefix_ + "." + key; }
-  [[nodiscard]] double number_of(const YAML::Node& n, const std::string& what) const {
-    const auto v = n.IsScalar() ? parse_number(n.Scalar()) : std::nullopt;
-    if (!v) model_error(where_, "'" + what + "' must be a finite number" + (n.IsScalar() ? " (got '" + n.Scalar() + "')" : ""));
-    return *v;
-  }
-
- private:
-  ModelReader(YAML::Node node, std::string where, std::string prefix)
-      : node_(std::move(node)), where_(std::move(where)), prefix_(std::move(prefix)) {}
-  YAML::Node node_;
-  std::string where_;
-  std::string prefix_;
-};
-
-inline YAML::Emitter& emit_number(YAML::Emitter& e, double v) { return e << format_number(v); }
-
-inline YAML::Emitter& emit_numbers(YAML::Emitter& e, const Eigen::Ref<const Eigen::VectorXd>& v) {
-  e << YAML::Flow << YAML::BeginSeq;
-  for (Eigen::Index k = 0; k < v.size(); ++k) emit_number(e, v(k));
-  return e << YAML::EndSeq;
-}
-
-inline YAML::Emitter& emit_numbers(YAML::Emitter& e, const std::vector<double>& v) {
-  return emit_numbers(e, Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size())));
-}
-
-inline const char* flag_text(bool b) { return b ? "true" : "false"; }
-
-/// A fitted GP as a mapping: kernel, hyperparameters with bounds, options, normalisation, data.
-inline void emit_gp(YAML::Emitter& e, const ModelGp& gp) {
-  const auto s = gp.state();
-  e << YAML::BeginMap;
-  e << YAML::Key << "kernel" << YAML::Value << std::string(ArdSquaredExponentialKernel::kName);
-  e << YAML::Key << "log_parameters" << YAML::Value;
-  emit_numbers(e, s.kernel.log_parameters());
-  e << YAML::Key << "log_lower_bounds" << YAML::Value;
-  emit_numbers(e, s.kernel.log_lower_bounds());
-  e << YAML::Key << "log_upper_bounds" << YAML::Value;
-  emit_numbers(e, s.kernel.log_upper_bounds());
-  e << YAML::Key << "normalize_y" << YAML::Value << flag_text(s.options.normalize_y);
-  e << YAML::Key << "y_mean" << YAML::Value;
-  emit_number(e, s.y_mean);
-  e << YAML::Key << "y_std" << YAML::Value;
-  emit_number(e, s.y_std);
-  e << YAML::Key << "initial_jitter" << YAML::Value;
-  emit_number(e, s.options.initial_jitter);
-  e << YAML::Key << "max_jitter_attempts" << YAML::Value << std::to_string(s.options.max_jitter_attempts);
-  e << YAML::Key << "inputs" << YAML::Value << YAML::BeginSeq;
-  for (Eigen::Index r = 0; r < s.inputs.rows(); ++r) emit_numbers(e, s.inputs.row(r).transpose());
-  e << YAML::EndSeq;
-  e << YAML::Key << "targets" << YAML::Value;
-  emit_numbers(e, s.targets);
-  e << YAML::EndMap;
-}
-
-/// Reads what emit_gp wrote; `dimension` is the number of inputs the model's role needs
-/// (0: 1 or 2).
-inline ModelGp read_gp(const ModelReader& r, int dimension) {
-  const std::string kernel = r.text("kernel");
-  if (kernel != ArdSquaredExponentialKernel::kName)
-    model_error(r.where(), "'" + r.path("kernel") + "' must be " + std::string(ArdSquaredExponentialKernel::kName) +
-                               " (got '" + kernel + "')");
-  const auto vec = [&](const char* key) {
-    const auto v = r.numbers(key);
-    return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size())));
-  };
-  ModelGp::State s{ArdSquaredExponentialKernel::from_log_parameters(vec("log_parameters"), vec("log_lower_bounds"),
-                                                                    vec("log_upper_bounds")),
-                   {}, 0.0, 1.0, {}, {}};
-  s.options.normalize_y = r.flag("normalize_y");
-  s.options.initial_jitter = r.number("initial_jitter");
-  s.options.max_jitter_attempts = static_cast<int>(r.integer("max_jitter_attempts", 0, 30));
-  s.y_mean = r.number("y_mean");
-  s.y_std = r.number("y_std");
-  s.targets = vec("targets");
-  const YAML::Node rows = r.node("inputs");
-  if (!rows.IsSequence() || rows.size() != static_cast<std::size_t>(s.targets.size()) || rows.size() == 0)
-    model_error(r.where(), "'" + r.path("inputs") + "' must be a list of as many input rows as 'targets' has values (>= 1)");
-  const auto dims = rows[0].IsSequence() ? static_cast<Eigen::Index>(rows[0].size()) : 0;
-  if ((dimension > 0 && dims != dimension) || (dimension == 0 && dims != 1 && dims != 2))
-    model_error(r.where(), "'" + r.path("inputs") + "' rows must have " +
-                               (dimension > 0 ? std::to_string(dimension) : std::string("1 or 2")) + " values");
-  s.inputs.resize(static_cast<Eigen::Index>(rows.size()), dims);
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    if (!rows[i].IsSequence() || static_cast<Eigen::Index>(rows[i].size()) != dims)
-      model_error(r.where(), "'" + r.path("inputs") + "' rows must all have " + std::to_string(dims) + " values");
-    for (Eigen::Index d = 0; d < dims; ++d)
-      s.inputs(static_cast<Eigen::Index>(i), d) =
-          r.number_of(rows[i][static_cast<std::size_t>(d)], r.path("inputs") + "[" + std::to_string(i) + "]");
-  }
-  return ModelGp::from_state(std::move(s));
-}
 
 /// Reads the decision-function text of adaptseg 0.1 (`adaptseg.decision_function` versions
 /// 1-3, embedded in decision-model files of format 1). `field` names the calibration field
@@ -247,10 +96,10 @@ inline ModelGp read_gp(const ModelReader& r, int dimension) {
     }
   }
   is >> std::ws;
-  ModelGp o = ModelGp::load(is);
+  ModelGp o = read_gp_text_v1<ModelGp::KernelType>(is);
   is >> std::ws;
   ModelGp i = [&] {
-    if (version == "3") return ModelGp::load(is);
+    if (version == "3") return read_gp_text_v1<ModelGp::KernelType>(is);
     // Versions 1-2 stored I with the isotropic kernel, which for its one input is the ARD
     // kernel with one length scale (same parameters, same layout).
     std::string block, line;
@@ -266,7 +115,7 @@ inline ModelGp read_gp(const ModelReader& r, int dimension) {
     }
     require(ended, "DecisionFunction::load: input ends inside I's Gaussian process", "<end of input>");
     std::istringstream in(block);
-    ModelGp gp = ModelGp::load(in);
+    ModelGp gp = read_gp_text_v1<ModelGp::KernelType>(in);
     require(gp.dimension() == 1, "DecisionFunction::load: I of a version 1-2 file must have 1 input; dimension",
             gp.dimension());
     return gp;
@@ -461,17 +310,17 @@ struct DecisionModel {
   ///         another format, a missing or mistyped key, a broken decision function).
   [[nodiscard]] static DecisionModel load(const std::filesystem::path& path) {
     const std::string where = path.string();
-    if (!std::filesystem::is_regular_file(path)) detail::model_error(where, "decision model file not found");
+    if (!std::filesystem::is_regular_file(path)) detail::yaml_error(where, "decision model file not found");
     YAML::Node root;
     try {
       root = YAML::LoadFile(path.string());
     } catch (const YAML::Exception& ex) {
-      detail::model_error(where, std::string("YAML error: ") + ex.what());
+      detail::yaml_error(where, std::string("YAML error: ") + ex.what());
     }
-    if (!root.IsMap()) detail::model_error(where, "not a decision model (the document must be a mapping)");
-    try {
+    if (!root.IsMap()) detail::yaml_error(where, "not a decision model (the document must be a mapping)");
+    return detail::naming_file(where, [&] {
       const std::string format = root["format"] && root["format"].IsScalar() ? root["format"].Scalar() : "";
-      const detail::ModelReader r(root, where);
+      const detail::YamlReader r(root, where);
       DecisionModel m = format == "adaptseg.decision_model/2"   ? read_v2(r)
                         : format == "adaptseg.decision_model/1" ? read_v1(r)
                                                                 : throw std::invalid_argument(
@@ -480,13 +329,7 @@ struct DecisionModel {
                                                                       "be adaptseg.decision_model/2 or /1)");
       m.check(where);
       return m;
-    } catch (const YAML::Exception& ex) {
-      detail::model_error(where, std::string("bad value: ") + ex.what());
-    } catch (const std::invalid_argument& ex) {
-      const std::string what = ex.what();
-      if (what.rfind(where, 0) == 0) throw;
-      detail::model_error(where, what);
-    }
+    });
   }
 
  private:
@@ -497,7 +340,7 @@ struct DecisionModel {
   }
 
   /// The keys both formats share, read into `m`.
-  static void read_common(const detail::ModelReader& r, DecisionModel& m) {
+  static void read_common(const detail::YamlReader& r, DecisionModel& m) {
     m.classes = r.texts("classes");
     m.interest = r.texts("interest");
     const auto cam = r.map("camera");
@@ -538,7 +381,7 @@ struct DecisionModel {
 
   // Both readers read keys in the order of the model's members: a file with several faults
   // reports the first in that order.
-  static DecisionModel read_v1(const detail::ModelReader& r) {
+  static DecisionModel read_v1(const detail::YamlReader& r) {
     const std::string field = r.text("calibration_field");
     std::istringstream df(r.text("decision_function"));
     std::string segmenter = r.text("segmenter");
@@ -550,12 +393,12 @@ struct DecisionModel {
     return m;
   }
 
-  static DecisionModel read_v2(const detail::ModelReader& r) {
+  static DecisionModel read_v2(const detail::YamlReader& r) {
     const auto cal = r.map("calibration");
     const auto gm = r.map("gain_model");
     const std::string inputs = gm.text("gain_inputs");
     if (inputs != "delta-sigma" && inputs != "delta-sigma-height")
-      detail::model_error(r.where(), "'gain_model.gain_inputs' must be delta-sigma or delta-sigma-height (got '" +
+      detail::yaml_error(r.where(), "'gain_model.gain_inputs' must be delta-sigma or delta-sigma-height (got '" +
                                          inputs + "')");
     const bool with_c = gm.has("C");
     std::vector<GainModel::EfficiencyPoint> efficiency;
@@ -564,12 +407,14 @@ struct DecisionModel {
       const auto h = eff.numbers("delta_h_m");
       const auto v = eff.numbers("eta");
       if (h.size() != v.size() || h.empty())
-        detail::model_error(r.where(), "'gain_model.efficiency' needs as many 'eta' as 'delta_h_m' values (>= 1)");
+        detail::yaml_error(r.where(), "'gain_model.efficiency' needs as many 'eta' as 'delta_h_m' values (>= 1)");
       for (std::size_t k = 0; k < h.size(); ++k) efficiency.push_back({h[k], v[k]});
     }
-    GainModel model(detail::read_gp(gm.map("O"), 2), detail::read_gp(gm.map("I"), inputs == "delta-sigma" ? 1 : 2),
-                    with_c ? std::optional(detail::read_gp(gm.map("C"), 2)) : std::nullopt, std::move(efficiency),
-                    static_cast<int>(gm.integer("refit_every", 0, 1'000'000'000)));
+    const auto gp = [&](const char* key, Eigen::Index dimension) {
+      return detail::read_gp<detail::ModelGp::KernelType>(gm.map(key), dimension);
+    };
+    GainModel model(gp("O", 2), gp("I", inputs == "delta-sigma" ? 1 : 2), with_c ? std::optional(gp("C", 2)) : std::nullopt,
+                    std::move(efficiency), static_cast<int>(gm.integer("refit_every", 0, 1'000'000'000)));
     const auto rule = r.map("rule");
     const std::string kind = rule.text("kind");
     const bool online = rule.flag("online");
@@ -578,15 +423,15 @@ struct DecisionModel {
     const auto make_function = [&]() -> DecisionFunction {
       if (kind == "front-aware") {
         const YAML::Node refs = rule.node("reference");
-        if (!refs.IsSequence()) detail::model_error(r.where(), "'rule.reference' must be a list of curves");
+        if (!refs.IsSequence()) detail::yaml_error(r.where(), "'rule.reference' must be a list of curves");
         std::vector<ReferenceCurve> reference;
         for (std::size_t k = 0; k < refs.size(); ++k) {
-          if (!refs[k].IsMap()) detail::model_error(r.where(), "'rule.reference' entries must be mappings");
-          const detail::ModelReader c(refs[k], r.where());
+          if (!refs[k].IsMap()) detail::yaml_error(r.where(), "'rule.reference' entries must be mappings");
+          const detail::YamlReader c(refs[k], r.where());
           const auto g = c.numbers("gsd_cm");
           const auto v = c.numbers("miou");
           if (g.size() != v.size())
-            detail::model_error(r.where(), "a 'rule.reference' curve needs as many 'miou' as 'gsd_cm' values");
+            detail::yaml_error(r.where(), "a 'rule.reference' curve needs as many 'miou' as 'gsd_cm' values");
           ReferenceCurve curve{c.text("field"), {}, c.has("field_sigma") ? c.number("field_sigma") : 0.0};
           for (std::size_t i = 0; i < g.size(); ++i) curve.points.push_back({g[i], v[i]});
           reference.push_back(std::move(curve));
@@ -606,7 +451,7 @@ struct DecisionModel {
                                                                  .weight_by_sigma = weight_by_sigma,
                                                                  .online = online,
                                                                  .relative_utility = rule.flag("relative_utility")}));
-      detail::model_error(r.where(), "'rule.kind' must be front-aware or utility (got '" + kind + "')");
+      detail::yaml_error(r.where(), "'rule.kind' must be front-aware or utility (got '" + kind + "')");
     };
     std::vector<std::string> fields = cal.texts("fields");
     std::string segmenter = cal.text("segmenter");
@@ -621,19 +466,19 @@ struct DecisionModel {
 
   /// What the model must satisfy whatever its format.
   void check(const std::string& where) const {
-    if (calibration_fields.empty()) detail::model_error(where, "no calibration field is named");
-    if (classes.empty()) detail::model_error(where, "'classes' is empty");
-    if (interest.empty()) detail::model_error(where, "'interest' is empty");
+    if (calibration_fields.empty()) detail::yaml_error(where, "no calibration field is named");
+    if (classes.empty()) detail::yaml_error(where, "'classes' is empty");
+    if (interest.empty()) detail::yaml_error(where, "'interest' is empty");
     for (const auto& n : interest)
       if (std::find(classes.begin(), classes.end(), n) == classes.end())
-        detail::model_error(where, "label of interest '" + n + "' is not among the classes");
-    if (!(top_gsd_cm > 0.0)) detail::model_error(where, "'top_gsd_cm' must be > 0");
-    if (candidate_gsd_cm.empty()) detail::model_error(where, "'candidate_gsd_cm' is empty");
+        detail::yaml_error(where, "label of interest '" + n + "' is not among the classes");
+    if (!(top_gsd_cm > 0.0)) detail::yaml_error(where, "'top_gsd_cm' must be > 0");
+    if (candidate_gsd_cm.empty()) detail::yaml_error(where, "'candidate_gsd_cm' is empty");
     for (double g : candidate_gsd_cm)
       if (!(g > 0.0 && g < top_gsd_cm))
-        detail::model_error(where, "candidate GSDs must be positive and finer than top_gsd_cm");
+        detail::yaml_error(where, "candidate GSDs must be positive and finer than top_gsd_cm");
     if (!(calibration_segmentation_time_s >= 0.0))
-      detail::model_error(where, "'calibration.segmentation_time_s' must be >= 0");
+      detail::yaml_error(where, "'calibration.segmentation_time_s' must be >= 0");
   }
 };
 

@@ -2,12 +2,13 @@
 /// @file
 /// Exact Gaussian-process regression with a squared-exponential kernel (paper eq:prior,
 /// eq:sqexp, eq:gp), hyperparameters by maximising the log marginal likelihood, online
-/// updates by extending the Cholesky factor, and a line-based text format for fitted models.
+/// updates by extending the Cholesky factor. A fitted model is saved and restored through its
+/// State (`state()`, `from_state`); the file format is in gp_io.hpp, not here.
 ///
 /// Self-contained: needs Eigen 3.4, LBFGSpp (header-only, reached only through
 /// detail/lbfgs.hpp) and adaptseg/error.hpp only. The kernel concept and the kernel are in
-/// gp_kernel.hpp, the vectorised loops in detail/gp_simd.hpp, the dense linear algebra and
-/// text helpers in detail/gp_numerics.hpp.
+/// gp_kernel.hpp, the vectorised loops in detail/gp_simd.hpp, the dense linear algebra in
+/// detail/gp_numerics.hpp.
 /// Conventions follow scikit-learn's `GaussianProcessRegressor` with the kernel
 /// `ConstantKernel(sf2) * RBF(length_scale) + WhiteKernel(sn2)` and `alpha = 0`, so that
 /// results can be checked against it (see tests/tools/make_gp_fixtures.py).
@@ -21,24 +22,17 @@
 #include <Eigen/Core>
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <concepts>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <exception>
-#include <filesystem>
-#include <fstream>
-#include <istream>
 #include <limits>
-#include <locale>
 #include <numbers>
-#include <ostream>
 #include <sstream>
 #include <string>
 #include <string_view>
-#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -117,8 +111,7 @@ enum class FitStatus {
 ///   Eigen::MatrixXd xq(1, 1); xq << 0.45;
 ///   const auto p = gp.predict(xq);                     // p.mean(0), p.variance(0)
 ///   gp.add_observation(Eigen::VectorXd::Constant(1, 1.2), -0.4);  // O(n^2), no refit
-///   gp.save("model.gp");                                  // readable text
-///   auto same = GaussianProcess<SquaredExponentialKernel>::load("model.gp");
+///   auto same = GaussianProcess<SquaredExponentialKernel>::from_state(gp.state());
 /// @endcode
 template <Kernel K>
 class GaussianProcess {
@@ -497,223 +490,9 @@ class GaussianProcess {
     return gp;
   }
 
-  /// Writes the model as text (format in `load`); leaves `os`'s formatting state unchanged.
-  /// Numbers are written in the classic "C" locale whatever the global one (load reads them
-  /// with `std::from_chars`, which knows no other).
-  /// @throws std::invalid_argument if the stream fails.
-  void save(std::ostream& os) const {
-    std::ostringstream s;
-    s.imbue(std::locale::classic());
-    s.precision(std::numeric_limits<double>::max_digits10);
-    const auto vec = [&s](std::string_view key, const Eigen::VectorXd& v) {
-      s << key << ' ' << v.size();
-      for (Eigen::Index i = 0; i < v.size(); ++i) s << ' ' << v(i);
-      s << '\n';
-    };
-    s << kMagic << ' ' << kFormatVersion << '\n';
-    s << "kernel " << K::kName << '\n';
-    vec("log_parameters", kernel_.log_parameters());
-    vec("log_lower_bounds", kernel_.log_lower_bounds());
-    vec("log_upper_bounds", kernel_.log_upper_bounds());
-    s << "normalize_y " << (options_.normalize_y ? 1 : 0) << '\n';
-    s << "y_mean " << y_mean_ << '\n';
-    s << "y_std " << y_std_ << '\n';
-    s << "initial_jitter " << options_.initial_jitter << '\n';
-    s << "max_jitter_attempts " << options_.max_jitter_attempts << '\n';
-    s << "dimension " << dimension_ << '\n';
-    s << "samples " << n_ << '\n';
-    for (Eigen::Index i = 0; i < n_; ++i) {
-      for (Eigen::Index d = 0; d < dimension_; ++d) s << x_(i, d) << ' ';
-      s << y_(i) << '\n';
-    }
-    s << "end " << kMagic << '\n';
-    os << s.str();
-    detail::require(static_cast<bool>(os), "GaussianProcess::save: output stream failed, good()", os.good());
-  }
-
-  /// Writes the model to `path` (created or truncated).
-  /// @throws std::invalid_argument if the file cannot be written.
-  void save(const std::filesystem::path& path) const {
-    std::ofstream f(path);
-    detail::require(static_cast<bool>(f), "GaussianProcess::save: cannot open file for writing", path);
-    save(f);
-  }
-
-  /// Reads a model written by `save` and refactorises it; reads exactly up to and including
-  /// the `end` line, so the model can be embedded in a larger stream.
-  ///
-  /// Format (one item per line; blank lines and lines starting with '#' are ignored):
-  /// @code
-  ///   adaptseg.gaussian_process 1
-  ///   kernel <K::kName>
-  ///   log_parameters <p> <theta_1> ... <theta_p>
-  ///   log_lower_bounds <p> ...
-  ///   log_upper_bounds <p> ...
-  ///   normalize_y <0|1>
-  ///   y_mean <mean>
-  ///   y_std <std>
-  ///   initial_jitter <value>
-  ///   max_jitter_attempts <count>
-  ///   dimension <D>
-  ///   samples <n>
-  ///   <x_1> ... <x_D> <y>        (n lines)
-  ///   end adaptseg.gaussian_process
-  /// @endcode
-  /// @throws std::invalid_argument naming the line and what was expected, on a truncated or
-  ///         garbled input, another kernel type or an unsupported version; NumericalError.
-  [[nodiscard]] static GaussianProcess load(std::istream& is) {
-    Reader r{is};
-    {
-      const auto t = r.expect(kMagic, 1);
-      detail::require(t[1] == kFormatVersion,
-                      r.where() + "unsupported format version (this library reads " +
-                          std::string(kFormatVersion) + "), version",
-                      t[1]);
-    }
-    {
-      const auto t = r.expect("kernel", 1);
-      detail::require(t[1] == K::kName,
-                      r.where() + "kernel type does not match this GaussianProcess (" + std::string(K::kName) +
-                          "), kernel",
-                      t[1]);
-    }
-    const Eigen::VectorXd theta = r.vector("log_parameters");
-    const Eigen::VectorXd lower = r.vector("log_lower_bounds");
-    const Eigen::VectorXd upper = r.vector("log_upper_bounds");
-    K kernel = K::from_log_parameters(theta, lower, upper);
-    Options options;
-    const long normalize = r.integer("normalize_y");
-    detail::require(normalize == 0 || normalize == 1, r.where() + "normalize_y must be 0 or 1", normalize);
-    options.normalize_y = normalize == 1;
-    const double mean = r.real("y_mean");
-    const double stddev = r.real("y_std");
-    detail::require(stddev > 0.0, r.where() + "y_std must be > 0", stddev);
-    options.initial_jitter = r.real("initial_jitter");
-    const long attempts = r.integer("max_jitter_attempts");
-    detail::require(attempts >= 0 && attempts <= 30, r.where() + "max_jitter_attempts must be in [0, 30]", attempts);
-    options.max_jitter_attempts = static_cast<int>(attempts);
-    const long dimension = r.integer("dimension");
-    const long samples = r.integer("samples");
-    detail::require(samples >= 0 && samples <= 100'000'000, r.where() + "samples must be in [0, 1e8]", samples);
-    detail::require(dimension >= (samples > 0 ? 1 : 0) && dimension <= 1'000'000,
-                    r.where() + "dimension must be in [1, 1e6] (0 allowed without samples)", dimension);
-    // The announced sizes are not trusted for allocation: the dimension must be the kernel's,
-    // and the samples are stored as their lines arrive (memory bounded by the input's size).
-    detail::require(dimension == 0 || kernel.accepts_dimension(static_cast<Eigen::Index>(dimension)),
-                    r.where() + "the kernel does not accept dimension", dimension);
-    GaussianProcess gp(std::move(kernel), options);
-    gp.y_mean_ = mean;
-    gp.y_std_ = stddev;
-    const Eigen::Index n = static_cast<Eigen::Index>(samples);
-    const Eigen::Index dims = static_cast<Eigen::Index>(dimension);
-    std::vector<double> values;  // row-major, dims + 1 per sample
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const auto tokens = r.next("sample " + std::to_string(i + 1) + " of " + std::to_string(n));
-      detail::require(static_cast<Eigen::Index>(tokens.size()) == dims + 1,
-                      r.where() + "a sample line needs " + std::to_string(dims + 1) + " numbers, found",
-                      tokens.size());
-      for (const auto& token : tokens) values.push_back(r.parse_real(token));
-    }
-    r.expect("end", 1);
-    if (n > 0) {
-      const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> rows(
-          values.data(), n, dims + 1);
-      const Eigen::MatrixXd x = rows.leftCols(dims);
-      const Eigen::VectorXd y = rows.col(dims);
-      gp.condition(x, y);
-    } else {
-      gp.dimension_ = dims;
-    }
-    return gp;
-  }
-
-  /// Reads a model from `path`.
-  /// @throws std::invalid_argument if the file cannot be opened or is malformed (the message
-  ///         names the path); NumericalError.
-  [[nodiscard]] static GaussianProcess load(const std::filesystem::path& path) {
-    std::ifstream f(path);
-    detail::require(static_cast<bool>(f), "GaussianProcess::load: cannot open file", path);
-    try {
-      return load(f);
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(path.string() + ": " + e.what());
-    }
-  }
-
  private:
-  static constexpr std::string_view kMagic = "adaptseg.gaussian_process";
-  static constexpr std::string_view kFormatVersion = "1";
   /// Fresh L-BFGS-B runs per start after a failed line search.
   static constexpr int kMaxSolverRestarts = 20;
-
-  /// Line-based tokenizer for `load`.
-  struct Reader {
-    explicit Reader(std::istream& input) : is(input) {}
-    std::istream& is;
-    long line_number = 0;
-    std::string line;
-
-    [[nodiscard]] std::string where() const {
-      return "GaussianProcess::load: line " + std::to_string(line_number) + ": ";
-    }
-
-    std::vector<std::string> next(const std::string& expected) {
-      while (true) {
-        if (!std::getline(is, line)) {
-          throw std::invalid_argument("GaussianProcess::load: unexpected end of input after line " +
-                                      std::to_string(line_number) + " (truncated file?), expected " + expected);
-        }
-        ++line_number;
-        const std::string t = detail::gp_trim(line);
-        if (t.empty() || t.front() == '#') continue;
-        std::vector<std::string> out;
-        for (auto v : detail::gp_split(t)) out.emplace_back(v);
-        return out;
-      }
-    }
-
-    std::vector<std::string> expect(std::string_view key, std::size_t values) {
-      auto t = next(detail::gp_quote(key));
-      detail::require(!t.empty() && t[0] == key && t.size() == values + 1,
-                      where() + "expected '" + std::string(key) + "' followed by " + std::to_string(values) +
-                          " value(s), got",
-                      detail::gp_quote(line));
-      return t;
-    }
-
-    double parse_real(const std::string& token) const {
-      double v = 0.0;
-      const auto* end = token.data() + token.size();
-      const auto [ptr, ec] = std::from_chars(token.data(), end, v);
-      detail::require(ec == std::errc() && ptr == end && std::isfinite(v), where() + "expected a finite number, got",
-                      detail::gp_quote(token));
-      return v;
-    }
-
-    long parse_integer(const std::string& token) const {
-      long v = 0;
-      const auto* end = token.data() + token.size();
-      const auto [ptr, ec] = std::from_chars(token.data(), end, v);
-      detail::require(ec == std::errc() && ptr == end, where() + "expected an integer, got", detail::gp_quote(token));
-      return v;
-    }
-
-    double real(std::string_view key) { return parse_real(expect(key, 1)[1]); }
-    long integer(std::string_view key) { return parse_integer(expect(key, 1)[1]); }
-
-    Eigen::VectorXd vector(std::string_view key) {
-      auto t = next(detail::gp_quote(key));
-      detail::require(t.size() >= 2 && t[0] == key, where() + "expected '" + std::string(key) + " <count> <values>', got",
-                      detail::gp_quote(line));
-      const long count = parse_integer(t[1]);
-      detail::require(count >= 1 && static_cast<std::size_t>(count) + 2 == t.size(),
-                      where() + "'" + std::string(key) + "' announces " + t[1] + " values, found",
-                      t.size() - 2);
-      Eigen::VectorXd v(count);
-      for (Eigen::Index i = 0; i < count; ++i) v(i) = parse_real(t[static_cast<std::size_t>(i) + 2]);
-      return v;
-    }
-  };
 
   void check_training_data(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y) const {
     detail::require(x.rows() >= 1, "GaussianProcess: number of training samples (rows of x) must be >= 1", x.rows());

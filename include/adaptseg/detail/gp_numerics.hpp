@@ -1,8 +1,7 @@
 #pragma once
 /// @file
 /// Internals of gaussian_process.hpp: blocked triangular inversion and Gram products, a scope
-/// that flushes subnormals, the seeded random generator of the optimiser's restarts, and the
-/// text helpers of the model format.
+/// that flushes subnormals, and the seeded random generator of the optimiser's restarts.
 
 #include <Eigen/Core>
 
@@ -12,9 +11,7 @@
 #endif
 
 #include <cstdint>
-#include <string>
-#include <string_view>
-#include <vector>
+#include <exception>
 
 namespace adaptseg {
 
@@ -123,35 +120,6 @@ class GpSplitMix64 {
 struct GpObjectiveAborted {
   std::exception_ptr cause;
 };
-
-inline std::string gp_trim(std::string_view s) {
-  const auto first = s.find_first_not_of(" \t\r");
-  if (first == std::string_view::npos) return {};
-  const auto last = s.find_last_not_of(" \t\r");
-  return std::string(s.substr(first, last - first + 1));
-}
-
-/// 'text', built without operator+ (GCC 12 -Wrestrict false positive on "'" + s + "'").
-inline std::string gp_quote(std::string_view s) {
-  std::string out;
-  out.reserve(s.size() + 2);
-  out.push_back('\'');
-  out.append(s);
-  out.push_back('\'');
-  return out;
-}
-
-inline std::vector<std::string_view> gp_split(std::string_view s) {
-  std::vector<std::string_view> out;
-  std::size_t i = 0;
-  while (i < s.size()) {
-    while (i < s.size() && (s[i] == ' ' || s[i] == '\t')) ++i;
-    const std::size_t start = i;
-    while (i < s.size() && s[i] != ' ' && s[i] != '\t') ++i;
-    if (i > start) out.push_back(s.substr(start, i - start));
-  }
-  return out;
-}
 
 }  // namespace detail
 
