@@ -8,7 +8,7 @@
 /// locale-independent codec (detail/number_text.hpp). Files of format 1 (adaptseg 0.1, with
 /// the decision function as an embedded text block) still load, with identical predictions.
 
-#include <adaptseg/adaptive_planner.hpp>
+#include <adaptseg/adaptive_options.hpp>
 #include <adaptseg/camera.hpp>
 #include <adaptseg/decision_function.hpp>
 #include <adaptseg/detail/number_text.hpp>

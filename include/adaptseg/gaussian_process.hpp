@@ -7,16 +7,19 @@
 ///
 /// Self-contained: needs Eigen 3.4, LBFGSpp (header-only, reached only through
 /// detail/lbfgs.hpp) and adaptseg/error.hpp only. The kernel concept and the kernel are in
-/// gp_kernel.hpp, the vectorised loops in detail/gp_simd.hpp, the dense linear algebra in
-/// detail/gp_numerics.hpp.
+/// gp_kernel.hpp, the options and results in gp_options.hpp, the vectorised loops in
+/// detail/gp_simd.hpp, the dense linear algebra in detail/gp_numerics.hpp, the multi-start
+/// hyperparameter search in detail/gp_optimize.hpp.
 /// Conventions follow scikit-learn's `GaussianProcessRegressor` with the kernel
 /// `ConstantKernel(sf2) * RBF(length_scale) + WhiteKernel(sn2)` and `alpha = 0`, so that
 /// results can be checked against it (see tests/tools/make_gp_fixtures.py).
 
 #include <adaptseg/detail/gp_numerics.hpp>
+#include <adaptseg/detail/gp_optimize.hpp>
 #include <adaptseg/detail/lbfgs.hpp>
 #include <adaptseg/error.hpp>
 #include <adaptseg/gp_kernel.hpp>
+#include <adaptseg/gp_options.hpp>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
@@ -41,35 +44,6 @@ namespace adaptseg {
 // ============================================================================================
 // GaussianProcess
 // ============================================================================================
-
-/// What a predictive variance describes.
-enum class PredictiveVariance {
-  kLatent,  ///< variance of the latent f(x*) (eq:gp's sigma_*^2); scikit-learn's std with the
-            ///< WhiteKernel removed from the kernel.
-  kNoisy,   ///< variance of a new observation y* = f(x*) + noise: latent + sn2; what
-            ///< scikit-learn's `predict(return_std=True)` returns for this kernel.
-};
-
-/// How a hyperparameter search ended (an expected outcome, never an exception).
-enum class FitStatus {
-  kNotOptimized,      ///< `FitOptions::optimize` was false: hyperparameters kept as given.
-  kConverged,         ///< projected-gradient or relative-reduction criterion met.
-  kMaxIterations,     ///< iteration budget exhausted; the best point seen is kept.
-  kLineSearchFailed,  ///< no acceptable step (typical at a flat optimum); best point kept.
-  kNumericalFailure,  ///< the covariance could not be factorised along the path; best point kept.
-};
-
-/// Readable name of a `FitStatus`.
-[[nodiscard]] inline std::string_view to_string(FitStatus s) {
-  switch (s) {
-    case FitStatus::kNotOptimized: return "not_optimized";
-    case FitStatus::kConverged: return "converged";
-    case FitStatus::kMaxIterations: return "max_iterations";
-    case FitStatus::kLineSearchFailed: return "line_search_failed";
-    case FitStatus::kNumericalFailure: return "numerical_failure";
-  }
-  return "unknown";
-}
 
 /// Exact GP regression, zero prior mean (paper eq:prior) on optionally normalised targets,
 /// covariance from a `Kernel` (paper eq:sqexp), posterior by eq:gp computed as Rasmussen &
@@ -118,88 +92,12 @@ class GaussianProcess {
  public:
   using KernelType = K;
 
-  /// Model options, validated once by the constructor.
-  struct Options {
-    /// Subtract the target mean and divide by the target std at `fit` (then frozen).
-    bool normalize_y = false;
-    /// First jitter, relative to the mean of diag(K_XX); > 0 and finite.
-    double initial_jitter = 1e-10;
-    /// Number of jitter retries (each 10x the previous) after a failed Cholesky; 0..30.
-    int max_jitter_attempts = 8;
-
-    /// @throws std::invalid_argument naming the field.
-    void validate() const {
-      detail::require_positive(initial_jitter, "GaussianProcess::Options::initial_jitter");
-      detail::require(max_jitter_attempts >= 0 && max_jitter_attempts <= 30,
-                      "GaussianProcess::Options::max_jitter_attempts must be in [0, 30]",
-                      max_jitter_attempts);
-    }
-  };
-
-  /// Hyperparameter-search options, validated by `fit`/`refit`.
-  struct FitOptions {
-    /// false: keep the kernel's hyperparameters, only condition on the data.
-    bool optimize = true;
-    /// Extra starts after the first (from the kernel's hyperparameters), uniform in the log
-    /// bounds; >= 0.
-    int restarts = 3;
-    /// Seed of the restart points; same seed, same points.
-    std::uint64_t seed = 0;
-    /// L-BFGS-B iterations per start; >= 1.
-    int max_iterations = 15000;
-    /// Stop when the projected gradient's max-norm is below this (scipy's gtol); >= 0.
-    double gradient_tolerance = 1e-5;
-    /// Stop when the relative reduction of -LML is below this (scipy's factr * eps); >= 0.
-    double relative_tolerance = 1e7 * std::numeric_limits<double>::epsilon();
-    /// L-BFGS memory (scipy's maxcor); >= 1.
-    int history = 10;
-
-    /// @throws std::invalid_argument naming the field.
-    void validate() const {
-      detail::require(restarts >= 0, "GaussianProcess::FitOptions::restarts must be >= 0", restarts);
-      detail::require(max_iterations >= 1, "GaussianProcess::FitOptions::max_iterations must be >= 1",
-                      max_iterations);
-      detail::require(std::isfinite(gradient_tolerance) && gradient_tolerance >= 0.0,
-                      "GaussianProcess::FitOptions::gradient_tolerance must be finite and >= 0",
-                      gradient_tolerance);
-      detail::require(std::isfinite(relative_tolerance) && relative_tolerance >= 0.0,
-                      "GaussianProcess::FitOptions::relative_tolerance must be finite and >= 0",
-                      relative_tolerance);
-      detail::require(history >= 1, "GaussianProcess::FitOptions::history must be >= 1", history);
-    }
-  };
-
-  /// One optimiser start.
-  struct StartSummary {
-    Eigen::VectorXd initial_log_parameters;
-    Eigen::VectorXd log_parameters;  ///< best point of this start
-    double log_marginal_likelihood = -std::numeric_limits<double>::infinity();
-    int iterations = 0;
-    int evaluations = 0;
-    FitStatus status = FitStatus::kNotOptimized;
-  };
-
-  /// Result of `fit`/`refit`.
-  struct FitSummary {
-    FitStatus status = FitStatus::kNotOptimized;  ///< status of the chosen start
-    double log_marginal_likelihood = 0.0;          ///< at the chosen hyperparameters
-    Eigen::VectorXd log_parameters;                ///< chosen hyperparameters (log)
-    std::vector<StartSummary> starts;              ///< empty if not optimised
-    std::size_t best_start = 0;
-    int evaluations = 0;  ///< LML + gradient evaluations over all starts
-  };
-
-  /// Posterior mean [output units] and variance [output units^2] at query rows.
-  struct Prediction {
-    Eigen::VectorXd mean;
-    Eigen::VectorXd variance;
-  };
-
-  /// Posterior mean and full covariance at query rows.
-  struct CovariancePrediction {
-    Eigen::VectorXd mean;
-    Eigen::MatrixXd covariance;
-  };
+  using Options = GpOptions;
+  using FitOptions = GpFitOptions;
+  using StartSummary = GpStartSummary;
+  using FitSummary = GpFitSummary;
+  using Prediction = GpPrediction;
+  using CovariancePrediction = GpCovariancePrediction;
 
   /// @throws std::invalid_argument if `options` is invalid (message names the field).
   explicit GaussianProcess(K kernel, const Options& options = {})
@@ -491,9 +389,6 @@ class GaussianProcess {
   }
 
  private:
-  /// Fresh L-BFGS-B runs per start after a failed line search.
-  static constexpr int kMaxSolverRestarts = 20;
-
   void check_training_data(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y) const {
     detail::require(x.rows() >= 1, "GaussianProcess: number of training samples (rows of x) must be >= 1", x.rows());
     detail::require(kernel_.accepts_dimension(x.cols()),
@@ -697,72 +592,10 @@ class GaussianProcess {
   };
 
   void optimize(const FitOptions& fo, FitSummary& summary) {
-    const Eigen::VectorXd lower = kernel_.log_lower_bounds();
-    const Eigen::VectorXd upper = kernel_.log_upper_bounds();
-    detail::GpSplitMix64 rng(fo.seed);
-    detail::BoxMinimizerSettings settings{.history = fo.history,
-                                          .gradient_tolerance = fo.gradient_tolerance,
-                                          .relative_tolerance = fo.relative_tolerance,
-                                          .max_iterations = fo.max_iterations};
-    double best = std::numeric_limits<double>::infinity();
-    for (int r = 0; r <= fo.restarts; ++r) {
-      StartSummary start;
-      Eigen::VectorXd theta = kernel_.log_parameters();
-      if (r > 0) {
-        for (Eigen::Index i = 0; i < theta.size(); ++i) theta(i) = lower(i) + rng.uniform() * (upper(i) - lower(i));
-      }
-      theta = theta.cwiseMax(lower).cwiseMin(upper);
-      start.initial_log_parameters = theta;
-      Objective objective{this, kernel_, {}, {}, std::numeric_limits<double>::infinity(), 0};
-      // The minimiser signals a failed line search (or a non-descent direction from its
-      // subspace minimisation) by an exception. Like scipy's driver, restart from the best
-      // point seen with a fresh quasi-Newton memory while that still improves the objective.
-      int runs = 0;
-      while (true) {
-        const double before = objective.best_value;
-        settings.max_iterations = std::max(1, fo.max_iterations - start.iterations);
-        try {
-          start.iterations += detail::minimize_in_box(objective, theta, lower, upper, settings);
-          start.status = start.iterations >= fo.max_iterations ? FitStatus::kMaxIterations : FitStatus::kConverged;
-          break;
-        } catch (const detail::GpObjectiveAborted& aborted) {
-          try {
-            std::rethrow_exception(aborted.cause);
-          } catch (const NumericalError&) {
-            start.status = FitStatus::kNumericalFailure;
-          }
-          break;
-        } catch (const std::exception&) {
-          start.status = FitStatus::kLineSearchFailed;
-          ++start.iterations;
-        }
-        const bool improved =
-            objective.best_value < before &&
-            (!std::isfinite(before) || before - objective.best_value > fo.relative_tolerance * std::max(1.0, std::abs(before)));
-        if (!improved || ++runs > kMaxSolverRestarts || start.iterations >= fo.max_iterations) break;
-        theta = objective.best_theta;
-      }
-      start.evaluations = objective.evaluations;
-      summary.evaluations += objective.evaluations;
-      if (objective.evaluations > 0) {
-        start.log_parameters = objective.best_theta;
-        start.log_marginal_likelihood = -objective.best_value;
-        if (objective.best_value < best) {
-          best = objective.best_value;
-          summary.best_start = summary.starts.size();
-        }
-      } else {
-        start.log_parameters = start.initial_log_parameters;
-      }
-      summary.starts.push_back(std::move(start));
-    }
-    if (!std::isfinite(best)) {
-      throw NumericalError("GaussianProcess::fit: the covariance could not be factorised at any start point (" +
-                           std::to_string(summary.starts.size()) + " starts)");
-    }
-    const StartSummary& chosen = summary.starts[summary.best_start];
-    summary.status = chosen.status;
-    kernel_.set_log_parameters(chosen.log_parameters);
+    const Eigen::VectorXd theta = detail::gp_multistart_minimize(
+        kernel_.log_parameters(), kernel_.log_lower_bounds(), kernel_.log_upper_bounds(), fo, summary,
+        [this] { return Objective{this, kernel_, {}, {}, std::numeric_limits<double>::infinity(), 0}; });
+    kernel_.set_log_parameters(theta);
   }
 
   K kernel_;
