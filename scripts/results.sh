@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reproduces docs/results.md.
-#   bash scripts/results.sh [all|oracle|oracle-default|network] [JOBS]   (default: all, one job per core)
+#   bash scripts/results.sh [all|oracle|oracle-default|network|sigma-prior] [JOBS]   (default: all, one job per core)
 #
 # oracle: the paper's experiment with the ground-truth oracle, deterministic (fixed 0.1 s per
 #   image and 0 s per waypoint), in two configurations: the defaults, and the paper's (utility
@@ -16,12 +16,16 @@
 #   each initialised on the five other tiles (the networks' training tiles 1, 2, 3, 5 and the
 #   other unseen tile), as a user calibrates on every labelled field they have. About 20 minutes
 #   on 2 cores.
+# sigma-prior: the defaults' runs flown again with the models `oracle-default` saved, only the
+#   front-aware rule's sigma_prior_weight changed (0.01 and 1; the calibrated models have 0.25):
+#   how much the prior on the field's share of L holds the forecasts back (docs/results.md,
+#   "Forecast against realised gain"). Needs out/results/oracle-default; about 8 minutes on 2 cores.
 # Outputs: out/results/<configuration>/<run>/ (adaptseg_evaluate's files); prints the tables.
 set -euo pipefail
 part=${1:-all}
 jobs=${2:-$(nproc 2>/dev/null || echo 2)}
-case "$part" in all | oracle | oracle-default | network) ;;
-  *) echo "usage: $0 [all|oracle|oracle-default|network] [JOBS]" >&2; exit 2 ;;
+case "$part" in all | oracle | oracle-default | network | sigma-prior) ;;
+  *) echo "usage: $0 [all|oracle|oracle-default|network|sigma-prior] [JOBS]" >&2; exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh plots
@@ -57,6 +61,33 @@ check() {
   done
   [ "$bad" = 0 ] || exit 1
 }
+
+if [ "$part" = sigma-prior ]; then
+  [ -d "$root/oracle-default" ] || { echo "run 'bash $0 oracle-default' first" >&2; exit 1; }
+  w=examples/data/weedmap-000
+  labels=("defaults=$(ls -d "$root/oracle-default"/*/ | sed 's:/$::' | paste -sd, -)")
+  for k in 0.01 1; do
+    config=oracle-sigma-prior-$k
+    rm -rf "${root:?}/$config"
+    mkdir -p "$root/$config"
+    for d in "$root"/oracle-default/*/; do
+      name=$(basename "$d")
+      model="$root/$config/$name.model.yaml"
+      sed "s/^\(  *sigma_prior_weight:\) .*/\1 $k/" "$d/model.yaml" >"$model"
+      case $name in
+        weedmap-train-left) test=(--test "$w:0.5,0,1,1") ;;
+        weedmap-train-right) test=(--test "$w:0,0,0.5,1") ;;
+        *) cls=${name#dubai-}; cls=${cls%%-*}; test=(--test "$(dubai "${name##*-}")" --interest "$cls") ;;
+      esac
+      run "$config" "$name" --model "$model" "${test[@]}" "${fixed[@]}" --no-plots
+    done
+  done
+  wait
+  check
+  for k in 0.01 1; do labels+=("sigma-prior-$k=$(ls -d "$root/oracle-sigma-prior-$k"/*/ | sed 's:/$::' | paste -sd, -)"); done
+  /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
+  exit 0
+fi
 
 if [ "$part" != network ]; then
   configs=(oracle-default oracle-paper)
