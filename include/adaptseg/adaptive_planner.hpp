@@ -130,8 +130,7 @@ class AdaptivePlanner {
     for (LawnmowerCost& l : lawnmowers_) {
       const auto plan = LawnmowerPlanner(camera_).plan(area_.area, l.gsd_cm,
                                                        Eigen::Vector2d(area_.area.x_min_m, area_.area.y_min_m), keep());
-      for (std::size_t k = 1; k < plan.size(); ++k)
-        l.flight_s += timing_.segment_time_s(plan[k - 1].position, plan[k].position);
+      l.flight_s = plan_flight_s(plan);
       l.images = plan.size();
     }
     valid_px_ = cv::countNonZero(area_.valid_mask);
@@ -440,6 +439,13 @@ class AdaptivePlanner {
                       "AdaptivePlanner::report: elapsed_s must be finite and >= 0", *elapsed_s);
   }
 
+  /// Flight time along `plan`'s waypoints, in order [s].
+  [[nodiscard]] double plan_flight_s(const std::vector<Waypoint>& plan) const {
+    double t = 0.0;
+    for (std::size_t k = 1; k < plan.size(); ++k) t += timing_.segment_time_s(plan[k - 1].position, plan[k].position);
+    return t;
+  }
+
   /// The decision at top-level waypoint `p` (paper §3.2.2), its candidates with exact costs.
   DecisionRecord decide(const PlannedWaypoint& p, double sigma) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -462,8 +468,7 @@ class AdaptivePlanner {
     for (double g : candidates_) {
       auto sub = descent_plan(i, g);
       if (sub.empty()) continue;
-      double inner = 0.0;
-      for (std::size_t k = 1; k < sub.size(); ++k) inner += timing_.segment_time_s(sub[k - 1].position, sub[k].position);
+      const double inner = plan_flight_s(sub);
       // What descending adds to the flight: at once, down and back up to the next waypoint ...
       double flight = timing_.segment_time_s(here, sub.front().position) + inner - direct;
       if (!last) flight += timing_.segment_time_s(sub.back().position, top_[i + 1].position);
