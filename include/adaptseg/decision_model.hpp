@@ -311,13 +311,8 @@ struct DecisionModel {
   [[nodiscard]] static DecisionModel load(const std::filesystem::path& path) {
     const std::string where = path.string();
     if (!std::filesystem::is_regular_file(path)) detail::yaml_error(where, "decision model file not found");
-    YAML::Node root;
-    try {
-      root = YAML::LoadFile(path.string());
-    } catch (const YAML::Exception& ex) {
-      detail::yaml_error(where, std::string("YAML error: ") + ex.what());
-    }
-    if (!root.IsMap()) detail::yaml_error(where, "not a decision model (the document must be a mapping)");
+    const YAML::Node root =
+        detail::yaml_mapping(where, "a decision model", [&] { return YAML::LoadFile(path.string()); });
     return detail::naming_file(where, [&] {
       const std::string format = root["format"] && root["format"].IsScalar() ? root["format"].Scalar() : "";
       const detail::YamlReader r(root, where);

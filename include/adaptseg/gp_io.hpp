@@ -195,14 +195,8 @@ template <Kernel K>
       std::istringstream in(text);
       return detail::read_gp_text_v1<K>(in);
     }
-    YAML::Node root;
-    try {
-      root = YAML::Load(text);
-    } catch (const YAML::Exception& ex) {
-      detail::yaml_error(where, std::string("YAML error: ") + ex.what());
-    }
-    if (!root.IsMap()) detail::yaml_error(where, "not a Gaussian process (the document must be a mapping)");
-    const detail::YamlReader r(root, where);
+    const detail::YamlReader r(detail::yaml_mapping(where, "a Gaussian process", [&] { return YAML::Load(text); }),
+                               where);
     const std::string format = r.text("format");
     if (format != kGaussianProcessFormat)
       detail::yaml_error(where, "not an adaptseg Gaussian process (format must be " +

@@ -40,6 +40,21 @@ decltype(auto) naming_file(const std::string& where, F&& read) {
   }
 }
 
+/// The document `load()` parses (YAML::Load of a text or YAML::LoadFile), which must be a
+/// mapping: a parse error becomes "<where>: YAML error: ...", another node "<where>: not
+/// <what> (the document must be a mapping)".
+template <class F>
+[[nodiscard]] YAML::Node yaml_mapping(const std::string& where, const std::string& what, F&& load) {
+  YAML::Node root;
+  try {
+    root = std::forward<F>(load)();
+  } catch (const YAML::Exception& ex) {
+    yaml_error(where, std::string("YAML error: ") + ex.what());
+  }
+  if (!root.IsMap()) yaml_error(where, "not " + what + " (the document must be a mapping)");
+  return root;
+}
+
 /// A reader of one YAML mapping of an adaptseg file: every value read through the number codec
 /// (number_text.hpp), every error naming the file and the key's path (`gain_model.O.y_std`).
 class YamlReader {
