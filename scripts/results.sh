@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reproduces docs/results.md.
-#   bash scripts/results.sh [all|oracle|oracle-default|network|sigma-prior] [JOBS]   (default: all, one job per core)
+#   bash scripts/results.sh [all|oracle|oracle-default|network|sigma-prior|sigma-prior-fit] [JOBS]   (default: all, one job per core)
 #
 # oracle: the paper's experiment with the ground-truth oracle, deterministic (fixed 0.1 s per
 #   image and 0 s per waypoint), in two configurations: the defaults, and the paper's (utility
@@ -20,12 +20,15 @@
 #   front-aware rule's sigma_prior_weight changed (0.01 and 1; the calibrated models have 0.25):
 #   how much the prior on the field's share of L holds the forecasts back (docs/results.md,
 #   "Forecast against realised gain"). Needs out/results/oracle-default; about 8 minutes on 2 cores.
+# sigma-prior-fit: the defaults' Dubai runs calibrated again with sigma-hat's prior taken from the
+#   training fields (--sigma-prior spread and estimated; the defaults keep it as given). Needs
+#   out/results/oracle-default for the comparison; about 20 minutes on 2 cores.
 # Outputs: out/results/<configuration>/<run>/ (adaptseg_evaluate's files); prints the tables.
 set -euo pipefail
 part=${1:-all}
 jobs=${2:-$(nproc 2>/dev/null || echo 2)}
-case "$part" in all | oracle | oracle-default | network | sigma-prior) ;;
-  *) echo "usage: $0 [all|oracle|oracle-default|network|sigma-prior] [JOBS]" >&2; exit 2 ;;
+case "$part" in all | oracle | oracle-default | network | sigma-prior | sigma-prior-fit) ;;
+  *) echo "usage: $0 [all|oracle|oracle-default|network|sigma-prior|sigma-prior-fit] [JOBS]" >&2; exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh plots
@@ -85,6 +88,28 @@ if [ "$part" = sigma-prior ]; then
   wait
   check
   for k in 0.01 1; do labels+=("sigma-prior-$k=$(ls -d "$root/oracle-sigma-prior-$k"/*/ | sed 's:/$::' | paste -sd, -)"); done
+  /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
+  exit 0
+fi
+
+if [ "$part" = sigma-prior-fit ]; then
+  [ -d "$root/oracle-default" ] || { echo "run 'bash $0 oracle-default' first" >&2; exit 1; }
+  labels=("defaults=$(ls -d "$root/oracle-default"/dubai-*/ | sed 's:/$::' | paste -sd, -)")
+  for mode in spread estimated; do
+    config=oracle-sigma-prior-$mode
+    rm -rf "${root:?}/$config"
+    for cls in $classes; do
+      for t in 1 2 3 4 5 6; do
+        train=()
+        for k in 1 2 3 4 5 6; do [ "$k" != "$t" ] && train+=(--train "$(dubai "$k")"); done
+        run "$config" "dubai-$cls-tile-$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" "${fixed[@]}" \
+          --sigma-prior "$mode" --no-plots
+      done
+    done
+  done
+  wait
+  check
+  for mode in spread estimated; do labels+=("$mode=$(ls -d "$root/oracle-sigma-prior-$mode"/*/ | sed 's:/$::' | paste -sd, -)"); done
   /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
   exit 0
 fi

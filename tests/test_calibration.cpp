@@ -8,6 +8,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -156,6 +157,9 @@ TEST_CASE("calibration: by default the front-aware rule, its confidence chosen o
   const auto& back_rule = std::get<FrontAwarePolicy>(back.decision_function.rule());
   CHECK(back_rule.params().confidence == rule.params().confidence);
   CHECK(back_rule.params().scale_prior_sd == rule.params().scale_prior_sd);
+  CHECK(back_rule.params().sigma_prior_weight == rule.params().sigma_prior_weight);
+  CHECK(back_rule.params().sigma_prior_sd == rule.params().sigma_prior_sd);
+  CHECK(rule.params().sigma_prior_sd == 0.0);  // one field: no spread of fields to estimate
   CHECK(back_rule.reference().front().points.size() == reference.points.size());
   CHECK(back_rule.reference().front().field_sigma == reference.field_sigma);
   for (double sigma : {0.0, 0.05, 0.2})
@@ -172,7 +176,8 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
   const Field b = t::blob_field(2000, 2600, 1.0, 11, 30).sub_field({0, 0, 1, 0.8});
   OracleSegmenter oracle(a.num_classes());
   const std::vector<Field> fields{a, b};
-  const CalibrationOptions options = small_options();
+  CalibrationOptions options = small_options();
+  options.sigma_prior = CalibrationOptions::SigmaPriorSource::estimated;
   const CalibrationResult cal = calibrate(fields, oracle, options);
   const auto only_a = collect_region_samples(a, oracle, CameraModel{}, 3.0, {1.0, 2.0}, a.interest(),
                                              DescentCoverage::region, 0);
@@ -187,12 +192,59 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
   CHECK(rule.reference()[1].field == b.name());
   // Each trial flew each field once, with a model fitted without it.
   for (const auto& trial : cal.trials) CHECK(trial.margins.size() == 2);
+  // σ̂'s prior estimated on the two fields (asked for): τ their σ's spread (n − 1).
+  const double sa = rule.reference()[0].field_sigma, sb = rule.reference()[1].field_sigma;
+  CHECK(rule.params().sigma_prior_sd == doctest::Approx(std::abs(sa - sb) / std::sqrt(2.0)));
+  CHECK(rule.params().sigma_prior_weight >= 0.01);
+  CHECK(rule.params().sigma_prior_weight <= 100.0);
+  // By default as given: k = 0.25, no spread.
+  const CalibrationResult plain = calibrate(fields, oracle, small_options());
+  CHECK(std::get<FrontAwarePolicy>(plain.decision_function.rule()).params().sigma_prior_sd == 0.0);
+  CHECK(std::get<FrontAwarePolicy>(plain.decision_function.rule()).params().sigma_prior_weight == 0.25);
   const DecisionModel model = make_decision_model(fields, oracle.name(), options, cal);
   CHECK(model.calibration_fields == std::vector<std::string>{a.name(), b.name()});
+  // The file keeps σ̂'s prior; a file written before it existed (no `sigma_prior_sd`) reads as
+  // τ = 0, the rule as it was then.
+  t::TempDir tmp;
+  model.save(tmp.path() / "model.yaml");
+  const auto rule_of = [](const DecisionModel& m) { return std::get<FrontAwarePolicy>(m.decision_function.rule()).params(); };
+  const DecisionModel back = DecisionModel::load(tmp.path() / "model.yaml");
+  CHECK(rule_of(back).sigma_prior_sd == rule.params().sigma_prior_sd);
+  CHECK(rule_of(back).sigma_prior_weight == rule.params().sigma_prior_weight);
+  std::stringstream text;
+  text << std::ifstream(tmp.path() / "model.yaml").rdbuf();
+  std::string old = text.str();
+  const auto at = old.find("  sigma_prior_sd:");
+  REQUIRE(at != std::string::npos);
+  old.erase(at, old.find('\n', at) + 1 - at);
+  std::ofstream(tmp.path() / "old.yaml") << old;
+  CHECK(rule_of(DecisionModel::load(tmp.path() / "old.yaml")).sigma_prior_sd == 0.0);
   // Fields of another class set are refused.
   const Field other("o", 1.0, a.labels(), {{"a", {0, 0, 0}}, {"b", {1, 1, 1}}, {"c", {2, 2, 2}}}, {1});
   const std::vector<Field> mixed{a, other};
   CHECK_THROWS_WITH_AS((void)calibrate(mixed, oracle, options), doctest::Contains("classes"), std::invalid_argument);
+}
+
+TEST_CASE("calibration: σ̂'s prior from the training fields' σ and how it varies along each flight") {
+  // Field 1: σ 0.1 then 0.3 over halves (mean 0.2; after half of it the mean seen is off by
+  // 0.1: v = 0.1²·0.5 / 0.5 = 0.01); field 2: 0.4 throughout (v = 0). τ² = 0.02 (mean 0.3,
+  // n − 1), v = 0.005, k = 0.25.
+  const std::vector<TopLevelTrace> two{{0.2, {0.1, 0.3}, {0.5, 0.5}}, {0.4, {0.4, 0.4}, {0.5, 0.5}}};
+  const auto prior = estimate_sigma_prior(two);
+  REQUIRE(prior.has_value());
+  CHECK(prior->sd == doctest::Approx(std::sqrt(0.02)));
+  CHECK(prior->weight == doctest::Approx(0.25));
+  // Shares need not sum to 1 (overlapping images): they are normalised per field.
+  const std::vector<TopLevelTrace> scaled{{0.2, {0.1, 0.3}, {0.6, 0.6}}, {0.4, {0.4, 0.4}, {0.7, 0.7}}};
+  CHECK(estimate_sigma_prior(scaled)->weight == doctest::Approx(0.25));
+  // Fields of one σ: no spread to be unsure of, the prior dominates.
+  const std::vector<TopLevelTrace> same{{0.2, {0.1, 0.3}, {0.5, 0.5}}, {0.2, {0.2, 0.2}, {0.5, 0.5}}};
+  CHECK(estimate_sigma_prior(same)->sd == 0.0);
+  CHECK(estimate_sigma_prior(same)->weight == 100.0);
+  // One field, or one without a top-level image: nothing to estimate from.
+  CHECK_FALSE(estimate_sigma_prior(std::span(two).first(1)).has_value());
+  const std::vector<TopLevelTrace> blind{{0.2, {0.1, 0.3}, {0.5, 0.5}}, {0.4, {}, {}}};
+  CHECK_FALSE(estimate_sigma_prior(blind).has_value());
 }
 
 TEST_CASE("calibration: the model is a function of its inputs (a declared time per image)") {

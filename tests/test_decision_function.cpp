@@ -413,6 +413,30 @@ TEST_CASE("front-aware policy: pessimistic when unsure, from the field factor an
   CHECK_FALSE(moderate_fixed.decide(s.region(1)).descend);
 }
 
+TEST_CASE("front-aware policy: unsure of the field's σ while little of it is seen, sure once all of it is") {
+  const Scenario s;
+  const double gain = 0.02 / 7.0 / 0.2;
+  // The curve rises by half the forecast gain over a descent; z = 1; the field factor is
+  // nearly certain (ω = 0.05), so only σ̂'s spread can hold a descent back.
+  const auto reference = s.reference(0.5 * gain);
+  const FrontAwarePolicy::Params sure{.confidence = 1.0, .scale_prior_sd = 0.05, .sigma_prior_weight = 0.25};
+  FrontAwarePolicy::Params unsure = sure;
+  unsure.sigma_prior_sd = 0.15;  // fields' σ spread 0.15 about the training fields' 0.2
+  FrontAwarePolicy a(fitted(), reference, sure), b(fitted(), reference, unsure);
+  // First region: 1/7 of the field seen. Var σ̂ = (6/7)²·τ²·k/(k + 1/7) + (6/7)·k·τ² = 0.0153,
+  // σ̂ = 0.2: ĝ's relative spread 0.62 > the 0.5 margin.
+  const Decision da = a.decide(s.region(0)), db = b.decide(s.region(0));
+  CHECK(da.descend);
+  CHECK_FALSE(db.descend);
+  CHECK(db.scores[0].predicted_field_gain == da.scores[0].predicted_field_gain);  // the mean is the same
+  // The other six regions (no descent): at the last one the field is seen, Var σ̂ = 0.
+  for (int k = 1; k < 6; ++k) (void)a.decide(s.region(k)), (void)b.decide(s.region(k));
+  const Decision la = a.decide(s.region(0)), lb = b.decide(s.region(0));
+  CHECK(la.descend);
+  CHECK(lb.descend);
+  CHECK(lb.scores[0].predicted_field_gain == doctest::Approx(la.scores[0].predicted_field_gain));
+}
+
 // ---------------------------------------------------------------------------------------------
 // DecisionFunction, LinearDecision, conformance
 // ---------------------------------------------------------------------------------------------

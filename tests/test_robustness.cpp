@@ -663,6 +663,8 @@ TEST_CASE("robustness: decision function: threshold out of range") {
                        Contains("confidence must be finite and >= 0"), std::invalid_argument);
   CHECK_THROWS_WITH_AS(FrontAwarePolicy::Params{.scale_prior_sd = 0.0}.validate(),
                        Contains("scale_prior_sd must be finite and > 0"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(FrontAwarePolicy::Params{.sigma_prior_sd = -0.1}.validate(),
+                       Contains("sigma_prior_sd must be in [0, 1]"), std::invalid_argument);
 }
 
 TEST_CASE("robustness: decision function: a policy that descends to a GSD it was not offered") {

@@ -158,6 +158,7 @@ struct CalibrationCli {
   std::string coverage = "interest";
   std::string gain_inputs = "delta-sigma-height";
   std::vector<double> confidences = kDefaultConfidences;
+  std::string sigma_prior = "given";
   std::optional<double> segmentation_time_s;
 
   void add_to(CLI::App& app) {
@@ -185,6 +186,12 @@ struct CalibrationCli {
             ->delimiter(',')
             ->check(CLI::NonNegativeNumber)
             ->capture_default_str(),
+        app.add_option("--sigma-prior", sigma_prior,
+                       "front-aware rule with several training fields: the prior of the field's share of L "
+                       "(sigma-hat): given (weight 0.25 fields, no spread), spread (its spread over the training "
+                       "fields enters the lower bound) or estimated (weight and spread from the training fields)")
+            ->check(CLI::IsMember({"given", "spread", "estimated"}))
+            ->capture_default_str(),
         app.add_option("--calibration-seg-time-s", segmentation_time_s,
                        "segmentation time charged per image during calibration [s], recorded in the model "
                        "(default: --seg-time-s if given, else 0.1)")
@@ -204,6 +211,9 @@ struct CalibrationCli {
     options.threshold_steps = threshold_steps;
     options.rule = rule == "front-aware" ? CalibrationOptions::Rule::front_aware : CalibrationOptions::Rule::utility;
     options.confidences = confidences;
+    options.sigma_prior = sigma_prior == "spread"      ? CalibrationOptions::SigmaPriorSource::spread
+                          : sigma_prior == "estimated" ? CalibrationOptions::SigmaPriorSource::estimated
+                                                       : CalibrationOptions::SigmaPriorSource::given;
     options.adaptive.coverage = parse_descent_coverage(coverage);
     options.fit.gain_inputs = gain_inputs == "delta-sigma-height" ? GainModel::GainInputs::delta_sigma_and_height
                                                                   : GainModel::GainInputs::delta_sigma;

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -56,14 +57,21 @@ struct CalibrationOptions {
   enum class Rule { front_aware, utility };
   Rule rule = Rule::front_aware;
 
-  /// Front-aware rule: `min_sigma`, `weight_by_sigma` and `scale_prior_sd` as given (with
-  /// several fields `scale_prior_sd` is estimated from their spread instead); `confidence`
+  /// Front-aware rule: `min_sigma`, `weight_by_sigma`, `scale_prior_sd`, `sigma_prior_weight`
+  /// and `sigma_prior_sd` as given (with several fields `scale_prior_sd` is estimated from
+  /// their spread instead, and the last two as `sigma_prior` says); `confidence`
   /// chosen among `confidences` by the mean front margin over the training fields, each flown
   /// with a model fitted without it (one field: the field and its halves, with the model of
   /// the whole field). Ties (e.g. where no setting descends on the training fields) go to the
   /// smaller z: the training fields give no evidence against descending.
   FrontAwarePolicy::Params front_aware{};
   std::vector<double> confidences = kDefaultConfidences;
+  /// Front-aware rule, σ̂'s prior (FrontAwarePolicy `sigma_prior_weight` k, `sigma_prior_sd` τ)
+  /// with several training fields: `given` keeps `front_aware`'s; `spread` estimates τ on the
+  /// training fields (estimate_sigma_prior) and keeps k; `estimated` estimates both. Each fold
+  /// of the z choice uses the values estimated without its field. One field: as given.
+  enum class SigmaPriorSource { given, spread, estimated };
+  SigmaPriorSource sigma_prior = SigmaPriorSource::given;
 
   /// Utility rule: `exploration` and `min_sigma` as given; thresholds searched (quantiles of
   /// the utilities seen, absolute and relative, σ weighting on and off, "never descend"), each
@@ -93,7 +101,72 @@ struct CalibrationResult {
   std::vector<RuleTrial> trials;                   ///< every setting tried, the chosen one first
 };
 
+/// The prior of a new field's σ the front-aware rule's σ̂ shrinks towards
+/// (FrontAwarePolicy::Params `sigma_prior_weight` k and `sigma_prior_sd` τ).
+struct SigmaPrior {
+  double weight = 0.25;  ///< k = v / τ² [fields]
+  double sd = 0.0;       ///< τ
+};
+
+/// The top-level images of one training field as the UAV sees them, in flight order: each
+/// image's σ and its region's share of the field (DecisionContext::sigma, region_share).
+struct TopLevelTrace {
+  double field_sigma = 0.0;  ///< σ of the field's top-level map (ReferenceCurve::field_sigma)
+  std::vector<double> sigma;
+  std::vector<double> share;
+};
+
+/// k and τ of σ̂'s hierarchical model (FrontAwarePolicy) estimated on training fields:
+/// τ² the sample variance of the fields' σ; v, the spread of the mean σ of a seen share S
+/// (variance v / S about the field's, hence v·(1 − S) / S about the whole field's mean m), is
+/// the mean over the fields and over the prefixes of each flight (0 < S <= 0.9) of
+/// (m_S − m)²·S / (1 − S), so that it holds the fields' spatial correlation along the flight
+/// as the UAV meets it; k = v / τ², kept in [0.01, 100]. std::nullopt for fewer than two
+/// fields or a field without a top-level image.
+[[nodiscard]] inline std::optional<SigmaPrior> estimate_sigma_prior(std::span<const TopLevelTrace> fields) {
+  if (fields.size() < 2) return std::nullopt;
+  double mean = 0.0;
+  for (const auto& f : fields) mean += f.field_sigma / static_cast<double>(fields.size());
+  double tau2 = 0.0, v = 0.0;
+  std::size_t prefixes = 0;
+  for (const auto& f : fields) {
+    tau2 += (f.field_sigma - mean) * (f.field_sigma - mean) / static_cast<double>(fields.size() - 1);
+    double total = 0.0, total_interest = 0.0;
+    for (std::size_t i = 0; i < f.share.size(); ++i) total += f.share[i], total_interest += f.share[i] * f.sigma[i];
+    if (!(total > 0.0)) return std::nullopt;
+    const double m = total_interest / total;
+    double seen = 0.0, seen_interest = 0.0;
+    for (std::size_t i = 0; i + 1 < f.share.size(); ++i) {
+      seen += f.share[i] / total;
+      seen_interest += f.share[i] / total * f.sigma[i];
+      if (seen <= 0.0 || seen > 0.9) continue;  // near the end (m_S − m)² / (1 − S) is all noise
+      const double d = seen_interest / seen - m;
+      v += d * d * seen / (1.0 - seen);
+      ++prefixes;
+    }
+  }
+  if (prefixes > 0) v /= static_cast<double>(prefixes);
+  const double k = tau2 > 0.0 ? std::clamp(v / tau2, 0.01, 100.0) : 100.0;
+  return SigmaPrior{k, std::sqrt(tau2)};
+}
+
 namespace detail {
+
+/// Records what each top-level image shows (σ, region share) and never descends.
+struct TopLevelRecorder {
+  TopLevelTrace trace;
+  void begin_mission() {
+    trace.sigma.clear();
+    trace.share.clear();
+  }
+  Decision decide(const DecisionContext& c) {
+    trace.sigma.push_back(c.sigma);
+    trace.share.push_back(c.region_share);
+    return {};
+  }
+  void observe(const DescentOutcome&) {}
+  [[nodiscard]] std::string name() const { return "top-level"; }
+};
 
 /// An adaptive mission of `policy` over `field`, scored against `curve`.
 template <SegmentationBackend Backend, DecisionPolicy Policy>
@@ -192,6 +265,17 @@ template <SegmentationBackend Backend>
       r.points.push_back({lawnmower_gsd[k], curves.back()[k].miou});
     reference.push_back(std::move(r));
   }
+  // What each training field's top-level images show along the flight, where σ̂'s prior is
+  // estimated from them (one top-level mission per field).
+  std::vector<TopLevelTrace> traces;
+  const bool fit_sigma_prior = options.rule == CalibrationOptions::Rule::front_aware && fields.size() >= 2 &&
+                               options.sigma_prior != CalibrationOptions::SigmaPriorSource::given;
+  for (std::size_t f = 0; fit_sigma_prior && f < fields.size(); ++f) {
+    detail::TopLevelRecorder recorder;
+    (void)run_adaptive_mission(fields[f], backend, recorder, adaptive, recorder.name());
+    recorder.trace.field_sigma = reference[f].field_sigma;
+    traces.push_back(std::move(recorder.trace));
+  }
   GainModel::FitOptions fit = options.fit;
   GainModel model = GainModel::fit(samples, fit);
   model.set_refit_every(options.refit_every);
@@ -219,20 +303,24 @@ template <SegmentationBackend Backend>
       const std::vector<CurvePoint>* curve;
       GainModel model;
       std::vector<ReferenceCurve> reference;
+      std::optional<SigmaPrior> sigma_prior;  ///< estimated without the field
     };
     std::vector<Fold> folds;
     std::vector<double> field_scales;
     if (fields.size() == 1) {
-      folds.push_back({&fields.front(), &curves.front(), model, reference});
-      for (std::size_t k = 0; k < halves.size(); ++k) folds.push_back({&halves[k], &half_curves[k], model, reference});
+      folds.push_back({&fields.front(), &curves.front(), model, reference, std::nullopt});
+      for (std::size_t k = 0; k < halves.size(); ++k)
+        folds.push_back({&halves[k], &half_curves[k], model, reference, std::nullopt});
     } else {
       for (std::size_t k = 0; k < fields.size(); ++k) {
         std::vector<RegionSample> rest;
         std::vector<ReferenceCurve> rest_reference;
+        std::vector<TopLevelTrace> rest_traces;
         for (std::size_t j = 0; j < fields.size(); ++j)
           if (j != k) {
             rest.insert(rest.end(), by_field[j].begin(), by_field[j].end());
             rest_reference.push_back(reference[j]);
+            if (fit_sigma_prior) rest_traces.push_back(traces[j]);
           }
         GainModel m = GainModel::fit(rest, fit);
         m.set_refit_every(options.refit_every);
@@ -245,7 +333,8 @@ template <SegmentationBackend Backend>
           den += f.relabelled * f.relabelled;
         }
         if (den > 0.0) field_scales.push_back(num / den);
-        folds.push_back({&fields[k], &curves[k], std::move(m), std::move(rest_reference)});
+        folds.push_back({&fields[k], &curves[k], std::move(m), std::move(rest_reference),
+                         estimate_sigma_prior(rest_traces)});
       }
     }
     if (field_scales.size() >= 2) {  // ω: the spread of s about 1 over the training fields
@@ -253,13 +342,21 @@ template <SegmentationBackend Backend>
       for (double s : field_scales) ss += (s - 1.0) * (s - 1.0);
       base.scale_prior_sd = std::max(0.1, std::sqrt(ss / static_cast<double>(field_scales.size())));
     }
+    const auto apply_prior = [&](FrontAwarePolicy::Params& p, const std::optional<SigmaPrior>& prior) {
+      if (!prior || options.sigma_prior == CalibrationOptions::SigmaPriorSource::given) return;
+      p.sigma_prior_sd = prior->sd;
+      if (options.sigma_prior == CalibrationOptions::SigmaPriorSource::estimated) p.sigma_prior_weight = prior->weight;
+    };
+    apply_prior(base, estimate_sigma_prior(traces));
     for (double z : options.confidences) {
       RuleTrial t;
       t.description = detail::z_text(z);
       FrontAwarePolicy::Params p = base;
       p.confidence = z;
       for (const Fold& fold : folds) {
-        FrontAwarePolicy policy(fold.model, fold.reference, p);
+        FrontAwarePolicy::Params fold_params = p;  // σ̂'s prior: the fold's estimate replaces all fields'
+        apply_prior(fold_params, fold.sigma_prior);
+        FrontAwarePolicy policy(fold.model, fold.reference, fold_params);
         double margin = 0.0;
         const AdaptiveResult r = detail::fly_scored(*fold.field, backend, policy, adaptive, *fold.curve, margin);
         detail::add_to_trial(t, r, margin);

@@ -278,6 +278,7 @@ struct DecisionModel {
             e << YAML::Key << "confidence" << YAML::Value << num(p.confidence);
             e << YAML::Key << "scale_prior_sd" << YAML::Value << num(p.scale_prior_sd);
             e << YAML::Key << "sigma_prior_weight" << YAML::Value << num(p.sigma_prior_weight);
+            e << YAML::Key << "sigma_prior_sd" << YAML::Value << num(p.sigma_prior_sd);
             e << YAML::Key << "reference" << YAML::Value << YAML::BeginSeq;
             for (const auto& r : rule.reference()) {
               std::vector<double> g, m;
@@ -437,7 +438,10 @@ struct DecisionModel {
                                                   .online = online,
                                                   .confidence = rule.number("confidence"),
                                                   .scale_prior_sd = rule.number("scale_prior_sd"),
-                                                  .sigma_prior_weight = rule.number("sigma_prior_weight")}));
+                                                  .sigma_prior_weight = rule.number("sigma_prior_weight"),
+                                                  .sigma_prior_sd = rule.has("sigma_prior_sd")
+                                                                        ? rule.number("sigma_prior_sd")
+                                                                        : 0.0}));
       }
       if (kind == "utility")
         return DecisionFunction(UtilityPolicy(std::move(model), {.min_sigma = min_sigma,

@@ -42,11 +42,17 @@ struct ReferenceCurve {
 /// - T0 = elapsed + rest of the top-level coverage: the mission's end if it descends no more;
 /// - per candidate, the descent's field-level gain ĝ = η · s · μ_C · a / σ̂ (GainModel: μ_C the
 ///   share of the region's pixels the descent relabels, η the field gain per relabelled share;
-///   s the field correction below), with variance (η·a/σ̂)²·(s²·sd_C² + Var(s)·μ_C²). Field
-///   mIoU counts a class's pixels over the whole field, so a corrected pixel is worth 1 / (the
-///   field's pixels of L): σ̂ estimates the field's σ from the top-level images so far (area
+///   s the field correction below), with variance (η·a/σ̂)²·(s²·sd_C² + Var(s)·μ_C²) plus
+///   σ̂'s (below). Field mIoU counts a class's pixels over the whole field, so a corrected pixel
+///   is worth 1 / (the field's pixels of L): σ̂ estimates the field's σ from the top-level images so far (area
 ///   weighted), the part not yet seen taken at their σ shrunk towards the training fields' mean
-///   σ with a weight of `sigma_prior_weight` fields;
+///   σ with a weight of k = `sigma_prior_weight` fields (share of a field);
+/// - σ̂'s own uncertainty (a hierarchical model: the field's mean σ spread τ = `sigma_prior_sd`
+///   about the training fields' mean, the mean of a seen share S spread v / S about the field's,
+///   v = k·τ²): Var σ̂ = (1 − S)²·τ²·k / (k + S) + (1 − S)·v, zero once the field is seen; it
+///   enters Var ĝ as ĝ²·Var σ̂ / σ̂² (delta method). τ = 0 (one training field; model files
+///   without `sigma_prior_sd`): none, the default. Calibration can estimate τ, or k and τ, on
+///   several training fields (CalibrationOptions::sigma_prior; measured in docs/results.md);
 /// - the curve's rise ΔD over the descent's extra time, [T0, T0 + T], on each training field's
 ///   predicted curve: mean ΔD̄ and spread sd_D over the training fields; beyond the curve's
 ///   last point its last segment goes on (rising_curve_miou);
@@ -79,7 +85,8 @@ class FrontAwarePolicy {
     bool online = true;             ///< field correction and O's update (false: non-adaptive)
     double confidence = 0.0;        ///< z >= 0 of the lower bound (see class comment)
     double scale_prior_sd = 0.5;    ///< ω > 0, prior spread of the field factor s
-    double sigma_prior_weight = 0.25;  ///< > 0: weight of the training fields' σ in σ̂ [fields]
+    double sigma_prior_weight = 0.25;  ///< k > 0: weight of the training fields' σ in σ̂ [fields]
+    double sigma_prior_sd = 0.0;    ///< τ >= 0: spread of a field's σ about the training fields' mean
 
     /// @throws std::invalid_argument naming the field.
     void validate() const {
@@ -91,6 +98,8 @@ class FrontAwarePolicy {
                       "FrontAwarePolicy::Params::scale_prior_sd must be finite and > 0", scale_prior_sd);
       detail::require(std::isfinite(sigma_prior_weight) && sigma_prior_weight > 0.0,
                       "FrontAwarePolicy::Params::sigma_prior_weight must be finite and > 0", sigma_prior_weight);
+      detail::require(std::isfinite(sigma_prior_sd) && sigma_prior_sd >= 0.0 && sigma_prior_sd <= 1.0,
+                      "FrontAwarePolicy::Params::sigma_prior_sd must be in [0, 1]", sigma_prior_sd);
     }
   };
 
@@ -169,7 +178,7 @@ class FrontAwarePolicy {
     seen_share_ += c.region_share;
     seen_interest_ += c.region_share * c.sigma;
     const bool by_relabelling = model_.c_model().has_value();
-    const double weight = by_relabelling ? gain_weight(c) : legacy_gain_weight(c);
+    const auto [weight, sigma_cv2] = by_relabelling ? gain_weight(c) : std::pair{legacy_gain_weight(c), 0.0};
     const double t0 = c.elapsed_s + c.rest_s;
 
     Decision d;
@@ -186,7 +195,8 @@ class FrontAwarePolicy {
       const double base = (by_relabelling ? f.relabelled : -f.delta_miou) * eta * weight;
       const double base_sd = (by_relabelling ? f.relabelled_std : f.delta_miou_std) * eta * weight;
       const double gain = scale_mean_ * base;
-      const double gain_var = scale_mean_ * scale_mean_ * base_sd * base_sd + scale_var_ * base * base;
+      const double gain_var =
+          scale_mean_ * scale_mean_ * base_sd * base_sd + scale_var_ * base * base + gain * gain * sigma_cv2;
       s.predicted_field_gain = gain;
       if (by_relabelling) s.predicted_relabelled = scale_mean_ * f.relabelled;
       s.utility = utility(gain, cand.extra_time_s);
@@ -237,17 +247,23 @@ class FrontAwarePolicy {
   }
 
  private:
-  /// a / σ̂: a relabelled share of the region, times η, as a field-level gain (see the class comment).
-  [[nodiscard]] double gain_weight(const DecisionContext& c) const {
+  /// a / σ̂: a relabelled share of the region, times η, as a field-level gain; and Var σ̂ / σ̂²
+  /// (see the class comment).
+  [[nodiscard]] std::pair<double, double> gain_weight(const DecisionContext& c) const {
     double sigma = 0.0;
+    double sigma_var = 0.0;
     if (prior_sigma_ > 0.0) {
       const double k = params_.sigma_prior_weight;
       const double rest = (seen_interest_ + k * prior_sigma_) / (seen_share_ + k);
-      sigma = seen_interest_ + std::max(0.0, 1.0 - seen_share_) * rest;
+      const double unseen = std::max(0.0, 1.0 - seen_share_);
+      sigma = seen_interest_ + unseen * rest;
+      const double tau2 = params_.sigma_prior_sd * params_.sigma_prior_sd;
+      sigma_var = unseen * unseen * tau2 * k / (k + seen_share_) + unseen * k * tau2;
     } else {
       sigma = sigma_sum_ / static_cast<double>(sigma_count_);
     }
-    return sigma > 0.0 ? c.region_share / sigma : 0.0;
+    if (!(sigma > 0.0)) return {0.0, 0.0};
+    return {c.region_share / sigma, sigma_var / (sigma * sigma)};
   }
 
   /// a · w of adaptseg 0.1 (models without C).
