@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reproduces docs/results.md.
-#   bash scripts/results.sh [all|oracle|oracle-default|network|sigma-prior|sigma-prior-fit] [JOBS]   (default: all, one job per core)
+#   bash scripts/results.sh [all|oracle|oracle-default|network|sigma-prior|sigma-prior-fit|z-choice] [JOBS]   (default: all, one job per core)
 #
 # oracle: the paper's experiment with the ground-truth oracle, deterministic (fixed 0.1 s per
 #   image and 0 s per waypoint), in two configurations: the defaults, and the paper's (utility
@@ -23,18 +23,23 @@
 # sigma-prior-fit: the defaults' Dubai runs calibrated again with sigma-hat's prior taken from the
 #   training fields (--sigma-prior spread and estimated; the defaults keep it as given). Needs
 #   out/results/oracle-default for the comparison; about 20 minutes on 2 cores.
+# z-choice: for each of the defaults' runs, the training folds' margins per confidence level z
+#   (adaptseg_calibrate) and the test field flown with the run's model at every z: how much any
+#   choice of z could buy (docs/results.md). Needs out/results/oracle-default; about 14 minutes
+#   on 2 cores.
 # Outputs: out/results/<configuration>/<run>/ (adaptseg_evaluate's files); prints the tables.
 set -euo pipefail
 part=${1:-all}
 jobs=${2:-$(nproc 2>/dev/null || echo 2)}
-case "$part" in all | oracle | oracle-default | network | sigma-prior | sigma-prior-fit) ;;
-  *) echo "usage: $0 [all|oracle|oracle-default|network|sigma-prior|sigma-prior-fit] [JOBS]" >&2; exit 2 ;;
+case "$part" in all | oracle | oracle-default | network | sigma-prior | sigma-prior-fit | z-choice) ;;
+  *) echo "usage: $0 [all|oracle|oracle-default|network|sigma-prior|sigma-prior-fit|z-choice] [JOBS]" >&2; exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh plots
 cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build build/release -j"$jobs" --target adaptseg_evaluate
+cmake --build build/release -j"$jobs" --target adaptseg_evaluate adaptseg_calibrate
 eval_bin=build/release/examples/adaptseg_evaluate
+calibrate_bin=build/release/examples/adaptseg_calibrate
 root=out/results
 classes="building road vegetation water"
 fixed=(--seg-time-s 0.1 --plan-time-s 0)
@@ -89,6 +94,47 @@ if [ "$part" = sigma-prior ]; then
   check
   for k in 0.01 1; do labels+=("sigma-prior-$k=$(ls -d "$root/oracle-sigma-prior-$k"/*/ | sed 's:/$::' | paste -sd, -)"); done
   /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
+  exit 0
+fi
+
+if [ "$part" = z-choice ]; then
+  [ -d "$root/oracle-default" ] || { echo "run 'bash $0 oracle-default' first" >&2; exit 1; }
+  out=$root/z-choice
+  rm -rf "${out:?}"
+  mkdir -p "$out"
+  w=examples/data/weedmap-000
+  # One run: its training folds' trials, then its test field at every z (sequential, one core).
+  z_run() {
+    local name=$1 d=$root/oracle-default/$1 train=() test=() interest=()
+    case $name in
+      weedmap-train-left) train=(--train "$w:0,0,0.5,1") test=(--test "$w:0.5,0,1,1") ;;
+      weedmap-train-right) train=(--train "$w:0.5,0,1,1") test=(--test "$w:0,0,0.5,1") ;;
+      *)
+        local cls=${name#dubai-} t=${name##*-}
+        cls=${cls%%-*}
+        interest=(--interest "$cls")
+        for k in 1 2 3 4 5 6; do [ "$k" != "$t" ] && train+=(--train "$(dubai "$k")"); done
+        test=(--test "$(dubai "$t")")
+        ;;
+    esac
+    "$calibrate_bin" "${train[@]}" "${interest[@]}" "${fixed[@]}" --out "$out/$name.model.yaml" >"$out/$name.trials.txt" 2>&1
+    for z in 0 0.5 1 1.5 2; do
+      sed "s/^\(  *confidence:\) .*/\1 $z/" "$d/model.yaml" >"$out/$name.z$z.yaml"
+      "$eval_bin" --model "$out/$name.z$z.yaml" "${test[@]}" "${interest[@]}" "${fixed[@]}" --no-plots \
+        --out "$out/$name.z$z" >"$out/$name.z$z.log" 2>&1
+    done
+  }
+  running=0
+  for d in "$root"/oracle-default/*/; do
+    z_run "$(basename "$d")" &
+    running=$((running + 1))
+    if [ "$running" -ge "$jobs" ]; then
+      wait -n || true
+      running=$((running - 1))
+    fi
+  done
+  wait
+  /usr/bin/python3 examples/tools/z_choice_table.py "$out"
   exit 0
 fi
 
