@@ -22,10 +22,10 @@
 #   "Forecast against realised gain"). Needs out/results/oracle-default; about 8 minutes on 2 cores.
 # sigma-prior-fit: the defaults' Dubai runs calibrated again with sigma-hat's prior taken from the
 #   training fields (--sigma-prior spread and estimated; the defaults keep it as given). Needs
-#   out/results/oracle-default for the comparison; about 20 minutes on 2 cores.
+#   out/results/oracle-default for the comparison; about 13 minutes on 2 cores.
 # z-choice: for each of the defaults' runs, the training folds' margins per confidence level z
 #   (adaptseg_calibrate) and the test field flown with the run's model at every z: how much any
-#   choice of z could buy (docs/results.md). Needs out/results/oracle-default; about 14 minutes
+#   choice of z could buy (docs/results.md). Needs out/results/oracle-default; about 8 minutes
 #   on 2 cores.
 # Outputs: out/results/<configuration>/<run>/ (adaptseg_evaluate's files); prints the tables.
 set -euo pipefail
