@@ -43,10 +43,10 @@ struct ReferenceCurve {
 /// - per candidate, the descent's field-level gain ĝ = η · s · μ_C · a / σ̂ (GainModel: μ_C the
 ///   share of the region's pixels the descent relabels, η the field gain per relabelled share;
 ///   s the field correction below), with variance (η·a/σ̂)²·(s²·sd_C² + Var(s)·μ_C²) plus
-///   σ̂'s (below). Field mIoU counts a class's pixels over the whole field, so a corrected pixel
-///   is worth 1 / (the field's pixels of L): σ̂ estimates the field's σ from the top-level images so far (area
-///   weighted), the part not yet seen taken at their σ shrunk towards the training fields' mean
-///   σ with a weight of k = `sigma_prior_weight` fields (share of a field);
+///   σ̂'s (below). Field mIoU counts a class's pixels over the whole field, so a corrected
+///   pixel is worth 1 / (the field's pixels of L): σ̂ estimates the field's σ from the
+///   top-level images so far (area weighted), the part not yet seen taken at their σ shrunk
+///   towards the training fields' mean σ with a weight of k = `sigma_prior_weight` fields;
 /// - σ̂'s own uncertainty (a hierarchical model: the field's mean σ spread τ = `sigma_prior_sd`
 ///   about the training fields' mean, the mean of a seen share S spread v / S about the field's,
 ///   v = k·τ²): Var σ̂ = (1 − S)²·τ²·k / (k + S) + (1 − S)·v, zero once the field is seen; it
