@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds, and runs the whole test suite twice: a Release build with
-# warnings as errors, and a Debug build under AddressSanitizer + UndefinedBehaviorSanitizer.
+# warnings as errors, and a Debug build under AddressSanitizer + UndefinedBehaviorSanitizer
+# (every test compiled with them; the package, doxygen, snippet, header-alone and Python tests,
+# which build or run nothing sanitized, run in the Release build only).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh test
