@@ -20,8 +20,14 @@ using namespace adaptseg;
 namespace t = adaptseg::test;
 
 namespace {
+/// Half the default camera's image (same lens and sensor): with fields of half the size, the
+/// calibrations below see the same 2 x 2 regions as with the default camera over twice the
+/// field, at a quarter of the pixels (and of the time, which the sanitizer build multiplies).
+const CameraParams kSmallCamera{.image_width_px = 240, .image_height_px = 180};
+
 CalibrationOptions small_options() {
   CalibrationOptions o;
+  o.adaptive.mission.camera = kSmallCamera;
   o.adaptive.mission.fixed_segmentation_time_s = 0.1;
   o.adaptive.mission.fixed_planning_time_s = 0.0;
   o.adaptive.top_gsd_cm = 3.0;
@@ -103,7 +109,7 @@ TEST_CASE("calibration: region samples carry what the descent relabelled and wha
 }
 
 TEST_CASE("calibration: the paper's rule takes the threshold with the best worst-case training margin") {
-  const Field f = t::blob_field(2600, 2000, 1.0, 4, 30);
+  const Field f = t::blob_field(1300, 1000, 1.0, 4, 15);
   OracleSegmenter oracle(f.num_classes());
   CalibrationOptions options = small_options();
   options.rule = CalibrationOptions::Rule::utility;
@@ -128,7 +134,7 @@ TEST_CASE("calibration: the paper's rule takes the threshold with the best worst
 }
 
 TEST_CASE("calibration: by default the front-aware rule, its confidence chosen on the training field") {
-  const Field f = t::blob_field(2600, 2000, 1.0, 4, 30);
+  const Field f = t::blob_field(1300, 1000, 1.0, 4, 15);
   OracleSegmenter oracle(f.num_classes());
   const CalibrationOptions options = small_options();
   REQUIRE(options.rule == CalibrationOptions::Rule::front_aware);
@@ -172,16 +178,16 @@ TEST_CASE("calibration: by default the front-aware rule, its confidence chosen o
 }
 
 TEST_CASE("calibration: several training fields pool their samples and keep every field's curve") {
-  const Field a = t::blob_field(2600, 2000, 1.0, 4, 30);
-  const Field b = t::blob_field(2000, 2600, 1.0, 11, 30).sub_field({0, 0, 1, 0.8});
+  const Field a = t::blob_field(1300, 1000, 1.0, 4, 15);
+  const Field b = t::blob_field(1000, 1300, 1.0, 11, 15).sub_field({0, 0, 1, 0.8});
   OracleSegmenter oracle(a.num_classes());
   const std::vector<Field> fields{a, b};
   CalibrationOptions options = small_options();
   options.sigma_prior = CalibrationOptions::SigmaPriorSource::estimated;
   const CalibrationResult cal = calibrate(fields, oracle, options);
-  const auto only_a = collect_region_samples(a, oracle, CameraModel{}, 3.0, {1.0, 2.0}, a.interest(),
+  const auto only_a = collect_region_samples(a, oracle, CameraModel(kSmallCamera), 3.0, {1.0, 2.0}, a.interest(),
                                              DescentCoverage::region, 0);
-  const auto only_b = collect_region_samples(b, oracle, CameraModel{}, 3.0, {1.0, 2.0}, b.interest(),
+  const auto only_b = collect_region_samples(b, oracle, CameraModel(kSmallCamera), 3.0, {1.0, 2.0}, b.interest(),
                                              DescentCoverage::region, 1);
   CHECK(cal.samples.size() == only_a.size() + only_b.size());
   CHECK(std::count_if(cal.samples.begin(), cal.samples.end(), [](const RegionSample& s) { return s.field == 1; }) ==
@@ -248,7 +254,7 @@ TEST_CASE("calibration: σ̂'s prior from the training fields' σ and how it var
 }
 
 TEST_CASE("calibration: the model is a function of its inputs (a declared time per image)") {
-  const Field f = t::blob_field(2000, 1500, 1.0, 9, 30);
+  const Field f = t::blob_field(1000, 750, 1.0, 9, 15);
   OracleSegmenter oracle(f.num_classes());
   CalibrationOptions options = small_options();
   options.adaptive.mission.fixed_segmentation_time_s.reset();  // replaced by the declared time
@@ -408,7 +414,7 @@ TEST_CASE("decision model: files of format 1 load with the forecasts and decisio
 }
 
 TEST_CASE("decision model: a plain YAML file, every fitted number a key, written and read under any locale") {
-  const Field f = t::blob_field(2000, 1500, 1.0, 9, 30);
+  const Field f = t::blob_field(1000, 750, 1.0, 9, 15);
   OracleSegmenter oracle(f.num_classes());
   CalibrationOptions options = small_options();
   options.confidences = {0.5};
