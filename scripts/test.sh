@@ -12,7 +12,9 @@ cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release -DADAPTSEG_WARNINGS_AS_ER
 cmake --build build/release -j"$jobs"
 ctest --test-dir build/release --output-on-failure -j"$jobs"
 
-cmake -S . -B build/asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS="-O1" \
+# -g1: line tables only, enough for file:line in sanitizer stack traces; full -g cost the
+# sanitized build ~12 % more compile time (test_decision_function: 100 s against 88 s).
+cmake -S . -B build/asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS="-O1" -DCMAKE_CXX_FLAGS_DEBUG="-g1" \
       -DADAPTSEG_WARNINGS_AS_ERRORS=ON -DADAPTSEG_SANITIZE=ON -DADAPTSEG_BUILD_BENCHMARKS=OFF \
       -DADAPTSEG_BUILD_EXAMPLES=OFF
 cmake --build build/asan -j"$jobs"

@@ -6,6 +6,8 @@
 
 #include <doctest/doctest.h>
 
+#include <utility>
+
 using namespace adaptseg;
 namespace t = adaptseg::test;
 
@@ -317,59 +319,60 @@ TEST_CASE("AdaptivePlanner: stepping by hand over WeedMap gives run_adaptive_mis
   const Field f = Field::load(t::example_field("weedmap-000"));
   OracleSegmenter oracle(f.num_classes());
   double unlimited_s = 0.0;
-  for (const bool budget : {false, true}) {
-    for (const bool report_elapsed : {false, true}) {
-      CAPTURE(budget);
-      CAPTURE(report_elapsed);
-      AdaptiveOptions o = weedmap_options(f);
-      if (budget) o.budget_s = unlimited_s - 1.0;  // at least one descent less
-      Scripted sim_policy{.gsd = 1.5, .which = {0, 2, 3, 5, 8, 9, 11}};
-      const AdaptiveResult sim = run_adaptive_mission(f, oracle, sim_policy, o, "scripted");
-      Scripted live_policy = Scripted{.gsd = 1.5, .which = {0, 2, 3, 5, 8, 9, 11}};
-      Planner planner(SurveyArea::of(f), oracle, live_policy, o);
-      const auto steps = fly(planner, f, report_elapsed);
+  // Each flag both ways, in two missions: without a budget the caller reports the elapsed time,
+  // with one the planner keeps its own clock (a budget driven by the reported time: "the elapsed
+  // time the caller reports drives the budget" below).
+  for (const auto& [budget, report_elapsed] : {std::pair{false, true}, std::pair{true, false}}) {
+    CAPTURE(budget);
+    CAPTURE(report_elapsed);
+    AdaptiveOptions o = weedmap_options(f);
+    if (budget) o.budget_s = unlimited_s - 1.0;  // at least one descent less
+    Scripted sim_policy{.gsd = 1.5, .which = {0, 2, 3, 5, 8, 9, 11}};
+    const AdaptiveResult sim = run_adaptive_mission(f, oracle, sim_policy, o, "scripted");
+    Scripted live_policy = Scripted{.gsd = 1.5, .which = {0, 2, 3, 5, 8, 9, 11}};
+    Planner planner(SurveyArea::of(f), oracle, live_policy, o);
+    const auto steps = fly(planner, f, report_elapsed);
 
-      REQUIRE(sim.descents() >= 2);
-      if (!budget) unlimited_s = sim.mission.total_s();
-      if (budget) CHECK(sim.descents() < 7);
-      REQUIRE(steps.size() == sim.mission.waypoints.size());
-      REQUIRE(planner.path().size() == steps.size());
-      for (std::size_t k = 0; k < steps.size(); ++k) {
-        const auto& w = sim.mission.waypoints[k];
-        CHECK(steps[k].waypoint.index == k);
-        CHECK(steps[k].waypoint.level == w.level);
-        CHECK(steps[k].waypoint.waypoint.position == w.waypoint.position);
-        CHECK(steps[k].sigma == w.semantic_ratio);
-      }
-      REQUIRE(planner.decisions().size() == sim.decisions.size());
-      for (std::size_t k = 0; k < sim.decisions.size(); ++k) {
-        const auto& a = planner.decisions()[k];
-        const auto& b = sim.decisions[k];
-        CHECK(a.waypoint_index == b.waypoint_index);
-        CHECK(a.sigma == b.sigma);
-        CHECK(a.decision.descend == b.decision.descend);
-        CHECK(a.decision.gsd_cm == b.decision.gsd_cm);
-        CHECK(a.budget_limited == b.budget_limited);
-        REQUIRE(a.candidates.size() == b.candidates.size());
-        for (std::size_t c = 0; c < a.candidates.size(); ++c)
-          CHECK(a.candidates[c].extra_time_s == b.candidates[c].extra_time_s);
-        REQUIRE(a.outcome.has_value() == b.outcome.has_value());
-        if (a.outcome) CHECK(a.outcome->sigma_sub == b.outcome->sigma_sub);
-      }
-      CHECK(live_policy.observed == sim_policy.observed);
-      CHECK(cv::countNonZero(planner.map().labels() != sim.mission.fused_labels) == 0);
-      CHECK(planner.elapsed_s() == doctest::Approx(sim.mission.total_s()).epsilon(1e-12));
-      if (budget) CHECK(planner.elapsed_s() <= *o.budget_s + 1e-9);
-      // The step results carry the decisions and outcomes as they happen.
-      int decided = 0, outcomes = 0;
-      for (const auto& s : steps) {
-        decided += s.decision ? 1 : 0;
-        outcomes += s.outcome ? 1 : 0;
-        CHECK(s.decision.has_value() == (s.waypoint.level == 0));
-      }
-      CHECK(decided == static_cast<int>(sim.decisions.size()));
-      CHECK(outcomes == sim.descents());
+    REQUIRE(sim.descents() >= 2);
+    if (!budget) unlimited_s = sim.mission.total_s();
+    if (budget) CHECK(sim.descents() < 7);
+    REQUIRE(steps.size() == sim.mission.waypoints.size());
+    REQUIRE(planner.path().size() == steps.size());
+    for (std::size_t k = 0; k < steps.size(); ++k) {
+      const auto& w = sim.mission.waypoints[k];
+      CHECK(steps[k].waypoint.index == k);
+      CHECK(steps[k].waypoint.level == w.level);
+      CHECK(steps[k].waypoint.waypoint.position == w.waypoint.position);
+      CHECK(steps[k].sigma == w.semantic_ratio);
     }
+    REQUIRE(planner.decisions().size() == sim.decisions.size());
+    for (std::size_t k = 0; k < sim.decisions.size(); ++k) {
+      const auto& a = planner.decisions()[k];
+      const auto& b = sim.decisions[k];
+      CHECK(a.waypoint_index == b.waypoint_index);
+      CHECK(a.sigma == b.sigma);
+      CHECK(a.decision.descend == b.decision.descend);
+      CHECK(a.decision.gsd_cm == b.decision.gsd_cm);
+      CHECK(a.budget_limited == b.budget_limited);
+      REQUIRE(a.candidates.size() == b.candidates.size());
+      for (std::size_t c = 0; c < a.candidates.size(); ++c)
+        CHECK(a.candidates[c].extra_time_s == b.candidates[c].extra_time_s);
+      REQUIRE(a.outcome.has_value() == b.outcome.has_value());
+      if (a.outcome) CHECK(a.outcome->sigma_sub == b.outcome->sigma_sub);
+    }
+    CHECK(live_policy.observed == sim_policy.observed);
+    CHECK(cv::countNonZero(planner.map().labels() != sim.mission.fused_labels) == 0);
+    CHECK(planner.elapsed_s() == doctest::Approx(sim.mission.total_s()).epsilon(1e-12));
+    if (budget) CHECK(planner.elapsed_s() <= *o.budget_s + 1e-9);
+    // The step results carry the decisions and outcomes as they happen.
+    int decided = 0, outcomes = 0;
+    for (const auto& s : steps) {
+      decided += s.decision ? 1 : 0;
+      outcomes += s.outcome ? 1 : 0;
+      CHECK(s.decision.has_value() == (s.waypoint.level == 0));
+    }
+    CHECK(decided == static_cast<int>(sim.decisions.size()));
+    CHECK(outcomes == sim.descents());
   }
 }
 
