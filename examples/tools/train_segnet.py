@@ -33,10 +33,16 @@ data workers; --device cpu in float32. A checkpoint written on one continues on 
 --max-minutes stops a run with a checkpoint before a wall-clock limit (for sessions of
 limited length); --resume continues it.
 
-Outputs (in --work-dir): checkpoint.pt (latest, for --resume), train_log.csv, val_log.csv; at
-the end (or with --export-only) in --model-dir: model.onnx (fp32, input 1x3xHxW "input",
-output 1xCx(H/s)x(W/s) "logits"), model.yaml (metadata), model.pt (final weights, state_dict),
-train_log.csv, val_log.csv.
+Weight averaging (--ema DECAY): the run also keeps an exponential moving average of the weights
+(and batch-norm statistics), validates it next to the trained weights (val_ema_log.csv) and
+exports the average instead of the last step's weights; averaged weights tend to sit in flatter
+minima that transfer better to unseen scenes (Izmailov et al., UAI 2018; Cha et al., SWAD,
+NeurIPS 2021).
+
+Outputs (in --work-dir): checkpoint.pt (latest, for --resume), train_log.csv, val_log.csv
+(val_ema_log.csv with --ema); at the end (or with --export-only) in --model-dir: model.onnx
+(fp32, input 1x3xHxW "input", output 1xCx(H/s)x(W/s) "logits"), model.yaml (metadata),
+model.pt (final weights, state_dict), train_log.csv, val_log.csv (val_ema_log.csv).
 
 Split: train on dubai-tile-1,2,3,5, validate on dubai-tile-4; dubai-tile-6 (the test field)
 is never read by this script. The commands of the bundled models are in their READMEs
@@ -56,6 +62,7 @@ Usage:
 from __future__ import annotations
 
 import argparse
+import copy
 import datetime
 import math
 import os
@@ -528,6 +535,8 @@ def export(model, ckpt, args, model_dir: Path, val_result):
             "train_minutes": round(float(ckpt["train_seconds"]) / 60.0, 1),
             "devices": sorted(set(ckpt.get("devices", []))),
             "seed": int(ckpt["seed"]),
+            "weights": (f"exponential moving average of the trained weights, decay {ckpt['ema_decay']:g}"
+                        if ckpt.get("ema_decay") else "the trained weights at the last step"),
             "initialised_from": ckpt.get("init_weights", "ImageNet encoder" if ckpt["arch"] == "mobilenetv2"
                                          else "random"),
             "optimizer": f"{ckpt['optimizer']} wd {ckpt['weight_decay']}; per learning-rate cycle linear "
@@ -556,7 +565,7 @@ def export(model, ckpt, args, model_dir: Path, val_result):
     (model_dir / "model.yaml").write_text(
         "# Segmentation model metadata for adaptseg::ErfnetSegmenter (written by examples/tools/train_segnet.py)\n"
         + yaml.safe_dump(meta, sort_keys=False, default_flow_style=None, width=100))
-    for name in ("train_log.csv", "val_log.csv"):
+    for name in ("train_log.csv", "val_log.csv", "val_ema_log.csv"):
         src = Path(args.work_dir) / name
         if src.exists():
             (model_dir / name).write_text(src.read_text())
@@ -649,6 +658,9 @@ def main(argv=None):
     ap.add_argument("--weight-decay", type=float, default=1e-4)
     ap.add_argument("--warmup", type=int, default=50)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--ema", type=float, default=0.0, metavar="DECAY",
+                    help="new runs: also keep an exponential moving average of the weights (decay in "
+                         "(0, 1), e.g. 0.998), validate it next to the trained weights and export it")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--max-minutes", type=float, default=0.0,
                     help="> 0: checkpoint and stop after this much wall-clock time (continue with --resume)")
@@ -738,7 +750,9 @@ def main(argv=None):
         # from dominating a short training run.
         class_weights = 1.0 / np.log(1.10 + freq)
         class_weights = class_weights / class_weights.mean()
-        ckpt = {"step": 0, "arch": args.arch, "classes": classes, "mean": mean.tolist(),
+        if not 0.0 <= args.ema < 1.0:
+            raise SystemExit(f"--ema {args.ema}: the decay must lie in [0, 1) (0: no average)")
+        ckpt = {"step": 0, "arch": args.arch, "ema_decay": args.ema, "classes": classes, "mean": mean.tolist(),
                 "std": std.tolist(), "class_weights": class_weights.tolist(),
                 "train_fields": train_names, "val_field": args.val_field, "camera_wh": list(camera_wh),
                 "input_wh": list(input_wh), "augment": augment, "crop": crop,
@@ -790,6 +804,16 @@ def main(argv=None):
         if cuda and ckpt.get("cuda_rng") is not None:
             torch.cuda.set_rng_state(ckpt["cuda_rng"])
         print(f"resumed from {ckpt_path} at step {ckpt['step']}", flush=True)
+    # Weight averaging (--ema): a copy of the network whose weights and buffers follow the trained
+    # ones as an exponential moving average, debiased over the first steps; what --ema exports.
+    ema_decay = float(ckpt.get("ema_decay", 0.0))
+    ema_model = None
+    if ema_decay > 0.0:
+        ema_model = copy.deepcopy(model).eval()
+        for p in ema_model.parameters():
+            p.requires_grad = False
+        if resume:
+            ema_model.load_state_dict(ckpt["ema_model"])
     # Learning-rate cycles: the first from step 0 to --steps (--lr, --warmup); each --extend
     # appends one. The checkpoint keeps them, so --resume continues the schedule it was in.
     stages = ckpt.setdefault("stages", [{"start": 0, "end": args.steps, "lr": args.lr,
@@ -809,8 +833,10 @@ def main(argv=None):
           f"class weights {np.round(ckpt['class_weights'], 3).tolist()}", flush=True)
 
     if args.export_only:
-        val = ckpt.get("last_val") or evaluate(model, val_field, val_factors, spec, device=device)
-        export(model, ckpt, args, Path(args.model_dir), {float(k): v for k, v in val.items()})
+        val = ckpt.get("last_val") or evaluate(model if ema_model is None else ema_model, val_field,
+                                               val_factors, spec, device=device)
+        export(model if ema_model is None else ema_model, ckpt, args, Path(args.model_dir),
+               {float(k): v for k, v in val.items()})
         return 0
 
     sampler = Sampler(train_fields, spec, ckpt["crop"], *ckpt["gsd_factor_range"], ckpt["augment"], ckpt["seed"])
@@ -818,12 +844,14 @@ def main(argv=None):
                                     ignore_index=IGNORE).to(device)
     train_log = work / "train_log.csv"
     val_log = work / "val_log.csv"
+    val_ema_log = work / "val_ema_log.csv"
     iou_cols = ",".join(f"iou_{c}" for c in classes)
     if not resume:
         train_log.write_text("step,elapsed_s,loss,lr,img_per_s\n")
-        val_log.write_text(f"step,elapsed_s,gsd_factor,gsd_cm,images,miou_camera,miou_ortho,{iou_cols}\n")
+        for log in (val_log, val_ema_log) if ema_model is not None else (val_log,):
+            log.write_text(f"step,elapsed_s,gsd_factor,gsd_cm,images,miou_camera,miou_ortho,{iou_cols}\n")
     else:  # drop log rows written after the checkpoint: they will be redone
-        for log in (train_log, val_log):
+        for log in (train_log, val_log, val_ema_log):
             if log.exists():
                 lines = log.read_text().splitlines(keepends=True)
                 log.write_text("".join(lines[:1] + [ln for ln in lines[1:] if int(ln.split(",")[0]) <= ckpt["step"]]))
@@ -836,6 +864,8 @@ def main(argv=None):
         return st["lr"] * (1.0 - (i - w) / max(1, n - w)) ** 0.9
 
     def save_checkpoint():
+        if ema_model is not None:
+            ckpt["ema_model"] = {k: v.detach().cpu() for k, v in ema_model.state_dict().items()}
         ckpt.update({"model": {k: v.detach().cpu() for k, v in model.state_dict().items()},
                      "optimizer_state": opt.state_dict(), "torch_rng": torch.get_rng_state(),
                      "cuda_rng": torch.cuda.get_rng_state() if cuda else None})
@@ -844,16 +874,21 @@ def main(argv=None):
         os.replace(tmp, ckpt_path)
 
     def validate(step):
-        tv = time.time()
-        res = evaluate(model, val_field, val_factors, spec, args.val_max_images or None, device)
-        with val_log.open("a") as fh:
-            for fac, r in res.items():
-                ious = ",".join("" if u is None else f"{u:.4f}" for u in r["iou_ortho"])
-                fh.write(f"{step},{ckpt['train_seconds']:.1f},{fac},{r['gsd_cm']:.3f},{r['images']},"
-                         f"{r['miou_camera']:.4f},{r['miou_ortho']:.4f},{ious}\n")
-        summary = " ".join(f"x{fac:g}:{r['miou_camera']:.3f}/{r['miou_ortho']:.3f}" for fac, r in res.items())
-        print(f"[val step {step}] mIoU camera/ortho per GSD factor: {summary} ({time.time() - tv:.0f} s)",
-              flush=True)
+        """Validates the trained weights (val_log.csv) and, with --ema, their average
+        (val_ema_log.csv); returns the result of the weights that are exported."""
+        for net, log, name in ((model, val_log, "val"), (ema_model, val_ema_log, "val ema")):
+            if net is None:
+                continue
+            tv = time.time()
+            res = evaluate(net, val_field, val_factors, spec, args.val_max_images or None, device)
+            with log.open("a") as fh:
+                for fac, r in res.items():
+                    ious = ",".join("" if u is None else f"{u:.4f}" for u in r["iou_ortho"])
+                    fh.write(f"{step},{ckpt['train_seconds']:.1f},{fac},{r['gsd_cm']:.3f},{r['images']},"
+                             f"{r['miou_camera']:.4f},{r['miou_ortho']:.4f},{ious}\n")
+            summary = " ".join(f"x{fac:g}:{r['miou_camera']:.3f}/{r['miou_ortho']:.3f}" for fac, r in res.items())
+            print(f"[{name} step {step}] mIoU camera/ortho per GSD factor: {summary} ({time.time() - tv:.0f} s)",
+                  flush=True)
         ckpt["last_val"] = {str(k): v for k, v in res.items()}
         return res
 
@@ -884,6 +919,14 @@ def main(argv=None):
         opt.zero_grad(set_to_none=True)
         loss.backward()
         opt.step()
+        if ema_model is not None:
+            with torch.no_grad():
+                d = min(ema_decay, (1.0 + step) / (10.0 + step))
+                for e, w in zip(ema_model.state_dict().values(), model.state_dict().values()):
+                    if e.dtype.is_floating_point:
+                        e.mul_(d).add_(w.detach(), alpha=1.0 - d)
+                    else:
+                        e.copy_(w)
         step += 1
         ckpt["step"] = step
         ckpt["train_seconds"] += time.time() - ts
@@ -915,7 +958,7 @@ def main(argv=None):
     save_checkpoint()
     print(f"training done: {step} steps, {ckpt['train_seconds'] / 60:.1f} min of training", flush=True)
     if not args.no_export:
-        export(model, ckpt, args, Path(args.model_dir), val)
+        export(model if ema_model is None else ema_model, ckpt, args, Path(args.model_dir), val)
     return 0
 
 
