@@ -6,6 +6,7 @@
 #include <GeographicLib/Geodesic.hpp>
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -223,15 +224,23 @@ TEST_CASE("export: paths keep positions, GSD and levels of a planned or flown mi
                   std::invalid_argument);
 }
 
-TEST_CASE("export: mission items hold at every waypoint, then capture one image") {
+TEST_CASE("export: mission items take off, hold at every waypoint, capture one image, and come back") {
   const ExportPath p = sample_path();
   adaptseg::ExportOptions opt;
   opt.hold_s = 2.5;
   const auto items = adaptseg::mission_items(p, opt);
-  REQUIRE(items.size() == 2 * p.waypoints.size());
+  REQUIRE(items.size() == 2 * p.waypoints.size() + 2);
+  const MissionItem& takeoff = items.front();
+  CHECK(takeoff.command == 22);
+  CHECK(takeoff.frame == 3);
+  CHECK(takeoff.params[0] == 0.0);  // pitch
+  CHECK(std::isnan(takeoff.params[3]));
+  CHECK(takeoff.params[4] == p.home.latitude_deg);
+  CHECK(takeoff.params[5] == p.home.longitude_deg);
+  CHECK(takeoff.params[6] == p.waypoints.front().relative_altitude_m);
   for (std::size_t i = 0; i < p.waypoints.size(); ++i) {
-    const MissionItem& nav = items[2 * i];
-    const MissionItem& cap = items[2 * i + 1];
+    const MissionItem& nav = items[1 + 2 * i];
+    const MissionItem& cap = items[2 + 2 * i];
     CHECK(nav.command == 16);
     CHECK(nav.frame == 3);
     CHECK(nav.params[0] == 2.5);
@@ -244,10 +253,43 @@ TEST_CASE("export: mission items hold at every waypoint, then capture one image"
     CHECK(cap.params[2] == 1.0);                          // one image
     CHECK(cap.params[3] == static_cast<double>(i + 1));   // capture sequence number
   }
+  const MissionItem& rtl = items.back();
+  CHECK(rtl.command == 20);
+  CHECK(rtl.frame == 2);
+  CHECK(rtl.params == std::array<double, 7>{});
+
+  // Mission Planner's camera item, a landing at home instead of RTL, no take-off.
+  opt.camera_trigger = adaptseg::CameraTrigger::digicam_control;
+  opt.end = adaptseg::MissionEnd::land;
+  opt.takeoff = false;
+  const auto other = adaptseg::mission_items(p, opt);
+  REQUIRE(other.size() == 2 * p.waypoints.size() + 1);
+  CHECK(other.front().command == 16);
+  CHECK(other[1].command == 203);
+  CHECK(other[1].frame == 2);
+  CHECK(other[1].params == std::array<double, 7>{0, 0, 0, 0, 1, 0, 0});  // param5 1: one shot
+  CHECK(other.back().command == 21);
+  CHECK(other.back().frame == 3);
+  CHECK(other.back().params[4] == p.home.latitude_deg);
+  CHECK(other.back().params[5] == p.home.longitude_deg);
+  CHECK(other.back().params[6] == 0.0);
+  opt.end = adaptseg::MissionEnd::none;
   opt.capture_images = false;
   CHECK(adaptseg::mission_items(p, opt).size() == p.waypoints.size());
+
+  // A take-off needs somewhere to climb to.
+  ExportPath low = p;
+  low.waypoints.front().relative_altitude_m = 0.0;
+  CHECK_THROWS_WITH_AS((void)adaptseg::mission_items(low), doctest::Contains("take-off needs the first waypoint above home"),
+                       std::invalid_argument);
+  opt.takeoff = false;
+  CHECK(adaptseg::mission_items(low, opt).size() == p.waypoints.size());
   opt.hold_s = -1.0;
   CHECK_THROWS_WITH_AS((void)adaptseg::mission_items(p, opt), doctest::Contains("hold_s"), std::invalid_argument);
+  opt.hold_s = 1.0;
+  opt.end = static_cast<adaptseg::MissionEnd>(7);
+  CHECK_THROWS_WITH_AS((void)adaptseg::mission_items(p, opt), doctest::Contains("end must be a MissionEnd"),
+                       std::invalid_argument);
 }
 
 TEST_CASE("export: a QGroundControl plan reads back equal and has QGC's structure") {
@@ -267,19 +309,31 @@ TEST_CASE("export: a QGroundControl plan reads back equal and has QGC's structur
   CHECK(m["version"] == 2);
   CHECK(m["hoverSpeed"] == 2.0);
   CHECK(m["plannedHomePosition"].size() == 3);
-  const auto& first = m["items"][0];
+  const auto& takeoff = m["items"][0];
+  CHECK(takeoff["type"] == "SimpleItem");
+  CHECK(takeoff["command"] == 22);
+  CHECK(takeoff["frame"] == 3);
+  CHECK(takeoff["doJumpId"] == 1);
+  CHECK(takeoff["AltitudeMode"] == 1);
+  CHECK(takeoff["Altitude"] == p.waypoints.front().relative_altitude_m);
+  const auto& first = m["items"][1];
   CHECK(first["type"] == "SimpleItem");
   CHECK(first["command"] == 16);
   CHECK(first["frame"] == 3);
-  CHECK(first["doJumpId"] == 1);
+  CHECK(first["doJumpId"] == 2);
   CHECK(first["autoContinue"] == true);
   CHECK(first["AltitudeMode"] == 1);
   CHECK(first["AMSLAltAboveTerrain"].is_null());
   CHECK(first["Altitude"] == first["params"][6]);
   CHECK(first["params"][3].is_null());
-  CHECK(m["items"][1]["command"] == 2000);
-  CHECK_FALSE(m["items"][1].contains("Altitude"));
-  CHECK(m["items"][1]["doJumpId"] == 2);
+  CHECK(m["items"][2]["command"] == 2000);
+  CHECK_FALSE(m["items"][2].contains("Altitude"));
+  CHECK(m["items"][2]["doJumpId"] == 3);
+  const auto& last = m["items"].back();
+  CHECK(last["command"] == 20);
+  CHECK(last["frame"] == 2);
+  CHECK_FALSE(last.contains("Altitude"));
+  CHECK(last["doJumpId"] == m["items"].size());
 }
 
 TEST_CASE("export: a QGC WPL 110 file reads back equal") {
@@ -290,7 +344,7 @@ TEST_CASE("export: a QGC WPL 110 file reads back equal") {
   check_same_home(back.home, p.home);
   check_same_items(back.items, adaptseg::mission_items(p));
   // Exact, too: shortest round-trip text.
-  CHECK(back.items[0].params[4] == p.waypoints[0].latitude_deg);
+  CHECK(back.items[1].params[4] == p.waypoints[0].latitude_deg);
   // Spaces, \r\n and blank lines are read as well.
   std::string crlf;
   for (char c : text) {
@@ -403,8 +457,8 @@ TEST_CASE("export: malformed plan and GeoJSON files are rejected, naming the mem
   j["mission"]["items"][0]["params"].erase(0);
   expect_plan_error(j, "mission.items[0].params must be an array of 7");
   j = plan;
-  j["mission"]["items"][2]["params"][4] = 123.0;
-  expect_plan_error(j, "mission.items[2]: latitude");
+  j["mission"]["items"][3]["params"][4] = 123.0;
+  expect_plan_error(j, "mission.items[3]: latitude");
   j = plan;
   j["mission"]["items"][0]["command"] = -1;
   expect_plan_error(j, "mission.items[0].command must be an integer");

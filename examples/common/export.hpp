@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <set>
 #include <stdexcept>
@@ -37,6 +38,21 @@ struct ExportCli {
                    "field.yaml's geo section");
     app.add_option("--hold-s", file_options.hold_s, "hold time at every exported waypoint [s]")
         ->capture_default_str();
+    app.add_flag("--takeoff,!--no-takeoff", file_options.takeoff,
+                 "begin the exported mission with a take-off at home to the first waypoint's altitude "
+                 "(default; --no-takeoff for a UAV already airborne)");
+    app.add_option("--mission-end", file_options.end,
+                   "after the last exported waypoint: rtl (return to launch, default), land (at home) or none")
+        ->transform(CLI::CheckedTransformer(std::map<std::string, MissionEnd>{{"rtl", MissionEnd::return_to_launch},
+                                                                             {"land", MissionEnd::land},
+                                                                             {"none", MissionEnd::none}}));
+    app.add_option("--camera-trigger", file_options.camera_trigger,
+                   "the item after every exported waypoint that takes its image: capture "
+                   "(IMAGE_START_CAPTURE, as QGroundControl writes it; default) or digicam "
+                   "(DO_DIGICAM_CONTROL, as Mission Planner writes it)")
+        ->transform(CLI::CheckedTransformer(
+            std::map<std::string, CameraTrigger>{{"capture", CameraTrigger::image_start_capture},
+                                                 {"digicam", CameraTrigger::digicam_control}}));
   }
 
   /// --geo-origin as a FieldGeo, if given.

@@ -4,11 +4,14 @@
 /// same files: QGroundControl `.plan` (JSON), the MAVLink plain-text waypoint format
 /// (`QGC WPL 110`) and GeoJSON (RFC 7946). CMake target adaptseg::geo.
 ///
-/// Every waypoint becomes a MAV_CMD_NAV_WAYPOINT that holds there (the UAV stops at each
-/// waypoint, paper §3.2.1) followed by a MAV_CMD_IMAGE_START_CAPTURE of one image. Waypoint
-/// altitudes are relative (MAV_FRAME_GLOBAL_RELATIVE_ALT): the waypoint's z, its height above
-/// the field plane, on which the UAV takes off (the home position). Formats and conventions:
-/// docs/data_format.md, "Mission export".
+/// A mission file is one an autopilot flies from the ground and back: a MAV_CMD_NAV_TAKEOFF
+/// above home to the first waypoint's altitude; every waypoint a MAV_CMD_NAV_WAYPOINT that
+/// holds there (the UAV stops at each waypoint, paper §3.2.1) followed by one camera trigger
+/// (QGroundControl's MAV_CMD_IMAGE_START_CAPTURE of one image, or Mission Planner's
+/// MAV_CMD_DO_DIGICAM_CONTROL); then MAV_CMD_NAV_RETURN_TO_LAUNCH (or a landing at home, or
+/// nothing: ExportOptions). Altitudes are relative (MAV_FRAME_GLOBAL_RELATIVE_ALT): the
+/// waypoint's z, its height above the field plane, on which the UAV takes off (the home
+/// position). Formats and conventions: docs/data_format.md, "Mission export".
 ///
 /// @code
 /// const adaptseg::GeoReference geo(field);
@@ -17,6 +20,7 @@
 /// const adaptseg::MissionFile back = adaptseg::read_qgc_plan(plan);
 /// @endcode
 
+#include <adaptseg/detail/export_text.hpp>
 #include <adaptseg/error.hpp>
 #include <adaptseg/geo.hpp>
 #include <adaptseg/lawnmower_planner.hpp>
@@ -25,7 +29,6 @@
 #include <nlohmann/json.hpp>
 
 #include <array>
-#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -34,7 +37,6 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
-#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -43,6 +45,10 @@ namespace adaptseg {
 /// The MAVLink enumeration values the exports use (MAVLink common.xml).
 namespace mavlink {
 inline constexpr int kCmdNavWaypoint = 16;          ///< MAV_CMD_NAV_WAYPOINT: p1 hold [s], p4 yaw, p5-7 position
+inline constexpr int kCmdNavReturnToLaunch = 20;    ///< MAV_CMD_NAV_RETURN_TO_LAUNCH: no parameters
+inline constexpr int kCmdNavLand = 21;              ///< MAV_CMD_NAV_LAND: p4 yaw, p5-7 position (altitude ignored)
+inline constexpr int kCmdNavTakeoff = 22;           ///< MAV_CMD_NAV_TAKEOFF: p1 pitch, p4 yaw, p5-6 position, p7 altitude
+inline constexpr int kCmdDoDigicamControl = 203;    ///< MAV_CMD_DO_DIGICAM_CONTROL: p5 1 = take one shot
 inline constexpr int kCmdImageStartCapture = 2000;  ///< MAV_CMD_IMAGE_START_CAPTURE: p1 camera, p2 interval, p3 count, p4 sequence
 inline constexpr int kFrameGlobal = 0;              ///< MAV_FRAME_GLOBAL: altitude above mean sea level
 inline constexpr int kFrameMission = 2;             ///< MAV_FRAME_MISSION: the item has no position
@@ -69,10 +75,26 @@ struct ExportPath {
   std::vector<ExportWaypoint> waypoints;   ///< in visiting order
 };
 
+/// What a mission file does after its last waypoint.
+enum class MissionEnd {
+  return_to_launch,  ///< MAV_CMD_NAV_RETURN_TO_LAUNCH: the autopilot flies home at its RTL altitude and lands
+  land,              ///< MAV_CMD_NAV_LAND at home: flies there at the last waypoint's altitude and lands
+  none,              ///< nothing: the autopilot's end-of-mission behaviour (often: hover at the last waypoint)
+};
+
+/// The mission item that takes each image.
+enum class CameraTrigger {
+  image_start_capture,  ///< MAV_CMD_IMAGE_START_CAPTURE of one image, as QGroundControl writes "Take photo"
+  digicam_control,      ///< MAV_CMD_DO_DIGICAM_CONTROL with shoot = 1, as Mission Planner writes it
+};
+
 /// Settings of the mission files.
 struct ExportOptions {
   double hold_s = 1.0;              ///< hold time at every waypoint before the image [s] (NAV_WAYPOINT param1)
-  bool capture_images = true;       ///< an IMAGE_START_CAPTURE item after every waypoint
+  bool capture_images = true;       ///< a camera trigger after every waypoint
+  CameraTrigger camera_trigger = CameraTrigger::image_start_capture;  ///< which item triggers the camera
+  bool takeoff = true;              ///< a NAV_TAKEOFF at home to the first waypoint's altitude, first
+  MissionEnd end = MissionEnd::return_to_launch;  ///< the item after the last waypoint
   double hover_speed_mps = 2.0;     ///< multicopter speed [m/s] (.plan `hoverSpeed`)
   double cruise_speed_mps = 15.0;   ///< fixed-wing speed [m/s] (.plan `cruiseSpeed`, required by QGC)
   int firmware_type = mavlink::kAutopilotPx4;  ///< MAV_AUTOPILOT of the .plan (3: ArduPilot)
@@ -87,6 +109,11 @@ struct ExportOptions {
                     firmware_type);
     detail::require(vehicle_type >= 0 && vehicle_type <= 255, "ExportOptions: vehicle_type must be in 0..255",
                     vehicle_type);
+    detail::require(end == MissionEnd::return_to_launch || end == MissionEnd::land || end == MissionEnd::none,
+                    "ExportOptions: end must be a MissionEnd", static_cast<int>(end));
+    detail::require(camera_trigger == CameraTrigger::image_start_capture ||
+                        camera_trigger == CameraTrigger::digicam_control,
+                    "ExportOptions: camera_trigger must be a CameraTrigger", static_cast<int>(camera_trigger));
   }
 };
 
@@ -173,24 +200,47 @@ inline ExportPath make_export_path(const MissionResult& result, const GeoReferen
   return make_export_path(path, levels, geo, result.field + " " + result.strategy);
 }
 
-/// The mission items of `path` (home excluded): per waypoint a NAV_WAYPOINT in the relative
-/// altitude frame holding `hold_s` (param4 yaw NaN: the autopilot's yaw mode), then, if
-/// `capture_images`, an IMAGE_START_CAPTURE of one image (all cameras, sequence 1, 2, ...).
-/// @throws std::invalid_argument for invalid options.
+/// The mission items of `path` (home excluded), in the relative altitude frame where they
+/// have a position (yaw NaN: the autopilot's yaw mode):
+/// - if `takeoff`, a NAV_TAKEOFF at home (pitch 0) to the first waypoint's altitude;
+/// - per waypoint a NAV_WAYPOINT holding `hold_s`, then, if `capture_images`, one camera
+///   trigger: an IMAGE_START_CAPTURE of one image (all cameras, sequence 1, 2, ...) or a
+///   DO_DIGICAM_CONTROL with shoot = 1;
+/// - `end`: a RETURN_TO_LAUNCH, a NAV_LAND at home, or nothing.
+/// @throws std::invalid_argument for invalid options, or a take-off with the first waypoint
+///         not above home.
 inline std::vector<MissionItem> mission_items(const ExportPath& path, const ExportOptions& options = {}) {
   options.validate();
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   std::vector<MissionItem> items;
+  if (options.takeoff && !path.waypoints.empty()) {
+    const double altitude = path.waypoints.front().relative_altitude_m;
+    detail::require(altitude > 0.0, "mission_items: a take-off needs the first waypoint above home, relative altitude",
+                    altitude);
+    items.push_back({mavlink::kCmdNavTakeoff, mavlink::kFrameGlobalRelativeAlt,
+                     {0.0, 0.0, 0.0, kNaN, path.home.latitude_deg, path.home.longitude_deg, altitude},
+                     true});
+  }
   int sequence = 0;
   for (const auto& w : path.waypoints) {
     items.push_back({mavlink::kCmdNavWaypoint, mavlink::kFrameGlobalRelativeAlt,
                      {options.hold_s, 0.0, 0.0, kNaN, w.latitude_deg, w.longitude_deg, w.relative_altitude_m},
                      true});
-    if (options.capture_images)
+    if (!options.capture_images) continue;
+    if (options.camera_trigger == CameraTrigger::image_start_capture)
       items.push_back({mavlink::kCmdImageStartCapture, mavlink::kFrameMission,
                        {0.0, 0.0, 1.0, static_cast<double>(++sequence), kNaN, kNaN, kNaN},
                        true});
+    else
+      items.push_back({mavlink::kCmdDoDigicamControl, mavlink::kFrameMission, {0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0},
+                       true});
   }
+  if (options.end == MissionEnd::return_to_launch)
+    items.push_back({mavlink::kCmdNavReturnToLaunch, mavlink::kFrameMission, {}, true});
+  else if (options.end == MissionEnd::land)
+    items.push_back({mavlink::kCmdNavLand, mavlink::kFrameGlobalRelativeAlt,
+                     {0.0, 0.0, 0.0, kNaN, path.home.latitude_deg, path.home.longitude_deg, 0.0},
+                     true});
   return items;
 }
 
@@ -198,10 +248,6 @@ namespace detail {
 
 inline void require_exportable(const ExportPath& path, const char* who) {
   if (path.waypoints.empty()) throw std::invalid_argument(std::string(who) + ": the path has no waypoint");
-}
-
-[[noreturn]] inline void export_parse_error(const char* format, const std::string& what) {
-  throw std::invalid_argument(std::string(format) + ": " + what);
 }
 
 /// Checks the position of an item in a global frame (latitude, longitude in range, finite
@@ -217,83 +263,6 @@ inline void check_item_position(const MissionItem& item, const char* format, con
   if (!(std::isfinite(p[5]) && p[5] >= -180.0 && p[5] <= 180.0))
     export_parse_error(format, where + ": longitude must be in [-180, 180] (got " + std::to_string(p[5]) + ")");
   if (!std::isfinite(p[6])) export_parse_error(format, where + ": altitude must be finite");
-}
-
-// --- JSON access that reports the path of the offending member ---
-
-inline const nlohmann::json& json_member(const nlohmann::json& obj, const char* key, const char* format,
-                                         const std::string& where) {
-  if (!obj.is_object()) export_parse_error(format, where + " must be an object");
-  const auto it = obj.find(key);
-  if (it == obj.end()) export_parse_error(format, where + ": missing key '" + key + "'");
-  return *it;
-}
-
-/// Requires the string member `key` of `obj` to be `want`.
-inline void json_expect(const nlohmann::json& obj, const char* key, std::string_view want, const char* format) {
-  const auto& j = json_member(obj, key, format, "the file");
-  if (!j.is_string() || j.get_ref<const std::string&>() != want)
-    export_parse_error(format, std::string(key) + " must be \"" + std::string(want) + "\"");
-}
-
-inline double json_number(const nlohmann::json& j, const char* format, const std::string& where) {
-  if (!j.is_number()) export_parse_error(format, where + " must be a number");
-  return j.get<double>();
-}
-
-inline long long json_integer(const nlohmann::json& j, long long lo, long long hi, const char* format,
-                              const std::string& where) {
-  const std::string range = " must be an integer in " + std::to_string(lo) + ".." + std::to_string(hi);
-  if (j.is_number_unsigned()) {
-    const auto u = j.get<std::uint64_t>();
-    if (u > static_cast<std::uint64_t>(hi)) export_parse_error(format, where + range);
-    return static_cast<long long>(u);
-  }
-  if (!j.is_number_integer()) export_parse_error(format, where + range);
-  const auto v = j.get<std::int64_t>();
-  if (v < lo || v > hi) export_parse_error(format, where + range);
-  return v;
-}
-
-inline const std::string& json_string(const nlohmann::json& j, const char* format, const std::string& where) {
-  if (!j.is_string()) export_parse_error(format, where + " must be a string");
-  return j.get_ref<const std::string&>();
-}
-
-inline nlohmann::json json_parse(std::string_view text, const char* format) {
-  nlohmann::json j = nlohmann::json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/false);
-  if (j.is_discarded()) export_parse_error(format, "not valid JSON");
-  return j;
-}
-
-/// [lon, lat, h] (GeoJSON position order) -> GeoPoint, validated.
-inline GeoPoint json_position(const nlohmann::json& j, const char* format, const std::string& where) {
-  if (!j.is_array() || j.size() != 3) export_parse_error(format, where + " must be [longitude, latitude, height]");
-  const GeoPoint g{json_number(j[1], format, where + "[1]"), json_number(j[0], format, where + "[0]"),
-                   json_number(j[2], format, where + "[2]")};
-  if (!(std::isfinite(g.latitude_deg) && g.latitude_deg >= -90.0 && g.latitude_deg <= 90.0 &&
-        std::isfinite(g.longitude_deg) && g.longitude_deg >= -180.0 && g.longitude_deg <= 180.0 &&
-        std::isfinite(g.altitude_m)))
-    export_parse_error(format, where + ": latitude must be in [-90, 90], longitude in [-180, 180], height finite");
-  return g;
-}
-
-// --- WPL numbers: locale-independent, shortest round-trip text ---
-
-inline std::string wpl_number(double v) {
-  char buf[64];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
-
-inline bool wpl_parse(std::string_view token, double& out) {
-  const auto r = std::from_chars(token.data(), token.data() + token.size(), out);
-  return r.ec == std::errc() && r.ptr == token.data() + token.size();
-}
-
-inline bool wpl_parse(std::string_view token, long long& out) {
-  const auto r = std::from_chars(token.data(), token.data() + token.size(), out);
-  return r.ec == std::errc() && r.ptr == token.data() + token.size();
 }
 
 }  // namespace detail

@@ -27,6 +27,10 @@ bad_inputs)
   [ ! -e "$work/o" ] || fail "an error must be reported before the mission writes anything"
   "$mission" --field "$field" --gsd 3 --export kml --geo-origin "$origin" --out "$work/o" >/dev/null 2>&1
   rc=$?; [ "$rc" -ne 0 ] && [ "$rc" -lt 128 ] || fail "--export kml: exit code $rc"
+  expect_error "--mission-end" --field "$field" --gsd 3 --export plan --geo-origin "$origin" --mission-end hover \
+    --out "$work/o"
+  expect_error "--camera-trigger" --field "$field" --gsd 3 --export plan --geo-origin "$origin" --camera-trigger shutter \
+    --out "$work/o"
   ;;
 files)
   fly "$work/m" --export plan,wpl --export geojson --geo-origin "$origin" --hold-s 2
@@ -34,6 +38,11 @@ files)
   # The same mission without --export writes no mission file.
   fly "$work/plain"
   [ ! -e "$work/plain/mission.plan" ] || fail "mission.plan without --export"
+  # No take-off, a landing at home, Mission Planner's camera item.
+  fly "$work/mp" --export wpl --geo-origin "$origin" --no-takeoff --mission-end land --camera-trigger digicam
+  sed -n 3,4p "$work/mp/mission.waypoints" | cut -f2-4 | tr '\n' ' ' | grep -qx "0	3	16 0	2	203 " ||
+    fail "--no-takeoff --camera-trigger digicam: want a waypoint then DO_DIGICAM_CONTROL first: $(sed -n 3,4p "$work/mp/mission.waypoints")"
+  tail -1 "$work/mp/mission.waypoints" | cut -f2-4 | grep -qx "0	3	21" || fail "--mission-end land: last item $(tail -1 "$work/mp/mission.waypoints")"
   "$python" - "$work/m" "$origin" <<'PY' || fail "mission file checks"
 import json, math, sys
 out, origin = sys.argv[1], [float(v) for v in sys.argv[2].split(",")]
@@ -58,19 +67,24 @@ want = [wgs84(w["x"], w["y"]) for w in wps]
 plan = json.load(open(f"{out}/mission.plan"))
 assert plan["fileType"] == "Plan" and plan["version"] == 1
 items = plan["mission"]["items"]
-assert len(items) == 2 * n, (len(items), n)
+assert len(items) == 2 * n + 2, (len(items), n)
+takeoff, rtl = items[0], items[-1]
+assert takeoff["command"] == 22 and takeoff["frame"] == 3 and abs(takeoff["params"][6] - wps[0]["z"]) < 0.01, takeoff
+assert rtl["command"] == 20 and rtl["params"] == [0] * 7, rtl
 for k, w in enumerate(wps[:50]):
-    nav, cap = items[2 * k], items[2 * k + 1]
+    nav, cap = items[1 + 2 * k], items[2 + 2 * k]
     assert nav["command"] == 16 and nav["frame"] == 3 and nav["params"][0] == 2, nav
     assert abs(nav["params"][4] - want[k][0]) < 1e-7 and abs(nav["params"][5] - want[k][1]) < 1e-7, (nav, want[k])
     assert abs(nav["params"][6] - w["z"]) < 0.01
     assert cap["command"] == 2000 and cap["params"][2] == 1
 lines = open(f"{out}/mission.waypoints").read().splitlines()
-assert lines[0] == "QGC WPL 110" and len(lines) == 2 + 2 * n, len(lines)
+assert lines[0] == "QGC WPL 110" and len(lines) == 4 + 2 * n, len(lines)
 home = lines[1].split("\t")
 assert home[:4] == ["0", "1", "0", "16"] and float(home[10]) == 500.0, home
-f1 = lines[2].split("\t")
-assert f1[:4] == ["1", "0", "3", "16"] and len(f1) == 12, f1
+assert lines[2].split("\t")[:4] == ["1", "0", "3", "22"], lines[2]
+assert lines[-1].split("\t")[1:4] == ["0", "2", "20"], lines[-1]
+f1 = lines[3].split("\t")
+assert f1[:4] == ["2", "0", "3", "16"] and len(f1) == 12, f1
 assert abs(float(f1[8]) - want[0][0]) < 1e-7 and abs(float(f1[9]) - want[0][1]) < 1e-7
 gj = json.load(open(f"{out}/mission.geojson"))
 assert gj["type"] == "FeatureCollection" and len(gj["features"]) == n + 1
