@@ -814,6 +814,7 @@ def main(argv=None):
             p.requires_grad = False
         if resume:
             ema_model.load_state_dict(ckpt["ema_model"])
+    exported_model = model if ema_model is None else ema_model  # what validation reports and export writes
     # Learning-rate cycles: the first from step 0 to --steps (--lr, --warmup); each --extend
     # appends one. The checkpoint keeps them, so --resume continues the schedule it was in.
     stages = ckpt.setdefault("stages", [{"start": 0, "end": args.steps, "lr": args.lr,
@@ -833,10 +834,8 @@ def main(argv=None):
           f"class weights {np.round(ckpt['class_weights'], 3).tolist()}", flush=True)
 
     if args.export_only:
-        val = ckpt.get("last_val") or evaluate(model if ema_model is None else ema_model, val_field,
-                                               val_factors, spec, device=device)
-        export(model if ema_model is None else ema_model, ckpt, args, Path(args.model_dir),
-               {float(k): v for k, v in val.items()})
+        val = ckpt.get("last_val") or evaluate(exported_model, val_field, val_factors, spec, device=device)
+        export(exported_model, ckpt, args, Path(args.model_dir), {float(k): v for k, v in val.items()})
         return 0
 
     sampler = Sampler(train_fields, spec, ckpt["crop"], *ckpt["gsd_factor_range"], ckpt["augment"], ckpt["seed"])
@@ -958,7 +957,7 @@ def main(argv=None):
     save_checkpoint()
     print(f"training done: {step} steps, {ckpt['train_seconds'] / 60:.1f} min of training", flush=True)
     if not args.no_export:
-        export(model if ema_model is None else ema_model, ckpt, args, Path(args.model_dir), val)
+        export(exported_model, ckpt, args, Path(args.model_dir), val)
     return 0
 
 
