@@ -114,6 +114,24 @@ TEST_CASE("geo: the heading is the compass bearing of +x, and +y lies 90 degrees
     CHECK(dy == doctest::Approx(100.0).epsilon(1e-6));
     CHECK(std::abs(angle_diff(ay, c.azimuth_y)) < 1e-6);
   }
+  // A grid's scale (a GeoTIFF field's frame is in grid metres): 100 grid metres are 100 / k on
+  // the ground, in the same directions, and the round trip stays exact.
+  for (const double k : {0.9996, 1.0004}) {
+    CAPTURE(k);
+    const FieldGeo g{kGeo.latitude_deg, kGeo.longitude_deg, 0.0, 30.0, 0.0, 0.0, k};
+    const GeoReference geo(g);
+    const GeoPoint origin = geo.to_wgs84({0.0, 0.0, 0.0});
+    const auto [dx, ax] = geodesic(origin, geo.to_wgs84({100.0, 0.0, 0.0}));
+    CHECK(dx == doctest::Approx(100.0 / k).epsilon(1e-7));
+    CHECK(std::abs(angle_diff(ax, 30.0)) < 1e-6);
+    const auto [dy, ay] = geodesic(origin, geo.to_wgs84({0.0, 100.0, 0.0}));
+    CHECK(dy == doctest::Approx(100.0 / k).epsilon(1e-7));
+    CHECK(std::abs(angle_diff(ay, -60.0)) < 1e-6);
+    const Eigen::Vector3d p(250.0, -40.0, 12.0);
+    CHECK((geo.to_field(geo.to_wgs84(p)) - p).norm() < 1e-6);
+  }
+  CHECK_THROWS_WITH_AS(GeoReference(FieldGeo{0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}), doctest::Contains("scale"),
+                       std::invalid_argument);
   // The local frame directly: heading 90 is the identity on (x, y).
   const GeoReference east(kGeo);
   CHECK((east.field_to_enu({3.0, 4.0, 5.0}) - Eigen::Vector3d(3.0, 4.0, 5.0)).norm() < 1e-12);

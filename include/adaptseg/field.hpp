@@ -1,7 +1,8 @@
 #pragma once
 /// @file
 /// A field to survey: the orthomosaic's label map (and RGB image, when there is one), its
-/// GSD and class set, loaded from the project's field directory format (docs/data_format.md).
+/// GSD and class set, loaded from the project's field directory format (docs/data_format.md),
+/// and where it lies on the Earth (FieldGeo; FieldCrs for a field read from GeoTIFFs).
 
 #include <adaptseg/error.hpp>
 #include <adaptseg/image.hpp>
@@ -51,8 +52,24 @@ struct FieldGeo {
   /// Field::sub_field moves the frame origin and shifts the anchor accordingly.
   double anchor_x_m = 0.0;
   double anchor_y_m = 0.0;  ///< see anchor_x_m
+  /// Field-frame metres per metre on the ground at the anchor: 1 for a `geo:` section; a
+  /// projected grid's scale factor (e.g. 0.9996 on a UTM zone's central meridian) for a field
+  /// georeferenced by its raster (<adaptseg/gdal_io.hpp>), whose frame is in the grid's metres.
+  double scale = 1.0;
 
   friend bool operator==(const FieldGeo&, const FieldGeo&) = default;
+};
+
+/// The projected coordinate reference system of a field georeferenced by its raster (a
+/// GeoTIFF, read by <adaptseg/gdal_io.hpp>): the field frame is the CRS's grid shifted to the
+/// orthomosaic's bottom-left corner, +x along the easting axis, +y along the northing axis
+/// (north-up grids only). Plain data; written back into the fused map's GeoTIFF.
+struct FieldCrs {
+  std::string wkt;                ///< the CRS as WKT (what GDAL read from the raster)
+  double origin_easting_m = 0.0;  ///< CRS easting of the field frame's origin [m]
+  double origin_northing_m = 0.0; ///< CRS northing of the field frame's origin [m]
+
+  friend bool operator==(const FieldCrs&, const FieldCrs&) = default;
 };
 
 namespace detail {
@@ -68,6 +85,7 @@ inline void validate_field_geo(const FieldGeo& g, const std::string& where) {
   require_finite(g.heading_deg, where + ".heading_deg");
   require_finite(g.anchor_x_m, where + ".anchor_x_m");
   require_finite(g.anchor_y_m, where + ".anchor_y_m");
+  require(std::isfinite(g.scale) && g.scale > 0.5 && g.scale < 2.0, where + ".scale must be in (0.5, 2)", g.scale);
 }
 
 }  // namespace detail
@@ -111,6 +129,8 @@ class Field {
   }
 
   /// Loads a field directory: `field.yaml`, the label PNG it names and the optional image.
+  /// `gsd_cm` is required here; a field whose rasters carry their georeference (GeoTIFFs)
+  /// loads with gdal::load_field (<adaptseg/gdal_io.hpp>), which may take it from them.
   /// @throws std::invalid_argument naming the file and the problem (missing file, YAML
   ///         syntax error, missing or mistyped key, unknown key, unknown class of interest,
   ///         wrong image type, size mismatch, out-of-range label value, a `geo:` section
@@ -141,6 +161,21 @@ class Field {
     if (geo) detail::validate_field_geo(*geo, "Field '" + name_ + "': geo");
     Field out = *this;
     out.geo_ = std::move(geo);
+    return out;
+  }
+  /// The projected CRS the field frame is a shifted copy of, for a field georeferenced by its
+  /// raster (<adaptseg/gdal_io.hpp>); nullopt otherwise.
+  [[nodiscard]] const std::optional<FieldCrs>& crs() const noexcept { return crs_; }
+  /// A copy of this field whose frame is the grid of `crs` (nullopt: none).
+  /// @throws std::invalid_argument for an empty WKT or a non-finite origin.
+  [[nodiscard]] Field with_crs(std::optional<FieldCrs> crs) const {
+    if (crs) {
+      detail::require(!crs->wkt.empty(), "Field '" + name_ + "': crs.wkt must not be empty", "''");
+      detail::require_finite(crs->origin_easting_m, "Field '" + name_ + "': crs.origin_easting_m");
+      detail::require_finite(crs->origin_northing_m, "Field '" + name_ + "': crs.origin_northing_m");
+    }
+    Field out = *this;
+    out.crs_ = std::move(crs);
     return out;
   }
   [[nodiscard]] int width_px() const noexcept { return labels_.cols; }
@@ -193,7 +228,8 @@ class Field {
   /// The part of the field inside `region` (fractions along the image axes) as a field of
   /// its own, named "<name>[x0,y0,x1,y1]"; pixel edges are rounded to the nearest pixel.
   /// Its frame origin is the region's bottom-left corner; a geo-reference is kept, its
-  /// anchor shifted into the new frame, so every ground point keeps its WGS84 position.
+  /// anchor (and a CRS origin) shifted into the new frame, so every ground point keeps its
+  /// WGS84 position.
   /// @throws std::invalid_argument unless 0 <= x0 < x1 <= 1 and 0 <= y0 < y1 <= 1 and the
   ///         region holds at least one pixel.
   [[nodiscard]] Field sub_field(const FieldRegion& region) const {
@@ -217,6 +253,11 @@ class Field {
       out.geo_ = geo_;
       out.geo_->anchor_x_m -= c0 * gsd_cm_ / 100.0;
       out.geo_->anchor_y_m -= (height_px() - r1) * gsd_cm_ / 100.0;
+    }
+    if (crs_) {
+      out.crs_ = crs_;
+      out.crs_->origin_easting_m += c0 * gsd_cm_ / 100.0;
+      out.crs_->origin_northing_m += (height_px() - r1) * gsd_cm_ / 100.0;
     }
     return out;
   }
@@ -279,6 +320,7 @@ class Field {
   int ignore_label_;
   cv::Mat valid_;
   std::optional<FieldGeo> geo_;
+  std::optional<FieldCrs> crs_;
 };
 
 namespace detail {
@@ -339,9 +381,22 @@ inline cv::Mat field_read_image(const std::filesystem::path& file, int flags,
   return m;
 }
 
-}  // namespace detail
+/// field.yaml read and checked, the rasters not yet loaded (Field::load, gdal::load_field).
+struct FieldYaml {
+  std::filesystem::path yaml;                  ///< the field.yaml file
+  std::string name;
+  std::optional<double> gsd_cm;                ///< absent: the rasters must carry it
+  std::string labels_file;                     ///< as written, relative to the directory
+  std::optional<std::string> image_file;       ///< as written, relative to the directory
+  int ignore_label = 255;
+  std::vector<ClassInfo> classes;
+  std::vector<int> interest;
+  std::optional<FieldGeo> geo;
+};
 
-inline Field Field::load(const std::filesystem::path& dir) {
+/// Reads `dir`/field.yaml (docs/data_format.md); `gsd_cm` may be absent (the caller decides).
+/// @throws std::invalid_argument naming the file and the problem.
+inline FieldYaml read_field_yaml(const std::filesystem::path& dir) {
   namespace fs = std::filesystem;
   if (!fs::is_directory(dir))
     throw std::invalid_argument("field directory not found: " + dir.string());
@@ -351,71 +406,74 @@ inline Field Field::load(const std::filesystem::path& dir) {
   try {
     root = YAML::LoadFile(yaml.string());
   } catch (const YAML::Exception& e) {
-    detail::field_error(yaml, std::string("YAML error: ") + e.what());
+    field_error(yaml, std::string("YAML error: ") + e.what());
   }
-  if (!root.IsMap()) detail::field_error(yaml, "the document must be a mapping");
+  if (!root.IsMap()) field_error(yaml, "the document must be a mapping");
   static const std::set<std::string> kKeys{"name", "gsd_cm", "labels", "image", "ignore_label",
                                            "classes", "interest", "geo"};
   for (const auto& kv : root) {
     const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "<non-scalar>";
     if (!kKeys.count(key))
-      detail::field_error(yaml, "unknown key '" + key +
-                                    "' (known: name, gsd_cm, labels, image, ignore_label, "
-                                    "classes, interest, geo)");
+      field_error(yaml, "unknown key '" + key +
+                            "' (known: name, gsd_cm, labels, image, ignore_label, "
+                            "classes, interest, geo)");
   }
-  const auto name = detail::field_scalar<std::string>(detail::field_key(root, "name", yaml), "name", yaml);
-  const auto gsd = detail::field_scalar<double>(detail::field_key(root, "gsd_cm", yaml), "gsd_cm", yaml);
-  if (!std::isfinite(gsd) || gsd <= 0.0)
-    detail::field_error(yaml, "'gsd_cm' must be finite and > 0 (got " + std::to_string(gsd) + ")");
-  const auto labels_file =
-      detail::field_scalar<std::string>(detail::field_key(root, "labels", yaml), "labels", yaml);
-  int ignore = 255;
+  FieldYaml out;
+  out.yaml = yaml;
+  out.name = field_scalar<std::string>(field_key(root, "name", yaml), "name", yaml);
+  if (root["gsd_cm"]) {
+    const auto gsd = field_scalar<double>(root["gsd_cm"], "gsd_cm", yaml);
+    if (!std::isfinite(gsd) || gsd <= 0.0)
+      field_error(yaml, "'gsd_cm' must be finite and > 0 (got " + std::to_string(gsd) + ")");
+    out.gsd_cm = gsd;
+  }
+  out.labels_file = field_scalar<std::string>(field_key(root, "labels", yaml), "labels", yaml);
+  if (root["image"]) out.image_file = field_scalar<std::string>(root["image"], "image", yaml);
   if (root["ignore_label"]) {
-    ignore = detail::field_scalar<int>(root["ignore_label"], "ignore_label", yaml);
-    if (ignore < 0 || ignore > 255)
-      detail::field_error(yaml, "'ignore_label' must be in 0..255 (got " + std::to_string(ignore) + ")");
+    out.ignore_label = field_scalar<int>(root["ignore_label"], "ignore_label", yaml);
+    if (out.ignore_label < 0 || out.ignore_label > 255)
+      field_error(yaml, "'ignore_label' must be in 0..255 (got " + std::to_string(out.ignore_label) + ")");
   }
-
-  const YAML::Node classes_node = detail::field_key(root, "classes", yaml);
+  const YAML::Node classes_node = field_key(root, "classes", yaml);
   if (!classes_node.IsSequence() || classes_node.size() == 0)
-    detail::field_error(yaml, "'classes' must be a non-empty list");
+    field_error(yaml, "'classes' must be a non-empty list");
   std::vector<ClassInfo> classes;
   for (std::size_t i = 0; i < classes_node.size(); ++i) {
     const YAML::Node c = classes_node[i];
     const std::string where = "classes[" + std::to_string(i) + "]";
-    if (!c.IsMap()) detail::field_error(yaml, where + " must be a mapping {name, color}");
+    if (!c.IsMap()) field_error(yaml, where + " must be a mapping {name, color}");
     for (const auto& kv : c) {
       const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "<non-scalar>";
       if (key != "name" && key != "color")
-        detail::field_error(yaml, where + ": unknown key '" + key + "' (known: name, color)");
+        field_error(yaml, where + ": unknown key '" + key + "' (known: name, color)");
     }
-    if (!c["name"]) detail::field_error(yaml, where + ": missing key 'name'");
+    if (!c["name"]) field_error(yaml, where + ": missing key 'name'");
     ClassInfo info;
-    info.name = detail::field_scalar<std::string>(c["name"], (where + ".name").c_str(), yaml);
+    info.name = field_scalar<std::string>(c["name"], (where + ".name").c_str(), yaml);
     if (c["color"]) {
       const YAML::Node col = c["color"];
       if (!col.IsSequence() || col.size() != 3)
-        detail::field_error(yaml, where + ".color must be a list of 3 integers [r, g, b]");
+        field_error(yaml, where + ".color must be a list of 3 integers [r, g, b]");
       for (std::size_t k = 0; k < 3; ++k) {
-        const int v = detail::field_scalar<int>(col[k], (where + ".color").c_str(), yaml);
+        const int v = field_scalar<int>(col[k], (where + ".color").c_str(), yaml);
         if (v < 0 || v > 255)
-          detail::field_error(yaml, where + ".color values must be in 0..255 (got " + std::to_string(v) + ")");
+          field_error(yaml, where + ".color values must be in 0..255 (got " + std::to_string(v) + ")");
         info.color_rgb[k] = static_cast<std::uint8_t>(v);
       }
     } else {
-      detail::field_error(yaml, where + ": missing key 'color'");
+      field_error(yaml, where + ": missing key 'color'");
     }
     for (const auto& earlier : classes)
-      if (earlier.name == info.name) detail::field_error(yaml, where + ": class name '" + info.name + "' listed twice");
+      if (earlier.name == info.name) field_error(yaml, where + ": class name '" + info.name + "' listed twice");
     classes.push_back(std::move(info));
   }
 
   std::vector<std::string> interest_names;
   if (root["interest"]) {
     const YAML::Node in = root["interest"];
-    if (!in.IsSequence()) detail::field_error(yaml, "'interest' must be a list of class names");
+    if (!in.IsSequence()) field_error(yaml, "'interest' must be a list of class names");
     for (std::size_t i = 0; i < in.size(); ++i)
-      interest_names.push_back(detail::field_scalar<std::string>(in[i], "interest[]", yaml));
+      interest_names.push_back(field_scalar<std::string>(in[i], "interest[]", yaml));
   }
   std::vector<int> interest;
   for (const auto& n : interest_names) {
@@ -426,31 +484,48 @@ inline Field Field::load(const std::filesystem::path& dir) {
         found = true;
       }
     }
-    if (!found) detail::field_error(yaml, "'interest' names unknown class '" + n + "'");
+    if (!found) field_error(yaml, "'interest' names unknown class '" + n + "'");
   }
   std::sort(interest.begin(), interest.end());
   interest.erase(std::unique(interest.begin(), interest.end()), interest.end());
 
-  std::optional<FieldGeo> geo;
-  if (root["geo"]) geo = detail::field_read_geo(root["geo"], yaml);
+  if (root["geo"]) out.geo = field_read_geo(root["geo"], yaml);
+  out.classes = std::move(classes);
+  out.interest = std::move(interest);
+  return out;
+}
 
-  cv::Mat labels = detail::field_read_image(dir / labels_file, cv::IMREAD_UNCHANGED, yaml);
+/// The label map as read from `file`: it must be 8-bit single channel.
+inline cv::Mat field_check_labels(cv::Mat labels, const FieldYaml& y) {
   if (labels.type() != CV_8UC1)
-    detail::field_error(yaml, "'" + labels_file + "' must be an 8-bit single-channel PNG (got " +
-                                  std::to_string(labels.channels()) + " channels, depth " +
-                                  std::to_string(labels.depth()) + ")");
-  cv::Mat image;
-  if (root["image"]) {
-    const auto image_file = detail::field_scalar<std::string>(root["image"], "image", yaml);
-    image = detail::field_read_image(dir / image_file, cv::IMREAD_COLOR, yaml);
-  }
+    field_error(y.yaml, "'" + y.labels_file + "' must be an 8-bit single-channel PNG (got " +
+                            std::to_string(labels.channels()) + " channels, depth " +
+                            std::to_string(labels.depth()) + ")");
+  return labels;
+}
+
+/// The Field of `y` with these rasters; a violation of Field's rules names field.yaml.
+inline Field field_from_yaml(const FieldYaml& y, double gsd_cm, cv::Mat labels, cv::Mat image) {
   try {
-    return Field(name, gsd, std::move(labels), std::move(classes), std::move(interest), ignore,
-                 std::move(image))
-        .with_geo(geo);
+    return Field(y.name, gsd_cm, std::move(labels), y.classes, y.interest, y.ignore_label, std::move(image))
+        .with_geo(y.geo);
   } catch (const std::invalid_argument& e) {
-    detail::field_error(yaml, e.what());
+    field_error(y.yaml, e.what());
   }
+}
+
+}  // namespace detail
+
+inline Field Field::load(const std::filesystem::path& dir) {
+  const detail::FieldYaml y = detail::read_field_yaml(dir);
+  if (!y.gsd_cm)
+    detail::field_error(y.yaml, "missing key 'gsd_cm' (a field whose rasters carry their georeference, "
+                                "e.g. GeoTIFFs, loads with adaptseg::gdal::load_field, <adaptseg/gdal_io.hpp>)");
+  cv::Mat labels = detail::field_check_labels(
+      detail::field_read_image(dir / y.labels_file, cv::IMREAD_UNCHANGED, y.yaml), y);
+  cv::Mat image;
+  if (y.image_file) image = detail::field_read_image(dir / *y.image_file, cv::IMREAD_COLOR, y.yaml);
+  return detail::field_from_yaml(y, *y.gsd_cm, std::move(labels), std::move(image));
 }
 
 }  // namespace adaptseg

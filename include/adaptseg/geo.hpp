@@ -30,10 +30,12 @@ struct GeoPoint {
 /// With h the heading (compass bearing of the field's +x axis, clockwise from north) and
 /// (ax, ay) the anchor's field-frame position, a field point (x, y, z) lies at
 ///
-///     east  = (x - ax) sin h - (y - ay) cos h
-///     north = (x - ax) cos h + (y - ay) sin h
+///     east  = ((x - ax) sin h - (y - ay) cos h) / k
+///     north = ((x - ax) cos h + (y - ay) sin h) / k
 ///     up    = z
 ///
+/// (k = FieldGeo::scale: 1 for a `geo:` section; a projected grid's scale factor at the
+/// anchor for a field georeferenced by its GeoTIFF, see <adaptseg/gdal_io.hpp>)
 /// in the local tangent plane (east-north-up) whose origin is the anchor at the field
 /// plane's height, and GeographicLib::LocalCartesian maps that plane to WGS84. Heading 90:
 /// +x east, +y north; heading 0: +x north, +y west. The field frame is flat; over a field
@@ -63,15 +65,16 @@ class GeoReference {
 
   /// Field frame (x, y, z) [m] -> local east, north, up [m] about the anchor.
   [[nodiscard]] Eigen::Vector3d field_to_enu(const Eigen::Vector3d& p) const noexcept {
-    const double dx = p.x() - geo_.anchor_x_m;
-    const double dy = p.y() - geo_.anchor_y_m;
+    const double dx = (p.x() - geo_.anchor_x_m) / geo_.scale;
+    const double dy = (p.y() - geo_.anchor_y_m) / geo_.scale;
     return {dx * sin_h_ - dy * cos_h_, dx * cos_h_ + dy * sin_h_, p.z()};
   }
 
   /// Local east, north, up [m] about the anchor -> field frame (x, y, z) [m].
   [[nodiscard]] Eigen::Vector3d enu_to_field(const Eigen::Vector3d& enu) const noexcept {
-    return {geo_.anchor_x_m + enu.x() * sin_h_ + enu.y() * cos_h_,
-            geo_.anchor_y_m - enu.x() * cos_h_ + enu.y() * sin_h_, enu.z()};
+    const double k = geo_.scale;
+    return {geo_.anchor_x_m + k * (enu.x() * sin_h_ + enu.y() * cos_h_),
+            geo_.anchor_y_m + k * (-enu.x() * cos_h_ + enu.y() * sin_h_), enu.z()};
   }
 
   /// Field frame (x, y, z) [m], z above the field plane -> WGS84. The altitude is the

@@ -41,6 +41,7 @@ struct MissionResult {
   std::vector<int> interest;
   std::vector<WaypointRecord> waypoints;  ///< in visiting order
   cv::Mat fused_labels;                   ///< SemanticMap::labels() at the end
+  cv::Mat fused_gsd_cm;                   ///< SemanticMap::gsd_cm() at the end (+inf: unobserved)
   ConfusionMatrix confusion{1};           ///< fused map vs the field's ground truth
   double flight_s = 0.0;
   double segmentation_s = 0.0;
@@ -154,6 +155,7 @@ class Mission {
     detail::require(map.labels().size() == field().labels().size(),
                     "Mission::finish: the map must have the field's size", map.labels().cols);
     result_.fused_labels = map.labels().clone();  // the map may go on changing
+    result_.fused_gsd_cm = map.gsd_cm().clone();
     result_.confusion.add(field().labels(), map.labels(), field().ignore_label());
     return std::move(result_);
   }
