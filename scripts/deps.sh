@@ -2,7 +2,8 @@
 # Installs the Debian packages adaptseg needs, or says which are missing.
 #   scripts/deps.sh build   compiler, CMake and the C++ libraries (library, examples, tests)
 #   scripts/deps.sh test    build + what the test suite runs (Python for the data converters,
-#                           GDAL's ogrinfo to read the exported GeoJSON, doxygen for docs:doxygen)
+#                           GDAL's ogrinfo, gdalinfo, gdal_translate, gdaltransform for the
+#                           exports and GeoTIFF fields, doxygen for docs:doxygen)
 #   scripts/deps.sh docs    doxygen, for the API reference (scripts/docs.sh)
 #   scripts/deps.sh bench   test + what the benchmarks compare against (scikit-learn, with
 #                           OpenBLAS as well as the reference BLAS)
@@ -13,8 +14,9 @@ set -euo pipefail
 
 # libopencv-dev: the only package that ships OpenCV's CMake config (OpenCVConfig.cmake).
 # libgeographiclib-dev: geo-reference and mission export (adaptseg::geo).
+# libgdal-dev: GeoTIFF fields and georeferenced maps (adaptseg::gdal; optional to the build).
 build=(cmake g++ make pkg-config libeigen3-dev libopencv-dev doctest-dev liblbfgspp-dev
-       libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libgeographiclib-dev)
+       libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libgeographiclib-dev libgdal-dev)
 python=(python3 python3-numpy python3-opencv python3-yaml python3-pil)
 case "${1:-build}" in
   build) want=("${build[@]}") ;;

@@ -1,6 +1,6 @@
 # Installs the build tree into a scratch prefix, then configures, builds and runs the consumer
 # projects against it. Called by CTest with BUILD_DIR, SOURCE_DIR and WORK_DIR.
-#   - SOURCE_DIR: every component (vision, erfnet, geo) asked for and used;
+#   - SOURCE_DIR: every component (vision, erfnet, geo; gdal where installed) asked for and used;
 #   - SOURCE_DIR/core: the core alone with OpenCV, yaml-cpp, nlohmann_json and GeographicLib
 #     hidden (a GP fitted); asking for vision there must fail, naming OpenCV.
 
@@ -19,7 +19,11 @@ step("install" "${CMAKE_COMMAND}" --install "${BUILD_DIR}" --prefix "${WORK_DIR}
 step("configuring the consumer" "${CMAKE_COMMAND}" -S "${SOURCE_DIR}" -B "${WORK_DIR}/build" ${prefix}
      -DCMAKE_BUILD_TYPE=Release)
 step("building the consumer" "${CMAKE_COMMAND}" --build "${WORK_DIR}/build")
-foreach(exe consumer consumer_core consumer_geo consumer_erfnet)
+set(exes consumer consumer_core consumer_geo consumer_erfnet)
+if(EXISTS "${WORK_DIR}/prefix/share/cmake/adaptseg/adaptsegGdalTargets.cmake")  # installed with GDAL
+  list(APPEND exes consumer_gdal)
+endif()
+foreach(exe IN LISTS exes)
   step("${exe}" "${WORK_DIR}/build/${exe}")
 endforeach()
 

@@ -1,0 +1,384 @@
+// GeoTIFF fields and georeferenced maps (adaptseg::gdal): a bundled tile written to GeoTIFF by
+// gdal_translate's own code (GDALTranslate) under a UTM georeference, loaded back, its frame
+// checked against GDAL's transformation of the CRS, its map written and read back by GDAL.
+#include <adaptseg/gdal_io.hpp>
+
+#include "test_support.hpp"
+
+#include <doctest/doctest.h>
+#include <gdal_utils.h>
+
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace adaptseg;
+
+namespace {
+
+const fs::path kTile = fs::path(ADAPTSEG_EXAMPLES_DIR) / "data" / "dubai-tile-6";
+// Somewhere in Dubai, UTM zone 40N (EPSG:32640): the field origin (bottom-left corner).
+constexpr double kE0 = 329000.0;
+constexpr double kN0 = 2787000.0;
+
+/// This process's scratch directory, removed at exit.
+const fs::path& scratch() {
+  static const test::TempDir dir;
+  return dir.path();
+}
+
+/// gdal_translate SRC DST ARGS... through GDAL's library entry point.
+void translate(const fs::path& src, const fs::path& dst, std::vector<std::string> args) {
+  gdal::detail::register_drivers();
+  gdal::detail::Dataset in(GDALDataset::Open(src.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
+  REQUIRE(in);
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  GDALTranslateOptions* opt = GDALTranslateOptionsNew(argv.data(), nullptr);
+  REQUIRE(opt != nullptr);
+  int usage_error = 0;
+  GDALDatasetH out = GDALTranslate(dst.c_str(), GDALDataset::ToHandle(in.get()), opt, &usage_error);
+  GDALTranslateOptionsFree(opt);
+  REQUIRE(out != nullptr);
+  GDALClose(out);
+}
+
+std::string f2s(double v) {
+  std::ostringstream s;
+  s.precision(12);
+  s << v;
+  return s.str();
+}
+
+/// `-a_ullr` of a north-up grid of `w` x `h` pixels of `px` metres with its bottom-left at (e0, n0).
+std::vector<std::string> ullr(double e0, double n0, int w, int h, double px, double py) {
+  return {"-a_ullr", f2s(e0), f2s(n0 + h * py), f2s(e0 + w * px), f2s(n0)};
+}
+
+/// A field directory: tile 6's field.yaml without gsd_cm (and with `extra` lines), its labels
+/// and image written to GeoTIFF under `srs` on the grid of `px` x `py` metre pixels.
+fs::path geotiff_field(const std::string& name, const std::string& srs = "EPSG:32640", double px = 0.05,
+                       double py = 0.05, const std::string& extra = "") {
+  const fs::path dir = scratch() / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const Field png = Field::load(kTile);
+  const auto grid = ullr(kE0, kN0, png.width_px(), png.height_px(), px, py);
+  std::vector<std::string> args{"-of", "GTiff", "-a_srs", srs};
+  args.insert(args.end(), grid.begin(), grid.end());
+  translate(kTile / "labels.png", dir / "labels.tif", args);
+  translate(kTile / "image.jpg", dir / "image.tif", args);
+  std::ifstream in(kTile / "field.yaml");
+  std::ofstream out(dir / "field.yaml");
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("gsd_cm:", 0) == 0) continue;
+    if (line.rfind("labels:", 0) == 0) line = "labels: labels.tif";
+    if (line.rfind("image:", 0) == 0) line = "image: image.tif";
+    out << line << '\n';
+  }
+  out << extra;
+  return dir;
+}
+
+/// WGS84 of CRS coordinates through GDAL/PROJ: the reference, not our code.
+GeoPoint gdal_wgs84(const std::string& srs_text, double e, double n) {
+  OGRSpatialReference src, dst;
+  src.SetFromUserInput(srs_text.c_str());
+  src.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  dst.SetWellKnownGeogCS("WGS84");
+  dst.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  OGRCoordinateTransformation* ct = OGRCreateCoordinateTransformation(&src, &dst);
+  REQUIRE(ct != nullptr);
+  double x = e, y = n;
+  REQUIRE(ct->Transform(1, &x, &y));
+  OGRCoordinateTransformation::DestroyCT(ct);
+  return {y, x, 0.0};
+}
+
+double metres_apart(const GeoPoint& a, const GeoPoint& b) {
+  double s = 0, a1 = 0, a2 = 0;
+  GeographicLib::Geodesic::WGS84().Inverse(a.latitude_deg, a.longitude_deg, b.latitude_deg, b.longitude_deg, s, a1, a2);
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("a bundled tile as UTM GeoTIFFs: same labels and image, GSD and frame from the raster") {
+  const fs::path dir = geotiff_field("utm");
+  const Field png = Field::load(kTile);
+  const Field tif = gdal::load_field(dir);
+  CHECK(tif.gsd_cm() == doctest::Approx(5.0).epsilon(1e-9));
+  // Field::load (no GDAL) cannot know the GSD, and says where to look.
+  CHECK_THROWS_WITH_AS((void)Field::load(dir), doctest::Contains("missing key 'gsd_cm' (a field whose rasters carry"),
+                       std::invalid_argument);
+  REQUIRE(tif.labels().size() == png.labels().size());
+  CHECK(cv::countNonZero(tif.labels() != png.labels()) == 0);  // byte-identical
+  REQUIRE(tif.has_image());
+  // The JPEG is decoded by GDAL here, by OpenCV there: the same pixels to a grey level or two.
+  cv::Mat diff;
+  cv::absdiff(tif.image(), png.image(), diff);
+  CHECK(cv::mean(diff.reshape(1))[0] < 0.5);
+  REQUIRE(tif.crs());
+  CHECK(tif.crs()->origin_easting_m == doctest::Approx(kE0));
+  CHECK(tif.crs()->origin_northing_m == doctest::Approx(kN0));
+  OGRSpatialReference utm;
+  utm.importFromEPSG(32640);
+  OGRSpatialReference got;
+  got.importFromWkt(tif.crs()->wkt.c_str());
+  CHECK(got.IsSame(&utm));
+  // One geo-reference model: the field's GeoReference against GDAL's own transformation.
+  REQUIRE(tif.geo());
+  CHECK(tif.geo()->scale == doctest::Approx(0.9996).epsilon(1e-3));
+  const GeoReference geo(tif);
+  const Area a = tif.area();
+  double worst = 0.0;
+  for (double fx : {0.0, 0.25, 0.5, 1.0})
+    for (double fy : {0.0, 0.6, 1.0}) {
+      const double x = fx * a.width_m(), y = fy * a.height_m();
+      worst = std::max(worst, metres_apart(geo.to_wgs84({x, y, 0.0}), gdal_wgs84("EPSG:32640", kE0 + x, kN0 + y)));
+    }
+  CHECK(worst < 0.0005);  // 0.5 mm over a 129 x 126 m field (without the grid scale: 4 mm)
+  // A region keeps its ground: its origin moves in the CRS as in the frame.
+  const Field part = tif.sub_field({0.5, 0.0, 1.0, 0.5});
+  REQUIRE(part.crs());
+  const double dx = static_cast<int>(std::lround(0.5 * tif.width_px())) * 0.05;
+  const double dy = (tif.height_px() - static_cast<int>(std::lround(0.5 * tif.height_px()))) * 0.05;
+  CHECK(part.crs()->origin_easting_m == doctest::Approx(kE0 + dx));
+  CHECK(part.crs()->origin_northing_m == doctest::Approx(kN0 + dy));
+  CHECK(metres_apart(GeoReference(part).to_wgs84({1.0, 2.0, 0.0}), geo.to_wgs84({1.0 + dx, 2.0 + dy, 0.0})) < 1e-6);
+}
+
+TEST_CASE("a raster read in strips equals the raster read at once") {
+  const fs::path dir = geotiff_field("strips");
+  for (const char* name : {"image.tif", "labels.tif"}) {
+    CAPTURE(name);
+    gdal::detail::Dataset d = gdal::detail::open(dir / name);
+    const std::vector<int> bands = d->GetRasterCount() >= 3 ? std::vector<int>{3, 2, 1} : std::vector<int>{1};
+    const cv::Mat whole = gdal::detail::read_interleaved(*d, dir / name, bands);
+    const cv::Mat strips = gdal::detail::read_interleaved(*d, dir / name, bands, 50'000);  // ~6-20 rows a strip
+    REQUIRE(whole.size() == strips.size());
+    cv::Mat diff;
+    cv::absdiff(whole, strips, diff);
+    CHECK(cv::countNonZero(diff.reshape(1)) == 0);
+  }
+}
+
+TEST_CASE("a PNG field loads through gdal::load_field exactly as through Field::load") {
+  const Field a = Field::load(kTile);
+  const Field b = gdal::load_field(kTile);
+  CHECK(cv::countNonZero(a.labels() != b.labels()) == 0);
+  cv::Mat diff;
+  cv::absdiff(a.image(), b.image(), diff);
+  CHECK(cv::countNonZero(diff.reshape(1)) == 0);
+  CHECK(a.gsd_cm() == b.gsd_cm());
+  CHECK_FALSE(b.crs());
+  CHECK_FALSE(b.geo());
+}
+
+TEST_CASE("labels as class colours with nodata, and field.yaml's gsd_cm and geo: checked against the raster") {
+  const fs::path dir = geotiff_field("colours");
+  const Field ref = gdal::load_field(dir);
+  // Colour labels: each class's colour, and nodata (0, 0, 0) where the ignore label was.
+  const Field png = Field::load(kTile);
+  cv::Mat rgb(png.labels().size(), CV_8UC3, cv::Scalar(0, 0, 0));
+  for (int r = 0; r < rgb.rows; ++r)
+    for (int c = 0; c < rgb.cols; ++c) {
+      const int v = png.labels().at<std::uint8_t>(r, c);
+      if (v < png.num_classes()) {
+        const auto& col = png.classes()[static_cast<std::size_t>(v)].color_rgb;
+        rgb.at<cv::Vec3b>(r, c) = {col[2], col[1], col[0]};  // BGR for imwrite
+      }
+    }
+  rgb.at<cv::Vec3b>(0, 0) = {0, 0, 0};  // at least one unlabelled pixel
+  const fs::path colour_png = dir / "labels_rgb.png";
+  REQUIRE(cv::imwrite(colour_png.string(), rgb));
+  const auto grid = ullr(kE0, kN0, rgb.cols, rgb.rows, 0.05, 0.05);
+  std::vector<std::string> args{"-of", "GTiff", "-a_srs", "EPSG:32640", "-a_nodata", "0"};
+  args.insert(args.end(), grid.begin(), grid.end());
+  translate(colour_png, dir / "labels.tif", args);
+  const Field colour = gdal::load_field(dir);
+  cv::Mat expected = png.labels().clone();
+  expected.at<std::uint8_t>(0, 0) = 255;
+  CHECK(cv::countNonZero(colour.labels() != expected) == 0);
+
+  // Without nodata an unknown colour is one error naming it and the fix.
+  translate(colour_png, dir / "labels.tif", [&] {
+    std::vector<std::string> a{"-of", "GTiff", "-a_srs", "EPSG:32640"};
+    a.insert(a.end(), grid.begin(), grid.end());
+    return a;
+  }());
+  CHECK_THROWS_WITH_AS((void)gdal::load_field(dir), doctest::Contains("colour (0, 0, 0) at row 0, col 0 is no class colour"),
+                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)gdal::load_field(dir), doctest::Contains("no nodata value"), std::invalid_argument);
+  translate(kTile / "labels.png", dir / "labels.tif", [&] {
+    std::vector<std::string> a{"-of", "GTiff", "-a_srs", "EPSG:32640"};
+    a.insert(a.end(), grid.begin(), grid.end());
+    return a;
+  }());
+
+  // gsd_cm and geo: may be given, and must agree.
+  std::ofstream(dir / "field.yaml", std::ios::app) << "gsd_cm: 5.0\n";
+  CHECK(gdal::load_field(dir).gsd_cm() == doctest::Approx(5.0));
+  const GeoPoint origin = GeoReference(ref).to_wgs84({0.0, 0.0, 0.0});
+  const auto with_geo = [&](double lat, double heading) {
+    const fs::path d2 = geotiff_field("colours_geo", "EPSG:32640", 0.05, 0.05,
+                                      "geo: {latitude_deg: " + f2s(lat) + ", longitude_deg: " + f2s(origin.longitude_deg) +
+                                          ", altitude_m: 12.5, heading_deg: " + f2s(heading) + "}\n");
+    return gdal::load_field(d2);
+  };
+  const Field agreed = with_geo(origin.latitude_deg, ref.geo()->heading_deg);
+  CHECK(agreed.geo()->altitude_m == 12.5);
+  CHECK_THROWS_WITH_AS((void)with_geo(origin.latitude_deg + 1e-4, ref.geo()->heading_deg),
+                       doctest::Contains("geo: disagrees with 'labels.tif'"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)with_geo(origin.latitude_deg, ref.geo()->heading_deg + 1.0),
+                       doctest::Contains("heading"), std::invalid_argument);
+  const fs::path d3 = geotiff_field("gsd", "EPSG:32640", 0.05, 0.05, "gsd_cm: 4.0\n");
+  CHECK_THROWS_WITH_AS((void)gdal::load_field(d3), doctest::Contains("gsd_cm 4 disagrees with 'labels.tif'"),
+                       std::invalid_argument);
+}
+
+TEST_CASE("bad GeoTIFF fields: one clear error each") {
+  SUBCASE("geographic CRS in degrees") {
+    const fs::path dir = scratch() / "geographic";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    translate(kTile / "labels.png", dir / "labels.tif", {"-of", "GTiff", "-a_srs", "EPSG:4326", "-a_ullr", "55.1", "25.2", "55.101", "25.199"});
+    fs::copy_file(geotiff_field("geographic_yaml") / "field.yaml", dir / "field.yaml");
+    std::ofstream(dir / "image.tif") << "";  // never read: the labels fail first
+    CHECK_THROWS_WITH_AS((void)gdal::load_field(dir), doctest::Contains("geographic CRS (coordinates in degrees)"),
+                         std::invalid_argument);
+  }
+  SUBCASE("non-square pixels") {
+    CHECK_THROWS_WITH_AS((void)gdal::load_field(geotiff_field("nonsquare", "EPSG:32640", 0.05, 0.06)),
+                         doctest::Contains("non-square pixels"), std::invalid_argument);
+  }
+  SUBCASE("image and labels on different grids") {
+    const fs::path dir = geotiff_field("mismatch");
+    const Field png = Field::load(kTile);
+    const auto shifted = ullr(kE0 + 1.0, kN0, png.width_px(), png.height_px(), 0.05, 0.05);
+    std::vector<std::string> args{"-of", "GTiff", "-a_srs", "EPSG:32640"};
+    args.insert(args.end(), shifted.begin(), shifted.end());
+    translate(kTile / "image.jpg", dir / "image.tif", args);
+    CHECK_THROWS_WITH_AS((void)gdal::load_field(dir), doctest::Contains("are not on the same grid"), std::invalid_argument);
+    // ... or in different CRSs.
+    const auto grid = ullr(kE0, kN0, png.width_px(), png.height_px(), 0.05, 0.05);
+    std::vector<std::string> args2{"-of", "GTiff", "-a_srs", "EPSG:32639"};
+    args2.insert(args2.end(), grid.begin(), grid.end());
+    translate(kTile / "image.jpg", dir / "image.tif", args2);
+    CHECK_THROWS_WITH_AS((void)gdal::load_field(dir), doctest::Contains("differ in CRS"), std::invalid_argument);
+  }
+  SUBCASE("labels without nodata holding a value that is no class") {
+    const fs::path dir = geotiff_field("nodata");
+    cv::Mat l = Field::load(kTile).labels().clone();
+    l.at<std::uint8_t>(3, 4) = 7;
+    REQUIRE(cv::imwrite((dir / "bad.png").string(), l));
+    const auto grid = ullr(kE0, kN0, l.cols, l.rows, 0.05, 0.05);
+    std::vector<std::string> args{"-of", "GTiff", "-a_srs", "EPSG:32640"};
+    args.insert(args.end(), grid.begin(), grid.end());
+    translate(dir / "bad.png", dir / "labels.tif", args);
+    CHECK_THROWS_WITH_AS((void)gdal::load_field(dir),
+                         doctest::Contains("value 7 at row 3, col 4 is no class index (0..4), not the ignore label 255, "
+                                           "and the band has no nodata value"),
+                         std::invalid_argument);
+    // Declared as nodata, it is unlabelled.
+    args.insert(args.end(), {"-a_nodata", "7"});
+    translate(dir / "bad.png", dir / "labels.tif", args);
+    CHECK(gdal::load_field(dir).labels().at<std::uint8_t>(3, 4) == 255);
+  }
+  SUBCASE("a truncated TIFF") {
+    const fs::path dir = geotiff_field("truncated");
+    const auto size = fs::file_size(dir / "labels.tif");
+    fs::resize_file(dir / "labels.tif", size / 2);
+    CHECK_THROWS_WITH_AS((void)gdal::load_field(dir), doctest::Contains("labels.tif: "), std::invalid_argument);
+    fs::resize_file(dir / "labels.tif", 100);
+    CHECK_THROWS_WITH_AS((void)gdal::load_field(dir), doctest::Contains("labels.tif: GDAL cannot read it as a raster"),
+                         std::invalid_argument);
+  }
+  SUBCASE("a rotated geotransform") {
+    const fs::path dir = geotiff_field("rotated");
+    gdal::detail::Dataset d(GDALDataset::Open((dir / "labels.tif").c_str(), GDAL_OF_RASTER | GDAL_OF_UPDATE));
+    REQUIRE(d);
+    double gt[6] = {kE0, 0.05 * 0.8, 0.05 * 0.6, kN0 + 100.0, 0.05 * 0.6, -0.05 * 0.8};
+    REQUIRE(d->SetGeoTransform(gt) == CE_None);
+    d.reset();
+    CHECK_THROWS_WITH_AS((void)gdal::load_field(dir), doctest::Contains("only north-up rasters are supported"),
+                         std::invalid_argument);
+  }
+}
+
+TEST_CASE("map.tif and map_gsd.tif: the field's grid and CRS, classes as colours and names, nodata where unobserved") {
+  const Field field = gdal::load_field(geotiff_field("map"));
+  cv::Mat labels = field.labels().clone();
+  labels(cv::Rect(0, 0, 50, 40)).setTo(field.ignore_label());
+  cv::Mat gsd(field.labels().size(), CV_32F, cv::Scalar(5.0f));
+  gsd(cv::Rect(0, 0, 50, 40)).setTo(std::numeric_limits<float>::infinity());
+  const fs::path map = scratch() / "map_out" / "map.tif";
+  fs::create_directories(map.parent_path());
+  gdal::write_map_geotiff(map, field, labels);
+  gdal::write_gsd_geotiff(map.parent_path() / "map_gsd.tif", field, gsd);
+
+  gdal::detail::Dataset d(GDALDataset::Open(map.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
+  REQUIRE(d);
+  double gt[6];
+  REQUIRE(d->GetGeoTransform(gt) == CE_None);
+  CHECK(gt[0] == doctest::Approx(kE0));
+  CHECK(gt[3] == doctest::Approx(kN0 + field.height_px() * 0.05));
+  CHECK(gt[1] == doctest::Approx(0.05));
+  CHECK(gt[5] == doctest::Approx(-0.05));
+  OGRSpatialReference utm;
+  utm.importFromEPSG(32640);
+  CHECK(d->GetSpatialRef()->IsSame(&utm));
+  GDALRasterBand* band = d->GetRasterBand(1);
+  int has = 0;
+  CHECK(band->GetNoDataValue(&has) == 255.0);
+  CHECK(has);
+  REQUIRE(band->GetColorTable() != nullptr);
+  const GDALColorEntry* veg = band->GetColorTable()->GetColorEntry(3);
+  CHECK(veg->c1 == 254);
+  CHECK(veg->c2 == 221);
+  CHECK(veg->c3 == 58);
+  char** names = band->GetCategoryNames();
+  REQUIRE(names != nullptr);
+  CHECK(std::string(names[3]) == "vegetation");
+  cv::Mat back(labels.size(), CV_8UC1);
+  REQUIRE(band->RasterIO(GF_Read, 0, 0, back.cols, back.rows, back.data, back.cols, back.rows, GDT_Byte, 0, 0) == CE_None);
+  CHECK(cv::countNonZero(back != labels) == 0);
+
+  gdal::detail::Dataset g(GDALDataset::Open((map.parent_path() / "map_gsd.tif").c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
+  REQUIRE(g);
+  cv::Mat gsd_back(gsd.size(), CV_32F);
+  REQUIRE(g->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, gsd.cols, gsd.rows, gsd_back.data, gsd.cols, gsd.rows, GDT_Float32,
+                                        0, 0) == CE_None);
+  CHECK(gsd_back.at<float>(0, 0) == 0.0f);
+  CHECK(gsd_back.at<float>(100, 100) == 5.0f);
+  CHECK(g->GetRasterBand(1)->GetNoDataValue(&has) == 0.0);
+}
+
+TEST_CASE("a geo: field's map.tif: every pixel where GeoReference puts it") {
+  const Field field = Field::load(kTile).with_geo(FieldGeo{25.2, 55.3, 4.0, 237.5, 10.0, -20.0});
+  const fs::path map = scratch() / "geo_map.tif";
+  gdal::write_map_geotiff(map, field, field.labels());
+  gdal::detail::Dataset d(GDALDataset::Open(map.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
+  REQUIRE(d);
+  double gt[6];
+  REQUIRE(d->GetGeoTransform(gt) == CE_None);
+  char* wkt = nullptr;
+  d->GetSpatialRef()->exportToWkt(&wkt);
+  const std::string srs = wkt;
+  CPLFree(wkt);
+  const GeoReference geo(field);
+  const double g = field.gsd_cm() / 100.0;
+  double worst = 0.0;
+  for (const auto& [col, row] : {std::pair{0, 0}, std::pair{field.width_px(), 0}, std::pair{0, field.height_px()},
+                                 std::pair{field.width_px(), field.height_px()}, std::pair{1000, 700}}) {
+    const double e = gt[0] + col * gt[1] + row * gt[2], n = gt[3] + col * gt[4] + row * gt[5];
+    const GeoPoint ours = geo.to_wgs84({col * g, (field.height_px() - row) * g, 0.0});
+    worst = std::max(worst, metres_apart(ours, gdal_wgs84(srs, e, n)));
+  }
+  CHECK(worst < 0.001);
+}
