@@ -276,6 +276,7 @@ int main(int argc, char** argv) {
                                                              label + " | mIoU interest " +
                                                                  fmt(m.miou_interest().value_or(NAN), 3) +
                                                                  ", front margin " + fmt(margin, 3)));
+        adaptseg::examples::write_geo_maps(field, m.fused_labels, m.fused_gsd_cm, dir);
       }
       results.flush();
       per_image.flush();

@@ -6,7 +6,8 @@
 //                    --segmenter erfnet --model-file examples/models/erfnet-dubai --out out/erfnet-15
 //   adaptseg_mission --field DIR --strategy adaptive --model model.yaml --out OUT [--budget-s 900]
 //
-// Writes OUT/result.json (scores, time, waypoints, decisions), OUT/path.png and OUT/map.png;
+// Writes OUT/result.json (scores, time, waypoints, decisions), OUT/path.png and OUT/map.png
+// (and OUT/map.tif + OUT/map_gsd.tif in the field's CRS for a georeferenced field, built with GDAL);
 // with --export plan,wpl,geojson also OUT/mission.{plan,waypoints,geojson}.
 
 #include "common/export.hpp"
@@ -84,6 +85,7 @@ int main(int argc, char** argv) {
                                         field.name() + ": " + what + " | mIoU interest " +
                                             adaptseg::examples::fmt(mi.value_or(NAN), 3) + ", all " +
                                             adaptseg::examples::fmt(ma.value_or(NAN), 3)));
+    adaptseg::examples::write_geo_maps(field, result.fused_labels, result.fused_gsd_cm, out_dir);
     std::printf("%s: %s images=%zu time=%.1f s (flight %.1f, segmentation %.2f, planning %.4f) "
                 "mIoU interest=%.4f all=%.4f -> %s\n",
                 field.name().c_str(), what.c_str(), result.waypoints.size(), result.total_s(), result.flight_s,

@@ -6,6 +6,9 @@
 #include <adaptseg/adaptive_mission.hpp>
 #include <adaptseg/decision_model.hpp>
 #include <adaptseg/linear_decision.hpp>
+#ifdef ADAPTSEG_HAVE_GDAL
+#include <adaptseg/gdal_io.hpp>
+#endif
 
 #include <array>
 #include <filesystem>
@@ -47,7 +50,13 @@ inline FieldRegion parse_region(const std::string& text) {
 /// the whole field's frame, like field.yaml's `geo:` section).
 inline Field load_field_spec(const std::string& spec, const std::optional<FieldGeo>& geo = std::nullopt) {
   const auto load = [&](const std::string& dir) {
+#ifdef ADAPTSEG_HAVE_GDAL
+    const Field f = gdal::load_field(dir);  // GeoTIFF fields too; PNG fields as Field::load
+#else
     const Field f = Field::load(dir);
+#endif
+    if (geo && f.crs())
+      throw std::invalid_argument("field '" + f.name() + "' is georeferenced by its rasters; --geo-origin cannot replace that");
     return geo ? f.with_geo(geo) : f;
   };
   // "DIR:tail" where the tail looks like numbers is a region (a malformed one is an error that
@@ -68,6 +77,22 @@ inline Field load_field_spec(const std::string& spec, const std::optional<FieldG
     }
   }
   return load(spec);
+}
+
+/// Writes `dir`/map.tif (class indices) and `dir`/map_gsd.tif (the GSD each pixel was mapped
+/// at) in the field's CRS when the field is georeferenced (a GeoTIFF field or a geo: section)
+/// and the program was built with GDAL; returns whether it did.
+inline bool write_geo_maps(const Field& field, const cv::Mat& labels, const cv::Mat& gsd_cm,
+                           const std::filesystem::path& dir) {
+#ifdef ADAPTSEG_HAVE_GDAL
+  if (!field.crs() && !field.geo()) return false;
+  gdal::write_map_geotiff(dir / "map.tif", field, labels);
+  gdal::write_gsd_geotiff(dir / "map_gsd.tif", field, gsd_cm);
+  return true;
+#else
+  (void)field, (void)labels, (void)gsd_cm, (void)dir;
+  return false;
+#endif
 }
 
 /// One flown strategy: the mission, and the decisions for the model-based ones.

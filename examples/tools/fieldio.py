@@ -3,6 +3,7 @@
 Field format (docs/data_format.md): DIR/field.yaml, DIR/labels.png (8-bit class indices,
 255 = ignore), optional DIR/image.jpg|png.
 """
+import math
 import os
 
 import cv2
@@ -47,10 +48,19 @@ def check_field(field_dir):
             raise ValueError(f"{path}: YAML error: {e}") from e
     if not isinstance(meta, dict):
         raise ValueError(f"{path}: the document must be a mapping")
-    known = {"name", "gsd_cm", "labels", "image", "ignore_label", "classes", "interest"}
+    known = {"name", "gsd_cm", "labels", "image", "ignore_label", "classes", "interest", "geo"}
     for key in meta:
         if key not in known:
             raise ValueError(f"{path}: unknown key '{key}'")
+    if "gsd_cm" not in meta:
+        raise ValueError(f"{path}: missing key 'gsd_cm' (a GeoTIFF field, whose rasters give the GSD, "
+                         "is checked by the C++ loader: adaptseg_mission --field DIR)")
+    if "geo" in meta:
+        geo = meta["geo"]
+        keys = {"latitude_deg", "longitude_deg", "altitude_m", "heading_deg"}
+        if not isinstance(geo, dict) or set(geo) != keys or not all(
+                isinstance(v, (int, float)) and math.isfinite(v) for v in geo.values()):
+            raise ValueError(f"{path}: 'geo' must map exactly {sorted(keys)} to finite numbers")
     for key in ("name", "gsd_cm", "labels", "classes"):
         if key not in meta:
             raise ValueError(f"{path}: missing key '{key}'")

@@ -3,7 +3,8 @@
 # parse back, their first waypoint is result.json's first waypoint in WGS84, and GDAL's
 # ogrinfo (a real GeoJSON client) reads the GeoJSON with the right features and coordinates.
 #   test_export_cli.sh MISSION_BINARY EXAMPLES_DIR PYTHON CASE
-# Exit 77 (CTest SKIP_RETURN_CODE) when the gdal case finds no ogrinfo.
+# Exit 77 (CTest SKIP_RETURN_CODE) when the gdal case finds no ogrinfo (geotiff: no gdal-bin).
+# The geotiff case flies a bundled tile written to GeoTIFF (programs built with adaptseg::gdal).
 set -uo pipefail
 mission=$1 examples=$2 python=$3 case=$4
 source "$(dirname "$0")/cli_common.sh"
@@ -121,6 +122,66 @@ assert abs(float(first[0]) - lon) < 1e-7 and abs(float(first[1]) - lat) < 1e-7, 
 for key in ("role (String) = top-level", "gsd_cm (Real) = 3", "level (Integer) = 0"):
     assert key in full, f"GDAL does not show '{key}'"
 print(f"ok: GDAL reads {count} features; first waypoint {glat:.8f}, {glon:.8f}, {gh:.2f} m")
+PY
+  ;;
+geotiff)
+  # A bundled tile as GeoTIFFs under UTM 40N (gdal_translate), flown: map.tif and map_gsd.tif in
+  # the tile's CRS and extent (gdalinfo), and every exported waypoint where the frame puts it in
+  # that CRS (GDAL's gdaltransform, not our code).
+  for t in gdal_translate gdalinfo gdaltransform; do
+    command -v "$t" >/dev/null || { echo "SKIP: $t (gdal-bin) not installed"; exit 77; }
+  done
+  tile="$examples/data/dubai-tile-6"  # 2577 x 2514 px at 5 cm/px: 128.85 x 125.7 m
+  d="$work/field"; mkdir -p "$d"
+  ullr=(-a_ullr 329000 2787125.7 329128.85 2787000)
+  gdal_translate -q -of GTiff -a_srs EPSG:32640 "${ullr[@]}" "$tile/labels.png" "$d/labels.tif" || fail "gdal_translate labels"
+  gdal_translate -q -of GTiff -a_srs EPSG:32640 "${ullr[@]}" "$tile/image.jpg" "$d/ortho.tif" || fail "gdal_translate image"
+  sed -e '/^gsd_cm:/d' -e 's/^labels: .*/labels: labels.tif/' -e 's/^image: .*/image: ortho.tif/' \
+    "$tile/field.yaml" >"$d/field.yaml"
+  "$mission" --field "$d" --strategy lawnmower --gsd 15 --seg-time-s 0.1 --plan-time-s 0 --export geojson \
+    --out "$work/g" >/dev/null || fail "mission over the GeoTIFF field failed"
+  expect_error "cannot replace that" --field "$d" --gsd 15 --export geojson --geo-origin "$origin" --out "$work/o"
+  gdalinfo -json "$work/g/map.tif" >"$work/map.json" 2>&1 || fail "gdalinfo map.tif: $(cat "$work/map.json")"
+  gdalinfo -json "$work/g/map_gsd.tif" >"$work/gsd.json" 2>&1 || fail "gdalinfo map_gsd.tif: $(cat "$work/gsd.json")"
+  "$python" - "$work/g" "$work/map.json" "$work/gsd.json" <<'PY' >"$work/lonlat" || fail "map.tif checks"
+import json, sys
+out, info, gsd = sys.argv[1], json.load(open(sys.argv[2])), json.load(open(sys.argv[3]))
+for i in (info, gsd):
+    assert 'ID["EPSG",32640]' in i["coordinateSystem"]["wkt"], i["coordinateSystem"]["wkt"][-200:]
+    assert i["size"] == [2577, 2514], i["size"]
+    ul, lr = i["cornerCoordinates"]["upperLeft"], i["cornerCoordinates"]["lowerRight"]
+    assert abs(ul[0] - 329000) < 1e-6 and abs(ul[1] - 2787125.7) < 1e-6, ul
+    assert abs(lr[0] - 329128.85) < 1e-6 and abs(lr[1] - 2787000) < 1e-6, lr
+band = info["bands"][0]
+assert band["type"] == "Byte" and band["noDataValue"] == 255, band
+assert band["colorInterpretation"] == "Palette", band
+assert band["colorTable"]["entries"][3][:3] == [254, 221, 58], band["colorTable"]["entries"][3]
+assert band.get("categories", [])[:5] == ["building", "land", "road", "vegetation", "water"], band.get("categories")
+assert gsd["bands"][0]["type"] == "Float32" and gsd["bands"][0]["noDataValue"] == 0, gsd["bands"][0]
+for f in json.load(open(f"{out}/mission.geojson"))["features"]:
+    if f["geometry"]["type"] == "Point":
+        lon, lat, _ = f["geometry"]["coordinates"]
+        print(f"{lon:.10f} {lat:.10f}")
+PY
+  gdaltransform -s_srs EPSG:4326 -t_srs EPSG:32640 <"$work/lonlat" >"$work/en" || fail "gdaltransform"
+  "$python" - "$work/g" "$work/en" <<'PY' || fail "waypoints against the GeoTIFF's grid"
+import json, sys
+res = json.load(open(f"{sys.argv[1]}/result.json"))
+en = [list(map(float, l.split()[:2])) for l in open(sys.argv[2]) if l.strip()]
+wps = res["waypoints"]
+assert len(en) == len(wps) > 0, (len(en), len(wps))
+worst, inside = 0.0, 0
+for w, (e, n) in zip(wps, en):
+    # The lawnmower's last row and column may be centred beyond the field's edge: a waypoint is
+    # inside map.tif's extent exactly when it is inside the field.
+    in_field = 0 <= w["x"] <= 128.85 and 0 <= w["y"] <= 125.7
+    in_extent = 329000 <= e <= 329128.85 and 2787000 <= n <= 2787125.7
+    assert in_field == in_extent, (w["x"], w["y"], e, n)
+    inside += in_extent
+    worst = max(worst, abs(e - (329000 + w["x"])), abs(n - (2787000 + w["y"])))
+assert inside > 0 and worst < 0.01, f"{inside} inside; a waypoint is {worst:.4f} m off its grid position"
+print(f"ok: {inside} of {len(wps)} waypoints inside map.tif's extent (the others beyond the field's edge, "
+      f"as planned); all at most {worst * 1000:.2f} mm off their grid position")
 PY
   ;;
 *) fail "unknown case $case" ;;

@@ -55,7 +55,7 @@ run_file docs/quickstart.md
 # What the docs promise those commands write.
 for f in out/demo/results.csv out/demo/model.yaml out/demo/decisions.csv out/lawnmower-3.0/result.json \
   out/model.yaml out/adaptive/result.json out/eval/results.csv out/road/results.csv \
-  out/live-images/area.yaml out/live/map.png; do
+  out/live-images/area.yaml out/live/map.png out/my-field-15/map.tif out/my-field-15/mission.plan; do
   [ -s "$work/$f" ] || fail "missing $f"
 done
 echo "ok: the commands of README.md and docs/quickstart.md run in order"
