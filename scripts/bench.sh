@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds in Release, and runs the benchmarks:
 #   GaussianProcess vs scikit-learn, the per-waypoint decision time, and each bundled network
-#   through the ONNX backend (OpenCV DNN vs PyTorch). Results: docs/benchmarks.md.
+#   through the ONNX backend (OpenCV DNN vs PyTorch), and a 20000 x 20000 GeoTIFF field loaded.
+#   Results: docs/benchmarks.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh bench
 cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release
-cmake --build build/release -j"$(nproc 2>/dev/null || echo 2)" --target bench_gaussian_process bench_decision bench_erfnet
+cmake --build build/release -j"$(nproc 2>/dev/null || echo 2)" --target bench_gaussian_process bench_decision bench_erfnet \
+  bench_geotiff
 # GaussianProcess vs scikit-learn twice, side by side: numpy/scipy on Debian's reference BLAS and
 # LAPACK (single-threaded), then on OpenBLAS (multi-threaded; what a pip user's numpy brings).
 # The loader picks the BLAS by LD_LIBRARY_PATH; adaptseg's own code uses Eigen, not BLAS.
@@ -21,3 +23,5 @@ for m in erfnet-dubai mobilenetv2-dubai; do
   /usr/bin/python3 benchmarks/bench_erfnet.py --model-dir "examples/models/$m" \
       --bench-bin build/release/benchmarks/bench_erfnet --rounds 5 --iters 10
 done
+# A large GeoTIFF field: load time and memory (writes ~1.6 GB of scratch GeoTIFFs, then removes them).
+bash benchmarks/bench_geotiff.sh build/release/benchmarks/bench_geotiff 20000
