@@ -38,6 +38,10 @@ int main(int argc, char** argv) {
   app.add_option("--gsd", gsd_cm, "lawnmower GSD [cm/px] (>= the field's GSD)");
   app.add_option("--model", model_file, "decision model from adaptseg_calibrate (adaptive, nonadaptive, linear)");
   app.add_option("--budget-s", budget_s, "mission-time budget [s] for adaptive strategies (never exceeded)");
+  std::string overlap_text;
+  app.add_option("--overlap", overlap_text,
+                 "OVERLAP or ALONG,ACROSS: image overlap of the lawnmower strategy, fractions of a footprint in "
+                 "[0, 0.9] along and across its rows (default 0: the paper's footprints that only touch)");
   app.add_option("--out", out_dir, "output directory")->required();
   common.add_to(app);
   segmenter.add_to(app);
@@ -53,18 +57,25 @@ int main(int argc, char** argv) {
     if (strategy != "lawnmower" && model) common.check_camera_matches(app, *model);
     if (budget_s && strategy == "lawnmower")
       throw std::invalid_argument("--budget-s applies to adaptive strategies only");
+    const adaptseg::LawnmowerOverlap overlap =
+        overlap_text.empty() ? adaptseg::LawnmowerOverlap{} : adaptseg::examples::parse_overlap(overlap_text);
+    if (strategy != "lawnmower" && overlap != adaptseg::LawnmowerOverlap{})
+      throw std::invalid_argument("--overlap applies to --strategy lawnmower only");
     segmenter.validate();
     const auto camera = strategy != "lawnmower" && model ? model->camera : options.camera;
     const auto run = segmenter.with_backend(field, camera, [&](auto& backend) {
       return adaptseg::examples::run_strategy(field, backend, strategy, gsd_cm, model ? &*model : nullptr, options,
-                                              budget_s);
+                                              budget_s, overlap);
     });
     const adaptseg::MissionResult& result = run.mission;
     if (strategy != "lawnmower") options.camera = model->camera, options.timing = model->timing;
 
     fs::create_directories(out_dir);
     auto json = adaptseg::examples::result_json(field, result, options, run.decisions ? &*run.decisions : nullptr);
-    if (strategy == "lawnmower") json["gsd_cm"] = gsd_cm;
+    if (strategy == "lawnmower") {
+      json["gsd_cm"] = gsd_cm;
+      json["overlap"] = {{"along", overlap.along}, {"across", overlap.across}};
+    }
     if (budget_s) json["budget_s"] = *budget_s;
     adaptseg::examples::write_text(out_dir / "result.json", json.dump(2) + "\n");
     exports.write(field, result, options, out_dir);

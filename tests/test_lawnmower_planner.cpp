@@ -96,3 +96,51 @@ TEST_CASE("lawnmower: bad input is rejected") {
   CHECK_THROWS_WITH_AS((void)planner.plan({0, 0, 0, 10}, 1.0), doctest::Contains("area"), std::invalid_argument);
   CHECK_THROWS_AS((void)planner.plan({0, 0, std::nan(""), 10}, 1.0), std::invalid_argument);
 }
+
+TEST_CASE("lawnmower: overlap along and across the rows") {
+  using adaptseg::LawnmowerOverlap;
+  const Area field{0, 0, 40.0, 30.0};  // footprint 14.4 x 10.8 m at 3 cm/px
+  // No overlap is the paper's grid, to the bit.
+  const auto paper = LawnmowerPlanner(CameraModel{}).plan(field, 3.0, {40.0, 30.0});
+  const auto zero = LawnmowerPlanner(CameraModel{}, LawnmowerOverlap{0.0, 0.0}).plan(field, 3.0, {40.0, 30.0});
+  REQUIRE(paper.size() == zero.size());
+  for (std::size_t i = 0; i < paper.size(); ++i) CHECK(paper[i].footprint == zero[i].footprint);
+
+  for (const Eigen::Vector2d& start : {Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(40.0, 30.0)}) {
+    CAPTURE(start.transpose());
+    const LawnmowerPlanner planner(CameraModel{}, LawnmowerOverlap{0.5, 0.25});
+    const auto plan = planner.plan(field, 3.0, start);
+    // Along: 1 + ceil((40 - 14.4) / 7.2) = 5 columns; across: 1 + ceil((30 - 10.8) / 8.1) = 4 rows.
+    REQUIRE(plan.size() == 5 * 4);
+    // Neighbours in a row share half a footprint's width; neighbouring rows a quarter of its height.
+    CHECK(std::abs(plan[1].footprint.x_min_m - plan[0].footprint.x_min_m) == doctest::Approx(7.2));
+    CHECK(std::abs(plan[5].footprint.y_min_m - plan[0].footprint.y_min_m) == doctest::Approx(8.1));
+    // The grid is anchored at the start corner; only the far row and column stick out.
+    const double x_near = start.x() == 0.0 ? plan[0].footprint.x_min_m : plan[0].footprint.x_max_m;
+    const double y_near = start.y() == 0.0 ? plan[0].footprint.y_min_m : plan[0].footprint.y_max_m;
+    CHECK(x_near == doctest::Approx(start.x()));
+    CHECK(y_near == doctest::Approx(start.y()));
+    for (const auto& w : plan) {
+      CHECK(w.footprint.width_m() == doctest::Approx(14.4));
+      CHECK(w.footprint.height_m() == doctest::Approx(10.8));
+    }
+    // Every point of the field lies under at least one footprint, and seams are covered twice:
+    // a point 0.3 m either side of a paper-grid seam (x = 14.4) is seen by two images.
+    int twice = 0;
+    for (double x = 0.05; x < 40.0; x += 0.5)
+      for (double y = 0.05; y < 30.0; y += 0.5) {
+        int seen = 0;
+        for (const auto& w : plan)
+          seen += x >= w.footprint.x_min_m && x < w.footprint.x_max_m && y >= w.footprint.y_min_m &&
+                  y < w.footprint.y_max_m;
+        REQUIRE(seen >= 1);
+        twice += seen >= 2;
+      }
+    CHECK(twice > 0);
+  }
+  // A side no longer than one footprint takes one image whatever the overlap.
+  CHECK(LawnmowerPlanner(CameraModel{}, LawnmowerOverlap{0.8, 0.8}).plan(Area{0, 0, 14.4, 10.8}, 3.0).size() == 1);
+  CHECK_THROWS_AS(LawnmowerPlanner(CameraModel{}, LawnmowerOverlap{0.95, 0.0}), std::invalid_argument);
+  CHECK_THROWS_AS(LawnmowerPlanner(CameraModel{}, LawnmowerOverlap{0.0, -0.1}), std::invalid_argument);
+  CHECK_THROWS_AS(LawnmowerPlanner(CameraModel{}, LawnmowerOverlap{NAN, 0.0}), std::invalid_argument);
+}

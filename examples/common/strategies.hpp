@@ -11,7 +11,9 @@
 #endif
 
 #include <array>
+#include <cmath>
 #include <filesystem>
+#include <locale>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -36,6 +38,23 @@ inline std::array<double, 4> parse_four_numbers(const std::string& text, const s
   ok = ok && (is >> std::ws).eof();
   if (!ok) throw std::invalid_argument("'" + text + "' is not " + what);
   return v;
+}
+
+/// "O" or "ALONG,ACROSS" -> LawnmowerOverlap (fractions in [0, 0.9]; one value: both).
+/// @throws std::invalid_argument for anything else.
+inline LawnmowerOverlap parse_overlap(const std::string& text) {
+  std::istringstream is(text);
+  is.imbue(std::locale::classic());
+  LawnmowerOverlap o;
+  char comma = 0;
+  bool ok = static_cast<bool>(is >> o.along);
+  o.across = o.along;
+  if (ok && (is >> std::ws).peek() == ',') ok = (is >> comma) && static_cast<bool>(is >> o.across);
+  ok = ok && (is >> std::ws).eof();
+  const auto in_range = [](double v) { return std::isfinite(v) && v >= 0.0 && v <= 0.9; };
+  if (!ok || !in_range(o.along) || !in_range(o.across))
+    throw std::invalid_argument("--overlap '" + text + "' is not OVERLAP or ALONG,ACROSS with fractions in [0, 0.9]");
+  return o;
 }
 
 /// "x0,y0,x1,y1" -> FieldRegion (fractions along the image axes).
@@ -102,19 +121,23 @@ struct StrategyRun {
   std::vector<RealisedDescent> realised{};  ///< simulation: what each descent gained
 };
 
-/// Flies `strategy` over `field`. Lawnmower: at `gsd_cm`. Others: from `model`'s top GSD
-/// with its candidates, camera and timing (the mission options' camera and timing are
-/// replaced by the model's), within `budget_s` if set.
+/// Flies `strategy` over `field`. Lawnmower: at `gsd_cm`, with `overlap`. Others: from
+/// `model`'s top GSD with its candidates, camera and timing (the mission options' camera and
+/// timing are replaced by the model's), within `budget_s` if set.
 template <SegmentationBackend Backend>
 StrategyRun run_strategy(const Field& field, Backend& backend, const std::string& strategy, double gsd_cm,
-                         const DecisionModel* model, MissionOptions options, std::optional<double> budget_s) {
+                         const DecisionModel* model, MissionOptions options, std::optional<double> budget_s,
+                         LawnmowerOverlap overlap = {}) {
   if (strategy == "lawnmower") {
     if (!(gsd_cm > 0.0)) throw std::invalid_argument("--strategy lawnmower needs --gsd (a positive GSD in cm/px)");
     if (gsd_cm < field.gsd_cm() * (1.0 - 1e-9))
       throw std::invalid_argument("--gsd " + std::to_string(gsd_cm) + " cm/px is finer than field '" +
                                   field.name() + "' (" + std::to_string(field.gsd_cm()) + " cm/px)");
-    return {run_lawnmower_mission(field, gsd_cm, backend, options), std::nullopt};
+    return {run_lawnmower_mission(field, gsd_cm, backend, options, overlap), std::nullopt};
   }
+  if (overlap != LawnmowerOverlap{})
+    throw std::invalid_argument("--overlap applies to --strategy lawnmower only (the decision function's regions "
+                                "are the paper's non-overlapping top-level footprints)");
   if (model == nullptr) throw std::invalid_argument("--strategy " + strategy + " needs --model (from adaptseg_calibrate)");
   if (model->segmenter != backend.name())
     throw std::invalid_argument("the decision model was calibrated with segmenter '" + model->segmenter +

@@ -62,11 +62,25 @@ enum class DescentCoverage { region, interest };
   throw std::invalid_argument("descent coverage must be 'region' or 'interest', not '" + s + "'");
 }
 
+/// Image overlap of a lawnmower (beyond the paper, whose footprints tile the area without
+/// overlap: the default). `along`: the fraction of a footprint's width shared with the next
+/// image of its row (rows run along x); `across`: the fraction of its height shared with the
+/// neighbouring row. Photogrammetry surveys fly 0.6-0.8; a little overlap closes the seams that
+/// position errors open between footprints that only touch.
+struct LawnmowerOverlap {
+  double along = 0.0;   ///< in [0, 0.9]
+  double across = 0.0;  ///< in [0, 0.9]
+
+  friend bool operator==(const LawnmowerOverlap&, const LawnmowerOverlap&) = default;
+};
+
 /// Lawnmower coverage of a rectangle at one altitude: the rectangle is cut into a grid of
 /// camera footprints (ceil(width / footprint width) by ceil(height / footprint height)),
 /// anchored at the starting corner so that only the far row and column may stick out, and
 /// visited row by row, alternating direction. Cells for which `keep(footprint)` is false
 /// (e.g. no valid field pixel under them) are skipped without changing the order of the rest.
+/// With an overlap o the grid steps by (1 - o) footprints and has 1 + ceil((L - f) / ((1 - o) f))
+/// cells along a side of length L > f (f: the footprint's side); o = 0 is the grid above.
 ///
 /// @code
 /// adaptseg::LawnmowerPlanner planner(adaptseg::CameraModel{});
@@ -76,10 +90,17 @@ enum class DescentCoverage { region, interest };
 /// @endcode
 class LawnmowerPlanner {
  public:
-  /// @throws std::invalid_argument via CameraModel for an invalid camera.
-  explicit LawnmowerPlanner(CameraModel camera) : camera_(camera) {}
+  /// @throws std::invalid_argument via CameraModel for an invalid camera, and for an overlap
+  ///         outside [0, 0.9].
+  explicit LawnmowerPlanner(CameraModel camera, LawnmowerOverlap overlap = {}) : camera_(camera), overlap_(overlap) {
+    detail::require(std::isfinite(overlap.along) && overlap.along >= 0.0 && overlap.along <= 0.9,
+                    "LawnmowerPlanner: overlap.along must be in [0, 0.9]", overlap.along);
+    detail::require(std::isfinite(overlap.across) && overlap.across >= 0.0 && overlap.across <= 0.9,
+                    "LawnmowerPlanner: overlap.across must be in [0, 0.9]", overlap.across);
+  }
 
   [[nodiscard]] const CameraModel& camera() const noexcept { return camera_; }
+  [[nodiscard]] const LawnmowerOverlap& overlap() const noexcept { return overlap_; }
 
   /// Covers `area` at `gsd_cm`, starting in the corner of `area` nearest `start_xy` [m].
   /// @throws std::invalid_argument if the GSD is not positive or the area is empty.
@@ -93,8 +114,10 @@ class LawnmowerPlanner {
                     area.width_m() * area.height_m());
     const Extent fp = camera_.footprint_at_gsd(gsd_cm);
     const double altitude = camera_.altitude_m(gsd_cm);
-    const int nx = cells(area.width_m(), fp.width_m);
-    const int ny = cells(area.height_m(), fp.height_m);
+    const double step_x = fp.width_m * (1.0 - overlap_.along);
+    const double step_y = fp.height_m * (1.0 - overlap_.across);
+    const int nx = cells(area.width_m(), fp.width_m, overlap_.along);
+    const int ny = cells(area.height_m(), fp.height_m, overlap_.across);
     // Start corner: the side of each axis nearest the UAV; the grid grows away from it.
     const bool from_x_min = std::abs(start_xy.x() - area.x_min_m) <= std::abs(start_xy.x() - area.x_max_m);
     const bool from_y_min = std::abs(start_xy.y() - area.y_min_m) <= std::abs(start_xy.y() - area.y_max_m);
@@ -102,12 +125,10 @@ class LawnmowerPlanner {
     std::vector<Waypoint> out;
     out.reserve(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny));
     for (int row = 0; row < ny; ++row) {
-      const double y0 = from_y_min ? area.y_min_m + row * fp.height_m
-                                   : area.y_max_m - (row + 1) * fp.height_m;
+      const double y0 = from_y_min ? area.y_min_m + row * step_y : far_edge(area.y_max_m, row, step_y, fp.height_m);
       for (int k = 0; k < nx; ++k) {
         const int col = (row % 2 == 0) ? k : nx - 1 - k;
-        const double x0 = from_x_min ? area.x_min_m + col * fp.width_m
-                                     : area.x_max_m - (col + 1) * fp.width_m;
+        const double x0 = from_x_min ? area.x_min_m + col * step_x : far_edge(area.x_max_m, col, step_x, fp.width_m);
         Waypoint w;
         w.footprint = {x0, y0, x0 + fp.width_m, y0 + fp.height_m};
         const Eigen::Vector2d c = w.footprint.centre();
@@ -132,11 +153,20 @@ class LawnmowerPlanner {
 
  private:
   /// Number of footprints needed along one axis; a tolerance keeps exact multiples exact.
-  static int cells(double length_m, double footprint_m) {
-    return std::max(1, static_cast<int>(std::ceil(length_m / footprint_m - 1e-9)));
+  static int cells(double length_m, double footprint_m, double overlap) {
+    if (overlap == 0.0) return std::max(1, static_cast<int>(std::ceil(length_m / footprint_m - 1e-9)));
+    if (length_m <= footprint_m * (1.0 + 1e-9)) return 1;
+    return 1 + static_cast<int>(std::ceil((length_m - footprint_m) / (footprint_m * (1.0 - overlap)) - 1e-9));
+  }
+
+  /// Low edge of cell `i` counted from the high edge `max` of a side; without overlap exactly
+  /// the paper's max - (i + 1) f (the same floating-point value as before overlaps existed).
+  static double far_edge(double max, int i, double step, double footprint) {
+    return step == footprint ? max - (i + 1) * footprint : max - i * step - footprint;
   }
 
   CameraModel camera_;
+  LawnmowerOverlap overlap_;
 };
 
 }  // namespace adaptseg

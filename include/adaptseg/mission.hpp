@@ -176,19 +176,20 @@ class Mission {
 
 /// The fixed-altitude lawnmower baseline (paper §5.2): the whole field at one GSD,
 /// regions without a valid pixel skipped. Planning time: the plan's computation, spread
-/// over its waypoints (or the fixed per-waypoint time).
-/// @throws std::invalid_argument if `gsd_cm` is finer than the field's GSD, and for the
-///         reasons of Mission's constructor.
+/// over its waypoints (or the fixed per-waypoint time). `overlap` (beyond the paper; default
+/// none, as the paper): the images' along- and across-track overlap, see LawnmowerOverlap.
+/// @throws std::invalid_argument if `gsd_cm` is finer than the field's GSD, for an overlap
+///         outside [0, 0.9], and for the reasons of Mission's constructor.
 template <SegmentationBackend Backend>
 [[nodiscard]] MissionResult run_lawnmower_mission(const Field& field, double gsd_cm, Backend& backend,
-                                                  const MissionOptions& options) {
+                                                  const MissionOptions& options, LawnmowerOverlap overlap = {}) {
   detail::require(std::isfinite(gsd_cm) && gsd_cm >= field.gsd_cm() * (1.0 - 1e-9),
                   "run_lawnmower_mission: gsd_cm must be finite and not finer than the field's " +
                       std::to_string(field.gsd_cm()) + " cm/px",
                   gsd_cm);
   Mission<Backend> mission(field, backend, options, "lawnmower");
   const auto t0 = std::chrono::steady_clock::now();
-  const LawnmowerPlanner planner(mission.camera());
+  const LawnmowerPlanner planner(mission.camera(), overlap);
   const auto plan = planner.plan(field.area(), gsd_cm, {0.0, 0.0},
                                  [&](const Area& a) { return field.has_valid(a); });
   const double per_waypoint = plan.empty() ? 0.0 : Mission<Backend>::seconds_since(t0) / static_cast<double>(plan.size());

@@ -42,6 +42,30 @@ bad_inputs)
   expect_error "The following argument was not expected: --bogus" --field "$field" --gsd 3 --out "$work/o" --bogus
   expect_error "did you mean --gsd?" --field "$field" --gds 3 --out "$work/o"
   expect_error "--out is required" --field "$field" --gsd 3
+  expect_error "is not OVERLAP or ALONG,ACROSS with fractions in [0, 0.9]" --field "$field" --gsd 3 --overlap 0.95 --out "$work/o"
+  expect_error "is not OVERLAP or ALONG,ACROSS" --field "$field" --gsd 3 --overlap 0.2,x --out "$work/o"
+  expect_error "--overlap applies to --strategy lawnmower only" --field "$field" --strategy adaptive --overlap 0.2 \
+    --out "$work/o"
+  [ ! -e "$work/o" ] || fail "an error must be reported before the mission writes anything"
+  # With overlap the lawnmower takes more images over the same field and says so in result.json.
+  for o in 0 0.5,0.25; do
+    "$mission" --field "$field" --gsd 3 --seg-time-s 0.1 --plan-time-s 0 --overlap "$o" \
+      --out "$work/overlap-$o" >/dev/null || fail "mission with --overlap $o failed"
+  done
+  "$python" - "$work/overlap-0/result.json" "$work/overlap-0.5,0.25/result.json" <<'PY' || fail "--overlap checks"
+import json, math, sys
+plain, over = (json.load(open(f)) for f in sys.argv[1:])
+assert plain["overlap"] == {"along": 0.0, "across": 0.0} and over["overlap"] == {"along": 0.5, "across": 0.25}
+xs = sorted({round(w["x"], 6) for w in over["waypoints"]})
+ys = sorted({round(w["y"], 6) for w in over["waypoints"]})
+fp_w, fp_h = 14.4, 10.8  # the default camera at 3 cm/px
+assert len(xs) == 3 and len(ys) == 9, (xs, ys)  # 27.33 x 68.08 m: 1 + ceil(12.93 / 7.2), 1 + ceil(57.28 / 8.1)
+assert all(math.isclose(b - a, fp_w * 0.5) for a, b in zip(xs, xs[1:])), xs
+assert all(math.isclose(b - a, fp_h * 0.75) for a, b in zip(ys, ys[1:])), ys
+assert over["images"] > plain["images"], (over["images"], plain["images"])
+assert over["coverage"] >= plain["coverage"] - 1e-12, (over["coverage"], plain["coverage"])
+print(f"ok: {plain['images']} images without overlap, {over['images']} with 0.5 along and 0.25 across")
+PY
   ;;
 weedmap_sweep)
   for gsd in 1.0 1.5 2.0 2.5 3.0; do
