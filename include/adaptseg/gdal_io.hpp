@@ -172,6 +172,15 @@ inline RasterGrid grid_of(GDALDataset& d, const std::filesystem::path& file) {
   return g;
 }
 
+/// Rows per strip of ~`strip_bytes` for a band whose blocks are `block_h` rows high and whose
+/// rows take `row_bytes` in memory: whole blocks, at least one block row.
+inline int strip_rows(GDALRasterBand& band, std::size_t row_bytes, std::size_t strip_bytes) {
+  int block_w = 0, block_h = 0;
+  band.GetBlockSize(&block_w, &block_h);
+  const int rows_wanted = static_cast<int>(std::max<std::size_t>(1, strip_bytes / std::max<std::size_t>(1, row_bytes)));
+  return std::max(1, block_h) * std::max(1, rows_wanted / std::max(1, block_h));
+}
+
 /// Reads bands `band_map` (1-based) of an 8-bit raster into one interleaved CV_8UC(n) matrix:
 /// GDAL writes straight into the matrix (no per-band copy), in strips of ~64 MiB whose cached
 /// blocks are dropped after each strip, so GDAL's block cache (5 % of RAM by default) does not
@@ -184,12 +193,8 @@ inline cv::Mat read_interleaved(GDALDataset& d, const std::filesystem::path& fil
       fail(file, "band " + std::to_string(b) + " is " +
                      GDALGetDataTypeName(d.GetRasterBand(b)->GetRasterDataType()) + ", need 8-bit (Byte)");
   cv::Mat m(d.GetRasterYSize(), d.GetRasterXSize(), CV_8UC(n));
-  int block_w = 0, block_h = 0;
-  d.GetRasterBand(band_map.front())->GetBlockSize(&block_w, &block_h);
   const std::size_t row_bytes = m.step[0];
-  // Whole blocks per strip, at least one block row.
-  const int rows_wanted = static_cast<int>(std::max<std::size_t>(1, strip_bytes / std::max<std::size_t>(1, row_bytes)));
-  const int strip = std::max(1, block_h) * std::max(1, rows_wanted / std::max(1, block_h));
+  const int strip = strip_rows(*d.GetRasterBand(band_map.front()), row_bytes, strip_bytes);
   const QuietErrors quiet;
   CPLErrorReset();
   for (int r0 = 0; r0 < m.rows; r0 += strip) {
@@ -485,11 +490,8 @@ inline Dataset create_on_field_grid(const std::filesystem::path& file, const Fie
 /// read_interleaved: GDAL's block cache holds no second copy of a large map).
 inline void write_band(GDALDataset& d, const cv::Mat& m, GDALDataType type, const std::filesystem::path& file) {
   GDALRasterBand* band = d.GetRasterBand(1);
-  int block_w = 0, block_h = 0;
-  band->GetBlockSize(&block_w, &block_h);
   const std::size_t row_bytes = m.step[0];
-  const int rows_wanted = static_cast<int>(std::max<std::size_t>(1, (std::size_t{64} << 20) / std::max<std::size_t>(1, row_bytes)));
-  const int strip = std::max(1, block_h) * std::max(1, rows_wanted / std::max(1, block_h));
+  const int strip = strip_rows(*band, row_bytes, std::size_t{64} << 20);
   const QuietErrors quiet;
   CPLErrorReset();
   for (int r0 = 0; r0 < m.rows; r0 += strip) {
