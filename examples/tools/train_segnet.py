@@ -31,7 +31,10 @@ sees the same batches, however many data workers (--workers) produce them.
 Devices: --device cuda runs the network in bfloat16 autocast with channels-last tensors and
 data workers; --device cpu in float32. A checkpoint written on one continues on the other.
 --max-minutes stops a run with a checkpoint before a wall-clock limit (for sessions of
-limited length); --resume continues it.
+limited length); --resume continues it. --minutes M instead fits the learning-rate cycle into M
+minutes: at the end of the warm-up the cycle's length (at most --steps) is set from the
+measured time per step and of one validation, so that the whole schedule, annealing
+included, ends in time (for a lease of an accelerator of unknown speed).
 
 Weight averaging (--ema DECAY): the run also keeps an exponential moving average of the weights
 (and batch-norm statistics), validates it next to the trained weights (val_ema_log.csv) and
@@ -541,12 +544,13 @@ def export(model, ckpt, args, model_dir: Path, val_result):
                                          else "random"),
             "optimizer": f"{ckpt['optimizer']} wd {ckpt['weight_decay']}; per learning-rate cycle linear "
                          "warm-up to the peak, then poly(0.9) decay to 0",
-            "lr_cycles": [{k: (float(v) if k == "lr" else int(v)) for k, v in c.items()}
-                          for c in ckpt.get("stages", [])],
+            "lr_cycles": [{k: (int(v) if k in ("start", "end", "warmup", "fitted_steps") else float(v))
+                           for k, v in c.items()} for c in ckpt.get("stages", [])],
             "dropout": dropout,
             "augmentation": ckpt["augment"],
             "class_weights": [float(v) for v in ckpt["class_weights"]],
-            "torch_version": str(torch.__version__),
+            "torch_version": str(torch.__version__),  # of the export
+            **({"train_torch_versions": sorted(ckpt["torch_versions"])} if ckpt.get("torch_versions") else {}),
             "opencv_version": str(cv2.__version__),
             "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
         },
@@ -664,6 +668,11 @@ def main(argv=None):
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--max-minutes", type=float, default=0.0,
                     help="> 0: checkpoint and stop after this much wall-clock time (continue with --resume)")
+    ap.add_argument("--minutes", type=float, default=0.0,
+                    help="> 0: fit the new learning-rate cycle (of a new run or of --extend) into this much "
+                         "wall-clock time from the start of this invocation, export excluded: its length, "
+                         "at most --steps (--extend), is set at the end of the warm-up from the measured "
+                         "time per step and per validation")
     ap.add_argument("--resume", action="store_true", help="continue from WORK_DIR/checkpoint.pt")
     ap.add_argument("--extend", type=int, default=0, metavar="STEPS",
                     help="with --resume of a finished run: train STEPS more steps under a new "
@@ -713,7 +722,7 @@ def main(argv=None):
 
     torch.manual_seed(args.seed)
     if resume:
-        ckpt = torch.load(ckpt_path, map_location="cpu")
+        ckpt = torch.load(ckpt_path, map_location="cpu", weights_only=False)  # our own file
         if ckpt["classes"] != classes:
             raise SystemExit("checkpoint classes differ from the fields' classes")
         if "arch" not in ckpt:
@@ -817,14 +826,20 @@ def main(argv=None):
     exported_model = model if ema_model is None else ema_model  # what validation reports and export writes
     # Learning-rate cycles: the first from step 0 to --steps (--lr, --warmup); each --extend
     # appends one. The checkpoint keeps them, so --resume continues the schedule it was in.
+    if args.minutes < 0 or (args.minutes > 0 and args.resume and not args.extend):
+        raise SystemExit("--minutes fits a new learning-rate cycle: give it to a new run or with --extend")
+    if args.minutes > 0 and args.warmup < 40:
+        raise SystemExit("--minutes measures the time per step over the second half of the warm-up: "
+                         "--warmup must be at least 40 steps")
+    fit = {"minutes": args.minutes} if args.minutes > 0 else {}
     stages = ckpt.setdefault("stages", [{"start": 0, "end": args.steps, "lr": args.lr,
-                                         "warmup": args.warmup}])
+                                         "warmup": args.warmup, **fit}])
     if args.extend:
         if ckpt["step"] != stages[-1]["end"]:
             raise SystemExit(f"--extend: the checkpoint is at step {ckpt['step']}, inside its last "
                              f"learning-rate cycle (ends at {stages[-1]['end']}); finish it with --resume first")
         stages.append({"start": ckpt["step"], "end": ckpt["step"] + args.extend, "lr": args.lr,
-                       "warmup": args.warmup})
+                       "warmup": args.warmup, **fit})
         print(f"extending by {args.extend} steps: new learning-rate cycle, peak {args.lr:g}", flush=True)
     total_steps = stages[-1]["end"]
     print(f"{ckpt['arch']}: {sum(p.numel() for p in model.parameters())} parameters "
@@ -891,12 +906,42 @@ def main(argv=None):
         ckpt["last_val"] = {str(k): v for k, v in res.items()}
         return res
 
+    # --minutes: the last cycle's length is fitted at the end of its warm-up (the learning rate of
+    # the warm-up does not depend on it). A run resumed before that point fits it on resuming.
+    fit_stage = stages[-1] if stages[-1].get("minutes") and "fitted_steps" not in stages[-1] else None
+    fit_step = fit_stage["start"] + fit_stage["warmup"] if fit_stage else -1
+    if fit_stage and ckpt["step"] >= fit_step - fit_stage["warmup"] // 2:
+        raise SystemExit(f"--minutes: the checkpoint (step {ckpt['step']}) is past the start of the "
+                         "measurement; the cycle cannot be fitted")
+    fit_t0 = None
+
+    def fit_cycle(step):
+        """Sets the cycle's end so that the steps left, their validations and the final one end
+        within the budget; returns the validation's result run to measure it."""
+        nonlocal total_steps
+        t_step = (time.time() - fit_t0) / (fit_stage["warmup"] - fit_stage["warmup"] // 2)
+        tv = time.time()
+        res = validate(step)
+        t_val = time.time() - tv
+        left = 60.0 * fit_stage["minutes"] - (time.time() - t_start) - t_val - 15.0  # final validation, checkpoint
+        per_step = t_step + (t_val / args.val_every if args.val_every > 0 else 0.0)
+        n = max(1, int(0.97 * left / per_step))
+        fit_stage["end"] = min(fit_stage["end"], step + n)
+        fit_stage["fitted_steps"] = fit_stage["end"] - fit_stage["start"]
+        fit_stage["measured_s_per_step"] = round(t_step, 5)
+        fit_stage["measured_s_per_validation"] = round(t_val, 2)
+        total_steps = stages[-1]["end"]
+        print(f"--minutes {fit_stage['minutes']:g}: {t_step * 1000:.1f} ms per step, {t_val:.1f} s per "
+              f"validation -> the cycle ends at step {total_steps}", flush=True)
+        return res
+
     workers = args.workers if args.workers >= 0 else (min(12, max(0, (os.cpu_count() or 1) - 2)) if cuda else 0)
     loader = torch.utils.data.DataLoader(
         StepBatches(sampler, ckpt["step"], total_steps, ckpt["batch"]), batch_size=None, shuffle=False,
         num_workers=workers, pin_memory=cuda, persistent_workers=False,
         **({"prefetch_factor": 4} if workers > 0 else {}))
     ckpt["devices"] = sorted(set(ckpt.get("devices", [])) | {args.device})
+    ckpt["torch_versions"] = sorted(set(ckpt.get("torch_versions", [])) | {str(torch.__version__)})
     set_train_mode(model, ckpt)
     step = ckpt["step"]
     run_loss, run_n, t_log = 0.0, 0, time.time()
@@ -939,7 +984,14 @@ def main(argv=None):
             print(f"step {step}/{total_steps} loss {run_loss / run_n:.4f} lr {lr:.2e} {ips:.2f} img/s "
                   f"elapsed {ckpt['train_seconds'] / 60:.1f} min, eta {eta:.1f} min", flush=True)
             run_loss, run_n, t_log = 0.0, 0, time.time()
-        if args.val_every > 0 and step % args.val_every == 0 and step < total_steps:
+        if fit_stage and step == fit_step - fit_stage["warmup"] // 2:
+            fit_t0 = time.time()
+        if fit_stage and step == fit_step:
+            fit_cycle(step)  # validates too
+            fit_stage = None
+            set_train_mode(model, ckpt)
+            t_log = time.time()
+        elif args.val_every > 0 and step % args.val_every == 0 and step < total_steps:
             validate(step)
             set_train_mode(model, ckpt)
             t_log = time.time()
