@@ -167,6 +167,7 @@ int main(int argc, char** argv) {
     if (!model_file.empty()) {
       loaded = adaptseg::DecisionModel::load(model_file);
       for (const auto& t : tests) loaded->check_classes(t);
+      common.check_camera_matches(app, *loaded);
     } else {
       std::vector<adaptseg::Field> trains;
       for (const auto& spec : train_specs) trains.push_back(adaptseg::examples::load_field_spec(spec));
@@ -205,7 +206,11 @@ int main(int argc, char** argv) {
     const std::size_t total_runs = tests.size() * (lawnmower_factors.size() + 4);
     std::size_t run_index = 0;
     for (const auto& field : tests) {
-      const adaptseg::MissionOptions mo = common.resolve(field);
+      // Every strategy, the lawnmowers too, flies the model's camera and speed limits (equal to
+      // the options when the model is calibrated here; checked against explicit ones above).
+      adaptseg::MissionOptions mo = common.resolve(field);
+      mo.camera = model.camera;
+      mo.timing = model.timing;
       struct Row {
         std::string strategy;
         double gsd;
@@ -218,7 +223,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "[%6.1f s] (%zu/%zu) %s: %s%s ...", elapsed(), run_index, total_runs, field.name().c_str(),
                      strategy.c_str(), strategy == "lawnmower" ? (" " + fmt(gsd, 2) + " cm/px").c_str() : "");
         progress_open = true;
-        auto run = segmenter.with_backend(field, strategy == "lawnmower" ? mo.camera : model.camera,
+        auto run = segmenter.with_backend(field, mo.camera,
                                           [&](auto& backend) {
                                             return adaptseg::examples::run_strategy(
                                                 field, backend, strategy, gsd, &model, mo,
@@ -259,9 +264,7 @@ int main(int argc, char** argv) {
         const std::string name = row.strategy + (row.strategy == "lawnmower" ? "-" + fmt(row.gsd, 2) : "");
         const fs::path dir = field_dir / name;
         fs::create_directories(dir);
-        auto opts = mo;
-        if (row.strategy != "lawnmower") opts.camera = model.camera, opts.timing = model.timing;
-        auto json = adaptseg::examples::result_json(field, m, opts, row.run.decisions ? &*row.run.decisions : nullptr);
+        auto json = adaptseg::examples::result_json(field, m, mo, row.run.decisions ? &*row.run.decisions : nullptr);
         json["gsd_cm"] = row.gsd;
         json["front_margin"] = margin;
         adaptseg::examples::write_text(dir / "result.json", json.dump(2) + "\n");

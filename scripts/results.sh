@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Reproduces docs/results.md.
-#   bash scripts/results.sh [all|oracle|oracle-default|network|sigma-prior|sigma-prior-fit|z-choice] [JOBS]   (default: all, one job per core)
+#   bash scripts/results.sh [all|oracle|oracle-default|network|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]
+#   (default: all, one job per core)
 #
 # oracle: the paper's experiment with the ground-truth oracle, deterministic (fixed 0.1 s per
 #   image and 0 s per waypoint), in two configurations: the defaults, and the paper's (utility
@@ -27,12 +28,17 @@
 #   (adaptseg_calibrate) and the test field flown with the run's model at every z: how much any
 #   choice of z could buy (docs/results.md). Needs out/results/oracle-default; about 8 minutes
 #   on 2 cores.
+# vertical-speed: the defaults' sweep (calibration included) with climbs and descents limited to
+#   1 m/s against 2 m/s level (--vertical-speed 1; the paper's model climbs at the level speed):
+#   what the immediate descent and the survey-first tour are worth when altitude is expensive,
+#   as on real multicopters (issue 17). About 8 minutes on 2 cores.
 # Outputs: out/results/<configuration>/<run>/ (adaptseg_evaluate's files); prints the tables.
 set -euo pipefail
 part=${1:-all}
 jobs=${2:-$(nproc 2>/dev/null || echo 2)}
-case "$part" in all | oracle | oracle-default | network | sigma-prior | sigma-prior-fit | z-choice) ;;
-  *) echo "usage: $0 [all|oracle|oracle-default|network|sigma-prior|sigma-prior-fit|z-choice] [JOBS]" >&2; exit 2 ;;
+case "$part" in all | oracle | oracle-default | network | sigma-prior | sigma-prior-fit | z-choice | vertical-speed) ;;
+  *) echo "usage: $0 [all|oracle|oracle-default|network|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]" >&2
+    exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh plots
@@ -68,6 +74,22 @@ check() {
     [ -s "$root/$r/results.csv" ] || { echo "FAILED: $r (see $root/$r.log)" >&2; bad=1; }
   done
   [ "$bad" = 0 ] || exit 1
+}
+# The oracle sweep of one configuration, each run with ARGS...: both WeedMap splits, and
+# leave-one-tile-out over the Dubai tiles for every class.
+sweep() {
+  local config=$1 w=examples/data/weedmap-000 cls t k
+  local -a train
+  shift
+  run "$config" weedmap-train-left --train "$w:0,0,0.5,1" --test "$w:0.5,0,1,1" "$@"
+  run "$config" weedmap-train-right --train "$w:0.5,0,1,1" --test "$w:0,0,0.5,1" "$@"
+  for cls in $classes; do
+    for t in 1 2 3 4 5 6; do
+      train=()
+      for k in 1 2 3 4 5 6; do [ "$k" != "$t" ] && train+=(--train "$(dubai "$k")"); done
+      run "$config" "dubai-$cls-tile-$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" "$@"
+    done
+  done
 }
 
 if [ "$part" = sigma-prior ]; then
@@ -160,23 +182,24 @@ if [ "$part" = sigma-prior-fit ]; then
   exit 0
 fi
 
+if [ "$part" = vertical-speed ]; then
+  config=oracle-vertical-speed
+  rm -rf "${root:?}/$config"
+  sweep "$config" "${fixed[@]}" --vertical-speed 1 --no-plots
+  wait
+  check
+  /usr/bin/python3 examples/tools/sweep_table.py "vertical 1 m/s=$(ls -d "$root/$config"/*/ | sed 's:/$::' | paste -sd, -)"
+  exit 0
+fi
+
 if [ "$part" != network ]; then
   configs=(oracle-default oracle-paper)
   [ "$part" = oracle-default ] && configs=(oracle-default)
   for config in "${configs[@]}"; do rm -rf "${root:?}/$config"; done
-  w=examples/data/weedmap-000
   for config in "${configs[@]}"; do
     extra=("${fixed[@]}")
     [ "$config" = oracle-paper ] && extra+=("${paper[@]}")
-    run "$config" weedmap-train-left --train "$w:0,0,0.5,1" --test "$w:0.5,0,1,1" "${extra[@]}"
-    run "$config" weedmap-train-right --train "$w:0.5,0,1,1" --test "$w:0,0,0.5,1" "${extra[@]}"
-    for cls in $classes; do
-      for t in 1 2 3 4 5 6; do
-        train=()
-        for k in 1 2 3 4 5 6; do [ "$k" != "$t" ] && train+=(--train "$(dubai "$k")"); done
-        run "$config" "dubai-$cls-tile-$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" "${extra[@]}"
-      done
-    done
+    sweep "$config" "${extra[@]}"
   done
   wait
   check

@@ -321,6 +321,22 @@ TEST_CASE("decision model: file round trip and compatibility checks") {
     CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "bad.yaml"), doctest::Contains("'region' or 'interest'"),
                          std::invalid_argument);
   }
+  {  // the vertical speed limit: kept when set, absent from the file (0) when not
+    CHECK(back.timing.max_vertical_speed_mps == 0.0);
+    CHECK(t::read_file(tmp.path() / "model.yaml").find("vertical") == std::string::npos);
+    DecisionModel slow = m;
+    slow.timing.max_vertical_speed_mps = 1.5;
+    slow.save(tmp.path() / "slow.yaml");
+    const DecisionModel slow_back = DecisionModel::load(tmp.path() / "slow.yaml");
+    CHECK(slow_back.timing.max_vertical_speed_mps == 1.5);
+    CHECK(slow_back.adaptive_options(MissionOptions{}, 100.0).mission.timing.max_vertical_speed_mps == 1.5);
+    std::string text = t::read_file(tmp.path() / "slow.yaml");
+    const auto at = text.find("max_vertical_speed_mps: 1.5");
+    REQUIRE(at != std::string::npos);
+    t::write_file(tmp.path() / "bad_vz.yaml", std::string(text).replace(at, 27, "max_vertical_speed_mps: -1"));
+    CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "bad_vz.yaml"),
+                         doctest::Contains("max_vertical_speed_mps must be finite and >= 0"), std::invalid_argument);
+  }
   CHECK_THROWS_WITH_AS(back.check_compatible(f, {2}), doctest::Contains("labels of interest"), std::invalid_argument);
   const Field other("o", 1.0, f.labels(), {{"a", {0, 0, 0}}, {"b", {1, 1, 1}}, {"c", {2, 2, 2}}}, {1});
   CHECK_THROWS_WITH_AS(back.check_compatible(other, {1}), doctest::Contains("classes"), std::invalid_argument);

@@ -108,6 +108,9 @@ struct CommonOptions {
     app.add_option("--focal-mm", cam.focal_length_mm, "focal length [mm]")->capture_default_str();
     app.add_option("--speed", mission.timing.max_speed_mps, "maximum speed [m/s]")->capture_default_str();
     app.add_option("--accel", mission.timing.max_accel_mps2, "maximum acceleration [m/s^2]")->capture_default_str();
+    app.add_option("--vertical-speed", mission.timing.max_vertical_speed_mps,
+                   "maximum climb and sink rate [m/s] (0: none, climbs as fast as level flight, the paper's model)")
+        ->capture_default_str();
     app.add_option("--seg-time-s", seg_time_s,
                    "fixed segmentation time per image [s] (default: measured)");
     app.add_option("--plan-time-s", plan_time_s,
@@ -133,6 +136,7 @@ struct CommonOptions {
     differs("--focal-mm", c.focal_length_mm, m.focal_length_mm);
     differs("--speed", mission.timing.max_speed_mps, model.timing.max_speed_mps);
     differs("--accel", mission.timing.max_accel_mps2, model.timing.max_accel_mps2);
+    differs("--vertical-speed", mission.timing.max_vertical_speed_mps, model.timing.max_vertical_speed_mps);
   }
 
   /// Resolves names against the field and validates the values (throws invalid_argument).
@@ -304,7 +308,9 @@ inline nlohmann::json result_json(const Field& field, const MissionResult& r, co
                  {"image_height_px", cam.image_height_px},
                  {"sensor_width_mm", cam.sensor_width_mm},
                  {"focal_length_mm", cam.focal_length_mm}};
-  j["timing"] = {{"max_speed_mps", opt.timing.max_speed_mps}, {"max_accel_mps2", opt.timing.max_accel_mps2}};
+  j["timing"] = {{"max_speed_mps", opt.timing.max_speed_mps},
+                 {"max_accel_mps2", opt.timing.max_accel_mps2},
+                 {"max_vertical_speed_mps", opt.timing.max_vertical_speed_mps}};
   j["adaptseg_version"] = kVersion;
   return j;
 }

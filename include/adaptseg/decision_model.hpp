@@ -235,7 +235,11 @@ struct DecisionModel {
       << YAML::Key << "focal_length_mm" << YAML::Value << num(camera.focal_length_mm) << YAML::EndMap;
     e << YAML::Key << "timing" << YAML::Value << YAML::Flow << YAML::BeginMap
       << YAML::Key << "max_speed_mps" << YAML::Value << num(timing.max_speed_mps)
-      << YAML::Key << "max_accel_mps2" << YAML::Value << num(timing.max_accel_mps2) << YAML::EndMap;
+      << YAML::Key << "max_accel_mps2" << YAML::Value << num(timing.max_accel_mps2);
+    // Written only when set, so that models of the isotropic model keep their bytes.
+    if (timing.max_vertical_speed_mps > 0.0)
+      e << YAML::Key << "max_vertical_speed_mps" << YAML::Value << num(timing.max_vertical_speed_mps);
+    e << YAML::EndMap;
     e << YAML::Key << "top_gsd_cm" << YAML::Value << num(top_gsd_cm);
     e << YAML::Key << "candidate_gsd_cm" << YAML::Value;
     emit_numbers(e, candidate_gsd_cm);
@@ -345,7 +349,8 @@ struct DecisionModel {
                 cam.number("focal_length_mm")};
     (void)CameraModel(m.camera);
     const auto tim = r.map("timing");
-    m.timing = {tim.number("max_speed_mps"), tim.number("max_accel_mps2")};
+    m.timing = {tim.number("max_speed_mps"), tim.number("max_accel_mps2"),
+                tim.has("max_vertical_speed_mps") ? tim.number("max_vertical_speed_mps") : 0.0};
     (void)TimingModel(m.timing);
     m.top_gsd_cm = r.number("top_gsd_cm");
     m.candidate_gsd_cm = r.numbers("candidate_gsd_cm");

@@ -35,6 +35,8 @@ adaptseg_calibrate)
   expect_error "is not a region x0,y0,x1,y1 (fractions 0..1); write DIR:x0,y0,x1,y1" --train "$weedmap:0.5,0,1" \
     --out "$work/m.yaml"
   expect_error "field directory not found" --train "$work/none" --out "$work/m.yaml"
+  expect_error "max_vertical_speed_mps must be finite and >= 0" --field "$weedmap" --out "$work/m.yaml" \
+    --vertical-speed -1
   # None of them wrote a model.
   [ ! -e "$work/m.yaml" ] || fail "a refused calibration wrote $work/m.yaml"
   ;;
@@ -49,6 +51,11 @@ adaptseg_evaluate)
     --out "$work/o" --no-plots --lawnmower-factors 0.5,1
   expect_error "write DIR:x0,y0,x1,y1" --test "$weedmap:0,0,1" --model "$weedmap_model" --out "$work/o" --no-plots
   expect_error "give exactly one of --train (calibrate) and --model (load)" --test "$weedmap" --out "$work/o"
+  # The lawnmowers fly the model's camera and speed limits too: explicit ones must agree.
+  expect_error "--vertical-speed 1.0000 differs from the decision model's 0.0000" --test "$weedmap" \
+    --model "$weedmap_model" --out "$work/o" --no-plots --vertical-speed 1
+  expect_error "--speed 3.0000 differs from the decision model's 2.0000" --test "$weedmap" --model "$weedmap_model" \
+    --out "$work/o" --no-plots --speed 3
   ;;
 adaptseg_live)
   common_parse_errors --images "$work/images" --model "$weedmap_model" --record-from "$weedmap"

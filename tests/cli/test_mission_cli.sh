@@ -24,6 +24,8 @@ bad_inputs)
   expect_error "image_width_px" --field "$field" --gsd 3 --image-width -480 --out "$work/o"
   expect_error "sensor_width_mm" --field "$field" --gsd 3 --sensor-width-mm -1 --out "$work/o"
   expect_error "max_speed_mps" --field "$field" --gsd 3 --speed 0 --out "$work/o"
+  expect_error "max_vertical_speed_mps must be finite and >= 0" --field "$field" --gsd 3 --vertical-speed -0.5 \
+    --out "$work/o"
   expect_error "fixed_segmentation_time_s" --field "$field" --gsd 3 --seg-time-s -1 --out "$work/o"
   expect_error "needs --model-file" --field "$field" --gsd 3 --segmenter erfnet --out "$work/o"
   expect_error "applies to --segmenter erfnet only" --field "$field" --gsd 3 --model-file "$work" --out "$work/o"
