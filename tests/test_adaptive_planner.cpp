@@ -6,6 +6,7 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <utility>
 
 using namespace adaptseg;
@@ -235,6 +236,53 @@ TEST_CASE("adaptive planner (tour): each descent flown at once or after the surv
       CHECK(tour.realised.at(k).decision == k);
     }
   }
+}
+
+TEST_CASE("adaptive planner: a climb rate limit is charged exactly, and makes the survey-first tour pay") {
+  const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
+  OracleSegmenter oracle(f.num_classes());
+  AdaptiveOptions o = options();
+  o.candidate_gsd_cm = {1.0};  // 3 -> 1 cm/px: a descent of 11 m over 30 x 22 m regions
+  const auto fly = [&](double vz, DescentSchedule schedule, std::vector<int> which = {}) {
+    AdaptiveOptions a = o;
+    a.mission.timing.max_vertical_speed_mps = vz;
+    a.schedule = schedule;
+    Scripted policy{.gsd = 1.0, .which = std::move(which)};
+    return run_adaptive_mission(f, oracle, policy, a, "scripted");
+  };
+  const auto deferred = [](const AdaptiveResult& r) {
+    return std::count_if(r.decisions.begin(), r.decisions.end(), [](const DecisionRecord& d) {
+      return d.decision.descend && !d.candidates.empty() && d.candidates.at(0).deferred;
+    });
+  };
+  // A candidate's extra time is what the descent adds, under the limit too.
+  Scripted never{.gsd = 0.5};
+  AdaptiveOptions slow = o;
+  slow.mission.timing.max_vertical_speed_mps = 0.25;
+  const double base = run_adaptive_mission(f, oracle, never, slow, "never").mission.total_s();
+  const AdaptiveResult one = fly(0.25, DescentSchedule::immediate, {2});
+  REQUIRE(one.descents() == 1);
+  CHECK(one.mission.total_s() - base == doctest::Approx(one.decisions[2].candidates.at(0).extra_time_s).epsilon(1e-9));
+  // Every region descends: the paper's time model defers less than a slow climb does, and the
+  // slow climb makes the tour's saving larger.
+  const AdaptiveResult iso_now = fly(0.0, DescentSchedule::immediate);
+  const AdaptiveResult iso_tour = fly(0.0, DescentSchedule::tour);
+  const AdaptiveResult slow_now = fly(0.25, DescentSchedule::immediate);
+  const AdaptiveResult slow_tour = fly(0.25, DescentSchedule::tour);
+  for (const AdaptiveResult* r : {&iso_now, &iso_tour, &slow_now, &slow_tour}) {
+    CHECK(r->descents() == static_cast<int>(r->decisions.size()));
+    CHECK(r->mission.miou_all().value() == 1.0);
+  }
+  CAPTURE(deferred(iso_tour));
+  CAPTURE(deferred(slow_tour));
+  CHECK(deferred(slow_tour) > deferred(iso_tour));
+  CHECK(slow_now.mission.total_s() > iso_now.mission.total_s() + 10.0);  // every descent climbs slower
+  const double saved_iso = iso_now.mission.total_s() - iso_tour.mission.total_s();
+  const double saved_slow = slow_now.mission.total_s() - slow_tour.mission.total_s();
+  CAPTURE(saved_iso);
+  CAPTURE(saved_slow);
+  CHECK(saved_iso >= -1e-9);
+  CHECK(saved_slow > saved_iso + 5.0);
 }
 
 TEST_CASE("adaptive planner (tour): the budget is never exceeded") {
