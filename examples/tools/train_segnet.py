@@ -26,7 +26,9 @@ Augmentations (--augment):
             each drawn per image; crops of --crop camera pixels, scaled like the whole image.
 
 Samples are a function of (seed, step, index in batch) only, so a run resumed from a checkpoint
-sees the same batches, however many data workers (--workers) produce them.
+sees the same batches, however many data workers (--workers) produce them. --sampler device
+makes the `altitude` batches on the training device instead of in CPU workers (device_sampler.py:
+the same draws and resampling, different rounding; for a GPU, whose pace the CPU workers set).
 
 Devices: --device cuda runs the network in bfloat16 autocast with channels-last tensors and
 data workers; --device cpu in float32. A checkpoint written on one continues on the other.
@@ -84,6 +86,7 @@ import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from erfnet import ERFNet, ERFNetInference, erfnet_channels  # noqa: E402
+import device_sampler  # noqa: E402
 import mobilenet_v2  # noqa: E402
 
 IGNORE = 255
@@ -548,6 +551,7 @@ def export(model, ckpt, args, model_dir: Path, val_result):
                            for k, v in c.items()} for c in ckpt.get("stages", [])],
             "dropout": dropout,
             "augmentation": ckpt["augment"],
+            "sampler": ckpt.get("sampler", "cpu"),
             "class_weights": [float(v) for v in ckpt["class_weights"]],
             "torch_version": str(torch.__version__),  # of the export
             **({"train_torch_versions": sorted(ckpt["torch_versions"])} if ckpt.get("torch_versions") else {}),
@@ -624,6 +628,9 @@ def main(argv=None):
     ap.add_argument("--device", choices=("auto", "cpu", "cuda"), default="auto")
     ap.add_argument("--workers", type=int, default=-1,
                     help="data worker processes (-1: none on CPU, up to 12 on CUDA)")
+    ap.add_argument("--sampler", choices=("cpu", "device"), default="cpu",
+                    help="new runs: make the batches in CPU workers (cpu) or on the training device "
+                         "(device; augmentation altitude only; examples/tools/device_sampler.py)")
     ap.add_argument("--width", type=float, default=0.5, help="ERFNet width multiplier")
     ap.add_argument("--encoder-weights", default="",
                     help="MobileNetV2 encoder state_dict from mobilenet_v2.py (default: import with npm)")
@@ -747,6 +754,8 @@ def main(argv=None):
             raise SystemExit(f"--crop {crop}: the crop must map to whole network pixels, a multiple of {multiple}")
         if augment == "mild" and input_wh != camera_wh:
             raise SystemExit("--augment mild crops the network input from the camera image: --input must be the camera size")
+        if args.sampler == "device" and augment != "altitude":
+            raise SystemExit("--sampler device makes the batches of --augment altitude only")
         if erf:
             mean, std = channel_stats(train_fields)
         else:  # Keras MobileNetV2 preprocessing: x / 127.5 - 1
@@ -769,7 +778,7 @@ def main(argv=None):
                 "gsd_factor_range": [args.gsd_min_factor, args.gsd_max_factor],
                 "gsd_cm_range": [train_fields[0].gsd_cm * args.gsd_min_factor,
                                  train_fields[0].gsd_cm * args.gsd_max_factor],
-                "weight_decay": args.weight_decay, "optimizer": "Adam" if erf else "AdamW",
+                "weight_decay": args.weight_decay, "optimizer": "Adam" if erf else "AdamW", "sampler": args.sampler,
                 "train_seconds": 0.0, "last_val": None, "devices": []}
         if erf:
             ckpt.update(width=args.width, dropout_scale=args.dropout_scale)
@@ -935,11 +944,15 @@ def main(argv=None):
               f"validation -> the cycle ends at step {total_steps}", flush=True)
         return res
 
-    workers = args.workers if args.workers >= 0 else (min(12, max(0, (os.cpu_count() or 1) - 2)) if cuda else 0)
-    loader = torch.utils.data.DataLoader(
-        StepBatches(sampler, ckpt["step"], total_steps, ckpt["batch"]), batch_size=None, shuffle=False,
-        num_workers=workers, pin_memory=cuda, persistent_workers=False,
-        **({"prefetch_factor": 4} if workers > 0 else {}))
+    if ckpt.get("sampler", "cpu") == "device":  # resumed runs keep the sampler they started with
+        on_device = device_sampler.DeviceSampler(sampler, device)
+        loader = (on_device.batch(s, ckpt["batch"]) for s in range(ckpt["step"], total_steps))
+    else:
+        workers = args.workers if args.workers >= 0 else (min(12, max(0, (os.cpu_count() or 1) - 2)) if cuda else 0)
+        loader = torch.utils.data.DataLoader(
+            StepBatches(sampler, ckpt["step"], total_steps, ckpt["batch"]), batch_size=None, shuffle=False,
+            num_workers=workers, pin_memory=cuda, persistent_workers=False,
+            **({"prefetch_factor": 4} if workers > 0 else {}))
     ckpt["devices"] = sorted(set(ckpt.get("devices", [])) | {args.device})
     ckpt["torch_versions"] = sorted(set(ckpt.get("torch_versions", [])) | {str(torch.__version__)})
     set_train_mode(model, ckpt)
