@@ -916,19 +916,21 @@ def main(argv=None):
         return res
 
     # --minutes: the last cycle's length is fitted at the end of its warm-up (the learning rate of
-    # the warm-up does not depend on it). A run resumed before that point fits it on resuming.
+    # the warm-up does not depend on it), from the time per step over its second half (or from the
+    # step a resumed run starts at). A run resumed before that point fits it on resuming.
     fit_stage = stages[-1] if stages[-1].get("minutes") and "fitted_steps" not in stages[-1] else None
     fit_step = fit_stage["start"] + fit_stage["warmup"] if fit_stage else -1
-    if fit_stage and ckpt["step"] >= fit_step - fit_stage["warmup"] // 2:
-        raise SystemExit(f"--minutes: the checkpoint (step {ckpt['step']}) is past the start of the "
-                         "measurement; the cycle cannot be fitted")
+    fit_from = max(fit_step - fit_stage["warmup"] // 2, ckpt["step"]) if fit_stage else -1
+    if fit_stage and fit_step - fit_from < 10:
+        raise SystemExit(f"--minutes: the checkpoint (step {ckpt['step']}) leaves fewer than 10 warm-up steps "
+                         f"(to step {fit_step}) to measure the time per step; the cycle cannot be fitted")
     fit_t0 = None
 
     def fit_cycle(step):
         """Sets the cycle's end so that the steps left, their validations and the final one end
         within the budget; returns the validation's result run to measure it."""
         nonlocal total_steps
-        t_step = (time.time() - fit_t0) / (fit_stage["warmup"] - fit_stage["warmup"] // 2)
+        t_step = (time.time() - fit_t0) / (fit_step - fit_from)
         tv = time.time()
         res = validate(step)
         t_val = time.time() - tv
@@ -958,6 +960,8 @@ def main(argv=None):
     set_train_mode(model, ckpt)
     step = ckpt["step"]
     run_loss, run_n, t_log = 0.0, 0, time.time()
+    if fit_stage and fit_from == step:  # resumed inside the measurement: it starts now (data start-up included)
+        fit_t0 = time.time()
     paused = False
     for x, y in loader:
         if step >= total_steps:
@@ -997,7 +1001,7 @@ def main(argv=None):
             print(f"step {step}/{total_steps} loss {run_loss / run_n:.4f} lr {lr:.2e} {ips:.2f} img/s "
                   f"elapsed {ckpt['train_seconds'] / 60:.1f} min, eta {eta:.1f} min", flush=True)
             run_loss, run_n, t_log = 0.0, 0, time.time()
-        if fit_stage and step == fit_step - fit_stage["warmup"] // 2:
+        if fit_stage and step == fit_from:
             fit_t0 = time.time()
         if fit_stage and step == fit_step:
             fit_cycle(step)  # validates too
