@@ -75,14 +75,11 @@ check() {
   done
   [ "$bad" = 0 ] || exit 1
 }
-# The oracle sweep of one configuration, each run with ARGS...: both WeedMap splits, and
-# leave-one-tile-out over the Dubai tiles for every class.
-sweep() {
-  local config=$1 w=examples/data/weedmap-000 cls t k
+# Leave-one-tile-out over the Dubai tiles for every class, each run with ARGS...: CONFIG ARGS...
+sweep_dubai() {
+  local config=$1 cls t k
   local -a train
   shift
-  run "$config" weedmap-train-left --train "$w:0,0,0.5,1" --test "$w:0.5,0,1,1" "$@"
-  run "$config" weedmap-train-right --train "$w:0.5,0,1,1" --test "$w:0,0,0.5,1" "$@"
   for cls in $classes; do
     for t in 1 2 3 4 5 6; do
       train=()
@@ -90,6 +87,14 @@ sweep() {
       run "$config" "dubai-$cls-tile-$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" "$@"
     done
   done
+}
+# The oracle sweep of one configuration: both WeedMap splits, then sweep_dubai. CONFIG ARGS...
+sweep() {
+  local config=$1 w=examples/data/weedmap-000
+  shift
+  run "$config" weedmap-train-left --train "$w:0,0,0.5,1" --test "$w:0.5,0,1,1" "$@"
+  run "$config" weedmap-train-right --train "$w:0.5,0,1,1" --test "$w:0,0,0.5,1" "$@"
+  sweep_dubai "$config" "$@"
 }
 
 if [ "$part" = sigma-prior ]; then
@@ -166,14 +171,7 @@ if [ "$part" = sigma-prior-fit ]; then
   for mode in spread estimated; do
     config=oracle-sigma-prior-$mode
     rm -rf "${root:?}/$config"
-    for cls in $classes; do
-      for t in 1 2 3 4 5 6; do
-        train=()
-        for k in 1 2 3 4 5 6; do [ "$k" != "$t" ] && train+=(--train "$(dubai "$k")"); done
-        run "$config" "dubai-$cls-tile-$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" "${fixed[@]}" \
-          --sigma-prior "$mode" --no-plots
-      done
-    done
+    sweep_dubai "$config" "${fixed[@]}" --sigma-prior "$mode" --no-plots
   done
   wait
   check
