@@ -119,6 +119,7 @@ class DeviceSampler:
         self.nc = cpu_sampler.nc
         self.images = [torch.from_numpy(np.ascontiguousarray(f.image)).to(self.device) for f in cpu_sampler.fields]
         self.labels = [torch.from_numpy(np.ascontiguousarray(f.labels)).to(self.device) for f in cpu_sampler.fields]
+        self.index = {id(f): i for i, f in enumerate(cpu_sampler.fields)}
         self.mean = torch.tensor(self.spec.mean, dtype=torch.float32, device=self.device).view(3, 1, 1)
         self.std = torch.tensor(self.spec.std, dtype=torch.float32, device=self.device).view(3, 1, 1)
         self._weights = {}
@@ -131,12 +132,12 @@ class DeviceSampler:
 
     # -- one sample ----------------------------------------------------------------------------
     def camera(self, rng):
-        """The geometric part: camera image (3 x ch x cw float, rounded to 8 bits, BGR) and oracle
-        target (ch x cw long) of one crop, or None where under 5 % of the crop is labelled."""
+        """train_segnet.Sampler.altitude_camera on the device: camera image (3 x ch x cw float,
+        rounded to 8 bits, BGR) and oracle target (ch x cw long) of one crop."""
         cw, ch = self.spec.camera_wh
         k = int(rng.integers(0, 4))
         f, c0, r0, fw, fh = self.cpu.footprint(rng, k % 2 == 1)
-        fi = self.cpu.fields.index(f)
+        fi = self.index[id(f)]
         img = crop_fill(self.images[fi], c0, r0, fw, fh, 0)       # fh x fw x 3 uint8
         lab = crop_fill(self.labels[fi], c0, r0, fw, fh, IGNORE)  # fh x fw uint8
         img = torch.rot90(img, k, dims=(0, 1))
@@ -206,12 +207,3 @@ class DeviceSampler:
     def batch(self, step: int, size: int):
         xs, ys = zip(*[self.sample(step, j) for j in range(size)])
         return torch.stack(xs), torch.stack(ys)
-
-
-def _selfcheck():
-    w = area_weights(2, 6, "cpu")
-    assert torch.allclose(w.sum(1), torch.ones(2))
-    assert math.isclose(float(w[0, :3].sum()), 1.0, rel_tol=1e-6)
-
-
-_selfcheck()

@@ -35,24 +35,6 @@ import device_sampler as ds  # noqa: E402
 import train_segnet as ts  # noqa: E402
 
 
-def cpu_camera(sampler, rng):
-    """train_segnet.Sampler.sample_altitude up to the crop (same draws as DeviceSampler.camera)."""
-    spec = sampler.spec
-    k = int(rng.integers(0, 4))
-    f, c0, r0, fw, fh = sampler.footprint(rng, k % 2 == 1)
-    rgb = np.rot90(ts.crop_fill(f.image, c0, r0, fw, fh, 0), k)
-    gt = np.rot90(ts.crop_fill(f.labels, c0, r0, fw, fh, ts.IGNORE), k)
-    if rng.random() < 0.5:
-        rgb, gt = rgb[:, ::-1], gt[:, ::-1]
-    cam = cv2.resize(np.ascontiguousarray(rgb), spec.camera_wh, interpolation=cv2.INTER_AREA)
-    target = ts.oracle_labels(np.ascontiguousarray(gt), spec.camera_wh, sampler.nc)
-    cw, ch = spec.camera_wh
-    ccw, cch = min(sampler.crop, cw), min(sampler.crop, ch)
-    x = int(rng.integers(0, cw - ccw + 1))
-    y = int(rng.integers(0, ch - cch + 1))
-    return cam[y:y + cch, x:x + ccw], target[y:y + cch, x:x + ccw]
-
-
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--device", default="cpu")
@@ -88,7 +70,7 @@ def main(argv=None):
     # 2. Same draws, same crop.
     cam_diff, cam_max, agree = [], 0.0, []
     for i in range(args.n):
-        a_img, a_t = cpu_camera(cpu, np.random.default_rng((7, 0, i)))
+        a_img, a_t = cpu.altitude_camera(np.random.default_rng((7, 0, i)))
         b_img, b_t = dev.camera(np.random.default_rng((7, 0, i)))
         b_img = b_img.permute(1, 2, 0).cpu().numpy()
         d = np.abs(b_img - a_img.astype(np.float32))
@@ -102,7 +84,7 @@ def main(argv=None):
     # 3. Photometric augmentation, same parameters.
     diffs = []
     for i in range(args.n):
-        a_img, _ = cpu_camera(cpu, np.random.default_rng((7, 1, i)))
+        a_img, _ = cpu.altitude_camera(np.random.default_rng((7, 1, i)))
         probe = np.random.default_rng((9, i))
         draws = [probe.uniform(0.7, 1.3), probe.uniform(0.75, 1.25), probe.uniform(-20, 20), probe.uniform(0.92, 1.08, 3),
                  probe.uniform(0.8, 1.25), probe.random()]

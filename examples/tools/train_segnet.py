@@ -324,7 +324,9 @@ class Sampler:
         x = x * np.float32(rng.uniform(0.9, 1.1)) + rng.uniform(-0.1, 0.1, (3, 1, 1)).astype(np.float32)
         return x, np.ascontiguousarray(target).astype(np.int64)
 
-    def sample_altitude(self, rng):
+    def altitude_camera(self, rng):
+        """The geometric part of sample_altitude: the camera image (BGR uint8) and oracle target
+        of one crop, before the labelled-share check and the photometric augmentation."""
         spec = self.spec
         k = int(rng.integers(0, 4))  # camera yaw in quarter turns
         f, c0, r0, fw, fh = self.footprint(rng, k % 2 == 1)
@@ -339,12 +341,17 @@ class Sampler:
         ccw, cch = min(self.crop, cw), min(self.crop, ch)
         x = int(rng.integers(0, cw - ccw + 1))
         y = int(rng.integers(0, ch - cch + 1))
-        cam, target = cam[y:y + cch, x:x + ccw], target[y:y + cch, x:x + ccw]
+        return cam[y:y + cch, x:x + ccw], target[y:y + cch, x:x + ccw]
+
+    def sample_altitude(self, rng):
+        spec = self.spec
+        cam, target = self.altitude_camera(rng)
         if (target != IGNORE).mean() < 0.05:
             return None
         black = (cam == 0).all(axis=2)  # no-data pixels stay exactly black (the backend masks them)
         cam = photometric(cam, rng)
         cam[black] = 0
+        (cw, ch), (cch, ccw) = spec.camera_wh, cam.shape[:2]
         sx, sy = spec.input_wh[0] / cw, spec.input_wh[1] / ch
         net = to_network_size(cam, (lround(ccw * sx), lround(cch * sy)))
         return to_tensor(net, spec.mean, spec.std), target.astype(np.int64)
@@ -928,11 +935,11 @@ def main(argv=None):
 
     def fit_cycle(step):
         """Sets the cycle's end so that the steps left, their validations and the final one end
-        within the budget; returns the validation's result run to measure it."""
+        within the budget (validating once here to measure a validation's time)."""
         nonlocal total_steps
         t_step = (time.time() - fit_t0) / (fit_step - fit_from)
         tv = time.time()
-        res = validate(step)
+        validate(step)
         t_val = time.time() - tv
         left = 60.0 * fit_stage["minutes"] - (time.time() - t_start) - t_val - 15.0  # final validation, checkpoint
         per_step = t_step + (t_val / args.val_every if args.val_every > 0 else 0.0)
@@ -944,7 +951,6 @@ def main(argv=None):
         total_steps = stages[-1]["end"]
         print(f"--minutes {fit_stage['minutes']:g}: {t_step * 1000:.1f} ms per step, {t_val:.1f} s per "
               f"validation -> the cycle ends at step {total_steps}", flush=True)
-        return res
 
     if ckpt.get("sampler", "cpu") == "device":  # resumed runs keep the sampler they started with
         on_device = device_sampler.DeviceSampler(sampler, device)
