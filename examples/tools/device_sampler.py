@@ -26,19 +26,12 @@ arithmetic differs in rounding (tests: examples/tools/test_device_sampler.py com
 
 from __future__ import annotations
 
-import math
-
 import cv2
 import numpy as np
 import torch
 import torch.nn.functional as F
 
 IGNORE = 255
-
-
-def lround(v: float) -> int:
-    """std::lround: half away from zero (as train_segnet.lround)."""
-    return int(math.copysign(math.floor(abs(v) + 0.5), v))
 
 
 def area_weights(n_out: int, n_in: int, device) -> torch.Tensor:
@@ -193,9 +186,7 @@ class DeviceSampler:
         black = (cam == 0).all(0)
         cam = self.photometric(cam, rng)
         cam = torch.where(black[None], torch.zeros_like(cam), cam)
-        cw, ch = self.spec.camera_wh
-        sx, sy = self.spec.input_wh[0] / cw, self.spec.input_wh[1] / ch
-        nw, nh = lround(cam.shape[2] * sx), lround(cam.shape[1] * sy)
+        nw, nh = self.cpu.network_size(cam.shape[2], cam.shape[1])
         if (nw, nh) != (cam.shape[2], cam.shape[1]):  # train_segnet.to_network_size
             mode = "area" if nw < cam.shape[2] else "bilinear"
             cam = F.interpolate(cam[None], size=(nh, nw), mode=mode,

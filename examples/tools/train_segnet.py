@@ -351,10 +351,14 @@ class Sampler:
         black = (cam == 0).all(axis=2)  # no-data pixels stay exactly black (the backend masks them)
         cam = photometric(cam, rng)
         cam[black] = 0
-        (cw, ch), (cch, ccw) = spec.camera_wh, cam.shape[:2]
-        sx, sy = spec.input_wh[0] / cw, spec.input_wh[1] / ch
-        net = to_network_size(cam, (lround(ccw * sx), lround(cch * sy)))
+        net = to_network_size(cam, self.network_size(cam.shape[1], cam.shape[0]))
         return to_tensor(net, spec.mean, spec.std), target.astype(np.int64)
+
+    def network_size(self, w: int, h: int) -> tuple[int, int]:
+        """Network pixels (w, h) of a crop of w x h camera pixels: the scale the whole camera
+        image has in the network."""
+        (cw, ch), (iw, ih) = self.spec.camera_wh, self.spec.input_wh
+        return lround(w * iw / cw), lround(h * ih / ch)
 
     def sample(self, step: int, index: int):
         rng = np.random.default_rng((self.seed, step, index))
