@@ -10,9 +10,12 @@
 //   adaptseg_live --record-from examples/data/weedmap-000:0.5,0,1,0.5 --model model.yaml --images DIR
 //   adaptseg_live --images DIR --model model.yaml [--budget-s 300] [--out OUT]
 //
+// (--record-yaw DEG records every image with the camera turned by DEG, as a UAV that does not
+// hold the plan's heading would take them; the planner fuses each at its recorded yaw.)
+//
 // The folder (docs/method.md, "Live use"): DIR/area.yaml (area, map GSD, classes, labels of
 // interest, camera), DIR/valid_mask.png (where the field is), DIR/poses.csv
-// (file,x,y,z,yaw_deg), and per image DIR/rgb/FILE (the camera image) and/or DIR/labels/FILE
+// (file,x,y,z,yaw_deg; yaw counter-clockwise from the field's x axis), and per image DIR/rgb/FILE (the camera image) and/or DIR/labels/FILE
 // (ground-truth labels under the footprint at map resolution, for --segmenter oracle).
 // --segmenter erfnet segments the RGB images with the ERFNet model of --model-file.
 //
@@ -28,6 +31,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -64,7 +68,7 @@ struct ImageSetInfo {
 // --- recording (simulation) ---
 
 void write_image_set(const fs::path& dir, const adaptseg::Field& field, const adaptseg::DecisionModel& model,
-                     const std::vector<adaptseg::Waypoint>& waypoints) {
+                     const std::vector<adaptseg::Waypoint>& waypoints, double yaw_deg) {
   fs::create_directories(dir / "labels");
   if (field.has_image()) fs::create_directories(dir / "rgb");
   ex::write_png(dir / "valid_mask.png", field.valid_mask());
@@ -96,13 +100,13 @@ void write_image_set(const fs::path& dir, const adaptseg::Field& field, const ad
   csv << "file,x,y,z,yaw_deg\n";
   char buf[160];
   for (std::size_t k = 0; k < waypoints.size(); ++k) {
-    const adaptseg::Image img = sensor.capture(waypoints[k]);
+    const adaptseg::Image img = sensor.capture(waypoints[k], yaw_deg);
     std::snprintf(buf, sizeof buf, "%05zu.png", k);
     const std::string file = buf;
     ex::write_png(dir / "labels" / file, img.ground_truth);
     if (!img.rgb.empty()) ex::write_png(dir / "rgb" / file, img.rgb);
     const Eigen::Vector3d& p = waypoints[k].position;
-    std::snprintf(buf, sizeof buf, "%s,%.9f,%.9f,%.9f,0\n", file.c_str(), p.x(), p.y(), p.z());
+    std::snprintf(buf, sizeof buf, "%s,%.9f,%.9f,%.9f,%.9g\n", file.c_str(), p.x(), p.y(), p.z(), yaw_deg);
     csv << buf;
   }
   ex::write_text(dir / "poses.csv", csv.str());
@@ -168,8 +172,10 @@ std::vector<PosedImage> read_poses(const fs::path& dir) {
       p.file = cell[0];
       p.pose = {std::stod(cell[1]), std::stod(cell[2]), std::stod(cell[3])};
       if (cells == 5) p.yaw_deg = std::stod(cell[4]);
+      if (!p.pose.allFinite() || !std::isfinite(p.yaw_deg)) throw std::invalid_argument("");
     } catch (const std::exception&) {
-      fail(file, "line " + std::to_string(n) + " is not file,x,y,z[,yaw_deg]: '" + line + "'");
+      fail(file, "line " + std::to_string(n) + " is not file,x,y,z[,yaw_deg] (finite numbers: metres, degrees): '" +
+                     line + "'");
     }
     out.push_back(p);
   }
@@ -229,15 +235,12 @@ void fly(const ImageSetInfo& info, const std::vector<PosedImage>& images, Backen
   while (const auto w = planner.next()) {
     // The UAV's part: fly to w, hover, take the image; here, look it up in the folder.
     const PosedImage& shot = find_image(images, w->waypoint.position, s.tolerance_m);
-    if (std::abs(shot.yaw_deg) > 1.0)
-      throw std::invalid_argument(shot.file + ": yaw " + ex::fmt(shot.yaw_deg, 1) +
-                                  " deg; the planner's footprints assume the camera's x axis along the field's x");
     cv::Mat rgb;
     if (fs::is_regular_file(s.images / "rgb" / shot.file)) {
       rgb = cv::imread((s.images / "rgb" / shot.file).string(), cv::IMREAD_COLOR);
       if (rgb.empty()) fail(s.images / "rgb" / shot.file, "cannot decode image");
     }
-    adaptseg::Image image = planner.image_at(shot.pose, rgb);  // the pose measured, not the one planned
+    adaptseg::Image image = planner.image_at(shot.pose, rgb, shot.yaw_deg);  // the pose measured, not the one planned
     const fs::path labels_file = s.images / "labels" / shot.file;
     if (fs::is_regular_file(labels_file)) {
       image.ground_truth = cv::imread(labels_file.string(), cv::IMREAD_UNCHANGED);
@@ -332,11 +335,18 @@ int main(int argc, char** argv) {
   fs::path model_file, erfnet_dir;
   std::string record_from, strategy = "adaptive", segmenter = "oracle";
   std::optional<double> budget_s, seg_time_s, plan_time_s;
+  double record_yaw_deg = 0.0;
   app.add_option("--images", s.images, "folder of posed images (area.yaml, poses.csv, rgb/, labels/)")->required();
   app.add_option("--model", model_file, "decision model from adaptseg_calibrate")->required();
-  app.add_option("--record-from", record_from,
+  CLI::Option* record = app.add_option("--record-from", record_from,
                  "instead of flying: capture, in simulation, every waypoint the planner may ask for over this "
                  "field (DIR or DIR:x0,y0,x1,y1) into --images");
+  app.add_option("--record-yaw", record_yaw_deg,
+                 "with --record-from: the camera's yaw [deg, counter-clockwise from the field's x axis] in every "
+                 "recorded image (the planner fuses each image at its recorded yaw)")
+      ->check(CLI::Range(-360.0, 360.0))
+      ->needs(record)
+      ->capture_default_str();
   app.add_option("--strategy", strategy, "decision policy")
       ->check(CLI::IsMember({"adaptive", "nonadaptive", "tour", "linear"}))
       ->capture_default_str();
@@ -364,7 +374,7 @@ int main(int argc, char** argv) {
       adaptseg::DecisionFunction df = model.decision_function;
       const adaptseg::AdaptivePlanner planner(adaptseg::SurveyArea::of(field), oracle, df, o);
       const auto waypoints = planner.reachable_waypoints();
-      write_image_set(s.images, field, model, waypoints);
+      write_image_set(s.images, field, model, waypoints, record_yaw_deg);
       std::printf("%s: recorded %zu images (%zu top-level, %zu for the descents) -> %s\n", field.name().c_str(),
                   waypoints.size(), planner.top_level().size(), waypoints.size() - planner.top_level().size(),
                   s.images.string().c_str());

@@ -7,6 +7,8 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <limits>
+#include <map>
 #include <utility>
 
 using namespace adaptseg;
@@ -475,6 +477,11 @@ TEST_CASE("AdaptivePlanner: report() refuses a missing, repeated or malformed im
   CHECK_THROWS_WITH_AS((void)planner.report(first, -1.0), doctest::Contains("elapsed_s"), std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)planner.image_at(w->waypoint.position, cv::Mat(10, 10, CV_8UC3)),
                        doctest::Contains("rgb must be CV_8UC3 of the camera's size"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)planner.image_at(w->waypoint.position, {}, std::numeric_limits<double>::quiet_NaN()),
+                       doctest::Contains("yaw_deg must be finite"), std::invalid_argument);
+  Image lost = first;
+  lost.yaw_deg = std::numeric_limits<double>::infinity();
+  CHECK_THROWS_WITH_AS((void)planner.report(lost), doctest::Contains("yaw_deg must be finite"), std::invalid_argument);
   // A refused report changes nothing: the waypoint is still pending.
   CHECK(planner.pending().has_value());
   const PlannerStep step = planner.report(first);
@@ -530,6 +537,38 @@ TEST_CASE("AdaptivePlanner: live images made from poses land where the simulator
     CHECK(live.footprint_px == sim.footprint_px);
     CHECK(live.gsd_cm == doctest::Approx(sim.gsd_cm));
   }
+}
+
+TEST_CASE("AdaptivePlanner: a camera that does not hold the plan's heading is fused at its yaw") {
+  const Field f = Field::load(t::example_field("weedmap-000"));
+  OracleSegmenter oracle(f.num_classes());
+  const Scripted twice{.gsd = 2.0, .which = {0, 2}};
+  // upright: images at yaw 0; turned: the same waypoints, each image taken at yaw 180 (its
+  // labels upside down); askew: at 25 deg.
+  std::map<double, cv::Mat> maps;
+  for (double yaw : {0.0, 180.0, 25.0}) {
+    CAPTURE(yaw);
+    Scripted policy = twice;
+    Planner planner(SurveyArea::of(f), oracle, policy, weedmap_options(f));
+    const SimulatedSensor sensor(f, planner.camera());
+    while (const auto w = planner.next()) {
+      const Image sim = sensor.capture(w->waypoint, yaw);
+      Image live = planner.image_at(w->waypoint.position, sim.rgb, yaw);
+      CHECK(live.yaw_deg == yaw);
+      CHECK(live.footprint_px == sim.footprint_px);
+      live.ground_truth = sim.ground_truth;
+      (void)planner.report(live);
+    }
+    CHECK(policy.observed == 2);
+    maps[yaw] = planner.map().labels().clone();
+  }
+  CHECK(cv::countNonZero(maps[180.0] != maps[0.0]) == 0);
+  // Askew, the turned landscape footprints leave gaps and overlap elsewhere; where both maps
+  // are observed they agree but for nearest-neighbour edges.
+  const cv::Mat both = (maps[0.0] != f.ignore_label()) & (maps[25.0] != f.ignore_label());
+  const int agree = cv::countNonZero((maps[0.0] == maps[25.0]) & both);
+  CHECK(cv::countNonZero(both) > 0.8 * cv::countNonZero(maps[0.0] != f.ignore_label()));
+  CHECK(agree > 0.9 * cv::countNonZero(both));
 }
 
 TEST_CASE("AdaptivePlanner: a survey area without a mask covers the rectangle") {

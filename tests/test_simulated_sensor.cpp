@@ -4,6 +4,8 @@
 
 #include <doctest/doctest.h>
 
+#include <limits>
+
 using namespace adaptseg;
 namespace t = adaptseg::test;
 
@@ -17,6 +19,40 @@ TEST_CASE("sensor: at the orthomosaic's GSD the image is the orthomosaic crop") 
   CHECK(img.height_px == 360);
   CHECK(cv::countNonZero(img.ground_truth != f.labels()(img.footprint_px)) == 0);
   CHECK(img.rgb.empty());  // the field has no RGB
+}
+
+TEST_CASE("sensor: a turned camera cuts its footprint out in its own orientation") {
+  cv::Mat rgb(900, 1300, CV_8UC3);
+  cv::randu(rgb, 0, 256);
+  const Field blobs = t::blob_field(1300, 900, 1.0);
+  const Field f("turned", 1.0, blobs.labels(), t::soil_crop_weed(), {1}, 255, rgb);
+  const SimulatedSensor sensor(f, CameraModel{});
+  // Footprint (400, 200, 480, 360) on the map grid: x 4.0..8.8 m, y 3.4..7.0 m (rows run down).
+  const Waypoint w{{6.4, 5.2, 10.0}, 1.0, {4.0, 3.4, 8.8, 7.0}};
+  const Image upright = sensor.capture(w);
+  REQUIRE(upright.footprint_px == cv::Rect(400, 200, 480, 360));
+  // A half turn: the same pixels, upside down (labels and, at the orthomosaic's GSD, colour).
+  const Image half = sensor.capture(w, 180.0);
+  CHECK(half.yaw_deg == 180.0);
+  CHECK(half.footprint_px == upright.footprint_px);
+  cv::Mat flipped;
+  cv::flip(upright.ground_truth, flipped, -1);
+  CHECK(cv::countNonZero(half.ground_truth != flipped) == 0);
+  cv::flip(upright.rgb, flipped, -1);
+  CHECK(cv::norm(half.rgb, flipped, cv::NORM_INF) == 0.0);
+  // A quarter turn counter-clockwise: the image's x axis runs up the map, its rows to the
+  // right; camera pixel (c, r) sees map pixel (column 460 + r, row 619 - c).
+  const Image quarter = sensor.capture(w, 90.0);
+  REQUIRE(quarter.ground_truth.size() == cv::Size(480, 360));
+  int differ = 0;
+  for (int r = 0; r < 360; ++r)
+    for (int c = 0; c < 480; ++c) {
+      differ += quarter.ground_truth.at<std::uint8_t>(r, c) != f.labels().at<std::uint8_t>(619 - c, 460 + r);
+      differ += quarter.rgb.at<cv::Vec3b>(r, c) != f.image().at<cv::Vec3b>(619 - c, 460 + r);
+    }
+  CHECK(differ == 0);
+  CHECK_THROWS_WITH_AS((void)sensor.capture(w, std::numeric_limits<double>::infinity()),
+                       doctest::Contains("yaw_deg must be finite"), std::invalid_argument);
 }
 
 TEST_CASE("sensor: footprints of a lawnmower tile the orthomosaic exactly, at any GSD") {

@@ -28,7 +28,7 @@
 namespace adaptseg::examples {
 
 /// Memoises a deterministic backend: a simulated image is identified by its footprint, its
-/// size and its RGB sums. For calibration, which flies the same waypoints many times, and only
+/// yaw, its size and its RGB sums. For calibration, which flies the same waypoints many times, and only
 /// with a fixed segmentation time per image (a cache hit takes no time, so a measured time
 /// would be wrong).
 template <SegmentationBackend Backend>
@@ -39,7 +39,8 @@ class CachedBackend {
   [[nodiscard]] cv::Mat segment(const Image& image) {
     const cv::Scalar sum = image.rgb.empty() ? cv::Scalar() : cv::sum(image.rgb);
     const Key key{image.footprint_px.x, image.footprint_px.y, image.footprint_px.width,
-                  image.footprint_px.height, image.width_px, image.height_px, sum[0], sum[1], sum[2]};
+                  image.footprint_px.height, image.yaw_deg, image.width_px, image.height_px,
+                  sum[0], sum[1], sum[2]};
     const auto it = cache_.find(key);
     if (it != cache_.end()) return it->second.clone();
     cv::Mat labels = inner_.segment(image);
@@ -48,7 +49,7 @@ class CachedBackend {
   }
 
  private:
-  using Key = std::tuple<int, int, int, int, int, int, double, double, double>;
+  using Key = std::tuple<int, int, int, int, double, int, int, double, double, double>;
   Backend& inner_;
   std::map<Key, cv::Mat> cache_;
 };

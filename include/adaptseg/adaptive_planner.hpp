@@ -188,13 +188,13 @@ class AdaptivePlanner {
 
   /// Reports the image taken at the pending waypoint with its segmentation `labels`, which
   /// took `segmentation_s` [s] (ignored when the options fix a segmentation time). The image's
-  /// pose (`position`, `footprint_px`) is what gets fused: the waypoint's, or the one the UAV
-  /// measured (see image_at()). `elapsed_s`: the mission time [s] the caller measured up to
-  /// now (flight, segmentation, planning), used for the budget instead of the planner's own
-  /// account. Nothing changes when it throws: the waypoint stays pending.
+  /// pose (`position`, `footprint_px`, `yaw_deg`) is what gets fused: the waypoint's, or the
+  /// one the UAV measured (see image_at()). `elapsed_s`: the mission time [s] the caller
+  /// measured up to now (flight, segmentation, planning), used for the budget instead of the
+  /// planner's own account. Nothing changes when it throws: the waypoint stays pending.
   /// @throws std::invalid_argument if no waypoint is pending (next() not called, or its image
   ///         already reported), for an image that is not of the camera's size or has no
-  ///         footprint, labels that break the segmentation contract (check_segmentation()),
+  ///         footprint or a yaw that is not finite, labels that break the segmentation contract (check_segmentation()),
   ///         or a time that is negative or not finite.
   PlannerStep report(const Image& image, const cv::Mat& labels, double segmentation_s,
                      std::optional<double> elapsed_s = std::nullopt) {
@@ -206,14 +206,15 @@ class AdaptivePlanner {
   }
 
   /// The Image of a camera frame `rgb` (CV_8UC3 of the camera's size, or empty) taken at
-  /// `pose`: x, y [m] in the field frame, z the altitude above ground [m]. Nadir camera with
-  /// its image x axis along the field's x axis (the plan's yaw); the GSD follows from the
-  /// altitude, the footprint is centred under the camera and snapped to map pixels, as
-  /// SimulatedSensor does.
-  /// @throws std::invalid_argument for a pose that is not finite or an altitude <= 0, and an
-  ///         RGB image of another size or type.
-  [[nodiscard]] Image image_at(const Eigen::Vector3d& pose, cv::Mat rgb = {}) const {
+  /// `pose`: x, y [m] in the field frame, z the altitude above ground [m]. Nadir camera whose
+  /// image x axis is turned `yaw_deg` counter-clockwise from the field's x axis (Image::yaw_deg;
+  /// 0: the plan's heading); the GSD follows from the altitude, the footprint is centred under
+  /// the camera, snapped to map pixels as SimulatedSensor does, and turned by the yaw when fused.
+  /// @throws std::invalid_argument for a pose or yaw that is not finite or an altitude <= 0,
+  ///         and an RGB image of another size or type.
+  [[nodiscard]] Image image_at(const Eigen::Vector3d& pose, cv::Mat rgb = {}, double yaw_deg = 0.0) const {
     detail::require(pose.allFinite(), "AdaptivePlanner::image_at: the pose must be finite", pose.transpose());
+    detail::require(std::isfinite(yaw_deg), "AdaptivePlanner::image_at: yaw_deg must be finite", yaw_deg);
     detail::require(rgb.empty() || (rgb.type() == CV_8UC3 && rgb.cols == camera_.width_px() &&
                                     rgb.rows == camera_.height_px()),
                     "AdaptivePlanner::image_at: rgb must be CV_8UC3 of the camera's size " +
@@ -229,6 +230,7 @@ class AdaptivePlanner {
     const Extent fp = camera_.footprint_at_gsd(img.gsd_cm);
     img.footprint_px = pixel_rect({pose.x() - 0.5 * fp.width_m, pose.y() - 0.5 * fp.height_m,
                                    pose.x() + 0.5 * fp.width_m, pose.y() + 0.5 * fp.height_m});
+    img.yaw_deg = yaw_deg;
     return img;
   }
 
@@ -434,6 +436,8 @@ class AdaptivePlanner {
     detail::require(image.footprint_px.width > 0 && image.footprint_px.height > 0 && image.gsd_cm > 0.0,
                     "AdaptivePlanner::report: the image has no footprint (make it with image_at())",
                     image.gsd_cm);
+    detail::require(std::isfinite(image.yaw_deg), "AdaptivePlanner::report: the image's yaw_deg must be finite",
+                    image.yaw_deg);
     if (elapsed_s)
       detail::require(std::isfinite(*elapsed_s) && *elapsed_s >= 0.0,
                       "AdaptivePlanner::report: elapsed_s must be finite and >= 0", *elapsed_s);

@@ -45,17 +45,77 @@ struct Image {
   /// network wants RGB swaps the channels itself (ErfnetSegmenter does, from its model file).
   cv::Mat rgb;
   /// Simulation only: the orthomosaic's labels under the footprint at the orthomosaic's
-  /// resolution (CV_8UC1, ignore label outside the orthomosaic); empty in live use.
+  /// resolution, in the camera's orientation (CV_8UC1 of the footprint's size: row r, column c
+  /// is the orthomosaic pixel under point (c + 0.5, r + 0.5) of FootprintFrame; the ignore
+  /// label outside the orthomosaic); empty in live use.
   cv::Mat ground_truth;
-  /// Orthomosaic pixels seen by the camera (may extend beyond the orthomosaic): camera
-  /// pixel (u, v) covers the part (u, v) of a uniform I_w x I_h grid over this rectangle.
+  /// Orthomosaic pixels seen by the camera at yaw 0 (may extend beyond the orthomosaic):
+  /// camera pixel (u, v) covers the part (u, v) of a uniform I_w x I_h grid over this
+  /// rectangle, turned by `yaw_deg` about its centre (FootprintFrame).
   cv::Rect footprint_px;
+  /// The camera's heading [deg]: the angle from the field's x axis to the image's x axis (its
+  /// columns, u), counter-clockwise seen from above (field frame: x along the orthomosaic's
+  /// columns, y up its rows). 0: image x along field x, as the planners fly every waypoint.
+  double yaw_deg = 0.0;
   /// Where the image was taken: x, y [m] field frame, z altitude [m].
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   double gsd_cm = 0.0;    ///< [cm/px]
   int width_px = 0;       ///< I_w
   int height_px = 0;      ///< I_h
   int ignore_label = 255; ///< label for "no class" in ground_truth and in segmentations
+};
+
+/// Where a camera frame lies on the map grid: footprint coordinates (a, b) [map px] from the
+/// top-left corner of the frame's yaw-0 footprint (a along the image's columns, b down its rows)
+/// and map-pixel coordinates (x, y) [px] (x along the map's columns, y down its rows; pixel
+/// (i, j) spans [i, i + 1) x [j, j + 1)), related by a turn of `yaw_deg` about the footprint's
+/// centre. At yaw 0 the two frames differ by the footprint's offset only.
+class FootprintFrame {
+ public:
+  /// @throws std::invalid_argument for an empty footprint or a yaw that is not finite.
+  explicit FootprintFrame(const Image& image) : rect_(image.footprint_px) {
+    detail::require(rect_.width > 0 && rect_.height > 0, "FootprintFrame: the image has no footprint",
+                    rect_.width * rect_.height);
+    detail::require(std::isfinite(image.yaw_deg), "FootprintFrame: yaw_deg must be finite", image.yaw_deg);
+    const double r = std::remainder(image.yaw_deg, 360.0) * (3.14159265358979323846 / 180.0);
+    cos_ = std::cos(r);
+    sin_ = std::sin(r);
+    // Quarter turns exactly: no 1e-16 residue may move a pixel centre across a pixel edge.
+    if (std::abs(cos_) < 1e-12) cos_ = 0.0;
+    if (std::abs(sin_) < 1e-12) sin_ = 0.0;
+    cx_ = rect_.x + 0.5 * rect_.width;
+    cy_ = rect_.y + 0.5 * rect_.height;
+  }
+
+  /// Footprint point (a, b) in map-pixel coordinates. The image's x axis (cos ψ, sin ψ) in the
+  /// field frame is (cos ψ, -sin ψ) on the map grid, whose rows run down (field -y).
+  [[nodiscard]] cv::Point2d to_map(double a, double b) const noexcept {
+    const double da = a - 0.5 * rect_.width, db = b - 0.5 * rect_.height;
+    return {cx_ + cos_ * da + sin_ * db, cy_ - sin_ * da + cos_ * db};
+  }
+  /// Map-pixel point (x, y) in footprint coordinates (the inverse of to_map()).
+  [[nodiscard]] cv::Point2d to_footprint(double x, double y) const noexcept {
+    const double dx = x - cx_, dy = y - cy_;
+    return {0.5 * rect_.width + cos_ * dx - sin_ * dy, 0.5 * rect_.height + sin_ * dx + cos_ * dy};
+  }
+  /// The map pixels whose centres the turned footprint may cover (its bounding box, one pixel
+  /// of margin for rounding); the footprint itself at yaw 0.
+  [[nodiscard]] cv::Rect bounds() const {
+    if (cos_ == 1.0) return rect_;
+    double x0 = cx_, x1 = cx_, y0 = cy_, y1 = cy_;
+    const double w = rect_.width, h = rect_.height;
+    for (const cv::Point2d& corner : {cv::Point2d(0, 0), cv::Point2d(w, 0), cv::Point2d(0, h), cv::Point2d(w, h)}) {
+      const cv::Point2d p = to_map(corner.x, corner.y);
+      x0 = std::min(x0, p.x), x1 = std::max(x1, p.x), y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
+    }
+    const int c0 = static_cast<int>(std::floor(x0)) - 1, r0 = static_cast<int>(std::floor(y0)) - 1;
+    return {c0, r0, static_cast<int>(std::ceil(x1)) + 1 - c0, static_cast<int>(std::ceil(y1)) + 1 - r0};
+  }
+  [[nodiscard]] bool turned() const noexcept { return cos_ != 1.0; }
+
+ private:
+  cv::Rect rect_;
+  double cos_ = 1.0, sin_ = 0.0, cx_ = 0.0, cy_ = 0.0;
 };
 
 /// Checks a segmentation of `image` against the contract of segmentation_backend.hpp: a

@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <cmath>
 #include <limits>
 
 namespace adaptseg {
@@ -29,15 +30,19 @@ class SemanticMap {
   }
 
   /// Fuses the segmentation `labels` (I_h x I_w, CV_8UC1) of `image` into the map: each
-  /// camera pixel is spread over the orthomosaic pixels it covers (nearest neighbour) and
-  /// written where the image's GSD is at least as fine as what the map holds. Camera pixels
-  /// with the image's ignore label write nothing.
-  /// @throws std::invalid_argument if `labels` does not match the image's size or type.
+  /// camera pixel is spread over the orthomosaic pixels it covers (nearest neighbour: the
+  /// pixels whose centre it covers) and written where the image's GSD is at least as fine as
+  /// what the map holds. Camera pixels with the image's ignore label write nothing. A camera
+  /// turned by `image.yaw_deg` writes its turned footprint (FootprintFrame).
+  /// @throws std::invalid_argument if `labels` does not match the image's size or type, or the
+  ///         image has no footprint or a yaw that is not finite.
   void fuse(const Image& image, const cv::Mat& labels) {
     detail::require(labels.type() == CV_8UC1 && labels.cols == image.width_px &&
                         labels.rows == image.height_px,
                     "SemanticMap::fuse: labels must be CV_8UC1 of the image's size",
                     std::to_string(labels.cols) + "x" + std::to_string(labels.rows));
+    const FootprintFrame frame(image);
+    if (frame.turned()) return fuse_turned(image, frame, labels);
     const cv::Rect fp = image.footprint_px;
     const cv::Rect inside = fp & cv::Rect(0, 0, labels_.cols, labels_.rows);
     if (inside.area() == 0) return;
@@ -57,6 +62,28 @@ class SemanticMap {
   [[nodiscard]] int unknown_label() const noexcept { return unknown_; }
 
  private:
+  /// fuse() of a turned camera: each map pixel whose centre the footprint covers takes the
+  /// camera pixel over that centre.
+  void fuse_turned(const Image& image, const FootprintFrame& frame, const cv::Mat& labels) {
+    const cv::Rect inside = frame.bounds() & cv::Rect(0, 0, labels_.cols, labels_.rows);
+    const double su = image.width_px / static_cast<double>(image.footprint_px.width);
+    const double sv = image.height_px / static_cast<double>(image.footprint_px.height);
+    const auto gsd = static_cast<float>(image.gsd_cm);
+    for (int y = inside.y; y < inside.y + inside.height; ++y) {
+      auto* out = labels_.ptr<unsigned char>(y);
+      auto* held = gsd_.ptr<float>(y);
+      for (int x = inside.x; x < inside.x + inside.width; ++x) {
+        const cv::Point2d f = frame.to_footprint(x + 0.5, y + 0.5);
+        const double u = std::floor(f.x * su), v = std::floor(f.y * sv);
+        if (u < 0.0 || v < 0.0 || u >= image.width_px || v >= image.height_px) continue;
+        const unsigned char l = labels.at<unsigned char>(static_cast<int>(v), static_cast<int>(u));
+        if (l == image.ignore_label || held[x] < gsd) continue;
+        out[x] = l;
+        held[x] = gsd;
+      }
+    }
+  }
+
   cv::Mat labels_;
   cv::Mat gsd_;
   int unknown_;

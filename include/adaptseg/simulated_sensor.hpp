@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 
 namespace adaptseg {
@@ -34,11 +35,14 @@ class SimulatedSensor {
   [[nodiscard]] const Field& field() const noexcept { return field_; }
   [[nodiscard]] const CameraModel& camera() const noexcept { return camera_; }
 
-  /// The image taken at waypoint `w`.
+  /// The image taken at waypoint `w`, the camera turned by `yaw_deg` (Image::yaw_deg; the
+  /// planners fly 0): the footprint's orthomosaic pixels are cut out in the camera's
+  /// orientation (nearest neighbour: each footprint-grid point takes the orthomosaic pixel it
+  /// lies in), the colour then resampled as at yaw 0.
   /// @throws std::invalid_argument if the waypoint's GSD is finer than the orthomosaic's
   ///         (the simulator would have to invent detail), its footprint is empty, or the
-  ///         footprint exceeds kMaxFootprintPixels.
-  [[nodiscard]] Image capture(const Waypoint& w) const {
+  ///         footprint exceeds kMaxFootprintPixels, or for a yaw that is not finite.
+  [[nodiscard]] Image capture(const Waypoint& w, double yaw_deg = 0.0) const {
     detail::require(w.gsd_cm >= field_.gsd_cm() * (1.0 - 1e-9),
                     "SimulatedSensor::capture: waypoint GSD [cm/px] is finer than the field's " +
                         std::to_string(field_.gsd_cm()) + " cm/px",
@@ -60,9 +64,15 @@ class SimulatedSensor {
     img.footprint_px = field_.pixel_rect(w.footprint);
     detail::require(img.footprint_px.width > 0 && img.footprint_px.height > 0,
                     "SimulatedSensor::capture: footprint covers no orthomosaic pixel", w.gsd_cm);
-    img.ground_truth = crop(field_.labels(), img.footprint_px, cv::Scalar(field_.ignore_label()));
+    img.yaw_deg = yaw_deg;
+    const FootprintFrame frame(img);
+    const auto cut = [&](const cv::Mat& src, const cv::Scalar& fill) {
+      return frame.turned() ? crop_turned(src, frame, img.footprint_px.size(), fill)
+                            : crop(src, img.footprint_px, fill);
+    };
+    img.ground_truth = cut(field_.labels(), cv::Scalar(field_.ignore_label()));
     if (field_.has_image()) {
-      const cv::Mat rgb = crop(field_.image(), img.footprint_px, cv::Scalar(0, 0, 0));
+      const cv::Mat rgb = cut(field_.image(), cv::Scalar(0, 0, 0));
       cv::resize(rgb, img.rgb, cv::Size(img.width_px, img.height_px), 0, 0, cv::INTER_AREA);
     }
     return img;
@@ -74,6 +84,24 @@ class SimulatedSensor {
     cv::Mat out(rect.size(), src.type(), fill);
     const cv::Rect inside = rect & cv::Rect(0, 0, src.cols, src.rows);
     if (inside.area() > 0) src(inside).copyTo(out(inside - rect.tl()));
+    return out;
+  }
+
+  /// The footprint grid of `frame` (`size` points, row by row) cut out of `src` (8-bit, one or
+  /// three channels): each point takes the pixel of `src` it lies in, `fill` outside `src`.
+  static cv::Mat crop_turned(const cv::Mat& src, const FootprintFrame& frame, cv::Size size, const cv::Scalar& fill) {
+    cv::Mat out(size, src.type(), fill);
+    const auto bytes = src.elemSize();
+    for (int r = 0; r < size.height; ++r) {
+      auto* dst = out.ptr<unsigned char>(r);
+      for (int c = 0; c < size.width; ++c) {
+        const cv::Point2d p = frame.to_map(c + 0.5, r + 0.5);
+        const double x = std::floor(p.x), y = std::floor(p.y);
+        if (x < 0.0 || y < 0.0 || x >= src.cols || y >= src.rows) continue;
+        const auto* px = src.ptr<unsigned char>(static_cast<int>(y)) + static_cast<std::size_t>(x) * bytes;
+        std::copy(px, px + bytes, dst + static_cast<std::size_t>(c) * bytes);
+      }
+    }
     return out;
   }
 

@@ -64,6 +64,9 @@ adaptseg_live)
   expect_error "decision model was calibrated for classes [soil, crop, weed] but field 'dubai-tile-1' has" \
     --images "$work/images" --model "$weedmap_model" --record-from "$dubai"
   expect_error "area.yaml" --images "$work/none" --model "$weedmap_model"
+  expect_error "--record-yaw requires --record-from" --images "$work/images" --model "$weedmap_model" --record-yaw 30
+  expect_error "--record-yaw: Value 400 not in range" --images "$work/images" --model "$weedmap_model" \
+    --record-from "$weedmap" --record-yaw 400
   ;;
 *)
   fail "unknown program $program"

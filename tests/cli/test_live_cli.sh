@@ -52,6 +52,42 @@ limited = json.load(open(f"{work}/live-linear-budget/result.json"))
 assert limited["decisions"]["budget_limited"] > 0 and limited["time_s"]["total"] <= 45 + 1e-9, limited["decisions"]
 PY
 
+# A camera that does not hold the plan's heading: the same waypoints recorded with the camera
+# turned half a turn (every image and its labels upside down) fly the same mission to the same
+# map; turned 30 deg, the images are fused turned (the map differs at the footprints' edges).
+for yaw in 180 30; do
+  "$live" --record-from "$region" --model "$work/model.yaml" --images "$work/images-$yaw" --record-yaw $yaw \
+    >/dev/null || fail "recording at yaw $yaw"
+  grep -q ",$yaw\$" "$work/images-$yaw/poses.csv" || fail "yaw $yaw not in poses.csv: $(sed -n 2p "$work/images-$yaw/poses.csv")"
+  "$live" --images "$work/images-$yaw" --model "$work/model.yaml" --strategy adaptive "${times[@]}" \
+    --out "$work/live-yaw$yaw" >/dev/null || fail "live at yaw $yaw"
+done
+"$python" - "$work" <<'PY' || fail "turned cameras"
+import json, sys
+import cv2
+work = sys.argv[1]
+upright = json.load(open(f"{work}/live-adaptive/result.json"))
+upright_map = cv2.imread(f"{work}/live-adaptive/map.png")
+for yaw in ["180", "30"]:
+    turned = json.load(open(f"{work}/live-yaw{yaw}/result.json"))
+    assert [(w["x"], w["y"], w["z"]) for w in turned["waypoints"]] == \
+        [(w["x"], w["y"], w["z"]) for w in upright["waypoints"]], yaw
+    differ = (cv2.imread(f"{work}/live-yaw{yaw}/map.png") != upright_map).any(axis=2).mean()
+    print(f"yaw {yaw}: {turned['images']} images, decisions {turned['decisions']}, map pixels differing {differ:.4f}")
+    if yaw == "180":
+        assert differ == 0.0 and turned["decisions"] == upright["decisions"], (differ, turned["decisions"])
+        for a, b in zip(turned["waypoints"], upright["waypoints"]):
+            assert abs(a["semantic_ratio"] - b["semantic_ratio"]) < 1e-12, (a, b)
+    else:
+        assert 0.0 < differ < 0.1, differ
+PY
+# A yaw that is no number: one error line naming the line, exit code 2.
+sed -i '3s/,30$/,nan/' "$work/images-30/poses.csv"
+"$live" --images "$work/images-30" --model "$work/model.yaml" "${times[@]}" >/dev/null 2>"$work/err"
+rc=$?
+[ "$rc" -eq 2 ] && [ "$(wc -l <"$work/err")" -eq 1 ] && grep -qF "line 3 is not file,x,y,z[,yaw_deg]" "$work/err" ||
+  fail "yaw nan: exit code $rc, $(cat "$work/err")"
+
 # A folder without the image of a requested waypoint: one error line, exit code 2.
 sed -i '2d' "$work/images/poses.csv"  # the first top-level waypoint's image
 "$live" --images "$work/images" --model "$work/model.yaml" "${times[@]}" >/dev/null 2>"$work/err"
