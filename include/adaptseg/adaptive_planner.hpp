@@ -194,8 +194,8 @@ class AdaptivePlanner {
   /// planner's own account. Nothing changes when it throws: the waypoint stays pending.
   /// @throws std::invalid_argument if no waypoint is pending (next() not called, or its image
   ///         already reported), for an image that is not of the camera's size or has no
-  ///         footprint or a yaw that is not finite, labels that break the segmentation contract (check_segmentation()),
-  ///         or a time that is negative or not finite.
+  ///         footprint or a yaw that is not finite, labels that break the segmentation
+  ///         contract (check_segmentation()), or a time that is negative or not finite.
   PlannerStep report(const Image& image, const cv::Mat& labels, double segmentation_s,
                      std::optional<double> elapsed_s = std::nullopt) {
     check_report(image, elapsed_s);
