@@ -15,11 +15,13 @@
 //
 // The folder (docs/method.md, "Live use"): DIR/area.yaml (area, map GSD, classes, labels of
 // interest, camera), DIR/valid_mask.png (where the field is), DIR/poses.csv
-// (file,x,y,z,yaw_deg; yaw counter-clockwise from the field's x axis), and per image DIR/rgb/FILE (the camera image) and/or DIR/labels/FILE
-// (ground-truth labels under the footprint at map resolution, for --segmenter oracle).
+// (file,x,y,z,yaw_deg; yaw counter-clockwise from the field's x axis), and per image
+// DIR/rgb/FILE (the camera image) and/or DIR/labels/FILE (ground-truth labels under the
+// footprint at map resolution, in the camera's orientation, for --segmenter oracle).
 // --segmenter erfnet segments the RGB images with the ERFNet model of --model-file.
 //
-// Writes OUT/result.json (the path, σ and decisions) and OUT/map.png (the fused map).
+// Writes OUT/result.json (the path with each image and its yaw, σ and decisions) and OUT/map.png
+// (the fused map).
 
 #include "common/strategies.hpp"
 
@@ -240,7 +242,8 @@ void fly(const ImageSetInfo& info, const std::vector<PosedImage>& images, Backen
       rgb = cv::imread((s.images / "rgb" / shot.file).string(), cv::IMREAD_COLOR);
       if (rgb.empty()) fail(s.images / "rgb" / shot.file, "cannot decode image");
     }
-    adaptseg::Image image = planner.image_at(shot.pose, rgb, shot.yaw_deg);  // the pose measured, not the one planned
+    // The pose and heading measured, not the ones planned.
+    adaptseg::Image image = planner.image_at(shot.pose, rgb, shot.yaw_deg);
     const fs::path labels_file = s.images / "labels" / shot.file;
     if (fs::is_regular_file(labels_file)) {
       image.ground_truth = cv::imread(labels_file.string(), cv::IMREAD_UNCHANGED);
@@ -256,6 +259,7 @@ void fly(const ImageSetInfo& info, const std::vector<PosedImage>& images, Backen
                 p.x(), p.y(), p.z(), shot.file.c_str(), step.sigma);
     nlohmann::json wj{{"x", p.x()},       {"y", p.y()},          {"z", p.z()},
                       {"gsd_cm", w->waypoint.gsd_cm}, {"level", w->level}, {"image", shot.file},
+                      {"yaw_deg", shot.yaw_deg},
                       {"semantic_ratio", step.sigma}};
     if (step.decision) {
       const auto& d = step.decision->decision;
@@ -338,9 +342,10 @@ int main(int argc, char** argv) {
   double record_yaw_deg = 0.0;
   app.add_option("--images", s.images, "folder of posed images (area.yaml, poses.csv, rgb/, labels/)")->required();
   app.add_option("--model", model_file, "decision model from adaptseg_calibrate")->required();
-  CLI::Option* record = app.add_option("--record-from", record_from,
-                 "instead of flying: capture, in simulation, every waypoint the planner may ask for over this "
-                 "field (DIR or DIR:x0,y0,x1,y1) into --images");
+  CLI::Option* record =
+      app.add_option("--record-from", record_from,
+                     "instead of flying: capture, in simulation, every waypoint the planner may ask for over this "
+                     "field (DIR or DIR:x0,y0,x1,y1) into --images");
   app.add_option("--record-yaw", record_yaw_deg,
                  "with --record-from: the camera's yaw [deg, counter-clockwise from the field's x axis] in every "
                  "recorded image (the planner fuses each image at its recorded yaw)")

@@ -28,9 +28,9 @@
 namespace adaptseg::examples {
 
 /// Memoises a deterministic backend: a simulated image is identified by its footprint, its
-/// yaw, its size and its RGB sums. For calibration, which flies the same waypoints many times, and only
-/// with a fixed segmentation time per image (a cache hit takes no time, so a measured time
-/// would be wrong).
+/// yaw, its size and its RGB sums. For calibration, which flies the same waypoints many times,
+/// and only with a fixed segmentation time per image (a cache hit takes no time, so a measured
+/// time would be wrong).
 template <SegmentationBackend Backend>
 class CachedBackend {
  public:

@@ -72,6 +72,7 @@ for yaw in ["180", "30"]:
     turned = json.load(open(f"{work}/live-yaw{yaw}/result.json"))
     assert [(w["x"], w["y"], w["z"]) for w in turned["waypoints"]] == \
         [(w["x"], w["y"], w["z"]) for w in upright["waypoints"]], yaw
+    assert all(w["yaw_deg"] == float(yaw) for w in turned["waypoints"]), yaw
     differ = (cv2.imread(f"{work}/live-yaw{yaw}/map.png") != upright_map).any(axis=2).mean()
     print(f"yaw {yaw}: {turned['images']} images, decisions {turned['decisions']}, map pixels differing {differ:.4f}")
     if yaw == "180":
