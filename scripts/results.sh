@@ -20,7 +20,7 @@
 # network-held-out: ERFNet on tiles 4 and 6 again, each initialised on the other of the two
 #   alone (the one scene the network never trained on either) instead of the five other tiles:
 #   whether calibrating only where the network is as new to the ground as on the test field makes
-#   better decisions (docs/results.md: it does not). About 8 minutes on 2 cores.
+#   better decisions (docs/results.md: it does not). About 9 minutes on 2 cores.
 # sigma-prior: the defaults' runs flown again with the models `oracle-default` saved, only the
 #   front-aware rule's sigma_prior_weight changed (0.01 and 1; the calibrated models have 0.25):
 #   how much the prior on the field's share of L holds the forecasts back (docs/results.md,
