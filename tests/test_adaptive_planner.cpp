@@ -240,6 +240,94 @@ TEST_CASE("adaptive planner (tour): each descent flown at once or after the surv
   }
 }
 
+TEST_CASE("adaptive planner (row): a row's neighbouring descents share one descent and one climb, as costed") {
+  // 30 x 22 m, 2 rows of 3 regions at 3 cm/px, descents to 1 cm/px (11 m lower) with a climb
+  // rate of 0.25 m/s (44 s for 11 m): climbing back between two neighbouring regions costs more
+  // than flying back along the row at low altitude, so staying low pays.
+  const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
+  OracleSegmenter oracle(f.num_classes());
+  AdaptiveOptions o = options();
+  o.candidate_gsd_cm = {1.0};
+  o.mission.timing.max_vertical_speed_mps = 0.25;
+  Scripted never{.gsd = 0.5};
+  const AdaptiveResult base = run_adaptive_mission(f, oracle, never, o, "never");
+  const double coverage = base.mission.total_s();
+  const auto fly = [&](DescentSchedule schedule) {
+    AdaptiveOptions a = o;
+    a.schedule = schedule;
+    Scripted all{.gsd = 1.0};
+    return run_adaptive_mission(f, oracle, all, a, "all");
+  };
+  const AdaptiveResult now = fly(DescentSchedule::immediate);
+  const AdaptiveResult row = fly(DescentSchedule::row);
+  REQUIRE(row.descents() == static_cast<int>(row.decisions.size()));
+  CHECK(row.mission.miou_all().value() == 1.0);
+
+  // The rows of the top level (rows run along x) and where each ends.
+  std::vector<Eigen::Vector3d> top;
+  for (const auto& w : base.mission.waypoints) top.push_back(w.waypoint.position);
+  const auto row_ends = [&](std::size_t i) { return i + 1 == top.size() || top[i + 1].y() != top[i].y(); };
+  REQUIRE(top.size() >= 4);
+  std::size_t rows = 0;
+  for (std::size_t i = 0; i < top.size(); ++i) rows += row_ends(i) ? 1 : 0;
+  REQUIRE(rows >= 2);
+  REQUIRE(rows < top.size());  // some row holds two regions or more
+
+  // Each descent costs the cheaper of at once and deferred to its row's tour (at a row's last
+  // waypoint, once a tour is chosen, always the tour); the mission costs what was charged.
+  double charged = 0.0;
+  std::size_t deferred = 0, in_row = 0;
+  for (std::size_t k = 0; k < row.decisions.size(); ++k) {
+    const Candidate& c = row.decisions[k].candidates.at(0);
+    const Candidate& at_once = now.decisions[k].candidates.at(0);
+    CAPTURE(k);
+    if (!row_ends(k) || in_row == 0) {
+      CHECK(c.extra_time_s <= at_once.extra_time_s + 1e-9);
+      CHECK(c.deferred == (c.extra_time_s < at_once.extra_time_s));
+    } else {
+      CHECK(c.deferred);
+    }
+    charged += c.extra_time_s;
+    deferred += c.deferred ? 1 : 0;
+    in_row = row_ends(k) ? 0 : in_row + (c.deferred ? 1 : 0);
+  }
+  CAPTURE(deferred);
+  CHECK(deferred >= 2);
+  CHECK(row.mission.total_s() <= coverage + charged + 1e-9);
+  CHECK(row.mission.total_s() < now.mission.total_s() - 5.0);
+  // Fewer altitude changes: a row's deferred inspections are entered and left once.
+  const auto changes = [](const MissionResult& m) {
+    int n = 0;
+    for (std::size_t k = 1; k < m.waypoints.size(); ++k)
+      n += m.waypoints[k].waypoint.position.z() != m.waypoints[k - 1].waypoint.position.z() ? 1 : 0;
+    return n;
+  };
+  CHECK(changes(row.mission) < changes(now.mission));
+  MESSAGE(top.size(), " regions in ", rows, " rows, every one inspected: at once ", now.mission.total_s(), " s, ",
+          changes(now.mission), " altitude changes; after each row ", row.mission.total_s(), " s, ",
+          changes(row.mission));
+
+  // Path: every sub-lawnmower image is flown before the next row's first top-level image and
+  // lies in a region of the row flown last.
+  std::size_t top_seen = 0, row_first = 0;
+  for (const auto& w : row.mission.waypoints) {
+    if (w.level == 0) {
+      if (top_seen > 0 && row_ends(top_seen - 1)) row_first = top_seen;
+      ++top_seen;
+      continue;
+    }
+    const Eigen::Vector3d& p = w.waypoint.position;
+    bool in_this_row = false;
+    for (std::size_t i = row_first; i < top_seen; ++i) {
+      const Area& a = base.mission.waypoints[i].waypoint.footprint;
+      in_this_row |= p.x() >= a.x_min_m && p.x() <= a.x_max_m && p.y() >= a.y_min_m && p.y() <= a.y_max_m;
+    }
+    CHECK(in_this_row);
+  }
+  // Every descent's outcome reaches the policy (after its row's tour, for the deferred ones).
+  for (std::size_t k = 0; k < row.decisions.size(); ++k) CHECK(row.decisions[k].outcome.has_value());
+}
+
 TEST_CASE("adaptive planner: a climb rate limit is charged exactly, and makes the survey-first tour pay") {
   const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
   OracleSegmenter oracle(f.num_classes());
@@ -287,24 +375,27 @@ TEST_CASE("adaptive planner: a climb rate limit is charged exactly, and makes th
   CHECK(saved_slow > saved_iso + 5.0);
 }
 
-TEST_CASE("adaptive planner (tour): the budget is never exceeded") {
+TEST_CASE("adaptive planner (tour, row): the budget is never exceeded") {
   const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
   OracleSegmenter oracle(f.num_classes());
-  AdaptiveOptions o = options();
-  o.top_gsd_cm = 6.0;
-  o.schedule = DescentSchedule::tour;
-  Scripted never{.gsd = 0.5};
-  const double coverage = run_adaptive_mission(f, oracle, never, o, "never").mission.total_s();
-  Scripted all{.gsd = 1.0};
-  const double everything = run_adaptive_mission(f, oracle, all, o, "all").mission.total_s();
-  REQUIRE(everything > coverage + 100.0);
-  for (double budget : {coverage + 1.0, coverage + 60.0, 0.5 * (coverage + everything), everything - 1.0}) {
-    o.budget_s = budget;
-    Scripted greedy{.gsd = 1.0};
-    const AdaptiveResult r = run_adaptive_mission(f, oracle, greedy, o, "greedy");
-    CAPTURE(budget);
-    CHECK(r.mission.total_s() <= budget + 1e-9);
-    CHECK(greedy.observed == r.descents());
+  for (const DescentSchedule schedule : {DescentSchedule::tour, DescentSchedule::row}) {
+    CAPTURE(to_string(schedule));
+    AdaptiveOptions o = options();
+    o.top_gsd_cm = 6.0;
+    o.schedule = schedule;
+    Scripted never{.gsd = 0.5};
+    const double coverage = run_adaptive_mission(f, oracle, never, o, "never").mission.total_s();
+    Scripted all{.gsd = 1.0};
+    const double everything = run_adaptive_mission(f, oracle, all, o, "all").mission.total_s();
+    REQUIRE(everything > coverage + 100.0);
+    for (double budget : {coverage + 1.0, coverage + 60.0, 0.5 * (coverage + everything), everything - 1.0}) {
+      o.budget_s = budget;
+      Scripted greedy{.gsd = 1.0};
+      const AdaptiveResult r = run_adaptive_mission(f, oracle, greedy, o, "greedy");
+      CAPTURE(budget);
+      CHECK(r.mission.total_s() <= budget + 1e-9);
+      CHECK(greedy.observed == r.descents());
+    }
   }
 }
 

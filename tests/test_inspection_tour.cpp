@@ -147,3 +147,57 @@ TEST_CASE("inspection tour: the planned order is never longer than the insertion
             doctest::Approx(tour_flight_s(timing, start, stops, optimal_tour_order(timing, start, stops))));
   }
 }
+
+TEST_CASE("inspection tour: a tour with a fixed end (a row's tour, up to the next row) prices its last leg") {
+  // From the origin, A at (10, 0) and B at (0, 12) (z = 0): open, A then B (10 + 15.6 m of
+  // legs) beats B then A (12 + 15.6); to an end at (20, 0), B then A (12 + 15.6 + 10) beats
+  // A then B (10 + 15.6 + 23.3): the end turns the order round.
+  const std::vector<TourStop> s{{{10, 0, 0}, {10, 0, 0}, 4.0}, {{0, 12, 0}, {0, 12, 0}, 4.0}};
+  const Eigen::Vector3d start(0, 0, 0), end(20, 0, 0);
+  const std::vector<std::size_t> ab{0, 1}, ba{1, 0};
+  CHECK(tour_flight_s(timing, start, s, ab, end) ==
+        doctest::Approx(tour_flight_s(timing, start, s, ab) + timing.segment_time_s(s[1].exit, end)));
+  CHECK(tour_flight_s(timing, start, s, std::vector<std::size_t>{}, end) ==
+        doctest::Approx(timing.segment_time_s(start, end)));
+  CHECK(optimal_tour_order(timing, start, s) == ab);
+  CHECK(optimal_tour_order(timing, start, s, end) == ba);
+  CHECK(plan_tour_order(timing, start, s, ab, end) == ba);
+
+  // Insertion, exact order and local search against brute force, with an end.
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> x(0.0, 120.0), y(0.0, 100.0);
+  for (std::size_t n = 1; n <= 6; ++n)
+    for (int trial = 0; trial < 10; ++trial) {
+      auto stops = random_stops(rng, n);
+      const Eigen::Vector3d from(x(rng), y(rng), 82.5), to(x(rng), y(rng), 82.5);
+      // Cheapest insertion of the last stop adds exactly what the best tour through it grows by.
+      const TourStop extra = stops.back();
+      stops.pop_back();
+      std::vector<std::size_t> order(stops.size());
+      std::iota(order.begin(), order.end(), std::size_t{0});
+      const double before = tour_flight_s(timing, from, stops, order, to);
+      const TourInsertion ins = cheapest_insertion(timing, from, stops, order, extra, to);
+      stops.push_back(extra);
+      auto grown = order;
+      grown.insert(grown.begin() + static_cast<std::ptrdiff_t>(ins.position), n - 1);
+      CHECK(tour_flight_s(timing, from, stops, grown, to) - before == doctest::Approx(ins.added_s).epsilon(1e-12));
+      for (std::size_t p = 0; p <= order.size(); ++p) {
+        auto o = order;
+        o.insert(o.begin() + static_cast<std::ptrdiff_t>(p), n - 1);
+        CHECK(tour_flight_s(timing, from, stops, o, to) >= before + ins.added_s - 1e-9);
+      }
+      // The exact order is the best permutation; the planned one never longer than the insertion's.
+      std::vector<std::size_t> all(n);
+      std::iota(all.begin(), all.end(), std::size_t{0});
+      double brute = tour_flight_s(timing, from, stops, all, to);
+      while (std::next_permutation(all.begin(), all.end()))
+        brute = std::min(brute, tour_flight_s(timing, from, stops, all, to));
+      CAPTURE(n);
+      CHECK(tour_flight_s(timing, from, stops, optimal_tour_order(timing, from, stops, to), to) ==
+            doctest::Approx(brute).epsilon(1e-12));
+      CHECK(tour_flight_s(timing, from, stops, plan_tour_order(timing, from, stops, grown, to), to) <=
+            tour_flight_s(timing, from, stops, grown, to) + 1e-9);
+      CHECK(tour_flight_s(timing, from, stops, improve_tour_order(timing, from, stops, grown, to), to) <=
+            tour_flight_s(timing, from, stops, grown, to) + 1e-9);
+    }
+}

@@ -31,11 +31,25 @@ enum class DescentSchedule {
   /// tour chosen so far (cheapest insertion); the tour is reordered once the survey is flown,
   /// never longer, so the budget holds. Candidate::deferred says which way each was costed.
   tour,
+  /// Inspect at once or after the lawnmower row, whichever is cheaper (beyond the paper: stay
+  /// low between neighbouring regions): as `tour`, but a tour is flown after each row of the
+  /// top-level lawnmower (rows run along x), from the row's last top-level waypoint through the
+  /// row's deferred sub-lawnmowers, back to back at low altitude, up to the next row's first
+  /// top-level waypoint. Regions of one row that all want a descent share one descent and one
+  /// climb, without the flight back from the survey's end that `tour` needs; each is still
+  /// decided on its own top-level image. A deferred descent is charged what it adds to the row's
+  /// tour, its leg up to the next row included.
+  row,
 };
 
-/// The name used in results and on the command line: "immediate" or "tour".
+/// The name used in results and on the command line: "immediate", "tour" or "row".
 [[nodiscard]] inline const char* to_string(DescentSchedule s) noexcept {
-  return s == DescentSchedule::tour ? "tour" : "immediate";
+  switch (s) {
+    case DescentSchedule::tour: return "tour";
+    case DescentSchedule::row: return "row";
+    case DescentSchedule::immediate: break;
+  }
+  return "immediate";
 }
 
 /// Settings of an adaptive mission.
@@ -55,7 +69,8 @@ struct AdaptiveOptions {
   /// What a descent re-maps: the whole region (the paper) or only its cells that show a label
   /// of interest (DescentCoverage). A decision model must be calibrated with the same.
   DescentCoverage coverage = DescentCoverage::region;
-  /// When the chosen descents are flown: at once (the paper) or as one tour after the survey.
+  /// When the chosen descents are flown: at once (the paper), or deferred to a tour after the
+  /// survey or after each lawnmower row where that is cheaper.
   DescentSchedule schedule = DescentSchedule::immediate;
 };
 

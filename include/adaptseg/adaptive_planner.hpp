@@ -49,8 +49,9 @@ namespace adaptseg {
 /// cells that show a label of interest, see descent_plan()) and computes its exact extra time: the
 /// flight i → sub-lawnmower → i+1 minus the flight i → i+1, plus the per-image segmentation
 /// and per-waypoint planning estimates. Candidates that would break the budget are dropped; the
-/// policy decides; a descent's waypoints come next (DescentSchedule::tour: next, or after the
-/// last top-level image, as one tour with the other deferred descents, as each was costed).
+/// policy decides; a descent's waypoints come next (DescentSchedule::tour / row: next, or after
+/// the last top-level image of the survey / of the row, as one tour with the other deferred
+/// descents, as each was costed).
 /// After a descent's last image, the region's σ at h' and what it relabelled (from the fused
 /// map) go back to the policy (paper §3.2.3).
 ///
@@ -135,6 +136,15 @@ class AdaptivePlanner {
     }
     valid_px_ = cv::countNonZero(area_.valid_mask);
     charge_measured_planning(seconds_since(t0));
+    window_last_.resize(top_.size());
+    for (std::size_t i = top_.size(); i-- > 0;) {
+      const bool row_ends = i + 1 == top_.size() || std::abs(top_[i + 1].position.y() - top_[i].position.y()) > 1e-6;
+      switch (options_.schedule) {
+        case DescentSchedule::immediate: window_last_[i] = i; break;
+        case DescentSchedule::tour: window_last_[i] = top_.size() - 1; break;
+        case DescentSchedule::row: window_last_[i] = row_ends ? i : window_last_[i + 1]; break;
+      }
+    }
     flight_after_.assign(top_.size() + 1, 0.0);
     for (std::size_t i = top_.size(); i-- > 1;)
       flight_after_[i - 1] = flight_after_[i] + timing_.segment_time_s(top_[i - 1].position, top_[i].position);
@@ -152,7 +162,13 @@ class AdaptivePlanner {
   /// not been reported; nullopt once the mission is complete.
   [[nodiscard]] std::optional<PlannedWaypoint> next() {
     if (pending_) return path_.back();
-    if (sub_next_ >= sub_.size() && top_next_ >= top_.size() && tour_next_ < tour_order_.size()) start_inspection();
+    // A tour starts once the last top-level waypoint of its window (the survey, or the row) is
+    // flown; once flown, it is cleared for the next window's.
+    if (sub_next_ >= sub_.size() && tour_next_ < tour_order_.size() && top_next_ > 0 &&
+        top_next_ - 1 == window_last_[top_next_ - 1])
+      start_inspection();
+    if (sub_next_ >= sub_.size() && top_next_ < top_.size() && tour_next_ > 0 && tour_next_ >= tour_order_.size())
+      clear_tour();
     PlannedWaypoint p;
     if (sub_next_ < sub_.size()) {
       p.waypoint = sub_[sub_next_];
@@ -271,8 +287,8 @@ class AdaptivePlanner {
   }
 
   /// The waypoints of the descent in progress, in visiting order: decided at the last
-  /// top-level image, or (DescentSchedule::tour) the inspection being flown; empty when none is
-  /// in progress or decided.
+  /// top-level image, or (DescentSchedule::tour / row) the inspection being flown; empty when
+  /// none is in progress or decided.
   [[nodiscard]] const std::vector<Waypoint>& descent() const noexcept { return sub_; }
 
   /// The top-level lawnmower W^{h_max}.
@@ -459,13 +475,14 @@ class AdaptivePlanner {
     rec.sigma = sigma;
     const Eigen::Vector3d here = top_[i].position;
     const bool last = i + 1 == top_.size();
-    const bool tour = options_.schedule == DescentSchedule::tour;
+    const bool tour = options_.schedule != DescentSchedule::immediate;
+    const bool window_last = i == window_last_[i];  // the tour (of the survey / row) starts here
     const double per_image = segmentation_estimate() + planning_estimate();
     const double direct = last ? 0.0 : timing_.segment_time_s(here, top_[i + 1].position);
     // Time still needed after this waypoint's decision to finish the top-level coverage (and
-    // the tour chosen so far).
+    // the tour chosen so far: what it adds to the top-level legs).
     double rest = (last ? 0.0 : direct + flight_after_[i + 1]) + static_cast<double>(top_.size() - i - 1) * per_image;
-    if (tour) rest += tour_flight_s(timing_, tour_start(), tour_stops_, tour_order_) + static_cast<double>(tour_images_) * per_image;
+    if (tour) rest += tour_extra_s(i) + static_cast<double>(tour_images_) * per_image;
     const double elapsed = elapsed_s();
     std::vector<std::vector<Waypoint>> sub_plans;
     std::vector<std::pair<TourStop, TourInsertion>> stops;  // per candidate, for a deferred descent
@@ -476,16 +493,16 @@ class AdaptivePlanner {
       // What descending adds to the flight: at once, down and back up to the next waypoint ...
       double flight = timing_.segment_time_s(here, sub.front().position) + inner - direct;
       if (!last) flight += timing_.segment_time_s(sub.back().position, top_[i + 1].position);
-      // ... or, on a tour, inserted where it adds least (if that is less). At the last
-      // top-level waypoint, where a tour already chosen starts, flying it at once is the
+      // ... or, on a tour, inserted where it adds least (if that is less). At the window's
+      // last top-level waypoint, where a tour already chosen starts, flying it at once is the
       // insertion at the tour's head, so the tour prices it (the at-once cost above would
       // ignore that the tour then starts from the descent's end).
       const TourStop stop{sub.front().position, sub.back().position, inner};
       TourInsertion insertion;
       bool deferred = false;
       if (tour) {
-        insertion = cheapest_insertion(timing_, tour_start(), tour_stops_, tour_order_, stop);
-        deferred = (last && !tour_order_.empty()) || insertion.added_s < flight;
+        insertion = cheapest_insertion(timing_, tour_start(i), tour_stops_, tour_order_, stop, tour_end(i));
+        deferred = (window_last && !tour_order_.empty()) || insertion.added_s < flight;
         if (deferred) flight = insertion.added_s;
       }
       Candidate c;
@@ -546,13 +563,38 @@ class AdaptivePlanner {
   /// (plan_tour_order: never longer than the order the decisions were charged for).
   void start_inspection() {
     const auto t0 = std::chrono::steady_clock::now();
-    if (tour_next_ == 0) tour_order_ = plan_tour_order(timing_, tour_start(), tour_stops_, std::move(tour_order_));
+    const std::size_t i = top_next_ - 1;  // the window's last top-level waypoint
+    if (tour_next_ == 0)
+      tour_order_ = plan_tour_order(timing_, tour_start(i), tour_stops_, std::move(tour_order_), tour_end(i));
     start_descent(queued_[tour_order_[tour_next_++]]);
     charge_measured_planning(seconds_since(t0));
   }
 
-  /// Where a tour starts: the last top-level waypoint.
-  [[nodiscard]] Eigen::Vector3d tour_start() const { return top_.back().position; }
+  /// After a window's tour is flown: the next window's starts empty.
+  void clear_tour() {
+    queued_.clear();
+    tour_stops_.clear();
+    tour_order_.clear();
+    tour_next_ = 0;
+    tour_images_ = 0;
+  }
+
+  /// Where the tour of top-level waypoint i's window starts: the window's last top-level
+  /// waypoint (DescentSchedule::tour: the survey's last; row: the row's last).
+  [[nodiscard]] Eigen::Vector3d tour_start(std::size_t i) const { return top_[window_last_[i]].position; }
+  /// Where it ends: the next window's first top-level waypoint (none after the survey's end).
+  [[nodiscard]] TourEnd tour_end(std::size_t i) const {
+    const std::size_t after = window_last_[i] + 1;
+    return after < top_.size() ? TourEnd(top_[after].position) : std::nullopt;
+  }
+  /// What the tour chosen so far in top-level waypoint i's window adds to the top-level flight
+  /// [s] (it replaces the direct leg from its start to its end).
+  [[nodiscard]] double tour_extra_s(std::size_t i) const {
+    if (tour_order_.empty()) return 0.0;
+    const TourEnd end = tour_end(i);
+    return tour_flight_s(timing_, tour_start(i), tour_stops_, tour_order_, end) -
+           (end ? timing_.segment_time_s(tour_start(i), *end) : 0.0);
+  }
 
   /// After a descent's last image: σ of the region at h' from the fused map, to the policy.
   DescentOutcome finish_descent() {
@@ -604,8 +646,11 @@ class AdaptivePlanner {
   ChosenDescent current_;             ///< the descent in progress (its plan moved to sub_)
   std::size_t descents_chosen_ = 0;
   cv::Mat descent_before_;            ///< the region's map before the descent in progress
-  // DescentSchedule::tour:
-  std::vector<ChosenDescent> queued_;     ///< every descent chosen during the survey, in decision order
+  /// Per top-level waypoint, the last top-level waypoint of its window: where the window's tour
+  /// starts (immediate: itself; tour: the survey's last; row: its row's last).
+  std::vector<std::size_t> window_last_;
+  // DescentSchedule::tour and row (the tour of the window being flown):
+  std::vector<ChosenDescent> queued_;     ///< every descent deferred in the window, in decision order
   std::vector<TourStop> tour_stops_;      ///< ... as tour stops (same order)
   std::vector<std::size_t> tour_order_;   ///< indices into queued_, in flight order
   std::size_t tour_next_ = 0;             ///< next of tour_order_ to fly

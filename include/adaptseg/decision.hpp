@@ -60,7 +60,8 @@ struct Candidate {
   double altitude_m = 0.0;    ///< h' [m]
   int images = 0;             ///< waypoints of the sub-lawnmower over the region
   double extra_time_s = 0.0;  ///< mission time added by the sub-lawnmower [s] (flight, segmentation, planning)
-  /// Costed as deferred to the tour after the survey (DescentSchedule::tour), not flown at once.
+  /// Costed as deferred to the tour after the survey or the row (DescentSchedule::tour, row),
+  /// not flown at once.
   bool deferred = false;
 };
 
@@ -119,8 +120,8 @@ struct DescentOutcome {
   /// What the descent changed in the region's map (field pixels; no ground truth needed).
   Relabelling relabelled{};
   /// Which descent this is: 0, 1, ... in the order the policy chose them. The planner flies
-  /// them in that order, except a survey-then-inspect tour (DescentSchedule::tour), which
-  /// chooses them all during the survey and flies them in its own order.
+  /// them in that order, except a survey-then-inspect tour (DescentSchedule::tour, row), which
+  /// chooses them during the survey (or the row) and flies them in its own order.
   std::size_t descent = 0;
 };
 
@@ -137,8 +138,9 @@ struct DescentOutcome {
 ///   per candidate, in order;
 /// - `observe(outcome)` after every descent (a policy that does not adapt ignores it). With the
 ///   paper's immediate descents it comes before the next `decide`; a tour
-///   (DescentSchedule::tour) takes every decision first and reports the outcomes afterwards,
-///   in its flight order: `outcome.descent` says which of the chosen descents it is;
+///   (DescentSchedule::tour, row) takes every decision of the survey (of the row) first and
+///   reports the outcomes afterwards, in its flight order: `outcome.descent` says which of the
+///   chosen descents it is;
 /// - `name()` names the strategy (e.g. in results).
 template <typename P>
 concept DecisionPolicy = requires(P& policy, const DecisionContext& context, const DescentOutcome& outcome) {

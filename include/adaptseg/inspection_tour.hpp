@@ -1,11 +1,13 @@
 #pragma once
 /// @file
-/// Ordering inspections into one tour (beyond the paper; docs/method.md §"Survey first,
-/// inspect after"): once the top-level lawnmower is flown, the sub-lawnmowers it chose are
-/// flown back to back at low altitude, in the order that takes least flight time. Each
+/// Ordering inspections into one tour (beyond the paper; docs/method.md §"When descents are
+/// flown"): once the top-level lawnmower (or one of its rows) is flown, the sub-lawnmowers it
+/// chose are flown back to back at low altitude, in the order that takes least flight time. Each
 /// inspection is flown as planned (its own waypoint order), so it enters at its first
 /// waypoint and leaves at its last: the tour is an open path from a fixed start through
-/// directed stops, an asymmetric travelling-salesman path.
+/// directed stops, an asymmetric travelling-salesman path. A tour may also have a fixed end
+/// (`end`, e.g. the next lawnmower row's first top-level waypoint for a tour flown after each
+/// row): the leg from its last stop's exit to that point is then part of its time.
 ///
 /// Each stop is priced as it is chosen by cheapest insertion into the tour so far. Once every
 /// stop is known, `plan_tour_order` orders them: exactly (Held-Karp dynamic programme) up to
@@ -25,6 +27,7 @@
 #include <cstddef>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -39,11 +42,16 @@ struct TourStop {
   double inner_flight_s = 0.0;
 };
 
+/// Where a tour must end, if anywhere (nullopt: at its last stop's exit).
+using TourEnd = std::optional<Eigen::Vector3d>;
+
 /// Flight time [s] of the tour from `start` through `stops` in `order` (indices into
-/// `stops`), each stop's inner flight included; it ends at the last stop's exit.
+/// `stops`), each stop's inner flight included; it ends at the last stop's exit, or flies on
+/// to `end` if one is given (with no stop: start to end).
 /// @throws std::invalid_argument for an index out of range.
 [[nodiscard]] inline double tour_flight_s(const TimingModel& timing, const Eigen::Vector3d& start,
-                                          std::span<const TourStop> stops, std::span<const std::size_t> order) {
+                                          std::span<const TourStop> stops, std::span<const std::size_t> order,
+                                          const TourEnd& end = std::nullopt) {
   double t = 0.0;
   Eigen::Vector3d at = start;
   for (std::size_t k : order) {
@@ -51,6 +59,7 @@ struct TourStop {
     t += timing.segment_time_s(at, stops[k].entry) + stops[k].inner_flight_s;
     at = stops[k].exit;
   }
+  if (end) t += timing.segment_time_s(at, *end);
   return t;
 }
 
@@ -60,11 +69,13 @@ struct TourInsertion {
   double added_s = 0.0;      ///< flight time it adds [s], its inner flight included
 };
 
-/// The cheapest place for `stop` in the tour from `start` through `stops` in `order`.
+/// The cheapest place for `stop` in the tour from `start` through `stops` in `order` (to
+/// `end`, if given).
 /// @throws std::invalid_argument for an index out of range.
 [[nodiscard]] inline TourInsertion cheapest_insertion(const TimingModel& timing, const Eigen::Vector3d& start,
                                                       std::span<const TourStop> stops,
-                                                      std::span<const std::size_t> order, const TourStop& stop) {
+                                                      std::span<const std::size_t> order, const TourStop& stop,
+                                                      const TourEnd& end = std::nullopt) {
   TourInsertion best{0, std::numeric_limits<double>::infinity()};
   Eigen::Vector3d before = start;
   for (std::size_t p = 0; p <= order.size(); ++p) {
@@ -74,6 +85,8 @@ struct TourInsertion {
       const TourStop& next = stops[order[p]];
       added += timing.segment_time_s(stop.exit, next.entry) - timing.segment_time_s(before, next.entry);
       before = next.exit;
+    } else if (end) {
+      added += timing.segment_time_s(stop.exit, *end) - timing.segment_time_s(before, *end);
     }
     if (added < best.added_s) best = {p, added};
   }
@@ -81,16 +94,17 @@ struct TourInsertion {
 }
 
 /// `order` improved by 2-opt and or-opt (runs of 1-3 stops) moves, each taken only if it
-/// shortens the tour by more than a microsecond, until none does (or after `max_passes`
-/// passes); never longer than `order`. O(n³) per pass; meant for the tens of inspections of
-/// one mission.
+/// shortens the tour (to `end`, if given) by more than a microsecond, until none does (or
+/// after `max_passes` passes); never longer than `order`. O(n³) per pass; meant for the tens
+/// of inspections of one mission.
 /// @throws std::invalid_argument for an index out of range.
 [[nodiscard]] inline std::vector<std::size_t> improve_tour_order(const TimingModel& timing,
                                                                  const Eigen::Vector3d& start,
                                                                  std::span<const TourStop> stops,
                                                                  std::vector<std::size_t> order,
+                                                                 const TourEnd& end = std::nullopt,
                                                                  int max_passes = 100) {
-  const auto cost = [&](const std::vector<std::size_t>& o) { return tour_flight_s(timing, start, stops, o); };
+  const auto cost = [&](const std::vector<std::size_t>& o) { return tour_flight_s(timing, start, stops, o, end); };
   double best = cost(order);
   const std::size_t n = order.size();
   for (int pass = 0; pass < max_passes; ++pass) {
@@ -123,11 +137,13 @@ struct TourInsertion {
 inline constexpr std::size_t kExactTourStops = 12;
 
 /// The order of least flight time (Held-Karp: for every set of stops and every last stop, the
-/// fastest way from `start` through that set ending there). O(2^n · n²) time, O(2^n · n) memory.
+/// fastest way from `start` through that set ending there; with an `end`, the leg from the
+/// last stop to it added). O(2^n · n²) time, O(2^n · n) memory.
 /// @throws std::invalid_argument for more than kExactTourStops stops.
 [[nodiscard]] inline std::vector<std::size_t> optimal_tour_order(const TimingModel& timing,
                                                                  const Eigen::Vector3d& start,
-                                                                 std::span<const TourStop> stops) {
+                                                                 std::span<const TourStop> stops,
+                                                                 const TourEnd& end = std::nullopt) {
   const std::size_t n = stops.size();
   detail::require(n <= kExactTourStops,
                   "optimal_tour_order: at most " + std::to_string(kExactTourStops) + " stops (exact search)", n);
@@ -151,8 +167,11 @@ inline constexpr std::size_t kExactTourStops = 12;
       }
     }
   std::size_t set = sets - 1, last = 0;
+  const auto finish = [&](std::size_t k) {
+    return best[set * n + k] + (end ? timing.segment_time_s(stops[k].exit, *end) : 0.0);
+  };
   for (std::size_t k = 1; k < n; ++k)
-    if (best[set * n + k] < best[set * n + last]) last = k;
+    if (finish(k) < finish(last)) last = k;
   std::vector<std::size_t> order;
   while (last < n) {
     order.push_back(last);
@@ -165,18 +184,21 @@ inline constexpr std::size_t kExactTourStops = 12;
 }
 
 /// The order a tour is flown in: optimal_tour_order up to kExactTourStops stops, else `order`
-/// improved by improve_tour_order. Never longer than `order` (a permutation of the stops).
+/// improved by improve_tour_order (both to `end`, if given). Never longer than `order` (a
+/// permutation of the stops).
 /// @throws std::invalid_argument for an index out of range.
 [[nodiscard]] inline std::vector<std::size_t> plan_tour_order(const TimingModel& timing,
                                                               const Eigen::Vector3d& start,
                                                               std::span<const TourStop> stops,
-                                                              std::vector<std::size_t> order) {
+                                                              std::vector<std::size_t> order,
+                                                              const TourEnd& end = std::nullopt) {
   if (stops.size() <= kExactTourStops && order.size() == stops.size()) {
-    auto exact = optimal_tour_order(timing, start, stops);
-    if (tour_flight_s(timing, start, stops, exact) <= tour_flight_s(timing, start, stops, order)) return exact;
+    auto exact = optimal_tour_order(timing, start, stops, end);
+    if (tour_flight_s(timing, start, stops, exact, end) <= tour_flight_s(timing, start, stops, order, end))
+      return exact;
     return order;
   }
-  return improve_tour_order(timing, start, stops, std::move(order));
+  return improve_tour_order(timing, start, stops, std::move(order), end);
 }
 
 }  // namespace adaptseg
