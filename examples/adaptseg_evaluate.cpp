@@ -238,7 +238,7 @@ int main(int argc, char** argv) {
         fly("lawnmower", f * field.gsd_cm());
         curve.push_back({rows.back().run.mission.total_s(), rows.back().run.mission.miou_interest().value_or(0.0)});
       }
-      for (const char* s : {"nonadaptive", "adaptive", "tour", "linear"}) fly(s, model.top_gsd_cm);
+      for (const char* s : {"nonadaptive", "adaptive", "tour", "row", "linear"}) fly(s, model.top_gsd_cm);
 
       const fs::path field_dir = out_dir / slug(field.name());
       for (const auto& row : rows) {

@@ -230,7 +230,9 @@ void fly(const ImageSetInfo& info, const std::vector<PosedImage>& images, Backen
               planner.top_level().size(), options.top_gsd_cm);
   for (double g : planner.candidate_gsd_cm()) std::printf(" %.2f", g);
   std::printf(" cm/px, policy %s, descents %s, segmenter %s\n", std::string(policy.name()).c_str(),
-              options.schedule == adaptseg::DescentSchedule::tour ? "at once or toured" : "at once",
+              options.schedule == adaptseg::DescentSchedule::tour  ? "at once or toured after the survey"
+              : options.schedule == adaptseg::DescentSchedule::row ? "at once or toured after each row"
+                                                                   : "at once",
               std::string(backend.name()).c_str());
 
   nlohmann::json wps = nlohmann::json::array();
@@ -327,6 +329,7 @@ void fly_strategy(const std::string& strategy, const adaptseg::DecisionModel& mo
   df.set_online(strategy != "nonadaptive");
   adaptseg::AdaptiveOptions o = options;
   if (strategy == "tour") o.schedule = adaptseg::DescentSchedule::tour;
+  if (strategy == "row") o.schedule = adaptseg::DescentSchedule::row;
   fly(info, images, backend, df, o, s);
 }
 
@@ -353,7 +356,7 @@ int main(int argc, char** argv) {
       ->needs(record)
       ->capture_default_str();
   app.add_option("--strategy", strategy, "decision policy")
-      ->check(CLI::IsMember({"adaptive", "nonadaptive", "tour", "linear"}))
+      ->check(CLI::IsMember({"adaptive", "nonadaptive", "tour", "row", "linear"}))
       ->capture_default_str();
   app.add_option("--segmenter", segmenter, "oracle: ground-truth labels/ of the folder; erfnet: its RGB images")
       ->check(CLI::IsMember({"oracle", "erfnet"}))

@@ -23,9 +23,10 @@ namespace adaptseg::examples {
 
 /// lawnmower: one fixed GSD; adaptive / nonadaptive: the decision model with online updates on /
 /// off, descents flown at once (the paper); tour: adaptive, but the whole top level first and the
-/// chosen descents after it as one low-altitude tour (DescentSchedule::tour); linear: the
-/// conference version's rule.
-inline const std::vector<std::string> kStrategies{"lawnmower", "adaptive", "nonadaptive", "tour", "linear"};
+/// chosen descents after it as one low-altitude tour where that is cheaper (DescentSchedule::tour);
+/// row: the same per lawnmower row, staying low between a row's inspections
+/// (DescentSchedule::row); linear: the conference version's rule.
+inline const std::vector<std::string> kStrategies{"lawnmower", "adaptive", "nonadaptive", "tour", "row", "linear"};
 
 /// "a,b,c,d" -> four numbers; `what` describes the expected text in the error.
 /// @throws std::invalid_argument for anything else.
@@ -153,11 +154,12 @@ StrategyRun run_strategy(const Field& field, Backend& backend, const std::string
     auto r = run_adaptive_mission(field, backend, policy, ao, policy.name());
     return {std::move(r.mission), std::move(r.decisions), std::move(r.realised)};
   }
-  if (strategy != "adaptive" && strategy != "nonadaptive" && strategy != "tour")
+  if (strategy != "adaptive" && strategy != "nonadaptive" && strategy != "tour" && strategy != "row")
     throw std::invalid_argument("unknown strategy '" + strategy + "'");
   DecisionFunction df = model->decision_function;
   df.set_online(strategy != "nonadaptive");
   if (strategy == "tour") ao.schedule = DescentSchedule::tour;
+  if (strategy == "row") ao.schedule = DescentSchedule::row;
   auto r = run_adaptive_mission(field, backend, df, ao, strategy);
   return {std::move(r.mission), std::move(r.decisions), std::move(r.realised)};
 }

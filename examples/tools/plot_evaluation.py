@@ -7,7 +7,7 @@ Reads OUTDIR/results.csv, per_image.csv and decisions.csv (written by adaptseg_e
   OUTDIR/miou_vs_time.png       field mIoU over the labels of interest vs execution time
   OUTDIR/per_image_miou.png     per-image mIoU vs image GSD, mean and standard deviation
   OUTDIR/decisions.png          per descent: forecast vs realised field gain (simulation)
-  OUTDIR/paths.png              top views of the paths (lawnmower, non-adaptive, adaptive, tour, linear), 2 per row
+  OUTDIR/paths.png              top views of the paths (lawnmower, non-adaptive, adaptive, tour, row, linear), 2 per row
   OUTDIR/maps.png               fused maps vs ground truth (coarsest lawnmower, adaptive)
 Needs matplotlib (Debian: python3-matplotlib).
 """
@@ -30,8 +30,9 @@ STYLE = {
     "adaptive": dict(color="tab:red", marker="*", s=220, label="adaptive"),
     # Hollow and drawn over the adaptive star: both stay visible when the two coincide.
     "nonadaptive": dict(color="tab:blue", marker="s", s=260, label="non-adaptive"),
-    # Hollow too: the tour often flies adaptive's mission.
+    # Hollow too: the tour and row strategies often fly adaptive's mission.
     "tour": dict(color="tab:purple", marker="D", s=150, label="tour (at once or after the survey)"),
+    "row": dict(color="tab:orange", marker="o", s=90, label="row (at once or after each row)"),
     "linear": dict(color="tab:green", marker="^", s=110, label="linear (ECMR 2021)"),
 }
 
@@ -77,7 +78,7 @@ def main(out):
         for r in fr:
             if r["strategy"] in STYLE:
                 st = STYLE[r["strategy"]]
-                hollow = r["strategy"] in ("nonadaptive", "tour")
+                hollow = r["strategy"] in ("nonadaptive", "tour", "row")
                 ax.scatter([num(r["time_total"])], [num(r["miou_interest"])], zorder=4 if hollow else 3,
                            label=f"{st['label']} (margin {num(r['front_margin']):+.3f})", marker=st["marker"],
                            s=st["s"], facecolors="none" if hollow else st["color"], edgecolors=st["color"],
@@ -159,7 +160,7 @@ def main(out):
         for field in fields:
             lm = sorted((r for r in rows if r["field"] == field and r["strategy"] == "lawnmower"),
                         key=lambda r: num(r["gsd_cm"]))
-            wanted = ([f"lawnmower-{num(lm[-1]['gsd_cm']):.2f}", "nonadaptive", "adaptive", "tour", "linear"]
+            wanted = ([f"lawnmower-{num(lm[-1]['gsd_cm']):.2f}", "nonadaptive", "adaptive", "tour", "row", "linear"]
                       if name == "paths.png" else [f"lawnmower-{num(lm[-1]['gsd_cm']):.2f}", "adaptive"])
             for w in wanted:
                 p = os.path.join(out, slug(field), w, picks[0] + ".png")

@@ -7,15 +7,16 @@ Each LABEL names a configuration; its OUTDIRs are adaptseg_evaluate output direc
 alike across configurations (the run's name is the directory's path below the common root,
 e.g. out/results/loo/road/dubai-tile-3 and out/results/loo-paper/road/dubai-tile-3 are one run).
 Prints, as Markdown:
-  1. per run and test field: the front margin (and descents) of adaptive, non-adaptive, tour
+  1. per run and test field: the front margin (and descents) of adaptive, non-adaptive, tour, row
      and linear in the first configuration, and of adaptive in the others;
   2. per configuration: runs with margin > 0 and >= -0.002, median and mean margin, and the
      share of positive runs among those where some strategy flown in any configuration beat
      the lawnmower curve (margin > 0);
   3. the runs where adaptive and non-adaptive differ, and by how much;
   4. per descent (decisions.csv), forecast against realised field gain, by descent GSD;
-  5. when descents are flown (adaptive: at once; tour: at once or after the survey): margins,
-     mission time, altitude changes, descents deferred to the tour, runs where tour differs.
+  5. when descents are flown (adaptive: at once; tour: at once or after the survey; row: at once
+     or after the lawnmower row): margins, mission time, altitude changes, descents deferred to
+     a tour, runs where tour / row differ from adaptive.
 """
 import csv
 import os
@@ -73,14 +74,14 @@ def main(args):
     keys = sorted({k for _, runs, _ in configs for k in runs})
     first_label, first, _ = configs[0]
 
-    print(f"| run | field | adaptive | non-adaptive | tour | linear |" +
+    print(f"| run | field | adaptive | non-adaptive | tour | row | linear |" +
           "".join(f" adaptive, {c[0]} |" for c in configs[1:]))
-    print("| --- | --- | ---: | ---: | ---: | ---: |" + " ---: |" * (len(configs) - 1))
+    print("| --- | --- | ---: | ---: | ---: | ---: | ---: |" + " ---: |" * (len(configs) - 1))
     for run, field in keys:
         row = first.get((run, field), {})
         others = "".join(f" {cell(c[1].get((run, field), {}).get('adaptive'))} |" for c in configs[1:])
         print(f"| {run} | {field} | {cell(row.get('adaptive'))} | {cell(row.get('nonadaptive'))} | "
-              f"{cell(row.get('tour'))} | {cell(row.get('linear'))} |{others}")
+              f"{cell(row.get('tour'))} | {cell(row.get('row'))} | {cell(row.get('linear'))} |{others}")
 
     # Runs where some strategy, in some configuration, beat the curve.
     beatable = {k for k in keys for _, runs, _ in configs for v in runs.get(k, {}).values() if v[0] > 0}
@@ -131,30 +132,36 @@ def main(args):
     schedule_table(configs, keys)
 
 
+SCHEDULES = ("tour", "row")  # the strategies that may defer a descent to a tour
+
+
 def schedule_table(configs, keys):
-    """Table 5: the paper's immediate descents against the tour strategy, per configuration."""
+    """Table 5: the paper's immediate descents against the tour and row strategies, per configuration."""
     print()
     print("| configuration | strategy | runs | median margin | mean margin | mission time (sum) [s] | "
-          "altitude changes (sum) | descents | deferred to the tour | runs where tour differs |")
+          "altitude changes (sum) | descents | deferred to a tour | runs where it differs from adaptive |")
     print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
     for label, runs, decisions in configs:
-        both = [k for k in keys if k in runs and "adaptive" in runs[k] and "tour" in runs[k]]
-        if not both:
+        flown = [s for s in ("adaptive",) + SCHEDULES if any(s in runs[k] for k in keys if k in runs)]
+        every = [k for k in keys if k in runs and all(s in runs[k] for s in flown)]
+        if len(flown) < 2 or not every:
             continue
-        # A different mission: a descent deferred, or other descents (times alone move with
-        # measured segmentation times).
-        deferred_runs = {d["run"] for d in decisions if d["strategy"] == "tour" and d["action"] == "descend"
-                         and d.get("flown") == "tour"}
-        differ = sum(1 for k in both if k[0] in deferred_runs or runs[k]["tour"][1] != runs[k]["adaptive"][1])
-        for strategy in ("adaptive", "tour"):
-            v = [runs[k][strategy] for k in both]
+        for strategy in flown:
+            v = [runs[k][strategy] for k in every]
             deferred = sum(1 for d in decisions if d["strategy"] == strategy and d["action"] == "descend"
                            and d.get("flown") == "tour")
+            differ = ""
+            if strategy != "adaptive":
+                # A different mission: a descent deferred, or other descents (times alone move
+                # with measured segmentation times).
+                deferred_runs = {d["run"] for d in decisions if d["strategy"] == strategy
+                                 and d["action"] == "descend" and d.get("flown") == "tour"}
+                differ = sum(1 for k in every
+                             if k[0] in deferred_runs or runs[k][strategy][1] != runs[k]["adaptive"][1])
             changes = [x[3] for x in v if x[3] is not None]
             print(f"| {label} | {strategy} | {len(v)} | {statistics.median(x[0] for x in v):+.4f} | "
                   f"{statistics.mean(x[0] for x in v):+.4f} | {sum(x[2] for x in v):.0f} | "
-                  f"{sum(changes) if changes else '—'} | {sum(x[1] for x in v)} | {deferred} | "
-                  f"{differ if strategy == 'tour' else ''} |")
+                  f"{sum(changes) if changes else '—'} | {sum(x[1] for x in v)} | {deferred} | {differ} |")
 
 
 if __name__ == "__main__":

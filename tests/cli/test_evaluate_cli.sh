@@ -35,11 +35,12 @@ awk -F, -v n="$descents" '$2 == "adaptive" {rows++} $2 == "adaptive" && $6 == "d
   END {exit !(rows > 0 && d == n && d > 0 && bad == 0)}' "$work/e/decisions.csv" ||
   fail "decisions.csv: adaptive's $descents descents not all recorded with forecast, observation and realised gain"
 echo "ok: decisions.csv records adaptive's $descents descents"
-# How each descent was flown: adaptive always at once; tour at once or in the tour. Adaptive's
-# altitude changes (results.csv column 13): one or two per descent.
-awk -F, '$6 == "descend" && !(($2 == "tour" && ($21 == "now" || $21 == "tour")) || ($2 != "tour" && $21 == "now")) {bad++}
-  $2 == "tour" {tour++} END {exit !(bad == 0 && tour > 0)}' "$work/e/decisions.csv" ||
-  fail "decisions.csv: column flown is not now/tour as the strategy allows, or no tour rows"
+# How each descent was flown: adaptive always at once; tour and row at once or in a tour.
+# Adaptive's altitude changes (results.csv column 13): one or two per descent.
+awk -F, '$6 == "descend" && !((($2 == "tour" || $2 == "row") && ($21 == "now" || $21 == "tour")) ||
+                              ($2 != "tour" && $2 != "row" && $21 == "now")) {bad++}
+  $2 == "tour" {tour++} $2 == "row" {row++} END {exit !(bad == 0 && tour > 0 && row > 0)}' "$work/e/decisions.csv" ||
+  fail "decisions.csv: column flown is not now/tour as the strategy allows, or no tour or row rows"
 awk -F, -v n="$descents" '$2 == "adaptive" {exit !($13 >= n && $13 <= 2 * n)}' "$work/e/results.csv" ||
   fail "results.csv: adaptive's altitude_changes is not between its descents and twice them"
 echo "ok: decisions.csv says how each descent was flown"

@@ -27,6 +27,7 @@ run() {
     >/dev/null || fail "mission $name"
 }
 run adaptive --strategy adaptive
+run row --strategy row
 run linear --strategy linear
 run linear-budget --strategy linear --budget-s 45
 
@@ -34,7 +35,7 @@ run linear-budget --strategy linear --budget-s 45
 import json, sys
 work = sys.argv[1]
 descents = 0
-for strategy in ["adaptive", "linear", "linear-budget"]:
+for strategy in ["adaptive", "row", "linear", "linear-budget"]:
     live = json.load(open(f"{work}/live-{strategy}/result.json"))
     sim = json.load(open(f"{work}/mission-{strategy}/result.json"))
     assert live["images"] == sim["images"] == len(sim["waypoints"]), (strategy, live["images"], sim["images"])
