@@ -34,8 +34,8 @@
 #   on 2 cores.
 # vertical-speed: the defaults' sweep (calibration included) with climbs and descents limited to
 #   1 m/s against 2 m/s level (--vertical-speed 1; the paper's model climbs at the level speed):
-#   what the immediate descent and the survey-first tour are worth when altitude is expensive,
-#   as on real multicopters (issue 17). About 8 minutes on 2 cores.
+#   what the immediate descent, the survey-first tour and staying low along a row are worth
+#   when altitude is expensive, as on real multicopters (issue 17). About 8 minutes on 2 cores.
 # Outputs: out/results/<configuration>/<run>/ (adaptseg_evaluate's files); prints the tables.
 set -euo pipefail
 part=${1:-all}
@@ -55,6 +55,7 @@ root=out/results
 classes="building road vegetation water"
 fixed=(--seg-time-s 0.1 --plan-time-s 0)
 paper=(--rule threshold --gain-inputs delta-sigma --coverage region --no-plots)
+network=(--segmenter erfnet --threads 1)  # a bundled network (--model-file examples/models/NET), one thread per run
 
 # One adaptseg_evaluate run: CONFIG RUN ARGS... -> $root/CONFIG/RUN (log: RUN.log beside it).
 running=0
@@ -201,7 +202,7 @@ if [ "$part" = network-held-out ]; then
   for cls in $classes; do
     for t in 4 6; do
       run "$config" "erfnet-dubai-$cls-fly$t" --train "$(dubai $((10 - t)))" --test "$(dubai "$t")" \
-        --interest "$cls" --segmenter erfnet --model-file examples/models/erfnet-dubai --threads 1 --no-plots
+        --interest "$cls" --model-file examples/models/erfnet-dubai "${network[@]}" --no-plots
     done
   done
   wait
@@ -239,7 +240,7 @@ if [ "$part" = all ] || [ "$part" = network ]; then
         train=()
         for k in 1 2 3 4 5 6; do [ "$k" != "$t" ] && train+=(--train "$(dubai "$k")"); done
         run network "$net-$cls-fly$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
-          --segmenter erfnet --model-file "examples/models/$net" --threads 1
+          --model-file "examples/models/$net" "${network[@]}"
       done
     done
   done

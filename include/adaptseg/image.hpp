@@ -101,7 +101,7 @@ class FootprintFrame {
   /// The map pixels whose centres the turned footprint may cover (its bounding box, one pixel
   /// of margin for rounding); the footprint itself at yaw 0.
   [[nodiscard]] cv::Rect bounds() const {
-    if (cos_ == 1.0) return rect_;
+    if (!turned()) return rect_;
     double x0 = cx_, x1 = cx_, y0 = cy_, y1 = cy_;
     const double w = rect_.width, h = rect_.height;
     for (const cv::Point2d& corner : {cv::Point2d(0, 0), cv::Point2d(w, 0), cv::Point2d(0, h), cv::Point2d(w, h)}) {
