@@ -203,7 +203,9 @@ int main(int argc, char** argv) {
                      "forecast_delta_miou,forecast_delta_miou_std,forecast_relabelled_interest,forecast_field_gain,forecast_front_margin,"
                      "observed_sigma_sub,observed_relabelled,observed_relabelled_interest,realised_region_delta_miou,"
                      "realised_field_gain,flown\n";
-    const std::size_t total_runs = tests.size() * (lawnmower_factors.size() + 4);
+    // The strategies that fly the model, after the lawnmowers, in this order on every test field.
+    const std::vector<std::string> model_strategies{"nonadaptive", "adaptive", "tour", "row", "linear"};
+    const std::size_t total_runs = tests.size() * (lawnmower_factors.size() + model_strategies.size());
     std::size_t run_index = 0;
     for (const auto& field : tests) {
       // Every strategy, the lawnmowers too, flies the model's camera and speed limits (equal to
@@ -238,7 +240,7 @@ int main(int argc, char** argv) {
         fly("lawnmower", f * field.gsd_cm());
         curve.push_back({rows.back().run.mission.total_s(), rows.back().run.mission.miou_interest().value_or(0.0)});
       }
-      for (const char* s : {"nonadaptive", "adaptive", "tour", "row", "linear"}) fly(s, model.top_gsd_cm);
+      for (const std::string& s : model_strategies) fly(s, model.top_gsd_cm);
 
       const fs::path field_dir = out_dir / slug(field.name());
       for (const auto& row : rows) {
