@@ -328,8 +328,7 @@ void fly_strategy(const std::string& strategy, const adaptseg::DecisionModel& mo
   adaptseg::DecisionFunction df = model.decision_function;
   df.set_online(strategy != "nonadaptive");
   adaptseg::AdaptiveOptions o = options;
-  if (strategy == "tour") o.schedule = adaptseg::DescentSchedule::tour;
-  if (strategy == "row") o.schedule = adaptseg::DescentSchedule::row;
+  o.schedule = adaptseg::examples::schedule_of(strategy);
   fly(info, images, backend, df, o, s);
 }
 

@@ -28,6 +28,14 @@ namespace adaptseg::examples {
 /// (DescentSchedule::row); linear: the conference version's rule.
 inline const std::vector<std::string> kStrategies{"lawnmower", "adaptive", "nonadaptive", "tour", "row", "linear"};
 
+/// When a model-based strategy flies its descents: tour and row defer where cheaper, the others
+/// descend at once.
+inline DescentSchedule schedule_of(const std::string& strategy) {
+  if (strategy == "tour") return DescentSchedule::tour;
+  if (strategy == "row") return DescentSchedule::row;
+  return DescentSchedule::immediate;
+}
+
 /// "a,b,c,d" -> four numbers; `what` describes the expected text in the error.
 /// @throws std::invalid_argument for anything else.
 inline std::array<double, 4> parse_four_numbers(const std::string& text, const std::string& what) {
@@ -158,8 +166,7 @@ StrategyRun run_strategy(const Field& field, Backend& backend, const std::string
     throw std::invalid_argument("unknown strategy '" + strategy + "'");
   DecisionFunction df = model->decision_function;
   df.set_online(strategy != "nonadaptive");
-  if (strategy == "tour") ao.schedule = DescentSchedule::tour;
-  if (strategy == "row") ao.schedule = DescentSchedule::row;
+  ao.schedule = schedule_of(strategy);
   auto r = run_adaptive_mission(field, backend, df, ao, strategy);
   return {std::move(r.mission), std::move(r.decisions), std::move(r.realised)};
 }
