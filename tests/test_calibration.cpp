@@ -177,6 +177,23 @@ TEST_CASE("calibration: by default the front-aware rule, its confidence chosen o
     }
 }
 
+TEST_CASE("calibration: confidence levels the training fields cannot tell apart go to the more cautious") {
+  // At z = 20 and z = 40 no forecast's lower bound beats the curve: neither setting descends,
+  // both fly the lawnmower and tie exactly. The tie goes to the larger z, in either order.
+  const Field f = t::blob_field(1300, 1000, 1.0, 4, 15);
+  OracleSegmenter oracle(f.num_classes());
+  for (const std::vector<double>& levels : {std::vector<double>{20.0, 40.0}, std::vector<double>{40.0, 20.0}}) {
+    CalibrationOptions options = small_options();
+    options.confidences = levels;
+    const CalibrationResult cal = calibrate(f, oracle, options);
+    REQUIRE(cal.trials.size() == 2);
+    CHECK(cal.trials[0].front_margin == cal.trials[1].front_margin);
+    for (const auto& trial : cal.trials) CHECK(trial.descents == 0);
+    CHECK(std::get<FrontAwarePolicy>(cal.decision_function.rule()).params().confidence == 40.0);
+    CHECK(cal.trials.front().description == "front-aware z=40");
+  }
+}
+
 TEST_CASE("calibration: several training fields pool their samples and keep every field's curve") {
   const Field a = t::blob_field(1300, 1000, 1.0, 4, 15);
   const Field b = t::blob_field(1000, 1300, 1.0, 11, 15).sub_field({0, 0, 1, 0.8});

@@ -63,7 +63,9 @@ struct CalibrationOptions {
   /// chosen among `confidences` by the mean front margin over the training fields, each flown
   /// with a model fitted without it (one field: the field and its halves, with the model of
   /// the whole field). Ties (e.g. where no setting descends on the training fields) go to the
-  /// smaller z: the training fields give no evidence against descending.
+  /// larger z, the more cautious of settings the training fields cannot tell apart: a z at
+  /// which no training fold descends has not been shown to pay anywhere (docs/results.md,
+  /// "What any choice of z can buy").
   FrontAwarePolicy::Params front_aware{};
   std::vector<double> confidences = kDefaultConfidences;
   /// Front-aware rule, σ̂'s prior (FrontAwarePolicy `sigma_prior_weight` k, `sigma_prior_sd` τ)
@@ -366,7 +368,7 @@ template <SegmentationBackend Backend>
     std::size_t best = 0;
     for (std::size_t k = 1; k < trials.size(); ++k)
       if (trials[k].front_margin > trials[best].front_margin ||
-          (trials[k].front_margin == trials[best].front_margin && options.confidences[k] < options.confidences[best]))
+          (trials[k].front_margin == trials[best].front_margin && options.confidences[k] > options.confidences[best]))
         best = k;
     base.confidence = options.confidences[best];
     chosen = DecisionFunction(FrontAwarePolicy(model, reference, base));
