@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Black-box test of adaptseg_evaluate, the paper's experiment on a scene the decision function
-# never saw: initialised on Dubai tile 4, flown on tile 6 with the oracle, L = {road} (0.8 % of
+# never saw: initialised on Dubai tile 3, flown on tile 6 with the oracle, L = {road} (0.8 % of
 # tile 6's pixels: a spatially localised class). Checks results.csv's and decisions.csv's
 # columns, the figures (and the tour strategy's rows), a positive front margin for the adaptive strategy, and that a budget is
 # never exceeded.
@@ -9,7 +9,7 @@ set -uo pipefail
 evaluate=$1 examples=$2
 source "$(dirname "$0")/cli_common.sh"
 fixed=(--seg-time-s 0.1 --plan-time-s 0)
-"$evaluate" --train "$examples/data/dubai-tile-4" --test "$examples/data/dubai-tile-6" --interest road \
+"$evaluate" --train "$examples/data/dubai-tile-3" --test "$examples/data/dubai-tile-6" --interest road \
   "${fixed[@]}" --out "$work/e" >"$work/log" 2>&1 || fail "evaluate failed: $(tail -5 "$work/log")"
 for f in results.csv per_image.csv decisions.csv model.yaml miou_vs_time.png per_image_miou.png decisions.png paths.png \
   maps.png; do
