@@ -66,7 +66,7 @@ def main(out):
     fields = list(dict.fromkeys(r["field"] for r in rows))
 
     # Field mIoU vs execution time (paper Fig. results).
-    fig, axes = plt.subplots(1, len(fields), figsize=(6.5 * len(fields), 5), squeeze=False)
+    fig, axes = plt.subplots(1, len(fields), figsize=(6.5 * len(fields), 6.2), squeeze=False)
     for ax, field in zip(axes[0], fields):
         fr = [r for r in rows if r["field"] == field]
         lm = sorted((r for r in fr if r["strategy"] == "lawnmower"), key=lambda r: num(r["time_total"]))
@@ -87,7 +87,8 @@ def main(out):
         ax.set_ylabel("field mIoU over the labels of interest")
         ax.set_title(field, fontsize=10)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=8, loc="lower right")
+        # Below the axes: the strategies' points cluster where the legend would sit inside.
+        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
     fig.suptitle("Field mIoU vs execution time (above the lawnmower curve: front margin > 0)", fontsize=11)
     save(fig, os.path.join(out, "miou_vs_time.png"))
 
