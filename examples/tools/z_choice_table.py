@@ -52,17 +52,12 @@ def by_worst(folds):  # best worst fold, then best mean, then smaller z (margins
     return max(ZS, key=lambda z: (folds[z][1], folds[z][0], -float(z)))
 
 
-def by_mean_cautious(folds):  # best mean, ties (as printed) to the larger z: the more cautious of equals
-    return max(ZS, key=lambda z: (folds[z][0], float(z)))
-
-
 def main():
     if len(sys.argv) != 2:
         sys.exit(__doc__)
     runs = load(sys.argv[1])
-    rules = [("best mean over the folds (calibrate's choice)", lambda f, t: f["chosen"]),
-             ("best worst fold", lambda f, t: by_worst(f)),
-             ("best mean over the folds, ties to the larger z", lambda f, t: by_mean_cautious(f))]
+    rules = [("best mean over the folds, ties to the larger z (calibrate's choice)", lambda f, t: f["chosen"]),
+             ("best worst fold", lambda f, t: by_worst(f))]
     rules += [(f"fixed z = {z}", lambda f, t, z=z: z) for z in ZS]
     rules.append(("best z per run on the test field (ceiling)", lambda f, t: max(ZS, key=lambda z: t[z][0])))
     print("| z chosen by | runs | margin > 0 | margin >= -0.002 | median | mean | smallest |")
