@@ -62,10 +62,10 @@ struct CalibrationOptions {
   /// their spread instead, and the last two as `sigma_prior` says); `confidence`
   /// chosen among `confidences` by the mean front margin over the training fields, each flown
   /// with a model fitted without it (one field: the field and its halves, with the model of
-  /// the whole field). Ties (e.g. where no setting descends on the training fields) go to the
-  /// larger z, the more cautious of settings the training fields cannot tell apart: a z at
-  /// which no training fold descends has not been shown to pay anywhere (docs/results.md,
-  /// "What any choice of z can buy").
+  /// the whole field). Ties (several z at which no training fold descends, or which take the
+  /// same descents there) go to the larger z, the more cautious of settings the training
+  /// fields cannot tell apart: whatever a smaller z would add on a new field has not been seen
+  /// to pay on any of them (docs/results.md, "What any choice of z can buy").
   FrontAwarePolicy::Params front_aware{};
   std::vector<double> confidences = kDefaultConfidences;
   /// Front-aware rule, σ̂'s prior (FrontAwarePolicy `sigma_prior_weight` k, `sigma_prior_sd` τ)
