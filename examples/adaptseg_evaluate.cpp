@@ -197,7 +197,7 @@ int main(int argc, char** argv) {
     std::ofstream results(out_dir / "results.csv"), per_image(out_dir / "per_image.csv"),
         decisions_csv(out_dir / "decisions.csv");
     results << "field,strategy,gsd_cm,miou_interest,miou_all,time_total,time_flight,time_segmentation,"
-               "time_planning,images,front_margin,descents,altitude_changes\n";
+               "time_planning,images,front_margin,descents,altitude_changes,curve_front_margin\n";
     per_image << "field,strategy,gsd_cm,image,level,image_gsd_cm,sigma,image_miou_interest,image_miou_all,truth_sigma\n";
     decisions_csv << "field,strategy,decision,image,sigma,action,gsd_cm,images,extra_time_s,forecast_delta_sigma,"
                      "forecast_delta_miou,forecast_delta_miou_std,forecast_relabelled_interest,forecast_field_gain,forecast_front_margin,"
@@ -245,7 +245,10 @@ int main(int argc, char** argv) {
       const fs::path field_dir = out_dir / slug(field.name());
       for (const auto& row : rows) {
         const auto& m = row.run.mission;
+        // Against the curve's upper envelope (the honest margin), and against the curve itself,
+        // which differs where a lawnmower is slower and maps worse than a faster one.
         const double margin = adaptseg::front_margin(curve, m.total_s(), m.miou_interest().value_or(0.0));
+        const double curve_margin = adaptseg::curve_front_margin(curve, m.total_s(), m.miou_interest().value_or(0.0));
         const int descents = row.run.decisions
                                  ? static_cast<int>(std::count_if(row.run.decisions->begin(), row.run.decisions->end(),
                                                                   [](const auto& d) { return d.decision.descend; }))
@@ -253,7 +256,7 @@ int main(int argc, char** argv) {
         results << csv(field.name()) << ',' << row.strategy << ',' << fmt(row.gsd, 3) << ',' << csv(m.miou_interest())
                 << ',' << csv(m.miou_all()) << ',' << fmt(m.total_s(), 3) << ',' << fmt(m.flight_s, 3) << ','
                 << fmt(m.segmentation_s, 4) << ',' << fmt(m.planning_s, 4) << ',' << m.waypoints.size() << ','
-                << fmt(margin, 6) << ',' << descents << ',' << altitude_changes(m) << '\n';
+                << fmt(margin, 6) << ',' << descents << ',' << altitude_changes(m) << ',' << fmt(curve_margin, 6) << '\n';
         for (std::size_t k = 0; k < m.waypoints.size(); ++k) {
           const auto& w = m.waypoints[k];
           per_image << csv(field.name()) << ',' << row.strategy << ',' << fmt(row.gsd, 3) << ',' << k << ',' << w.level
@@ -269,6 +272,7 @@ int main(int argc, char** argv) {
         auto json = adaptseg::examples::result_json(field, m, mo, row.run.decisions ? &*row.run.decisions : nullptr);
         json["gsd_cm"] = row.gsd;
         json["front_margin"] = margin;
+        json["curve_front_margin"] = curve_margin;
         adaptseg::examples::write_text(dir / "result.json", json.dump(2) + "\n");
         std::vector<adaptseg::Waypoint> path;
         for (const auto& w : m.waypoints) path.push_back(w.waypoint);

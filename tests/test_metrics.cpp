@@ -2,6 +2,7 @@
 
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <vector>
 
 using namespace adaptseg;
@@ -69,4 +70,32 @@ TEST_CASE("metrics: per-image confusion compares at the orthomosaic's resolution
   CHECK(cm.total() == 7);
   CHECK(cm.count(0, 1) == 1);  // the soil pixel under the crop camera pixel
   CHECK(cm.iou(1).value() == doctest::Approx(3.0 / 4.0));
+}
+
+TEST_CASE("front margin: measured against the curve's upper envelope, not a curve that falls") {
+  // A lawnmower that is slower and maps worse (0.4 at 200 s) than a faster one (0.5 at 100 s).
+  const std::vector<CurvePoint> curve{{300.0, 0.6}, {100.0, 0.5}, {200.0, 0.4}};
+  const auto env = upper_envelope(curve);
+  REQUIRE(env.size() == 3);
+  CHECK(env[0].time_s == 100.0);
+  CHECK(env[0].miou == 0.5);
+  CHECK(env[1].time_s == doctest::Approx(250.0));  // where 200 -> 300 climbs back through 0.5
+  CHECK(env[1].miou == 0.5);
+  CHECK(env[2].time_s == 300.0);
+  CHECK(env[2].miou == 0.6);
+  // A mission of 0.45 at 200 s lies above the curve (0.4) but below the best lawnmower it could
+  // have flown in that time (0.5): the front margin says so; the curve's reading does not.
+  CHECK(front_margin(curve, 200.0, 0.45) == doctest::Approx(-0.05));
+  CHECK(curve_front_margin(curve, 200.0, 0.45) == doctest::Approx(0.05));
+  // Where the curve rises, both readings agree, and both are flat beyond the ends.
+  CHECK(front_margin(curve, 275.0, 0.6) == doctest::Approx(curve_front_margin(curve, 275.0, 0.6)));
+  CHECK(front_margin(curve, 50.0, 0.5) == 0.0);
+  CHECK(front_margin(curve, 400.0, 0.6) == 0.0);
+  // A rising curve is its own envelope.
+  const std::vector<CurvePoint> rising{{10.0, 0.1}, {20.0, 0.3}, {30.0, 0.35}};
+  const auto same = upper_envelope(rising);
+  REQUIRE(same.size() == rising.size());
+  for (std::size_t k = 0; k < same.size(); ++k) CHECK((same[k].time_s == rising[k].time_s && same[k].miou == rising[k].miou));
+  CHECK_THROWS_AS((void)upper_envelope({}), std::invalid_argument);
+  CHECK_THROWS_AS((void)front_margin({{1.0, NAN}}, 1.0, 0.5), std::invalid_argument);
 }

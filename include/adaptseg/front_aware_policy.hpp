@@ -53,9 +53,10 @@ struct ReferenceCurve {
 ///   enters Var ĝ as ĝ²·Var σ̂ / σ̂² (delta method). τ = 0 (one training field; model files
 ///   without `sigma_prior_sd`): none, the default. Calibration can estimate τ, or k and τ, on
 ///   several training fields (CalibrationOptions::sigma_prior; measured in docs/results.md);
-/// - the curve's rise ΔD over the descent's extra time, [T0, T0 + T], on each training field's
-///   predicted curve: mean ΔD̄ and spread sd_D over the training fields; beyond the curve's
-///   last point its last segment goes on (rising_curve_miou);
+/// - the curve's rise ΔD over the descent's extra time, [T0, T0 + T], on the upper envelope
+///   (upper_envelope(): never falling) of each training field's predicted curve: mean ΔD̄ and
+///   spread sd_D over the training fields; beyond the curve's last point its last segment goes
+///   on (rising_curve_miou);
 /// - the descent is worth its time if its lower bound (ĝ − ΔD̄) − z·sqrt(Var ĝ + sd_D²) > 0
 ///   (z = `confidence`, chosen on training fields; 0: the forecasts' means). The UAV descends
 ///   to the candidate of largest lower bound, if σ >= `min_sigma`. Since ΔD̄ grows with T0, it
@@ -165,13 +166,14 @@ class FrontAwarePolicy {
     detail::require(!c.lawnmowers.empty(),
                     "FrontAwarePolicy::decide: the context needs the field's lawnmower forecasts; count",
                     c.lawnmowers.size());
-    // Each training field's lawnmower accuracy, placed at this field's lawnmower times, in time
-    // order (curve_miou and rising_curve_miou read them there).
+    // Each training field's lawnmower accuracy, placed at this field's lawnmower times: the
+    // upper envelope of that predicted curve (the best lawnmower at a time or sooner, as the
+    // front margin reads it), in time order (curve_miou and rising_curve_miou read it there).
     std::vector<std::vector<CurvePoint>> curves;
     for (const auto& r : reference_) {
-      auto& curve = curves.emplace_back();
+      std::vector<CurvePoint> curve;
       for (const auto& f : c.lawnmowers) curve.push_back({f.time_s, miou_at_gsd(r.points, f.gsd_cm)});
-      std::sort(curve.begin(), curve.end(), [](const CurvePoint& a, const CurvePoint& b) { return a.time_s < b.time_s; });
+      curves.push_back(upper_envelope(std::move(curve)));
     }
     sigma_sum_ += c.sigma;
     ++sigma_count_;
