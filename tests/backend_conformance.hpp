@@ -14,7 +14,8 @@ namespace adaptseg::test {
 
 /// Segments images of `sensor`'s field at several GSDs and checks the contract: type and
 /// size, values in the class set or the ignore label, input untouched, same output for the
-/// same image, and a non-empty name.
+/// same image, and a non-empty name; for a backend that gives probabilities
+/// (SegmentsWithProbabilities), the same labels and probabilities that keep their contract.
 template <SegmentationBackend Backend>
 void check_backend_conformance(Backend& backend, const SimulatedSensor& sensor, int num_classes) {
   CHECK_FALSE(std::string(backend.name()).empty());
@@ -40,6 +41,16 @@ void check_backend_conformance(Backend& backend, const SimulatedSensor& sensor, 
       if (!rgb_before.empty()) CHECK(cv::norm(rgb_before, image.rgb, cv::NORM_INF) == 0.0);
       const cv::Mat again = backend.segment(image);
       CHECK(cv::countNonZero(again != labels) == 0);
+      if constexpr (SegmentsWithProbabilities<Backend>) {
+        // The same labels, with probabilities that keep the contract (check_probabilities).
+        const Segmentation s = backend.segment_with_probabilities(image);
+        CHECK(cv::countNonZero(s.labels != labels) == 0);
+        REQUIRE(s.probabilities.size() == static_cast<std::size_t>(num_classes));
+        CHECK_NOTHROW(check_probabilities(s.probabilities, s.labels, image, num_classes, "backend"));
+        const Segmentation s2 = backend.segment_with_probabilities(image);
+        for (std::size_t c = 0; c < s.probabilities.size(); ++c)
+          CHECK(cv::norm(s.probabilities[c], s2.probabilities[c], cv::NORM_INF) == 0.0);
+      }
     }
   }
 }

@@ -201,6 +201,41 @@ TEST_CASE("erfnet: probabilities are the softmax of the logits and black pixels 
   CHECK(cv::countNonZero(all != labels) == 30 * 40);
 }
 
+TEST_CASE("erfnet: labels and tempered probabilities from one pass") {
+  const Image img = fixture_image();
+  ErfnetSegmenter erfnet(model_dir(), ErfnetParams{.num_threads = 2});
+  const Segmentation s = erfnet.segment_with_probabilities(img);
+  CHECK(cv::countNonZero(s.labels != erfnet.segment(img)) == 0);
+  const auto probs = erfnet.probabilities(img);
+  REQUIRE(s.probabilities.size() == probs.size());
+  for (std::size_t c = 0; c < probs.size(); ++c) CHECK(cv::norm(s.probabilities[c], probs[c], cv::NORM_INF) == 0.0);
+  CHECK(erfnet.model_info().temperature > 0.0);
+  // The same network at temperature 2: the same labels, probabilities softmax(logits / 2).
+  t::TempDir tmp;
+  fs::copy_file(model_dir() / "model.onnx", tmp.path() / "model.onnx");
+  std::string yaml = t::read_file(model_dir() / "model.yaml");
+  if (const auto at = yaml.find("\ntemperature:"); at != std::string::npos) yaml.erase(at + 1, yaml.find('\n', at + 1) - at);
+  t::write_file(tmp.path() / "model.yaml", yaml + "temperature: 2\n");
+  ErfnetSegmenter warm(tmp.path(), ErfnetParams{.num_threads = 2});
+  CHECK(warm.model_info().temperature == 2.0);
+  const Segmentation w = warm.segment_with_probabilities(img);
+  CHECK(cv::countNonZero(w.labels != s.labels) == 0);
+  const auto logits = warm.logits(img);
+  int bad = 0;
+  for (int r = 0; r < img.height_px; r += 7)
+    for (int x = 0; x < img.width_px; x += 7) {
+      double z = 0.0;
+      for (const auto& l : logits) z += std::exp(l.at<float>(r, x) / 2.0);
+      for (std::size_t c = 0; c < logits.size(); ++c)
+        bad += std::abs(w.probabilities[c].at<float>(r, x) - std::exp(logits[c].at<float>(r, x) / 2.0) / z) > 1e-5 ? 1 : 0;
+    }
+  CHECK(bad == 0);
+  // A temperature outside [0.01, 100] is refused, naming the file.
+  t::write_file(tmp.path() / "model.yaml", yaml + "temperature: 0\n");
+  CHECK_THROWS_WITH_AS(ErfnetSegmenter(tmp.path()), doctest::Contains("temperature must be a number in [0.01, 100]"),
+                       std::invalid_argument);
+}
+
 TEST_CASE("erfnet: resize_to_network takes other camera sizes of the same aspect ratio") {
   const Image native = fixture_image();
   Image big = native;

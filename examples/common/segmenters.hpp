@@ -30,28 +30,47 @@ namespace adaptseg::examples {
 /// Memoises a deterministic backend: a simulated image is identified by its footprint, its
 /// yaw, its size and its RGB sums. For calibration, which flies the same waypoints many times,
 /// and only with a fixed segmentation time per image (a cache hit takes no time, so a measured
-/// time would be wrong).
+/// time would be wrong). Gives probabilities where the backend does (computed, and kept, the
+/// first time an image is asked for with them).
 template <SegmentationBackend Backend>
 class CachedBackend {
  public:
   explicit CachedBackend(Backend& inner) : inner_(inner) {}
   [[nodiscard]] std::string name() const { return inner_.name(); }
   [[nodiscard]] cv::Mat segment(const Image& image) {
-    const cv::Scalar sum = image.rgb.empty() ? cv::Scalar() : cv::sum(image.rgb);
-    const Key key{image.footprint_px.x, image.footprint_px.y, image.footprint_px.width,
-                  image.footprint_px.height, image.yaw_deg, image.width_px, image.height_px,
-                  sum[0], sum[1], sum[2]};
-    const auto it = cache_.find(key);
-    if (it != cache_.end()) return it->second.clone();
-    cv::Mat labels = inner_.segment(image);
-    cache_.emplace(key, labels.clone());
+    const Key key = key_of(image);
+    if (const auto it = cache_.find(key); it != cache_.end()) return it->second.labels.clone();
+    Segmentation s{inner_.segment(image), {}};
+    cv::Mat labels = s.labels.clone();
+    cache_.emplace(key, std::move(s));
     return labels;
+  }
+  [[nodiscard]] Segmentation segment_with_probabilities(const Image& image)
+    requires SegmentsWithProbabilities<Backend>
+  {
+    const Key key = key_of(image);
+    auto it = cache_.find(key);
+    if (it == cache_.end() || it->second.probabilities.empty()) {
+      Segmentation s = inner_.segment_with_probabilities(image);
+      if (it == cache_.end())
+        it = cache_.emplace(key, std::move(s)).first;
+      else
+        it->second = std::move(s);
+    }
+    Segmentation out{it->second.labels.clone(), {}};
+    for (const cv::Mat& p : it->second.probabilities) out.probabilities.push_back(p.clone());
+    return out;
   }
 
  private:
   using Key = std::tuple<int, int, int, int, double, int, int, double, double, double>;
+  static Key key_of(const Image& image) {
+    const cv::Scalar sum = image.rgb.empty() ? cv::Scalar() : cv::sum(image.rgb);
+    return {image.footprint_px.x, image.footprint_px.y, image.footprint_px.width, image.footprint_px.height,
+            image.yaw_deg, image.width_px, image.height_px, sum[0], sum[1], sum[2]};
+  }
   Backend& inner_;
-  std::map<Key, cv::Mat> cache_;
+  std::map<Key, Segmentation> cache_;
 };
 
 /// adaptseg::calibrate with `backend` cached: calibration flies the same waypoints many times

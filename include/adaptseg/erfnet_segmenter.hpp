@@ -41,6 +41,10 @@ struct ErfnetModelInfo {
   std::array<float, 3> std{};        ///< per input channel, > 0
   int output_stride = 1;             ///< logits are input / output_stride per side (`output.stride`, default 1)
   double width_multiplier = 0.0;     ///< informational (ERFNet; 1.0 = the paper's 16/64/128 channels)
+  /// T > 0 of the probabilities softmax(logits / T) (`temperature`, default 1): fitted on the
+  /// network's validation data so that its confidence matches its accuracy
+  /// (examples/tools/eval_segnet.py --fit-temperature); labels do not depend on it.
+  double temperature = 1.0;
 };
 
 /// Options of ErfnetSegmenter, validated once by its constructor.
@@ -79,7 +83,8 @@ struct ErfnetParams {
 ///
 /// Per image: BGR -> the network's channel order, `(v / 255 - mean) / std` per channel
 /// (exactly the training normalisation, from the metadata), forward, then argmax over the
-/// logits (ties to the lower class index) for `segment`, softmax for `probabilities`.
+/// logits (ties to the lower class index) for `segment`, softmax of the logits over the model's
+/// temperature for `probabilities` (both from one pass: `segment_with_probabilities`).
 /// Every pixel with RGB content gets a class: the network cannot know the field boundary,
 /// so pixels inside the footprint but outside the labelled field are labelled too (metrics
 /// skip them through the ground truth's ignore label). Pixels without RGB content (exactly
@@ -169,57 +174,32 @@ class ErfnetSegmenter {
   ///         with labels only), an RGB that is not CV_8UC3 of `width_px x height_px`, or a
   ///         size the network cannot take.
   [[nodiscard]] cv::Mat segment(const Image& image) {
-    const std::vector<cv::Mat> planes = logits(image);
-    const cv::Size size = planes.front().size();
-    cv::Mat labels(size, CV_8UC1);
-    const int n = num_classes();
-    std::vector<const float*> rows(static_cast<std::size_t>(n));
-    for (int r = 0; r < size.height; ++r) {
-      for (int c = 0; c < n; ++c) rows[static_cast<std::size_t>(c)] = planes[static_cast<std::size_t>(c)].ptr<float>(r);
-      auto* out = labels.ptr<std::uint8_t>(r);
-      for (int x = 0; x < size.width; ++x) {
-        int best = 0;
-        float best_v = rows[0][x];
-        for (int c = 1; c < n; ++c)
-          if (rows[static_cast<std::size_t>(c)][x] > best_v) {  // strict: ties keep the lower index
-            best_v = rows[static_cast<std::size_t>(c)][x];
-            best = c;
-          }
-        out[x] = static_cast<std::uint8_t>(best);
-      }
-    }
+    cv::Mat labels = argmax(logits(image));
     if (params_.black_is_no_data) labels.setTo(cv::Scalar(image.ignore_label), no_data_mask(image.rgb));
     return labels;
   }
 
-  /// Class probabilities: one CV_32FC1 plane per class, each `image.height_px x
-  /// image.width_px`, the softmax of the logits; they sum to 1 per pixel, except on pixels
-  /// without RGB content (see ErfnetParams::black_is_no_data), where all are 0.
+  /// segment() and probabilities() from one forward pass (SegmentsWithProbabilities).
   /// @throws std::invalid_argument as segment().
-  [[nodiscard]] std::vector<cv::Mat> probabilities(const Image& image) {
-    std::vector<cv::Mat> planes = logits(image);
-    const cv::Size size = planes.front().size();
-    const auto n = planes.size();
-    std::vector<float*> rows(n);
-    for (int r = 0; r < size.height; ++r) {
-      for (std::size_t c = 0; c < n; ++c) rows[c] = planes[c].ptr<float>(r);
-      for (int x = 0; x < size.width; ++x) {
-        float m = rows[0][x];
-        for (std::size_t c = 1; c < n; ++c) m = std::max(m, rows[c][x]);
-        float sum = 0.0f;
-        for (std::size_t c = 0; c < n; ++c) {
-          rows[c][x] = std::exp(rows[c][x] - m);
-          sum += rows[c][x];
-        }
-        for (std::size_t c = 0; c < n; ++c) rows[c][x] /= sum;
-      }
-    }
+  [[nodiscard]] Segmentation segment_with_probabilities(const Image& image) {
+    Segmentation s;
+    s.probabilities = logits(image);
+    s.labels = argmax(s.probabilities);
+    softmax_in_place(s.probabilities);
     if (params_.black_is_no_data) {
       const cv::Mat mask = no_data_mask(image.rgb);
-      for (auto& p : planes) p.setTo(cv::Scalar(0.0), mask);
+      s.labels.setTo(cv::Scalar(image.ignore_label), mask);
+      for (auto& p : s.probabilities) p.setTo(cv::Scalar(0.0), mask);
     }
-    return planes;
+    return s;
   }
+
+  /// Class probabilities: one CV_32FC1 plane per class, each `image.height_px x
+  /// image.width_px`, the softmax of the logits over the model's temperature
+  /// (ErfnetModelInfo::temperature); they sum to 1 per pixel, except on pixels without RGB
+  /// content (see ErfnetParams::black_is_no_data), where all are 0.
+  /// @throws std::invalid_argument as segment().
+  [[nodiscard]] std::vector<cv::Mat> probabilities(const Image& image) { return segment_with_probabilities(image).probabilities; }
 
   /// The raw network output: one CV_32FC1 plane of logits per class at the image's size
   /// (resampled bilinearly where the network's output size differs from it). No masking.
@@ -251,6 +231,50 @@ class ErfnetSegmenter {
   }
 
  private:
+  /// Per pixel, the index of the largest plane (ties to the lower index).
+  [[nodiscard]] static cv::Mat argmax(const std::vector<cv::Mat>& planes) {
+    const cv::Size size = planes.front().size();
+    cv::Mat labels(size, CV_8UC1);
+    const auto n = planes.size();
+    std::vector<const float*> rows(n);
+    for (int r = 0; r < size.height; ++r) {
+      for (std::size_t c = 0; c < n; ++c) rows[c] = planes[c].ptr<float>(r);
+      auto* out = labels.ptr<std::uint8_t>(r);
+      for (int x = 0; x < size.width; ++x) {
+        std::size_t best = 0;
+        float best_v = rows[0][x];
+        for (std::size_t c = 1; c < n; ++c)
+          if (rows[c][x] > best_v) {  // strict: ties keep the lower index
+            best_v = rows[c][x];
+            best = c;
+          }
+        out[x] = static_cast<std::uint8_t>(best);
+      }
+    }
+    return labels;
+  }
+
+  /// Logits -> softmax(logits / T) per pixel, in place.
+  void softmax_in_place(std::vector<cv::Mat>& planes) const {
+    const cv::Size size = planes.front().size();
+    const auto n = planes.size();
+    const auto inv_t = static_cast<float>(1.0 / info_.temperature);
+    std::vector<float*> rows(n);
+    for (int r = 0; r < size.height; ++r) {
+      for (std::size_t c = 0; c < n; ++c) rows[c] = planes[c].ptr<float>(r);
+      for (int x = 0; x < size.width; ++x) {
+        float m = rows[0][x];
+        for (std::size_t c = 1; c < n; ++c) m = std::max(m, rows[c][x]);
+        float sum = 0.0f;
+        for (std::size_t c = 0; c < n; ++c) {
+          rows[c][x] = std::exp((rows[c][x] - m) * inv_t);
+          sum += rows[c][x];
+        }
+        for (std::size_t c = 0; c < n; ++c) rows[c][x] /= sum;
+      }
+    }
+  }
+
   static std::filesystem::path checked_dir(const std::filesystem::path& dir) {
     if (!std::filesystem::is_directory(dir))
       throw std::invalid_argument("ErfnetSegmenter: model directory not found: " + dir.string());
@@ -331,6 +355,11 @@ class ErfnetSegmenter {
                                std::to_string(info.output_stride) + ")");
       }
       if (root["width"]) info.width_multiplier = root["width"].as<double>();
+      if (root["temperature"]) {
+        info.temperature = root["temperature"].as<double>();
+        if (!std::isfinite(info.temperature) || info.temperature < 0.01 || info.temperature > 100.0)
+          meta_error(file, "temperature must be a number in [0.01, 100] (got " + std::to_string(info.temperature) + ")");
+      }
     } catch (const YAML::Exception& e) {
       meta_error(file, std::string("malformed value: ") + e.what());
     }
@@ -472,5 +501,6 @@ class ErfnetSegmenter {
 };
 
 static_assert(SegmentationBackend<ErfnetSegmenter>);
+static_assert(SegmentsWithProbabilities<ErfnetSegmenter>);
 
 }  // namespace adaptseg

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace adaptseg {
 
@@ -150,6 +151,63 @@ inline void check_segmentation(const cv::Mat& labels, const Image& image, int nu
                                   " at pixel (x " + std::to_string(x) + ", y " + std::to_string(y) +
                                   ") is neither a class index 0.." + std::to_string(num_classes - 1) +
                                   " nor the ignore label " + std::to_string(image.ignore_label));
+    }
+  }
+}
+
+/// A segmentation as a backend may give it: per-pixel labels and, optionally, the class
+/// probabilities behind them (SegmentationBackend, SegmentsWithProbabilities).
+struct Segmentation {
+  /// CV_8UC1 of the image's size: a class index or the image's ignore label per pixel.
+  cv::Mat labels;
+  /// Empty (a labels-only backend), or one CV_32FC1 plane per class of the image's size: the
+  /// backend's probability of each class per pixel. On a pixel with a class label they are
+  /// in [0, 1] and sum to 1; on a pixel with the ignore label they are all 0 or sum to 1.
+  std::vector<cv::Mat> probabilities;
+};
+
+/// Checks `probabilities` of a segmentation of `image` with `labels` (already checked by
+/// check_segmentation()) against the contract of Segmentation: none, or `num_classes` CV_32FC1
+/// planes of the image's size, finite, in [0, 1], summing to 1 within `tolerance` on every
+/// pixel with a class label, and to 1 or 0 on pixels with the ignore label. Always on, as
+/// check_segmentation(): one pass over I_w x I_h x classes floats.
+/// @throws std::invalid_argument naming `who` and the number of planes, a plane's type or size,
+///         or the first bad pixel (column x, row y) with its value or sum.
+inline void check_probabilities(const std::vector<cv::Mat>& probabilities, const cv::Mat& labels, const Image& image,
+                                int num_classes, std::string_view who, double tolerance = 1e-3) {
+  if (probabilities.empty()) return;
+  const std::string source(who);
+  const std::string broke = source + " broke the segmentation contract: ";
+  detail::require(static_cast<int>(probabilities.size()) == num_classes,
+                  broke + "probabilities must have one plane per class (" + std::to_string(num_classes) + ")",
+                  probabilities.size());
+  for (const cv::Mat& p : probabilities) {
+    detail::require(p.type() == CV_32FC1, broke + "probability planes must be CV_32FC1",
+                    "type " + cv::typeToString(p.type()));
+    detail::require(p.cols == image.width_px && p.rows == image.height_px,
+                    broke + "probability planes must have the image's size " + std::to_string(image.width_px) + "x" +
+                        std::to_string(image.height_px),
+                    std::to_string(p.cols) + "x" + std::to_string(p.rows));
+  }
+  const auto where = [](int x, int y) { return " at pixel (x " + std::to_string(x) + ", y " + std::to_string(y) + ")"; };
+  std::vector<const float*> rows(probabilities.size());
+  for (int y = 0; y < image.height_px; ++y) {
+    for (std::size_t c = 0; c < rows.size(); ++c) rows[c] = probabilities[c].ptr<float>(y);
+    const auto* label = labels.ptr<unsigned char>(y);
+    for (int x = 0; x < image.width_px; ++x) {
+      double sum = 0.0;
+      for (std::size_t c = 0; c < rows.size(); ++c) {
+        const float v = rows[c][x];
+        if (!(v >= 0.0f && v <= 1.0f))  // NaN fails too
+          throw std::invalid_argument(broke + "probability " + std::to_string(v) + " of class " + std::to_string(c) +
+                                      where(x, y) + " is not in [0, 1]");
+        sum += v;
+      }
+      const bool one = std::abs(sum - 1.0) <= tolerance;
+      if (!one && !(label[x] == image.ignore_label && sum == 0.0))
+        throw std::invalid_argument(broke + "probabilities" + where(x, y) + " sum to " + std::to_string(sum) +
+                                    (label[x] == image.ignore_label ? ", neither 1 nor 0" : ", not 1") +
+                                    " (tolerance " + std::to_string(tolerance) + ")");
     }
   }
 }

@@ -33,7 +33,18 @@ class OracleSegmenter {
 
   /// @throws std::invalid_argument if the image carries no ground truth, or its ground
   ///         truth does not match its footprint.
-  [[nodiscard]] cv::Mat segment(const Image& image) const {
+  [[nodiscard]] cv::Mat segment(const Image& image) const { return vote(image, false).labels; }
+
+  /// segment() with the area vote behind each label as its probabilities: per camera pixel, the
+  /// share of the valid orthomosaic pixels it covers that are of each class (the oracle's
+  /// honest analogue of a network's softmax: 1 for the majority class of a pure pixel, split
+  /// where the pixel mixes classes, as a coarse camera pixel does on a class boundary). All 0
+  /// where no valid pixel votes (the ignore label). At the orthomosaic's GSD: one-hot.
+  /// @throws std::invalid_argument as segment().
+  [[nodiscard]] Segmentation segment_with_probabilities(const Image& image) const { return vote(image, true); }
+
+ private:
+  [[nodiscard]] Segmentation vote(const Image& image, bool with_probabilities) const {
     detail::require(!image.ground_truth.empty() && image.ground_truth.type() == CV_8UC1,
                     "OracleSegmenter::segment: the image carries no CV_8UC1 ground truth "
                     "(the oracle works on simulated images only)",
@@ -44,27 +55,54 @@ class OracleSegmenter {
     detail::require(image.width_px > 0 && image.height_px > 0,
                     "OracleSegmenter::segment: image size must be positive", image.width_px);
     const cv::Size out_size(image.width_px, image.height_px);
-    if (image.ground_truth.size() == out_size) return image.ground_truth.clone();
-
+    Segmentation out;
+    if (image.ground_truth.size() == out_size) {
+      out.labels = image.ground_truth.clone();
+      for (int c = 0; with_probabilities && c < num_classes_; ++c) {
+        cv::Mat one_hot;
+        cv::compare(out.labels, c, one_hot, cv::CMP_EQ);
+        one_hot.convertTo(one_hot, CV_32F, 1.0 / 255.0);
+        out.probabilities.push_back(one_hot);
+      }
+      return out;
+    }
     cv::Mat best_votes(out_size, CV_32F, cv::Scalar(0.0f));
-    cv::Mat labels(out_size, CV_8UC1, cv::Scalar(image.ignore_label));
+    cv::Mat total(out_size, CV_32F, cv::Scalar(0.0f));
+    out.labels = cv::Mat(out_size, CV_8UC1, cv::Scalar(image.ignore_label));
     cv::Mat indicator, votes;
     for (int c = 0; c < num_classes_; ++c) {
       cv::compare(image.ground_truth, c, indicator, cv::CMP_EQ);  // 255 where class c
-      if (cv::countNonZero(indicator) == 0) continue;
+      if (cv::countNonZero(indicator) == 0) {
+        if (with_probabilities) out.probabilities.emplace_back(out_size, CV_32F, cv::Scalar(0.0f));
+        continue;
+      }
       indicator.convertTo(indicator, CV_32F, 1.0 / 255.0);
       cv::resize(indicator, votes, out_size, 0, 0, cv::INTER_AREA);  // area fraction of c
       const cv::Mat better = votes > best_votes;  // strict: ties keep the lower index
       votes.copyTo(best_votes, better);
-      labels.setTo(c, better);
+      out.labels.setTo(c, better);
+      if (with_probabilities) {
+        total += votes;
+        out.probabilities.push_back(votes.clone());
+      }
     }
-    return labels;
+    if (with_probabilities) {
+      // Shares of the valid pixels (ignore pixels do not vote); none where no pixel votes.
+      const cv::Mat none = total <= 0.0f;
+      total.setTo(1.0f, none);
+      for (cv::Mat& p : out.probabilities) {
+        cv::divide(p, total, p);
+        p.setTo(0.0f, none);
+        cv::min(p, 1.0f, p);  // rounding of INTER_AREA
+      }
+    }
+    return out;
   }
 
- private:
   int num_classes_;
 };
 
 static_assert(SegmentationBackend<OracleSegmenter>);
+static_assert(SegmentsWithProbabilities<OracleSegmenter>);
 
 }  // namespace adaptseg

@@ -42,6 +42,20 @@ concept NamedBackend = requires(const B& backend) {
 template <typename B>
 concept SegmentationBackend = SegmentsImages<B> && NamedBackend<B>;
 
+/// Optionally, a backend says how sure it is: `segment_with_probabilities(image)` returns the
+/// labels `segment(image)` would give together with per-pixel class probabilities (Segmentation).
+/// Rationale: where a network hesitates is where flying lower can change its map (docs/method.md,
+/// "Decision inputs"); a labels-only backend still flies, with the decision inputs that need no
+/// probabilities.
+///
+/// Contract, beyond SegmentationBackend's: the labels equal `segment(image)`'s; `probabilities`
+/// holds one CV_32FC1 plane per class of the image's size, in [0, 1], summing to 1 on every
+/// labelled pixel (0 or 1 on ignore pixels; check_probabilities()). Same image, same output.
+template <typename B>
+concept SegmentsWithProbabilities = requires(B& backend, const Image& image) {
+  { backend.segment_with_probabilities(image) } -> std::same_as<Segmentation>;
+};
+
 /// `backend.segment(image)`, checked against the contract (check_segmentation()) for a class
 /// set of `num_classes` classes; what every planner and calibration of the library calls.
 /// @throws std::invalid_argument naming the backend if its labels break the contract, and
@@ -51,6 +65,25 @@ template <SegmentationBackend B>
   cv::Mat labels = backend.segment(image);
   check_segmentation(labels, image, num_classes, "segmentation backend '" + std::string(backend.name()) + "'");
   return labels;
+}
+
+/// The labels and, where the backend gives them (SegmentsWithProbabilities), the class
+/// probabilities of `image`, both checked against the contract (check_segmentation(),
+/// check_probabilities()) for a class set of `num_classes` classes. A labels-only backend gives
+/// empty probabilities.
+/// @throws std::invalid_argument naming the backend if its output breaks the contract, and
+///         whatever the backend throws.
+template <SegmentationBackend B>
+[[nodiscard]] Segmentation segment_with_probabilities_checked(B& backend, const Image& image, int num_classes) {
+  if constexpr (SegmentsWithProbabilities<B>) {
+    Segmentation s = backend.segment_with_probabilities(image);
+    const std::string who = "segmentation backend '" + std::string(backend.name()) + "'";
+    check_segmentation(s.labels, image, num_classes, who);
+    check_probabilities(s.probabilities, s.labels, image, num_classes, who);
+    return s;
+  } else {
+    return {segment_checked(backend, image, num_classes), {}};
+  }
 }
 
 }  // namespace adaptseg
