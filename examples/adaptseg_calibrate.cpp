@@ -115,6 +115,13 @@ int main(int argc, char** argv) {
     for (const auto& t : cal.trials)
       std::printf("  %-52s %9.1f %8.4f %+13.4f %+13.4f %8d\n", t.description.c_str(), t.time_s, t.miou_interest,
                   t.front_margin, t.worst_margin, t.descents);
+    if (!cal.cell_input_scores.empty()) {
+      std::printf("decision inputs tried for ranking the cells (share of the achievable gain the best 20 %% of the "
+                  "training fields' cells capture), the chosen one first:\n");
+      for (const auto& [input, score] : cal.cell_input_scores)
+        std::printf("  %-16s %+.3f\n", adaptseg::to_string(input).c_str(), score);
+      std::printf("%zu cell samples\n", cal.cell_samples.size());
+    }
     std::printf("%zu region samples; linear sigma range [%.4f, %.4f]; model -> %s\n", cal.samples.size(),
                 cal.linear.sigma_low, cal.linear.sigma_high, out_file.string().c_str());
     return 0;

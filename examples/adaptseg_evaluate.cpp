@@ -41,15 +41,16 @@ void write_decisions(std::ostream& os, const std::string& field, const std::stri
   std::size_t next_realised = 0;
   for (std::size_t k = 0; k < decisions.size(); ++k) {
     const auto& d = decisions[k];
-    // The candidate the row describes: the chosen one, else the one with the best forecast.
+    // The candidate the row describes: the chosen one, else the one with the best forecast (field
+    // gain where the rule makes one, else ΔmIoU).
     std::optional<std::size_t> c;
-    for (std::size_t i = 0; i < d.candidates.size(); ++i) {
-      if (d.decision.descend) {
-        if (d.candidates[i].gsd_cm == d.decision.gsd_cm) c = i;
-      } else if (i < d.decision.scores.size() &&
-                 (!c || d.decision.scores[i].predicted_delta_miou < d.decision.scores[*c].predicted_delta_miou)) {
+    if (d.decision.descend) c = adaptseg::chosen_candidate(d.decision, d.candidates, strategy);
+    for (std::size_t i = 0; !d.decision.descend && i < d.candidates.size() && i < d.decision.scores.size(); ++i) {
+      const auto& s = d.decision.scores[i];
+      const bool by_gain = std::isfinite(s.predicted_field_gain);
+      if (!c || (by_gain ? s.predicted_field_gain > d.decision.scores[*c].predicted_field_gain
+                         : s.predicted_delta_miou < d.decision.scores[*c].predicted_delta_miou))
         c = i;
-      }
     }
     const adaptseg::RealisedDescent* r = nullptr;
     if (next_realised < realised.size() && realised[next_realised].decision == k) r = &realised[next_realised++];
@@ -220,7 +221,7 @@ int main(int argc, char** argv) {
       };
       std::vector<Row> rows;
       std::vector<adaptseg::CurvePoint> curve;
-      const auto fly = [&](const std::string& strategy, double gsd) {
+      const auto fly = [&](const std::string& strategy, double gsd) {  // gsd: lawnmower GSD, or the model's top
         ++run_index;
         std::fprintf(stderr, "[%6.1f s] (%zu/%zu) %s: %s%s ...", elapsed(), run_index, total_runs, field.name().c_str(),
                      strategy.c_str(), strategy == "lawnmower" ? (" " + fmt(gsd, 2) + " cm/px").c_str() : "");
@@ -234,6 +235,14 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, " %zu images, %.1f s, mIoU %.4f\n", run.mission.waypoints.size(), run.mission.total_s(),
                      run.mission.miou_interest().value_or(NAN));
         progress_open = false;
+        // A model-based strategy reports the GSD its top level flew at (the policy may choose
+        // another than the model's nominal one: ChoosesTopLevel).
+        if (strategy != "lawnmower")
+          for (const auto& w : run.mission.waypoints)
+            if (w.level == 0) {
+              gsd = w.waypoint.gsd_cm;
+              break;
+            }
         rows.push_back({strategy, gsd, std::move(run)});
       };
       for (double f : lawnmower_factors) {

@@ -266,9 +266,9 @@ void fly(const ImageSetInfo& info, const std::vector<PosedImage>& images, Backen
     if (step.decision) {
       const auto& d = step.decision->decision;
       if (d.descend) {
-        const auto c = std::find_if(step.decision->candidates.begin(), step.decision->candidates.end(),
-                                    [&](const adaptseg::Candidate& k) { return k.gsd_cm == d.gsd_cm; });
-        std::printf("  -> descend to %.2f cm/px (%d images, +%.1f s)", d.gsd_cm, c->images, c->extra_time_s);
+        const adaptseg::Candidate& c =
+            step.decision->candidates[adaptseg::chosen_candidate(d, step.decision->candidates, policy.name())];
+        std::printf("  -> descend to %.2f cm/px (%d images, +%.1f s)", d.gsd_cm, c.images, c.extra_time_s);
       } else {
         std::printf("  -> continue (%zu candidates%s)", step.decision->candidates.size(),
                     step.decision->budget_limited ? ", budget-limited" : "");

@@ -150,6 +150,71 @@ TEST_CASE("adaptive planner: coverage 'interest' re-maps only the sub-cells that
   CHECK(focused.mission.waypoints.size() == 2 + 1);
 }
 
+TEST_CASE("adaptive planner: coverage 'ranked' offers the best k cells by their expected error, for every k") {
+  // Two top-level regions of 3 x 3 sub-cells at 1 cm/px; in the first, a small crop patch in
+  // the top-left cell and a larger one in the bottom-right cell, both with edges off the 3 cm/px
+  // grid, so that the oracle's top-level pixels on their edges are mixed (its expected error);
+  // the second region is all soil.
+  cv::Mat labels(1080, 2880, CV_8UC1, cv::Scalar(0));
+  labels(cv::Rect(50, 50, 100, 100)).setTo(1);
+  labels(cv::Rect(1000, 751, 301, 250)).setTo(1);
+  const Field f("patches", 1.0, labels, t::soil_crop_weed(), {1});
+  OracleSegmenter oracle(f.num_classes());
+  AdaptiveOptions o = options();
+  o.candidate_gsd_cm = {1.0};
+  o.coverage = DescentCoverage::ranked;
+  o.cell_input = DecisionInput::expected_error;
+  // Descends to the candidate at index `pick` (clamped), wherever there is one.
+  struct Pick {
+    std::size_t pick = 0;
+    std::vector<std::vector<Candidate>> offered{};
+    std::string name() const { return "pick"; }
+    void begin_mission() { offered.clear(); }
+    Decision decide(const DecisionContext& c) {
+      offered.emplace_back(c.candidates.begin(), c.candidates.end());
+      Decision d;
+      if (c.candidates.empty()) return d;
+      d.descend = true;
+      d.candidate = std::min(pick, c.candidates.size() - 1);
+      d.gsd_cm = c.candidates[d.candidate].gsd_cm;
+      d.scores.resize(c.candidates.size());
+      return d;
+    }
+    void observe(const DescentOutcome&) {}
+  };
+  static_assert(DecisionPolicy<Pick>);
+  Pick best_one{.pick = 0};
+  const AdaptiveResult one = run_adaptive_mission(f, oracle, best_one, o, "one");
+  REQUIRE(best_one.offered.size() == 2);
+  REQUIRE(best_one.offered[0].size() == 2);  // k = 1 and k = 2: the two cells with mixed pixels
+  CHECK(best_one.offered[1].empty());        // all soil: no error to correct, nothing offered
+  const Candidate& k1 = best_one.offered[0][0];
+  const Candidate& k2 = best_one.offered[0][1];
+  CHECK(k1.images == 1);
+  CHECK(k2.images == 2);
+  REQUIRE(k1.cells.size() == 1);
+  REQUIRE(k2.cells.size() == 2);
+  CHECK(k1.extra_time_s < k2.extra_time_s);
+  // The best cell is the larger patch's (more boundary, more expected error) ...
+  const double big = k1.cells[0].mass(DecisionInput::expected_error);
+  CHECK(big > 0.0);
+  for (const auto& c : k2.cells) CHECK(c.mass(DecisionInput::expected_error) <= big);
+  // ... and the descent of k = 1 flies over it alone.
+  REQUIRE(one.descents() == 1);
+  std::vector<Waypoint> low;
+  for (const auto& w : one.mission.waypoints)
+    if (w.level == 1) low.push_back(w.waypoint);
+  REQUIRE(low.size() == 1);
+  const cv::Rect cell = f.pixel_rect(low.front().footprint);
+  CHECK((cell & cv::Rect(1000, 751, 301, 250)) == cv::Rect(1000, 751, 301, 250));
+  // Both cells re-mapped at the field's GSD: the map is exact.
+  Pick both{.pick = 1};
+  const AdaptiveResult two = run_adaptive_mission(f, oracle, both, o, "two");
+  CHECK(two.mission.miou_interest().value() == 1.0);
+  CHECK(one.mission.miou_interest().value() < 1.0);
+  CHECK(two.mission.waypoints.size() == 2 + 2);
+}
+
 TEST_CASE("adaptive planner: the budget is never exceeded and the top level is always covered") {
   const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
   OracleSegmenter oracle(f.num_classes());

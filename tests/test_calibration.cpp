@@ -177,6 +177,76 @@ TEST_CASE("calibration: by default the front-aware rule, its confidence chosen o
     }
 }
 
+TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the input that ranks them best is chosen") {
+  const Field a = t::blob_field(1300, 1000, 1.0, 4, 15);
+  const Field b = t::blob_field(1000, 1300, 1.0, 11, 15);
+  OracleSegmenter oracle(a.num_classes());
+  CalibrationOptions options = small_options();
+  options.adaptive.coverage = DescentCoverage::ranked;
+  options.confidences = {0.0, 1.0};
+  const std::vector<Field> fields{a, b};
+  const CalibrationResult cal = calibrate(std::span<const Field>(fields), oracle, options);
+  REQUIRE_FALSE(cal.cell_samples.empty());
+  // Every input of the table is known from the oracle (it gives probabilities) and scored; the
+  // chosen one first, with the best capture.
+  REQUIRE(cal.cell_input_scores.size() == kDecisionInputCount);
+  for (const auto& [input, score] : cal.cell_input_scores) CHECK(score <= cal.cell_input_scores.front().second);
+  const auto& cells = cal.decision_function.model().cells();
+  REQUIRE(cells.has_value());
+  CHECK(cells->input() == cal.cell_input_scores.front().first);
+  // Cells of both fields at both candidate GSDs; each re-mapped alone.
+  std::size_t at_g0 = 0;
+  for (const CellSample& c : cal.cell_samples) {
+    CHECK(c.field < 2);
+    CHECK(c.top.field_px > 0.0);
+    CHECK(c.relabelled >= 0.0);
+    if (c.sub_gsd_cm == 1.0) ++at_g0;
+  }
+  CHECK(at_g0 > 0);
+  CHECK(at_g0 < cal.cell_samples.size());
+  // The oracle's expected error is the share of pixels its top-level map has wrong, and a cell
+  // re-mapped at the field's own GSD is exact: nearly all of it is gained (β near 1, the field's
+  // σ standing in for its union of L), and re-mapping the best fifth of the cells by it captures
+  // a large part of the achievable gain.
+  const CellGainModel by_error = CellGainModel::fit(cal.cell_samples, DecisionInput::expected_error);
+  CHECK(by_error.at(3.0, 1.0).gain_slope > 0.7);
+  CHECK(by_error.at(3.0, 1.0).gain_slope < 1.2);
+  // Cells seen from the coarsest candidate GSD too (the alternative top level), re-mapped below it.
+  CHECK(cells->top_gsds() == std::vector<double>{2.0, 3.0});
+  CHECK(std::any_of(cal.cell_samples.begin(), cal.cell_samples.end(),
+                    [](const CellSample& c) { return c.top_gsd_cm == 2.0 && c.sub_gsd_cm == 1.0; }));
+  CHECK(cell_ranking_capture(cal.cell_samples, DecisionInput::expected_error) > 0.3);
+  // The model file keeps the cell model; a mission from it ranks by the same input.
+  t::TempDir tmp;
+  const DecisionModel model = make_decision_model(std::span<const Field>(fields), oracle.name(), options, cal);
+  CHECK(model.coverage == DescentCoverage::ranked);
+  model.save(tmp.path() / "model.yaml");
+  const DecisionModel back = DecisionModel::load(tmp.path() / "model.yaml");
+  REQUIRE(back.decision_function.model().cells().has_value());
+  const auto& back_cells = *back.decision_function.model().cells();
+  CHECK(back_cells.input() == cells->input());
+  REQUIRE(back_cells.points().size() == cells->points().size());
+  for (std::size_t k = 0; k < cells->points().size(); ++k) {
+    CHECK(back_cells.points()[k].gain_slope == cells->points()[k].gain_slope);
+    CHECK(back_cells.points()[k].relabel_noise == cells->points()[k].relabel_noise);
+  }
+  const AdaptiveOptions ao = back.adaptive_options(MissionOptions{});
+  CHECK(ao.coverage == DescentCoverage::ranked);
+  CHECK(ao.cell_input == cells->input());
+  // A labels-only choice: only the inputs the labels give are tried.
+  options.cell_inputs = {DecisionInput::sigma, DecisionInput::boundary};
+  const CalibrationResult labels_only = calibrate(std::span<const Field>(fields), oracle, options);
+  REQUIRE(labels_only.cell_input_scores.size() == 2);
+  // A ranked model without its cell model is refused when read.
+  std::string text = t::read_file(tmp.path() / "model.yaml");
+  const auto at = text.find("  cells:");
+  REQUIRE(at != std::string::npos);
+  const auto end = text.find("\nrule:", at);
+  t::write_file(tmp.path() / "no_cells.yaml", text.substr(0, at) + text.substr(end + 1));
+  CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "no_cells.yaml"), doctest::Contains("cell gain model"),
+                       std::invalid_argument);
+}
+
 TEST_CASE("calibration: confidence levels the training fields cannot tell apart go to the more cautious") {
   // At z = 20 and z = 40 no forecast's lower bound beats the curve: neither setting descends,
   // both fly the lawnmower and tie exactly. The tie goes to the larger z, in either order.
@@ -335,7 +405,7 @@ TEST_CASE("decision model: file round trip and compatibility checks") {
     t::write_file(tmp.path() / "old.yaml", std::string(text).erase(at, std::string("descent_coverage: interest\n").size()));
     CHECK(DecisionModel::load(tmp.path() / "old.yaml").coverage == DescentCoverage::region);
     t::write_file(tmp.path() / "bad.yaml", std::string(text).replace(at, 26, "descent_coverage: everywhere"));
-    CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "bad.yaml"), doctest::Contains("'region' or 'interest'"),
+    CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "bad.yaml"), doctest::Contains("'region', 'interest' or 'ranked'"),
                          std::invalid_argument);
   }
   {  // the vertical speed limit: kept when set, absent from the file (0) when not

@@ -785,7 +785,7 @@ TEST_CASE("robustness: decision model: refit count out of range") {
 TEST_CASE("robustness: decision model: unknown descent coverage") {
   const t::TempDir dir;
   const std::string text = replaced(model_text(), "descent_coverage: region", "descent_coverage: everywhere");
-  CHECK_THROWS_WITH_AS((void)load_model_text(dir, text), Contains("'region' or 'interest'"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, text), Contains("'region', 'interest' or 'ranked'"), std::invalid_argument);
 }
 
 TEST_CASE("robustness: decision model: I with three inputs") {

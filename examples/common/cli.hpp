@@ -164,6 +164,7 @@ struct CalibrationCli {
   std::vector<double> confidences = kDefaultConfidences;
   std::string sigma_prior = "given";
   std::optional<double> segmentation_time_s;
+  std::vector<std::string> cell_inputs;
 
   void add_to(CLI::App& app) {
     options_ = {
@@ -175,10 +176,17 @@ struct CalibrationCli {
         app.add_option("--threshold-steps", threshold_steps, "utility thresholds tried per weighting")
             ->capture_default_str(),
         app.add_option("--coverage", coverage,
-                       "what a descent re-maps: region (the whole top-level footprint, the paper's) or interest "
-                       "(only the cells where the top-level image shows a label of interest); saved in the model")
-            ->check(CLI::IsMember({"region", "interest"}))
+                       "what a descent re-maps: region (the whole top-level footprint, the paper's), interest "
+                       "(only the cells where the top-level image shows a label of interest) or ranked (the cells "
+                       "ranked by a decision input of the top-level image, e.g. the network's expected error about "
+                       "L; the number of cells chosen in flight); saved in the model")
+            ->check(CLI::IsMember({"region", "interest", "ranked"}))
             ->capture_default_str(),
+        app.add_option("--cell-input", cell_inputs,
+                       "coverage ranked: the decision inputs tried for ranking and forecasting cells, comma-separated "
+                       "(default: every one the backend gives; the one that ranks the training fields' cells best is "
+                       "saved in the model)")
+            ->delimiter(','),
         app.add_option("--gain-inputs", gain_inputs,
                        "what the GP I predicts the accuracy gain from: delta-sigma (the paper's) or "
                        "delta-sigma-height (the change of semantic ratio and of altitude)")
@@ -219,6 +227,8 @@ struct CalibrationCli {
                           : sigma_prior == "estimated" ? CalibrationOptions::SigmaPriorSource::estimated
                                                        : CalibrationOptions::SigmaPriorSource::given;
     options.adaptive.coverage = parse_descent_coverage(coverage);
+    options.cell_inputs.clear();
+    for (const auto& name : cell_inputs) options.cell_inputs.push_back(parse_decision_input(name));
     options.fit.gain_inputs = gain_inputs == "delta-sigma-height" ? GainModel::GainInputs::delta_sigma_and_height
                                                                   : GainModel::GainInputs::delta_sigma;
     options.segmentation_time_s = segmentation_time_s.value_or(common.seg_time_s.value_or(0.1));
@@ -279,7 +289,10 @@ inline nlohmann::json result_json(const Field& field, const MissionResult& r, co
       json dj{{"action", d.decision.descend ? "descend" : "continue"},
               {"sigma", d.sigma},
               {"budget_limited", d.budget_limited}};
-      if (d.decision.descend) dj["gsd_cm"] = d.decision.gsd_cm;
+      if (d.decision.descend) {
+        dj["gsd_cm"] = d.decision.gsd_cm;
+        dj["candidate"] = chosen_candidate(d.decision, d.candidates, "result_json");
+      }
       json cands = json::array();
       for (std::size_t k = 0; k < d.candidates.size(); ++k) {
         json cj{{"gsd_cm", d.candidates[k].gsd_cm},

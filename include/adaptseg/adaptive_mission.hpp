@@ -83,8 +83,11 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
       descents.push_back({w->decision, region, planner.map().labels()(region).clone(),
                           covered & cv::Rect(0, 0, field.width_px(), field.height_px()), w->waypoint.gsd_cm});
     }
-    const auto visit = mission.visit_without_fusion(w->waypoint, w->level);
-    planner.report(visit.image, visit.labels, visit.record->segmentation_s, mission.elapsed_s());
+    // The top-level images with the backend's class probabilities where the decision reads them.
+    const bool probabilities = w->level == 0 && options.coverage == DescentCoverage::ranked;
+    auto visit = mission.visit_without_fusion(w->waypoint, w->level, probabilities);
+    planner.report(visit.image, Segmentation{visit.labels, std::move(visit.probabilities)},
+                   visit.record->segmentation_s, mission.elapsed_s());
     if (w->level == 0) top_only.fuse(visit.image, visit.labels);
   }
   // In decision order (a tour flies them in its own).

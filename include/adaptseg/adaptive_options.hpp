@@ -7,6 +7,7 @@
 /// compile it.
 
 #include <adaptseg/decision.hpp>
+#include <adaptseg/decision_inputs.hpp>
 #include <adaptseg/lawnmower_planner.hpp>
 #include <adaptseg/mission_options.hpp>
 
@@ -69,6 +70,9 @@ struct AdaptiveOptions {
   /// What a descent re-maps: the whole region (the paper) or only its cells that show a label
   /// of interest (DescentCoverage). A decision model must be calibrated with the same.
   DescentCoverage coverage = DescentCoverage::region;
+  /// DescentCoverage::ranked: the decision input whose mass over a cell ranks the cells
+  /// (decision_inputs.hpp); a decision model sets the one it was calibrated with.
+  DecisionInput cell_input = DecisionInput::expected_error;
   /// When the chosen descents are flown: at once (the paper), or deferred to a tour after the
   /// survey or after each lawnmower row where that is cheaper.
   DescentSchedule schedule = DescentSchedule::immediate;

@@ -14,6 +14,7 @@
 #include <adaptseg/adaptive_options.hpp>
 #include <adaptseg/camera.hpp>
 #include <adaptseg/decision.hpp>
+#include <adaptseg/image_summary.hpp>
 #include <adaptseg/inspection_tour.hpp>
 #include <adaptseg/lawnmower_planner.hpp>
 #include <adaptseg/metrics.hpp>
@@ -30,6 +31,7 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -122,8 +124,6 @@ class AdaptivePlanner {
       detail::require(std::isfinite(*options_.budget_s) && *options_.budget_s > 0.0,
                       "AdaptivePlanner: budget_s must be finite and > 0", *options_.budget_s);
 
-    top_ = LawnmowerPlanner(camera_).plan(area_.area, options_.top_gsd_cm,
-                                          Eigen::Vector2d(area_.area.x_min_m, area_.area.y_min_m), keep());
     // The area's lawnmowers at the candidate and top GSDs (what the mission could fly instead;
     // planned as run_lawnmower_mission plans them), for front-aware policies.
     for (double g : candidates_) lawnmowers_.push_back({g, 0.0, 0});
@@ -134,6 +134,22 @@ class AdaptivePlanner {
       l.flight_s = plan_flight_s(plan);
       l.images = plan.size();
     }
+    // The top level: the options' top GSD, or another of the lawnmower GSDs where the policy
+    // chooses one (ChoosesTopLevel); descents go to the candidates finer than it.
+    top_gsd_cm_ = options_.top_gsd_cm;
+    if constexpr (ChoosesTopLevel<Policy>) {
+      const double g = policy_.top_gsd(lawnmower_forecasts(), options_.top_gsd_cm);
+      const bool known = std::any_of(lawnmowers_.begin(), lawnmowers_.end(), [&](const LawnmowerCost& l) { return l.gsd_cm == g; });
+      const bool below = std::any_of(candidates_.begin(), candidates_.end(), [&](double c) { return c < g; });
+      if (!known || !below)
+        throw std::logic_error("decision policy '" + std::string(policy_.name()) + "' chose the top-level GSD " +
+                               std::to_string(g) + " cm/px, which is not one of the lawnmower GSDs with a candidate "
+                               "below it");
+      top_gsd_cm_ = g;
+      std::erase_if(candidates_, [&](double c) { return c >= g; });
+    }
+    top_ = LawnmowerPlanner(camera_).plan(area_.area, top_gsd_cm_,
+                                          Eigen::Vector2d(area_.area.x_min_m, area_.area.y_min_m), keep());
     valid_px_ = cv::countNonZero(area_.valid_mask);
     charge_measured_planning(seconds_since(t0));
     window_last_.resize(top_.size());
@@ -195,11 +211,14 @@ class AdaptivePlanner {
   PlannerStep report(const Image& image, std::optional<double> elapsed_s = std::nullopt) {
     check_report(image, elapsed_s);
     const auto t0 = std::chrono::steady_clock::now();
-    const cv::Mat labels = backend_.segment(image);
+    // A top-level image with the backend's class probabilities where it gives them and the
+    // decision reads them (DescentCoverage::ranked: the cells' decision inputs,
+    // image_summary.hpp); otherwise the labels alone.
+    const bool probabilities = path_.back().level == 0 && options_.coverage == DescentCoverage::ranked;
+    Segmentation s = probabilities ? segment_with_probabilities_checked(backend_, image, area_.num_classes)
+                                   : Segmentation{segment_checked(backend_, image, area_.num_classes), {}};
     const double segmentation_s = seconds_since(t0);  // the network's time, as Mission measures it
-    check_segmentation(labels, image, area_.num_classes,
-                       "segmentation backend '" + std::string(backend_.name()) + "'");
-    return accept(image, labels, segmentation_s, elapsed_s);
+    return accept(image, s, segmentation_s, elapsed_s);
   }
 
   /// Reports the image taken at the pending waypoint with its segmentation `labels`, which
@@ -214,11 +233,23 @@ class AdaptivePlanner {
   ///         contract (check_segmentation()), or a time that is negative or not finite.
   PlannerStep report(const Image& image, const cv::Mat& labels, double segmentation_s,
                      std::optional<double> elapsed_s = std::nullopt) {
+    return report(image, Segmentation{labels, {}}, segmentation_s, elapsed_s);
+  }
+
+  /// As the labels overload, with the class probabilities behind the labels where the caller's
+  /// segmentation gives them (Segmentation; the decision inputs that need them are unknown
+  /// without).
+  /// @throws std::invalid_argument as the labels overload, and for probabilities that break
+  ///         their contract (check_probabilities()).
+  PlannerStep report(const Image& image, const Segmentation& segmentation, double segmentation_s,
+                     std::optional<double> elapsed_s = std::nullopt) {
     check_report(image, elapsed_s);
-    check_segmentation(labels, image, area_.num_classes, "AdaptivePlanner::report: the labels reported");
+    check_segmentation(segmentation.labels, image, area_.num_classes, "AdaptivePlanner::report: the labels reported");
+    check_probabilities(segmentation.probabilities, segmentation.labels, image, area_.num_classes,
+                        "AdaptivePlanner::report: the probabilities reported");
     detail::require(std::isfinite(segmentation_s) && segmentation_s >= 0.0,
                     "AdaptivePlanner::report: segmentation_s must be finite and >= 0", segmentation_s);
-    return accept(image, labels, segmentation_s, elapsed_s);
+    return accept(image, segmentation, segmentation_s, elapsed_s);
   }
 
   /// The Image of a camera frame `rgb` (CV_8UC3 of the camera's size, or empty) taken at
@@ -272,7 +303,7 @@ class AdaptivePlanner {
     const cv::Rect region = region_rect(top_index);
     const cv::Mat labels = map_.labels()(region);
     const auto keep_cell = [&](const Area& a) {
-      return valid_pixels(a) > 0 && cell_shows_interest(labels, pixel_rect(a) - region.tl(), options_.top_gsd_cm,
+      return valid_pixels(a) > 0 && cell_shows_interest(labels, pixel_rect(a) - region.tl(), top_gsd_cm_,
                                                          area_.map_gsd_cm, options_.mission.interest);
     };
     return LawnmowerPlanner(camera_).plan(t.footprint, gsd_cm, Eigen::Vector2d(t.position.x(), t.position.y()),
@@ -293,7 +324,11 @@ class AdaptivePlanner {
 
   /// The top-level lawnmower W^{h_max}.
   [[nodiscard]] const std::vector<Waypoint>& top_level() const noexcept { return top_; }
-  /// The candidate GSDs a descent may fly [cm/px] (those not finer than the map).
+  /// The GSD it is flown at [cm/px]: the options' top GSD, or the policy's choice
+  /// (ChoosesTopLevel).
+  [[nodiscard]] double top_gsd_cm() const noexcept { return top_gsd_cm_; }
+  /// The candidate GSDs a descent may fly [cm/px] (those not finer than the map, finer than
+  /// the top level).
   [[nodiscard]] const std::vector<double>& candidate_gsd_cm() const noexcept { return candidates_; }
   /// Every waypoint next() may hand out: the top level and, per region, every candidate's
   /// sub-lawnmower (what a pre-recorded image set must cover).
@@ -367,8 +402,9 @@ class AdaptivePlanner {
 
   /// A reported image and its checked labels: the time account, the fused map, and at a
   /// top-level waypoint the decision, after a descent's last image its outcome.
-  PlannerStep accept(const Image& image, const cv::Mat& labels, double segmentation_s,
+  PlannerStep accept(const Image& image, const Segmentation& segmentation, double segmentation_s,
                      std::optional<double> elapsed_s) {
+    const cv::Mat& labels = segmentation.labels;
     pending_ = false;
     reported_elapsed_s_ = elapsed_s;
     const PlannedWaypoint& p = path_.back();
@@ -384,7 +420,7 @@ class AdaptivePlanner {
     step.waypoint = p;
     step.sigma = semantic_ratio(labels, options_.mission.interest, image.ignore_label);
     if (p.level == 0)
-      step.decision = decide(p, step.sigma);
+      step.decision = decide(p, step.sigma, image, segmentation);
     else if (sub_next_ == sub_.size())
       step.outcome = finish_descent();
     return step;
@@ -459,6 +495,15 @@ class AdaptivePlanner {
                       "AdaptivePlanner::report: elapsed_s must be finite and >= 0", *elapsed_s);
   }
 
+  /// The area's lawnmowers at the candidate and nominal top GSDs with their forecast times:
+  /// flight plus the per-image segmentation and planning estimates.
+  [[nodiscard]] std::vector<LawnmowerForecast> lawnmower_forecasts() const {
+    const double per_image = segmentation_estimate() + planning_estimate();
+    std::vector<LawnmowerForecast> out;
+    for (const auto& l : lawnmowers_) out.push_back({l.gsd_cm, l.flight_s + static_cast<double>(l.images) * per_image});
+    return out;
+  }
+
   /// Flight time along `plan`'s waypoints, in order [s].
   [[nodiscard]] double plan_flight_s(const std::vector<Waypoint>& plan) const {
     double t = 0.0;
@@ -466,8 +511,56 @@ class AdaptivePlanner {
     return t;
   }
 
+  /// What a descent at top-level waypoint i may fly at one GSD: its sub-lawnmower and, for
+  /// DescentCoverage::ranked, the cells it re-maps.
+  struct DescentOption {
+    double gsd_cm = 0.0;
+    std::vector<Waypoint> plan;
+    std::vector<CellInputs> cells;
+  };
+
+  /// Every descent the decision at top-level waypoint i may choose from, per candidate GSD:
+  /// descent_plan() (DescentCoverage::region, interest), or for DescentCoverage::ranked the
+  /// cells of the region's sub-lawnmower ranked by their mass of `options().cell_input` in the
+  /// top-level image (`image`, `segmentation`), one option per number k of the best cells
+  /// (cells without any of the input left out), each flown in the sub-lawnmower's order.
+  [[nodiscard]] std::vector<DescentOption> descent_options(std::size_t i, const Image& image,
+                                                           const Segmentation& segmentation) const {
+    std::vector<DescentOption> out;
+    if (options_.coverage != DescentCoverage::ranked) {
+      for (double g : candidates_) out.push_back({g, descent_plan(i, g), {}});
+      return out;
+    }
+    const cv::Rect region = region_rect(i);
+    if (region.area() == 0) return out;
+    const std::vector<cv::Mat> planes =
+        planes_on_grid(image, pixel_inputs(segmentation, options_.mission.interest, area_.ignore_label), region);
+    const cv::Mat field = area_.valid_mask(region);
+    const DecisionInput input = options_.cell_input;
+    for (double g : candidates_) {
+      const std::vector<Waypoint> all = sub_plan(i, g);
+      std::vector<CellInputs> cells;
+      std::vector<std::size_t> ranked;
+      for (std::size_t k = 0; k < all.size(); ++k) {
+        cells.push_back(cell_inputs(planes, field, (pixel_rect(all[k].footprint) & region) - region.tl()));
+        if (cells.back().mass(input) > 0.0) ranked.push_back(k);
+      }
+      std::stable_sort(ranked.begin(), ranked.end(),
+                       [&](std::size_t a, std::size_t b) { return cells[a].mass(input) > cells[b].mass(input); });
+      std::vector<bool> chosen(all.size(), false);
+      for (std::size_t n = 0; n < ranked.size(); ++n) {
+        chosen[ranked[n]] = true;
+        DescentOption o{g, {}, {}};
+        for (std::size_t k = 0; k < all.size(); ++k)
+          if (chosen[k]) o.plan.push_back(all[k]), o.cells.push_back(cells[k]);
+        out.push_back(std::move(o));
+      }
+    }
+    return out;
+  }
+
   /// The decision at top-level waypoint `p` (paper §3.2.2), its candidates with exact costs.
-  DecisionRecord decide(const PlannedWaypoint& p, double sigma) {
+  DecisionRecord decide(const PlannedWaypoint& p, double sigma, const Image& image, const Segmentation& segmentation) {
     const auto t0 = std::chrono::steady_clock::now();
     const std::size_t i = p.top_index;
     DecisionRecord rec;
@@ -486,8 +579,9 @@ class AdaptivePlanner {
     const double elapsed = elapsed_s();
     std::vector<std::vector<Waypoint>> sub_plans;
     std::vector<std::pair<TourStop, TourInsertion>> stops;  // per candidate, for a deferred descent
-    for (double g : candidates_) {
-      auto sub = descent_plan(i, g);
+    for (DescentOption& option : descent_options(i, image, segmentation)) {
+      const double g = option.gsd_cm;
+      std::vector<Waypoint>& sub = option.plan;
       if (sub.empty()) continue;
       const double inner = plan_flight_s(sub);
       // What descending adds to the flight: at once, down and back up to the next waypoint ...
@@ -511,6 +605,7 @@ class AdaptivePlanner {
       c.altitude_m = camera_.altitude_m(g);
       c.images = static_cast<int>(sub.size());
       c.extra_time_s = flight + static_cast<double>(sub.size()) * per_image;
+      c.cells = std::move(option.cells);
       // Descending replaces the direct leg to i+1: elapsed + extra + rest must fit.
       if (options_.budget_s && elapsed + c.extra_time_s + rest > *options_.budget_s + 1e-9) {
         rec.budget_limited = true;
@@ -520,19 +615,17 @@ class AdaptivePlanner {
       sub_plans.push_back(std::move(sub));
       stops.emplace_back(stop, insertion);
     }
-    std::vector<LawnmowerForecast> forecasts;
-    for (const auto& l : lawnmowers_)
-      forecasts.push_back(
-          {l.gsd_cm, l.flight_s + static_cast<double>(l.images) * per_image});
+    const std::vector<LawnmowerForecast> forecasts = lawnmower_forecasts();
     DecisionContext ctx;
     ctx.sigma = rec.sigma;
     ctx.valid_fraction = valid_fraction(top_[i].footprint);
-    ctx.top_gsd_cm = options_.top_gsd_cm;
+    ctx.top_gsd_cm = top_gsd_cm_;
     ctx.top_altitude_m = here.z();
     ctx.candidates = rec.candidates;
     ctx.elapsed_s = elapsed;
     ctx.rest_s = rest;
     ctx.region_share = valid_px_ > 0 ? static_cast<double>(valid_pixels(top_[i].footprint)) / valid_px_ : 0.0;
+    ctx.region_px = static_cast<double>(valid_pixels(top_[i].footprint));
     ctx.lawnmowers = forecasts;
     rec.decision = policy_.decide(ctx);
     if (rec.decision.descend) {
@@ -629,6 +722,7 @@ class AdaptivePlanner {
   Policy& policy_;
   AdaptiveOptions options_;
   std::vector<double> candidates_;
+  double top_gsd_cm_ = 0.0;  ///< the GSD the top level is flown at
   std::vector<Waypoint> top_;
   std::vector<double> flight_after_;  ///< flight time of the top-level plan from waypoint i on [s]
   /// A fixed-altitude lawnmower over the area (a front-aware policy's yardstick).

@@ -49,6 +49,19 @@ struct CalibrationOptions {
     g.erase(std::unique(g.begin(), g.end()), g.end());
     return g;
   }
+  /// DescentCoverage::ranked (`adaptive.coverage`): the decision inputs the cells may be ranked
+  /// and forecast by; the one whose ranking captures most of the training fields' achievable
+  /// gain is chosen (cell_ranking_capture(), each field scored on its own) and set as
+  /// `adaptive.cell_input`. Empty: every input of the table whose values the backend gives (the
+  /// ones that need probabilities only from a backend that gives them).
+  std::vector<DecisionInput> cell_inputs{};
+  /// DescentCoverage::ranked: other top-level GSDs the cell gain model is calibrated for, so
+  /// that a mission may fly its top level at one of them where the predicted lawnmower curve
+  /// shows the model's top lawnmower dominated by a faster one on the field flown
+  /// (FrontAwarePolicy::top_gsd). nullopt: the coarsest candidate GSD (the one that can be
+  /// faster than the top where its grid fits the field better). Each must be a candidate GSD
+  /// with a finer candidate below it.
+  std::optional<std::vector<double>> alternative_top_gsd_cm{};
   GainModel::FitOptions fit{};             ///< what I predicts from, hyperparameter restarts
   int refit_every = 0;                     ///< O's scheduled re-optimisation (GainModel)
 
@@ -97,6 +110,10 @@ struct RuleTrial {
 /// Everything calibration produced.
 struct CalibrationResult {
   std::vector<RegionSample> samples;               ///< pooled over the fields (RegionSample::field)
+  /// DescentCoverage::ranked: the cell samples, pooled (CellSample::field), and every input
+  /// tried with its capture on the training fields (the chosen one first).
+  std::vector<CellSample> cell_samples{};
+  std::vector<std::pair<DecisionInput, double>> cell_input_scores{};
   DecisionFunction decision_function;              ///< fitted, with the chosen rule and settings
   LinearDecision::Params linear{};                 ///< σ range of the training fields' top-level images
   std::vector<std::vector<CurvePoint>> lawnmower_curves;  ///< per training field, at lawnmower_gsds()
@@ -242,13 +259,61 @@ template <SegmentationBackend Backend>
   const std::vector<int>& interest = adaptive.mission.interest;
   const CameraModel camera(adaptive.mission.camera);
 
+  const bool ranked = adaptive.coverage == DescentCoverage::ranked;
+  std::vector<double> alternative_tops;
+  if (ranked) {
+    std::vector<double> c = adaptive.candidate_gsd_cm;
+    std::sort(c.begin(), c.end());
+    if (options.alternative_top_gsd_cm)
+      alternative_tops = *options.alternative_top_gsd_cm;
+    else if (c.size() >= 2)
+      alternative_tops = {c.back()};
+    for (double a : alternative_tops)
+      detail::require(std::find(c.begin(), c.end(), a) != c.end() && a > c.front(),
+                      "calibrate: an alternative top GSD must be a candidate GSD with a finer candidate below it", a);
+  }
   std::vector<RegionSample> samples;
   std::vector<std::vector<RegionSample>> by_field;
+  std::vector<CellSample> cell_samples;
+  std::vector<std::vector<CellSample>> cells_by_field;
   for (std::size_t k = 0; k < fields.size(); ++k) {
-    by_field.push_back(collect_region_samples(fields[k], backend, camera, adaptive.top_gsd_cm,
-                                              adaptive.candidate_gsd_cm, interest, adaptive.coverage, k));
+    CalibrationSamples c = collect_samples(fields[k], backend, camera, adaptive.top_gsd_cm, adaptive.candidate_gsd_cm,
+                                           interest, adaptive.coverage, k);
+    by_field.push_back(std::move(c.regions));
     detail::require(!by_field.back().empty(), "calibrate: the training field gave no region sample", fields[k].name());
     samples.insert(samples.end(), by_field.back().begin(), by_field.back().end());
+    cells_by_field.push_back(std::move(c.cells));
+    // The cells as seen from the alternative top levels, re-mapped at the candidates below them.
+    for (double top : ranked ? alternative_tops : std::vector<double>{}) {
+      std::vector<double> below;
+      for (double g : adaptive.candidate_gsd_cm)
+        if (g < top) below.push_back(g);
+      CalibrationSamples alt = collect_samples(fields[k], backend, camera, top, below, interest, adaptive.coverage, k);
+      cells_by_field.back().insert(cells_by_field.back().end(), alt.cells.begin(), alt.cells.end());
+    }
+    cell_samples.insert(cell_samples.end(), cells_by_field.back().begin(), cells_by_field.back().end());
+  }
+  // DescentCoverage::ranked: the input that ranks the training fields' cells best.
+  std::vector<std::pair<DecisionInput, double>> input_scores;
+  if (ranked) {
+    detail::require(!cell_samples.empty(), "calibrate: the training fields gave no cell sample", fields.front().name());
+    std::vector<DecisionInput> tried = options.cell_inputs;
+    if (tried.empty())
+      for (const auto& row : kDecisionInputs) tried.push_back(row.input);
+    for (DecisionInput i : tried) {
+      // An input the backend cannot give (probabilities from a labels-only backend) is unknown
+      // on every cell.
+      const bool known = std::any_of(cell_samples.begin(), cell_samples.end(),
+                                     [&](const CellSample& c) { return std::isfinite(c.top.value(i)); });
+      if (known) input_scores.emplace_back(i, cell_ranking_capture(cell_samples, i));
+    }
+    detail::require(!input_scores.empty(), "calibrate: no decision input to rank the cells by is known from this backend; inputs tried",
+                    tried.size());
+    // Best capture first; ties keep the table's order; an input without a score last.
+    const auto score = [](double v) { return std::isnan(v) ? -std::numeric_limits<double>::infinity() : v; };
+    std::stable_sort(input_scores.begin(), input_scores.end(),
+                     [&](const auto& a, const auto& b) { return score(a.second) > score(b.second); });
+    adaptive.cell_input = input_scores.front().first;
   }
   const auto curve_of = [&](const Field& f) {
     std::vector<CurvePoint> c;
@@ -281,6 +346,7 @@ template <SegmentationBackend Backend>
   GainModel::FitOptions fit = options.fit;
   GainModel model = GainModel::fit(samples, fit);
   model.set_refit_every(options.refit_every);
+  if (ranked) model.set_cells(CellGainModel::fit(cell_samples, adaptive.cell_input));
 
   // Layouts of a single field: the field and its halves across the longer axis.
   std::vector<Field> halves;
@@ -326,13 +392,27 @@ template <SegmentationBackend Backend>
           }
         GainModel m = GainModel::fit(rest, fit);
         m.set_refit_every(options.refit_every);
-        // The field factor s of this field under the model that did not see it: the least-squares
-        // scale of C's forecasts onto what its descents relabelled.
         double num = 0.0, den = 0.0;
-        for (const RegionSample& s : by_field[k]) {
-          const GainForecast f = m.forecast(s.delta_h_m, s.sigma_top);
-          num += f.relabelled * s.relabelled.interest_share;
-          den += f.relabelled * f.relabelled;
+        if (ranked) {
+          // The field factor s of this field under the cell model that did not see it: the
+          // least-squares scale of the cells' forecast gains onto their realised gains.
+          std::vector<CellSample> rest_cells;
+          for (std::size_t j = 0; j < fields.size(); ++j)
+            if (j != k) rest_cells.insert(rest_cells.end(), cells_by_field[j].begin(), cells_by_field[j].end());
+          m.set_cells(CellGainModel::fit(rest_cells, adaptive.cell_input));
+          for (const CellSample& c : cells_by_field[k]) {
+            const double f = m.cells()->cell_gain(c.top_gsd_cm, c.sub_gsd_cm, c.top) * c.top.field_px;
+            num += f * c.normalized_gain() * c.top.field_px;
+            den += f * f;
+          }
+        } else {
+          // The field factor s of this field under the model that did not see it: the
+          // least-squares scale of C's forecasts onto what its descents relabelled.
+          for (const RegionSample& s : by_field[k]) {
+            const GainForecast f = m.forecast(s.delta_h_m, s.sigma_top);
+            num += f.relabelled * s.relabelled.interest_share;
+            den += f.relabelled * f.relabelled;
+          }
         }
         if (den > 0.0) field_scales.push_back(num / den);
         folds.push_back({&fields[k], &curves[k], std::move(m), std::move(rest_reference),
@@ -452,7 +532,9 @@ template <SegmentationBackend Backend>
   LinearDecision::Params linear{pct(0.05), pct(0.95)};
   if (!(linear.sigma_high > linear.sigma_low)) linear = {0.0, std::max(1e-6, sig.back())};
   linear.sigma_high = std::min(1.0, linear.sigma_high);
-  return CalibrationResult{std::move(samples), std::move(*chosen), linear, std::move(curves), std::move(trials)};
+  return CalibrationResult{std::move(samples),     std::move(cell_samples), std::move(input_scores),
+                           std::move(*chosen),     linear,                  std::move(curves),
+                           std::move(trials)};
 }
 
 /// The single-field case (the paper's).

@@ -8,6 +8,8 @@
 /// first two a calibrated model file holds). Each passes the conformance suite in
 /// tests/policy_conformance.hpp.
 
+#include <adaptseg/decision_inputs.hpp>
+
 #include <concepts>
 #include <cstddef>
 #include <limits>
@@ -63,6 +65,9 @@ struct Candidate {
   /// Costed as deferred to the tour after the survey or the row (DescentSchedule::tour, row),
   /// not flown at once.
   bool deferred = false;
+  /// DescentCoverage::ranked: the cells it re-maps, as the top-level image saw them (their
+  /// decision inputs and field pixels); empty for the other coverages.
+  std::vector<CellInputs> cells{};
 };
 
 /// What a fixed-altitude lawnmower over the whole field at one GSD would take, known from the
@@ -83,6 +88,8 @@ struct DecisionContext {
   double elapsed_s = 0.0;         ///< mission time so far, this image included [s]
   double rest_s = 0.0;            ///< time to finish the top-level coverage from here without descending [s]
   double region_share = 0.0;      ///< the region's ground inside the field / the field's (0..1]
+  /// The region's field pixels on the map grid (Candidate::cells' pixels are shares of it).
+  double region_px = 0.0;
   std::span<const LawnmowerForecast> lawnmowers{};  ///< this field's lawnmowers at the top and candidate GSDs
 };
 
@@ -100,7 +107,7 @@ struct CandidateScore {
   /// a label of interest involved (compare DescentOutcome::relabelled; NaN where none is made).
   double predicted_relabelled = std::numeric_limits<double>::quiet_NaN();
   /// Front-aware policies: the predicted front margin of the mission if it descends here
-  /// (NaN otherwise; see DecisionFunction::Params::front_aware).
+  /// (NaN otherwise; see FrontAwarePolicy).
   double predicted_front_margin = std::numeric_limits<double>::quiet_NaN();
 };
 
@@ -108,6 +115,10 @@ struct CandidateScore {
 struct Decision {
   bool descend = false;
   double gsd_cm = 0.0;                 ///< chosen GSD when descending
+  /// The chosen candidate's index in the context's order, where several share a GSD
+  /// (DescentCoverage::ranked: one candidate per number of cells). A policy that leaves it at 0
+  /// names its candidate by `gsd_cm` alone: the first candidate of that GSD (chosen_candidate()).
+  std::size_t candidate = 0;
   std::vector<CandidateScore> scores;  ///< one per candidate, in the context's order
 };
 
@@ -133,9 +144,9 @@ struct DescentOutcome {
 ///   policy learnt or kept during a previous mission, so one object can fly many missions and
 ///   two missions given the same contexts take the same decisions;
 /// - `decide(context)` at every top-level image, in flight order: a Decision that, when
-///   descending, names one of `context.candidates` by its `gsd_cm` (the planner checks it and
-///   throws std::logic_error otherwise); never descending without candidates; `scores` one
-///   per candidate, in order;
+///   descending, names one of `context.candidates` by its `gsd_cm` (and, where several share
+///   it, by its index `candidate`; the planner checks it and throws std::logic_error otherwise);
+///   never descending without candidates; `scores` one per candidate, in order;
 /// - `observe(outcome)` after every descent (a policy that does not adapt ignores it). With the
 ///   paper's immediate descents it comes before the next `decide`; a tour
 ///   (DescentSchedule::tour, row) takes every decision of the survey (of the row) first and
@@ -150,11 +161,26 @@ concept DecisionPolicy = requires(P& policy, const DecisionContext& context, con
   { policy.name() } -> std::convertible_to<std::string>;
 };
 
-/// The index of the candidate a descending `decision` names (its `gsd_cm`), checked.
+/// Optionally, a policy chooses the GSD the top-level lawnmower is flown at, once per mission
+/// before it starts: `top_gsd(lawnmowers, nominal)` gets the area's lawnmowers at the nominal
+/// top GSD and every candidate GSD (times known from the geometry) and returns one of their
+/// GSDs (AdaptivePlanner checks it, and descends only to the candidates finer than it).
+/// Rationale: where a finer lawnmower is faster than the nominal top level over the area (its
+/// grid fits the area better) and maps better, starting at the nominal top gives away accuracy
+/// and time that no descent needs to buy back (FrontAwarePolicy::top_gsd).
+template <typename P>
+concept ChoosesTopLevel = requires(P& policy, std::span<const LawnmowerForecast> lawnmowers, double nominal) {
+  { policy.top_gsd(lawnmowers, nominal) } -> std::convertible_to<double>;
+};
+
+/// The index of the candidate a descending `decision` names: `decision.candidate` if that
+/// candidate has the decision's `gsd_cm`, else the first candidate of that GSD; checked.
 /// @throws std::logic_error naming `policy` if the decision descends to a GSD that is not one
 ///         of `candidates` (a policy breaking the DecisionPolicy contract).
 [[nodiscard]] inline std::size_t chosen_candidate(const Decision& decision, std::span<const Candidate> candidates,
                                                   const std::string& policy) {
+  if (decision.candidate < candidates.size() && candidates[decision.candidate].gsd_cm == decision.gsd_cm)
+    return decision.candidate;
   for (std::size_t k = 0; k < candidates.size(); ++k)
     if (candidates[k].gsd_cm == decision.gsd_cm) return k;
   throw std::logic_error("decision policy '" + policy + "' descends to " + std::to_string(decision.gsd_cm) +

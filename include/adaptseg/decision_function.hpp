@@ -8,6 +8,7 @@
 #include <adaptseg/gain_model.hpp>
 #include <adaptseg/utility_policy.hpp>
 
+#include <span>
 #include <string>
 #include <utility>
 #include <variant>
@@ -43,6 +44,18 @@ class DecisionFunction {
     std::visit([&](auto& r) { r.observe(outcome); }, rule_);
   }
 
+  /// The rule's top-level GSD (ChoosesTopLevel; `nominal` for a rule that does not choose).
+  [[nodiscard]] double top_gsd(std::span<const LawnmowerForecast> lawnmowers, double nominal) const {
+    return std::visit(
+        [&](const auto& r) -> double {
+          if constexpr (requires { r.top_gsd(lawnmowers, nominal); })
+            return r.top_gsd(lawnmowers, nominal);
+          else
+            return nominal;
+        },
+        rule_);
+  }
+
   /// Whether the rule learns in flight ("adaptive") or not ("non-adaptive").
   [[nodiscard]] bool online() const {
     return std::visit([](const auto& r) { return r.params().online; }, rule_);
@@ -70,5 +83,6 @@ class DecisionFunction {
 };
 
 static_assert(DecisionPolicy<DecisionFunction>);
+static_assert(ChoosesTopLevel<DecisionFunction>);
 
 }  // namespace adaptseg

@@ -22,6 +22,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -142,6 +143,16 @@ using ModelGp = GainModel::Gp;
 
 }  // namespace detail
 
+/// The keys of the cell gain model's points in a model file (`gain_model.cells`), one list each.
+inline constexpr std::array<std::pair<const char*, double CellGainModel::Point::*>, 6> kCellPointKeys{{
+    {"top_gsd_cm", &CellGainModel::Point::top_gsd_cm},
+    {"sub_gsd_cm", &CellGainModel::Point::sub_gsd_cm},
+    {"gain_slope", &CellGainModel::Point::gain_slope},
+    {"gain_noise", &CellGainModel::Point::gain_noise},
+    {"relabel_slope", &CellGainModel::Point::relabel_slope},
+    {"relabel_noise", &CellGainModel::Point::relabel_noise},
+}};
+
 /// A calibrated decision model and its provenance.
 struct DecisionModel {
   std::vector<std::string> calibration_fields;  ///< names of the training fields (with regions)
@@ -169,7 +180,9 @@ struct DecisionModel {
                                                  std::optional<double> budget_s = std::nullopt) const {
     mission.camera = camera;
     mission.timing = timing;
-    return {std::move(mission), top_gsd_cm, candidate_gsd_cm, budget_s, coverage};
+    AdaptiveOptions o{std::move(mission), top_gsd_cm, candidate_gsd_cm, budget_s, coverage};
+    if (const auto& cells = decision_function.model().cells()) o.cell_input = cells->input();
+    return o;
   }
 
   /// The labels of interest as class indices of the model's class set (the labels the
@@ -265,6 +278,17 @@ struct DecisionModel {
       emit_numbers(e, h);
       e << YAML::Key << "eta" << YAML::Value;
       emit_numbers(e, v);
+      e << YAML::EndMap;
+    }
+    if (const auto& cells = gm.cells()) {
+      e << YAML::Key << "cells" << YAML::Value << YAML::BeginMap;
+      e << YAML::Key << "input" << YAML::Value << to_string(cells->input());
+      for (const auto& [key, member] : kCellPointKeys) {
+        std::vector<double> v;
+        for (const auto& p : cells->points()) v.push_back(p.*member);
+        e << YAML::Key << key << YAML::Value;
+        emit_numbers(e, v);
+      }
       e << YAML::EndMap;
     }
     e << YAML::EndMap;
@@ -416,6 +440,20 @@ struct DecisionModel {
     };
     GainModel model(gp("O", 2), gp("I", inputs == "delta-sigma" ? 1 : 2), with_c ? std::optional(gp("C", 2)) : std::nullopt,
                     std::move(efficiency), static_cast<int>(gm.integer("refit_every", 0, 1'000'000'000)));
+    if (gm.has("cells")) {
+      const auto c = gm.map("cells");
+      const DecisionInput input = parse_decision_input(c.text("input"));
+      std::vector<CellGainModel::Point> points;
+      for (const auto& [key, member] : kCellPointKeys) {
+        const auto v = c.numbers(key);
+        if (points.empty()) points.resize(v.size());
+        if (v.empty() || v.size() != points.size())
+          detail::yaml_error(r.where(), "'gain_model.cells' needs one top_gsd_cm, sub_gsd_cm, gain_slope, gain_noise, "
+                                        "relabel_slope and relabel_noise value per point (>= 1 point)");
+        for (std::size_t j = 0; j < v.size(); ++j) points[j].*member = v[j];
+      }
+      model.set_cells(CellGainModel(input, std::move(points)));
+    }
     const auto rule = r.map("rule");
     const std::string kind = rule.text("kind");
     const bool online = rule.flag("online");
@@ -483,6 +521,8 @@ struct DecisionModel {
         detail::yaml_error(where, "candidate GSDs must be positive and finer than top_gsd_cm");
     if (!(calibration_segmentation_time_s >= 0.0))
       detail::yaml_error(where, "'calibration.segmentation_time_s' must be >= 0");
+    if (coverage == DescentCoverage::ranked && !decision_function.model().cells())
+      detail::yaml_error(where, "descent_coverage 'ranked' needs a cell gain model ('gain_model.cells')");
   }
 };
 

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
@@ -156,7 +157,7 @@ class FrontAwarePolicy {
     forecast_gain_ = 0.0;
     chosen_.clear();
     scale_mean_ = 1.0;
-    scale_var_ = model_.c_model() ? params_.scale_prior_sd * params_.scale_prior_sd : 0.0;
+    scale_var_ = model_.c_model() || model_.cells() ? params_.scale_prior_sd * params_.scale_prior_sd : 0.0;
     scale_precision_sum_ = 0.0;
     scale_evidence_sum_ = 0.0;
   }
@@ -179,7 +180,7 @@ class FrontAwarePolicy {
     ++sigma_count_;
     seen_share_ += c.region_share;
     seen_interest_ += c.region_share * c.sigma;
-    const bool by_relabelling = model_.c_model().has_value();
+    const bool by_relabelling = model_.c_model().has_value() || model_.cells().has_value();
     const auto [weight, sigma_cv2] = by_relabelling ? gain_weight(c) : std::pair{legacy_gain_weight(c), 0.0};
     const double t0 = c.elapsed_s + c.rest_s;
 
@@ -187,20 +188,35 @@ class FrontAwarePolicy {
     std::optional<std::size_t> best_index;
     double best = 0.0;
     std::vector<double> gains;
-    std::vector<GainForecast> forecasts;
+    std::vector<Relabelled> forecasts;
     for (std::size_t k = 0; k < c.candidates.size(); ++k) {
       const Candidate& cand = c.candidates[k];
       const double delta_h = c.top_altitude_m - cand.altitude_m;
       const GainForecast f = model_.forecast(delta_h, c.sigma);
       CandidateScore s = scored(cand, f);
-      const double eta = by_relabelling ? model_.efficiency(delta_h) : 1.0;
-      const double base = (by_relabelling ? f.relabelled : -f.delta_miou) * eta * weight;
-      const double base_sd = (by_relabelling ? f.relabelled_std : f.delta_miou_std) * eta * weight;
+      // The descent's gain in shares of the region (its sd, and what it relabels): from its
+      // cells (DescentCoverage::ranked), from C and η, or as adaptseg 0.1 did (−μ_I).
+      double base = 0.0, base_sd = 0.0;
+      Relabelled relabelled;
+      if (!cand.cells.empty() && model_.cells() && c.region_px > 0.0) {
+        const CellGainModel::Forecast cf = model_.cells()->forecast(c.top_gsd_cm, cand.gsd_cm, cand.cells, c.region_px);
+        base = cf.gain * weight;
+        base_sd = std::sqrt(cf.gain_var) * weight;
+        relabelled = {cf.relabelled, std::sqrt(cf.relabelled_var)};
+      } else if (model_.c_model()) {
+        const double eta = model_.efficiency(delta_h);
+        base = f.relabelled * eta * weight;
+        base_sd = f.relabelled_std * eta * weight;
+        relabelled = {f.relabelled, f.relabelled_noisy_std};
+      } else {
+        base = -f.delta_miou * weight;
+        base_sd = f.delta_miou_std * weight;
+      }
       const double gain = scale_mean_ * base;
       const double gain_var =
           scale_mean_ * scale_mean_ * base_sd * base_sd + scale_var_ * base * base + gain * gain * sigma_cv2;
       s.predicted_field_gain = gain;
-      if (by_relabelling) s.predicted_relabelled = scale_mean_ * f.relabelled;
+      if (std::isfinite(relabelled.mean)) s.predicted_relabelled = scale_mean_ * relabelled.mean;
       s.utility = utility(gain, cand.extra_time_s);
       // The curve's rise over the descent's extra time, on every training field's curve.
       double rise_sum = 0.0, rise_sq = 0.0;
@@ -220,28 +236,63 @@ class FrontAwarePolicy {
       }
       d.scores.push_back(s);
       gains.push_back(gain);
-      forecasts.push_back(f);
+      forecasts.push_back(relabelled);
     }
     if (best_index && c.sigma >= params_.min_sigma) {
       d.descend = true;
       d.gsd_cm = c.candidates[*best_index].gsd_cm;
+      d.candidate = *best_index;
       forecast_gain_ += gains[*best_index];
       chosen_.push_back(forecasts[*best_index]);
     }
     return d;
   }
 
+  /// The GSD to fly the top level at (ChoosesTopLevel): the coarsest of those the model can
+  /// decide from (its cell gain model's top-level GSDs, else the nominal one) whose lawnmower over
+  /// the area is not dominated on the predicted curve: no lawnmower of `lawnmowers` is as fast
+  /// or faster and predicted better (mIoU by GSD: the mean of the training fields' curves).
+  /// Where each is dominated, the one predicted to fall least short. Both the adaptive and the
+  /// non-adaptive rule choose so (nothing is learnt here).
+  [[nodiscard]] double top_gsd(std::span<const LawnmowerForecast> lawnmowers, double nominal) const {
+    std::vector<double> allowed;
+    if (model_.cells())
+      for (double g : model_.cells()->top_gsds())
+        for (const auto& l : lawnmowers)
+          if (std::abs(l.gsd_cm - g) <= 1e-9 * g) allowed.push_back(l.gsd_cm);
+    if (std::find(allowed.begin(), allowed.end(), nominal) == allowed.end()) allowed.push_back(nominal);
+    std::sort(allowed.begin(), allowed.end(), std::greater<>());
+    const auto predicted = [&](double g) {
+      double m = 0.0;
+      for (const auto& r : reference_) m += miou_at_gsd(r.points, g);
+      return m / static_cast<double>(reference_.size());
+    };
+    const auto time_of = [&](double g) {
+      for (const auto& l : lawnmowers)
+        if (l.gsd_cm == g) return l.time_s;
+      return std::numeric_limits<double>::infinity();  // the nominal top without a forecast: never dominated
+    };
+    double best = nominal, best_deficit = std::numeric_limits<double>::infinity();
+    for (double g : allowed) {
+      double deficit = 0.0;
+      for (const auto& l : lawnmowers)
+        if (l.time_s <= time_of(g)) deficit = std::max(deficit, predicted(l.gsd_cm) - predicted(g));
+      if (deficit < best_deficit - 1e-12) best = g, best_deficit = deficit;
+    }
+    return best;
+  }
+
   /// After a descent: the paper's update of O and the field correction (no-op unless `online`).
   void observe(const DescentOutcome& out) {
     if (!params_.online) return;
     model_.update(out);
-    const std::optional<GainForecast> f =
-        out.descent < chosen_.size() ? std::optional<GainForecast>(chosen_[out.descent]) : std::nullopt;
-    if (!f || !std::isfinite(f->relabelled) || !model_.c_model()) return;
+    if (out.descent >= chosen_.size()) return;
+    const Relabelled& f = chosen_[out.descent];
+    if (!std::isfinite(f.mean) || !(model_.c_model() || model_.cells())) return;
     // Conjugate update of s in χ_obs = s·μ_C + ε, ε ~ N(0, sd_C²), prior s ~ N(1, ω²).
-    const double noise = std::max(f->relabelled_noisy_std * f->relabelled_noisy_std, 1e-12);
-    scale_precision_sum_ += f->relabelled * f->relabelled / noise;
-    scale_evidence_sum_ += f->relabelled * out.relabelled.interest_share / noise;
+    const double noise = std::max(f.noisy_sd * f.noisy_sd, 1e-12);
+    scale_precision_sum_ += f.mean * f.mean / noise;
+    scale_evidence_sum_ += f.mean * out.relabelled.interest_share / noise;
     const double prior_precision = 1.0 / (params_.scale_prior_sd * params_.scale_prior_sd);
     const double precision = prior_precision + scale_precision_sum_;
     scale_mean_ = std::max(0.0, (prior_precision + scale_evidence_sum_) / precision);
@@ -249,6 +300,13 @@ class FrontAwarePolicy {
   }
 
  private:
+  /// A descent's forecast of the share of its region it relabels with L involved, and the
+  /// spread of one such observation (NaN: no forecast, no field correction from it).
+  struct Relabelled {
+    double mean = std::numeric_limits<double>::quiet_NaN();
+    double noisy_sd = 0.0;
+  };
+
   /// a / σ̂: a relabelled share of the region, times η, as a field-level gain; and Var σ̂ / σ̂²
   /// (see the class comment).
   [[nodiscard]] std::pair<double, double> gain_weight(const DecisionContext& c) const {
@@ -314,7 +372,7 @@ class FrontAwarePolicy {
   double seen_share_ = 0.0;         ///< field share of the top-level regions seen so far
   double seen_interest_ = 0.0;      ///< ... and Σ share · σ over them
   double forecast_gain_ = 0.0;      ///< forecast field-level gain of the descents taken
-  std::vector<GainForecast> chosen_;  ///< the forecast of each descent chosen (DescentOutcome::descent)
+  std::vector<Relabelled> chosen_;  ///< what each descent chosen was forecast to relabel (DescentOutcome::descent)
   double scale_mean_ = 1.0;         ///< field factor s: posterior mean
   double scale_var_ = 0.0;          ///< ... and variance
   double scale_precision_sum_ = 0.0;
@@ -322,5 +380,6 @@ class FrontAwarePolicy {
 };
 
 static_assert(DecisionPolicy<FrontAwarePolicy>);
+static_assert(ChoosesTopLevel<FrontAwarePolicy>);
 
 }  // namespace adaptseg

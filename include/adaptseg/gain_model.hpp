@@ -5,6 +5,7 @@
 /// changes, fitted to initialisation samples. The decision rules that weigh these forecasts
 /// against time are separate types (UtilityPolicy, FrontAwarePolicy).
 
+#include <adaptseg/cell_gain_model.hpp>
 #include <adaptseg/decision.hpp>
 #include <adaptseg/detail/interpolate.hpp>
 #include <adaptseg/error.hpp>
@@ -78,6 +79,9 @@ struct GainForecast {
 ///   relabels only to correct (η ≈ 1 with a ground-truth oracle), one to a GSD barely finer
 ///   than the top moves errors about as much as it corrects them (η ≈ 0.07 at 12.5 cm/px from
 ///   15 on the Dubai tiles): η says how much of a relabelling is gain.
+///
+/// With DescentCoverage::ranked, the descent's cells are forecast by a CellGainModel instead of
+/// C and η (set_cells(); fitted by calibration to single cells re-mapped alone).
 ///
 /// All three: ARD squared-exponential kernel plus noise, normalised targets, hyperparameters
 /// by maximum marginal likelihood. Online (§3.2.3), `update` adds the observed (Δh, σ_{h_max})
@@ -258,6 +262,9 @@ class GainModel {
   }
   /// η's points (empty for a model without C).
   [[nodiscard]] const std::vector<EfficiencyPoint>& efficiency_points() const noexcept { return efficiency_; }
+  /// The cell gain model (DescentCoverage::ranked), absent unless calibration set one.
+  [[nodiscard]] const std::optional<CellGainModel>& cells() const noexcept { return cells_; }
+  void set_cells(std::optional<CellGainModel> cells) { cells_ = std::move(cells); }
   /// @throws std::invalid_argument for a negative value.
   void set_refit_every(int k) {
     detail::require(k >= 0, "GainModel::set_refit_every: refit_every must be >= 0", k);
@@ -294,6 +301,7 @@ class GainModel {
   Gp i_;
   std::optional<Gp> c_;
   std::vector<EfficiencyPoint> efficiency_;
+  std::optional<CellGainModel> cells_;
   int refit_every_ = 0;
   int updates_ = 0;
 };

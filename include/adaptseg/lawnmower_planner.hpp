@@ -47,19 +47,30 @@ struct Waypoint {
 ///   localised class the errors of the top-level map lie on the class's edges, so a descent
 ///   that re-maps only those cells buys most of the gain for a fraction of the time. Cells
 ///   where a small instance vanished at h_max are not re-mapped.
-enum class DescentCoverage { region, interest };
+/// - `ranked` (beyond the paper): the region's cells ranked by their own expected gain, the mass
+///   of one decision input of the top-level image over the cell (AdaptiveOptions::cell_input,
+///   e.g. its expected error about L from the backend's class probabilities; decision_inputs.hpp),
+///   and the descent re-maps the k best, k chosen by the decision: one candidate per k. Cells
+///   with none of the input are never re-mapped.
+enum class DescentCoverage { region, interest, ranked };
 
-/// The name used in files and on the command line: "region" or "interest".
+/// The name used in files and on the command line: "region", "interest" or "ranked".
 [[nodiscard]] inline const char* to_string(DescentCoverage c) noexcept {
-  return c == DescentCoverage::interest ? "interest" : "region";
+  switch (c) {
+    case DescentCoverage::interest: return "interest";
+    case DescentCoverage::ranked: return "ranked";
+    case DescentCoverage::region: break;
+  }
+  return "region";
 }
 
-/// Parses "region" or "interest".
+/// Parses "region", "interest" or "ranked".
 /// @throws std::invalid_argument for anything else.
 [[nodiscard]] inline DescentCoverage parse_descent_coverage(const std::string& s) {
   if (s == "region") return DescentCoverage::region;
   if (s == "interest") return DescentCoverage::interest;
-  throw std::invalid_argument("descent coverage must be 'region' or 'interest', not '" + s + "'");
+  if (s == "ranked") return DescentCoverage::ranked;
+  throw std::invalid_argument("descent coverage must be 'region', 'interest' or 'ranked', not '" + s + "'");
 }
 
 /// Image overlap of a lawnmower (beyond the paper, whose footprints tile the area without

@@ -103,6 +103,8 @@ class Mission {
     Image image;
     cv::Mat labels;
     const WaypointRecord* record;
+    /// The backend's class probabilities, if asked for and given (SegmentsWithProbabilities).
+    std::vector<cv::Mat> probabilities{};
   };
 
   /// Flies to `w`, takes and segments the image, fuses it into the map and records it.
@@ -113,12 +115,20 @@ class Mission {
   }
 
   /// visit() without fusing the image into this mission's map, for a planner that keeps the
-  /// map itself (AdaptivePlanner); score that map with `finish(map)`.
-  Visit visit_without_fusion(const Waypoint& w, int level) {
+  /// map itself (AdaptivePlanner); score that map with `finish(map)`. With `probabilities`, the
+  /// backend's class probabilities come with the labels where it gives them (checked, and
+  /// their computation counted in the segmentation time).
+  Visit visit_without_fusion(const Waypoint& w, int level, bool probabilities = false) {
     if (const auto p = position()) result_.flight_s += timing_.segment_time_s(*p, w.position);
     Visit v{sensor_.capture(w), cv::Mat(), nullptr};
     const auto t0 = std::chrono::steady_clock::now();
-    v.labels = backend_.segment(v.image);
+    if (probabilities) {
+      Segmentation s = segment_with_probabilities_checked(backend_, v.image, sensor_.field().num_classes());
+      v.labels = std::move(s.labels);
+      v.probabilities = std::move(s.probabilities);
+    } else {
+      v.labels = backend_.segment(v.image);
+    }
     const double measured = seconds_since(t0);
     check_segmentation(v.labels, v.image, sensor_.field().num_classes(),
                        "segmentation backend '" + result_.segmenter + "'");

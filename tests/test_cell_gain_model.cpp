@@ -1,0 +1,103 @@
+#include <adaptseg/cell_gain_model.hpp>
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <vector>
+
+using namespace adaptseg;
+
+namespace {
+/// A cell of `px` field pixels whose expected error is `x`, seen at `top` cm/px and re-mapped at
+/// `sub` on field `field`, gaining `nu` (normalised) and relabelling `chi`.
+CellSample cell(std::size_t field, double top, double sub, double x, double px, double nu, double chi) {
+  CellSample c;
+  c.field = field;
+  c.top_gsd_cm = top;
+  c.sub_gsd_cm = sub;
+  c.top.values.fill(NAN);
+  c.top.values[index_of(DecisionInput::expected_error)] = x;
+  c.top.values[index_of(DecisionInput::sigma)] = 0.5;
+  c.top.field_px = px;
+  c.field_sigma = 0.1;
+  c.field_share = px / 1e6;
+  c.field_gain = nu * c.field_share / c.field_sigma;  // normalized_gain() == nu
+  c.relabelled = chi;
+  return c;
+}
+}  // namespace
+
+TEST_CASE("cell gain model: slopes and noise per pair of GSDs, forecasts of a set of cells") {
+  std::vector<CellSample> s;
+  // From 15 cm/px: re-mapped at 5 the gain is 0.9 x exactly, relabelling 1.2 x; at 10 it
+  // scatters about 0.2 x (±0.05 x). From 12.5 cm/px at 5: 0.8 x.
+  for (double x : {0.01, 0.02, 0.05, 0.1}) {
+    s.push_back(cell(0, 15.0, 5.0, x, 1000.0, 0.9 * x, 1.2 * x));
+    s.push_back(cell(1, 15.0, 10.0, x, 1000.0, 0.25 * x, 0.5 * x));
+    s.push_back(cell(1, 15.0, 10.0, x, 1000.0, 0.15 * x, 0.5 * x));
+    s.push_back(cell(0, 12.5, 5.0, x, 1000.0, 0.8 * x, 1.0 * x));
+  }
+  CHECK(s.front().normalized_gain() == doctest::Approx(0.009));
+  const CellGainModel m = CellGainModel::fit(s, DecisionInput::expected_error);
+  CHECK(m.input() == DecisionInput::expected_error);
+  REQUIRE(m.points().size() == 3);
+  CHECK(m.top_gsds() == std::vector<double>{12.5, 15.0});
+  CHECK(m.points()[0].top_gsd_cm == 12.5);  // sorted by (top, descent)
+  CHECK(m.points()[1].sub_gsd_cm == 5.0);
+  CHECK(m.at(15.0, 10.0).gain_slope == doctest::Approx(0.2));
+  CHECK(m.at(15.0, 5.0).gain_slope == doctest::Approx(0.9));
+  CHECK(m.at(15.0, 5.0).gain_noise == doctest::Approx(0.0).epsilon(1e-12));
+  CHECK(m.at(15.0, 10.0).gain_noise > 0.0);
+  CHECK(m.at(15.0, 5.0).relabel_slope == doctest::Approx(1.2));
+  CHECK(m.at(12.5, 5.0).gain_slope == doctest::Approx(0.8));
+  // Between the calibrated descent GSDs linear, beyond them constant; a top-level GSD that was
+  // not calibrated reads the nearest that was.
+  CHECK(m.at(15.0, 7.5).gain_slope == doctest::Approx(0.55));
+  CHECK(m.at(15.0, 2.0).gain_slope == doctest::Approx(0.9));
+  CHECK(m.at(20.0, 5.0).gain_slope == doctest::Approx(0.9));
+  CHECK(m.at(12.0, 5.0).gain_slope == doctest::Approx(0.8));
+  // Two cells of a region of 4000 field pixels: shares 1/4 and 1/8.
+  CellInputs a, b;
+  a.values.fill(NAN);
+  b.values.fill(NAN);
+  a.values[index_of(DecisionInput::expected_error)] = 0.2;
+  a.field_px = 1000.0;
+  b.values[index_of(DecisionInput::expected_error)] = 0.4;
+  b.field_px = 500.0;
+  const std::vector<CellInputs> cells{a, b};
+  const auto f = m.forecast(15.0, 5.0, cells, 4000.0);
+  CHECK(f.gain == doctest::Approx(0.9 * (0.25 * 0.2 + 0.125 * 0.4)));
+  CHECK(f.relabelled == doctest::Approx(1.2 * (0.25 * 0.2 + 0.125 * 0.4)));
+  const auto g = m.forecast(15.0, 10.0, cells, 4000.0);
+  CHECK(g.gain_var == doctest::Approx(m.at(15.0, 10.0).gain_noise * (0.0625 * 0.2 + 0.015625 * 0.4)));
+  CHECK(m.cell_gain(15.0, 5.0, a) == doctest::Approx(0.18));
+  // An unknown input value (a labels-only backend) holds nothing.
+  CellInputs unknown;
+  unknown.values.fill(NAN);
+  unknown.field_px = 1000.0;
+  CHECK(m.forecast(15.0, 5.0, std::vector<CellInputs>{unknown}, 4000.0).gain == 0.0);
+  CHECK_THROWS_AS((void)m.forecast(15.0, 5.0, cells, 0.0), std::invalid_argument);
+  CHECK_THROWS_AS((void)CellGainModel::fit({}, DecisionInput::expected_error), std::invalid_argument);
+  CHECK_THROWS_AS(CellGainModel(DecisionInput::sigma, {}), std::invalid_argument);
+  CHECK_THROWS_AS(CellGainModel(DecisionInput::sigma, {{15.0, 5.0, 1.0, -1.0, 1.0, 0.0}}), std::invalid_argument);
+  CHECK_THROWS_AS(CellGainModel(DecisionInput::sigma, {{15.0, 20.0, 1.0, 0.0, 1.0, 0.0}}), std::invalid_argument);
+  CHECK_THROWS_AS(CellGainModel(DecisionInput::sigma, {{15.0, 10.0, 1.0, 0.0, 1.0, 0.0}, {15.0, 5.0, 1.0, 0.0, 1.0, 0.0}}),
+                  std::invalid_argument);
+}
+
+TEST_CASE("cell gain model: an input is scored by how much of each field's gain its best cells capture") {
+  // Two fields, one pair of GSDs: expected error ranks the cells by their gain, sigma against it.
+  std::vector<CellSample> s;
+  for (std::size_t f = 0; f < 2; ++f)
+    for (int k = 0; k < 10; ++k) {
+      CellSample c = cell(f, 15.0, 5.0, 0.01 * (k + 1), 1000.0, 0.9 * 0.01 * (k + 1), 0.0);
+      c.top.values[index_of(DecisionInput::sigma)] = 1.0 - 0.1 * k;
+      s.push_back(c);
+    }
+  const double best = cell_ranking_capture(s, DecisionInput::expected_error);
+  const double worst = cell_ranking_capture(s, DecisionInput::sigma);
+  // The best 20 % of 10 cells: gains 10 and 9 of 55 parts.
+  CHECK(best == doctest::Approx(19.0 / 55.0));
+  CHECK(worst == doctest::Approx(3.0 / 55.0));
+  CHECK(std::isnan(cell_ranking_capture({}, DecisionInput::sigma)));
+}
