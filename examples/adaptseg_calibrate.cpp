@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "calibrating on %s (%dx%d px, %.2f cm/px) with %s ...\n", f.name().c_str(), f.width_px(),
                    f.height_px(), g0, segmenter.name.c_str());
     const auto [cal, model] = segmenter.with_backend(field, mission.camera, [&](auto& backend) {
-      adaptseg::CalibrationResult c = adaptseg::examples::calibrate_cached(fields, backend, options);
+      adaptseg::CalibrationResult c = adaptseg::examples::calibrate_cached(fields, backend, options, segmenter.calibration_cache());
       adaptseg::DecisionModel m = adaptseg::make_decision_model(fields, backend.name(), options, c);
       return std::pair{std::move(c), std::move(m)};
     });

@@ -79,10 +79,11 @@ void write_decisions(std::ostream& os, const std::string& field, const std::stri
       os << fmt(r->region_delta_miou(), 6) << ',' << fmt(r->field_gain, 6) << ',';
     else
       os << ",,";
-    if (c)
-      os << (d.candidates[*c].deferred ? "tour" : "now") << '\n';
-    else
-      os << '\n';
+    if (c) os << (d.candidates[*c].deferred ? "tour" : "now");
+    os << ',';
+    if (d.outcome) os << csv_finite(d.outcome->top_input) << ',' << csv_finite(d.outcome->fine_input);
+    else os << ',';
+    os << '\n';
   }
 }
 
@@ -184,7 +185,7 @@ int main(int argc, char** argv) {
       for (const auto& f : trains) names += (names.empty() ? "" : ", ") + f.name();
       std::fprintf(stderr, "[%6.1f s] calibrating on %s ...\n", elapsed(), names.c_str());
       const auto cal = segmenter.with_backend(train, co.adaptive.mission.camera, [&](auto& backend) {
-        adaptseg::CalibrationResult c = adaptseg::examples::calibrate_cached(trains, backend, co);
+        adaptseg::CalibrationResult c = adaptseg::examples::calibrate_cached(trains, backend, co, segmenter.calibration_cache());
         loaded = adaptseg::make_decision_model(trains, backend.name(), co, c);
         return c;
       });
@@ -203,7 +204,7 @@ int main(int argc, char** argv) {
     decisions_csv << "field,strategy,decision,image,sigma,action,gsd_cm,images,extra_time_s,forecast_delta_sigma,"
                      "forecast_delta_miou,forecast_delta_miou_std,forecast_relabelled_interest,forecast_field_gain,forecast_front_margin,"
                      "observed_sigma_sub,observed_relabelled,observed_relabelled_interest,realised_region_delta_miou,"
-                     "realised_field_gain,flown\n";
+                     "realised_field_gain,flown,observed_top_input,observed_fine_input\n";
     // The strategies that fly the model, after the lawnmowers, in this order on every test field.
     const std::vector<std::string> model_strategies{"nonadaptive", "adaptive", "tour", "row", "linear"};
     const std::size_t total_runs = tests.size() * (lawnmower_factors.size() + model_strategies.size());

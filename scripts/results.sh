@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reproduces docs/results.md.
-#   bash scripts/results.sh [all|oracle|oracle-default|network|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]
+#   bash scripts/results.sh [all|oracle|oracle-default|network|cells|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]
 #   (default: all, one job per core)
 #
 # oracle: the paper's experiment with the ground-truth oracle, deterministic (fixed 0.1 s per
@@ -40,22 +40,24 @@
 set -euo pipefail
 part=${1:-all}
 jobs=${2:-$(nproc 2>/dev/null || echo 2)}
-case "$part" in all | oracle | oracle-default | network | network-held-out | sigma-prior | sigma-prior-fit | z-choice | \
+case "$part" in all | oracle | oracle-default | network | cells | network-held-out | sigma-prior | sigma-prior-fit | z-choice | \
   vertical-speed) ;;
-  *) echo "usage: $0 [all|oracle|oracle-default|network|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]" >&2
+  *) echo "usage: $0 [all|oracle|oracle-default|network|cells|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]" >&2
     exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh plots
 cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build build/release -j"$jobs" --target adaptseg_evaluate adaptseg_calibrate
+cmake --build build/release -j"$jobs" --target adaptseg_evaluate adaptseg_calibrate adaptseg_cell_study
 eval_bin=build/release/examples/adaptseg_evaluate
 calibrate_bin=build/release/examples/adaptseg_calibrate
 root=out/results
 classes="building road vegetation water"
 fixed=(--seg-time-s 0.1 --plan-time-s 0)
 paper=(--rule threshold --gain-inputs delta-sigma --coverage region --no-plots)
-network=(--segmenter erfnet --threads 1)  # a bundled network (--model-file examples/models/NET), one thread per run
+# A bundled network (--model-file examples/models/NET), one thread per run; calibration keeps the
+# network's segmentations on disk, so that the runs over the same tiles segment each image once.
+network=(--segmenter erfnet --threads 1 --segmentation-cache "out/results/segmentation-cache")
 
 # One adaptseg_evaluate run: CONFIG RUN ARGS... -> $root/CONFIG/RUN (log: RUN.log beside it).
 running=0
@@ -193,6 +195,28 @@ if [ "$part" = vertical-speed ]; then
   wait
   check
   /usr/bin/python3 examples/tools/sweep_table.py "vertical 1 m/s=$(ls -d "$root/$config"/*/ | sed 's:/$::' | paste -sd, -)"
+  exit 0
+fi
+
+if [ "$part" = cells ]; then
+  # Per network, tile it never trained on and class: how the decision inputs rank the 5 cm/px
+  # cells of every 15 cm/px region by what re-mapping each alone gains, and how much the input
+  # of the run's model (bash scripts/results.sh network) captures.
+  [ -d "$root/network" ] || { echo "run 'bash $0 network' first" >&2; exit 1; }
+  out=$root/cells
+  mkdir -p "$out"
+  for net in mobilenetv2-dubai erfnet-dubai; do
+    for t in 4 6; do
+      for cls in $classes; do
+        build/release/examples/adaptseg_cell_study --field "$(dubai "$t")" --classes "$cls" --gsd 5 \
+          --segmenter erfnet --model-file "examples/models/$net" --threads "$jobs" \
+          --model "$root/network/$net-$cls-fly$t/model.yaml" --csv "$out/$net-$cls-$t.csv" >"$out/$net-$cls-$t.md" 2>/dev/null
+      done
+    done
+    echo
+    echo "## $net: capture of the achievable gain by the best 20 % of cells (mean over tiles 4, 6 and the four classes)"
+    cat "$out/$net"-*.md | /usr/bin/python3 examples/tools/cell_study_table.py
+  done
   exit 0
 fi
 

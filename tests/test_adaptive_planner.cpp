@@ -2,6 +2,7 @@
 
 #include <adaptseg/adaptive_mission.hpp>
 #include <adaptseg/adaptive_planner.hpp>
+#include <adaptseg/front_aware_policy.hpp>
 #include <adaptseg/oracle_segmenter.hpp>
 
 #include <doctest/doctest.h>
@@ -199,8 +200,13 @@ TEST_CASE("adaptive planner: coverage 'ranked' offers the best k cells by their 
   const double big = k1.cells[0].mass(DecisionInput::expected_error);
   CHECK(big > 0.0);
   for (const auto& c : k2.cells) CHECK(c.mass(DecisionInput::expected_error) <= big);
-  // ... and the descent of k = 1 flies over it alone.
+  // ... and the descent of k = 1 flies over it alone. What it showed, for the scene check: the
+  // cell's expected error at the top, and none in the image at the field's GSD (the oracle is
+  // sure there).
   REQUIRE(one.descents() == 1);
+  const DescentOutcome& out = *one.decisions[0].outcome;
+  CHECK(out.top_input == doctest::Approx(big / static_cast<double>(1440 * 1080)));
+  CHECK(out.fine_input == 0.0);
   std::vector<Waypoint> low;
   for (const auto& w : one.mission.waypoints)
     if (w.level == 1) low.push_back(w.waypoint);
@@ -213,6 +219,69 @@ TEST_CASE("adaptive planner: coverage 'ranked' offers the best k cells by their 
   CHECK(two.mission.miou_interest().value() == 1.0);
   CHECK(one.mission.miou_interest().value() < 1.0);
   CHECK(two.mission.waypoints.size() == 2 + 2);
+}
+
+namespace {
+/// The oracle from the top level; from lower down a backend that hesitates everywhere: the
+/// oracle's labels with half their probability on crop (what a network worse lower down shows).
+struct WorseLower {
+  OracleSegmenter oracle{3};
+  double top_gsd_cm = 3.0;
+  std::string name() const { return "worse-lower"; }
+  cv::Mat segment(const Image& image) { return segment_with_probabilities(image).labels; }
+  Segmentation segment_with_probabilities(const Image& image) {
+    Segmentation s = oracle.segment_with_probabilities(image);
+    if (image.gsd_cm >= top_gsd_cm * (1.0 - 1e-9)) return s;
+    const cv::Mat valid = s.labels != image.ignore_label;
+    for (auto& p : s.probabilities) p *= 0.5;
+    cv::add(s.probabilities[1], 0.5, s.probabilities[1], valid);
+    return s;
+  }
+};
+static_assert(SegmentsWithProbabilities<WorseLower>);
+}  // namespace
+
+TEST_CASE("adaptive planner (ranked): the scene check stops descending where the finer look is worse") {
+  // 2 x 2 regions at 3 cm/px, each with a crop patch whose edges are off the 3 cm/px grid.
+  cv::Mat labels(2160, 2880, CV_8UC1, cv::Scalar(0));
+  for (const cv::Point at : {cv::Point(50, 50), cv::Point(1490, 50), cv::Point(50, 1130), cv::Point(1490, 1130)})
+    labels(cv::Rect(at, cv::Size(301, 250))).setTo(1);
+  const Field f("patches", 1.0, labels, t::soil_crop_weed(), {1});
+  // A model that expects a descent to 1 cm/px to gain what the top-level image's expected error
+  // says (β = γ = 1), against a flat curve: every region with a patch is worth a descent.
+  std::vector<RegionSample> samples;
+  for (double dh : {5.5, 11.0})
+    for (double sigma : {0.05, 0.2}) {
+      RegionSample r;
+      r.top_gsd_cm = 3.0;
+      r.delta_h_m = dh;
+      r.sigma_top = r.sigma_sub = sigma;
+      r.miou_top = 0.8;
+      r.miou_sub = 0.9;
+      r.relabelled = {0.01, 0.01};
+      r.region_share = 0.25;
+      r.field_sigma = 0.05;
+      r.field_gain = 0.01;
+      samples.push_back(r);
+    }
+  GainModel model = GainModel::fit(samples, {.restarts = 0});
+  model.set_cells(CellGainModel(DecisionInput::expected_error, {{3.0, 1.0, 1.0, 1e-6, 1.0, 1e-6, 1.0, 1e-4}}));
+  const std::vector<ReferenceCurve> flat{{"flat", {{1.0, 0.8}, {3.0, 0.8}}, 0.05, 0.01}};
+  AdaptiveOptions o = options();
+  o.candidate_gsd_cm = {1.0};
+  o.coverage = DescentCoverage::ranked;
+  WorseLower backend;
+  FrontAwarePolicy adaptive(model, flat, {.online = true});
+  FrontAwarePolicy fixed(model, flat, {.online = false});
+  const AdaptiveResult learns = run_adaptive_mission(f, backend, adaptive, o, "adaptive");
+  const AdaptiveResult frozen = run_adaptive_mission(f, backend, fixed, o, "nonadaptive");
+  // Without the check every region is re-mapped; with it the first descent shows a finer look
+  // far less sure than the top (its expected error about crop 0.5 everywhere) and the UAV stops.
+  CHECK(frozen.descents() == 4);
+  CHECK(learns.descents() == 1);
+  const DescentOutcome& first = *learns.decisions[0].outcome;
+  CHECK(first.fine_input > first.top_input);
+  CHECK(adaptive.field_scale() < 0.0);
 }
 
 TEST_CASE("adaptive planner: the budget is never exceeded and the top level is always covered") {

@@ -187,9 +187,9 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
   const std::vector<Field> fields{a, b};
   const CalibrationResult cal = calibrate(std::span<const Field>(fields), oracle, options);
   REQUIRE_FALSE(cal.cell_samples.empty());
-  // Every input of the table is known from the oracle (it gives probabilities) and scored; the
+  // Every input about L is known from the oracle (it gives probabilities) and scored; the
   // chosen one first, with the best capture.
-  REQUIRE(cal.cell_input_scores.size() == kDecisionInputCount);
+  REQUIRE(cal.cell_input_scores.size() == 5);
   for (const auto& [input, score] : cal.cell_input_scores) CHECK(score <= cal.cell_input_scores.front().second);
   const auto& cells = cal.decision_function.model().cells();
   REQUIRE(cells.has_value());
@@ -211,6 +211,11 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
   const CellGainModel by_error = CellGainModel::fit(cal.cell_samples, DecisionInput::expected_error);
   CHECK(by_error.at(3.0, 1.0).gain_slope > 0.7);
   CHECK(by_error.at(3.0, 1.0).gain_slope < 1.2);
+  // At the field's GSD the oracle is sure everywhere (one-hot): its finer look removes all of
+  // the top's expected error, and the scene check reads that as the gain it is.
+  CHECK(by_error.at(3.0, 1.0).proxy_slope == doctest::Approx(by_error.at(3.0, 1.0).gain_slope).epsilon(1e-9));
+  for (const CellSample& c : cal.cell_samples)
+    if (c.sub_gsd_cm == 1.0) CHECK(c.fine.value(DecisionInput::expected_error) == 0.0);
   // Cells seen from the coarsest candidate GSD too (the alternative top level), re-mapped below it.
   CHECK(cells->top_gsds() == std::vector<double>{2.0, 3.0});
   CHECK(std::any_of(cal.cell_samples.begin(), cal.cell_samples.end(),

@@ -391,6 +391,149 @@ TEST_CASE("front-aware policy: what a descent relabelled changes a later decisio
   }
 }
 
+namespace {
+/// The synthetic gain model with a cell gain model of input expected_error: from 3 cm/px (and from
+/// 2 cm/px) re-mapped at 1 cm/px a cell gains `beta` of its input; the scene check reads the
+/// finer look's input with γ = beta.
+GainModel with_cells(double beta) {
+  GainModel m = fitted();
+  m.set_cells(CellGainModel(DecisionInput::expected_error,
+                            {{2.0, 1.0, beta, 1e-4, 1.0, 1e-4, beta, 4e-3 * beta * beta},
+                             {3.0, 1.0, beta, 1e-4, 1.0, 1e-4, beta, 4e-3 * beta * beta}}));
+  return m;
+}
+
+/// `n` cells of 1000 field pixels with expected error `x` (of a 4000-pixel region).
+std::vector<CellInputs> cells(int n, double x) {
+  CellInputs c;
+  c.values.fill(NAN);
+  c.values[index_of(DecisionInput::expected_error)] = x;
+  c.field_px = 1000.0;
+  return std::vector<CellInputs>(static_cast<std::size_t>(n), c);
+}
+
+/// The Scenario's region k offering the 2 best cells (k = 1) or all 4 (k = 2) of its region at
+/// 1 cm/px, each cell costing 20 s, and the mission's mean input so far `x`.
+struct CellScenario {
+  std::vector<Candidate> offers;
+  std::vector<LawnmowerForecast> lawnmowers{{1.0, 185.0}, {3.0, 40.0}};
+  explicit CellScenario(double x) {
+    for (int n : {2, 4}) {
+      Candidate c{1.0, 5.5, n, 10.0 + 20.0 * n};
+      c.cells = cells(n, x);
+      offers.push_back(c);
+    }
+  }
+  DecisionContext region(int k, double x) const {
+    DecisionContext c{.sigma = 0.2, .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5,
+                      .candidates = offers};
+    c.elapsed_s = 5.7 * (k + 1) + 40.0 * k;
+    c.rest_s = 40.0 - 5.7 * (k + 1);
+    c.region_share = 1.0 / 7.0;
+    c.region_px = 4000.0;
+    c.region_input = x;
+    c.lawnmowers = lawnmowers;
+    return c;
+  }
+};
+
+DescentOutcome cell_outcome(double top_input, double fine_input) {
+  DescentOutcome o{.top_altitude_m = 16.5, .sub_altitude_m = 5.5, .sigma_top = 0.2, .sigma_sub = 0.2};
+  o.relabelled = {0.05, 0.05};
+  o.top_input = top_input;
+  o.fine_input = fine_input;
+  return o;
+}
+}  // namespace
+
+TEST_CASE("front-aware policy with cells: gain from the cells' input, the field's own curve, the scene check") {
+  const CellScenario s(0.1);
+  const std::vector<ReferenceCurve> reference{{"a", {{1.0, 0.95}, {3.0, 0.75}}, 0.2, 0.05}};
+  SUBCASE("the forecast is β·Σ w·x over the cells, as a share of the field's L") {
+    FrontAwarePolicy p(with_cells(1.0), reference, {});
+    const Decision d = p.decide(s.region(0, 0.1));
+    REQUIRE(d.scores.size() == 2);
+    // 2 cells of a quarter of the region with x = 0.1: 0.05 of the region, a = 1/7, σ̂ = 0.2.
+    CHECK(d.scores[0].predicted_field_gain == doctest::Approx(0.05 / 7.0 / 0.2));
+    CHECK(d.scores[1].predicted_field_gain == doctest::Approx(0.10 / 7.0 / 0.2));
+  }
+  SUBCASE("against the field's own predicted curve, the forecasts' scale cancels") {
+    // The training curve rises by 0.2 mIoU over 145 s: against it, a descent of twice the cells'
+    // gain looks better than one of half of it. Against the curve the same model predicts for
+    // this field (what flying everything at 1 cm/px would gain from the field's input), only the
+    // gain per second of the descent against that of the lawnmower counts: the same decision
+    // whatever the scale.
+    std::vector<Decision> training, field;
+    for (double beta : {0.5, 2.0}) {
+      FrontAwarePolicy t(with_cells(beta), reference, {});
+      FrontAwarePolicy f(with_cells(beta), reference, {.field_curve = true});
+      training.push_back(t.decide(s.region(0, 0.1)));
+      field.push_back(f.decide(s.region(0, 0.1)));
+    }
+    CHECK(training[0].descend != training[1].descend);
+    CHECK(field[0].descend == field[1].descend);
+    CHECK(field[0].candidate == field[1].candidate);
+    // The predicted curve rises with the field's input: after five regions that hold little of
+    // it, the same cells are worth a descent; after five that hold as much, flying lower is.
+    for (const double elsewhere : {0.001, 0.1}) {
+      FrontAwarePolicy p(with_cells(1.0), reference, {.field_curve = true});
+      for (int k = 0; k < 5; ++k) {
+        DecisionContext seen = s.region(0, elsewhere);
+        seen.candidates = {};
+        REQUIRE_FALSE(p.decide(seen).descend);
+      }
+      DecisionContext here = s.region(0, 0.1);
+      here.elapsed_s = 5.7 * 6;
+      here.rest_s = 40.0 - here.elapsed_s;
+      CHECK(p.decide(here).descend == (elsewhere < 0.01));
+    }
+  }
+  // A flatter training curve (0.05 over 145 s): the cells' descents are worth their time.
+  const std::vector<ReferenceCurve> flat{{"a", {{1.0, 0.80}, {3.0, 0.75}}, 0.2, 0.05}};
+  SUBCASE("the scene check: a finer look less sure than the coarse one stops the descents") {
+    FrontAwarePolicy adaptive(with_cells(1.0), flat, {.online = true});
+    FrontAwarePolicy fixed(with_cells(1.0), flat, {.online = false});
+    for (FrontAwarePolicy* p : {&adaptive, &fixed}) {
+      const Decision d = p->decide(s.region(0, 0.1));
+      REQUIRE(d.descend);
+      // The chosen cells held 0.05 (or 0.1) of the region's input at the top; the finer
+      // images are less sure: 0.08 (0.16).
+      const double top = d.candidate == 0 ? 0.05 : 0.1;
+      p->observe(cell_outcome(top, 1.6 * top));
+    }
+    CHECK(adaptive.field_scale() < 0.0);
+    CHECK(fixed.field_scale() == 1.0);
+    CHECK_FALSE(adaptive.decide(s.region(1, 0.1)).descend);
+    CHECK(fixed.decide(s.region(1, 0.1)).descend);
+  }
+  SUBCASE("the scene check: a finer look that clears what the top doubted keeps descending") {
+    FrontAwarePolicy adaptive(with_cells(1.0), flat, {.online = true});
+    const Decision d = adaptive.decide(s.region(0, 0.1));
+    REQUIRE(d.descend);
+    const double top = d.candidate == 0 ? 0.05 : 0.1;
+    adaptive.observe(cell_outcome(top, 0.0));  // the finer images are sure everywhere
+    CHECK(adaptive.field_scale() == doctest::Approx(1.0).epsilon(0.05));
+    CHECK(adaptive.field_scale_sd() < 0.5);
+    CHECK(adaptive.decide(s.region(1, 0.1)).descend);
+    // Without the finer images' input (a labels-only backend) nothing is learnt.
+    FrontAwarePolicy blind(with_cells(1.0), flat, {.online = true});
+    REQUIRE(blind.decide(s.region(0, 0.1)).descend);
+    blind.observe(cell_outcome(top, NAN));
+    CHECK(blind.field_scale() == 1.0);
+  }
+  SUBCASE("the top level: the coarsest calibrated GSD whose lawnmower nothing faster beats") {
+    FrontAwarePolicy p(with_cells(1.0), {{"a", {{1.0, 0.95}, {2.0, 0.85}, {3.0, 0.75}}, 0.2, 0.05}}, {});
+    // 2 cm/px is faster than 3 over this area (its grid fits it better) and maps better.
+    const std::vector<LawnmowerForecast> fits{{1.0, 185.0}, {2.0, 35.0}, {3.0, 40.0}};
+    CHECK(p.top_gsd(fits, 3.0) == 2.0);
+    const std::vector<LawnmowerForecast> usual{{1.0, 185.0}, {2.0, 60.0}, {3.0, 40.0}};
+    CHECK(p.top_gsd(usual, 3.0) == 3.0);
+    // A model calibrated for its nominal top level alone keeps it.
+    FrontAwarePolicy nominal(fitted(), {{"a", {{1.0, 0.95}, {2.0, 0.85}, {3.0, 0.75}}, 0.2}}, {});
+    CHECK(nominal.top_gsd(fits, 3.0) == 3.0);
+  }
+}
+
 TEST_CASE("front-aware policy: pessimistic when unsure, from the field factor and the spread of the training curves") {
   const Scenario s;
   const double gain = 0.02 / 7.0 / 0.2;

@@ -159,12 +159,13 @@ struct CommonOptions {
 struct CalibrationCli {
   std::string rule = "front-aware";
   int threshold_steps = 10;
-  std::string coverage = "interest";
+  std::string coverage = "ranked";
   std::string gain_inputs = "delta-sigma-height";
   std::vector<double> confidences = kDefaultConfidences;
   std::string sigma_prior = "given";
   std::optional<double> segmentation_time_s;
   std::vector<std::string> cell_inputs;
+  std::string curve = "field";
 
   void add_to(CLI::App& app) {
     options_ = {
@@ -184,9 +185,15 @@ struct CalibrationCli {
             ->capture_default_str(),
         app.add_option("--cell-input", cell_inputs,
                        "coverage ranked: the decision inputs tried for ranking and forecasting cells, comma-separated "
-                       "(default: every one the backend gives; the one that ranks the training fields' cells best is "
-                       "saved in the model)")
+                       "(default: sigma, boundary, ambiguity, expected_error, second_choice, those the backend gives; "
+                       "the one that ranks the training fields' cells best is saved in the model)")
             ->delimiter(','),
+        app.add_option("--curve", curve,
+                       "front-aware rule with --coverage ranked: the lawnmower curve a descent is compared with, "
+                       "the training fields' (training) or this field's as the cell gain model predicts it from "
+                       "the top-level images (field)")
+            ->check(CLI::IsMember({"training", "field"}))
+            ->capture_default_str(),
         app.add_option("--gain-inputs", gain_inputs,
                        "what the GP I predicts the accuracy gain from: delta-sigma (the paper's) or "
                        "delta-sigma-height (the change of semantic ratio and of altitude)")
@@ -227,6 +234,7 @@ struct CalibrationCli {
                           : sigma_prior == "estimated" ? CalibrationOptions::SigmaPriorSource::estimated
                                                        : CalibrationOptions::SigmaPriorSource::given;
     options.adaptive.coverage = parse_descent_coverage(coverage);
+    options.front_aware.field_curve = curve == "field";
     options.cell_inputs.clear();
     for (const auto& name : cell_inputs) options.cell_inputs.push_back(parse_decision_input(name));
     options.fit.gain_inputs = gain_inputs == "delta-sigma-height" ? GainModel::GainInputs::delta_sigma_and_height

@@ -16,9 +16,13 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
+#include <optional>
 #include <tuple>
 #include <stdexcept>
 #include <string>
@@ -27,58 +31,157 @@
 
 namespace adaptseg::examples {
 
+/// FNV-1a, 64 bits, over `bytes`, continuing from `h`: names cached segmentations and models.
+inline std::uint64_t fnv1a(const void* bytes, std::size_t n, std::uint64_t h = 14695981039346656037ull) {
+  const auto* p = static_cast<const unsigned char*>(bytes);
+  for (std::size_t k = 0; k < n; ++k) h = (h ^ p[k]) * 1099511628211ull;
+  return h;
+}
+
+/// A model directory's (or ONNX file's) identity for a segmentation cache: its name and the hash
+/// of its ONNX file and metadata (the temperature included), e.g. "mobilenetv2-dubai-3fa2...".
+inline std::string model_digest(const std::filesystem::path& onnx, const std::filesystem::path& metadata) {
+  std::uint64_t h = 14695981039346656037ull;
+  for (const auto& f : {onnx, metadata}) {
+    std::ifstream in(f, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    h = fnv1a(bytes.data(), bytes.size(), h);
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  const std::filesystem::path dir = onnx.parent_path();
+  return (dir.filename().empty() ? std::string("model") : dir.filename().string()) + "-" + hex;
+}
+
 /// Memoises a deterministic backend: a simulated image is identified by its footprint, its
 /// yaw, its size and its RGB sums. For calibration, which flies the same waypoints many times,
 /// and only with a fixed segmentation time per image (a cache hit takes no time, so a measured
-/// time would be wrong). Gives probabilities where the backend does (computed, and kept, the
-/// first time an image is asked for with them).
+/// time would be wrong). Gives probabilities where the backend does; they are kept (3.5 MB an
+/// image for 5 classes at 480 x 360) only for images asked for with them a second time, as the
+/// top-level images are by every mission of a calibration, not for the many finer images its
+/// samples look at once. With a directory, the segmentations are also kept on disk there (one
+/// file per image: labels, and the probabilities where they are kept), so that calibrations
+/// with the same backend over the same fields (a sweep's runs) segment each image once; the
+/// directory must be the backend's own (model_digest()).
 template <SegmentationBackend Backend>
 class CachedBackend {
  public:
-  explicit CachedBackend(Backend& inner) : inner_(inner) {}
-  [[nodiscard]] std::string name() const { return inner_.name(); }
-  [[nodiscard]] cv::Mat segment(const Image& image) {
-    const Key key = key_of(image);
-    if (const auto it = cache_.find(key); it != cache_.end()) return it->second.labels.clone();
-    Segmentation s{inner_.segment(image), {}};
-    cv::Mat labels = s.labels.clone();
-    cache_.emplace(key, std::move(s));
-    return labels;
+  explicit CachedBackend(Backend& inner, std::optional<std::filesystem::path> dir = std::nullopt)
+      : inner_(inner), dir_(std::move(dir)) {
+    if (dir_) std::filesystem::create_directories(*dir_);
   }
+  [[nodiscard]] std::string name() const { return inner_.name(); }
+  [[nodiscard]] cv::Mat segment(const Image& image) { return lookup(image, false).labels; }
   [[nodiscard]] Segmentation segment_with_probabilities(const Image& image)
     requires SegmentsWithProbabilities<Backend>
   {
-    const Key key = key_of(image);
-    auto it = cache_.find(key);
-    if (it == cache_.end() || it->second.probabilities.empty()) {
-      Segmentation s = inner_.segment_with_probabilities(image);
-      if (it == cache_.end())
-        it = cache_.emplace(key, std::move(s)).first;
-      else
-        it->second = std::move(s);
-    }
-    Segmentation out{it->second.labels.clone(), {}};
-    for (const cv::Mat& p : it->second.probabilities) out.probabilities.push_back(p.clone());
-    return out;
+    return lookup(image, true);
   }
 
  private:
   using Key = std::tuple<int, int, int, int, double, int, int, double, double, double>;
+  struct Entry {
+    Segmentation segmentation;
+    int probability_asks = 0;
+  };
   static Key key_of(const Image& image) {
     const cv::Scalar sum = image.rgb.empty() ? cv::Scalar() : cv::sum(image.rgb);
     return {image.footprint_px.x, image.footprint_px.y, image.footprint_px.width, image.footprint_px.height,
             image.yaw_deg, image.width_px, image.height_px, sum[0], sum[1], sum[2]};
   }
+
+  static Segmentation copy(const Segmentation& s) {
+    Segmentation out{s.labels.clone(), {}};
+    for (const cv::Mat& p : s.probabilities) out.probabilities.push_back(p.clone());
+    return out;
+  }
+
+  /// The image's segmentation (a copy), with probabilities if `probabilities` (and the backend
+  /// gives them): from memory, from disk, or computed.
+  Segmentation lookup(const Image& image, bool probabilities) {
+    const Key key = key_of(image);
+    Entry& e = cache_[key];
+    const bool known = !e.segmentation.labels.empty();
+    if (known && (!probabilities || !e.segmentation.probabilities.empty())) return copy(e.segmentation);
+    const bool keep = probabilities && ++e.probability_asks >= 2;
+    std::optional<Segmentation> s = load(key);
+    if (!s || (probabilities && s->probabilities.empty())) {
+      if constexpr (SegmentsWithProbabilities<Backend>)
+        s = probabilities ? inner_.segment_with_probabilities(image) : Segmentation{inner_.segment(image), {}};
+      else
+        s = Segmentation{inner_.segment(image), {}};
+      // On disk: the labels the first time, the probabilities once they are kept.
+      if (!known || keep) store(key, keep ? *s : Segmentation{s->labels, {}});
+    }
+    if (keep || !known) e.segmentation = keep ? copy(*s) : Segmentation{s->labels.clone(), {}};
+    return std::move(*s);
+  }
+
+  [[nodiscard]] std::filesystem::path file_of(const Key& key) const {
+    const auto& [x, y, w, h, yaw, iw, ih, b, g, r] = key;
+    std::uint64_t hash = 14695981039346656037ull;
+    for (int v : {x, y, w, h, iw, ih}) hash = fnv1a(&v, sizeof v, hash);
+    for (double v : {yaw, b, g, r}) hash = fnv1a(&v, sizeof v, hash);
+    char name[32];
+    std::snprintf(name, sizeof name, "%016llx.seg", static_cast<unsigned long long>(hash));
+    return *dir_ / name;
+  }
+
+  /// File: rows, cols, planes (int32), the labels (rows x cols bytes), the planes (float32).
+  [[nodiscard]] std::optional<Segmentation> load(const Key& key) const {
+    if (!dir_) return std::nullopt;
+    std::ifstream in(file_of(key), std::ios::binary);
+    std::int32_t head[3] = {0, 0, 0};
+    if (!in.read(reinterpret_cast<char*>(head), sizeof head)) return std::nullopt;
+    const auto& [x, y, w, h, yaw, iw, ih, b, g, r] = key;
+    if (head[0] != ih || head[1] != iw || head[2] < 0 || head[2] > 255) return std::nullopt;
+    Segmentation s{cv::Mat(ih, iw, CV_8UC1), {}};
+    if (!in.read(reinterpret_cast<char*>(s.labels.data), static_cast<std::streamsize>(s.labels.total())))
+      return std::nullopt;
+    for (int k = 0; k < head[2]; ++k) {
+      cv::Mat p(ih, iw, CV_32FC1);
+      if (!in.read(reinterpret_cast<char*>(p.data), static_cast<std::streamsize>(p.total() * sizeof(float))))
+        return std::nullopt;
+      s.probabilities.push_back(std::move(p));
+    }
+    return s;
+  }
+
+  /// Written to a temporary file and renamed, so that concurrent runs never read half a file.
+  void store(const Key& key, const Segmentation& s) const {
+    if (!dir_) return;
+    const std::filesystem::path target = file_of(key);
+    std::filesystem::path tmp = target;
+    tmp += ".tmp" + std::to_string(reinterpret_cast<std::uintptr_t>(this));
+    {
+      std::ofstream out(tmp, std::ios::binary);
+      const std::int32_t head[3] = {s.labels.rows, s.labels.cols, static_cast<std::int32_t>(s.probabilities.size())};
+      out.write(reinterpret_cast<const char*>(head), sizeof head);
+      const cv::Mat labels = s.labels.isContinuous() ? s.labels : s.labels.clone();
+      out.write(reinterpret_cast<const char*>(labels.data), static_cast<std::streamsize>(labels.total()));
+      for (const cv::Mat& p0 : s.probabilities) {
+        const cv::Mat p = p0.isContinuous() ? p0 : p0.clone();
+        out.write(reinterpret_cast<const char*>(p.data), static_cast<std::streamsize>(p.total() * sizeof(float)));
+      }
+      if (!out) return;  // a full disk costs time, not correctness
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, target, ec);
+    if (ec) std::filesystem::remove(tmp, ec);
+  }
+
   Backend& inner_;
-  std::map<Key, Segmentation> cache_;
+  std::optional<std::filesystem::path> dir_;
+  std::map<Key, Entry> cache_;
 };
 
-/// adaptseg::calibrate with `backend` cached: calibration flies the same waypoints many times
-/// (at its declared per-image time, so a cache hit changes no number), and a network backend
-/// is the slow part.
+/// adaptseg::calibrate with `backend` cached (in memory, and in `dir` if given; CachedBackend):
+/// calibration flies the same waypoints many times (at its declared per-image time, so a cache
+/// hit changes no number), and a network backend is the slow part.
 template <SegmentationBackend Backend>
-CalibrationResult calibrate_cached(std::span<const Field> fields, Backend& backend, const CalibrationOptions& options) {
-  CachedBackend<Backend> cached(backend);
+CalibrationResult calibrate_cached(std::span<const Field> fields, Backend& backend, const CalibrationOptions& options,
+                                   std::optional<std::filesystem::path> dir = std::nullopt) {
+  CachedBackend<Backend> cached(backend, std::move(dir));
   return calibrate(fields, cached, options);
 }
 
@@ -87,6 +190,7 @@ struct SegmenterOptions {
   std::string name = "oracle";
   std::filesystem::path model_file;  ///< ERFNet: model directory, or the .onnx (metadata: same stem .yaml)
   int threads = 0;                   ///< ERFNet: OpenCV threads (0: OpenCV's default)
+  std::filesystem::path cache_root;  ///< ERFNet: where calibration keeps segmentations on disk (empty: nowhere)
 
   void add_to(CLI::App& app) {
     app.add_option("--segmenter", name,
@@ -100,6 +204,27 @@ struct SegmenterOptions {
     app.add_option("--threads", threads, "ERFNet: OpenCV threads (0: OpenCV's default)")
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
+    app.add_option("--segmentation-cache", cache_root,
+                   "ERFNet: keep calibration's segmentations on disk below this directory (one folder per network "
+                   "and weights), so that calibrations over the same fields segment each image once; missions "
+                   "always segment (their time is measured)");
+  }
+
+  /// The ONNX file and metadata of --model-file.
+  [[nodiscard]] std::pair<std::filesystem::path, std::filesystem::path> model_paths() const {
+    const bool dir = std::filesystem::is_directory(model_file);
+    const std::filesystem::path onnx = dir ? model_file / "model.onnx" : model_file;
+    std::filesystem::path metadata = onnx;
+    metadata.replace_extension(".yaml");
+    return {onnx, metadata};
+  }
+
+  /// Where calibration keeps the network's segmentations (--segmentation-cache), if anywhere:
+  /// a folder named by the network and the hash of its files.
+  [[nodiscard]] std::optional<std::filesystem::path> calibration_cache() const {
+    if (name != "erfnet" || cache_root.empty()) return std::nullopt;
+    const auto [onnx, metadata] = model_paths();
+    return cache_root / model_digest(onnx, metadata);
   }
 
   /// @throws std::invalid_argument for a model file given to the oracle or missing for ERFNet.
@@ -124,10 +249,7 @@ struct SegmenterOptions {
     ErfnetParams p = ErfnetSegmenter::for_field(field, CameraModel(camera));
     p.num_threads = threads;
     p.resize_to_network = true;
-    const bool dir = std::filesystem::is_directory(model_file);
-    const std::filesystem::path onnx = dir ? model_file / "model.onnx" : model_file;
-    std::filesystem::path metadata = onnx;
-    metadata.replace_extension(".yaml");
+    const auto [onnx, metadata] = model_paths();
     ErfnetSegmenter erfnet(onnx, metadata, std::move(p));
     return std::forward<F>(f)(erfnet);
   }

@@ -8,7 +8,8 @@
 // for every input of the table in include/adaptseg/decision_inputs.hpp, the rank correlation of
 // the cells' input mass (value x field pixels) with their gain and the share of the achievable
 // positive gain that re-mapping the top 10 % / 20 % of cells by that mass captures, beside a
-// random choice and the best possible (hindsight). --csv writes every cell.
+// random choice and the best possible (hindsight), and their means over the groups; with --model,
+// the mean capture of the input that model's planner ranks cells by. --csv writes every cell.
 //
 //   adaptseg_cell_study --field examples/data/dubai-tile-4 --field examples/data/dubai-tile-6
 //       --classes building,road,vegetation,water --segmenter erfnet
@@ -17,12 +18,14 @@
 #include "common/segmenters.hpp"
 #include "common/strategies.hpp"
 
+#include <adaptseg/decision_model.hpp>
 #include <adaptseg/image_summary.hpp>
 
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <numeric>
+#include <optional>
 
 namespace {
 
@@ -173,10 +176,21 @@ int main(int argc, char** argv) {
   app.add_option("--top-gsd", top_gsd, "top-level GSD [cm/px]")->capture_default_str();
   app.add_option("--gsd", gsds, "candidate GSDs of the cells [cm/px], comma-separated")->delimiter(',')->capture_default_str();
   app.add_option("--csv", csv_path, "write every cell to this CSV file");
+  std::filesystem::path model_file;
+  app.add_option("--model", model_file,
+                 "a decision model calibrated with --coverage ranked: its input is the planner's ranking, summarised "
+                 "on its own line");
   common.add_to(app);
   segmenter.add_to(app);
   if (const auto code = adaptseg::examples::parse_command_line(app, argc, argv)) return *code;
   try {
+    std::optional<DecisionInput> planner_input;
+    if (!model_file.empty()) {
+      const DecisionModel model = DecisionModel::load(model_file);
+      if (!model.decision_function.model().cells())
+        throw std::invalid_argument("--model " + model_file.string() + " has no cell gain model (calibrate with --coverage ranked)");
+      planner_input = model.decision_function.model().cells()->input();
+    }
     std::vector<Cell> cells;
     for (const auto& spec : field_specs) {
       const Field field = adaptseg::examples::load_field_spec(spec);
@@ -212,6 +226,9 @@ int main(int argc, char** argv) {
     for (std::size_t k = 0; k < kDecisionInputCount; ++k) std::printf("---|");
     std::printf("\n");
     std::vector<std::tuple<std::string, std::string, double>> groups;
+    std::array<double, kDecisionInputCount> rho_sum{}, c10_sum{}, c20_sum{};
+    std::array<int, kDecisionInputCount> counted{};
+    double best_sum = 0.0, random_sum = 0.0;
     for (const Cell& c : cells)
       if (std::find(groups.begin(), groups.end(), std::tuple{c.field, c.cls, c.gsd_cm}) == groups.end())
         groups.emplace_back(c.field, c.cls, c.gsd_cm);
@@ -230,11 +247,30 @@ int main(int argc, char** argv) {
       for (double x : gain) positive += std::max(0.0, x), total += x;
       std::printf("| %s | %s | %.1f | %zu | %.4f | %.2f | %.2f |", f.c_str(), cls.c_str(), g, gain.size(), positive,
                   positive > 0.0 ? top_gain(gain, gain, 0.2) / positive : NAN, positive > 0.0 ? 0.2 * total / positive : NAN);
-      for (std::size_t k = 0; k < kDecisionInputCount; ++k)
-        std::printf(" %+.2f / %.2f / %.2f |", spearman(mass[k], gain),
-                    positive > 0.0 ? top_gain(mass[k], gain, 0.1) / positive : NAN,
-                    positive > 0.0 ? top_gain(mass[k], gain, 0.2) / positive : NAN);
+      for (std::size_t k = 0; k < kDecisionInputCount; ++k) {
+        const double rho = spearman(mass[k], gain);
+        const double c10 = positive > 0.0 ? top_gain(mass[k], gain, 0.1) / positive : NAN;
+        const double c20 = positive > 0.0 ? top_gain(mass[k], gain, 0.2) / positive : NAN;
+        std::printf(" %+.2f / %.2f / %.2f |", rho, c10, c20);
+        if (std::isfinite(rho) && std::isfinite(c20)) rho_sum[k] += rho, c10_sum[k] += c10, c20_sum[k] += c20, ++counted[k];
+      }
+      if (positive > 0.0) best_sum += top_gain(gain, gain, 0.2) / positive, random_sum += 0.2 * total / positive;
       std::printf("\n");
+    }
+    // The means over the groups, and the planner's input.
+    const int n = *std::max_element(counted.begin(), counted.end());
+    std::printf("| mean | | | %d | | %.2f | %.2f |", n, n > 0 ? best_sum / n : NAN, n > 0 ? random_sum / n : NAN);
+    for (std::size_t k = 0; k < kDecisionInputCount; ++k)
+      std::printf(" %+.2f / %.2f / %.2f |", counted[k] ? rho_sum[k] / counted[k] : NAN,
+                  counted[k] ? c10_sum[k] / counted[k] : NAN, counted[k] ? c20_sum[k] / counted[k] : NAN);
+    std::printf("\n");
+    if (planner_input) {
+      const std::size_t k = index_of(*planner_input);
+      std::printf("\nthe planner's ranking (%s, from %s): mean capture of the achievable positive gain %.2f at 10 %% "
+                  "and %.2f at 20 %% of the cells (best possible at 20 %%: %.2f; random: %.2f)\n",
+                  to_string(*planner_input).c_str(), model_file.string().c_str(),
+                  counted[k] ? c10_sum[k] / counted[k] : NAN, counted[k] ? c20_sum[k] / counted[k] : NAN,
+                  n > 0 ? best_sum / n : NAN, n > 0 ? random_sum / n : NAN);
     }
     return 0;
   } catch (const std::exception& e) {

@@ -211,10 +211,10 @@ class AdaptivePlanner {
   PlannerStep report(const Image& image, std::optional<double> elapsed_s = std::nullopt) {
     check_report(image, elapsed_s);
     const auto t0 = std::chrono::steady_clock::now();
-    // A top-level image with the backend's class probabilities where it gives them and the
-    // decision reads them (DescentCoverage::ranked: the cells' decision inputs,
-    // image_summary.hpp); otherwise the labels alone.
-    const bool probabilities = path_.back().level == 0 && options_.coverage == DescentCoverage::ranked;
+    // With the backend's class probabilities where it gives them and the decision reads them
+    // (DescentCoverage::ranked: the cells' decision inputs at the top level, image_summary.hpp,
+    // and in a descent's images the scene check's); otherwise the labels alone.
+    const bool probabilities = options_.coverage == DescentCoverage::ranked;
     Segmentation s = probabilities ? segment_with_probabilities_checked(backend_, image, area_.num_classes)
                                    : Segmentation{segment_checked(backend_, image, area_.num_classes), {}};
     const double segmentation_s = seconds_since(t0);  // the network's time, as Mission measures it
@@ -413,7 +413,23 @@ class AdaptivePlanner {
     segmentation_s_ += seg;
     slowest_segmentation_s_ = std::max(slowest_segmentation_s_, seg);
     // A descent's first image: the region's map before the descent (what its outcome compares).
-    if (p.level == 1 && p.step == 0) descent_before_ = map_.labels()(region_rect(p.top_index)).clone();
+    if (p.level == 1 && p.step == 0) {
+      descent_before_ = map_.labels()(region_rect(p.top_index)).clone();
+      fine_mass_ = 0.0;
+      fine_known_ = true;
+    }
+    // Ranked: the finer image's own value of the ranking input over its cell (the scene check).
+    if (p.level == 1 && options_.coverage == DescentCoverage::ranked) {
+      const cv::Rect region = region_rect(p.top_index);
+      const cv::Rect cell = pixel_rect(p.waypoint.footprint) & region;
+      if (cell.area() > 0) {
+        const CellInputs c = cell_inputs(
+            planes_on_grid(image, pixel_inputs(segmentation, options_.mission.interest, area_.ignore_label), cell),
+            area_.valid_mask(cell), cv::Rect(0, 0, cell.width, cell.height));
+        fine_known_ = fine_known_ && (c.field_px == 0.0 || std::isfinite(c.value(options_.cell_input)));
+        fine_mass_ += c.mass(options_.cell_input);
+      }
+    }
     map_.fuse(image, labels);
 
     PlannerStep step;
@@ -519,13 +535,22 @@ class AdaptivePlanner {
     std::vector<CellInputs> cells;
   };
 
+  /// The decision inputs of the top-level image of waypoint i (`image`, `segmentation`) over its
+  /// region on the map grid (pixel_inputs(), planes_on_grid()); none unless
+  /// DescentCoverage::ranked.
+  [[nodiscard]] std::vector<cv::Mat> region_inputs(std::size_t i, const Image& image,
+                                                   const Segmentation& segmentation) const {
+    const cv::Rect region = region_rect(i);
+    if (options_.coverage != DescentCoverage::ranked || region.area() == 0) return {};
+    return planes_on_grid(image, pixel_inputs(segmentation, options_.mission.interest, area_.ignore_label), region);
+  }
+
   /// Every descent the decision at top-level waypoint i may choose from, per candidate GSD:
   /// descent_plan() (DescentCoverage::region, interest), or for DescentCoverage::ranked the
   /// cells of the region's sub-lawnmower ranked by their mass of `options().cell_input` in the
-  /// top-level image (`image`, `segmentation`), one option per number k of the best cells
+  /// region's inputs (`planes`, region_inputs()), one option per number k of the best cells
   /// (cells without any of the input left out), each flown in the sub-lawnmower's order.
-  [[nodiscard]] std::vector<DescentOption> descent_options(std::size_t i, const Image& image,
-                                                           const Segmentation& segmentation) const {
+  [[nodiscard]] std::vector<DescentOption> descent_options(std::size_t i, const std::vector<cv::Mat>& planes) const {
     std::vector<DescentOption> out;
     if (options_.coverage != DescentCoverage::ranked) {
       for (double g : candidates_) out.push_back({g, descent_plan(i, g), {}});
@@ -533,8 +558,6 @@ class AdaptivePlanner {
     }
     const cv::Rect region = region_rect(i);
     if (region.area() == 0) return out;
-    const std::vector<cv::Mat> planes =
-        planes_on_grid(image, pixel_inputs(segmentation, options_.mission.interest, area_.ignore_label), region);
     const cv::Mat field = area_.valid_mask(region);
     const DecisionInput input = options_.cell_input;
     for (double g : candidates_) {
@@ -579,7 +602,8 @@ class AdaptivePlanner {
     const double elapsed = elapsed_s();
     std::vector<std::vector<Waypoint>> sub_plans;
     std::vector<std::pair<TourStop, TourInsertion>> stops;  // per candidate, for a deferred descent
-    for (DescentOption& option : descent_options(i, image, segmentation)) {
+    const std::vector<cv::Mat> planes = region_inputs(i, image, segmentation);
+    for (DescentOption& option : descent_options(i, planes)) {
       const double g = option.gsd_cm;
       std::vector<Waypoint>& sub = option.plan;
       if (sub.empty()) continue;
@@ -626,6 +650,11 @@ class AdaptivePlanner {
     ctx.rest_s = rest;
     ctx.region_share = valid_px_ > 0 ? static_cast<double>(valid_pixels(top_[i].footprint)) / valid_px_ : 0.0;
     ctx.region_px = static_cast<double>(valid_pixels(top_[i].footprint));
+    if (!planes.empty()) {
+      const cv::Rect region = region_rect(i);
+      ctx.region_input = cell_inputs(planes, area_.valid_mask(region), cv::Rect(0, 0, region.width, region.height))
+                             .value(options_.cell_input);
+    }
     ctx.lawnmowers = forecasts;
     rec.decision = policy_.decide(ctx);
     if (rec.decision.descend) {
@@ -706,6 +735,16 @@ class AdaptivePlanner {
     if (region.area() > 0)
       out.relabelled = relabelling(descent_before_, map_.labels()(region), area_.valid_mask(region),
                                    options_.mission.interest);
+    if (options_.coverage == DescentCoverage::ranked) {
+      const Candidate& chosen = rec.candidates[chosen_candidate(rec.decision, rec.candidates, policy_.name())];
+      const double region_px = static_cast<double>(valid_pixels(top_[top_index].footprint));
+      double top_mass = 0.0;
+      for (const CellInputs& c : chosen.cells) top_mass += c.mass(options_.cell_input);
+      if (region_px > 0.0) {
+        out.top_input = top_mass / region_px;
+        if (fine_known_) out.fine_input = fine_mass_ / region_px;
+      }
+    }
     policy_.observe(out);
     rec.outcome = out;
     sub_.clear();
@@ -740,6 +779,8 @@ class AdaptivePlanner {
   ChosenDescent current_;             ///< the descent in progress (its plan moved to sub_)
   std::size_t descents_chosen_ = 0;
   cv::Mat descent_before_;            ///< the region's map before the descent in progress
+  double fine_mass_ = 0.0;            ///< ranked: Σ over its images so far of the finer look's input mass
+  bool fine_known_ = true;            ///< ... every image of it gave the input
   /// Per top-level waypoint, the last top-level waypoint of its window: where the window's tour
   /// starts (immediate: itself; tour: the survey's last; row: its row's last).
   std::vector<std::size_t> window_last_;

@@ -52,8 +52,10 @@ struct CalibrationOptions {
   /// DescentCoverage::ranked (`adaptive.coverage`): the decision inputs the cells may be ranked
   /// and forecast by; the one whose ranking captures most of the training fields' achievable
   /// gain is chosen (cell_ranking_capture(), each field scored on its own) and set as
-  /// `adaptive.cell_input`. Empty: every input of the table whose values the backend gives (the
-  /// ones that need probabilities only from a backend that gives them).
+  /// `adaptive.cell_input`; those the backend does not give (probabilities from a labels-only
+  /// backend) are left out. Empty: the inputs about L (sigma, boundary, ambiguity,
+  /// expected_error, second_choice); the generic ones, blind to which errors matter for L, are
+  /// tried only when named.
   std::vector<DecisionInput> cell_inputs{};
   /// DescentCoverage::ranked: other top-level GSDs the cell gain model is calibrated for, so
   /// that a mission may fly its top level at one of them where the predicted lawnmower curve
@@ -299,7 +301,8 @@ template <SegmentationBackend Backend>
     detail::require(!cell_samples.empty(), "calibrate: the training fields gave no cell sample", fields.front().name());
     std::vector<DecisionInput> tried = options.cell_inputs;
     if (tried.empty())
-      for (const auto& row : kDecisionInputs) tried.push_back(row.input);
+      tried = {DecisionInput::sigma, DecisionInput::boundary, DecisionInput::ambiguity, DecisionInput::expected_error,
+               DecisionInput::second_choice};
     for (DecisionInput i : tried) {
       // An input the backend cannot give (probabilities from a labels-only backend) is unknown
       // on every cell.
@@ -346,7 +349,19 @@ template <SegmentationBackend Backend>
   GainModel::FitOptions fit = options.fit;
   GainModel model = GainModel::fit(samples, fit);
   model.set_refit_every(options.refit_every);
-  if (ranked) model.set_cells(CellGainModel::fit(cell_samples, adaptive.cell_input));
+  if (ranked) {
+    model.set_cells(CellGainModel::fit(cell_samples, adaptive.cell_input));
+    // Each training field's mean input at the top level (the prior of a new field's): the
+    // cells of one candidate GSD tile its regions.
+    for (std::size_t f = 0; f < fields.size(); ++f) {
+      double mass = 0.0, px = 0.0;
+      const double sub = adaptive.candidate_gsd_cm.front();
+      for (const CellSample& c : cells_by_field[f])
+        if (c.top_gsd_cm == adaptive.top_gsd_cm && c.sub_gsd_cm == sub)
+          mass += c.top.mass(adaptive.cell_input), px += c.top.field_px;
+      reference[f].field_input = px > 0.0 ? mass / px : 0.0;
+    }
+  }
 
   // Layouts of a single field: the field and its halves across the longer axis.
   std::vector<Field> halves;

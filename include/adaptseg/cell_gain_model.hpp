@@ -30,6 +30,9 @@ struct CellSample {
   double top_gsd_cm = 0.0;    ///< the GSD of the top-level image that saw it [cm/px]
   double sub_gsd_cm = 0.0;    ///< the GSD it was re-mapped at [cm/px]
   CellInputs top;             ///< the cell as the top-level image saw it
+  /// The same quantities from the finer image over the cell (NaN values where unknown): what a
+  /// descent shows in flight about how much surer the finer look is.
+  CellInputs fine;
   double field_share = 0.0;   ///< the cell's field pixels / the field's
   double field_sigma = 0.0;   ///< σ of the field's top-level map (share of L over its field pixels)
   /// Share of the cell's field pixels whose label the re-mapping changed with L involved
@@ -66,6 +69,16 @@ struct CellSample {
 /// A descent re-mapping a set S of cells of a region of R field pixels forecasts (as shares of
 /// the region: the same units as GainModel's relabelled share)
 /// gain = β·Σ_S w_c·x_c, Var = κ·Σ_S w_c²·x_c, and likewise the relabelled share, w_c = px_c / R.
+///
+/// What a descent shows, without ground truth (the scene check, FrontAwarePolicy::observe): the
+/// finer images' own value of the input over the same cells, x'_c. Where the finer look is surer
+/// (x' < x) the re-mapping corrected something, where it is less sure it likely did harm:
+/// ν_c ≈ γ·(x_c − x'_c) on the training cells (γ by least squares through the origin), so
+/// y = γ·Σ_S w_c·(x_c − x'_c) estimates the descent's realised gain. As a measurement of the
+/// forecast β·Σ_S w_c·x_c its spread is κ_p·Σ_S w_c²·x_c, κ_p the weighted mean squared
+/// difference per unit of x over the training cells: it holds how far the proxy misses and how
+/// far the training fields' own gains scatter, so that the scene check learns no faster than the
+/// training fields show it can. γ = κ_p = 0 where no fine inputs were known (labels-only backends).
 class CellGainModel {
  public:
   /// The model for one pair of top-level and descent GSDs.
@@ -76,6 +89,8 @@ class CellGainModel {
     double gain_noise = 0.0;      ///< κ >= 0
     double relabel_slope = 0.0;   ///< α
     double relabel_noise = 0.0;   ///< κ_χ >= 0
+    double proxy_slope = 0.0;     ///< γ: gain per unit of the input the finer look removes
+    double proxy_noise = 0.0;     ///< κ_p >= 0
   };
 
   /// A forecast for a set of cells, in shares of the region's field pixels.
@@ -84,6 +99,8 @@ class CellGainModel {
     double gain_var = 0.0;
     double relabelled = 0.0;      ///< relabelled share of the region with L involved
     double relabelled_var = 0.0;
+    double input = 0.0;           ///< Σ w_c·x_c: the cells' input, what the finer look is compared with
+    double proxy_var = 0.0;       ///< κ_p·Σ w_c²·x_c: the spread of the scene check's measurement
   };
 
   /// @throws std::invalid_argument for no point, GSDs that are not finite and positive with the
@@ -101,7 +118,8 @@ class CellGainModel {
                           (p.top_gsd_cm == points_[k - 1].top_gsd_cm && p.sub_gsd_cm > points_[k - 1].sub_gsd_cm),
                       "CellGainModel: points must be in increasing (top, descent) GSD order; descent GSD", p.sub_gsd_cm);
       detail::require(std::isfinite(p.gain_slope) && std::isfinite(p.relabel_slope) && std::isfinite(p.gain_noise) &&
-                          std::isfinite(p.relabel_noise) && p.gain_noise >= 0.0 && p.relabel_noise >= 0.0,
+                          std::isfinite(p.relabel_noise) && p.gain_noise >= 0.0 && p.relabel_noise >= 0.0 &&
+                          std::isfinite(p.proxy_slope) && std::isfinite(p.proxy_noise) && p.proxy_noise >= 0.0,
                       "CellGainModel: slopes must be finite and noises finite and >= 0; at descent GSD", p.sub_gsd_cm);
     }
   }
@@ -138,15 +156,30 @@ class CellGainModel {
         wxr += w * x * c->relabelled;
         wx += w * x;
       }
-      Point p{g.top, g.sub, wxx > 0.0 ? wxg / wxx : 0.0, 0.0, wxx > 0.0 ? wxr / wxx : 0.0, 0.0};
-      double eg = 0.0, er = 0.0;
+      Point p{g.top, g.sub, wxx > 0.0 ? wxg / wxx : 0.0, 0.0, wxx > 0.0 ? wxr / wxx : 0.0, 0.0, 0.0, 0.0};
+      double eg = 0.0, er = 0.0, wdd = 0.0, wdg = 0.0;
+      bool proxy = true;
       for (const CellSample* c : g.cells) {
         const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
         eg += w * std::pow(c->normalized_gain() - p.gain_slope * x, 2);
         er += w * std::pow(c->relabelled - p.relabel_slope * x, 2);
+        const double xf = c->fine.value(input);
+        proxy = proxy && std::isfinite(c->top.value(input)) && std::isfinite(xf);
+        if (!proxy) continue;
+        wdd += w * (x - xf) * (x - xf);
+        wdg += w * (x - xf) * c->normalized_gain();
       }
       p.gain_noise = wx > 0.0 ? eg / wx : 0.0;
       p.relabel_noise = wx > 0.0 ? er / wx : 0.0;
+      if (proxy && wdd > 0.0 && wx > 0.0) {
+        p.proxy_slope = wdg / wdd;
+        double ep = 0.0;
+        for (const CellSample* c : g.cells) {
+          const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
+          ep += w * std::pow(p.proxy_slope * (x - c->fine.value(input)) - p.gain_slope * x, 2);
+        }
+        p.proxy_noise = ep / wx;
+      }
       points.push_back(p);
     }
     std::sort(points.begin(), points.end(), [](const Point& a, const Point& b) {
@@ -168,7 +201,15 @@ class CellGainModel {
       sx += w * x_of(c);
       sxx += w * w * x_of(c);
     }
-    return {p.gain_slope * sx, p.gain_noise * sxx, std::max(0.0, p.relabel_slope * sx), p.relabel_noise * sxx};
+    return {p.gain_slope * sx, p.gain_noise * sxx, std::max(0.0, p.relabel_slope * sx), p.relabel_noise * sxx,
+            sx, p.proxy_noise * sxx};
+  }
+
+  /// The scene check's estimate of a descent's normalised gain (in shares of its region) from
+  /// the input its cells held at the top (`top_input`, Forecast::input) and in the finer images
+  /// (`fine_input`, the same sum): γ·(top − fine); 0 where the model has no proxy.
+  [[nodiscard]] double proxy_gain(double top_gsd_cm, double sub_gsd_cm, double top_input, double fine_input) const {
+    return at(top_gsd_cm, sub_gsd_cm).proxy_slope * (top_input - fine_input);
   }
 
   /// The normalised gain one cell is forecast (β·x).
@@ -185,11 +226,13 @@ class CellGainModel {
     std::vector<Point> row;
     for (const Point& p : points_)
       if (p.top_gsd_cm == top) row.push_back(p);
-    Point out{top_gsd_cm, sub_gsd_cm, 0.0, 0.0, 0.0, 0.0};
+    Point out{top_gsd_cm, sub_gsd_cm, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
     out.gain_slope = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::gain_slope);
     out.gain_noise = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::gain_noise);
     out.relabel_slope = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::relabel_slope);
     out.relabel_noise = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::relabel_noise);
+    out.proxy_slope = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::proxy_slope);
+    out.proxy_noise = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::proxy_noise);
     return out;
   }
 

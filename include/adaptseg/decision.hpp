@@ -90,6 +90,9 @@ struct DecisionContext {
   double region_share = 0.0;      ///< the region's ground inside the field / the field's (0..1]
   /// The region's field pixels on the map grid (Candidate::cells' pixels are shares of it).
   double region_px = 0.0;
+  /// DescentCoverage::ranked: the ranking decision input's value over the region's field pixels,
+  /// as the top-level image saw them (NaN otherwise).
+  double region_input = std::numeric_limits<double>::quiet_NaN();
   std::span<const LawnmowerForecast> lawnmowers{};  ///< this field's lawnmowers at the top and candidate GSDs
 };
 
@@ -130,6 +133,12 @@ struct DescentOutcome {
   double sigma_sub = 0.0;       ///< σ_{h'} of the region (fused sub-lawnmower images)
   /// What the descent changed in the region's map (field pixels; no ground truth needed).
   Relabelling relabelled{};
+  /// DescentCoverage::ranked: the ranking input over the re-mapped cells as the top-level image
+  /// saw it, and as the finer images see the same ground (Σ_c value_c·px_c / the region's field
+  /// pixels, as Candidate::cells' forecasts); NaN where unknown (the finer images came without
+  /// probabilities). The scene check compares them (CellGainModel::proxy_gain).
+  double top_input = std::numeric_limits<double>::quiet_NaN();
+  double fine_input = std::numeric_limits<double>::quiet_NaN();
   /// Which descent this is: 0, 1, ... in the order the policy chose them. The planner flies
   /// them in that order, except a survey-then-inspect tour (DescentSchedule::tour, row), which
   /// chooses them during the survey (or the row) and flies them in its own order.

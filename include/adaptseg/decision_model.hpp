@@ -144,13 +144,15 @@ using ModelGp = GainModel::Gp;
 }  // namespace detail
 
 /// The keys of the cell gain model's points in a model file (`gain_model.cells`), one list each.
-inline constexpr std::array<std::pair<const char*, double CellGainModel::Point::*>, 6> kCellPointKeys{{
+inline constexpr std::array<std::pair<const char*, double CellGainModel::Point::*>, 8> kCellPointKeys{{
     {"top_gsd_cm", &CellGainModel::Point::top_gsd_cm},
     {"sub_gsd_cm", &CellGainModel::Point::sub_gsd_cm},
     {"gain_slope", &CellGainModel::Point::gain_slope},
     {"gain_noise", &CellGainModel::Point::gain_noise},
     {"relabel_slope", &CellGainModel::Point::relabel_slope},
     {"relabel_noise", &CellGainModel::Point::relabel_noise},
+    {"proxy_slope", &CellGainModel::Point::proxy_slope},
+    {"proxy_noise", &CellGainModel::Point::proxy_noise},
 }};
 
 /// A calibrated decision model and its provenance.
@@ -307,12 +309,15 @@ struct DecisionModel {
             e << YAML::Key << "scale_prior_sd" << YAML::Value << num(p.scale_prior_sd);
             e << YAML::Key << "sigma_prior_weight" << YAML::Value << num(p.sigma_prior_weight);
             e << YAML::Key << "sigma_prior_sd" << YAML::Value << num(p.sigma_prior_sd);
+            if (p.field_curve) e << YAML::Key << "field_curve" << YAML::Value << detail::flag_text(true);
             e << YAML::Key << "reference" << YAML::Value << YAML::BeginSeq;
             for (const auto& r : rule.reference()) {
               std::vector<double> g, m;
               for (const auto& pt : r.points) g.push_back(pt.gsd_cm), m.push_back(pt.miou);
               e << YAML::BeginMap << YAML::Key << "field" << YAML::Value << r.field << YAML::Key << "field_sigma"
-                << YAML::Value << num(r.field_sigma) << YAML::Key << "gsd_cm" << YAML::Value;
+                << YAML::Value << num(r.field_sigma);
+              if (r.field_input > 0.0) e << YAML::Key << "field_input" << YAML::Value << num(r.field_input);
+              e << YAML::Key << "gsd_cm" << YAML::Value;
               emit_numbers(e, g);
               e << YAML::Key << "miou" << YAML::Value;
               emit_numbers(e, m);
@@ -449,7 +454,8 @@ struct DecisionModel {
         if (points.empty()) points.resize(v.size());
         if (v.empty() || v.size() != points.size())
           detail::yaml_error(r.where(), "'gain_model.cells' needs one top_gsd_cm, sub_gsd_cm, gain_slope, gain_noise, "
-                                        "relabel_slope and relabel_noise value per point (>= 1 point)");
+                                        "relabel_slope, relabel_noise, proxy_slope and proxy_noise value per point "
+                                        "(>= 1 point)");
         for (std::size_t j = 0; j < v.size(); ++j) points[j].*member = v[j];
       }
       model.set_cells(CellGainModel(input, std::move(points)));
@@ -471,7 +477,8 @@ struct DecisionModel {
           const auto v = c.numbers("miou");
           if (g.size() != v.size())
             detail::yaml_error(r.where(), "a 'rule.reference' curve needs as many 'miou' as 'gsd_cm' values");
-          ReferenceCurve curve{c.text("field"), {}, c.has("field_sigma") ? c.number("field_sigma") : 0.0};
+          ReferenceCurve curve{c.text("field"), {}, c.has("field_sigma") ? c.number("field_sigma") : 0.0,
+                               c.has("field_input") ? c.number("field_input") : 0.0};
           for (std::size_t i = 0; i < g.size(); ++i) curve.points.push_back({g[i], v[i]});
           reference.push_back(std::move(curve));
         }
@@ -484,7 +491,8 @@ struct DecisionModel {
                                                   .sigma_prior_weight = rule.number("sigma_prior_weight"),
                                                   .sigma_prior_sd = rule.has("sigma_prior_sd")
                                                                         ? rule.number("sigma_prior_sd")
-                                                                        : 0.0}));
+                                                                        : 0.0,
+                                                  .field_curve = rule.has("field_curve") && rule.flag("field_curve")}));
       }
       if (kind == "utility")
         return DecisionFunction(UtilityPolicy(std::move(model), {.min_sigma = min_sigma,

@@ -28,6 +28,10 @@ struct ReferenceCurve {
   /// σ of the field's top-level map (its share of L as the UAV sees it); 0: unknown (files of
   /// format 1). The mean over the reference curves is the prior of a new field's σ.
   double field_sigma = 0.0;
+  /// The mean over the field's top-level images of the cell gain model's input (its value per
+  /// field pixel); 0: unknown (models without cells). The mean over the reference curves is the
+  /// prior of a new field's (Params::field_curve).
+  double field_input = 0.0;
 };
 
 /// The front-aware rule over a GainModel; a DecisionPolicy.
@@ -89,6 +93,12 @@ class FrontAwarePolicy {
     double scale_prior_sd = 0.5;    ///< ω > 0, prior spread of the field factor s
     double sigma_prior_weight = 0.25;  ///< k > 0: weight of the training fields' σ in σ̂ [fields]
     double sigma_prior_sd = 0.0;    ///< τ >= 0: spread of a field's σ about the training fields' mean
+    /// With a cell gain model: the lawnmower curve a descent is compared with is predicted for
+    /// this field by the same model (what re-mapping the whole field at each lawnmower GSD would
+    /// gain, from the field's mean input estimated from its top-level images so far) instead of
+    /// taken from the training fields' curves. The field factor s and σ̂ then scale the descent's
+    /// gain and the curve's rise alike.
+    bool field_curve = false;
 
     /// @throws std::invalid_argument naming the field.
     void validate() const {
@@ -129,6 +139,11 @@ class FrontAwarePolicy {
       }
     }
     if (with_sigma != reference_.size()) prior_sigma_ = 0.0;  // unknown for some: the running mean of σ
+    for (const auto& r : reference_) {
+      detail::require(std::isfinite(r.field_input) && r.field_input >= 0.0,
+                      "FrontAwarePolicy: reference curve '" + r.field + "' needs field_input >= 0", r.field_input);
+      prior_input_ += r.field_input / static_cast<double>(reference_.size());
+    }
     begin_mission();
   }
 
@@ -154,6 +169,8 @@ class FrontAwarePolicy {
     sigma_count_ = 0;
     seen_share_ = 0.0;
     seen_interest_ = 0.0;
+    seen_input_ = 0.0;
+    seen_input_share_ = 0.0;
     forecast_gain_ = 0.0;
     chosen_.clear();
     scale_mean_ = 1.0;
@@ -180,9 +197,19 @@ class FrontAwarePolicy {
     ++sigma_count_;
     seen_share_ += c.region_share;
     seen_interest_ += c.region_share * c.sigma;
+    if (std::isfinite(c.region_input)) {
+      seen_input_ += c.region_share * c.region_input;
+      seen_input_share_ += c.region_share;
+    }
     const bool by_relabelling = model_.c_model().has_value() || model_.cells().has_value();
     const auto [weight, sigma_cv2] = by_relabelling ? gain_weight(c) : std::pair{legacy_gain_weight(c), 0.0};
     const double t0 = c.elapsed_s + c.rest_s;
+    // The predicted curve's mIoU relative to the top level's (field_curve) or absolute.
+    double curve_level = 0.0;
+    if (params_.field_curve && model_.cells() && c.region_share > 0.0 && weight > 0.0) {
+      curves = {field_curve(c, weight / c.region_share)};
+      curve_level = mean_top_miou(c);
+    }
 
     Decision d;
     std::optional<std::size_t> best_index;
@@ -202,12 +229,12 @@ class FrontAwarePolicy {
         const CellGainModel::Forecast cf = model_.cells()->forecast(c.top_gsd_cm, cand.gsd_cm, cand.cells, c.region_px);
         base = cf.gain * weight;
         base_sd = std::sqrt(cf.gain_var) * weight;
-        relabelled = {cf.relabelled, std::sqrt(cf.relabelled_var)};
+        relabelled = {cf.relabelled, std::sqrt(cf.relabelled_var), cf.gain, cf.proxy_var, c.top_gsd_cm, cand.gsd_cm};
       } else if (model_.c_model()) {
         const double eta = model_.efficiency(delta_h);
         base = f.relabelled * eta * weight;
         base_sd = f.relabelled_std * eta * weight;
-        relabelled = {f.relabelled, f.relabelled_noisy_std};
+        relabelled = {f.relabelled, f.relabelled_noisy_std, 0.0, 0.0, 0.0, 0.0};
       } else {
         base = -f.delta_miou * weight;
         base_sd = f.delta_miou_std * weight;
@@ -229,7 +256,8 @@ class FrontAwarePolicy {
       const double rise = rise_sum / n;
       const double rise_var = curves.size() > 1 ? std::max(0.0, (rise_sq - n * rise * rise) / (n - 1.0)) : 0.0;
       const double lower = gain - rise - params_.confidence * std::sqrt(gain_var + rise_var);
-      s.predicted_front_margin = mean_top_miou(c) + forecast_gain_ + gain - mean_curve_miou(curves, t0 + cand.extra_time_s);
+      s.predicted_front_margin =
+          mean_top_miou(c) + forecast_gain_ + gain - curve_level - mean_curve_miou(curves, t0 + cand.extra_time_s);
       if (gain > 0.0 && lower > best) {
         best = lower;
         best_index = k;
@@ -288,24 +316,67 @@ class FrontAwarePolicy {
     model_.update(out);
     if (out.descent >= chosen_.size()) return;
     const Relabelled& f = chosen_[out.descent];
-    if (!std::isfinite(f.mean) || !(model_.c_model() || model_.cells())) return;
-    // Conjugate update of s in χ_obs = s·μ_C + ε, ε ~ N(0, sd_C²), prior s ~ N(1, ω²).
-    const double noise = std::max(f.noisy_sd * f.noisy_sd, 1e-12);
-    scale_precision_sum_ += f.mean * f.mean / noise;
-    scale_evidence_sum_ += f.mean * out.relabelled.interest_share / noise;
+    if (model_.cells() && f.sub_gsd_cm > 0.0) {
+      // The scene check (cell gain model): the descent's gain as the finer look estimates it,
+      // y = γ·(top − fine input) = s·μ + ε, ε ~ N(0, κ_p·Σ w²x), μ the forecast before s. Without
+      // the finer images' input, or a proxy, nothing is learnt.
+      const CellGainModel::Point p = model_.cells()->at(f.top_gsd_cm, f.sub_gsd_cm);
+      if (!std::isfinite(out.fine_input) || !std::isfinite(out.top_input) || !(p.proxy_slope > 0.0) ||
+          !(f.proxy_var > 0.0) || !(f.gain > 0.0))
+        return;
+      const double y = model_.cells()->proxy_gain(f.top_gsd_cm, f.sub_gsd_cm, out.top_input, out.fine_input);
+      scale_precision_sum_ += f.gain * f.gain / f.proxy_var;
+      scale_evidence_sum_ += f.gain * y / f.proxy_var;
+    } else {
+      if (!std::isfinite(f.mean) || !model_.c_model()) return;
+      // Conjugate update of s in χ_obs = s·μ_C + ε, ε ~ N(0, sd_C²), prior s ~ N(1, ω²).
+      const double noise = std::max(f.noisy_sd * f.noisy_sd, 1e-12);
+      scale_precision_sum_ += f.mean * f.mean / noise;
+      scale_evidence_sum_ += f.mean * out.relabelled.interest_share / noise;
+    }
     const double prior_precision = 1.0 / (params_.scale_prior_sd * params_.scale_prior_sd);
     const double precision = prior_precision + scale_precision_sum_;
-    scale_mean_ = std::max(0.0, (prior_precision + scale_evidence_sum_) / precision);
+    // s >= 0 with C (a descent cannot relabel less than nothing); a scene check may find the
+    // finer look worse than the coarse one, s < 0: descending loses there, and the UAV stops.
+    scale_mean_ = (prior_precision + scale_evidence_sum_) / precision;
+    if (!model_.cells()) scale_mean_ = std::max(0.0, scale_mean_);
     scale_var_ = 1.0 / precision;
   }
 
  private:
-  /// A descent's forecast of the share of its region it relabels with L involved, and the
-  /// spread of one such observation (NaN: no forecast, no field correction from it).
+  /// What a chosen descent was forecast to show: the share of its region it relabels with L
+  /// involved and the spread of one such observation (NaN: no forecast, no field correction
+  /// from it); with a cell gain model, its normalised gain before the field factor and the
+  /// spread of the scene check's measurement of it, and the GSDs it was forecast for.
   struct Relabelled {
     double mean = std::numeric_limits<double>::quiet_NaN();
     double noisy_sd = 0.0;
+    double gain = 0.0;
+    double proxy_var = 0.0;
+    double top_gsd_cm = 0.0;
+    double sub_gsd_cm = 0.0;
   };
+
+  /// The lawnmower curve of this field as the cell gain model predicts it (Params::field_curve),
+  /// relative to the top level's mIoU: at each lawnmower GSD g finer than the top level,
+  /// s·β(top, g)·X̂·(1 / σ̂), X̂ the field's mean input (seen so far, the unseen part shrunk towards
+  /// the training fields' mean with σ̂'s weight k), `inv_sigma` = 1 / σ̂; 0 at the top level; its
+  /// upper envelope.
+  [[nodiscard]] std::vector<CurvePoint> field_curve(const DecisionContext& c, double inv_sigma) const {
+    const double k = params_.sigma_prior_weight;
+    const double unseen = std::max(0.0, 1.0 - seen_input_share_);
+    const double rest = prior_input_ > 0.0 ? (seen_input_ + k * prior_input_) / (seen_input_share_ + k)
+                        : seen_input_share_ > 0.0 ? seen_input_ / seen_input_share_
+                                                  : 0.0;
+    const double x = seen_input_ + unseen * rest;
+    std::vector<CurvePoint> curve;
+    for (const auto& l : c.lawnmowers) {
+      if (l.gsd_cm > c.top_gsd_cm) continue;  // coarser than the top level: not what it compares with
+      const double slope = l.gsd_cm < c.top_gsd_cm ? model_.cells()->at(c.top_gsd_cm, l.gsd_cm).gain_slope : 0.0;
+      curve.push_back({l.time_s, scale_mean_ * slope * x * inv_sigma});
+    }
+    return upper_envelope(std::move(curve));
+  }
 
   /// a / σ̂: a relabelled share of the region, times η, as a field-level gain; and Var σ̂ / σ̂²
   /// (see the class comment).
@@ -366,11 +437,14 @@ class FrontAwarePolicy {
   std::vector<ReferenceCurve> reference_;
   Params params_;
   double prior_sigma_ = 0.0;        ///< mean σ of the training fields (0: unknown)
+  double prior_input_ = 0.0;        ///< mean cell-model input of the training fields (0: unknown)
   // Per mission (reset by begin_mission):
   double sigma_sum_ = 0.0;          ///< σ of the top-level images so far
   std::size_t sigma_count_ = 0;
   double seen_share_ = 0.0;         ///< field share of the top-level regions seen so far
   double seen_interest_ = 0.0;      ///< ... and Σ share · σ over them
+  double seen_input_ = 0.0;         ///< Σ share · the region's mean cell-model input (DecisionContext::region_input)
+  double seen_input_share_ = 0.0;   ///< ... the share of the field those regions cover
   double forecast_gain_ = 0.0;      ///< forecast field-level gain of the descents taken
   std::vector<Relabelled> chosen_;  ///< what each descent chosen was forecast to relabel (DescentOutcome::descent)
   double scale_mean_ = 1.0;         ///< field factor s: posterior mean

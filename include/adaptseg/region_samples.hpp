@@ -117,11 +117,22 @@ template <SegmentationBackend Backend>
       SemanticMap local(region.size(), field.ignore_label());
       // Cells a focused descent skips keep their top-level labels, as in the mission's map.
       if (coverage == DescentCoverage::interest) local.fuse(top_local, top_labels);
+      // Ranked: each finer image's own decision inputs over its cell (the scene check's proxy).
+      std::vector<CellInputs> fine_inputs;
       for (const auto& w : sub) {
         Image img = sensor.capture(w);
-        const cv::Mat labels = segment_checked(backend, img, n);
+        const Segmentation seg = ranked ? segment_with_probabilities_checked(backend, img, n)
+                                        : Segmentation{segment_checked(backend, img, n), {}};
         img.footprint_px -= region.tl();
-        local.fuse(img, labels);
+        local.fuse(img, seg.labels);
+        if (!ranked) continue;
+        const cv::Rect cell = ((field.pixel_rect(w.footprint) & inside) - region.tl()) & cv::Rect(0, 0, region.width, region.height);
+        if (cell.area() == 0) {
+          fine_inputs.emplace_back();
+          continue;
+        }
+        const auto planes = planes_on_grid(img, pixel_inputs(seg, interest, field.ignore_label()), cell);
+        fine_inputs.push_back(cell_inputs(planes, field_px(cell), cv::Rect(0, 0, cell.width, cell.height)));
       }
       ConfusionMatrix sub_cm(n);
       sub_cm.add(top_image.ground_truth, local.labels(), field.ignore_label());
@@ -139,7 +150,8 @@ template <SegmentationBackend Backend>
       s.field_gain = with.miou(interest).value_or(0.0) - field_miou;
       // Each cell re-mapped alone: the field's top-level map with the cell's pixels from the
       // finer images (the cells of one sub-lawnmower tile the region).
-      for (const Waypoint& w : ranked ? sub : std::vector<Waypoint>{}) {
+      for (std::size_t k = 0; ranked && k < sub.size(); ++k) {
+        const Waypoint& w = sub[k];
         const cv::Rect cell_in = field.pixel_rect(w.footprint) & inside;
         if (cell_in.area() == 0) continue;
         const cv::Rect cell = cell_in - region.tl();
@@ -150,6 +162,7 @@ template <SegmentationBackend Backend>
         c.sub_gsd_cm = g;
         c.top = cell_inputs(top_planes, field_px, cell);
         if (!(c.top.field_px > 0.0)) continue;
+        c.fine = fine_inputs[k];
         c.field_share = c.top.field_px / field_px_total;
         c.field_sigma = field_sigma;
         c.relabelled = relabelling(top_map.labels()(cell), after(cell), field_px(cell), interest).interest_share;

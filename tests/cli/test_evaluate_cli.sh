@@ -27,7 +27,8 @@ echo "ok: adaptive front margin on dubai-tile-6 (road) = $margin"
 # adaptive carries its forecast, what it relabelled (no truth needed) and what it realised.
 want="field,strategy,decision,image,sigma,action,gsd_cm,images,extra_time_s,forecast_delta_sigma,forecast_delta_miou,"
 want+="forecast_delta_miou_std,forecast_relabelled_interest,forecast_field_gain,forecast_front_margin,observed_sigma_sub,"
-want+="observed_relabelled,observed_relabelled_interest,realised_region_delta_miou,realised_field_gain,flown"
+want+="observed_relabelled,observed_relabelled_interest,realised_region_delta_miou,realised_field_gain,flown,"
+want+="observed_top_input,observed_fine_input"
 [ "$(head -1 "$work/e/decisions.csv")" = "$want" ] || fail "decisions.csv header: $(head -1 "$work/e/decisions.csv")"
 descents=$(awk -F, '$2 == "adaptive" {print $12}' "$work/e/results.csv")
 awk -F, -v n="$descents" '$2 == "adaptive" {rows++} $2 == "adaptive" && $6 == "descend" {
