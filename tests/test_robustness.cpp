@@ -476,6 +476,91 @@ TEST_CASE("robustness: calibration: backend returns a label outside the class se
                        std::invalid_argument);
 }
 
+namespace {
+/// The oracle's segmentation with its probabilities broken as `fault` says.
+struct ProbabilityBreaker {
+  enum class Fault { planes, nan, sum };
+  Fault fault;
+  OracleSegmenter oracle{3};
+  std::string name() const { return "breaker"; }
+  cv::Mat segment(const Image& image) { return oracle.segment(image); }
+  Segmentation segment_with_probabilities(const Image& image) {
+    Segmentation s = oracle.segment_with_probabilities(image);
+    if (fault == Fault::planes) s.probabilities.pop_back();
+    if (fault == Fault::nan) s.probabilities[0].at<float>(5, 7) = static_cast<float>(kNaN);
+    // The first labelled pixel's probabilities sum to 1.5.
+    const cv::Mat labelled = s.labels != image.ignore_label;
+    std::vector<cv::Point> at;
+    cv::findNonZero(labelled, at);
+    if (fault == Fault::sum && !at.empty()) {  // the least likely class, so that no value leaves [0, 1]
+      std::size_t least = 0;
+      for (std::size_t c = 1; c < s.probabilities.size(); ++c)
+        if (s.probabilities[c].at<float>(at.front()) < s.probabilities[least].at<float>(at.front())) least = c;
+      s.probabilities[least].at<float>(at.front()) += 0.5f;
+    }
+    return s;
+  }
+};
+}  // namespace
+
+TEST_CASE("robustness: ranked missions: class probabilities that break the contract, from the backend or the caller") {
+  const Field f = weedmap_field();
+  AdaptiveOptions o;
+  o.mission = fixed_times();
+  o.top_gsd_cm = 3.0;
+  o.candidate_gsd_cm = {1.0};
+  o.coverage = DescentCoverage::ranked;
+  o.mission.interest = f.interest();
+  LinearDecision never({0.0, 1.0});
+  ProbabilityBreaker fewer{ProbabilityBreaker::Fault::planes}, nan{ProbabilityBreaker::Fault::nan},
+      sum{ProbabilityBreaker::Fault::sum};
+  CHECK_THROWS_WITH_AS((void)run_adaptive_mission(f, fewer, never, o, "ranked"),
+                       Contains("segmentation backend 'breaker' broke the segmentation contract: probabilities must "
+                                "have one plane per class (3) (got 2)"),
+                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)run_adaptive_mission(f, nan, never, o, "ranked"),
+                       Contains("probability nan of class 0 at pixel (x 7, y 5) is not in [0, 1]"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)run_adaptive_mission(f, sum, never, o, "ranked"),
+                       Contains("sum to 1.5, not 1 (tolerance 0.001)"), std::invalid_argument);
+  // Calibration collects the same images: the same errors.
+  CHECK_THROWS_WITH_AS((void)collect_samples(f, sum, CameraModel{}, 3.0, {1.0}, f.interest(), DescentCoverage::ranked),
+                       Contains("sum to 1.5"), std::invalid_argument);
+  // The caller's probabilities in report(image, segmentation, s): checked, nothing changes.
+  AdaptivePlanner planner(SurveyArea::of(f), sum, never, o);
+  const auto w = planner.next();
+  REQUIRE(w.has_value());
+  const Image image = SimulatedSensor(f, planner.camera()).capture(w->waypoint);
+  CHECK_THROWS_WITH_AS((void)planner.report(image, sum.segment_with_probabilities(image), 0.1),
+                       Contains("AdaptivePlanner::report: the probabilities reported broke the segmentation contract"),
+                       std::invalid_argument);
+  CHECK(planner.pending().has_value());
+}
+
+TEST_CASE("robustness: decision model: a broken cell gain model") {
+  const t::TempDir dir;
+  DecisionModel m = small_model();
+  m.coverage = DescentCoverage::ranked;
+  GainModel g = m.decision_function.model();
+  g.set_cells(CellGainModel(DecisionInput::expected_error,
+                            {{3.0, 1.0, 0.9, 0.01, 1.0, 0.01, 0.8, 0.02}, {3.0, 2.0, 0.3, 0.01, 0.9, 0.01, 0.2, 0.02}}));
+  m.decision_function = DecisionFunction(UtilityPolicy(g, {}));
+  m.save(dir.path() / "ranked.yaml");
+  const std::string text = read_text(dir.path() / "ranked.yaml");
+  REQUIRE(text.find("    input: expected_error") != std::string::npos);
+  CHECK(DecisionModel::load(dir.path() / "ranked.yaml").decision_function.model().cells().has_value());
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, replaced(text, "input: expected_error", "input: confusion")),
+                       Contains("decision input must be one of sigma, boundary"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, replaced(text, "gain_slope: [0.9, 0.3]", "gain_slope: [0.9]")),
+                       Contains("'gain_model.cells' needs one top_gsd_cm, sub_gsd_cm, gain_slope"),
+                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, replaced(text, "gain_noise: [0.01, 0.01]", "gain_noise: [0.01, -1]")),
+                       Contains("noises finite and >= 0"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, replaced(text, "sub_gsd_cm: [1, 2]", "sub_gsd_cm: [1, 4]")),
+                       Contains("the descent's finer than the top's"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, replaced(text, "sub_gsd_cm: [1, 2]", "sub_gsd_cm: [2, 1]")),
+                       Contains("increasing (top, descent) GSD order"), std::invalid_argument);
+}
+
 TEST_CASE("robustness: live planner: labels outside the class set, from the backend or the caller") {
   const Field f = weedmap_field();
   ContractBreaker backend{ContractBreaker::Fault::label};

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -190,6 +191,11 @@ inline void check_probabilities(const std::vector<cv::Mat>& probabilities, const
                     std::to_string(p.cols) + "x" + std::to_string(p.rows));
   }
   const auto where = [](int x, int y) { return " at pixel (x " + std::to_string(x) + ", y " + std::to_string(y) + ")"; };
+  const auto text = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return std::string(buf);
+  };
   std::vector<const float*> rows(probabilities.size());
   for (int y = 0; y < image.height_px; ++y) {
     for (std::size_t c = 0; c < rows.size(); ++c) rows[c] = probabilities[c].ptr<float>(y);
@@ -199,15 +205,15 @@ inline void check_probabilities(const std::vector<cv::Mat>& probabilities, const
       for (std::size_t c = 0; c < rows.size(); ++c) {
         const float v = rows[c][x];
         if (!(v >= 0.0f && v <= 1.0f))  // NaN fails too
-          throw std::invalid_argument(broke + "probability " + std::to_string(v) + " of class " + std::to_string(c) +
+          throw std::invalid_argument(broke + "probability " + text(v) + " of class " + std::to_string(c) +
                                       where(x, y) + " is not in [0, 1]");
         sum += v;
       }
       const bool one = std::abs(sum - 1.0) <= tolerance;
       if (!one && !(label[x] == image.ignore_label && sum == 0.0))
-        throw std::invalid_argument(broke + "probabilities" + where(x, y) + " sum to " + std::to_string(sum) +
+        throw std::invalid_argument(broke + "probabilities" + where(x, y) + " sum to " + text(sum) +
                                     (label[x] == image.ignore_label ? ", neither 1 nor 0" : ", not 1") +
-                                    " (tolerance " + std::to_string(tolerance) + ")");
+                                    " (tolerance " + text(tolerance) + ")");
     }
   }
 }
