@@ -52,6 +52,23 @@ def save(fig, path, dpi=110, tight=True):
     plt.close(fig)
 
 
+def upper_envelope(points):
+    """The lawnmower curve's running maximum over time as points ((time, mIoU), sorted by time),
+    as adaptseg::upper_envelope computes it: flat after a lawnmower that a slower one does not
+    beat, back on the curve where it climbs through that level."""
+    points = sorted(points)
+    env = [points[0]]
+    best = points[0][1]
+    for (ta, ma), (tb, mb) in zip(points, points[1:]):
+        if not mb > best:
+            continue
+        if ma < best and tb > ta:
+            env.append((ta + (best - ma) / (mb - ma) * (tb - ta), best))
+        env.append((tb, mb))
+        best = mb
+    return env
+
+
 def read_csv(path):
     with open(path, newline="") as f:
         return list(csv.DictReader(f))
@@ -72,6 +89,13 @@ def main(out):
         lm = sorted((r for r in fr if r["strategy"] == "lawnmower"), key=lambda r: num(r["time_total"]))
         ax.plot([num(r["time_total"]) for r in lm], [num(r["miou_interest"]) for r in lm], "-o", color="0.3",
                 label="lawnmower (fixed altitude)")
+        env = upper_envelope([(num(r["time_total"]), num(r["miou_interest"])) for r in lm])
+        if len(env) != len(lm) or any(e != (num(r["time_total"]), num(r["miou_interest"])) for e, r in zip(env, lm)):
+            last = max(num(r["time_total"]) for r in lm)
+            if env[-1][0] < last:
+                env.append((last, env[-1][1]))  # flat beyond its last rise
+            ax.plot([e[0] for e in env], [e[1] for e in env], "--", color="0.55", zorder=1,
+                    label="its upper envelope (the front margin's yardstick)")
         for r in lm:
             ax.annotate(f"{num(r['gsd_cm']):.1f} cm/px", (num(r["time_total"]), num(r["miou_interest"])),
                         textcoords="offset points", xytext=(6, -12), fontsize=8, color="0.3")
