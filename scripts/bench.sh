@@ -6,7 +6,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh bench
-cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release
+source scripts/configure.sh
+configure_for bench build/release
 cmake --build build/release -j"$(nproc 2>/dev/null || echo 2)" --target bench_gaussian_process bench_decision bench_erfnet \
   bench_geotiff
 # GaussianProcess vs scikit-learn twice, side by side: numpy/scipy on Debian's reference BLAS and

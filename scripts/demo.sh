@@ -5,7 +5,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh plots
-cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release -DADAPTSEG_BUILD_TESTS=OFF -DADAPTSEG_BUILD_BENCHMARKS=OFF
+source scripts/configure.sh
+configure_for demo build/release
 cmake --build build/release -j"$(nproc 2>/dev/null || echo 2)" --target adaptseg_mission adaptseg_calibrate adaptseg_evaluate adaptseg_live
 build/release/examples/adaptseg_evaluate --train examples/data/weedmap-000:0,0,0.5,1 \
   --test examples/data/weedmap-000:0.5,0,1,1 --segmenter oracle --out out/demo

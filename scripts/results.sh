@@ -47,7 +47,8 @@ case "$part" in all | oracle | oracle-default | network | cells | network-held-o
 esac
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh plots
-cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release >/dev/null
+source scripts/configure.sh
+configure_for results build/release >/dev/null
 cmake --build build/release -j"$jobs" --target adaptseg_evaluate adaptseg_calibrate adaptseg_cell_study
 eval_bin=build/release/examples/adaptseg_evaluate
 calibrate_bin=build/release/examples/adaptseg_calibrate

@@ -332,6 +332,9 @@ TEST_CASE("erfnet: clear errors for bad models, bad parameters and images withou
                        doctest::Contains("camera_width_px"), std::invalid_argument);
   CHECK_THROWS_WITH_AS(ErfnetSegmenter(model_dir(), ErfnetParams{.num_threads = -1}),
                        doctest::Contains("num_threads"), std::invalid_argument);
+  // 100000 threads crashed OpenCV's pool at exit: refused before any is started.
+  CHECK_THROWS_WITH_AS(ErfnetSegmenter(model_dir(), ErfnetParams{.num_threads = 100000}),
+                       doctest::Contains("num_threads must be in 0..256"), std::invalid_argument);
   CHECK_THROWS_WITH_AS(ErfnetSegmenter(model_dir(), ErfnetParams{.name = ""}), doctest::Contains("name"),
                        std::invalid_argument);
   CHECK_THROWS_WITH_AS(ErfnetSegmenter(model_dir(), ErfnetParams{.dnn_target = 12345}),

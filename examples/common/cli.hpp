@@ -67,15 +67,18 @@ inline std::optional<int> parse_command_line(CLI::App& app, int argc, char** arg
     std::string what = e.what();
     for (char& c : what)
       if (c == '\n') c = ' ';
-    // A misspelt flag: name the one that was probably meant.
+    // An unknown flag is the mistake to name (CLI11 may report a missing required option
+    // first), with the one that was probably meant.
     for (int k = 1; k < argc; ++k) {
       const std::string word = std::string(argv[k]).substr(0, std::string(argv[k]).find('='));
       if (word.rfind("--", 0) != 0 || word.size() < 3) continue;
+      bool known = false;
+      for (const CLI::Option* o : app.get_options())
+        for (const std::string& name : o->get_lnames()) known = known || "--" + name == word;
+      if (known) continue;
       const std::string near = nearest_flag(app, word);
-      if (!near.empty() && near != word) {
-        what += "; did you mean " + near + "?";
-        break;
-      }
+      what = "unknown option " + word + (near.empty() ? "" : "; did you mean " + near + "?");
+      break;
     }
     std::fprintf(stderr, "%s: error: %s (run %s --help for the options)\n", app.get_name().c_str(), what.c_str(),
                  app.get_name().c_str());
@@ -144,6 +147,18 @@ struct CommonOptions {
     MissionOptions out = mission;
     (void)CameraModel(out.camera);
     (void)TimingModel(out.timing);
+    // The velocity-ramp model is a multicopter's: far beyond one, its times mean nothing
+    // (--speed 1e308 flew a field in no time).
+    const auto realistic = [](const char* flag, double v, const char* unit) {
+      if (!(v > 100.0)) return;
+      char text[32];
+      std::snprintf(text, sizeof text, "%g", v);
+      throw std::invalid_argument(std::string(flag) + " " + text + " " + unit +
+                                  " is beyond any UAV the timing model describes (at most 100)");
+    };
+    realistic("--speed", out.timing.max_speed_mps, "m/s");
+    realistic("--accel", out.timing.max_accel_mps2, "m/s^2");
+    realistic("--vertical-speed", out.timing.max_vertical_speed_mps, "m/s");
     out.fixed_segmentation_time_s = seg_time_s;
     out.fixed_planning_time_s = plan_time_s;
     if (!interest_names.empty()) out.interest = field.class_indices(interest_names);

@@ -38,9 +38,9 @@ struct ExportCli {
                    "field.yaml's geo section");
     app.add_option("--hold-s", file_options.hold_s, "hold time at every exported waypoint [s]")
         ->capture_default_str();
-    app.add_flag("--takeoff,!--no-takeoff", file_options.takeoff,
-                 "begin the exported mission with a take-off at home to the first waypoint's altitude "
-                 "(default; --no-takeoff for a UAV already airborne)");
+    app.add_flag("!--no-takeoff", file_options.takeoff,
+                 "begin the exported mission without a take-off, for a UAV already airborne (default: a "
+                 "take-off at home to the first waypoint's altitude)");
     app.add_option("--mission-end", file_options.end,
                    "after the last exported waypoint: rtl (return to launch, default), land (at home) or none")
         ->transform(CLI::CheckedTransformer(std::map<std::string, MissionEnd>{{"rtl", MissionEnd::return_to_launch},

@@ -201,8 +201,8 @@ struct SegmenterOptions {
                    "network of --segmenter erfnet (the ONNX backend): a directory with model.onnx + model.yaml, "
                    "or an .onnx file with its .yaml next to it (examples/models/erfnet-dubai, "
                    "examples/models/mobilenetv2-dubai)");
-    app.add_option("--threads", threads, "ERFNet: OpenCV threads (0: OpenCV's default)")
-        ->check(CLI::NonNegativeNumber)
+    app.add_option("--threads", threads, "ERFNet: OpenCV threads (0: OpenCV's default; at most 256)")
+        ->check(CLI::Range(0, 256))
         ->capture_default_str();
     app.add_option("--segmentation-cache", cache_root,
                    "ERFNet: keep calibration's segmentations on disk below this directory (one folder per network "

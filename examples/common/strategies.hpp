@@ -138,7 +138,9 @@ StrategyRun run_strategy(const Field& field, Backend& backend, const std::string
                          const DecisionModel* model, MissionOptions options, std::optional<double> budget_s,
                          LawnmowerOverlap overlap = {}) {
   if (strategy == "lawnmower") {
-    if (!(gsd_cm > 0.0)) throw std::invalid_argument("--strategy lawnmower needs --gsd (a positive GSD in cm/px)");
+    if (gsd_cm == 0.0) throw std::invalid_argument("--strategy lawnmower needs --gsd (a positive GSD in cm/px)");
+    if (!(gsd_cm > 0.0) || !std::isfinite(gsd_cm))
+      throw std::invalid_argument("--gsd must be a finite positive GSD in cm/px (got " + fmt(gsd_cm, 3) + ")");
     if (gsd_cm < field.gsd_cm() * (1.0 - 1e-9))
       throw std::invalid_argument("--gsd " + std::to_string(gsd_cm) + " cm/px is finer than field '" +
                                   field.name() + "' (" + std::to_string(field.gsd_cm()) + " cm/px)");

@@ -68,7 +68,7 @@ struct ErfnetParams {
   /// image's ignore label and gives them all-zero probabilities; false lets the network
   /// label them like any other pixel.
   bool black_is_no_data = true;
-  /// > 0: `cv::setNumThreads(num_threads)` at construction. NOTE: this is OpenCV's
+  /// 1..256: `cv::setNumThreads(num_threads)` at construction. NOTE: this is OpenCV's
   /// process-wide thread count and affects all OpenCV calls. 0: leave it unchanged.
   int num_threads = 0;
   /// OpenCV DNN backend and target (`cv::dnn::Backend`, `cv::dnn::Target`).
@@ -286,7 +286,9 @@ class ErfnetSegmenter {
                         (params_.camera_width_px == 0) == (params_.camera_height_px == 0),
                     "ErfnetParams: camera_width_px and camera_height_px must both be 0 or both > 0",
                     std::to_string(params_.camera_width_px) + "x" + std::to_string(params_.camera_height_px));
-    detail::require(params_.num_threads >= 0, "ErfnetParams: num_threads must be >= 0",
+    // Beyond a few hundred threads OpenCV's pool is no faster and its teardown has crashed
+    // (100000 threads: a segmentation fault at exit).
+    detail::require(params_.num_threads >= 0 && params_.num_threads <= 256, "ErfnetParams: num_threads must be in 0..256",
                     params_.num_threads);
     detail::require(!params_.name.empty(), "ErfnetParams: name must not be empty", "''");
     const auto targets = cv::dnn::getAvailableTargets(static_cast<cv::dnn::Backend>(params_.dnn_backend));

@@ -11,11 +11,11 @@ weedmap="$examples/data/weedmap-000"
 dubai="$examples/data/dubai-tile-1"
 weedmap_model="$examples/../tests/data/decision_model_v1/weedmap_utility_v1.yaml"
 
-# CLI11's error for an unknown flag, in one line with the pointer to --help (each program's case
+# An unknown flag named as such, in one line with the pointer to --help (each program's case
 # adds a misspelt flag, for which the likely one is named; calibrate a flag without its value,
 # live a missing required option).
 common_parse_errors() {
-  expect_error "The following argument was not expected: --bogus" "$@" --bogus
+  expect_error "unknown option --bogus" "$@" --bogus
   expect_error "run $program --help for the options" "$@" --bogus
 }
 

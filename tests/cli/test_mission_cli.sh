@@ -41,9 +41,15 @@ bad_inputs)
     --field "$field:0.5,0,1" --gsd 3 --out "$work/o"
   # Command-line syntax errors (CLI11's): the same one line and exit code 2.
   expect_error "Could not convert: --gsd = abc" --field "$field" --gsd abc --out "$work/o"
-  expect_error "The following argument was not expected: --bogus" --field "$field" --gsd 3 --out "$work/o" --bogus
-  expect_error "did you mean --gsd?" --field "$field" --gds 3 --out "$work/o"
+  expect_error "unknown option --bogus" --field "$field" --gsd 3 --out "$work/o" --bogus
+  expect_error "unknown option --gds; did you mean --gsd?" --field "$field" --gds 3 --out "$work/o"
+  # A misspelt required flag is named as unknown, not as the required one missing.
+  expect_error "unknown option --feild; did you mean --field?" --feild "$field" --gsd 3 --out "$work/o"
   expect_error "--out is required" --field "$field" --gsd 3
+  expect_error "--gsd must be a finite positive GSD in cm/px (got nan)" --field "$field" --gsd nan --out "$work/o"
+  expect_error "--speed 1e+308 m/s is beyond any UAV the timing model describes" --field "$field" --gsd 3 \
+    --speed 1e308 --out "$work/o"
+  expect_error "--threads: Value 100000 not in range 0 to 256" --field "$field" --gsd 3 --threads 100000 --out "$work/o"
   expect_error "is not OVERLAP or ALONG,ACROSS with fractions in [0, 0.9]" --field "$field" --gsd 3 --overlap 0.95 --out "$work/o"
   expect_error "is not OVERLAP or ALONG,ACROSS" --field "$field" --gsd 3 --overlap 0.2,x --out "$work/o"
   expect_error "--overlap applies to --strategy lawnmower only" --field "$field" --strategy adaptive --overlap 0.2 \
