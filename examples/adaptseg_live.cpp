@@ -23,6 +23,7 @@
 // Writes OUT/result.json (the path with each image and its yaw, σ and decisions) and OUT/map.png
 // (the fused map).
 
+#include "common/segmenters.hpp"
 #include "common/strategies.hpp"
 
 #include <adaptseg/adaptive_planner.hpp>
@@ -320,6 +321,7 @@ template <adaptseg::SegmentationBackend Backend>
 void fly_strategy(const std::string& strategy, const adaptseg::DecisionModel& model, const ImageSetInfo& info,
                   const std::vector<PosedImage>& images, Backend& backend, const adaptseg::AdaptiveOptions& options,
                   const LiveSettings& s) {
+  adaptseg::examples::check_segmenter(model, backend.name());
   if (strategy == "linear") {
     adaptseg::LinearDecision policy(model.linear);
     fly(info, images, backend, policy, options, s);
@@ -417,6 +419,7 @@ int main(int argc, char** argv) {
       params.camera_width_px = m.image_width_px;
       params.camera_height_px = m.image_height_px;
       params.resize_to_network = true;
+      params.name = adaptseg::examples::network_name(erfnet_dir / "model.onnx", erfnet_dir / "model.yaml");
       adaptseg::ErfnetSegmenter erfnet(erfnet_dir, params);
       fly_strategy(strategy, model, info, images, erfnet, options, s);
     }

@@ -53,6 +53,14 @@ inline std::string model_digest(const std::filesystem::path& onnx, const std::fi
   return (dir.filename().empty() ? std::string("model") : dir.filename().string()) + "-" + hex;
 }
 
+/// The name a network backend goes by in results and decision models: "erfnet:" and the
+/// network's identity (model_digest(): its folder's name and the hash of its weights and
+/// metadata), so that a model calibrated with one network is refused with another (or with the
+/// same network at another temperature), whatever their folders are called.
+inline std::string network_name(const std::filesystem::path& onnx, const std::filesystem::path& metadata) {
+  return "erfnet:" + model_digest(onnx, metadata);
+}
+
 /// Memoises a deterministic backend: a simulated image is identified by its footprint, its
 /// yaw, its size and its RGB sums. For calibration, which flies the same waypoints many times,
 /// and only with a fixed segmentation time per image (a cache hit takes no time, so a measured
@@ -250,6 +258,7 @@ struct SegmenterOptions {
     p.num_threads = threads;
     p.resize_to_network = true;
     const auto [onnx, metadata] = model_paths();
+    p.name = network_name(onnx, metadata);
     ErfnetSegmenter erfnet(onnx, metadata, std::move(p));
     return std::forward<F>(f)(erfnet);
   }

@@ -123,6 +123,17 @@ inline bool write_geo_maps(const Field& field, const cv::Mat& labels, const cv::
 #endif
 }
 
+/// Throws unless `model` was calibrated with the backend named `segmenter` (a network's name
+/// holds its weights' identity: network_name()).
+/// @throws std::invalid_argument naming both.
+inline void check_segmenter(const DecisionModel& model, const std::string& segmenter) {
+  if (model.segmenter != segmenter)
+    throw std::invalid_argument("the decision model was calibrated with segmenter '" + model.segmenter +
+                                "' but the mission uses '" + segmenter +
+                                "': calibrate with the backend the mission flies (adaptseg_calibrate --segmenter, "
+                                "--model-file)");
+}
+
 /// One flown strategy: the mission, and the decisions for the model-based ones.
 struct StrategyRun {
   MissionResult mission;
@@ -150,10 +161,7 @@ StrategyRun run_strategy(const Field& field, Backend& backend, const std::string
     throw std::invalid_argument("--overlap applies to --strategy lawnmower only (the decision function's regions "
                                 "are the paper's non-overlapping top-level footprints)");
   if (model == nullptr) throw std::invalid_argument("--strategy " + strategy + " needs --model (from adaptseg_calibrate)");
-  if (model->segmenter != backend.name())
-    throw std::invalid_argument("the decision model was calibrated with segmenter '" + model->segmenter +
-                                "' but the mission uses '" + backend.name() +
-                                "': calibrate with the backend the mission flies (adaptseg_calibrate --segmenter)");
+  check_segmenter(*model, backend.name());
   // Without --interest, the model's labels of interest (its GPs were fitted for them).
   model->check_classes(field);
   if (options.interest.empty()) options.interest = field.class_indices(model->interest);

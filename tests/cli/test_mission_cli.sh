@@ -37,6 +37,17 @@ bad_inputs)
   expect_error "decision model was calibrated for classes [soil, crop, weed] but field 'dubai-tile-1' has" \
     --field "$examples/data/dubai-tile-1" --strategy adaptive \
     --model "$examples/../tests/data/decision_model_v1/weedmap_utility_v1.yaml" --out "$work/o"
+  # A model calibrated with one backend flown with another: refused, naming both (a network by its
+  # folder and the hash of its weights and metadata).
+  expect_error "decision model was calibrated with segmenter 'oracle' but the mission uses 'erfnet:erfnet-dubai-" \
+    --field "$examples/data/dubai-tile-1" --strategy adaptive --segmenter erfnet \
+    --model-file "$examples/models/erfnet-dubai" \
+    --model "$examples/../tests/data/decision_model_v1/dubai_road_front_aware_v3.yaml" --out "$work/o"
+  sed 's/^segmenter: oracle/segmenter: "erfnet:mobilenetv2-dubai-0123456789abcdef"/' \
+    "$examples/../tests/data/decision_model_v1/dubai_road_front_aware_v3.yaml" >"$work/mobilenet-model.yaml"
+  expect_error "calibrated with segmenter 'erfnet:mobilenetv2-dubai-0123456789abcdef' but the mission uses 'erfnet:erfnet-dubai-" \
+    --field "$examples/data/dubai-tile-1" --strategy adaptive --segmenter erfnet \
+    --model-file "$examples/models/erfnet-dubai" --model "$work/mobilenet-model.yaml" --out "$work/o"
   expect_error "'0.5,0,1' is not a region x0,y0,x1,y1 (fractions 0..1); write DIR:x0,y0,x1,y1" \
     --field "$field:0.5,0,1" --gsd 3 --out "$work/o"
   # Command-line syntax errors (CLI11's): the same one line and exit code 2.
@@ -124,7 +135,8 @@ work = sys.argv[1]
 for net in ("erfnet-dubai", "mobilenetv2-dubai"):
     fine, coarse = (json.load(open(f"{work}/{net}-{g}/result.json")) for g in (5, 15))
     for r in (fine, coarse):
-        assert r["segmenter"] == "erfnet", r["segmenter"]
+        # The network's name: erfnet:<its folder>-<the hash of its weights and metadata>.
+        assert r["segmenter"].startswith(f"erfnet:{net}-") and len(r["segmenter"]) == len(f"erfnet:{net}-") + 16, r["segmenter"]
         # Exactly black orthomosaic pixels carry no RGB: the backend leaves them unlabelled.
         assert r["coverage"] > 0.999, r["coverage"]
     print(net, "miou_all 5 cm/px", fine["miou_all"], "15 cm/px", coarse["miou_all"])
