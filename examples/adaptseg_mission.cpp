@@ -63,6 +63,9 @@ int main(int argc, char** argv) {
       throw std::invalid_argument("--overlap applies to --strategy lawnmower only");
     segmenter.validate();
     const auto camera = strategy != "lawnmower" && model ? model->camera : options.camera;
+    // Before flying: a mission whose export would fly above the ceiling is refused.
+    if (strategy == "lawnmower" && gsd_cm > 0.0) exports.check_altitude(gsd_cm, camera);
+    if (strategy != "lawnmower" && model) exports.check_altitude(model->top_gsd_cm, camera);
     const auto run = segmenter.with_backend(field, camera, [&](auto& backend) {
       return adaptseg::examples::run_strategy(field, backend, strategy, gsd_cm, model ? &*model : nullptr, options,
                                               budget_s, overlap);

@@ -214,7 +214,7 @@ TEST_CASE("export: paths keep positions, GSD and levels of a planned or flown mi
   CHECK(p.waypoints.back().level == 0);
   const auto& w = p.waypoints[0];
   const Eigen::Vector3d back = geo.to_field({w.latitude_deg, w.longitude_deg, kGeo.altitude_m + w.relative_altitude_m});
-  CHECK(back.z() == doctest::Approx(adaptseg::CameraModel{}.altitude_m(3.0)).epsilon(1e-6));
+  CHECK(back.z() == doctest::Approx(adaptseg::CameraModel{}.altitude_m(3.0)).epsilon(1e-3));  // to the centimetre
 
   // A flown mission: the levels come from its records.
   adaptseg::MissionResult r;
@@ -232,6 +232,11 @@ TEST_CASE("export: paths keep positions, GSD and levels of a planned or flown mi
   REQUIRE(flown.waypoints.size() == 3);
   CHECK(flown.waypoints[1].level == 1);
   CHECK(flown.waypoints[2].relative_altitude_m == 18.0);
+  // Altitudes to the centimetre, as an autopilot is told them.
+  r.waypoints[2].waypoint.position.z() = 165.00000000001054;
+  CHECK(adaptseg::make_export_path(r, geo).waypoints[2].relative_altitude_m == 165.0);
+  r.waypoints[2].waypoint.position.z() = 16.504999;
+  CHECK(adaptseg::make_export_path(r, geo).waypoints[2].relative_altitude_m == doctest::Approx(16.50).epsilon(1e-12));
   // A planned path alone: every waypoint top-level.
   const ExportPath planned = adaptseg::make_export_path({r.waypoints[0].waypoint}, geo, "planned");
   CHECK(planned.waypoints.at(0).level == 0);
@@ -246,8 +251,9 @@ TEST_CASE("export: mission items take off, hold at every waypoint, capture one i
   const ExportPath p = sample_path();
   adaptseg::ExportOptions opt;
   opt.hold_s = 2.5;
+  opt.hover_speed_mps = 3.5;
   const auto items = adaptseg::mission_items(p, opt);
-  REQUIRE(items.size() == 2 * p.waypoints.size() + 2);
+  REQUIRE(items.size() == 2 * p.waypoints.size() + 3);
   const MissionItem& takeoff = items.front();
   CHECK(takeoff.command == 22);
   CHECK(takeoff.frame == 3);
@@ -256,9 +262,16 @@ TEST_CASE("export: mission items take off, hold at every waypoint, capture one i
   CHECK(takeoff.params[4] == p.home.latitude_deg);
   CHECK(takeoff.params[5] == p.home.longitude_deg);
   CHECK(takeoff.params[6] == p.waypoints.front().relative_altitude_m);
+  // Then the speed the mission's times were computed with: ground speed, throttle unchanged.
+  const MissionItem& speed = items[1];
+  CHECK(speed.command == 178);
+  CHECK(speed.frame == 2);
+  CHECK(speed.params[0] == 1.0);
+  CHECK(speed.params[1] == 3.5);
+  CHECK(speed.params[2] == -1.0);
   for (std::size_t i = 0; i < p.waypoints.size(); ++i) {
-    const MissionItem& nav = items[1 + 2 * i];
-    const MissionItem& cap = items[2 + 2 * i];
+    const MissionItem& nav = items[2 + 2 * i];
+    const MissionItem& cap = items[3 + 2 * i];
     CHECK(nav.command == 16);
     CHECK(nav.frame == 3);
     CHECK(nav.params[0] == 2.5);
@@ -280,6 +293,7 @@ TEST_CASE("export: mission items take off, hold at every waypoint, capture one i
   opt.camera_trigger = adaptseg::CameraTrigger::digicam_control;
   opt.end = adaptseg::MissionEnd::land;
   opt.takeoff = false;
+  opt.set_speed = false;
   const auto other = adaptseg::mission_items(p, opt);
   REQUIRE(other.size() == 2 * p.waypoints.size() + 1);
   CHECK(other.front().command == 16);
@@ -302,6 +316,13 @@ TEST_CASE("export: mission items take off, hold at every waypoint, capture one i
                        std::invalid_argument);
   opt.takeoff = false;
   CHECK(adaptseg::mission_items(low, opt).size() == p.waypoints.size());
+  // Above the legal ceiling (120 m by default): refused.
+  ExportPath high = p;
+  high.waypoints.back().relative_altitude_m = 165.0;
+  CHECK_THROWS_WITH_AS((void)adaptseg::mission_items(high, opt), doctest::Contains("flies above max_altitude_m 120"),
+                       std::invalid_argument);
+  opt.max_altitude_m = 200.0;
+  CHECK(adaptseg::mission_items(high, opt).size() == p.waypoints.size());
   opt.hold_s = -1.0;
   CHECK_THROWS_WITH_AS((void)adaptseg::mission_items(p, opt), doctest::Contains("hold_s"), std::invalid_argument);
   opt.hold_s = 1.0;
@@ -334,19 +355,22 @@ TEST_CASE("export: a QGroundControl plan reads back equal and has QGC's structur
   CHECK(takeoff["doJumpId"] == 1);
   CHECK(takeoff["AltitudeMode"] == 1);
   CHECK(takeoff["Altitude"] == p.waypoints.front().relative_altitude_m);
-  const auto& first = m["items"][1];
+  const auto& speed = m["items"][1];  // DO_CHANGE_SPEED: no position, QGC writes no altitude keys
+  CHECK(speed["command"] == 178);
+  CHECK_FALSE(speed.contains("Altitude"));
+  const auto& first = m["items"][2];
   CHECK(first["type"] == "SimpleItem");
   CHECK(first["command"] == 16);
   CHECK(first["frame"] == 3);
-  CHECK(first["doJumpId"] == 2);
+  CHECK(first["doJumpId"] == 3);
   CHECK(first["autoContinue"] == true);
   CHECK(first["AltitudeMode"] == 1);
   CHECK(first["AMSLAltAboveTerrain"].is_null());
   CHECK(first["Altitude"] == first["params"][6]);
   CHECK(first["params"][3].is_null());
-  CHECK(m["items"][2]["command"] == 2000);
-  CHECK_FALSE(m["items"][2].contains("Altitude"));
-  CHECK(m["items"][2]["doJumpId"] == 3);
+  CHECK(m["items"][3]["command"] == 2000);
+  CHECK_FALSE(m["items"][3].contains("Altitude"));
+  CHECK(m["items"][3]["doJumpId"] == 4);
   const auto& last = m["items"].back();
   CHECK(last["command"] == 20);
   CHECK(last["frame"] == 2);
@@ -362,7 +386,7 @@ TEST_CASE("export: a QGC WPL 110 file reads back equal") {
   check_same_home(back.home, p.home);
   check_same_items(back.items, adaptseg::mission_items(p));
   // Exact, too: shortest round-trip text.
-  CHECK(back.items[1].params[4] == p.waypoints[0].latitude_deg);
+  CHECK(back.items[2].params[4] == p.waypoints[0].latitude_deg);
   // Spaces, \r\n and blank lines are read as well.
   std::string crlf;
   for (char c : text) {
@@ -475,8 +499,8 @@ TEST_CASE("export: malformed plan and GeoJSON files are rejected, naming the mem
   j["mission"]["items"][0]["params"].erase(0);
   expect_plan_error(j, "mission.items[0].params must be an array of 7");
   j = plan;
-  j["mission"]["items"][3]["params"][4] = 123.0;
-  expect_plan_error(j, "mission.items[3]: latitude");
+  j["mission"]["items"][4]["params"][4] = 123.0;
+  expect_plan_error(j, "mission.items[4]: latitude");
   j = plan;
   j["mission"]["items"][0]["command"] = -1;
   expect_plan_error(j, "mission.items[0].command must be an integer");

@@ -38,6 +38,15 @@ struct ExportCli {
                    "field.yaml's geo section");
     app.add_option("--hold-s", file_options.hold_s, "hold time at every exported waypoint [s]")
         ->capture_default_str();
+    app.add_option("--max-altitude-m", file_options.max_altitude_m,
+                   "the highest an exported waypoint may fly above home [m] (the usual legal ceiling); a mission "
+                   "that would fly higher is refused before it flies, with the GSD it may fly at")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    app.add_option("--firmware", file_options.firmware_type,
+                   "the autopilot of the exported .plan: px4 (default) or ardupilot")
+        ->transform(CLI::CheckedTransformer(std::map<std::string, int>{{"px4", mavlink::kAutopilotPx4},
+                                                                       {"ardupilot", mavlink::kAutopilotArduPilot}}));
     app.add_flag("!--no-takeoff", file_options.takeoff,
                  "begin the exported mission without a take-off, for a UAV already airborne (default: a "
                  "take-off at home to the first waypoint's altitude)");
@@ -77,7 +86,23 @@ struct ExportCli {
     return field;
   }
 
-  /// Writes one file per requested format into `out_dir`; hover speed from the mission's timing.
+  /// Throws, before a mission flies, if exporting it would fly above --max-altitude-m: the
+  /// highest waypoint of a mission is its top level's (or a lawnmower's) at `gsd_cm` with
+  /// `camera`; the message names the coarsest GSD that stays below the ceiling.
+  /// @throws std::invalid_argument naming the altitude, the ceiling and that GSD.
+  void check_altitude(double gsd_cm, const CameraParams& camera) const {
+    if (formats.empty()) return;
+    const CameraModel model(camera);
+    const double altitude = model.altitude_m(gsd_cm);
+    if (altitude <= file_options.max_altitude_m) return;
+    throw std::invalid_argument("the mission would fly " + fmt(altitude, 1) + " m above home at " + fmt(gsd_cm, 2) +
+                                " cm/px, above --max-altitude-m " + fmt(file_options.max_altitude_m, 1) +
+                                ": with this camera fly at most " + fmt(model.gsd_cm(file_options.max_altitude_m), 2) +
+                                " cm/px, or raise the ceiling where the law allows");
+  }
+
+  /// Writes one file per requested format into `out_dir`; hover speed (and the speed item) from
+  /// the mission's timing.
   void write(const Field& field, const MissionResult& result, const MissionOptions& options,
              const std::filesystem::path& out_dir) const {
     if (formats.empty()) return;

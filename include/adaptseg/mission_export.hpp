@@ -48,11 +48,13 @@ inline constexpr int kCmdNavWaypoint = 16;          ///< MAV_CMD_NAV_WAYPOINT: p
 inline constexpr int kCmdNavReturnToLaunch = 20;    ///< MAV_CMD_NAV_RETURN_TO_LAUNCH: no parameters
 inline constexpr int kCmdNavLand = 21;              ///< MAV_CMD_NAV_LAND: p4 yaw, p5-7 position (altitude ignored)
 inline constexpr int kCmdNavTakeoff = 22;           ///< MAV_CMD_NAV_TAKEOFF: p1 pitch, p4 yaw, p5-6 position, p7 altitude
+inline constexpr int kCmdDoChangeSpeed = 178;       ///< MAV_CMD_DO_CHANGE_SPEED: p1 speed type (1 ground), p2 speed [m/s], p3 throttle (-1: unchanged)
 inline constexpr int kCmdDoDigicamControl = 203;    ///< MAV_CMD_DO_DIGICAM_CONTROL: p5 1 = take one shot
 inline constexpr int kCmdImageStartCapture = 2000;  ///< MAV_CMD_IMAGE_START_CAPTURE: p1 camera, p2 interval, p3 count, p4 sequence
 inline constexpr int kFrameGlobal = 0;              ///< MAV_FRAME_GLOBAL: altitude above mean sea level
 inline constexpr int kFrameMission = 2;             ///< MAV_FRAME_MISSION: the item has no position
 inline constexpr int kFrameGlobalRelativeAlt = 3;   ///< MAV_FRAME_GLOBAL_RELATIVE_ALT: altitude above home
+inline constexpr int kAutopilotArduPilot = 3;       ///< MAV_AUTOPILOT_ARDUPILOTMEGA
 inline constexpr int kAutopilotPx4 = 12;            ///< MAV_AUTOPILOT_PX4
 inline constexpr int kTypeQuadrotor = 2;            ///< MAV_TYPE_QUADROTOR
 }  // namespace mavlink
@@ -95,9 +97,17 @@ struct ExportOptions {
   CameraTrigger camera_trigger = CameraTrigger::image_start_capture;  ///< which item triggers the camera
   bool takeoff = true;              ///< a NAV_TAKEOFF at home to the first waypoint's altitude, first
   MissionEnd end = MissionEnd::return_to_launch;  ///< the item after the last waypoint
-  double hover_speed_mps = 2.0;     ///< multicopter speed [m/s] (.plan `hoverSpeed`)
+  /// Multicopter speed [m/s]: .plan `hoverSpeed`, and the DO_CHANGE_SPEED item (`set_speed`);
+  /// the programs set the mission's modelled speed.
+  double hover_speed_mps = 2.0;
+  /// A DO_CHANGE_SPEED to `hover_speed_mps` (ground speed) before the first waypoint: without
+  /// it the autopilot flies its own default speed, and the mission's times and budget do not hold.
+  bool set_speed = true;
+  /// The highest a waypoint may fly above home [m] (120: the usual legal ceiling for small
+  /// UAVs); a path above it is refused.
+  double max_altitude_m = 120.0;
   double cruise_speed_mps = 15.0;   ///< fixed-wing speed [m/s] (.plan `cruiseSpeed`, required by QGC)
-  int firmware_type = mavlink::kAutopilotPx4;  ///< MAV_AUTOPILOT of the .plan (3: ArduPilot)
+  int firmware_type = mavlink::kAutopilotPx4;  ///< MAV_AUTOPILOT of the .plan (mavlink::kAutopilotArduPilot: 3)
   int vehicle_type = mavlink::kTypeQuadrotor;  ///< MAV_TYPE of the .plan
 
   /// @throws std::invalid_argument naming the first invalid member.
@@ -105,6 +115,7 @@ struct ExportOptions {
     detail::require(std::isfinite(hold_s) && hold_s >= 0.0, "ExportOptions: hold_s must be finite and >= 0", hold_s);
     detail::require_positive(hover_speed_mps, "ExportOptions: hover_speed_mps");
     detail::require_positive(cruise_speed_mps, "ExportOptions: cruise_speed_mps");
+    detail::require_positive(max_altitude_m, "ExportOptions: max_altitude_m");
     detail::require(firmware_type >= 0 && firmware_type <= 255, "ExportOptions: firmware_type must be in 0..255",
                     firmware_type);
     detail::require(vehicle_type >= 0 && vehicle_type <= 255, "ExportOptions: vehicle_type must be in 0..255",
@@ -179,7 +190,9 @@ inline ExportPath make_export_path(const std::vector<Waypoint>& path, const std:
     detail::require(levels[i] >= 0, "make_export_path: level of waypoint " + std::to_string(i) + " must be >= 0",
                     levels[i]);
     const GeoPoint g = geo.to_wgs84(p);
-    out.waypoints.push_back({g.latitude_deg, g.longitude_deg, p.z(), path[i].gsd_cm, levels[i]});
+    // Altitudes to the centimetre: 165.00000000001054 m is what a GSD's arithmetic gives, not
+    // what an autopilot should be told.
+    out.waypoints.push_back({g.latitude_deg, g.longitude_deg, std::round(p.z() * 100.0) / 100.0, path[i].gsd_cm, levels[i]});
   }
   return out;
 }
@@ -203,15 +216,21 @@ inline ExportPath make_export_path(const MissionResult& result, const GeoReferen
 /// The mission items of `path` (home excluded), in the relative altitude frame where they
 /// have a position (yaw NaN: the autopilot's yaw mode):
 /// - if `takeoff`, a NAV_TAKEOFF at home (pitch 0) to the first waypoint's altitude;
+/// - if `set_speed`, a DO_CHANGE_SPEED to `hover_speed_mps` (ground speed, throttle unchanged);
 /// - per waypoint a NAV_WAYPOINT holding `hold_s`, then, if `capture_images`, one camera
 ///   trigger: an IMAGE_START_CAPTURE of one image (all cameras, sequence 1, 2, ...) or a
 ///   DO_DIGICAM_CONTROL with shoot = 1;
 /// - `end`: a RETURN_TO_LAUNCH, a NAV_LAND at home, or nothing.
-/// @throws std::invalid_argument for invalid options, or a take-off with the first waypoint
-///         not above home.
+/// @throws std::invalid_argument for invalid options, a take-off with the first waypoint not
+///         above home, or a waypoint above `max_altitude_m`.
 inline std::vector<MissionItem> mission_items(const ExportPath& path, const ExportOptions& options = {}) {
   options.validate();
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t i = 0; i < path.waypoints.size(); ++i)
+    detail::require(path.waypoints[i].relative_altitude_m <= options.max_altitude_m,
+                    "mission_items: waypoint " + std::to_string(i) + " flies above max_altitude_m " +
+                        std::to_string(options.max_altitude_m) + " m; relative altitude",
+                    path.waypoints[i].relative_altitude_m);
   std::vector<MissionItem> items;
   if (options.takeoff && !path.waypoints.empty()) {
     const double altitude = path.waypoints.front().relative_altitude_m;
@@ -221,6 +240,10 @@ inline std::vector<MissionItem> mission_items(const ExportPath& path, const Expo
                      {0.0, 0.0, 0.0, kNaN, path.home.latitude_deg, path.home.longitude_deg, altitude},
                      true});
   }
+  if (options.set_speed)
+    items.push_back({mavlink::kCmdDoChangeSpeed, mavlink::kFrameMission,
+                     {1.0, options.hover_speed_mps, -1.0, 0.0, kNaN, kNaN, kNaN},
+                     true});
   int sequence = 0;
   for (const auto& w : path.waypoints) {
     items.push_back({mavlink::kCmdNavWaypoint, mavlink::kFrameGlobalRelativeAlt,

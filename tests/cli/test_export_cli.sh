@@ -32,17 +32,25 @@ bad_inputs)
     --out "$work/o"
   expect_error "--camera-trigger" --field "$field" --gsd 3 --export plan --geo-origin "$origin" --camera-trigger shutter \
     --out "$work/o"
+  # Above the legal ceiling: refused before the mission flies, with the GSD that stays below it
+  # (the default camera flies 1 cm/px at 5.5 m: 120 m is 21.82 cm/px).
+  expect_error "the mission would fly 165.0 m above home at 30.00 cm/px, above --max-altitude-m 120.0: with this camera fly at most 21.82 cm/px" \
+    --field "$field" --gsd 30 --export plan --geo-origin "$origin" --out "$work/o"
+  expect_error "--firmware" --field "$field" --gsd 3 --export plan --geo-origin "$origin" --firmware betaflight --out "$work/o"
+  [ ! -e "$work/o" ] || fail "an error must be reported before the mission writes anything"
   ;;
 files)
-  fly "$work/m" --export plan,wpl --export geojson --geo-origin "$origin" --hold-s 2
+  fly "$work/m" --export plan,wpl --export geojson --geo-origin "$origin" --hold-s 2 --speed 3
   for f in mission.plan mission.waypoints mission.geojson; do [ -s "$work/m/$f" ] || fail "missing $f"; done
   # The same mission without --export writes no mission file.
   fly "$work/plain"
   [ ! -e "$work/plain/mission.plan" ] || fail "mission.plan without --export"
-  # No take-off, a landing at home, Mission Planner's camera item.
-  fly "$work/mp" --export wpl --geo-origin "$origin" --no-takeoff --mission-end land --camera-trigger digicam
-  sed -n 3,4p "$work/mp/mission.waypoints" | cut -f2-4 | tr '\n' ' ' | grep -qx "0	3	16 0	2	203 " ||
-    fail "--no-takeoff --camera-trigger digicam: want a waypoint then DO_DIGICAM_CONTROL first: $(sed -n 3,4p "$work/mp/mission.waypoints")"
+  # No take-off, a landing at home, Mission Planner's camera item; ArduPilot's .plan.
+  fly "$work/mp" --export wpl,plan --geo-origin "$origin" --no-takeoff --mission-end land --camera-trigger digicam \
+    --firmware ardupilot
+  sed -n 3,5p "$work/mp/mission.waypoints" | cut -f2-4 | tr '\n' ' ' | grep -qx "0	2	178 0	3	16 0	2	203 " ||
+    fail "--no-takeoff --camera-trigger digicam: want the speed, a waypoint then DO_DIGICAM_CONTROL first: $(sed -n 3,5p "$work/mp/mission.waypoints")"
+  grep -q '"firmwareType": 3' "$work/mp/mission.plan" || fail "--firmware ardupilot: firmwareType is not 3"
   tail -1 "$work/mp/mission.waypoints" | cut -f2-4 | grep -qx "0	3	21" || fail "--mission-end land: last item $(tail -1 "$work/mp/mission.waypoints")"
   "$python" - "$work/m" "$origin" <<'PY' || fail "mission file checks"
 import json, math, sys
@@ -68,24 +76,29 @@ want = [wgs84(w["x"], w["y"]) for w in wps]
 plan = json.load(open(f"{out}/mission.plan"))
 assert plan["fileType"] == "Plan" and plan["version"] == 1
 items = plan["mission"]["items"]
-assert len(items) == 2 * n + 2, (len(items), n)
-takeoff, rtl = items[0], items[-1]
+assert len(items) == 2 * n + 3, (len(items), n)
+takeoff, speed, rtl = items[0], items[1], items[-1]
 assert takeoff["command"] == 22 and takeoff["frame"] == 3 and abs(takeoff["params"][6] - wps[0]["z"]) < 0.01, takeoff
+# The speed the mission's times were computed at (--speed 3), as the autopilot's ground speed.
+assert speed["command"] == 178 and speed["frame"] == 2 and speed["params"][:3] == [1, 3, -1], speed
+assert plan["mission"]["hoverSpeed"] == 3 and plan["mission"]["firmwareType"] == 12, plan["mission"]
 assert rtl["command"] == 20 and rtl["params"] == [0] * 7, rtl
 for k, w in enumerate(wps[:50]):
-    nav, cap = items[1 + 2 * k], items[2 + 2 * k]
+    nav, cap = items[2 + 2 * k], items[3 + 2 * k]
     assert nav["command"] == 16 and nav["frame"] == 3 and nav["params"][0] == 2, nav
     assert abs(nav["params"][4] - want[k][0]) < 1e-7 and abs(nav["params"][5] - want[k][1]) < 1e-7, (nav, want[k])
     assert abs(nav["params"][6] - w["z"]) < 0.01
+    assert nav["params"][6] == round(nav["params"][6], 2), nav["params"][6]  # to the centimetre
     assert cap["command"] == 2000 and cap["params"][2] == 1
 lines = open(f"{out}/mission.waypoints").read().splitlines()
-assert lines[0] == "QGC WPL 110" and len(lines) == 4 + 2 * n, len(lines)
+assert lines[0] == "QGC WPL 110" and len(lines) == 5 + 2 * n, len(lines)
 home = lines[1].split("\t")
 assert home[:4] == ["0", "1", "0", "16"] and float(home[10]) == 500.0, home
 assert lines[2].split("\t")[:4] == ["1", "0", "3", "22"], lines[2]
 assert lines[-1].split("\t")[1:4] == ["0", "2", "20"], lines[-1]
-f1 = lines[3].split("\t")
-assert f1[:4] == ["2", "0", "3", "16"] and len(f1) == 12, f1
+assert lines[3].split("\t")[:4] == ["2", "0", "2", "178"], lines[3]
+f1 = lines[4].split("\t")
+assert f1[:4] == ["3", "0", "3", "16"] and len(f1) == 12, f1
 assert abs(float(f1[8]) - want[0][0]) < 1e-7 and abs(float(f1[9]) - want[0][1]) < 1e-7
 gj = json.load(open(f"{out}/mission.geojson"))
 assert gj["type"] == "FeatureCollection" and len(gj["features"]) == n + 1
