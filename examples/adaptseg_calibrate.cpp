@@ -53,8 +53,10 @@ int main(int argc, char** argv) {
   try {
     std::vector<adaptseg::Field> fields;
     if (!field_dir.empty()) {
-      fields.push_back(adaptseg::Field::load(field_dir));
-      if (!region_text.empty()) fields.back() = fields.back().sub_field(adaptseg::examples::parse_region(region_text));
+      // As --train loads it: GeoTIFF fields too (built with GDAL), an empty region refused.
+      if (!region_text.empty()) (void)adaptseg::examples::parse_region(region_text);  // its own message
+      fields.push_back(adaptseg::examples::load_field_spec(region_text.empty() ? field_dir.string()
+                                                                                : field_dir.string() + ":" + region_text));
     }
     for (const auto& spec : train_specs) fields.push_back(adaptseg::examples::load_field_spec(spec));
     if (fields.empty()) throw std::invalid_argument("give a training field: --field DIR or --train DIR (repeatable)");

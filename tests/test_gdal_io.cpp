@@ -7,6 +7,8 @@
 
 #include <doctest/doctest.h>
 #include <gdal_utils.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <filesystem>
 #include <fstream>
@@ -267,6 +269,23 @@ TEST_CASE("bad GeoTIFF fields: one clear error each") {
     std::ofstream(dir / "image.tif") << "";  // never read: the labels fail first
     CHECK_THROWS_WITH_AS((void)gdal::load_field(dir), doctest::Contains("geographic CRS (coordinates in degrees)"),
                          std::invalid_argument);
+    // The hint names the field's own UTM zone (55.1 E: zone 40 north), not another.
+    CHECK_THROWS_WITH_AS((void)gdal::load_field(dir), doctest::Contains("EPSG:32640 (UTM zone 40N, the field's)"),
+                         std::invalid_argument);
+  }
+  SUBCASE("a field without a labelled pixel") {
+    const fs::path dir = geotiff_field("empty");
+    const Field png = Field::load(kTile);
+    cv::imwrite((dir / "empty.png").string(), cv::Mat(png.labels().size(), CV_8UC3, cv::Scalar(0, 0, 0)));
+    translate(dir / "empty.png", dir / "labels.tif",
+              [&] {
+                std::vector<std::string> a{"-of", "GTiff", "-a_srs", "EPSG:32640", "-a_nodata", "0"};
+                const auto g = ullr(kE0, kN0, png.width_px(), png.height_px(), 0.05, 0.05);
+                a.insert(a.end(), g.begin(), g.end());
+                return a;
+              }());
+    CHECK_THROWS_WITH_AS((void)gdal::load_field(dir), doctest::Contains("the field has no valid pixel"),
+                         std::invalid_argument);
   }
   SUBCASE("non-square pixels") {
     CHECK_THROWS_WITH_AS((void)gdal::load_field(geotiff_field("nonsquare", "EPSG:32640", 0.05, 0.06)),
@@ -326,6 +345,40 @@ TEST_CASE("bad GeoTIFF fields: one clear error each") {
   }
 }
 
+TEST_CASE("an orthomosaic's alpha band and nodata are no data: not field, black for the backend") {
+  // Tile 6's image as RGBA (OpenDroneMap's orthomosaics): a transparent strip of white pixels.
+  const fs::path dir = geotiff_field("rgba");
+  const Field png = Field::load(kTile);
+  cv::Mat bgra;
+  cv::cvtColor(png.image(), bgra, cv::COLOR_BGR2BGRA);
+  const cv::Rect strip(0, 0, 300, png.height_px());
+  bgra(strip).setTo(cv::Scalar(255, 255, 255, 0));
+  cv::imwrite((dir / "rgba.png").string(), bgra);
+  std::vector<std::string> args{"-of", "GTiff", "-a_srs", "EPSG:32640", "-colorinterp_4", "alpha"};
+  const auto grid = ullr(kE0, kN0, png.width_px(), png.height_px(), 0.05, 0.05);
+  args.insert(args.end(), grid.begin(), grid.end());
+  translate(dir / "rgba.png", dir / "image.tif", args);
+  const Field f = gdal::load_field(dir);
+  CHECK(cv::countNonZero(f.valid_mask()(strip)) == 0);
+  CHECK(cv::countNonZero(f.labels()(strip) != f.ignore_label()) == 0);
+  cv::Mat black;
+  cv::inRange(f.image()(strip), cv::Scalar(0, 0, 0), cv::Scalar(0, 0, 0), black);
+  CHECK(cv::countNonZero(black) == strip.area());
+  // Elsewhere the field as the PNG's.
+  const cv::Rect rest(300, 0, png.width_px() - 300, png.height_px());
+  CHECK(cv::countNonZero(f.labels()(rest) != png.labels()(rest)) == 0);
+  CHECK(cv::norm(f.image()(rest), png.image()(rest), cv::NORM_INF) == 0.0);
+  // An RGB image whose bands declare nodata (255, 255, 255): the same.
+  cv::Mat bgr = png.image().clone();
+  bgr(strip).setTo(cv::Scalar(255, 255, 255));
+  cv::imwrite((dir / "white.png").string(), bgr);
+  std::vector<std::string> args2{"-of", "GTiff", "-a_srs", "EPSG:32640", "-a_nodata", "255"};
+  args2.insert(args2.end(), grid.begin(), grid.end());
+  translate(dir / "white.png", dir / "image.tif", args2);
+  const Field g = gdal::load_field(dir);
+  CHECK(cv::countNonZero(g.valid_mask()(strip)) == 0);
+}
+
 TEST_CASE("map.tif and map_gsd.tif: the field's grid and CRS, classes as colours and names, nodata where unobserved") {
   const Field field = gdal::load_field(geotiff_field("map"));
   cv::Mat labels = field.labels().clone();
@@ -360,6 +413,11 @@ TEST_CASE("map.tif and map_gsd.tif: the field's grid and CRS, classes as colours
   char** names = band->GetCategoryNames();
   REQUIRE(names != nullptr);
   CHECK(std::string(names[3]) == "vegetation");
+  // The classes only: five names (the ignore label is nodata, not a class); a TIFF palette
+  // has 256 entries whatever is written, those after the classes transparent black.
+  CHECK(CSLCount(names) == field.num_classes());
+  const GDALColorEntry* after = band->GetColorTable()->GetColorEntry(field.num_classes());
+  CHECK((after == nullptr || (after->c1 == 0 && after->c2 == 0 && after->c3 == 0)));
   cv::Mat back(labels.size(), CV_8UC1);
   REQUIRE(band->RasterIO(GF_Read, 0, 0, back.cols, back.rows, back.data, back.cols, back.rows, GDT_Byte, 0, 0) == CE_None);
   CHECK(cv::countNonZero(back != labels) == 0);

@@ -101,7 +101,10 @@ inline Field load_field_spec(const std::string& spec, const std::optional<FieldG
       } catch (const std::invalid_argument& e) {
         throw std::invalid_argument("field '" + spec + "': " + e.what() + "; write DIR:x0,y0,x1,y1");
       }
-      return load(spec.substr(0, colon)).sub_field(region);
+      Field part = load(spec.substr(0, colon)).sub_field(region);
+      if (part.valid_pixels() == 0)
+        throw std::invalid_argument("field '" + spec + "': the region has no valid pixel (all of it is the ignore label)");
+      return part;
     }
   }
   return load(spec);

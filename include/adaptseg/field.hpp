@@ -507,8 +507,13 @@ inline cv::Mat field_check_labels(cv::Mat labels, const FieldYaml& y) {
 /// The Field of `y` with these rasters; a violation of Field's rules names field.yaml.
 inline Field field_from_yaml(const FieldYaml& y, double gsd_cm, cv::Mat labels, cv::Mat image) {
   try {
-    return Field(y.name, gsd_cm, std::move(labels), y.classes, y.interest, y.ignore_label, std::move(image))
-        .with_geo(y.geo);
+    Field f = Field(y.name, gsd_cm, std::move(labels), y.classes, y.interest, y.ignore_label, std::move(image))
+                  .with_geo(y.geo);
+    // A field without a labelled pixel would fly no image and score NaN: say so instead.
+    if (f.valid_pixels() == 0)
+      throw std::invalid_argument("the field has no valid pixel: every label is the ignore label " +
+                                  std::to_string(y.ignore_label) + " (or, in a GeoTIFF orthomosaic, transparent)");
+    return f;
   } catch (const std::invalid_argument& e) {
     field_error(y.yaml, e.what());
   }

@@ -139,9 +139,16 @@ inline RasterGrid grid_of(GDALDataset& d, const std::filesystem::path& file) {
   }
   const OGRSpatialReference* srs = d.GetSpatialRef();
   if (srs == nullptr || srs->IsEmpty()) fail(file, "the raster has no coordinate reference system");
-  if (srs->IsGeographic())
+  if (srs->IsGeographic()) {
+    // The UTM zone of the raster's centre (geotransform in degrees: longitude, latitude).
+    const double lon = g.geotransform[0] + 0.5 * g.width_px * g.geotransform[1];
+    const double lat = g.geotransform[3] + 0.5 * g.height_px * g.geotransform[5];
+    const int zone = std::clamp(static_cast<int>(std::floor((lon + 180.0) / 6.0)) + 1, 1, 60);
+    const int epsg = (lat >= 0.0 ? 32600 : 32700) + zone;
     fail(file, "geographic CRS (coordinates in degrees): reproject to a projected CRS in metres, "
-               "e.g. gdalwarp -t_srs EPSG:32632 (the field's UTM zone)");
+               "e.g. gdalwarp -t_srs EPSG:" + std::to_string(epsg) + " (UTM zone " + std::to_string(zone) +
+                   (lat >= 0.0 ? "N" : "S") + ", the field's)");
+  }
   if (!srs->IsProjected()) fail(file, "the CRS is not a projected one (need easting and northing in metres)");
   const char* unit = nullptr;
   const double to_metre = srs->GetLinearUnits(&unit);
@@ -408,6 +415,24 @@ inline FieldGeo field_geo_of(const RasterGrid& g, const std::filesystem::path& f
     if (id->GetRasterCount() < 3)
       detail::fail(image_file, std::to_string(id->GetRasterCount()) + " band(s): the image needs red, green, blue");
     image = detail::read_interleaved(*id, image_file, {3, 2, 1});  // BGR, as OpenCV
+    // No data in the orthomosaic (a 4th band's alpha 0, as OpenDroneMap writes outside the
+    // flown area, or the bands' nodata values): not the field. Black there, as the simulator
+    // fills ground outside the orthomosaic (a network backend leaves it unlabelled), and the
+    // ignore label, so that nothing is segmented, fused or scored there.
+    cv::Mat no_data(image.size(), CV_8UC1, cv::Scalar(0));
+    if (id->GetRasterCount() >= 4 && id->GetRasterBand(4)->GetColorInterpretation() == GCI_AlphaBand)
+      no_data = detail::read_interleaved(*id, image_file, {4}) == 0;
+    const std::array<std::optional<int>, 3> nodata{detail::nodata_byte(*id, 1, image_file),
+                                                   detail::nodata_byte(*id, 2, image_file),
+                                                   detail::nodata_byte(*id, 3, image_file)};
+    if (nodata[0] && nodata[1] && nodata[2]) {
+      cv::Mat is_nodata;
+      cv::inRange(image, cv::Scalar(*nodata[2], *nodata[1], *nodata[0]), cv::Scalar(*nodata[2], *nodata[1], *nodata[0]),
+                  is_nodata);  // BGR order
+      no_data |= is_nodata;
+    }
+    image.setTo(cv::Scalar(0, 0, 0), no_data);
+    labels.setTo(cv::Scalar(y.ignore_label), no_data);
   }
   const double gsd_cm = 100.0 * grid.pixel_size_m();
   if (y.gsd_cm && std::abs(*y.gsd_cm - gsd_cm) > 1e-6 * gsd_cm)
@@ -519,18 +544,13 @@ inline void write_map_geotiff(const std::filesystem::path& file, const Field& fi
   GDALRasterBand* band = d->GetRasterBand(1);
   band->SetDescription("class");
   band->SetNoDataValue(field.ignore_label());
-  GDALColorTable colors;
+  GDALColorTable colors;  // the classes only: the ignore label is nodata
   CPLStringList names;
-  for (int v = 0; v <= std::max(field.num_classes() - 1, field.ignore_label()); ++v) {
-    GDALColorEntry e{0, 0, 0, 0};
-    std::string name;
-    if (v < field.num_classes()) {
-      const auto& c = field.classes()[static_cast<std::size_t>(v)];
-      e = {c.color_rgb[0], c.color_rgb[1], c.color_rgb[2], 255};
-      name = c.name;
-    }
+  for (int v = 0; v < field.num_classes(); ++v) {
+    const auto& c = field.classes()[static_cast<std::size_t>(v)];
+    const GDALColorEntry e{c.color_rgb[0], c.color_rgb[1], c.color_rgb[2], 255};
     colors.SetColorEntry(v, &e);
-    names.AddString(name.c_str());
+    names.AddString(c.name.c_str());
   }
   band->SetColorTable(&colors);
   band->SetCategoryNames(names.List());
