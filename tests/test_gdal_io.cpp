@@ -2,6 +2,7 @@
 // gdal_translate's own code (GDALTranslate) under a UTM georeference, loaded back, its frame
 // checked against GDAL's transformation of the CRS, its map written and read back by GDAL.
 #include <adaptseg/gdal_io.hpp>
+#include <adaptseg/survey_site.hpp>
 
 #include "test_support.hpp"
 
@@ -13,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -454,4 +456,147 @@ TEST_CASE("a geo: field's map.tif: every pixel where GeoReference puts it") {
     worst = std::max(worst, metres_apart(ours, gdal_wgs84(srs, e, n)));
   }
   CHECK(worst < 0.001);
+}
+
+namespace {
+
+/// A GeoJSON FeatureCollection of one polygon per ring list, (longitude, latitude) pairs.
+std::string geojson_polygon(const std::vector<std::vector<GeoPoint>>& rings) {
+  std::ostringstream s;
+  s.precision(12);
+  s << R"({"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {}, )"
+    << R"("geometry": {"type": "Polygon", "coordinates": [)";
+  for (std::size_t r = 0; r < rings.size(); ++r) {
+    s << (r ? ", [" : "[");
+    for (std::size_t i = 0; i <= rings[r].size(); ++i) {
+      const GeoPoint& g = rings[r][i % rings[r].size()];  // closed: the first point again
+      s << (i ? ", [" : "[") << g.longitude_deg << ", " << g.latitude_deg << "]";
+    }
+    s << "]";
+  }
+  s << "]}}]}\n";
+  return s.str();
+}
+
+void write_file(const fs::path& p, const std::string& text) {
+  std::ofstream(p) << text;
+}
+
+}  // namespace
+
+TEST_CASE("a site from a GeoJSON polygon: its frame along the longer side, a plan inside it that sees all of it") {
+  // An L of 240 m by 100 m (an 80 m square bitten out of a corner) whose long side runs 30 deg
+  // north of east, in Dubai, through GeographicLib's tangent plane.
+  const GeographicLib::LocalCartesian plane(25.2, 55.3, 10.0);
+  const double a = 30.0 * std::numbers::pi / 180.0;
+  const std::vector<Eigen::Vector2d> local{{0, 0}, {240, 0}, {240, 20}, {160, 20}, {160, 100}, {0, 100}};
+  std::vector<GeoPoint> ring;
+  for (const auto& q : local) {
+    double lat = 0, lon = 0, h = 0;
+    plane.Reverse(std::cos(a) * q.x() - std::sin(a) * q.y(), std::sin(a) * q.x() + std::cos(a) * q.y(), 0.0, lat, lon, h);
+    ring.push_back({lat, lon, 10.0});
+  }
+  const fs::path file = scratch() / "l_site.geojson";
+  write_file(file, geojson_polygon({ring}));
+  const SurveySite site = load_survey_site(file, 10.0, 10.0);
+  CHECK(site.name == "l_site");
+  CHECK(site.area.area.width_m() == doctest::Approx(240.0).epsilon(0.002));
+  CHECK(site.area.area.height_m() == doctest::Approx(100.0).epsilon(0.002));
+  // +x along the long side: at compass bearing 60 deg (or its opposite).
+  CHECK(std::remainder(site.geo.heading_deg - 60.0, 180.0) == doctest::Approx(0.0).epsilon(0.01));  // the two tangent planes: meridians converge
+  // The frame is a georeference: every corner back where the file put it.
+  const GeoReference geo(site.geo);
+  REQUIRE(site.rings.size() == 1);
+  REQUIRE(site.rings[0].size() == ring.size() + 1);
+  for (std::size_t i = 0; i < ring.size(); ++i) {
+    const Eigen::Vector2d& q = site.rings[0][i];
+    CHECK(metres_apart(geo.to_wgs84(Eigen::Vector3d(q.x(), q.y(), 0.0)), ring[i]) < 0.01);
+  }
+  // The frame as a geo: section (anchored at its origin): the same frame to a millimetre.
+  const GeoReference as_section(site.origin_geo());
+  for (const auto& q : site.rings[0])
+    CHECK(metres_apart(as_section.to_wgs84(Eigen::Vector3d(q.x(), q.y(), 0.0)),
+                       geo.to_wgs84(Eigen::Vector3d(q.x(), q.y(), 0.0))) < 0.001);
+  // The mask is the L: 240 x 100 - 80 x 80 m^2 at 10 cm/px, to a pixel along the outline.
+  CHECK(cv::countNonZero(site.area.valid_mask) * 0.01 == doctest::Approx(240.0 * 100.0 - 80.0 * 80.0).epsilon(0.01));
+
+  // At 15 cm/px (72 m x 54 m footprints), the grid centred: every waypoint over the site's
+  // rectangle, the overhang even on both sides, the bitten-out corner's cells skipped, and every
+  // pixel of the site under a footprint.
+  const CameraModel camera;
+  const std::vector<Waypoint> plan = plan_site_survey(site, camera, 15.0);
+  REQUIRE(!plan.empty());
+  double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
+  cv::Mat seen(site.area.valid_mask.size(), CV_8UC1, cv::Scalar(0));
+  for (const auto& w : plan) {
+    CHECK(w.position.z() == doctest::Approx(camera.altitude_m(15.0)));
+    x0 = std::min(x0, w.footprint.x_min_m), x1 = std::max(x1, w.footprint.x_max_m);
+    y0 = std::min(y0, w.footprint.y_min_m), y1 = std::max(y1, w.footprint.y_max_m);
+    CHECK(w.position.x() > 0.0);
+    CHECK(w.position.x() < site.area.area.width_m());
+    CHECK(w.position.y() > 0.0);
+    CHECK(w.position.y() < site.area.area.height_m());
+    seen(raster_rect(w.footprint, 10.0, seen.rows) & cv::Rect(0, 0, seen.cols, seen.rows)).setTo(255);
+  }
+  CHECK(-x0 == doctest::Approx(x1 - site.area.area.width_m()).epsilon(1e-9));
+  CHECK(-y0 == doctest::Approx(y1 - site.area.area.height_m()).epsilon(1e-9));
+  const LawnmowerPlanner planner(camera);
+  const std::size_t full = planner.plan(planner.centred_grid(site.area.area, 15.0), 15.0, Eigen::Vector2d(x0, y0)).size();
+  CHECK(plan.size() < full);
+  CHECK(cv::countNonZero(site.area.valid_mask & ~seen) == 0);
+}
+
+TEST_CASE("a site from an orthomosaic without labels: the outline of its pixels with data") {
+  // Tile 6's image as RGBA, a transparent strip on the left: the site is the rest.
+  const fs::path dir = geotiff_field("site_rgba");
+  const Field png = Field::load(kTile);
+  cv::Mat bgra;
+  cv::cvtColor(png.image(), bgra, cv::COLOR_BGR2BGRA);
+  bgra(cv::Rect(0, 0, 300, png.height_px())).setTo(cv::Scalar(255, 255, 255, 0));
+  cv::imwrite((dir / "rgba.png").string(), bgra);
+  std::vector<std::string> args{"-of", "GTiff", "-a_srs", "EPSG:32640", "-colorinterp_4", "alpha"};
+  const auto grid = ullr(kE0, kN0, png.width_px(), png.height_px(), 0.05, 0.05);
+  args.insert(args.end(), grid.begin(), grid.end());
+  translate(dir / "rgba.png", dir / "ortho.tif", args);
+  const SurveySite site = load_survey_site(dir / "ortho.tif", 10.0);
+  const double w = (png.width_px() - 300) * 0.05, h = png.height_px() * 0.05;
+  // The frame follows the longer side; UTM's grid north is not true north, hence the tolerance.
+  const double longer = std::max(w, h), shorter = std::min(w, h);
+  CHECK(site.area.area.width_m() == doctest::Approx(longer).epsilon(0.01));
+  CHECK(site.area.area.height_m() == doctest::Approx(shorter).epsilon(0.01));
+  CHECK(cv::countNonZero(site.area.valid_mask) * 0.01 == doctest::Approx(w * h).epsilon(0.02));
+  // The corner of the data nearest the UTM origin, through GDAL, is a corner of the site.
+  const GeoPoint corner = gdal_wgs84("EPSG:32640", kE0 + 300 * 0.05, kN0);
+  const GeoReference geo(site.geo);
+  double nearest = 1e9;
+  for (const auto& c : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(site.area.area.width_m(), 0, 0),
+                        Eigen::Vector3d(0, site.area.area.height_m(), 0),
+                        Eigen::Vector3d(site.area.area.width_m(), site.area.area.height_m(), 0)})
+    nearest = std::min(nearest, metres_apart(geo.to_wgs84(c), corner));
+  CHECK(nearest < 0.5);
+}
+
+TEST_CASE("bad survey areas: one clear error each, naming the file") {
+  const auto error_of = [](const fs::path& f) {
+    try {
+      (void)load_survey_site(f);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  CHECK(error_of(scratch() / "nowhere.geojson").find("nowhere.geojson': file not found") != std::string::npos);
+  write_file(scratch() / "text.geojson", "not a vector file\n");
+  CHECK(error_of(scratch() / "text.geojson").find("neither a vector file nor a raster") != std::string::npos);
+  write_file(scratch() / "points.geojson",
+             R"({"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {}, )"
+             R"("geometry": {"type": "Point", "coordinates": [55.3, 25.2]}}]})");
+  CHECK(error_of(scratch() / "points.geojson").find("no polygon") != std::string::npos);
+  // A polygon of two distinct points (a line there and back).
+  write_file(scratch() / "flat.geojson", geojson_polygon({{{25.2, 55.3, 0}, {25.2001, 55.3001, 0}, {25.2, 55.3, 0}}}));
+  CHECK(error_of(scratch() / "flat.geojson").find("flat.geojson': the area covers no pixel") != std::string::npos);
+  // Coordinates that are not longitude, latitude (a projected CRS without its declaration).
+  write_file(scratch() / "metres.geojson",
+             geojson_polygon({{{2787000, 329000, 0}, {2787000, 329100, 0}, {2787100, 329100, 0}}}));
+  CHECK(error_of(scratch() / "metres.geojson").find("out of range") != std::string::npos);
 }

@@ -105,10 +105,14 @@ struct ExportCli {
   /// the mission's timing.
   void write(const Field& field, const MissionResult& result, const MissionOptions& options,
              const std::filesystem::path& out_dir) const {
+    write(make_export_path(result, GeoReference(field)), options.timing.max_speed_mps, out_dir);
+  }
+
+  /// Writes `path` in every requested format into `out_dir`, flown at `speed_mps`.
+  void write(const ExportPath& path, double speed_mps, const std::filesystem::path& out_dir) const {
     if (formats.empty()) return;
     ExportOptions opt = file_options;
-    opt.hover_speed_mps = options.timing.max_speed_mps;
-    const ExportPath path = make_export_path(result, GeoReference(field));
+    opt.hover_speed_mps = speed_mps;
     for (const std::string& name : std::set<std::string>(formats.begin(), formats.end())) {
       const ExportFormat format = parse_export_format(name);
       write_text(out_dir / export_file_name(format), write_mission(format, path, opt));

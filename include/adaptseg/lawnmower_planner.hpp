@@ -151,6 +151,26 @@ class LawnmowerPlanner {
     return out;
   }
 
+  /// The rectangle the grid of plan() at `gsd_cm` fills when it is laid *centred* on `area`: its
+  /// whole footprints' extent, the overhang split evenly between opposite sides (plan() over it
+  /// covers `area` with every footprint's centre inside `area`; plan() over `area` itself leaves
+  /// the whole overhang on the far side, the paper's grid).
+  /// @throws std::invalid_argument if the GSD is not positive or the area is empty.
+  [[nodiscard]] Area centred_grid(const Area& area, double gsd_cm) const {
+    detail::require_positive(gsd_cm, "LawnmowerPlanner::centred_grid: gsd_cm");
+    detail::require(std::isfinite(area.width_m()) && area.width_m() > 0.0 && std::isfinite(area.height_m()) &&
+                        area.height_m() > 0.0,
+                    "LawnmowerPlanner::centred_grid: area must have a finite positive size [m]",
+                    area.width_m() * area.height_m());
+    const Extent fp = camera_.footprint_at_gsd(gsd_cm);
+    const int nx = cells(area.width_m(), fp.width_m, overlap_.along);
+    const int ny = cells(area.height_m(), fp.height_m, overlap_.across);
+    const double w = (nx - 1) * fp.width_m * (1.0 - overlap_.along) + fp.width_m;
+    const double h = (ny - 1) * fp.height_m * (1.0 - overlap_.across) + fp.height_m;
+    const double dx = 0.5 * (w - area.width_m()), dy = 0.5 * (h - area.height_m());
+    return {area.x_min_m - dx, area.y_min_m - dy, area.x_max_m + dx, area.y_max_m + dy};
+  }
+
   /// plan() keeping every cell.
   [[nodiscard]] std::vector<Waypoint> plan(const Area& area, double gsd_cm,
                                            const Eigen::Vector2d& start_xy) const {

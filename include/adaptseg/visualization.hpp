@@ -165,6 +165,42 @@ inline cv::Mat class_legend(const std::vector<ClassInfo>& classes, int width, co
   return detail::with_title(out, title);
 }
 
+/// Top view of a survey plan over a site nobody has labelled: the site (`mask`, non-zero where
+/// the site is, at `map_gsd_cm` [cm/px], row 0 at the frame's top) in light green, every
+/// footprint outlined, the path as lines from the start, under `title`. Longer side at most
+/// `max_side` px.
+/// @throws std::invalid_argument if `mask` is not CV_8UC1 or the GSD is not positive.
+[[nodiscard]] inline cv::Mat render_site_plan(const cv::Mat& mask, double map_gsd_cm, std::span<const Waypoint> path,
+                                              const std::string& title, int max_side = 1000) {
+  detail::require(mask.type() == CV_8UC1 && !mask.empty(), "render_site_plan: mask must be a non-empty CV_8UC1",
+                  mask.type());
+  detail::require_positive(map_gsd_cm, "render_site_plan: map_gsd_cm");
+  cv::Rect canvas(0, 0, mask.cols, mask.rows);
+  for (const auto& w : path) canvas |= raster_rect(w.footprint, map_gsd_cm, mask.rows);
+  const double s = detail::display_scale(canvas.size(), max_side);
+  cv::Mat full(canvas.size(), CV_8UC3, cv::Scalar(255, 255, 255));
+  full(cv::Rect(-canvas.x, -canvas.y, mask.cols, mask.rows)).setTo(cv::Scalar(170, 225, 170), mask);
+  cv::Mat base;
+  cv::resize(full, base, cv::Size(std::max(1, static_cast<int>(std::lround(canvas.width * s))),
+                                  std::max(1, static_cast<int>(std::lround(canvas.height * s)))),
+             0, 0, cv::INTER_NEAREST);
+  const auto px = [&](double x_m, double y_m) {
+    return cv::Point(static_cast<int>(std::lround((x_m * 100.0 / map_gsd_cm - canvas.x) * s)),
+                     static_cast<int>(std::lround((mask.rows - y_m * 100.0 / map_gsd_cm - canvas.y) * s)));
+  };
+  for (const auto& w : path)
+    cv::rectangle(base, px(w.footprint.x_min_m, w.footprint.y_max_m), px(w.footprint.x_max_m, w.footprint.y_min_m),
+                  cv::Scalar(150, 90, 40), 1);
+  for (std::size_t i = 1; i < path.size(); ++i)
+    cv::line(base, px(path[i - 1].position.x(), path[i - 1].position.y()), px(path[i].position.x(), path[i].position.y()),
+             cv::Scalar(60, 60, 60), 1, cv::LINE_AA);
+  const int radius = std::max(2, static_cast<int>(std::lround(std::min(base.cols, base.rows) / 150.0)));
+  for (const auto& w : path) cv::circle(base, px(w.position.x(), w.position.y()), radius, cv::Scalar(0, 0, 0), cv::FILLED, cv::LINE_AA);
+  if (!path.empty())
+    detail::put_text(base, "start", px(path.front().position.x(), path.front().position.y()) + cv::Point(6, -6), 0.5);
+  return detail::with_title(base, title);
+}
+
 /// A label map in class colours beside its legend, under `title`, scaled (nearest neighbour)
 /// so that its longer side is `side` px: what a live mission, which has no ground truth, shows.
 [[nodiscard]] inline cv::Mat render_map(const cv::Mat& labels, const std::vector<ClassInfo>& classes,
