@@ -13,22 +13,32 @@
 // (--record-yaw DEG records every image with the camera turned by DEG, as a UAV that does not
 // hold the plan's heading would take them; the planner fuses each at its recorded yaw.)
 //
-// The folder (docs/method.md, "Live use"): DIR/area.yaml (area, map GSD, classes, labels of
-// interest, camera), DIR/valid_mask.png (where the field is), DIR/poses.csv
-// (file,x,y,z,yaw_deg; yaw counter-clockwise from the field's x axis), and per image
-// DIR/rgb/FILE (the camera image) and/or DIR/labels/FILE (ground-truth labels under the
-// footprint at map resolution, in the camera's orientation, for --segmenter oracle).
-// --segmenter erfnet segments the RGB images with the ERFNet model of --model-file.
+// The folder (docs/data_format.md, "The live image folder"): DIR/area.yaml (area, map GSD,
+// classes, labels of interest, camera, and optionally its geo-reference), DIR/valid_mask.png
+// (where the field is), DIR/poses.csv (in the area's frame, file,x,y,z,yaw_deg; or from GNSS,
+// file,latitude_deg,longitude_deg,relative_altitude_m,heading_deg), and per image DIR/rgb/FILE
+// (the camera image, for --segmenter erfnet) and/or DIR/labels/FILE (ground-truth labels under
+// the footprint at map resolution, in the camera's orientation, for --segmenter oracle).
+// --record-gnss records GNSS poses; --area SITE (the file adaptseg_plan takes) gives the area
+// and its frame for a folder of GNSS poses.
 //
 // Writes OUT/result.json (the path with each image and its yaw, σ and decisions) and OUT/map.png
-// (the fused map).
+// (the fused map); where the area is georeferenced also OUT/map.tif, OUT/map_gsd.tif (built
+// with GDAL) and the flown path as OUT/mission.{plan,waypoints,geojson}. When the loop stops on
+// an error (no image at a waypoint, an unreadable file) it writes them all for what was flown,
+// with the error in result.json's "stopped", and exits 2.
 
+#include "common/export.hpp"
+#include "common/image_set.hpp"
 #include "common/segmenters.hpp"
 #include "common/strategies.hpp"
 
 #include <adaptseg/adaptive_planner.hpp>
 #include <adaptseg/erfnet_segmenter.hpp>
 #include <adaptseg/planner.hpp>
+#ifdef ADAPTSEG_HAVE_GDAL
+#include <adaptseg/survey_site.hpp>
+#endif
 
 #include <opencv2/imgcodecs.hpp>
 #include <yaml-cpp/yaml.h>
@@ -41,6 +51,7 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <set>
 #include <sstream>
 
 namespace fs = std::filesystem;
@@ -48,164 +59,8 @@ namespace ex = adaptseg::examples;
 
 namespace {
 
-/// One image of the folder and the pose it was taken at.
-struct PosedImage {
-  std::string file;
-  Eigen::Vector3d pose;
-  double yaw_deg = 0.0;
-};
-
-/// What area.yaml says: the ground to cover, its classes, and the camera of the images.
-struct ImageSetInfo {
-  std::string name;
-  adaptseg::SurveyArea area;
-  std::vector<adaptseg::ClassInfo> classes;
-  std::vector<std::string> interest;
-  adaptseg::CameraParams camera;
-};
-
-[[noreturn]] void fail(const fs::path& file, const std::string& what) {
-  throw std::invalid_argument(file.string() + ": " + what);
-}
-
-// --- recording (simulation) ---
-
-void write_image_set(const fs::path& dir, const adaptseg::Field& field, const adaptseg::DecisionModel& model,
-                     const std::vector<adaptseg::Waypoint>& waypoints, double yaw_deg) {
-  fs::create_directories(dir / "labels");
-  if (field.has_image()) fs::create_directories(dir / "rgb");
-  ex::write_png(dir / "valid_mask.png", field.valid_mask());
-  YAML::Emitter e;
-  e << YAML::BeginMap << YAML::Key << "format" << YAML::Value << "adaptseg.image_set/1";
-  e << YAML::Key << "name" << YAML::Value << field.name();
-  const adaptseg::Area a = field.area();
-  e << YAML::Key << "area_m" << YAML::Value << YAML::Flow
-    << std::vector<double>{a.x_min_m, a.y_min_m, a.x_max_m, a.y_max_m};
-  e << YAML::Key << "map_gsd_cm" << YAML::Value << field.gsd_cm();
-  e << YAML::Key << "valid_mask" << YAML::Value << "valid_mask.png";
-  e << YAML::Key << "ignore_label" << YAML::Value << field.ignore_label();
-  e << YAML::Key << "classes" << YAML::Value << YAML::BeginSeq;
-  for (const auto& c : field.classes())
-    e << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << c.name << YAML::Key << "color"
-      << YAML::Value << YAML::Flow << std::vector<int>{c.color_rgb[0], c.color_rgb[1], c.color_rgb[2]}
-      << YAML::EndMap;
-  e << YAML::EndSeq;
-  e << YAML::Key << "interest" << YAML::Value << YAML::Flow << model.interest;
-  e << YAML::Key << "camera" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "image_width_px"
-    << YAML::Value << model.camera.image_width_px << YAML::Key << "image_height_px" << YAML::Value
-    << model.camera.image_height_px << YAML::Key << "sensor_width_mm" << YAML::Value << model.camera.sensor_width_mm
-    << YAML::Key << "focal_length_mm" << YAML::Value << model.camera.focal_length_mm << YAML::EndMap;
-  e << YAML::EndMap;
-  ex::write_text(dir / "area.yaml", std::string(e.c_str()) + "\n");
-
-  const adaptseg::SimulatedSensor sensor(field, adaptseg::CameraModel(model.camera));
-  std::ostringstream csv;
-  csv << "file,x,y,z,yaw_deg\n";
-  char buf[160];
-  for (std::size_t k = 0; k < waypoints.size(); ++k) {
-    const adaptseg::Image img = sensor.capture(waypoints[k], yaw_deg);
-    std::snprintf(buf, sizeof buf, "%05zu.png", k);
-    const std::string file = buf;
-    ex::write_png(dir / "labels" / file, img.ground_truth);
-    if (!img.rgb.empty()) ex::write_png(dir / "rgb" / file, img.rgb);
-    const Eigen::Vector3d& p = waypoints[k].position;
-    std::snprintf(buf, sizeof buf, "%s,%.9f,%.9f,%.9f,%.9g\n", file.c_str(), p.x(), p.y(), p.z(), yaw_deg);
-    csv << buf;
-  }
-  ex::write_text(dir / "poses.csv", csv.str());
-}
-
-// --- reading the folder ---
-
-ImageSetInfo read_image_set_info(const fs::path& dir) {
-  const fs::path file = dir / "area.yaml";
-  if (!fs::is_regular_file(file)) fail(file, "not found (is --images a folder written by --record-from?)");
-  try {
-    const YAML::Node root = YAML::LoadFile(file.string());
-    if (!root["format"] || root["format"].as<std::string>() != "adaptseg.image_set/1")
-      fail(file, "format must be adaptseg.image_set/1");
-    ImageSetInfo info;
-    info.name = root["name"].as<std::string>();
-    const auto a = root["area_m"].as<std::vector<double>>();
-    if (a.size() != 4) fail(file, "area_m must be [x_min, y_min, x_max, y_max]");
-    info.area.area = {a[0], a[1], a[2], a[3]};
-    info.area.map_gsd_cm = root["map_gsd_cm"].as<double>();
-    info.area.ignore_label = root["ignore_label"].as<int>();
-    if (root["valid_mask"]) {
-      const fs::path mask = dir / root["valid_mask"].as<std::string>();
-      info.area.valid_mask = cv::imread(mask.string(), cv::IMREAD_UNCHANGED);
-      if (info.area.valid_mask.empty() || info.area.valid_mask.type() != CV_8UC1)
-        fail(mask, "cannot read an 8-bit single-channel mask");
-    }
-    for (const auto& c : root["classes"]) {
-      const auto rgb = c["color"].as<std::vector<int>>();
-      if (rgb.size() != 3) fail(file, "a class colour must be [r, g, b]");
-      info.classes.push_back({c["name"].as<std::string>(),
-                              {static_cast<std::uint8_t>(rgb[0]), static_cast<std::uint8_t>(rgb[1]),
-                               static_cast<std::uint8_t>(rgb[2])}});
-    }
-    info.area.num_classes = static_cast<int>(info.classes.size());
-    info.interest = root["interest"].as<std::vector<std::string>>();
-    const YAML::Node cam = root["camera"];
-    info.camera = {cam["image_width_px"].as<int>(), cam["image_height_px"].as<int>(),
-                   cam["sensor_width_mm"].as<double>(), cam["focal_length_mm"].as<double>()};
-    return info;
-  } catch (const YAML::Exception& e) {
-    fail(file, std::string("YAML error: ") + e.what());
-  }
-}
-
-std::vector<PosedImage> read_poses(const fs::path& dir) {
-  const fs::path file = dir / "poses.csv";
-  std::ifstream is(file);
-  if (!is) fail(file, "not found");
-  std::string line;
-  std::getline(is, line);
-  if (line.rfind("file,x,y,z", 0) != 0) fail(file, "the header must be file,x,y,z[,yaw_deg]");
-  std::vector<PosedImage> out;
-  for (int n = 2; std::getline(is, line); ++n) {
-    if (line.empty()) continue;
-    std::istringstream row(line);
-    PosedImage p;
-    std::string cell[5];
-    int cells = 0;
-    while (cells < 5 && std::getline(row, cell[cells], ',')) ++cells;
-    try {
-      if (cells < 4) throw std::invalid_argument("");
-      p.file = cell[0];
-      p.pose = {std::stod(cell[1]), std::stod(cell[2]), std::stod(cell[3])};
-      if (cells == 5) p.yaw_deg = std::stod(cell[4]);
-      if (!p.pose.allFinite() || !std::isfinite(p.yaw_deg)) throw std::invalid_argument("");
-    } catch (const std::exception&) {
-      fail(file, "line " + std::to_string(n) + " is not file,x,y,z[,yaw_deg] (finite numbers: metres, degrees): '" +
-                     line + "'");
-    }
-    out.push_back(p);
-  }
-  if (out.empty()) fail(file, "no images");
-  return out;
-}
-
-/// The recorded image nearest `position`, if within `tolerance_m`; otherwise the error a UAV
-/// would give: no image at that waypoint.
-const PosedImage& find_image(const std::vector<PosedImage>& images, const Eigen::Vector3d& position,
-                             double tolerance_m) {
-  const PosedImage* best = nullptr;
-  double best_d = std::numeric_limits<double>::infinity();
-  for (const auto& p : images) {
-    const double d = (p.pose - position).norm();
-    if (d < best_d) best = &p, best_d = d;
-  }
-  if (best_d > tolerance_m) {
-    char buf[256];
-    std::snprintf(buf, sizeof buf,
-                  "no image recorded at waypoint (%.3f, %.3f, %.3f) m: the nearest, %s, is %.3f m away "
-                  "(--pose-tolerance-m %.3f)",
-                  position.x(), position.y(), position.z(), best->file.c_str(), best_d, tolerance_m);
-    throw std::invalid_argument(buf);
-  }
-  return *best;
-}
+using ex::ImageSetInfo;
+using ex::PosedImage;
 
 /// The planner's options from the decision model: its camera, speed, GSDs and coverage.
 adaptseg::AdaptiveOptions model_options(const adaptseg::DecisionModel& model, std::vector<int> interest) {
@@ -219,9 +74,86 @@ struct LiveSettings {
   fs::path images;
   double tolerance_m = 0.05;
   fs::path out;
+  std::string segmenter;  ///< oracle: labels/FILE; erfnet: rgb/FILE
+  ex::ExportCli exports;  ///< the flown path's mission files, where the area is georeferenced
 };
 
+// --- what a mission leaves behind: written when it ends, and when it stops on an error ---
+
+template <typename Planner>
+void write_outputs(const Planner& planner, const ImageSetInfo& info, const std::string& policy_name,
+                   const std::string& backend_name, const adaptseg::AdaptiveOptions& options,
+                   const nlohmann::json& wps, const std::optional<std::string>& stopped, const LiveSettings& s) {
+  if (s.out.empty()) return;
+  fs::create_directories(s.out);
+  int descents = 0, limited = 0;
+  for (const auto& d : planner.decisions()) {
+    descents += d.decision.descend ? 1 : 0;
+    limited += d.budget_limited ? 1 : 0;
+  }
+  nlohmann::json j{{"field", info.name},
+                   {"strategy", policy_name},
+                   {"schedule", adaptseg::to_string(options.schedule)},
+                   {"segmenter", backend_name},
+                   {"images", wps.size()},
+                   {"time_s", {{"total", planner.elapsed_s()}}},
+                   {"decisions",
+                    {{"descend", descents},
+                     {"continue", static_cast<int>(planner.decisions().size()) - descents},
+                     {"budget_limited", limited}}},
+                   {"waypoints", wps},
+                   {"adaptseg_version", adaptseg::kVersion}};
+  if (options.budget_s) j["budget_s"] = *options.budget_s;
+  if (stopped) {
+    // What stopped the mission, and the waypoint the UAV had flown to without an image from it.
+    j["stopped"] = *stopped;
+    if (const auto w = planner.pending())
+      j["stopped_at"] = {{"x", w->waypoint.position.x()}, {"y", w->waypoint.position.y()},
+                         {"z", w->waypoint.position.z()}, {"level", w->level}, {"index", w->index}};
+  }
+  std::vector<std::string> written{"result.json", "map.png"};
+  if (info.geo) {
+    // The flown path (the pending waypoint included: the UAV flew there) as mission files.
+    std::vector<adaptseg::Waypoint> path;
+    std::vector<int> levels;
+    for (const auto& w : planner.path()) path.push_back(w.waypoint), levels.push_back(w.level);
+    const adaptseg::GeoReference geo(*info.geo);
+    if (!path.empty() && !s.exports.formats.empty()) {
+      s.exports.write(adaptseg::make_export_path(path, levels, geo, info.name + " " + policy_name + " (live)"),
+                      options.mission.timing.max_speed_mps, s.out);
+      for (const auto& f : std::set<std::string>(s.exports.formats.begin(), s.exports.formats.end()))
+        written.push_back(adaptseg::export_file_name(adaptseg::parse_export_format(f)));
+    }
+#ifdef ADAPTSEG_HAVE_GDAL
+    const adaptseg::SemanticMap& map = planner.map();
+    const adaptseg::gdal::MapGrid grid{info.name, map.labels().cols, map.labels().rows, info.area.map_gsd_cm,
+                                       std::nullopt, info.geo, info.classes, info.area.ignore_label};
+    adaptseg::gdal::write_map_geotiff(s.out / "map.tif", grid, map.labels());
+    adaptseg::gdal::write_gsd_geotiff(s.out / "map_gsd.tif", grid, map.gsd_cm());
+    written.insert(written.end(), {"map.tif", "map_gsd.tif"});
+#endif
+  }
+  j["files"] = written;
+  ex::write_text(s.out / "result.json", j.dump(2) + "\n");
+  ex::write_png(s.out / "map.png",
+                adaptseg::render_map(planner.map().labels(), info.classes,
+                                     info.name + ": " + policy_name + ", " + std::to_string(wps.size()) + " images, " +
+                                         ex::fmt(planner.elapsed_s(), 0) + " s (live" +
+                                         (stopped ? ", stopped on an error)" : ")")));
+}
+
 // --- the companion-computer loop ---
+
+/// The image file of `shot` the backend needs: labels/FILE for the oracle, rgb/FILE for a
+/// network; a missing or unreadable one is named.
+cv::Mat read_shot(const fs::path& dir, const std::string& file, int flags, const char* what) {
+  const fs::path path = dir / file;
+  if (!fs::is_regular_file(path))
+    throw std::invalid_argument(path.string() + ": no " + what + " for this waypoint's image (poses.csv names it)");
+  cv::Mat m = cv::imread(path.string(), flags);
+  if (m.empty()) throw std::invalid_argument(path.string() + ": cannot decode the " + what);
+  return m;
+}
 
 template <adaptseg::SegmentationBackend Backend, adaptseg::DecisionPolicy Policy>
 void fly(const ImageSetInfo& info, const std::vector<PosedImage>& images, Backend& backend, Policy& policy,
@@ -237,83 +169,75 @@ void fly(const ImageSetInfo& info, const std::vector<PosedImage>& images, Backen
               std::string(backend.name()).c_str());
 
   nlohmann::json wps = nlohmann::json::array();
-  while (const auto w = planner.next()) {
-    // The UAV's part: fly to w, hover, take the image; here, look it up in the folder.
-    const PosedImage& shot = find_image(images, w->waypoint.position, s.tolerance_m);
-    cv::Mat rgb;
-    if (fs::is_regular_file(s.images / "rgb" / shot.file)) {
-      rgb = cv::imread((s.images / "rgb" / shot.file).string(), cv::IMREAD_COLOR);
-      if (rgb.empty()) fail(s.images / "rgb" / shot.file, "cannot decode image");
-    }
-    // The pose and heading measured, not the ones planned.
-    adaptseg::Image image = planner.image_at(shot.pose, rgb, shot.yaw_deg);
-    const fs::path labels_file = s.images / "labels" / shot.file;
-    if (fs::is_regular_file(labels_file)) {
-      image.ground_truth = cv::imread(labels_file.string(), cv::IMREAD_UNCHANGED);
-      if (image.ground_truth.type() != CV_8UC1 || image.ground_truth.size() != image.footprint_px.size())
-        fail(labels_file, "must be 8-bit single-channel labels of the footprint's " +
-                              std::to_string(image.footprint_px.width) + "x" +
-                              std::to_string(image.footprint_px.height) + " map pixels");
-    }
-    const adaptseg::PlannerStep step = planner.report(image);  // segment, fuse, σ, decide
-
-    const auto& p = w->waypoint.position;
-    std::printf("[%3zu] %s x=%7.2f y=%7.2f z=%6.2f m  %s  sigma=%.4f", w->index, w->level == 0 ? "top" : "sub",
-                p.x(), p.y(), p.z(), shot.file.c_str(), step.sigma);
-    nlohmann::json wj{{"x", p.x()},       {"y", p.y()},          {"z", p.z()},
-                      {"gsd_cm", w->waypoint.gsd_cm}, {"level", w->level}, {"image", shot.file},
-                      {"yaw_deg", shot.yaw_deg},
-                      {"semantic_ratio", step.sigma}};
-    if (step.decision) {
-      const auto& d = step.decision->decision;
-      if (d.descend) {
-        const adaptseg::Candidate& c =
-            step.decision->candidates[adaptseg::chosen_candidate(d, step.decision->candidates, policy.name())];
-        std::printf("  -> descend to %.2f cm/px (%d images, +%.1f s)", d.gsd_cm, c.images, c.extra_time_s);
-      } else {
-        std::printf("  -> continue (%zu candidates%s)", step.decision->candidates.size(),
-                    step.decision->budget_limited ? ", budget-limited" : "");
+  const auto write = [&](const std::optional<std::string>& stopped) {
+    write_outputs(planner, info, std::string(policy.name()), std::string(backend.name()), options, wps, stopped, s);
+  };
+  try {
+    while (const auto w = planner.next()) {
+      // The UAV's part: fly to w, hover, take the image; here, look it up in the folder.
+      const PosedImage& shot = ex::find_image(images, w->waypoint.position, s.tolerance_m);
+      cv::Mat rgb;
+      if (s.segmenter == "erfnet") rgb = read_shot(s.images / "rgb", shot.file, cv::IMREAD_COLOR, "camera image");
+      // The pose and heading measured, not the ones planned.
+      adaptseg::Image image = planner.image_at(shot.pose, rgb, shot.yaw_deg);
+      if (s.segmenter == "oracle") {
+        image.ground_truth = read_shot(s.images / "labels", shot.file, cv::IMREAD_UNCHANGED, "labels");
+        if (image.ground_truth.type() != CV_8UC1 || image.ground_truth.size() != image.footprint_px.size())
+          throw std::invalid_argument((s.images / "labels" / shot.file).string() +
+                                      ": must be 8-bit single-channel labels of the footprint's " +
+                                      std::to_string(image.footprint_px.width) + "x" +
+                                      std::to_string(image.footprint_px.height) + " map pixels");
       }
-      wj["decision"] = {{"action", d.descend ? "descend" : "continue"},
-                        {"budget_limited", step.decision->budget_limited}};
-      if (d.descend) wj["decision"]["gsd_cm"] = d.gsd_cm;
+      const adaptseg::PlannerStep step = planner.report(image);  // segment, fuse, σ, decide
+
+      const auto& p = w->waypoint.position;
+      std::printf("[%3zu] %s x=%7.2f y=%7.2f z=%6.2f m  %s  sigma=%.4f", w->index, w->level == 0 ? "top" : "sub",
+                  p.x(), p.y(), p.z(), shot.file.c_str(), step.sigma);
+      nlohmann::json wj{{"x", p.x()},       {"y", p.y()},          {"z", p.z()},
+                        {"gsd_cm", w->waypoint.gsd_cm}, {"level", w->level}, {"image", shot.file},
+                        {"yaw_deg", shot.yaw_deg},
+                        {"semantic_ratio", step.sigma}};
+      if (info.geo) {
+        const adaptseg::GeoPoint g = adaptseg::GeoReference(*info.geo).to_wgs84(p);
+        wj["latitude_deg"] = g.latitude_deg;
+        wj["longitude_deg"] = g.longitude_deg;
+      }
+      if (step.decision) {
+        const auto& d = step.decision->decision;
+        if (d.descend) {
+          const adaptseg::Candidate& c =
+              step.decision->candidates[adaptseg::chosen_candidate(d, step.decision->candidates, policy.name())];
+          std::printf("  -> descend to %.2f cm/px (%d images, +%.1f s)", d.gsd_cm, c.images, c.extra_time_s);
+        } else {
+          std::printf("  -> continue (%zu candidates%s)", step.decision->candidates.size(),
+                      step.decision->budget_limited ? ", budget-limited" : "");
+        }
+        wj["decision"] = {{"action", d.descend ? "descend" : "continue"},
+                          {"budget_limited", step.decision->budget_limited}};
+        if (d.descend) wj["decision"]["gsd_cm"] = d.gsd_cm;
+      }
+      if (step.outcome) {
+        std::printf("  [descent done: sigma %.4f at %.1f m, %.4f at %.1f m]", step.outcome->sigma_top,
+                    step.outcome->top_altitude_m, step.outcome->sigma_sub, step.outcome->sub_altitude_m);
+        wj["observed_sigma_sub"] = step.outcome->sigma_sub;
+      }
+      std::printf("\n");
+      wps.push_back(wj);
     }
-    if (step.outcome) {
-      std::printf("  [descent done: sigma %.4f at %.1f m, %.4f at %.1f m]", step.outcome->sigma_top,
-                  step.outcome->top_altitude_m, step.outcome->sigma_sub, step.outcome->sub_altitude_m);
-      wj["observed_sigma_sub"] = step.outcome->sigma_sub;
+  } catch (const std::exception& e) {
+    // Nothing flown is lost: what the mission mapped so far, and where it flew, are written
+    // before the error ends the program.
+    if (!s.out.empty()) {
+      write(std::string(e.what()));
+      std::printf("stopped: the %zu images flown so far are written to %s\n", wps.size(), s.out.string().c_str());
     }
-    std::printf("\n");
-    wps.push_back(wj);
+    throw;
   }
-  int descents = 0, limited = 0;
-  for (const auto& d : planner.decisions()) {
-    descents += d.decision.descend ? 1 : 0;
-    limited += d.budget_limited ? 1 : 0;
-  }
+  int descents = 0;
+  for (const auto& d : planner.decisions()) descents += d.decision.descend ? 1 : 0;
   std::printf("done: %zu images, %d descents, %.1f s mission time (planner's account)\n", planner.path().size(),
               descents, planner.elapsed_s());
-  if (s.out.empty()) return;
-  fs::create_directories(s.out);
-  nlohmann::json j{{"field", info.name},
-                   {"strategy", std::string(policy.name())},
-                   {"schedule", adaptseg::to_string(options.schedule)},
-                   {"segmenter", std::string(backend.name())},
-                   {"images", planner.path().size()},
-                   {"time_s", {{"total", planner.elapsed_s()}}},
-                   {"decisions",
-                    {{"descend", descents},
-                     {"continue", static_cast<int>(planner.decisions().size()) - descents},
-                     {"budget_limited", limited}}},
-                   {"waypoints", wps},
-                   {"adaptseg_version", adaptseg::kVersion}};
-  if (options.budget_s) j["budget_s"] = *options.budget_s;
-  ex::write_text(s.out / "result.json", j.dump(2) + "\n");
-  ex::write_png(s.out / "map.png",
-                adaptseg::render_map(planner.map().labels(), info.classes,
-                                     info.name + ": " + std::string(policy.name()) + ", " +
-                                         std::to_string(planner.path().size()) + " images, " +
-                                         ex::fmt(planner.elapsed_s(), 0) + " s (live)"));
+  write(std::nullopt);
 }
 
 /// Runs the loop with the policy of `strategy` from `model`.
@@ -368,13 +292,41 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--seg-time-s", seg_time_s, "fixed segmentation time per image [s] (default: measured)");
   app.add_option("--plan-time-s", plan_time_s, "fixed planning time per waypoint [s] (default: measured)");
-  app.add_option("--out", s.out, "output directory for result.json and map.png");
+  app.add_option("--out", s.out,
+                 "output directory: result.json and map.png; for a georeferenced area also map.tif, map_gsd.tif "
+                 "(with GDAL) and the flown path's mission files (--export); written too when the loop stops on "
+                 "an error");
+  bool record_gnss = false;
+  app.add_flag("--record-gnss", record_gnss,
+               "with --record-from: write poses.csv as a GNSS receiver gives them (latitude, longitude, relative "
+               "altitude, heading of the image's top); needs the field's geo-reference (geo:, --geo-origin or a "
+               "GeoTIFF field)")
+      ->needs(record);
+  fs::path area_file;
+  double map_gsd_cm = 0.0;
+#ifdef ADAPTSEG_HAVE_GDAL
+  CLI::Option* area_opt =
+      app.add_option("--area", area_file,
+                     "the site as adaptseg_plan takes it (a polygon file or an orthomosaic without labels): the area "
+                     "and its frame, replacing area.yaml's; the poses must then be GNSS poses");
+  app.add_option("--map-gsd-cm", map_gsd_cm, "with --area: the map's resolution [cm/px] (default: area.yaml's, or 10)")
+      ->needs(area_opt);
+#endif
+  s.exports.formats = {"plan", "wpl", "geojson"};
+  s.exports.add_to(app);
+  app.get_option("--export")->description(
+      "the flown path's mission files where the area is georeferenced: plan (QGroundControl), wpl (QGC WPL 110), "
+      "geojson; repeat or comma-separate (default: all three)");
+  app.get_option("--geo-origin")->description(
+      "with --record-from: LAT,LON,ALT,HEADING of the field directory's frame origin, replacing field.yaml's geo "
+      "section (recorded into area.yaml)");
   if (const auto code = adaptseg::examples::parse_command_line(app, argc, argv)) return *code;
+  s.segmenter = segmenter;
 
   try {
     const adaptseg::DecisionModel model = adaptseg::DecisionModel::load(model_file);
     if (!record_from.empty()) {
-      const adaptseg::Field field = ex::load_field_spec(record_from);
+      const adaptseg::Field field = ex::load_field_spec(record_from, s.exports.geo_override());
       model.check_classes(field);
       const std::vector<int> interest = field.class_indices(model.interest);
       model.check_compatible(field, interest);
@@ -383,15 +335,30 @@ int main(int argc, char** argv) {
       adaptseg::DecisionFunction df = model.decision_function;
       const adaptseg::AdaptivePlanner planner(adaptseg::SurveyArea::of(field), oracle, df, o);
       const auto waypoints = planner.reachable_waypoints();
-      write_image_set(s.images, field, model, waypoints, record_yaw_deg);
+      ex::write_image_set(s.images, field, model, waypoints, record_yaw_deg, record_gnss);
       std::printf("%s: recorded %zu images (%zu top-level, %zu for the descents) -> %s\n", field.name().c_str(),
                   waypoints.size(), planner.top_level().size(), waypoints.size() - planner.top_level().size(),
                   s.images.string().c_str());
       return 0;
     }
 
-    const ImageSetInfo info = read_image_set_info(s.images);
-    const std::vector<PosedImage> images = read_poses(s.images);
+    if (!s.exports.geo_origin.empty())
+      throw std::invalid_argument("--geo-origin is for --record-from; the folder's frame is area.yaml's geo: (or --area)");
+    s.exports.file_options.validate();
+    ImageSetInfo info = ex::read_image_set_info(s.images, !area_file.empty());
+#ifdef ADAPTSEG_HAVE_GDAL
+    if (!area_file.empty()) {
+      // The site's frame and mask replace area.yaml's: the poses must be GNSS ones, placed in it.
+      const double gsd = map_gsd_cm > 0.0 ? map_gsd_cm : info.area.map_gsd_cm > 0.0 ? info.area.map_gsd_cm : 10.0;
+      if (!(std::isfinite(gsd) && gsd > 0.0)) throw std::invalid_argument("--map-gsd-cm must be finite and positive");
+      const adaptseg::SurveySite site = adaptseg::load_survey_site(area_file, gsd, info.geo ? info.geo->altitude_m : 0.0);
+      info.area.area = site.area.area;
+      info.area.map_gsd_cm = site.area.map_gsd_cm;
+      info.area.valid_mask = site.area.valid_mask;
+      info.geo = site.geo;
+    }
+#endif
+    const std::vector<PosedImage> images = ex::read_poses(s.images, info, area_file.empty());
     std::vector<std::string> names;
     for (const auto& c : info.classes) names.push_back(c.name);
     if (names != model.classes || info.interest != model.interest)
@@ -409,6 +376,7 @@ int main(int argc, char** argv) {
     options.mission.fixed_segmentation_time_s = seg_time_s;
     options.mission.fixed_planning_time_s = plan_time_s;
     options.budget_s = budget_s;
+    if (info.geo) s.exports.check_altitude(options.top_gsd_cm, model.camera);
     if (segmenter == "oracle") {
       adaptseg::OracleSegmenter oracle(static_cast<int>(info.classes.size()));
       fly_strategy(strategy, model, info, images, oracle, options, s);

@@ -105,6 +105,7 @@ struct ExportCli {
   /// the mission's timing.
   void write(const Field& field, const MissionResult& result, const MissionOptions& options,
              const std::filesystem::path& out_dir) const {
+    if (formats.empty()) return;  // before GeoReference, which needs a geo-reference
     write(make_export_path(result, GeoReference(field)), options.timing.max_speed_mps, out_dir);
   }
 

@@ -67,6 +67,18 @@ adaptseg_live)
   expect_error "--record-yaw requires --record-from" --images "$work/images" --model "$weedmap_model" --record-yaw 30
   expect_error "--record-yaw: Value 400 not in range" --images "$work/images" --model "$weedmap_model" \
     --record-from "$weedmap" --record-yaw 400
+  # GNSS poses (issue 33): they need a geo-reference, to record and to fly.
+  expect_error "--record-gnss requires --record-from" --images "$work/images" --model "$weedmap_model" --record-gnss
+  expect_error "--record-gnss needs the field's geo-reference" --images "$work/images" --model "$weedmap_model" \
+    --record-from "$weedmap:0.5,0,1,0.5" --record-gnss
+  "$mission" --images "$work/images" --model "$weedmap_model" --record-from "$weedmap:0.5,0,1,0.5" >/dev/null ||
+    fail "recording"
+  expect_error "--geo-origin is for --record-from" --images "$work/images" --model "$weedmap_model" \
+    --geo-origin 47.4,8.5,500,30
+  printf 'file,latitude_deg,longitude_deg,relative_altitude_m\n00000.png,47.4,8.5,16.5\n' >"$work/images/poses.csv"
+  expect_error "GNSS poses need the area's geo-reference" --images "$work/images" --model "$weedmap_model"
+  printf 'file,lat,lon\n' >"$work/images/poses.csv"
+  expect_error "the header must be one of file,x,y,z[,yaw_deg]" --images "$work/images" --model "$weedmap_model"
   ;;
 *)
   fail "unknown program $program"

@@ -3,9 +3,12 @@
 # images from a small region of the bundled WeedMap field, fly the planner over it step by
 # step, and check that it visits exactly the waypoints adaptseg_mission visits in simulation
 # with the same model on the same region; a folder lacking a requested image is an error.
-#   test_live_cli.sh LIVE_BINARY MISSION_BINARY CALIBRATE_BINARY EXAMPLES_DIR PYTHON
+# Then the georeferenced loop (issue 33): GNSS poses on a geo-referenced area, the same area
+# given as a GeoJSON polygon (--area), and a loop that stops on a missing image leaving what it
+# flew in --out.
+#   test_live_cli.sh LIVE_BINARY MISSION_BINARY CALIBRATE_BINARY EXAMPLES_DIR PYTHON gdal|nogdal
 set -uo pipefail
-live=$1 mission=$2 calibrate=$3 examples=$4 python=$5
+live=$1 mission=$2 calibrate=$3 examples=$4 python=$5 gdal=${6:-nogdal}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 field="$examples/data/weedmap-000"
@@ -89,6 +92,125 @@ sed -i '3s/,30$/,nan/' "$work/images-30/poses.csv"
 rc=$?
 [ "$rc" -eq 2 ] && [ "$(wc -l <"$work/err")" -eq 1 ] && grep -qF "line 3 is not file,x,y,z[,yaw_deg]" "$work/err" ||
   fail "yaw nan: exit code $rc, $(cat "$work/err")"
+
+# GNSS poses: a wider region recorded as a UAV logs its images (latitude, longitude, relative
+# altitude, heading of the image's top) on a frame placed near Zurich at 30 deg; flown from
+# area.yaml's geo:, and from the area as a GeoJSON polygon (--area, the file adaptseg_plan
+# takes): the same waypoints in WGS84, images and decisions as the frame-metre folder's.
+wide="$field:0,0.5,1,0.75"
+"$live" --record-from "$wide" --model "$work/model.yaml" --images "$work/frame" >/dev/null || fail "recording wide"
+"$live" --record-from "$wide" --model "$work/model.yaml" --images "$work/gnss" --record-gnss \
+  --geo-origin 47.4,8.5,500,30 >/dev/null || fail "recording GNSS poses"
+head -1 "$work/gnss/poses.csv" | grep -qx "file,latitude_deg,longitude_deg,relative_altitude_m,heading_deg" ||
+  fail "GNSS poses.csv header: $(head -1 "$work/gnss/poses.csv")"
+"$python" - "$work" <<'PY' || fail "writing the area polygon"
+import json, math, sys, yaml
+work = sys.argv[1]
+info = yaml.safe_load(open(f"{work}/gnss/area.yaml"))
+g, a = info["geo"], info["area_m"]
+def wgs84(x, y):  # first-order WGS84 tangent plane: ~1e-9 deg over this area
+    lat0, lon0, h = g["latitude_deg"], g["longitude_deg"], math.radians(g["heading_deg"])
+    x, y = x - g["anchor_x_m"], y - g["anchor_y_m"]
+    east, north = x * math.sin(h) - y * math.cos(h), x * math.cos(h) + y * math.sin(h)
+    A, e2 = 6378137.0, 6.69437999014e-3
+    s = math.sin(math.radians(lat0))
+    m, n = A * (1 - e2) / (1 - e2 * s * s) ** 1.5, A / math.sqrt(1 - e2 * s * s)
+    return [lon0 + math.degrees(east / (n * math.cos(math.radians(lat0)))), lat0 + math.degrees(north / m)]
+ring = [wgs84(a[0], a[1]), wgs84(a[2], a[1]), wgs84(a[2], a[3]), wgs84(a[0], a[3]), wgs84(a[0], a[1])]
+json.dump({"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {},
+           "geometry": {"type": "Polygon", "coordinates": [ring]}}]}, open(f"{work}/wide.geojson", "w"))
+PY
+"$live" --images "$work/frame" --model "$work/model.yaml" "${times[@]}" --out "$work/live-frame" >/dev/null ||
+  fail "live, frame poses"
+"$live" --images "$work/gnss" --model "$work/model.yaml" "${times[@]}" --out "$work/live-gnss" >/dev/null ||
+  fail "live, GNSS poses"
+if [ "$gdal" = gdal ]; then
+  "$live" --images "$work/gnss" --model "$work/model.yaml" "${times[@]}" --area "$work/wide.geojson" \
+    --out "$work/live-area" >/dev/null || fail "live, --area"
+fi
+"$python" - "$work" "$gdal" <<'PY' || fail "GNSS poses"
+import json, os, sys
+import cv2
+work, gdal = sys.argv[1], sys.argv[2] == "gdal"
+frame = json.load(open(f"{work}/live-frame/result.json"))
+gnss = json.load(open(f"{work}/live-gnss/result.json"))
+assert frame["decisions"] == gnss["decisions"] and frame["images"] == gnss["images"], (frame["decisions"], gnss["decisions"])
+for a, b in zip(frame["waypoints"], gnss["waypoints"]):
+    assert a["image"] == b["image"] and abs(a["yaw_deg"] - b["yaw_deg"]) < 1e-6, (a, b)
+    assert abs(a["semantic_ratio"] - b["semantic_ratio"]) < 1e-12, (a, b)
+assert (cv2.imread(f"{work}/live-frame/map.png") == cv2.imread(f"{work}/live-gnss/map.png")).all()
+# The georeferenced run writes the flown path; the frame-metre one cannot.
+assert "mission.plan" not in frame["files"] and not os.path.exists(f"{work}/live-frame/mission.plan")
+want = {"result.json", "map.png", "mission.plan", "mission.waypoints", "mission.geojson"} | (
+    {"map.tif", "map_gsd.tif"} if gdal else set())
+assert set(gnss["files"]) == want, gnss["files"]
+for f in want:
+    assert os.path.getsize(f"{work}/live-gnss/{f}") > 0, f
+gj = json.load(open(f"{work}/live-gnss/mission.geojson"))
+points = [f["geometry"]["coordinates"] for f in gj["features"][1:]]
+assert len(points) == gnss["images"], (len(points), gnss["images"])
+for p, w in zip(points, gnss["waypoints"]):
+    assert abs(p[0] - w["longitude_deg"]) < 1e-9 and abs(p[1] - w["latitude_deg"]) < 1e-9, (p, w)
+if gdal:
+    tif = cv2.imread(f"{work}/live-gnss/map.tif", cv2.IMREAD_UNCHANGED)
+    area = json.load(open(f"{work}/live-area/result.json"))
+    assert area["decisions"] == gnss["decisions"] and area["images"] == gnss["images"], area["decisions"]
+    for a, b in zip(area["waypoints"], gnss["waypoints"]):
+        # The polygon's frame is the area's own to a few millimetres (the polygon's corners are
+        # written with a first-order formula): the same images at the same places.
+        assert a["image"] == b["image"], (a, b)
+        assert abs(a["latitude_deg"] - b["latitude_deg"]) < 1e-7 and abs(a["longitude_deg"] - b["longitude_deg"]) < 1e-7
+    print(f"map.tif {tif.shape}, --area: same {area['images']} images")
+print(f"GNSS poses: {gnss['images']} images, decisions {gnss['decisions']} as the frame poses'")
+PY
+
+# Poses in a projected CRS (UTM zone 32N, area.yaml's crs:), converted by GDAL's gdaltransform:
+# the same images and decisions as the WGS84 poses'.
+if [ "$gdal" = gdal ] && command -v gdaltransform >/dev/null; then
+  cp -r "$work/gnss" "$work/utm"
+  echo "crs: EPSG:32632" >>"$work/utm/area.yaml"
+  tail -n +2 "$work/gnss/poses.csv" | awk -F, '{print $3, $2}' |
+    gdaltransform -s_srs EPSG:4326 -t_srs EPSG:32632 -output_xy >"$work/utm.xy" || fail "gdaltransform"
+  { echo "file,easting_m,northing_m,relative_altitude_m,heading_deg"
+    tail -n +2 "$work/gnss/poses.csv" | paste -d' ' - "$work/utm.xy" |
+      awk '{split($1, c, ","); printf "%s,%.4f,%.4f,%s,%s\n", c[1], $2, $3, c[4], c[5]}'
+  } >"$work/utm/poses.csv"
+  "$live" --images "$work/utm" --model "$work/model.yaml" "${times[@]}" --out "$work/live-utm" >/dev/null ||
+    fail "live, UTM poses"
+  "$python" - "$work" <<'PY' || fail "UTM poses"
+import json, sys
+work = sys.argv[1]
+utm, gnss = (json.load(open(f"{work}/live-{k}/result.json")) for k in ["utm", "gnss"])
+assert utm["decisions"] == gnss["decisions"] and [w["image"] for w in utm["waypoints"]] == \
+    [w["image"] for w in gnss["waypoints"]], (utm["decisions"], gnss["decisions"])
+print(f"UTM poses: {utm['images']} images as the WGS84 poses'")
+PY
+fi
+
+# A mission that stops on an error leaves what it flew: the labels of the third image removed,
+# exit 2 with one line naming the file, and --out holds the first images' map, result.json
+# with the error and the waypoint it stopped at, and the flown path (that waypoint included).
+cp -r "$work/gnss" "$work/gnss-broken"
+rm "$work/gnss-broken/labels/00002.png"
+"$live" --images "$work/gnss-broken" --model "$work/model.yaml" "${times[@]}" --out "$work/live-broken" \
+  >/dev/null 2>"$work/err"
+rc=$?
+[ "$rc" -eq 2 ] && [ "$(wc -l <"$work/err")" -eq 1 ] && grep -qF "gnss-broken/labels/00002.png: no labels" "$work/err" ||
+  fail "missing labels: exit code $rc, $(cat "$work/err")"
+"$python" - "$work" <<'PY' || fail "a stopped mission's outputs"
+import json, sys
+work = sys.argv[1]
+r = json.load(open(f"{work}/live-broken/result.json"))
+full = json.load(open(f"{work}/live-gnss/result.json"))
+n = r["images"]
+assert 0 < n < full["images"] and "labels/00002.png" in r["stopped"], (n, r.get("stopped"))
+assert [w["image"] for w in r["waypoints"]] == [w["image"] for w in full["waypoints"][:n]]
+stop = full["waypoints"][n]
+assert abs(r["stopped_at"]["x"] - stop["x"]) < 1e-9 and abs(r["stopped_at"]["y"] - stop["y"]) < 1e-9, r["stopped_at"]
+gj = json.load(open(f"{work}/live-broken/mission.geojson"))
+assert len(gj["features"]) == n + 2, len(gj["features"])  # the path, n images, the waypoint it stopped at
+print(f"stopped after {n} images at {r['stopped_at']}: {r['stopped']}")
+PY
 
 # A folder without the image of a requested waypoint: one error line, exit code 2.
 sed -i '2d' "$work/images/poses.csv"  # the first top-level waypoint's image

@@ -4,7 +4,8 @@
 # first the main job of scripts/demo.sh (what `bash scripts/demo.sh` runs once it has
 # installed and built), then every ```sh block of README.md, then of docs/quickstart.md.
 # Skipped, because the test suite is itself their result: `bash scripts/...` (install + build
-# + demo / test suite) and `cmake ...` (configure, build, install). Every other command must
+# + demo / test suite), `source scripts/configure.sh` with its `configure_for ...` and `cmake ...`
+# (configure, build, install). Every other command must
 # exit with 0, and what the docs say the commands write must be there.
 #   run_commands.sh SOURCE_DIR BUILD_DIR
 set -euo pipefail
@@ -39,7 +40,8 @@ run_file() {
   local file=$1 kind=${2:-docs} n=0
   while IFS= read -r cmd; do
     case "$cmd" in
-      "bash scripts/"* | cmake* | set\ * | cd\ * | echo\ *) echo "skip ($file): $cmd"; continue ;;
+      "bash scripts/"* | "source scripts/"* | configure_for\ * | cmake* | set\ * | cd\ * | echo\ *)
+        echo "skip ($file): $cmd"; continue ;;
     esac
     n=$((n + 1))
     echo "run ($file): $cmd"
