@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reproduces docs/results.md.
-#   bash scripts/results.sh [all|oracle|oracle-default|network|cells|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]
+#   bash scripts/results.sh [all|oracle|oracle-default|network|cells|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]
 #   (default: all, one job per core)
 #
 # oracle: the paper's experiment with the ground-truth oracle, deterministic (fixed 0.1 s per
@@ -17,17 +17,29 @@
 #   each initialised on the five other tiles (the networks' training tiles 1, 2, 3, 5 and the
 #   other unseen tile), as a user calibrates on every labelled field they have. About 20 minutes
 #   on 2 cores.
+#   Calibration keeps each network's segmentations in out/results/segmentation-cache (one folder
+#   per network and weights), so a rerun segments only what the missions need.
+# cells: per network, tile it never trained on (4, 6) and class, how each decision input ranks the
+#   5 cm/px cells of every 15 cm/px region by the realised gain of re-mapping each alone, and how
+#   much of the achievable gain the input of the network run's model captures with 20 % of the
+#   cells (adaptseg_cell_study, examples/tools/cell_study_table.py). Needs network; about 10
+#   minutes on 2 cores.
+# previous: the oracle and network sweeps flown with the defaults before 2026-11-26's ranked
+#   cells (--coverage interest --curve training), side by side with the defaults' runs. Needs
+#   oracle-default and network; about 30 minutes on 2 cores.
 # network-held-out: ERFNet on tiles 4 and 6 again, each initialised on the other of the two
 #   alone (the one scene the network never trained on either) instead of the five other tiles:
 #   whether calibrating only where the network is as new to the ground as on the test field makes
 #   better decisions (docs/results.md: it does not). About 9 minutes on 2 cores.
-# sigma-prior: the defaults' runs flown again with the models `oracle-default` saved, only the
-#   front-aware rule's sigma_prior_weight changed (0.01 and 1; the calibrated models have 0.25):
-#   how much the prior on the field's share of L holds the forecasts back (docs/results.md,
-#   "Forecast against realised gain"). Needs out/results/oracle-default; about 8 minutes on 2 cores.
-# sigma-prior-fit: the defaults' Dubai runs calibrated again with sigma-hat's prior taken from the
-#   training fields (--sigma-prior spread and estimated; the defaults keep it as given). Needs
-#   out/results/oracle-default for the comparison; about 13 minutes on 2 cores.
+# sigma-prior: the previous defaults' runs (part previous) flown again with the models
+#   `oracle-previous` saved, only the front-aware rule's sigma_prior_weight changed (0.01 and 1;
+#   the calibrated models have 0.25): how much the prior on the field's share of L holds the
+#   forecasts of C and eta back (docs/results.md, "Forecast against realised gain"). Needs
+#   out/results/oracle-previous; about 8 minutes on 2 cores.
+# sigma-prior-fit: the previous defaults' Dubai runs calibrated again with sigma-hat's prior taken
+#   from the training fields (--sigma-prior spread and estimated). Needs out/results/oracle-previous
+#   for the comparison; about 13 minutes on 2 cores. (With the defaults' field curve sigma-hat
+#   scales a descent's gain and the curve's rise alike: neither part applies to them.)
 # z-choice: for each of the defaults' runs, the training folds' margins per confidence level z
 #   (adaptseg_calibrate) and the test field flown with the run's model at every z: how much any
 #   choice of z could buy (docs/results.md). Needs out/results/oracle-default; about 8 minutes
@@ -40,9 +52,9 @@
 set -euo pipefail
 part=${1:-all}
 jobs=${2:-$(nproc 2>/dev/null || echo 2)}
-case "$part" in all | oracle | oracle-default | network | cells | network-held-out | sigma-prior | sigma-prior-fit | z-choice | \
+case "$part" in all | oracle | oracle-default | network | cells | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | \
   vertical-speed) ;;
-  *) echo "usage: $0 [all|oracle|oracle-default|network|cells|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]" >&2
+  *) echo "usage: $0 [all|oracle|oracle-default|network|cells|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]" >&2
     exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
@@ -107,14 +119,14 @@ sweep() {
 }
 
 if [ "$part" = sigma-prior ]; then
-  [ -d "$root/oracle-default" ] || { echo "run 'bash $0 oracle-default' first" >&2; exit 1; }
+  [ -d "$root/oracle-previous" ] || { echo "run 'bash $0 previous' first" >&2; exit 1; }
   w=examples/data/weedmap-000
-  labels=("defaults=$(ls -d "$root/oracle-default"/*/ | sed 's:/$::' | paste -sd, -)")
+  labels=("previous=$(ls -d "$root/oracle-previous"/*/ | sed 's:/$::' | paste -sd, -)")
   for k in 0.01 1; do
     config=oracle-sigma-prior-$k
     rm -rf "${root:?}/$config"
     mkdir -p "$root/$config"
-    for d in "$root"/oracle-default/*/; do
+    for d in "$root"/oracle-previous/*/; do
       name=$(basename "$d")
       model="$root/$config/$name.model.yaml"
       sed "s/^\(  *sigma_prior_weight:\) .*/\1 $k/" "$d/model.yaml" >"$model"
@@ -175,12 +187,12 @@ if [ "$part" = z-choice ]; then
 fi
 
 if [ "$part" = sigma-prior-fit ]; then
-  [ -d "$root/oracle-default" ] || { echo "run 'bash $0 oracle-default' first" >&2; exit 1; }
-  labels=("defaults=$(ls -d "$root/oracle-default"/dubai-*/ | sed 's:/$::' | paste -sd, -)")
+  [ -d "$root/oracle-previous" ] || { echo "run 'bash $0 previous' first" >&2; exit 1; }
+  labels=("previous=$(ls -d "$root/oracle-previous"/dubai-*/ | sed 's:/$::' | paste -sd, -)")
   for mode in spread estimated; do
     config=oracle-sigma-prior-$mode
     rm -rf "${root:?}/$config"
-    sweep_dubai "$config" "${fixed[@]}" --sigma-prior "$mode" --no-plots
+    sweep_dubai "$config" "${fixed[@]}" --sigma-prior "$mode" --coverage interest --curve training --no-plots
   done
   wait
   check
@@ -196,6 +208,38 @@ if [ "$part" = vertical-speed ]; then
   wait
   check
   /usr/bin/python3 examples/tools/sweep_table.py "vertical 1 m/s=$(ls -d "$root/$config"/*/ | sed 's:/$::' | paste -sd, -)"
+  exit 0
+fi
+
+if [ "$part" = previous ]; then
+  # The defaults before 2026-11-26's (descents over the cells that show L, decided against the
+  # training fields' curves: --coverage interest --curve training), flown as the oracle and the
+  # network sweeps fly the defaults: what the ranked cells, the top level and the field's own
+  # curve changed. Needs oracle-default and network (for the comparison tables).
+  [ -d "$root/oracle-default" ] && [ -d "$root/network" ] || { echo "run 'bash $0 oracle-default' and 'network' first" >&2; exit 1; }
+  previous=(--coverage interest --curve training --no-plots)
+  rm -rf "$root/oracle-previous" "$root/network-previous"
+  sweep oracle-previous "${fixed[@]}" "${previous[@]}"
+  for net in erfnet-dubai mobilenetv2-dubai; do
+    for cls in $classes; do
+      for t in 4 6; do
+        train=()
+        for k in 1 2 3 4 5 6; do [ "$k" != "$t" ] && train+=(--train "$(dubai "$k")"); done
+        run network-previous "$net-$cls-fly$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
+          --model-file "examples/models/$net" "${network[@]}" "${previous[@]}"
+      done
+    done
+  done
+  wait
+  check
+  runs() { ls -d "$root/$1"/*/ | sed 's:/$::' | paste -sd, -; }
+  /usr/bin/python3 examples/tools/sweep_table.py "defaults=$(runs oracle-default)" "previous=$(runs oracle-previous)"
+  for net in erfnet-dubai mobilenetv2-dubai; do
+    echo
+    echo "## $net"
+    /usr/bin/python3 examples/tools/sweep_table.py "$net=$(ls -d "$root/network/$net"-*/ | sed 's:/$::' | paste -sd, -)" \
+      "previous=$(ls -d "$root/network-previous/$net"-*/ | sed 's:/$::' | paste -sd, -)"
+  done
   exit 0
 fi
 
