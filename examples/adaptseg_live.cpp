@@ -20,7 +20,8 @@
 // (the camera image, for --segmenter erfnet) and/or DIR/labels/FILE (ground-truth labels under
 // the footprint at map resolution, in the camera's orientation, for --segmenter oracle).
 // --record-gnss records GNSS poses; --area SITE (the file adaptseg_plan takes) gives the area
-// and its frame for a folder of GNSS poses.
+// and its frame for a folder of GNSS poses, and lays the top-level grid centred on it as
+// adaptseg_plan does (--grid corner|centred chooses; record and fly with the same).
 //
 // Writes OUT/result.json (the path with each image and its yaw, σ and decisions) and OUT/map.png
 // (the fused map); where the area is georeferenced also OUT/map.tif, OUT/map_gsd.tif (built
@@ -63,10 +64,13 @@ using ex::ImageSetInfo;
 using ex::PosedImage;
 
 /// The planner's options from the decision model: its camera, speed, GSDs and coverage.
-adaptseg::AdaptiveOptions model_options(const adaptseg::DecisionModel& model, std::vector<int> interest) {
+adaptseg::AdaptiveOptions model_options(const adaptseg::DecisionModel& model, std::vector<int> interest,
+                                        adaptseg::GridAnchor grid) {
   adaptseg::MissionOptions mission;
   mission.interest = std::move(interest);
-  return model.adaptive_options(std::move(mission));
+  adaptseg::AdaptiveOptions o = model.adaptive_options(std::move(mission));
+  o.grid_anchor = grid;
+  return o;
 }
 
 /// The live loop's settings.
@@ -182,6 +186,14 @@ void fly(const ImageSetInfo& info, const std::vector<PosedImage>& images, Backen
       adaptseg::Image image = planner.image_at(shot.pose, rgb, shot.yaw_deg);
       if (s.segmenter == "oracle") {
         image.ground_truth = read_shot(s.images / "labels", shot.file, cv::IMREAD_UNCHANGED, "labels");
+        // A recorded pose (a GNSS fix) is the planned one to within rounding, which can move each
+        // footprint edge that lies half-way between map pixels by one pixel: such labels (at most
+        // 2 pixels off each way) are stretched to the footprint (nearest neighbour); any other
+        // size is an error.
+        const cv::Size want = image.footprint_px.size(), got = image.ground_truth.size();
+        if (image.ground_truth.type() == CV_8UC1 && got != want && std::abs(got.width - want.width) <= 2 &&
+            std::abs(got.height - want.height) <= 2)
+          cv::resize(cv::Mat(image.ground_truth), image.ground_truth, want, 0, 0, cv::INTER_NEAREST);
         if (image.ground_truth.type() != CV_8UC1 || image.ground_truth.size() != image.footprint_px.size())
           throw std::invalid_argument((s.images / "labels" / shot.file).string() +
                                       ": must be 8-bit single-channel labels of the footprint's " +
@@ -320,8 +332,17 @@ int main(int argc, char** argv) {
   app.get_option("--geo-origin")->description(
       "with --record-from: LAT,LON,ALT,HEADING of the field directory's frame origin, replacing field.yaml's geo "
       "section (recorded into area.yaml)");
+  std::string grid_name;
+  app.add_option("--grid", grid_name,
+                 "where the top-level grid is laid: corner (from the area's corner, the paper's grid) or centred "
+                 "(on the area, every waypoint inside it: adaptseg_plan's); default centred with --area, else corner; "
+                 "record and fly with the same")
+      ->check(CLI::IsMember({"corner", "centred"}));
   if (const auto code = adaptseg::examples::parse_command_line(app, argc, argv)) return *code;
   s.segmenter = segmenter;
+  const adaptseg::GridAnchor grid = grid_name == "centred" || (grid_name.empty() && !area_file.empty())
+                                        ? adaptseg::GridAnchor::centred
+                                        : adaptseg::GridAnchor::corner;
 
   try {
     const adaptseg::DecisionModel model = adaptseg::DecisionModel::load(model_file);
@@ -330,7 +351,7 @@ int main(int argc, char** argv) {
       model.check_classes(field);
       const std::vector<int> interest = field.class_indices(model.interest);
       model.check_compatible(field, interest);
-      const adaptseg::AdaptiveOptions o = model_options(model, interest);
+      const adaptseg::AdaptiveOptions o = model_options(model, interest, grid);
       adaptseg::OracleSegmenter oracle(field.num_classes());
       adaptseg::DecisionFunction df = model.decision_function;
       const adaptseg::AdaptivePlanner planner(adaptseg::SurveyArea::of(field), oracle, df, o);
@@ -372,7 +393,7 @@ int main(int argc, char** argv) {
     std::vector<int> interest;
     for (const auto& n : model.interest)
       interest.push_back(static_cast<int>(std::find(names.begin(), names.end(), n) - names.begin()));
-    adaptseg::AdaptiveOptions options = model_options(model, interest);
+    adaptseg::AdaptiveOptions options = model_options(model, interest, grid);
     options.mission.fixed_segmentation_time_s = seg_time_s;
     options.mission.fixed_planning_time_s = plan_time_s;
     options.budget_s = budget_s;

@@ -764,6 +764,31 @@ TEST_CASE("AdaptivePlanner: live images made from poses land where the simulator
   }
 }
 
+TEST_CASE("AdaptivePlanner: GridAnchor::centred lays the top-level grid centred on the area, every waypoint inside") {
+  const Field f = Field::load(t::example_field("weedmap-000"));
+  OracleSegmenter oracle(f.num_classes());
+  Scripted never{.gsd = 0.5};
+  AdaptiveOptions o = weedmap_options(f);
+  const Planner corner(SurveyArea::of(f), oracle, never, o);
+  o.grid_anchor = GridAnchor::centred;
+  const Planner centred(SurveyArea::of(f), oracle, never, o);
+  REQUIRE(centred.top_level().size() == corner.top_level().size());
+  const Area& a = f.area();
+  double lo_x = a.x_max_m, hi_x = a.x_min_m, lo_y = a.y_max_m, hi_y = a.y_min_m;
+  bool moved = false;
+  for (std::size_t i = 0; i < centred.top_level().size(); ++i) {
+    const Eigen::Vector3d& p = centred.top_level()[i].position;
+    CHECK((p.x() > a.x_min_m && p.x() < a.x_max_m && p.y() > a.y_min_m && p.y() < a.y_max_m));
+    lo_x = std::min(lo_x, centred.top_level()[i].footprint.x_min_m), hi_x = std::max(hi_x, centred.top_level()[i].footprint.x_max_m);
+    lo_y = std::min(lo_y, centred.top_level()[i].footprint.y_min_m), hi_y = std::max(hi_y, centred.top_level()[i].footprint.y_max_m);
+    moved = moved || (p - corner.top_level()[i].position).norm() > 1e-6;
+  }
+  CHECK(moved);
+  // The footprints' overhang is split evenly between opposite sides.
+  CHECK(a.x_min_m - lo_x == doctest::Approx(hi_x - a.x_max_m));
+  CHECK(a.y_min_m - lo_y == doctest::Approx(hi_y - a.y_max_m));
+}
+
 TEST_CASE("AdaptivePlanner: a camera that does not hold the plan's heading is fused at its yaw") {
   const Field f = Field::load(t::example_field("weedmap-000")).sub_field({0.0, 0.0, 0.6, 0.6});
   OracleSegmenter oracle(f.num_classes());

@@ -19,6 +19,17 @@
 
 namespace adaptseg {
 
+/// Where the top-level lawnmower's grid is laid on the area.
+enum class GridAnchor {
+  /// From the area's corner (x_min, y_min), the whole overhang of the last column and row on the
+  /// far sides (the paper's grid, LawnmowerPlanner::plan).
+  corner,
+  /// Centred on the area, the overhang split evenly between opposite sides, so that every
+  /// waypoint lies inside the area (LawnmowerPlanner::centred_grid; the grid adaptseg_plan lays
+  /// on a new site, plan_site_survey).
+  centred,
+};
+
 /// When the chosen descents are flown.
 enum class DescentSchedule {
   /// At once (the paper): down from the region's top-level waypoint, the sub-lawnmower, back up
@@ -70,6 +81,9 @@ struct AdaptiveOptions {
   /// What a descent re-maps: the whole region (the paper) or only its cells that show a label
   /// of interest (DescentCoverage). A decision model must be calibrated with the same.
   DescentCoverage coverage = DescentCoverage::region;
+  /// Where the top-level grid (and the lawnmowers the front-aware rule compares with) is laid on
+  /// the area: a mission time choice, not part of a decision model.
+  GridAnchor grid_anchor = GridAnchor::corner;
   /// DescentCoverage::ranked: the decision input whose mass over a cell ranks the cells
   /// (decision_inputs.hpp); a decision model sets the one it was calibrated with.
   DecisionInput cell_input = DecisionInput::expected_error;

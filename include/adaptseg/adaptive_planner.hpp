@@ -129,8 +129,7 @@ class AdaptivePlanner {
     for (double g : candidates_) lawnmowers_.push_back({g, 0.0, 0});
     lawnmowers_.push_back({options_.top_gsd_cm, 0.0, 0});
     for (LawnmowerCost& l : lawnmowers_) {
-      const auto plan = LawnmowerPlanner(camera_).plan(area_.area, l.gsd_cm,
-                                                       Eigen::Vector2d(area_.area.x_min_m, area_.area.y_min_m), keep());
+      const auto plan = top_level_plan(l.gsd_cm);
       l.flight_s = plan_flight_s(plan);
       l.images = plan.size();
     }
@@ -148,8 +147,7 @@ class AdaptivePlanner {
       top_gsd_cm_ = g;
       std::erase_if(candidates_, [&](double c) { return c >= g; });
     }
-    top_ = LawnmowerPlanner(camera_).plan(area_.area, top_gsd_cm_,
-                                          Eigen::Vector2d(area_.area.x_min_m, area_.area.y_min_m), keep());
+    top_ = top_level_plan(top_gsd_cm_);
     valid_px_ = cv::countNonZero(area_.valid_mask);
     charge_measured_planning(seconds_since(t0));
     window_last_.resize(top_.size());
@@ -477,6 +475,14 @@ class AdaptivePlanner {
   /// Which lawnmower cells to fly: those with any field under them.
   [[nodiscard]] auto keep() const {
     return [this](const Area& a) { return valid_pixels(a) > 0; };
+  }
+
+  /// A lawnmower over the whole area at `gsd_cm`, its grid laid as AdaptiveOptions::grid_anchor
+  /// says, the cells without valid ground left out.
+  [[nodiscard]] std::vector<Waypoint> top_level_plan(double gsd_cm) const {
+    const LawnmowerPlanner planner(camera_);
+    const Area laid = options_.grid_anchor == GridAnchor::centred ? planner.centred_grid(area_.area, gsd_cm) : area_.area;
+    return planner.plan(laid, gsd_cm, Eigen::Vector2d(laid.x_min_m, laid.y_min_m), keep());
   }
 
   [[nodiscard]] double segmentation_estimate() const {

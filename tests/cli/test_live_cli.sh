@@ -126,7 +126,38 @@ PY
   fail "live, GNSS poses"
 if [ "$gdal" = gdal ]; then
   "$live" --images "$work/gnss" --model "$work/model.yaml" "${times[@]}" --area "$work/wide.geojson" \
-    --out "$work/live-area" >/dev/null || fail "live, --area"
+    --grid corner --out "$work/live-area" >/dev/null || fail "live, --area"
+  # --area alone lays the grid centred on the site, as adaptseg_plan does: recorded with the same
+  # grid, the folder's own area.yaml flies the same top-level waypoints, each inside the site.
+  # (The site's frame, rebuilt from the polygon, is the area's to about a centimetre, which can
+  # move a σ in the fourth digit and with it a marginal decision: the descents are not compared.)
+  "$live" --record-from "$wide" --model "$work/model.yaml" --images "$work/gnss-centred" --record-gnss \
+    --geo-origin 47.4,8.5,500,30 --grid centred >/dev/null || fail "recording GNSS poses, centred grid"
+  "$live" --images "$work/gnss-centred" --model "$work/model.yaml" "${times[@]}" --grid centred \
+    --out "$work/live-centred" >/dev/null || fail "live, centred grid"
+  "$live" --images "$work/gnss-centred" --model "$work/model.yaml" "${times[@]}" --area "$work/wide.geojson" \
+    --out "$work/live-area-centred" >/dev/null || fail "live, --area, centred grid"
+  "$python" - "$work" <<'PY' || fail "--area's centred grid"
+import json, sys
+work = sys.argv[1]
+a = json.load(open(f"{work}/live-centred/result.json"))
+b = json.load(open(f"{work}/live-area-centred/result.json"))
+corner = json.load(open(f"{work}/live-area/result.json"))
+top_images = lambda r: [w["image"] for w in r["waypoints"] if w["level"] == 0]
+assert top_images(a) == top_images(b), (top_images(a), top_images(b))
+ring = json.load(open(f"{work}/wide.geojson"))["features"][0]["geometry"]["coordinates"][0]
+def inside(lon, lat):  # ray casting
+    c = False
+    for (x0, y0), (x1, y1) in zip(ring, ring[1:]):
+        if (y0 > lat) != (y1 > lat) and lon < x0 + (lat - y0) * (x1 - x0) / (y1 - y0):
+            c = not c
+    return c
+top = lambda r: [(w["longitude_deg"], w["latitude_deg"]) for w in r["waypoints"] if w["level"] == 0]
+assert all(inside(*p) for p in top(b)), "a top-level waypoint of the centred grid lies outside the site"
+outside = sum(not inside(*p) for p in top(corner))
+assert top(b) != top(corner), "the centred grid is the corner one"
+print(f"--area: centred grid, {len(top(b))} top-level waypoints inside the site (corner grid: {outside} outside)")
+PY
 fi
 "$python" - "$work" "$gdal" <<'PY' || fail "GNSS poses"
 import json, os, sys
