@@ -32,11 +32,12 @@
 # network-held-out: ERFNet on tiles 4 and 6 again, each initialised on the other of the two
 #   alone (the one scene the network never trained on either) instead of the five other tiles:
 #   whether calibrating only where the network is as new to the ground as on the test field makes
-#   better decisions (docs/results.md: it does not). About 9 minutes on 2 cores.
+#   better decisions (docs/results.md: none below -0.002, but fewer gains and a lower mean). About
+#   9 minutes on 2 cores.
 # sigma-prior: the previous defaults' runs (part previous) flown again with the models
 #   `oracle-previous` saved, only the front-aware rule's sigma_prior_weight changed (0.01 and 1;
 #   the calibrated models have 0.25): how much the prior on the field's share of L holds the
-#   forecasts of C and eta back (docs/results.md, "Forecast against realised gain"). Needs
+#   forecasts of C and eta back (docs/results.md, "σ̂, the field's share of L"). Needs
 #   out/results/oracle-previous; about 8 minutes on 2 cores.
 # sigma-prior-fit: the previous defaults' Dubai runs calibrated again with sigma-hat's prior taken
 #   from the training fields (--sigma-prior spread and estimated). Needs out/results/oracle-previous

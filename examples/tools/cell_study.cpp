@@ -1,5 +1,5 @@
 // adaptseg_cell_study: how well each decision input, known at the top level, ranks the cells a
-// descent could re-map by what re-mapping them gains (docs/results.md, "Which cells pay").
+// descent could re-map by what re-mapping them gains (docs/results.md, "Cells").
 //
 // For each field and label of interest: the top-level lawnmower over the whole field is flown
 // and fused; then, for each top-level region and each candidate GSD, every cell of the region's

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Summary of adaptseg_cell_study outputs (docs/results.md, "Which cells pay").
+"""Summary of adaptseg_cell_study outputs (docs/results.md, "Cells").
 
 Usage: cat STUDY.md ... | /usr/bin/python3 examples/tools/cell_study_table.py
 

@@ -141,7 +141,7 @@ def main(out):
         ax.set_title(field, fontsize=10)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-    fig.suptitle("Per-image mIoU vs GSD: mean and standard deviation over the images taken")
+    fig.suptitle("Per-image mIoU vs GSD:\nmean and standard deviation over the images taken")
     save(fig, os.path.join(out, "per_image_miou.png"))
 
     # Per descent: the forecast field gain the decision was taken on, against what the descent
