@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reproduces docs/results.md.
-#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|cells|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]
+#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]
 #   (default: all, one job per core)
 #
 # oracle: the paper's experiment with the ground-truth oracle, deterministic (fixed 0.1 s per
@@ -26,6 +26,9 @@
 #   much of the achievable gain the input of the network run's model captures with 20 % of the
 #   cells (adaptseg_cell_study, examples/tools/cell_study_table.py). Needs network; about 10
 #   minutes on 2 cores.
+# curve-check: the field curve's predicted rise from the top level to each lawnmower GSD against
+#   the training fields' real curves, from the models oracle-default and network saved
+#   (examples/tools/curve_check_table.py; seconds, nothing flown).
 # previous: the oracle and network sweeps flown with the defaults before 2026-11-26's ranked
 #   cells (--coverage interest --curve training), side by side with the defaults' runs. Needs
 #   oracle-default and network; about 30 minutes on 2 cores.
@@ -55,9 +58,9 @@
 set -euo pipefail
 part=${1:-all}
 jobs=${2:-$(nproc 2>/dev/null || echo 2)}
-case "$part" in all | oracle | oracle-default | paper | network | cells | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | \
+case "$part" in all | oracle | oracle-default | paper | network | cells | curve-check | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | \
   vertical-speed) ;;
-  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|cells|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]" >&2
+  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]" >&2
     exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
@@ -243,6 +246,14 @@ if [ "$part" = previous ]; then
     /usr/bin/python3 examples/tools/sweep_table.py "$net=$(ls -d "$root/network/$net"-*/ | sed 's:/$::' | paste -sd, -)" \
       "previous=$(ls -d "$root/network-previous/$net"-*/ | sed 's:/$::' | paste -sd, -)"
   done
+  exit 0
+fi
+
+if [ "$part" = curve-check ]; then
+  [ -d "$root/oracle-default" ] && [ -d "$root/network" ] || { echo "run 'bash $0 oracle-default' and 'network' first" >&2; exit 1; }
+  runs() { ls -d "$@" | sed 's:/$::' | paste -sd, -; }
+  /usr/bin/python3 examples/tools/curve_check_table.py "oracle=$(runs "$root"/oracle-default/dubai-*/)" \
+    "mobilenetv2-dubai=$(runs "$root"/network/mobilenetv2-dubai-*/)" "erfnet-dubai=$(runs "$root"/network/erfnet-dubai-*/)"
   exit 0
 fi
 
