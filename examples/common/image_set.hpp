@@ -138,28 +138,6 @@ inline void write_image_set(const std::filesystem::path& dir, const Field& field
   write_text(dir / "poses.csv", csv.str());
 }
 
-/// area.yaml's `geo:`: latitude_deg, longitude_deg, altitude_m, heading_deg as field.yaml's, and
-/// optionally anchor_x_m, anchor_y_m (0) and scale (1) of FieldGeo.
-inline FieldGeo read_image_set_geo(const YAML::Node& n, const std::filesystem::path& file) {
-  if (!n.IsMap()) detail_image_set::fail(file, "'geo' must be a mapping {latitude_deg, longitude_deg, altitude_m, heading_deg}");
-  const auto get = [&](const char* key, std::optional<double> fallback) {
-    if (!n[key]) {
-      if (fallback) return *fallback;
-      detail_image_set::fail(file, std::string("missing key 'geo.") + key + "'");
-    }
-    return n[key].as<double>();
-  };
-  FieldGeo g{get("latitude_deg", std::nullopt), get("longitude_deg", std::nullopt), get("altitude_m", std::nullopt),
-             get("heading_deg", std::nullopt),  get("anchor_x_m", 0.0),             get("anchor_y_m", 0.0),
-             get("scale", 1.0)};
-  try {
-    adaptseg::detail::validate_field_geo(g, "geo");
-  } catch (const std::invalid_argument& e) {
-    detail_image_set::fail(file, e.what());
-  }
-  return g;
-}
-
 /// Reads area.yaml; `area_from_elsewhere`: the area (area_m, valid_mask, map_gsd_cm) comes from
 /// --area, so area.yaml may leave it out.
 inline ImageSetInfo read_image_set_info(const std::filesystem::path& dir, bool area_from_elsewhere = false) {
@@ -202,7 +180,7 @@ inline ImageSetInfo read_image_set_info(const std::filesystem::path& dir, bool a
     const YAML::Node cam = root["camera"];
     info.camera = {cam["image_width_px"].as<int>(), cam["image_height_px"].as<int>(),
                    cam["sensor_width_mm"].as<double>(), cam["focal_length_mm"].as<double>()};
-    if (root["geo"]) info.geo = read_image_set_geo(root["geo"], file);
+    if (root["geo"]) info.geo = adaptseg::detail::field_read_geo(root["geo"], file, /*anchored=*/true);
     if (root["crs"]) info.crs = root["crs"].as<std::string>();
     return info;
   } catch (const YAML::Exception& e) {

@@ -347,23 +347,31 @@ T field_scalar(const YAML::Node& n, const char* what, const std::filesystem::pat
 }
 
 /// The `geo:` section of field.yaml: a mapping of exactly latitude_deg, longitude_deg,
-/// altitude_m and heading_deg (numbers).
-inline FieldGeo field_read_geo(const YAML::Node& n, const std::filesystem::path& file) {
-  if (!n.IsMap())
-    field_error(file, "'geo' must be a mapping {latitude_deg, longitude_deg, altitude_m, heading_deg}");
-  static const char* const kGeoKeys[] = {"latitude_deg", "longitude_deg", "altitude_m", "heading_deg"};
+/// altitude_m and heading_deg (numbers); `anchored` (a live folder's area.yaml, which
+/// --record-from writes for a region or a GeoTIFF field) also allows FieldGeo's anchor_x_m,
+/// anchor_y_m (default 0) and scale (default 1).
+inline FieldGeo field_read_geo(const YAML::Node& n, const std::filesystem::path& file, bool anchored = false) {
+  static const char* const kGeoKeys[] = {"latitude_deg", "longitude_deg", "altitude_m", "heading_deg",
+                                         "anchor_x_m",   "anchor_y_m",    "scale"};
+  const int required = 4, known = anchored ? 7 : 4;
+  const std::string names = anchored ? "latitude_deg, longitude_deg, altitude_m, heading_deg, anchor_x_m, anchor_y_m, scale"
+                                     : "latitude_deg, longitude_deg, altitude_m, heading_deg";
+  if (!n.IsMap()) field_error(file, "'geo' must be a mapping {" + names + "}");
   for (const auto& kv : n) {
     const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "<non-scalar>";
-    if (std::none_of(std::begin(kGeoKeys), std::end(kGeoKeys), [&](const char* k) { return key == k; }))
-      field_error(file, "geo: unknown key '" + key + "' (known: latitude_deg, longitude_deg, altitude_m, heading_deg)");
+    if (std::none_of(kGeoKeys, kGeoKeys + known, [&](const char* k) { return key == k; }))
+      field_error(file, "geo: unknown key '" + key + "' (known: " + names + ")");
   }
-  double v[4];
-  for (int k = 0; k < 4; ++k) {
+  double v[7] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0};
+  for (int k = 0; k < known; ++k) {
     const std::string what = std::string("geo.") + kGeoKeys[k];
-    if (!n[kGeoKeys[k]]) field_error(file, "missing key '" + what + "'");
+    if (!n[kGeoKeys[k]]) {
+      if (k < required) field_error(file, "missing key '" + what + "'");
+      continue;
+    }
     v[k] = field_scalar<double>(n[kGeoKeys[k]], what.c_str(), file);
   }
-  const FieldGeo g{v[0], v[1], v[2], v[3]};
+  const FieldGeo g{v[0], v[1], v[2], v[3], v[4], v[5], v[6]};
   try {
     validate_field_geo(g, "geo");
   } catch (const std::invalid_argument& e) {
