@@ -298,7 +298,7 @@ int main(int argc, char** argv) {
   app.add_option("--segmenter", segmenter, "oracle: ground-truth labels/ of the folder; erfnet: its RGB images")
       ->check(CLI::IsMember({"oracle", "erfnet"}))
       ->capture_default_str();
-  app.add_option("--model-file", erfnet_dir, "ERFNet model directory (model.onnx, model.yaml) for --segmenter erfnet");
+  app.add_option("--model-file", erfnet_dir, "network of --segmenter erfnet: a model directory (model.onnx, model.yaml) or an ensemble directory (ensemble.yaml)");
   app.add_option("--budget-s", budget_s, "mission-time budget [s] (never exceeded)");
   app.add_option("--pose-tolerance-m", s.tolerance_m, "how far [m] a recorded pose may be from the waypoint")
       ->capture_default_str();
@@ -408,9 +408,9 @@ int main(int argc, char** argv) {
       params.camera_width_px = m.image_width_px;
       params.camera_height_px = m.image_height_px;
       params.resize_to_network = true;
-      params.name = adaptseg::examples::network_name(erfnet_dir / "model.onnx", erfnet_dir / "model.yaml");
-      adaptseg::ErfnetSegmenter erfnet(erfnet_dir, params);
-      fly_strategy(strategy, model, info, images, erfnet, options, s);
+      adaptseg::examples::with_network(erfnet_dir, std::move(params), [&](auto& network) {
+        fly_strategy(strategy, model, info, images, network, options, s);
+      });
     }
     return 0;
   } catch (const std::exception& e) {

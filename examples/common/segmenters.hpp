@@ -4,6 +4,7 @@
 
 #include <adaptseg/calibration.hpp>
 #include <adaptseg/camera.hpp>
+#include <adaptseg/ensemble_segmenter.hpp>
 #include <adaptseg/erfnet_segmenter.hpp>
 #include <adaptseg/field.hpp>
 #include <adaptseg/lawnmower_planner.hpp>
@@ -38,27 +39,78 @@ inline std::uint64_t fnv1a(const void* bytes, std::size_t n, std::uint64_t h = 1
   return h;
 }
 
-/// A model directory's (or ONNX file's) identity for a segmentation cache: its name and the hash
-/// of its ONNX file and metadata (the temperature included), e.g. "mobilenetv2-dubai-3fa2...".
-inline std::string model_digest(const std::filesystem::path& onnx, const std::filesystem::path& metadata) {
+/// The hash (FNV-1a over their bytes, in order) of `files`, as 16 hex digits.
+inline std::string files_hash(const std::vector<std::filesystem::path>& files) {
   std::uint64_t h = 14695981039346656037ull;
-  for (const auto& f : {onnx, metadata}) {
+  for (const auto& f : files) {
     std::ifstream in(f, std::ios::binary);
     const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     h = fnv1a(bytes.data(), bytes.size(), h);
   }
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
-  const std::filesystem::path dir = onnx.parent_path();
-  return (dir.filename().empty() ? std::string("model") : dir.filename().string()) + "-" + hex;
+  return hex;
 }
 
-/// The name a network backend goes by in results and decision models: "erfnet:" and the
-/// network's identity (model_digest(): its folder's name and the hash of its weights and
-/// metadata), so that a model calibrated with one network is refused with another (or with the
-/// same network at another temperature), whatever their folders are called.
-inline std::string network_name(const std::filesystem::path& onnx, const std::filesystem::path& metadata) {
-  return "erfnet:" + model_digest(onnx, metadata);
+/// A model directory's (or ONNX file's) identity for a segmentation cache: its name and the hash
+/// of its ONNX file and metadata (the temperature included), e.g. "mobilenetv2-dubai-3fa2...".
+inline std::string model_digest(const std::filesystem::path& onnx, const std::filesystem::path& metadata) {
+  const std::filesystem::path dir = onnx.parent_path();
+  return (dir.filename().empty() ? std::string("model") : dir.filename().string()) + "-" + files_hash({onnx, metadata});
+}
+
+/// An ensemble directory's identity: its name and the hash of its ensemble.yaml and of every
+/// member's ONNX file and metadata, in the file's order (a member retrained or re-tempered, or
+/// weights changed, is another ensemble).
+inline std::string ensemble_digest(const std::filesystem::path& dir) {
+  std::vector<std::filesystem::path> files{dir / "ensemble.yaml"};
+  for (const EnsembleMember& m : read_ensemble_file(dir)) {
+    files.push_back(m.model_dir / "model.onnx");
+    files.push_back(m.model_dir / "model.yaml");
+  }
+  const std::filesystem::path name = dir.filename().empty() ? dir.parent_path().filename() : dir.filename();
+  return name.string() + "-" + files_hash(files);
+}
+
+/// --model-file's ONNX file and metadata: a directory with model.onnx + model.yaml, or an .onnx
+/// file with its .yaml next to it.
+inline std::pair<std::filesystem::path, std::filesystem::path> model_paths(const std::filesystem::path& model_file) {
+  const bool dir = std::filesystem::is_directory(model_file);
+  const std::filesystem::path onnx = dir ? model_file / "model.onnx" : model_file;
+  std::filesystem::path metadata = onnx;
+  metadata.replace_extension(".yaml");
+  return {onnx, metadata};
+}
+
+/// --model-file's identity (a network's model_digest(), an ensemble directory's ensemble_digest()).
+inline std::string model_file_digest(const std::filesystem::path& model_file) {
+  if (EnsembleSegmenter::is_ensemble_dir(model_file)) return ensemble_digest(model_file);
+  const auto [onnx, metadata] = model_paths(model_file);
+  return model_digest(onnx, metadata);
+}
+
+/// The name a network backend goes by in results and decision models: "erfnet:" (one network)
+/// or "ensemble:" (an ensemble directory) and its identity (model_file_digest(): its folder's
+/// name and the hash of its weights and metadata), so that a model calibrated with one network
+/// is refused with another (or with the same network at another temperature), whatever their
+/// folders are called.
+inline std::string network_name(const std::filesystem::path& model_file) {
+  return (EnsembleSegmenter::is_ensemble_dir(model_file) ? "ensemble:" : "erfnet:") + model_file_digest(model_file);
+}
+
+/// Calls `f(backend)` with the network backend of `model_file`: an EnsembleSegmenter for an
+/// ensemble directory (ensemble.yaml), else an ErfnetSegmenter (model_paths()); named by
+/// network_name() and built with `params` otherwise.
+template <class F>
+decltype(auto) with_network(const std::filesystem::path& model_file, ErfnetParams params, F&& f) {
+  params.name = network_name(model_file);
+  if (EnsembleSegmenter::is_ensemble_dir(model_file)) {
+    EnsembleSegmenter ensemble(model_file, std::move(params));
+    return std::forward<F>(f)(ensemble);
+  }
+  const auto [onnx, metadata] = model_paths(model_file);
+  ErfnetSegmenter erfnet(onnx, metadata, std::move(params));
+  return std::forward<F>(f)(erfnet);
 }
 
 /// Memoises a deterministic backend: a simulated image is identified by its footprint, its
@@ -207,8 +259,9 @@ struct SegmenterOptions {
         ->capture_default_str();
     app.add_option("--model-file", model_file,
                    "network of --segmenter erfnet (the ONNX backend): a directory with model.onnx + model.yaml, "
-                   "or an .onnx file with its .yaml next to it (examples/models/erfnet-dubai, "
-                   "examples/models/mobilenetv2-dubai)");
+                   "an .onnx file with its .yaml next to it (examples/models/erfnet-dubai, "
+                   "examples/models/mobilenetv2-dubai), or an ensemble directory with ensemble.yaml "
+                   "(examples/models/ensemble-dubai: the mean of its members' probabilities)");
     app.add_option("--threads", threads, "ERFNet: OpenCV threads (0: OpenCV's default; at most 256)")
         ->check(CLI::Range(0, 256))
         ->capture_default_str();
@@ -218,21 +271,11 @@ struct SegmenterOptions {
                    "always segment (their time is measured)");
   }
 
-  /// The ONNX file and metadata of --model-file.
-  [[nodiscard]] std::pair<std::filesystem::path, std::filesystem::path> model_paths() const {
-    const bool dir = std::filesystem::is_directory(model_file);
-    const std::filesystem::path onnx = dir ? model_file / "model.onnx" : model_file;
-    std::filesystem::path metadata = onnx;
-    metadata.replace_extension(".yaml");
-    return {onnx, metadata};
-  }
-
   /// Where calibration keeps the network's segmentations (--segmentation-cache), if anywhere:
-  /// a folder named by the network and the hash of its files.
+  /// a folder named by the network and the hash of its files (model_file_digest()).
   [[nodiscard]] std::optional<std::filesystem::path> calibration_cache() const {
     if (name != "erfnet" || cache_root.empty()) return std::nullopt;
-    const auto [onnx, metadata] = model_paths();
-    return cache_root / model_digest(onnx, metadata);
+    return cache_root / model_file_digest(model_file);
   }
 
   /// @throws std::invalid_argument for a model file given to the oracle or missing for ERFNet.
@@ -257,10 +300,7 @@ struct SegmenterOptions {
     ErfnetParams p = ErfnetSegmenter::for_field(field, CameraModel(camera));
     p.num_threads = threads;
     p.resize_to_network = true;
-    const auto [onnx, metadata] = model_paths();
-    p.name = network_name(onnx, metadata);
-    ErfnetSegmenter erfnet(onnx, metadata, std::move(p));
-    return std::forward<F>(f)(erfnet);
+    return with_network(model_file, std::move(p), std::forward<F>(f));
   }
 };
 

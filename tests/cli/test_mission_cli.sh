@@ -118,11 +118,12 @@ assert all(a > b for a, b in zip(tt, tt[1:])), "total time must fall with GSD"
 PY
   ;;
 erfnet_sweep)
-  # Each bundled network on the held-out Dubai tile 6 (MobileNetV2: a 512x384 input for the
-  # 480x360 camera, logits at stride 4): the mission records the backend, and the field mIoU
-  # (all classes) is higher at the finest GSD than at the coarsest.
+  # Each bundled network and the bundled ensemble of the two on the held-out Dubai tile 6
+  # (MobileNetV2: a 512x384 input for the 480x360 camera, logits at stride 4): the mission
+  # records the backend, and the field mIoU (all classes) is higher at the finest GSD than at the
+  # coarsest.
   tile="$examples/data/dubai-tile-6"
-  for net in erfnet-dubai mobilenetv2-dubai; do
+  for net in erfnet-dubai mobilenetv2-dubai ensemble-dubai; do
     for gsd in 5 15; do
       "$mission" --field "$tile" --strategy lawnmower --gsd "$gsd" --segmenter erfnet \
         --model-file "$examples/models/$net" --seg-time-s 0.1 --plan-time-s 0 \
@@ -132,11 +133,14 @@ erfnet_sweep)
   "$python" - "$work" <<'PY' || fail "result.json checks"
 import json, sys
 work = sys.argv[1]
-for net in ("erfnet-dubai", "mobilenetv2-dubai"):
-    fine, coarse = (json.load(open(f"{work}/{net}-{g}/result.json")) for g in (5, 15))
+runs = {}
+for net in ("erfnet-dubai", "mobilenetv2-dubai", "ensemble-dubai"):
+    fine, coarse = runs[net] = [json.load(open(f"{work}/{net}-{g}/result.json")) for g in (5, 15)]
+    kind = "ensemble" if net.startswith("ensemble") else "erfnet"
     for r in (fine, coarse):
-        # The network's name: erfnet:<its folder>-<the hash of its weights and metadata>.
-        assert r["segmenter"].startswith(f"erfnet:{net}-") and len(r["segmenter"]) == len(f"erfnet:{net}-") + 16, r["segmenter"]
+        # The network's name: erfnet:<its folder>-<the hash of its weights and metadata>
+        # (ensemble:<its folder>-<the hash of ensemble.yaml and its members' files>).
+        assert r["segmenter"].startswith(f"{kind}:{net}-") and len(r["segmenter"]) == len(f"{kind}:{net}-") + 16, r["segmenter"]
         # Exactly black orthomosaic pixels carry no RGB: the backend leaves them unlabelled.
         assert r["coverage"] > 0.999, r["coverage"]
     print(net, "miou_all 5 cm/px", fine["miou_all"], "15 cm/px", coarse["miou_all"])
@@ -148,6 +152,11 @@ for net in ("erfnet-dubai", "mobilenetv2-dubai"):
     for name, r in (("fine", fine), ("coarse", coarse)):
         assert all(w["image_miou_all"] is not None for w in r["waypoints"]), name
         assert all(w["truth_ratio"] is not None and 0.0 <= w["truth_ratio"] <= 1.0 for w in r["waypoints"]), name
+# The ensemble maps the tile better than either member at both GSDs (eval_ensemble.py: 0.662
+# and 0.601 against 0.649 / 0.611 and 0.571 / 0.562).
+for k, g in enumerate((5, 15)):
+    members = max(runs[n][k]["miou_all"] for n in ("erfnet-dubai", "mobilenetv2-dubai"))
+    assert runs["ensemble-dubai"][k]["miou_all"] > members + 0.005, (g, runs["ensemble-dubai"][k]["miou_all"], members)
 PY
   ;;
 determinism)

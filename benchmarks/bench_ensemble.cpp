@@ -1,0 +1,88 @@
+// Times the ensemble backend against its members, side by side in one run: per round, K
+// segment() calls of each member (ErfnetSegmenter), then K of the ensemble (EnsembleSegmenter:
+// every member, the weighted mean, its argmax) and K of segment_with_disagreement() (the same
+// plus disagreement and class splits), on one 480x360 camera image of held-out Dubai tile 6
+// at 2x its GSD; medians over all rounds. One OpenCV thread count per run.
+//
+//   bench_ensemble ENSEMBLE_DIR FIELD_DIR [--threads N] [--rounds R] [--iters K]
+//
+// Prints a markdown table row per backend: name, threads, median and min [ms].
+
+#include <adaptseg/ensemble_segmenter.hpp>
+#include <adaptseg/lawnmower_planner.hpp>
+#include <adaptseg/simulated_sensor.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <exception>
+#include <iostream>
+#include <string>
+#include <vector>
+
+namespace {
+
+template <typename F>
+void time_into(std::vector<double>& out, F&& f, int iters) {
+  for (int i = 0; i < iters; ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    f();
+    out.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 3) {
+    std::cerr << "usage: bench_ensemble ENSEMBLE_DIR FIELD_DIR [--threads N] [--rounds R] [--iters K]\n";
+    return 2;
+  }
+  int threads = 2, rounds = 5, iters = 5;
+  for (int i = 3; i + 1 < argc; i += 2) {
+    const std::string a = argv[i];
+    const int v = std::stoi(argv[i + 1]);
+    if (a == "--threads") threads = v;
+    else if (a == "--rounds") rounds = v;
+    else if (a == "--iters") iters = v;
+    else {
+      std::cerr << "bench_ensemble: unknown option " << a << '\n';
+      return 2;
+    }
+  }
+  try {
+    const auto field = adaptseg::Field::load(argv[2]);
+    const adaptseg::CameraModel camera;
+    adaptseg::ErfnetParams p{.resize_to_network = true, .num_threads = threads};
+    adaptseg::EnsembleSegmenter ensemble(argv[1], field, camera, p);
+    std::vector<adaptseg::ErfnetSegmenter> members;
+    for (const auto& m : ensemble.member_list())
+      members.emplace_back(m.model_dir, field, camera, p);
+    const auto plan = adaptseg::LawnmowerPlanner(camera).plan(field.area(), 2.0 * field.gsd_cm());
+    const adaptseg::Image image = adaptseg::SimulatedSensor(field, camera).capture(plan.at(plan.size() / 2));
+    std::vector<std::vector<double>> member_ms(members.size());
+    std::vector<double> ens_ms, dis_ms;
+    for (auto& m : members) (void)m.segment(image);  // warm-up
+    (void)ensemble.segment_with_disagreement(image);
+    for (int r = 0; r < rounds; ++r) {
+      for (std::size_t k = 0; k < members.size(); ++k) time_into(member_ms[k], [&] { (void)members[k].segment(image); }, iters);
+      time_into(ens_ms, [&] { (void)ensemble.segment(image); }, iters);
+      time_into(dis_ms, [&] { (void)ensemble.segment_with_disagreement(image); }, iters);
+    }
+    for (std::size_t k = 0; k < members.size(); ++k)
+      std::printf("| %s (member) | %d | %.1f |\n", ensemble.member_list()[k].model_dir.filename().c_str(), threads,
+                  median(member_ms[k]));
+    std::printf("| ensemble segment() | %d | %.1f |\n", threads, median(ens_ms));
+    std::printf("| ensemble segment_with_disagreement() | %d | %.1f |\n", threads, median(dis_ms));
+  } catch (const std::exception& e) {
+    std::cerr << "bench_ensemble: " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}
