@@ -7,7 +7,7 @@
 //   adaptseg_calibrate --train examples/data/dubai-tile-1 --train examples/data/dubai-tile-2:0,0,1,0.5
 //                      --interest road --out roads.yaml
 //   adaptseg_calibrate --field examples/data/dubai-tile-4 --segmenter erfnet
-//                      --model-file examples/models/erfnet-dubai --out erfnet-model.yaml
+//                      --model-file examples/models/ensemble-dubai --out ensemble-model.yaml
 
 #include "common/segmenters.hpp"
 #include "common/strategies.hpp"

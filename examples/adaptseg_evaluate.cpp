@@ -5,7 +5,7 @@
 //   adaptseg_evaluate --train examples/data/weedmap-000:0,0,0.5,1
 //                     --test examples/data/weedmap-000:0.5,0,1,1 --segmenter oracle --out out/eval
 //   adaptseg_evaluate --train examples/data/dubai-tile-4 --test examples/data/dubai-tile-6
-//                     --segmenter erfnet --model-file examples/models/erfnet-dubai --out out/eval-erfnet
+//                     --segmenter erfnet --model-file examples/models/ensemble-dubai --out out/eval-ensemble
 
 #include "common/segmenters.hpp"
 #include "common/strategies.hpp"

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reproduces docs/results.md.
-#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]
+#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|ensemble|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]
 #   (default: all, one job per core)
 #
 # oracle: the paper's experiment with the ground-truth oracle, deterministic (fixed 0.1 s per
@@ -14,18 +14,25 @@
 #   configuration about 19 (its threshold search flies every setting over every training field).
 #   oracle-default flies the defaults alone, paper the paper's configuration alone (the defaults'
 #   runs, which its table compares with, from an earlier oracle-default).
-# network: the same with the bundled networks (examples/models/mobilenetv2-dubai and
-#   erfnet-dubai; measured segmentation times) on the two tiles they never trained on (4 and 6),
-#   each initialised on the five other tiles (the networks' training tiles 1, 2, 3, 5 and the
-#   other unseen tile), as a user calibrates on every labelled field they have. About 20 minutes
-#   on 2 cores.
+# network: the same with the bundled networks (examples/models/mobilenetv2-dubai, erfnet-dubai,
+#   and ensemble-dubai, the mean of the two; measured segmentation times) on the two tiles they
+#   never trained on (4 and 6), each initialised on the five other tiles (the networks' training
+#   tiles 1, 2, 3, 5 and the other unseen tile), as a user calibrates on every labelled field
+#   they have; then every backend's missions against every backend's lawnmower curve
+#   (examples/tools/backend_compare.py: which gives the better map per second). About 26 minutes
+#   on 2 cores for the two networks and 26 more for the ensemble (its calibration segments every
+#   image with both networks once, into the cache); NETS="..." (environment) flies a subset and
+#   keeps the other networks' runs.
 #   Calibration keeps each network's segmentations in out/results/segmentation-cache (one folder
 #   per network and weights), so a rerun segments only what the missions need.
+# ensemble: field mIoU of the bundled networks and of their ensemble (examples/models/ensemble-dubai)
+#   on the same whole-field lawnmowers of tiles 4 and 6 at 5, 10 and 15 cm/px
+#   (examples/tools/eval_ensemble.py, PyTorch on the exported weights); about 2 minutes on 2 cores.
 # cells: per network, tile it never trained on (4, 6) and class, how each decision input ranks the
 #   5 cm/px cells of every 15 cm/px region by the realised gain of re-mapping each alone, and how
 #   much of the achievable gain the input of the network run's model captures with 20 % of the
-#   cells (adaptseg_cell_study, examples/tools/cell_study_table.py). Needs network; about 10
-#   minutes on 2 cores.
+#   cells (adaptseg_cell_study, examples/tools/cell_study_table.py). Needs network; about 12
+#   minutes on 2 cores for the three backends (NETS as for network).
 # curve-check: the field curve's predicted rise from the top level to each lawnmower GSD against
 #   the training fields' real curves, from the models oracle-default and network saved
 #   (examples/tools/curve_check_table.py; seconds, nothing flown).
@@ -58,9 +65,9 @@
 set -euo pipefail
 part=${1:-all}
 jobs=${2:-$(nproc 2>/dev/null || echo 2)}
-case "$part" in all | oracle | oracle-default | paper | network | cells | curve-check | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | \
+case "$part" in all | oracle | oracle-default | paper | network | ensemble | cells | curve-check | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | \
   vertical-speed) ;;
-  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]" >&2
+  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|ensemble|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]" >&2
     exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
@@ -77,6 +84,9 @@ paper=(--rule threshold --gain-inputs delta-sigma --coverage region --no-plots)
 # A bundled network (--model-file examples/models/NET), one thread per run; calibration keeps the
 # network's segmentations on disk, so that the runs over the same tiles segment each image once.
 network=(--segmenter erfnet --threads 1 --segmentation-cache "out/results/segmentation-cache")
+# The networks of part network (environment NETS: a subset, e.g. NETS=ensemble-dubai reruns
+# only the ensemble's runs and keeps the others').
+nets=${NETS:-erfnet-dubai mobilenetv2-dubai ensemble-dubai}
 
 # One adaptseg_evaluate run: CONFIG RUN ARGS... -> $root/CONFIG/RUN (log: RUN.log beside it).
 running=0
@@ -264,7 +274,7 @@ if [ "$part" = cells ]; then
   [ -d "$root/network" ] || { echo "run 'bash $0 network' first" >&2; exit 1; }
   out=$root/cells
   mkdir -p "$out"
-  for net in mobilenetv2-dubai erfnet-dubai; do
+  for net in $nets; do
     for t in 4 6; do
       for cls in $classes; do
         build/release/examples/adaptseg_cell_study --field "$(dubai "$t")" --classes "$cls" --gsd 5 \
@@ -276,6 +286,14 @@ if [ "$part" = cells ]; then
     echo "## $net: capture of the achievable gain by the best 20 % of cells (mean over tiles 4, 6 and the four classes)"
     cat "$out/$net"-*.md | /usr/bin/python3 examples/tools/cell_study_table.py
   done
+  exit 0
+fi
+
+if [ "$part" = ensemble ]; then
+  mkdir -p "$root/ensemble"
+  /usr/bin/python3 examples/tools/eval_ensemble.py --threads "$jobs" --bands 1,2,3 \
+    --members mobilenetv2-dubai=examples/models/mobilenetv2-dubai,erfnet-dubai=examples/models/erfnet-dubai \
+    --ensembles ensemble-dubai=examples/models/ensemble-dubai --json "$root/ensemble/ensemble.json"
   exit 0
 fi
 
@@ -324,8 +342,8 @@ if [ "$part" != network ]; then
 fi
 
 if [ "$part" = all ] || [ "$part" = network ]; then
-  rm -rf "$root/network"
-  for net in erfnet-dubai mobilenetv2-dubai; do
+  for net in $nets; do rm -rf "$root/network/$net"-*; done
+  for net in $nets; do
     for cls in $classes; do
       for t in 4 6; do
         train=()
@@ -337,11 +355,15 @@ if [ "$part" = all ] || [ "$part" = network ]; then
   done
   wait
   check
-  for net in erfnet-dubai mobilenetv2-dubai; do
+  for net in $nets; do
     echo
     echo "## $net"
     /usr/bin/python3 examples/tools/sweep_table.py "$net=$(ls -d "$root/network/$net"-*/ | sed 's:/$::' | paste -sd, -)"
     /usr/bin/python3 examples/tools/per_image_table.py "$root/network/$net-vegetation-fly6" \
       "$root/network/$net-vegetation-fly4"
   done
+  # Map per second across backends: every backend's missions against every backend's curve.
+  echo
+  echo "## The backends against each other"
+  /usr/bin/python3 examples/tools/backend_compare.py "$root/network" mobilenetv2-dubai erfnet-dubai ensemble-dubai
 fi

@@ -24,6 +24,7 @@ import matplotlib.image as mpimg  # noqa: E402
 
 # Per-image figure: the lawnmower images are also shown restricted to those whose footprint's
 # ground truth has at least MIN_TRUTH_SIGMA of L (per_image.csv column truth_sigma).
+from lawnmower_envelope import upper_envelope  # noqa: E402
 from per_image_table import MIN_TRUTH_SIGMA, by_gsd  # noqa: E402
 
 STYLE = {
@@ -50,23 +51,6 @@ def save(fig, path, dpi=110, tight=True):
         fig.tight_layout()
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
-
-
-def upper_envelope(points):
-    """The lawnmower curve's running maximum over time as points ((time, mIoU), sorted by time),
-    as adaptseg::upper_envelope computes it: flat after a lawnmower that a slower one does not
-    beat, back on the curve where it climbs through that level."""
-    points = sorted(points)
-    env = [points[0]]
-    best = points[0][1]
-    for (ta, ma), (tb, mb) in zip(points, points[1:]):
-        if not mb > best:
-            continue
-        if ma < best and tb > ta:
-            env.append((ta + (best - ma) / (mb - ma) * (tb - ta), best))
-        env.append((tb, mb))
-        best = mb
-    return env
 
 
 def read_csv(path):

@@ -130,7 +130,8 @@ struct EnsembleSegmentation {
 class EnsembleSegmenter {
  public:
   /// Applied to every member (classes, camera size, resampling, no-data, threads, DNN backend);
-  /// `name` is the ensemble's.
+  /// `name` is the ensemble's (ErfnetParams' default, "erfnet", becomes "ensemble"; member k is
+  /// named `name/<its folder>`).
   using Params = ErfnetParams;
 
   /// Loads every member.
