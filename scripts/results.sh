@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reproduces docs/results.md.
-#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|ensemble|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]
+#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]
 #   (default: all, one job per core)
 #
 # oracle: the paper's experiment with the ground-truth oracle, deterministic (fixed 0.1 s per
@@ -28,6 +28,9 @@
 # ensemble: field mIoU of the bundled networks and of their ensemble (examples/models/ensemble-dubai)
 #   on the same whole-field lawnmowers of tiles 4 and 6 at 5, 10 and 15 cm/px
 #   (examples/tools/eval_ensemble.py, PyTorch on the exported weights); about 2 minutes on 2 cores.
+# ensemble-split: the ensemble's runs of part network again, calibration also offered the decision
+#   input split (the members split on a class of L) to rank cells by (--cell-input), side by side
+#   with the network part's ensemble runs. Needs network; about 26 minutes on 2 cores.
 # cells: per network, tile it never trained on (4, 6) and class, how each decision input ranks the
 #   5 cm/px cells of every 15 cm/px region by the realised gain of re-mapping each alone, and how
 #   much of the achievable gain the input of the network run's model captures with 20 % of the
@@ -65,9 +68,9 @@
 set -euo pipefail
 part=${1:-all}
 jobs=${2:-$(nproc 2>/dev/null || echo 2)}
-case "$part" in all | oracle | oracle-default | paper | network | ensemble | cells | curve-check | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | \
+case "$part" in all | oracle | oracle-default | paper | network | ensemble | ensemble-split | cells | curve-check | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | \
   vertical-speed) ;;
-  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|ensemble|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]" >&2
+  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]" >&2
     exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
@@ -294,6 +297,27 @@ if [ "$part" = ensemble ]; then
   /usr/bin/python3 examples/tools/eval_ensemble.py --threads "$jobs" --bands 1,2,3 \
     --members mobilenetv2-dubai=examples/models/mobilenetv2-dubai,erfnet-dubai=examples/models/erfnet-dubai \
     --ensembles ensemble-dubai=examples/models/ensemble-dubai --json "$root/ensemble/ensemble.json"
+  exit 0
+fi
+
+if [ "$part" = ensemble-split ]; then
+  [ -d "$root/network" ] || { echo "run 'bash $0 network' first" >&2; exit 1; }
+  config=network-split
+  rm -rf "${root:?}/$config"
+  for cls in $classes; do
+    for t in 4 6; do
+      train=()
+      for k in 1 2 3 4 5 6; do [ "$k" != "$t" ] && train+=(--train "$(dubai "$k")"); done
+      run "$config" "ensemble-dubai-$cls-fly$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
+        --model-file examples/models/ensemble-dubai "${network[@]}" \
+        --cell-input sigma,boundary,ambiguity,expected_error,second_choice,split
+    done
+  done
+  wait
+  check
+  /usr/bin/python3 examples/tools/sweep_table.py \
+    "ensemble-dubai=$(ls -d "$root/network/ensemble-dubai"-*/ | sed 's:/$::' | paste -sd, -)" \
+    "with-split=$(ls -d "$root/$config"/*/ | sed 's:/$::' | paste -sd, -)"
   exit 0
 fi
 

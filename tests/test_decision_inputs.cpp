@@ -50,6 +50,22 @@ TEST_CASE("decision inputs: each per-pixel quantity on hand-computed pixels") {
     CHECK(at(v, DecisionInput::sigma) == 1.0);
     CHECK(std::isnan(at(v, DecisionInput::expected_error)));
     CHECK(std::isnan(at(v, DecisionInput::entropy)));
+    CHECK(std::isnan(at(v, DecisionInput::split)));  // no ensemble, no votes
+  }
+  {  // an ensemble's votes: members split on class 1 (0.6 / 0.4 with class 0), agree on class 2
+    const std::vector<float> p{0.45f, 0.5f, 0.05f};
+    const std::vector<float> split_votes{0.4f, 0.6f, 0.0f};
+    CHECK(at(pixel_input_values(1, p, in1, split_votes), DecisionInput::split) == 1.0);
+    CHECK(at(pixel_input_values(1, p, lut({1, 2}), split_votes), DecisionInput::split) == 1.0);  // class 2: nobody
+    CHECK(at(pixel_input_values(1, p, lut({0, 1}), split_votes), DecisionInput::split) == 2.0);
+    // All members label 1 (three thirds, summed in float): no split, whatever the probabilities say.
+    const float third = 1.0f / 3.0f;
+    const std::vector<float> agree{0.0f, third + third + third, 0.0f};
+    CHECK(at(pixel_input_values(1, p, in1, agree), DecisionInput::split) == 0.0);
+    CHECK(at(pixel_input_values(1, p, in1, agree), DecisionInput::ambiguity) == 1.0);
+    // A pixel without votes (no RGB content) has no value.
+    const std::vector<float> none{0.0f, 0.0f, 0.0f};
+    CHECK(std::isnan(at(pixel_input_values(1, p, in1, none), DecisionInput::split)));
   }
   CHECK(parse_decision_input("expected_error") == DecisionInput::expected_error);
   CHECK_THROWS_WITH_AS((void)parse_decision_input("error"), doctest::Contains("one of sigma, boundary, ambiguity"),

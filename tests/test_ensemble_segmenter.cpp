@@ -8,6 +8,7 @@
 #include "test_support.hpp"
 
 #include <adaptseg/ensemble_segmenter.hpp>
+#include <adaptseg/image_summary.hpp>
 #include <adaptseg/lawnmower_planner.hpp>
 #include <adaptseg/metrics.hpp>
 
@@ -62,8 +63,11 @@ TEST_CASE("ensemble: the mean, its labels, disagreement and class splits follow 
   const EnsembleSegmentation e = ens.segment_with_disagreement(img);
   const int nc = ens.num_classes();
   REQUIRE(e.mean.probabilities.size() == static_cast<std::size_t>(nc));
+  REQUIRE(e.mean.member_votes.size() == static_cast<std::size_t>(nc));
+  // The votes keep the probabilities' contract (what the planner and calibration check).
+  check_probabilities(e.mean.member_votes, e.mean.labels, img, nc, "votes");
   CHECK(cv::countNonZero(e.mean.labels != ens.segment(img)) == 0);
-  int bad_mean = 0, bad_label = 0, bad_dis = 0, bad_split = 0, no_data = 0, disagreeing = 0;
+  int bad_mean = 0, bad_label = 0, bad_dis = 0, bad_split = 0, bad_vote = 0, no_data = 0, disagreeing = 0;
   for (int r = 0; r < img.height_px; ++r)
     for (int x = 0; x < img.width_px; ++x) {
       const int la = sa.labels.at<std::uint8_t>(r, x), lb = sb.labels.at<std::uint8_t>(r, x);
@@ -71,7 +75,10 @@ TEST_CASE("ensemble: the mean, its labels, disagreement and class splits follow 
       const float dis = e.disagreement.at<float>(r, x);
       if (r < 30 && x < 40) {  // no RGB content: ignore label, zero probabilities and disagreement
         no_data += (le == img.ignore_label && dis == 0.0f) ? 1 : 0;
-        for (int c = 0; c < nc; ++c) bad_mean += e.mean.probabilities[static_cast<std::size_t>(c)].at<float>(r, x) != 0.0f;
+        for (int c = 0; c < nc; ++c) {
+          bad_mean += e.mean.probabilities[static_cast<std::size_t>(c)].at<float>(r, x) != 0.0f;
+          bad_vote += e.mean.member_votes[static_cast<std::size_t>(c)].at<float>(r, x) != 0.0f;
+        }
         continue;
       }
       int best = 0;
@@ -82,6 +89,8 @@ TEST_CASE("ensemble: the mean, its labels, disagreement and class splits follow 
         if (e.mean.probabilities[k].at<float>(r, x) > e.mean.probabilities[static_cast<std::size_t>(best)].at<float>(r, x)) best = c;
         const bool split = (la == c) != (lb == c);
         bad_split += (e.class_split[k].at<std::uint8_t>(r, x) == 255) != split ? 1 : 0;
+        const float want_vote = (la == c ? 0.75f : 0.0f) + (lb == c ? 0.25f : 0.0f);
+        bad_vote += std::abs(e.mean.member_votes[k].at<float>(r, x) - want_vote) > 1e-6f ? 1 : 0;
       }
       bad_label += best != le ? 1 : 0;
       const float want_dis = (la != le ? 0.75f : 0.0f) + (lb != le ? 0.25f : 0.0f);
@@ -93,10 +102,27 @@ TEST_CASE("ensemble: the mean, its labels, disagreement and class splits follow 
   CHECK(bad_label == 0);
   CHECK(bad_dis == 0);
   CHECK(bad_split == 0);
+  CHECK(bad_vote == 0);
   // Two networks trained apart do disagree on real ground, and not everywhere.
   CAPTURE(disagreeing);
   CHECK(disagreeing > 500);
   CHECK(disagreeing < img.width_px * img.height_px / 2);
+  // Decision input `split` (image_summary.hpp) from the ensemble's segmentation: for L = {water},
+  // 1 exactly where the members split on water; a single network's segmentation leaves it unknown.
+  const int water = 4;
+  const std::vector<int> l{water};
+  const std::vector<cv::Mat> planes = pixel_inputs(e.mean, l, img.ignore_label);
+  const cv::Mat& split_plane = planes[index_of(DecisionInput::split)];
+  int bad_split_input = 0;
+  for (int r = 30; r < img.height_px; ++r)
+    for (int x = 0; x < img.width_px; ++x)
+      bad_split_input += split_plane.at<float>(r, x) != ((sa.labels.at<std::uint8_t>(r, x) == water) !=
+                                                                 (sb.labels.at<std::uint8_t>(r, x) == water)
+                                                             ? 1.0f
+                                                             : 0.0f);
+  CHECK(bad_split_input == 0);
+  CHECK(cv::countNonZero(pixel_inputs(sa, l, img.ignore_label)[index_of(DecisionInput::split)] ==
+                         pixel_inputs(sa, l, img.ignore_label)[index_of(DecisionInput::split)]) == 0);  // all NaN
   // A one-member ensemble is that network: same labels and probabilities, no disagreement.
   EnsembleSegmenter one(std::vector<EnsembleMember>{{mnv2(), 2.0}}, kParams);
   const EnsembleSegmentation o = one.segment_with_disagreement(img);

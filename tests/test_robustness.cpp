@@ -479,7 +479,7 @@ TEST_CASE("robustness: calibration: backend returns a label outside the class se
 namespace {
 /// The oracle's segmentation with its probabilities broken as `fault` says.
 struct ProbabilityBreaker {
-  enum class Fault { planes, nan, sum };
+  enum class Fault { planes, nan, sum, votes };
   Fault fault;
   OracleSegmenter oracle{3};
   std::string name() const { return "breaker"; }
@@ -488,6 +488,8 @@ struct ProbabilityBreaker {
     Segmentation s = oracle.segment_with_probabilities(image);
     if (fault == Fault::planes) s.probabilities.pop_back();
     if (fault == Fault::nan) s.probabilities[0].at<float>(5, 7) = static_cast<float>(kNaN);
+    // Member votes (as an ensemble gives them) of one plane too few.
+    if (fault == Fault::votes) s.member_votes = {s.probabilities[0].clone(), s.probabilities[1].clone()};
     // The first labelled pixel's probabilities sum to 1.5.
     const cv::Mat labelled = s.labels != image.ignore_label;
     std::vector<cv::Point> at;
@@ -522,6 +524,11 @@ TEST_CASE("robustness: ranked missions: class probabilities that break the contr
                        Contains("probability nan of class 0 at pixel (x 7, y 5) is not in [0, 1]"), std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)run_adaptive_mission(f, sum, never, o, "ranked"),
                        Contains("sum to 1.5, not 1 (tolerance 0.001)"), std::invalid_argument);
+  ProbabilityBreaker votes{ProbabilityBreaker::Fault::votes};
+  CHECK_THROWS_WITH_AS((void)run_adaptive_mission(f, votes, never, o, "ranked"),
+                       Contains("segmentation backend 'breaker' (member votes) broke the segmentation contract: "
+                                "probabilities must have one plane per class (3) (got 2)"),
+                       std::invalid_argument);
   // Calibration collects the same images: the same errors.
   CHECK_THROWS_WITH_AS((void)collect_samples(f, sum, CameraModel{}, 3.0, {1.0}, f.interest(), DescentCoverage::ranked),
                        Contains("sum to 1.5"), std::invalid_argument);
@@ -532,6 +539,9 @@ TEST_CASE("robustness: ranked missions: class probabilities that break the contr
   const Image image = SimulatedSensor(f, planner.camera()).capture(w->waypoint);
   CHECK_THROWS_WITH_AS((void)planner.report(image, sum.segment_with_probabilities(image), 0.1),
                        Contains("AdaptivePlanner::report: the probabilities reported broke the segmentation contract"),
+                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)planner.report(image, votes.segment_with_probabilities(image), 0.1),
+                       Contains("AdaptivePlanner::report: the member votes reported broke the segmentation contract"),
                        std::invalid_argument);
   CHECK(planner.pending().has_value());
 }

@@ -153,6 +153,7 @@ class CachedBackend {
   static Segmentation copy(const Segmentation& s) {
     Segmentation out{s.labels.clone(), {}};
     for (const cv::Mat& p : s.probabilities) out.probabilities.push_back(p.clone());
+    for (const cv::Mat& v : s.member_votes) out.member_votes.push_back(v.clone());
     return out;
   }
 
@@ -187,22 +188,34 @@ class CachedBackend {
     return *dir_ / name;
   }
 
-  /// File: rows, cols, planes (int32), the labels (rows x cols bytes), the planes (float32).
+  /// File: kMagic, rows, cols, probability planes, member-vote planes (int32), the labels (rows x
+  /// cols bytes), the probability planes, then the vote planes (float32). Files written before
+  /// the member votes (no magic: rows, cols, planes) are read as having none.
+  static constexpr std::int32_t kMagic = 0x32475341;  // "ASG2"
+
   [[nodiscard]] std::optional<Segmentation> load(const Key& key) const {
     if (!dir_) return std::nullopt;
     std::ifstream in(file_of(key), std::ios::binary);
-    std::int32_t head[3] = {0, 0, 0};
-    if (!in.read(reinterpret_cast<char*>(head), sizeof head)) return std::nullopt;
+    std::int32_t first[3] = {0, 0, 0};
+    if (!in.read(reinterpret_cast<char*>(first), sizeof first)) return std::nullopt;
+    // head: rows, cols, probability planes, vote planes (none in the format before the votes).
+    std::int32_t head[4] = {first[0], first[1], first[2], 0};
+    if (first[0] == kMagic) {
+      head[0] = first[1];
+      head[1] = first[2];
+      if (!in.read(reinterpret_cast<char*>(head + 2), 2 * sizeof(std::int32_t))) return std::nullopt;
+    }
     const auto& [x, y, w, h, yaw, iw, ih, b, g, r] = key;
-    if (head[0] != ih || head[1] != iw || head[2] < 0 || head[2] > 255) return std::nullopt;
+    if (head[0] != ih || head[1] != iw || head[2] < 0 || head[2] > 255 || head[3] < 0 || head[3] > 255)
+      return std::nullopt;
     Segmentation s{cv::Mat(ih, iw, CV_8UC1), {}};
     if (!in.read(reinterpret_cast<char*>(s.labels.data), static_cast<std::streamsize>(s.labels.total())))
       return std::nullopt;
-    for (int k = 0; k < head[2]; ++k) {
+    for (int k = 0; k < head[2] + head[3]; ++k) {
       cv::Mat p(ih, iw, CV_32FC1);
       if (!in.read(reinterpret_cast<char*>(p.data), static_cast<std::streamsize>(p.total() * sizeof(float))))
         return std::nullopt;
-      s.probabilities.push_back(std::move(p));
+      (k < head[2] ? s.probabilities : s.member_votes).push_back(std::move(p));
     }
     return s;
   }
@@ -215,14 +228,16 @@ class CachedBackend {
     tmp += ".tmp" + std::to_string(reinterpret_cast<std::uintptr_t>(this));
     {
       std::ofstream out(tmp, std::ios::binary);
-      const std::int32_t head[3] = {s.labels.rows, s.labels.cols, static_cast<std::int32_t>(s.probabilities.size())};
+      const std::int32_t head[5] = {kMagic, s.labels.rows, s.labels.cols, static_cast<std::int32_t>(s.probabilities.size()),
+                                    static_cast<std::int32_t>(s.member_votes.size())};
       out.write(reinterpret_cast<const char*>(head), sizeof head);
       const cv::Mat labels = s.labels.isContinuous() ? s.labels : s.labels.clone();
       out.write(reinterpret_cast<const char*>(labels.data), static_cast<std::streamsize>(labels.total()));
-      for (const cv::Mat& p0 : s.probabilities) {
-        const cv::Mat p = p0.isContinuous() ? p0 : p0.clone();
-        out.write(reinterpret_cast<const char*>(p.data), static_cast<std::streamsize>(p.total() * sizeof(float)));
-      }
+      for (const auto* planes : {&s.probabilities, &s.member_votes})
+        for (const cv::Mat& p0 : *planes) {
+          const cv::Mat p = p0.isContinuous() ? p0 : p0.clone();
+          out.write(reinterpret_cast<const char*>(p.data), static_cast<std::streamsize>(p.total() * sizeof(float)));
+        }
       if (!out) return;  // a full disk costs time, not correctness
     }
     std::error_code ec;

@@ -87,7 +87,7 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
     // images' decision inputs, a descent's scene check).
     const bool probabilities = options.coverage == DescentCoverage::ranked;
     auto visit = mission.visit_without_fusion(w->waypoint, w->level, probabilities);
-    planner.report(visit.image, Segmentation{visit.labels, std::move(visit.probabilities)},
+    planner.report(visit.image, Segmentation{visit.labels, std::move(visit.probabilities), std::move(visit.member_votes)},
                    visit.record->segmentation_s, mission.elapsed_s());
     if (w->level == 0) top_only.fuse(visit.image, visit.labels);
   }

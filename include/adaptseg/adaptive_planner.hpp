@@ -237,14 +237,16 @@ class AdaptivePlanner {
   /// As the labels overload, with the class probabilities behind the labels where the caller's
   /// segmentation gives them (Segmentation; the decision inputs that need them are unknown
   /// without).
-  /// @throws std::invalid_argument as the labels overload, and for probabilities that break
-  ///         their contract (check_probabilities()).
+  /// @throws std::invalid_argument as the labels overload, and for probabilities (member votes)
+  ///         that break their contract (check_probabilities()).
   PlannerStep report(const Image& image, const Segmentation& segmentation, double segmentation_s,
                      std::optional<double> elapsed_s = std::nullopt) {
     check_report(image, elapsed_s);
     check_segmentation(segmentation.labels, image, area_.num_classes, "AdaptivePlanner::report: the labels reported");
     check_probabilities(segmentation.probabilities, segmentation.labels, image, area_.num_classes,
                         "AdaptivePlanner::report: the probabilities reported");
+    check_probabilities(segmentation.member_votes, segmentation.labels, image, area_.num_classes,
+                        "AdaptivePlanner::report: the member votes reported");
     detail::require(std::isfinite(segmentation_s) && segmentation_s >= 0.0,
                     "AdaptivePlanner::report: segmentation_s must be finite and >= 0", segmentation_s);
     return accept(image, segmentation, segmentation_s, elapsed_s);

@@ -3,7 +3,8 @@
 /// What a top-level image tells the decision about the cells a descent may re-map (beyond the
 /// paper, whose only input is the image's σ, Eq. `eq:vr`): the decision inputs, each the mean
 /// over a cell's field pixels of one per-pixel quantity of the segmentation and, where the
-/// backend gives them, its class probabilities (SegmentsWithProbabilities).
+/// backend gives them, its class probabilities (SegmentsWithProbabilities) and its members'
+/// votes (an ensemble, EnsembleSegmenter).
 ///
 /// One place per input: to add one, add its enumerator, its row of `kDecisionInputs` and its
 /// formula in `pixel_input_values()`. Everything downstream reads the table: the per-image
@@ -33,6 +34,7 @@ enum class DecisionInput : int {
   second_choice,   ///< Σ_{C ∈ L} 1[C is the second most likely class and p_C > 0.2]
   low_confidence,  ///< 1[max_C p_C < 0.6]: generic hesitation, blind to L
   entropy,         ///< −Σ_C p_C ln p_C / ln(classes): generic, blind to L
+  split,           ///< Σ_{C ∈ L} 1[0 < v_C < 1], v_C the members' vote share for C: an ensemble's members split on a class of L (beyond the paper; issue 31)
 };
 
 /// One row of the table of inputs.
@@ -41,10 +43,11 @@ struct DecisionInputInfo {
   std::string_view name;     ///< in model files, on the command line and in tables
   bool needs_probabilities;  ///< false: computed from the labels alone
   std::string_view meaning;
+  bool needs_members = false;  ///< true: needs an ensemble's member votes (Segmentation::member_votes)
 };
 
 /// Every decision input, in enum order.
-inline constexpr std::array<DecisionInputInfo, 7> kDecisionInputs{{
+inline constexpr std::array<DecisionInputInfo, 8> kDecisionInputs{{
     {DecisionInput::sigma, "sigma", false, "share of the cell labelled in L"},
     {DecisionInput::boundary, "boundary", false, "sigma (1 - sigma) of the cell"},
     {DecisionInput::ambiguity, "ambiguity", true, "share of pixels with 0.2 < p_C < 0.8 for a class C of L"},
@@ -54,6 +57,7 @@ inline constexpr std::array<DecisionInputInfo, 7> kDecisionInputs{{
      "share of pixels where a class of L is second most likely with p > 0.2"},
     {DecisionInput::low_confidence, "low_confidence", true, "share of pixels whose most likely class has p < 0.6"},
     {DecisionInput::entropy, "entropy", true, "mean normalised entropy of the class probabilities"},
+    {DecisionInput::split, "split", false, "share of pixels where an ensemble's members split on a class of L", true},
 }};
 
 inline constexpr std::size_t kDecisionInputCount = kDecisionInputs.size();
@@ -79,16 +83,25 @@ using DecisionInputValues = std::array<double, kDecisionInputCount>;
 
 /// The per-pixel quantity behind every input at one labelled pixel: `label` l, the class
 /// probabilities `p` (empty for a labels-only backend: the inputs that need them are NaN),
-/// `in_interest[c]` true for the classes of L. `boundary` holds the σ indicator (its cell value
-/// is σ(1 − σ) of the mean, cell_value()).
+/// `in_interest[c]` true for the classes of L, and an ensemble's member vote shares `votes` per
+/// class (empty for one network: `split` is NaN). `boundary` holds the σ indicator (its cell
+/// value is σ(1 − σ) of the mean, cell_value()).
 [[nodiscard]] inline std::array<float, kDecisionInputCount> pixel_input_values(int label, std::span<const float> p,
-                                                                              const std::array<bool, 256>& in_interest) {
+                                                                              const std::array<bool, 256>& in_interest,
+                                                                              std::span<const float> votes = {}) {
   constexpr float nan = std::numeric_limits<float>::quiet_NaN();
   std::array<float, kDecisionInputCount> v;
   v.fill(nan);
   const float in = label >= 0 && label < 256 && in_interest[static_cast<std::size_t>(label)] ? 1.0f : 0.0f;
   v[index_of(DecisionInput::sigma)] = in;
   v[index_of(DecisionInput::boundary)] = in;
+  float vote_sum = 0.0f, split = 0.0f;
+  for (std::size_t c = 0; c < votes.size() && c < 256; ++c) {
+    vote_sum += votes[c];
+    // Strictly between none and all (1e-4: weight shares summed in float may miss 1 by an ulp).
+    if (in_interest[c]) split += (votes[c] > 1e-4f && votes[c] < 1.0f - 1e-4f) ? 1.0f : 0.0f;
+  }
+  if (vote_sum > 0.0f) v[index_of(DecisionInput::split)] = split;  // no votes at this pixel: unknown
   const std::size_t n = p.size();
   if (n == 0) return v;
   // The two most likely classes, the probability mass, the entropy.

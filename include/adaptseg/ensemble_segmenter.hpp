@@ -30,6 +30,7 @@
 #include <opencv2/core.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -50,11 +51,13 @@ struct EnsembleMember {
 struct EnsembleSegmentation {
   /// labels: argmax of the weighted mean of the members' probabilities (ties to the lower
   /// class), the image's ignore label on pixels without RGB content; probabilities: that mean
-  /// (one CV_32FC1 plane per class; all 0 on pixels without RGB content).
+  /// (one CV_32FC1 plane per class; all 0 on pixels without RGB content); member_votes: per
+  /// class, the weight share of the members whose own label is that class (all 0 on pixels
+  /// without RGB content).
   Segmentation mean;
   /// CV_32FC1: per pixel, the weight share of the members whose own label differs from the
-  /// mean's label, in [0, 1) (a member's label that agrees with the mean's carries its weight
-  /// to agreement); 0 on pixels without RGB content.
+  /// mean's label, in [0, 1] (1 where the mean's argmax is no member's label); 0 on pixels
+  /// without RGB content.
   cv::Mat disagreement;
   /// Per class, CV_8UC1: 255 where the members split on the class (some label the pixel with
   /// it and some do not), 0 elsewhere.
@@ -207,7 +210,8 @@ class EnsembleSegmenter {
   /// @throws std::invalid_argument as ErfnetSegmenter::segment().
   [[nodiscard]] cv::Mat segment(const Image& image) { return segment_with_probabilities(image).labels; }
 
-  /// Labels and the mean probabilities (SegmentsWithProbabilities).
+  /// Labels, the mean probabilities and the member votes (SegmentsWithProbabilities; the votes
+  /// feed decision input `split`).
   /// @throws std::invalid_argument as ErfnetSegmenter::segment().
   [[nodiscard]] Segmentation segment_with_probabilities(const Image& image) {
     return run(image, false).mean;
@@ -228,19 +232,26 @@ class EnsembleSegmenter {
       if (k == 0) {
         out.mean.probabilities.resize(ncs);
         for (std::size_t c = 0; c < ncs; ++c) out.mean.probabilities[c] = s.probabilities[c] * weights_[k];
+        // Member 0's labels carry the ignore pixels (pixels without RGB content, the same for all).
+        out.mean.labels = s.labels.clone();
       } else {
         for (std::size_t c = 0; c < ncs; ++c) cv::scaleAdd(s.probabilities[c], weights_[k], out.mean.probabilities[c], out.mean.probabilities[c]);
       }
-      // Member 0's labels carry the ignore pixels (pixels without RGB content, the same for all).
-      if (k == 0) out.mean.labels = disagreement ? s.labels.clone() : s.labels;
-      if (disagreement) member_labels.push_back(std::move(s.labels));
+      member_labels.push_back(std::move(s.labels));
     }
     const cv::Size size = out.mean.probabilities.front().size();
-    // Argmax of the mean; pixels the members left without a class (no RGB content) keep the
-    // ignore label.
+    // Argmax of the mean, and the members' vote shares; pixels the members left without a class
+    // (no RGB content) keep the ignore label and no votes.
+    auto& votes = out.mean.member_votes;
+    votes.assign(ncs, cv::Mat());
+    for (auto& v : votes) v = cv::Mat::zeros(size, CV_32FC1);
     std::vector<const float*> rows(ncs);
+    std::vector<float*> vote_rows(ncs);
     for (int r = 0; r < size.height; ++r) {
-      for (std::size_t c = 0; c < ncs; ++c) rows[c] = out.mean.probabilities[c].ptr<float>(r);
+      for (std::size_t c = 0; c < ncs; ++c) {
+        rows[c] = out.mean.probabilities[c].ptr<float>(r);
+        vote_rows[c] = votes[c].ptr<float>(r);
+      }
       auto* lab = out.mean.labels.ptr<std::uint8_t>(r);
       for (int x = 0; x < size.width; ++x) {
         if (lab[x] == image.ignore_label) continue;
@@ -248,29 +259,25 @@ class EnsembleSegmenter {
         for (std::size_t c = 1; c < ncs; ++c)
           if (rows[c][x] > rows[best][x]) best = c;  // strict: ties keep the lower index
         lab[x] = static_cast<std::uint8_t>(best);
+        for (std::size_t k = 0; k < member_labels.size(); ++k) {
+          const std::uint8_t v = member_labels[k].ptr<std::uint8_t>(r)[x];
+          if (v < nc) vote_rows[v][x] += weights_[k];
+        }
       }
     }
     if (!disagreement) return out;
+    // From the votes: the weight off the mean's label, and the classes the members split on.
     out.disagreement = cv::Mat::zeros(size, CV_32FC1);
     out.class_split.assign(ncs, cv::Mat());
-    for (auto& m : out.class_split) m = cv::Mat::zeros(size, CV_8UC1);
-    std::vector<int> votes(ncs);
+    for (std::size_t c = 0; c < ncs; ++c) {
+      cv::Mat between = (votes[c] > 1e-4f) & (votes[c] < 1.0f - 1e-4f);  // as decision input `split` counts
+      out.class_split[c] = between;
+    }
     for (int r = 0; r < size.height; ++r) {
       const auto* lab = out.mean.labels.ptr<std::uint8_t>(r);
       auto* dis = out.disagreement.ptr<float>(r);
-      for (int x = 0; x < size.width; ++x) {
-        if (lab[x] >= nc) continue;  // no RGB content
-        std::fill(votes.begin(), votes.end(), 0);
-        float off = 0.0f;
-        for (std::size_t k = 0; k < member_labels.size(); ++k) {
-          const std::uint8_t v = member_labels[k].ptr<std::uint8_t>(r)[x];
-          if (v < nc) ++votes[v];
-          if (v != lab[x]) off += weights_[k];
-        }
-        dis[x] = off;
-        for (std::size_t c = 0; c < ncs; ++c)
-          if (votes[c] > 0 && votes[c] < static_cast<int>(member_labels.size())) out.class_split[c].ptr<std::uint8_t>(r)[x] = 255;
-      }
+      for (int x = 0; x < size.width; ++x)
+        if (lab[x] < nc) dis[x] = std::max(0.0f, 1.0f - votes[lab[x]].ptr<float>(r)[x]);
     }
     return out;
   }

@@ -165,6 +165,11 @@ struct Segmentation {
   /// backend's probability of each class per pixel. On a pixel with a class label they are
   /// in [0, 1] and sum to 1; on a pixel with the ignore label they are all 0 or sum to 1.
   std::vector<cv::Mat> probabilities;
+  /// Empty (one network, or a backend without members), or, from an ensemble
+  /// (EnsembleSegmenter), one CV_32FC1 plane per class of the image's size: the weight share of
+  /// the members whose own label is that class. Same value contract as `probabilities`; where a
+  /// class's share lies strictly between 0 and 1 the members split on it (decision input `split`).
+  std::vector<cv::Mat> member_votes{};
 };
 
 /// Checks `probabilities` of a segmentation of `image` with `labels` (already checked by

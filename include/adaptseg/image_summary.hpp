@@ -22,19 +22,24 @@ namespace adaptseg {
 
 /// The per-pixel quantity behind each decision input over a camera frame: one CV_32FC1 plane
 /// per input (kDecisionInputs' order) of the segmentation's size; NaN on pixels with the ignore
-/// label, and everywhere for inputs that need probabilities when `segmentation` has none.
+/// label, and everywhere for inputs that need probabilities (member votes) when `segmentation`
+/// has none.
 /// `boundary`'s plane holds the σ indicator (its cell value is σ(1 − σ) of the mean;
 /// cell_inputs()).
-/// @throws std::invalid_argument for labels that are not CV_8UC1 or probabilities that are not
-///         CV_32FC1 planes of the labels' size.
+/// @throws std::invalid_argument for labels that are not CV_8UC1 or probabilities (member votes)
+///         that are not CV_32FC1 planes of the labels' size.
 [[nodiscard]] inline std::vector<cv::Mat> pixel_inputs(const Segmentation& segmentation, std::span<const int> interest,
                                                        int ignore_label) {
   const cv::Mat& labels = segmentation.labels;
   detail::require(labels.type() == CV_8UC1, "pixel_inputs: labels must be CV_8UC1", labels.type());
   const auto& probs = segmentation.probabilities;
+  const auto& votes = segmentation.member_votes;
   for (const cv::Mat& p : probs)
     detail::require(p.type() == CV_32FC1 && p.size() == labels.size(),
                     "pixel_inputs: probabilities must be CV_32FC1 planes of the labels' size", p.cols);
+  for (const cv::Mat& v : votes)
+    detail::require(v.type() == CV_32FC1 && v.size() == labels.size(),
+                    "pixel_inputs: member votes must be CV_32FC1 planes of the labels' size", v.cols);
   std::vector<cv::Mat> planes;
   for (std::size_t k = 0; k < kDecisionInputCount; ++k)
     planes.emplace_back(labels.size(), CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
@@ -44,15 +49,20 @@ namespace adaptseg {
   const std::size_t n = probs.size();
   std::vector<const float*> p_row(n);
   std::vector<float> p(n);
+  const std::size_t nv = votes.size();
+  std::vector<const float*> v_row(nv);
+  std::vector<float> vote(nv);
   std::array<float*, kDecisionInputCount> out{};
   for (int y = 0; y < labels.rows; ++y) {
     for (std::size_t k = 0; k < kDecisionInputCount; ++k) out[k] = planes[k].ptr<float>(y);
     for (std::size_t c = 0; c < n; ++c) p_row[c] = probs[c].ptr<float>(y);
+    for (std::size_t c = 0; c < nv; ++c) v_row[c] = votes[c].ptr<float>(y);
     const auto* l_row = labels.ptr<unsigned char>(y);
     for (int x = 0; x < labels.cols; ++x) {
       if (l_row[x] == ignore_label) continue;
       for (std::size_t c = 0; c < n; ++c) p[c] = p_row[c][x];
-      const auto v = pixel_input_values(l_row[x], p, in_l);
+      for (std::size_t c = 0; c < nv; ++c) vote[c] = v_row[c][x];
+      const auto v = pixel_input_values(l_row[x], p, in_l, vote);
       for (std::size_t k = 0; k < kDecisionInputCount; ++k) out[k][x] = v[k];
     }
   }

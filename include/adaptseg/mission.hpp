@@ -105,6 +105,9 @@ class Mission {
     const WaypointRecord* record;
     /// The backend's class probabilities, if asked for and given (SegmentsWithProbabilities).
     std::vector<cv::Mat> probabilities{};
+    /// An ensemble's member votes, with the probabilities where it gives them
+    /// (Segmentation::member_votes).
+    std::vector<cv::Mat> member_votes{};
   };
 
   /// Flies to `w`, takes and segments the image, fuses it into the map and records it.
@@ -126,6 +129,7 @@ class Mission {
       Segmentation s = segment_with_probabilities_checked(backend_, v.image, sensor_.field().num_classes());
       v.labels = std::move(s.labels);
       v.probabilities = std::move(s.probabilities);
+      v.member_votes = std::move(s.member_votes);
     } else {
       v.labels = backend_.segment(v.image);
     }

@@ -50,7 +50,8 @@ concept SegmentationBackend = SegmentsImages<B> && NamedBackend<B>;
 ///
 /// Contract, beyond SegmentationBackend's: the labels equal `segment(image)`'s; `probabilities`
 /// holds one CV_32FC1 plane per class of the image's size, in [0, 1], summing to 1 on every
-/// labelled pixel (0 or 1 on ignore pixels; check_probabilities()). Same image, same output.
+/// labelled pixel (0 or 1 on ignore pixels; check_probabilities()); `member_votes`, where an
+/// ensemble gives them, likewise. Same image, same output.
 template <typename B>
 concept SegmentsWithProbabilities = requires(B& backend, const Image& image) {
   { backend.segment_with_probabilities(image) } -> std::same_as<Segmentation>;
@@ -80,6 +81,7 @@ template <SegmentationBackend B>
     const std::string who = "segmentation backend '" + std::string(backend.name()) + "'";
     check_segmentation(s.labels, image, num_classes, who);
     check_probabilities(s.probabilities, s.labels, image, num_classes, who);
+    check_probabilities(s.member_votes, s.labels, image, num_classes, who + " (member votes)");
     return s;
   } else {
     return {segment_checked(backend, image, num_classes), {}};
