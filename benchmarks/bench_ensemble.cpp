@@ -6,38 +6,20 @@
 //
 //   bench_ensemble ENSEMBLE_DIR FIELD_DIR [--threads N] [--rounds R] [--iters K]
 //
-// Prints a markdown table row per backend: name, threads, median and min [ms].
+// Prints a markdown table row per backend: name, threads, median [ms].
+
+#include "bench_timing.hpp"
 
 #include <adaptseg/ensemble_segmenter.hpp>
 #include <adaptseg/lawnmower_planner.hpp>
 #include <adaptseg/simulated_sensor.hpp>
 
-#include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <exception>
 #include <iostream>
 #include <string>
 #include <vector>
 
-namespace {
-
-template <typename F>
-void time_into(std::vector<double>& out, F&& f, int iters) {
-  for (int i = 0; i < iters; ++i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    f();
-    out.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  }
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 3) {
@@ -70,11 +52,17 @@ int main(int argc, char** argv) {
     std::vector<double> ens_ms, dis_ms;
     for (auto& m : members) (void)m.segment(image);  // warm-up
     (void)ensemble.segment_with_disagreement(image);
+    // Rounds interleave the backends; each round's times join the backend's sample.
+    const auto time_into = [&](std::vector<double>& sample, auto&& f) {
+      const std::vector<double> t = adaptseg::bench::time_ms(f, 0, iters);
+      sample.insert(sample.end(), t.begin(), t.end());
+    };
     for (int r = 0; r < rounds; ++r) {
-      for (std::size_t k = 0; k < members.size(); ++k) time_into(member_ms[k], [&] { (void)members[k].segment(image); }, iters);
-      time_into(ens_ms, [&] { (void)ensemble.segment(image); }, iters);
-      time_into(dis_ms, [&] { (void)ensemble.segment_with_disagreement(image); }, iters);
+      for (std::size_t k = 0; k < members.size(); ++k) time_into(member_ms[k], [&] { (void)members[k].segment(image); });
+      time_into(ens_ms, [&] { (void)ensemble.segment(image); });
+      time_into(dis_ms, [&] { (void)ensemble.segment_with_disagreement(image); });
     }
+    const auto median = [](const std::vector<double>& v) { return adaptseg::bench::stats(v).median; };
     for (std::size_t k = 0; k < members.size(); ++k)
       std::printf("| %s (member) | %d | %.1f |\n", ensemble.member_list()[k].model_dir.filename().c_str(), threads,
                   median(member_ms[k]));

@@ -10,6 +10,8 @@
 // Prints one JSON object: {"threads": N, "iters": K, "input": [H, W], "camera": [H, W],
 // "forward_ms": {"median", "min", "max"}, "segment_ms": {...}, "opencv": "4.6.0"}.
 
+#include "bench_timing.hpp"
+
 #include <adaptseg/erfnet_segmenter.hpp>
 
 #include <opencv2/core.hpp>
@@ -26,30 +28,9 @@
 
 namespace {
 
-struct Stats {
-  double median = 0.0, min = 0.0, max = 0.0;
-};
-
-Stats stats(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  const double med = n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-  return {med, v.front(), v.back()};
-}
-
-template <typename F>
-std::vector<double> time_ms(F&& f, int warmup, int iters) {
-  for (int i = 0; i < warmup; ++i) f();
-  std::vector<double> out;
-  out.reserve(static_cast<std::size_t>(iters));
-  for (int i = 0; i < iters; ++i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    f();
-    const auto t1 = std::chrono::steady_clock::now();
-    out.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
-  }
-  return out;
-}
+using adaptseg::bench::Stats;
+using adaptseg::bench::stats;
+using adaptseg::bench::time_ms;
 
 void print_stats(const char* key, const Stats& s) {
   std::printf("\"%s\": {\"median\": %.3f, \"min\": %.3f, \"max\": %.3f}", key, s.median, s.min, s.max);

@@ -15,7 +15,6 @@ flying NET beats anything the other backend can fly in the same time. A last tab
 for the lawnmowers themselves: each NET's lawnmower at each GSD against the best other NET's
 curve at its time.
 """
-import csv
 import os
 import statistics
 import sys
@@ -23,11 +22,7 @@ from collections import defaultdict
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from lawnmower_envelope import envelope_at, upper_envelope  # noqa: E402
-
-
-def read(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
+from sweep_table import read_csv  # noqa: E402
 
 
 def main():
@@ -41,7 +36,7 @@ def main():
             if name.startswith(net + "-") and os.path.isfile(path):
                 case = name[len(net) + 1:]
                 if "-fly" in case and not any(n != net and name.startswith(n + "-") and len(n) > len(net) for n in nets):
-                    runs[case][net] = read(path)
+                    runs[case][net] = read_csv(path)
     cases = [c for c in sorted(runs) if all(n in runs[c] and any(r["strategy"] == "adaptive" for r in runs[c][n])
                                             for n in nets)]
     if not cases:

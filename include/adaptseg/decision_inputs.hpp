@@ -81,6 +81,11 @@ using DecisionInputValues = std::array<double, kDecisionInputCount>;
   throw std::invalid_argument("decision input must be one of " + all + ", not '" + std::string(name) + "'");
 }
 
+/// Member vote shares within this of 0 or 1 count as none or all of the members (weight shares
+/// summed in float may miss 1 by an ulp): where a class's share lies strictly inside, the members
+/// split on it (input `split`, EnsembleSegmentation::class_split).
+inline constexpr float kVoteShareTolerance = 1e-4f;
+
 /// The per-pixel quantity behind every input at one labelled pixel: `label` l, the class
 /// probabilities `p` (empty for a labels-only backend: the inputs that need them are NaN),
 /// `in_interest[c]` true for the classes of L, and an ensemble's member vote shares `votes` per
@@ -98,8 +103,8 @@ using DecisionInputValues = std::array<double, kDecisionInputCount>;
   float vote_sum = 0.0f, split = 0.0f;
   for (std::size_t c = 0; c < votes.size() && c < 256; ++c) {
     vote_sum += votes[c];
-    // Strictly between none and all (1e-4: weight shares summed in float may miss 1 by an ulp).
-    if (in_interest[c]) split += (votes[c] > 1e-4f && votes[c] < 1.0f - 1e-4f) ? 1.0f : 0.0f;
+    if (in_interest[c])
+      split += (votes[c] > kVoteShareTolerance && votes[c] < 1.0f - kVoteShareTolerance) ? 1.0f : 0.0f;
   }
   if (vote_sum > 0.0f) v[index_of(DecisionInput::split)] = split;  // no votes at this pixel: unknown
   const std::size_t n = p.size();

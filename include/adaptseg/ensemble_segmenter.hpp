@@ -22,6 +22,7 @@
 /// @endcode
 
 #include <adaptseg/camera.hpp>
+#include <adaptseg/decision_inputs.hpp>
 #include <adaptseg/erfnet_segmenter.hpp>
 #include <adaptseg/error.hpp>
 #include <adaptseg/field.hpp>
@@ -170,8 +171,8 @@ class EnsembleSegmenter {
       }
       if (members_.back().classes() != members_.front().classes())
         throw std::invalid_argument("EnsembleSegmenter: " + member_label(k) + " has classes " +
-                                    list(members_.back().classes()) + ", " + member_label(0) + " has " +
-                                    list(members_.front().classes()) + "; members must share one class set");
+                                    detail::class_list(members_.back().classes()) + ", " + member_label(0) + " has " +
+                                    detail::class_list(members_.front().classes()) + "; members must share one class set");
     }
   }
 
@@ -270,8 +271,7 @@ class EnsembleSegmenter {
     out.disagreement = cv::Mat::zeros(size, CV_32FC1);
     out.class_split.assign(ncs, cv::Mat());
     for (std::size_t c = 0; c < ncs; ++c) {
-      cv::Mat between = (votes[c] > 1e-4f) & (votes[c] < 1.0f - 1e-4f);  // as decision input `split` counts
-      out.class_split[c] = between;
+      out.class_split[c] = (votes[c] > kVoteShareTolerance) & (votes[c] < 1.0f - kVoteShareTolerance);
     }
     for (int r = 0; r < size.height; ++r) {
       const auto* lab = out.mean.labels.ptr<std::uint8_t>(r);
@@ -290,12 +290,6 @@ class EnsembleSegmenter {
     std::error_code ea, eb;
     const auto ca = std::filesystem::weakly_canonical(a, ea), cb = std::filesystem::weakly_canonical(b, eb);
     return (ea || eb) ? a.lexically_normal() == b.lexically_normal() : ca == cb;
-  }
-
-  static std::string list(const std::vector<std::string>& v) {
-    std::string s;
-    for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
-    return "[" + s + "]";
   }
 
   Params params_;

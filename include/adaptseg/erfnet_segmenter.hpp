@@ -31,6 +31,15 @@
 
 namespace adaptseg {
 
+namespace detail {
+/// Class names as "[a, b, c]", for messages about class sets.
+inline std::string class_list(const std::vector<std::string>& classes) {
+  std::string s;
+  for (const auto& x : classes) s += (s.empty() ? "" : ", ") + x;
+  return "[" + s + "]";
+}
+}  // namespace detail
+
 /// What a model's metadata YAML (model.yaml) says; read by ErfnetSegmenter.
 struct ErfnetModelInfo {
   std::vector<std::string> classes;  ///< class names, label-index order
@@ -370,20 +379,12 @@ class ErfnetSegmenter {
 
   void check_classes(const std::filesystem::path& file) const {
     if (params_.expected_classes.empty()) return;
-    const auto list = [](const std::vector<std::string>& v) {
-      std::string s;
-      for (const auto& x : v) {
-        if (!s.empty()) s += ", ";
-        s += x;
-      }
-      return "[" + s + "]";
-    };
     if (params_.expected_classes != info_.classes)
       throw std::invalid_argument(
           "ErfnetSegmenter: " + file.string() + ": the model's " +
-          std::to_string(info_.classes.size()) + " classes " + list(info_.classes) +
+          std::to_string(info_.classes.size()) + " classes " + detail::class_list(info_.classes) +
           " differ from the " + std::to_string(params_.expected_classes.size()) +
-          " expected classes " + list(params_.expected_classes));
+          " expected classes " + detail::class_list(params_.expected_classes));
   }
 
   /// Throws unless images of `size` can be fed to the network.
