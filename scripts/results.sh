@@ -107,6 +107,13 @@ run() {
   fi
 }
 dubai() { echo examples/data/dubai-tile-$1; }
+# The --train arguments of every Dubai tile but tile $1 (leave one out), into the array `train`.
+train_except() {
+  local k
+  train=()
+  for k in 1 2 3 4 5 6; do [ "$k" != "$1" ] && train+=(--train "$(dubai "$k")"); done
+  return 0
+}
 # After `wait`: every launched run must have written its results.
 check() {
   local bad=0
@@ -122,8 +129,7 @@ sweep_dubai() {
   shift
   for cls in $classes; do
     for t in 1 2 3 4 5 6; do
-      train=()
-      for k in 1 2 3 4 5 6; do [ "$k" != "$t" ] && train+=(--train "$(dubai "$k")"); done
+      train_except "$t"
       run "$config" "dubai-$cls-tile-$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" "$@"
     done
   done
@@ -180,7 +186,7 @@ if [ "$part" = z-choice ]; then
         local cls=${name#dubai-} t=${name##*-}
         cls=${cls%%-*}
         interest=(--interest "$cls")
-        for k in 1 2 3 4 5 6; do [ "$k" != "$t" ] && train+=(--train "$(dubai "$k")"); done
+        train_except "$t"  # the caller's local train
         test=(--test "$(dubai "$t")")
         ;;
     esac
@@ -242,8 +248,7 @@ if [ "$part" = previous ]; then
   for net in erfnet-dubai mobilenetv2-dubai; do
     for cls in $classes; do
       for t in 4 6; do
-        train=()
-        for k in 1 2 3 4 5 6; do [ "$k" != "$t" ] && train+=(--train "$(dubai "$k")"); done
+        train_except "$t"
         run network-previous "$net-$cls-fly$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
           --model-file "examples/models/$net" "${network[@]}" "${previous[@]}"
       done
@@ -306,8 +311,7 @@ if [ "$part" = ensemble-split ]; then
   rm -rf "${root:?}/$config"
   for cls in $classes; do
     for t in 4 6; do
-      train=()
-      for k in 1 2 3 4 5 6; do [ "$k" != "$t" ] && train+=(--train "$(dubai "$k")"); done
+      train_except "$t"
       run "$config" "ensemble-dubai-$cls-fly$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
         --model-file examples/models/ensemble-dubai "${network[@]}" \
         --cell-input sigma,boundary,ambiguity,expected_error,second_choice,split
@@ -370,8 +374,7 @@ if [ "$part" = all ] || [ "$part" = network ]; then
   for net in $nets; do
     for cls in $classes; do
       for t in 4 6; do
-        train=()
-        for k in 1 2 3 4 5 6; do [ "$k" != "$t" ] && train+=(--train "$(dubai "$k")"); done
+        train_except "$t"
         run network "$net-$cls-fly$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
           --model-file "examples/models/$net" "${network[@]}"
       done
