@@ -317,6 +317,17 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
   old.erase(at, old.find('\n', at) + 1 - at);
   std::ofstream(tmp.path() / "old.yaml") << old;
   CHECK(rule_of(DecisionModel::load(tmp.path() / "old.yaml")).sigma_prior_sd == 0.0);
+  CHECK_FALSE(rule_of(back).field_curve);
+  CHECK_FALSE(rule_of(back).curve_ratio);
+  // The lawnmower curve's kind is kept (files without the keys: the training fields' curves).
+  DecisionModel corrected = model;
+  auto& policy = std::get<FrontAwarePolicy>(corrected.decision_function.rule());
+  FrontAwarePolicy::Params p = policy.params();
+  p.field_curve = p.curve_ratio = true;
+  policy.set_params(p);
+  corrected.save(tmp.path() / "corrected.yaml");
+  CHECK(rule_of(DecisionModel::load(tmp.path() / "corrected.yaml")).field_curve);
+  CHECK(rule_of(DecisionModel::load(tmp.path() / "corrected.yaml")).curve_ratio);
   // Fields of another class set are refused.
   const Field other("o", 1.0, a.labels(), {{"a", {0, 0, 0}}, {"b", {1, 1, 1}}, {"c", {2, 2, 2}}}, {1});
   const std::vector<Field> mixed{a, other};

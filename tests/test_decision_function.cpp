@@ -488,6 +488,45 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
       CHECK(p.decide(here).descend == (elsewhere < 0.01));
     }
   }
+  SUBCASE("the field curve corrected by the training fields' real rise") {
+    // A training field that looks like this one (σ 0.2, input 0.1): its real curve rises 0.2 to
+    // 1 cm/px, the cell model predicts β·0.1/0.2. Corrected, the predicted curve is that field's
+    // real one whatever β: the descent is weighed as against the training curve, while the
+    // uncorrected field curve weighs it as if flying lower gained β/2.
+    const std::vector<ReferenceCurve> alike{{"a", {{1.0, 0.95}, {3.0, 0.75}}, 0.2, 0.1}};
+    for (double beta : {0.5, 1.0}) {
+      FrontAwarePolicy training(with_cells(beta), alike, {});
+      FrontAwarePolicy corrected(with_cells(beta), alike, {.field_curve = true, .curve_ratio = true});
+      FrontAwarePolicy field(with_cells(beta), alike, {.field_curve = true});
+      const Decision t = training.decide(s.region(0, 0.1));
+      const Decision c = corrected.decide(s.region(0, 0.1));
+      const Decision f = field.decide(s.region(0, 0.1));
+      REQUIRE(t.scores.size() == 2);
+      for (std::size_t k = 0; k < 2; ++k) {
+        CHECK(c.scores[k].predicted_front_margin == doctest::Approx(t.scores[k].predicted_front_margin));
+        CHECK(f.scores[k].predicted_front_margin != doctest::Approx(t.scores[k].predicted_front_margin));
+      }
+      CHECK(c.descend == t.descend);
+    }
+    // Two training fields whose real rise differs (a quarter and three quarters of the
+    // prediction) weigh a descent as one field of their mean ratio does, but their spread makes
+    // the lower bound more cautious. Cells of input 0.4 in a field of 0.1.
+    const CellScenario rich(0.4);
+    const std::vector<ReferenceCurve> two{{"a", {{1.0, 0.875}, {3.0, 0.75}}, 0.2, 0.1},
+                                          {"b", {{1.0, 1.125}, {3.0, 0.75}}, 0.2, 0.1}};
+    const std::vector<ReferenceCurve> mean{{"m", {{1.0, 1.0}, {3.0, 0.75}}, 0.2, 0.1}};
+    const FrontAwarePolicy::Params p{
+        .confidence = 1.5, .scale_prior_sd = 0.01, .field_curve = true, .curve_ratio = true};
+    FrontAwarePolicy spread(with_cells(1.0), two, p);
+    FrontAwarePolicy single(with_cells(1.0), mean, p);
+    FrontAwarePolicy uncorrected(with_cells(1.0), mean, {.confidence = 1.5, .scale_prior_sd = 0.01, .field_curve = true});
+    const Decision a = spread.decide(rich.region(0, 0.1));
+    const Decision b = single.decide(rich.region(0, 0.1));
+    CHECK(a.scores[1].predicted_front_margin == doctest::Approx(b.scores[1].predicted_front_margin));
+    CHECK(b.descend);
+    CHECK_FALSE(a.descend);
+    CHECK_FALSE(uncorrected.decide(rich.region(0, 0.1)).descend);  // the prediction: flying lower pays
+  }
   // A flatter training curve (0.05 over 145 s): the cells' descents are worth their time.
   const std::vector<ReferenceCurve> flat{{"a", {{1.0, 0.80}, {3.0, 0.75}}, 0.2, 0.05}};
   SUBCASE("the scene check: a finer look less sure than the coarse one stops the descents") {

@@ -205,9 +205,10 @@ struct CalibrationCli {
             ->delimiter(','),
         app.add_option("--curve", curve,
                        "front-aware rule with --coverage ranked: the lawnmower curve a descent is compared with, "
-                       "the training fields' (training) or this field's as the cell gain model predicts it from "
-                       "the top-level images (field)")
-            ->check(CLI::IsMember({"training", "field"}))
+                       "the training fields' (training), this field's as the cell gain model predicts it from "
+                       "the top-level images (field), or that prediction scaled per training field by its real "
+                       "lawnmowers' rise against the predicted one (corrected)")
+            ->check(CLI::IsMember({"training", "field", "corrected"}))
             ->capture_default_str(),
         app.add_option("--gain-inputs", gain_inputs,
                        "what the GP I predicts the accuracy gain from: delta-sigma (the paper's) or "
@@ -249,7 +250,8 @@ struct CalibrationCli {
                           : sigma_prior == "estimated" ? CalibrationOptions::SigmaPriorSource::estimated
                                                        : CalibrationOptions::SigmaPriorSource::given;
     options.adaptive.coverage = parse_descent_coverage(coverage);
-    options.front_aware.field_curve = curve == "field";
+    options.front_aware.field_curve = curve == "field" || curve == "corrected";
+    options.front_aware.curve_ratio = curve == "corrected";
     options.cell_inputs.clear();
     for (const auto& name : cell_inputs) options.cell_inputs.push_back(parse_decision_input(name));
     options.fit.gain_inputs = gain_inputs == "delta-sigma-height" ? GainModel::GainInputs::delta_sigma_and_height

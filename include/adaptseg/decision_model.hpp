@@ -310,6 +310,7 @@ struct DecisionModel {
             e << YAML::Key << "sigma_prior_weight" << YAML::Value << num(p.sigma_prior_weight);
             e << YAML::Key << "sigma_prior_sd" << YAML::Value << num(p.sigma_prior_sd);
             if (p.field_curve) e << YAML::Key << "field_curve" << YAML::Value << detail::flag_text(true);
+            if (p.curve_ratio) e << YAML::Key << "curve_ratio" << YAML::Value << detail::flag_text(true);
             e << YAML::Key << "reference" << YAML::Value << YAML::BeginSeq;
             for (const auto& r : rule.reference()) {
               std::vector<double> g, m;
@@ -492,7 +493,8 @@ struct DecisionModel {
                                                   .sigma_prior_sd = rule.has("sigma_prior_sd")
                                                                         ? rule.number("sigma_prior_sd")
                                                                         : 0.0,
-                                                  .field_curve = rule.has("field_curve") && rule.flag("field_curve")}));
+                                                  .field_curve = rule.has("field_curve") && rule.flag("field_curve"),
+                                                  .curve_ratio = rule.has("curve_ratio") && rule.flag("curve_ratio")}));
       }
       if (kind == "utility")
         return DecisionFunction(UtilityPolicy(std::move(model), {.min_sigma = min_sigma,

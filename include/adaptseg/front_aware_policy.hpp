@@ -99,6 +99,16 @@ class FrontAwarePolicy {
     /// taken from the training fields' curves. The field factor s and σ̂ then scale the descent's
     /// gain and the curve's rise alike.
     bool field_curve = false;
+    /// With `field_curve`: the predicted curve corrected by what the training fields' real
+    /// lawnmowers did. For each training field f and lawnmower GSD g, its real rise from the top
+    /// GSD against the rise the cell gain model predicts for it, r_f = (D_f(g) − D_f(top)) /
+    /// (β(top, g)·X_f / σ_f), clamped to [1/4, 4] (1 where f's X_f or σ_f is unknown or nothing is
+    /// predicted), scales this field's predicted rise to g: one curve per training field, their
+    /// mean the curve a descent is compared with and their spread the sd_D of the lower bound
+    /// (see the class comment). Single cells re-mapped alone inside a coarse map, which the model
+    /// is fitted on, predict a network's lawnmower poorly: it re-maps every cell with its
+    /// neighbours (docs/results.md, "The field curve against the real ones").
+    bool curve_ratio = false;
 
     /// @throws std::invalid_argument naming the field.
     void validate() const {
@@ -207,7 +217,11 @@ class FrontAwarePolicy {
     // The predicted curve's mIoU relative to the top level's (field_curve) or absolute.
     double curve_level = 0.0;
     if (params_.field_curve && model_.cells() && c.region_share > 0.0 && weight > 0.0) {
-      curves = {field_curve(c, weight / c.region_share)};
+      curves.clear();
+      if (params_.curve_ratio)
+        for (const auto& r : reference_) curves.push_back(field_curve(c, weight / c.region_share, &r));
+      else
+        curves.push_back(field_curve(c, weight / c.region_share, nullptr));
       curve_level = mean_top_miou(c);
     }
 
@@ -361,8 +375,10 @@ class FrontAwarePolicy {
   /// relative to the top level's mIoU: at each lawnmower GSD g finer than the top level,
   /// s·β(top, g)·X̂·(1 / σ̂), X̂ the field's mean input (seen so far, the unseen part shrunk towards
   /// the training fields' mean with σ̂'s weight k), `inv_sigma` = 1 / σ̂; 0 at the top level; its
-  /// upper envelope.
-  [[nodiscard]] std::vector<CurvePoint> field_curve(const DecisionContext& c, double inv_sigma) const {
+  /// upper envelope. With a training field `corrected_by`, each rise times that field's real /
+  /// predicted rise (Params::curve_ratio).
+  [[nodiscard]] std::vector<CurvePoint> field_curve(const DecisionContext& c, double inv_sigma,
+                                                    const ReferenceCurve* corrected_by) const {
     const double k = params_.sigma_prior_weight;
     const double unseen = std::max(0.0, 1.0 - seen_input_share_);
     const double rest = prior_input_ > 0.0 ? (seen_input_ + k * prior_input_) / (seen_input_share_ + k)
@@ -373,9 +389,20 @@ class FrontAwarePolicy {
     for (const auto& l : c.lawnmowers) {
       if (l.gsd_cm > c.top_gsd_cm) continue;  // coarser than the top level: not what it compares with
       const double slope = l.gsd_cm < c.top_gsd_cm ? model_.cells()->at(c.top_gsd_cm, l.gsd_cm).gain_slope : 0.0;
-      curve.push_back({l.time_s, scale_mean_ * slope * x * inv_sigma});
+      const double ratio = corrected_by ? rise_ratio(*corrected_by, c.top_gsd_cm, l.gsd_cm, slope) : 1.0;
+      curve.push_back({l.time_s, scale_mean_ * slope * x * inv_sigma * ratio});
     }
     return upper_envelope(std::move(curve));
+  }
+
+  /// Params::curve_ratio's r_f: training field `r`'s real lawnmower rise from GSD `top` to `g`
+  /// over the one the cell gain model predicts for it, slope·X_f / σ_f; clamped to [1/4, 4];
+  /// 1 where nothing is predicted.
+  static double rise_ratio(const ReferenceCurve& r, double top, double g, double slope) {
+    const double predicted = r.field_sigma > 0.0 ? slope * r.field_input / r.field_sigma : 0.0;
+    if (!(predicted > 0.0)) return 1.0;
+    const double real = miou_at_gsd(r.points, g) - miou_at_gsd(r.points, top);
+    return std::clamp(real / predicted, 0.25, 4.0);
   }
 
   /// a / σ̂: a relabelled share of the region, times η, as a field-level gain; and Var σ̂ / σ̂²
