@@ -235,6 +235,22 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
     CHECK(back_cells.points()[k].gain_slope == cells->points()[k].gain_slope);
     CHECK(back_cells.points()[k].relabel_noise == cells->points()[k].relabel_noise);
   }
+  // Each training field's mean input at both top levels: the nominal one's is field_input, and
+  // the finer top level's map has less wrong (the oracle's expected error is its share of
+  // wrong pixels), so less of it. The file keeps both.
+  const auto& reference = std::get<FrontAwarePolicy>(cal.decision_function.rule()).reference();
+  const auto& back_reference = std::get<FrontAwarePolicy>(back.decision_function.rule()).reference();
+  REQUIRE(back_reference.size() == reference.size());
+  for (std::size_t f = 0; f < reference.size(); ++f) {
+    const ReferenceCurve& r = reference[f];
+    REQUIRE(r.top_inputs.size() == 2);
+    CHECK(r.input_at(3.0) == r.field_input);
+    CHECK(r.field_input > 0.0);
+    CHECK(r.input_at(2.0) > 0.0);
+    CHECK(r.input_at(2.0) < r.input_at(3.0));
+    CHECK(back_reference[f].input_at(2.0) == doctest::Approx(r.input_at(2.0)));
+    CHECK(back_reference[f].input_at(3.0) == doctest::Approx(r.input_at(3.0)));
+  }
   const AdaptiveOptions ao = back.adaptive_options(MissionOptions{});
   CHECK(ao.coverage == DescentCoverage::ranked);
   CHECK(ao.cell_input == cells->input());

@@ -507,6 +507,15 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
         CHECK(f.scores[k].predicted_front_margin != doctest::Approx(t.scores[k].predicted_front_margin));
       }
       CHECK(c.descend == t.descend);
+      // The training field's input at this top level is what counts: a file that gives it per
+      // top level (here 0.1 at 3 cm/px, another nominal top's 0.3) reads the same.
+      ReferenceCurve by_top = alike.front();
+      by_top.field_input = 0.3;
+      by_top.top_inputs = {{1.5, 0.3}, {3.0, 0.1}};
+      FrontAwarePolicy per_top(with_cells(beta), {by_top}, {.field_curve = true, .curve_ratio = true});
+      const Decision pt = per_top.decide(s.region(0, 0.1));
+      for (std::size_t k = 0; k < 2; ++k)
+        CHECK(pt.scores[k].predicted_front_margin == doctest::Approx(t.scores[k].predicted_front_margin));
     }
     // Two training fields whose real rise differs (a quarter and three quarters of the
     // prediction) weigh a descent as one field of their mean ratio does, but their spread makes

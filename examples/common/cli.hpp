@@ -180,7 +180,7 @@ struct CalibrationCli {
   std::string sigma_prior = "given";
   std::optional<double> segmentation_time_s;
   std::vector<std::string> cell_inputs;
-  std::string curve = "field";
+  std::string curve = "corrected";
 
   void add_to(CLI::App& app) {
     options_ = {

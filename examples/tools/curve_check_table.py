@@ -7,7 +7,8 @@ With `--curve field` the front-aware rule weighs a descent against the rise of t
 lawnmower curve as the cell gain model predicts it: from the top-level GSD t to a lawnmower
 GSD g, the field mIoU rises by beta(t, g) * X / sigma (FrontAwarePolicy::field_curve, with the
 field factor s = 1; X the field's mean decision input, sigma its share of L). Each run's
-model.yaml holds the slopes beta and, for every training field, X (`field_input`), sigma
+model.yaml holds the slopes beta and, for every training field, X (`top_input` per top-level GSD,
+or `field_input`, the nominal top's, in models before it), sigma
 (`field_sigma`) and its real lawnmower curve (`miou` per `gsd_cm`). For every (top, g) pair of
 the slopes this prints the mean predicted and real rise over the training fields of all runs of
 a label, and their ratio: above 1 the model predicts too little for flying lower (a descent
@@ -31,11 +32,14 @@ def rises(run_dirs):
         beta = {(t, g): b for t, g, b in zip(cells["top_gsd_cm"], cells["sub_gsd_cm"], cells["gain_slope"])}
         for ref in model["rule"]["reference"]:
             curve = dict(zip(ref["gsd_cm"], ref["miou"]))
-            x, sigma = ref["field_input"], ref["field_sigma"]
+            sigma = ref["field_sigma"]
             if not sigma > 0:
                 continue
+            # X at each top level (models before top_input: field_input, the nominal top's, at every top)
+            x_at = dict(zip(ref.get("top_input_gsd_cm", []), ref.get("top_input", [])))
             for (t, g), b in beta.items():
                 if t in curve and g in curve:
+                    x = x_at.get(t, ref["field_input"])
                     out.setdefault((t, g), []).append((b * x / sigma, curve[g] - curve[t]))
     return out
 

@@ -351,15 +351,20 @@ template <SegmentationBackend Backend>
   model.set_refit_every(options.refit_every);
   if (ranked) {
     model.set_cells(CellGainModel::fit(cell_samples, adaptive.cell_input));
-    // Each training field's mean input at the top level (the prior of a new field's): the
-    // cells of one candidate GSD tile its regions.
+    // Each training field's mean input at each top level the cells were sampled from (the
+    // prior of a new field's): the cells of one descent GSD tile its regions.
     for (std::size_t f = 0; f < fields.size(); ++f) {
-      double mass = 0.0, px = 0.0;
-      const double sub = adaptive.candidate_gsd_cm.front();
-      for (const CellSample& c : cells_by_field[f])
-        if (c.top_gsd_cm == adaptive.top_gsd_cm && c.sub_gsd_cm == sub)
-          mass += c.top.mass(adaptive.cell_input), px += c.top.field_px;
-      reference[f].field_input = px > 0.0 ? mass / px : 0.0;
+      for (const double top : model.cells()->top_gsds()) {
+        double sub = 0.0;  // the coarsest descent GSD sampled from this top
+        for (const CellSample& c : cells_by_field[f])
+          if (c.top_gsd_cm == top) sub = std::max(sub, c.sub_gsd_cm);
+        double mass = 0.0, px = 0.0;
+        for (const CellSample& c : cells_by_field[f])
+          if (c.top_gsd_cm == top && c.sub_gsd_cm == sub) mass += c.top.mass(adaptive.cell_input), px += c.top.field_px;
+        const double input = px > 0.0 ? mass / px : 0.0;
+        if (top == adaptive.top_gsd_cm) reference[f].field_input = input;
+        reference[f].top_inputs.emplace_back(top, input);
+      }
     }
   }
 

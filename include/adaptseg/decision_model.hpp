@@ -318,6 +318,14 @@ struct DecisionModel {
               e << YAML::BeginMap << YAML::Key << "field" << YAML::Value << r.field << YAML::Key << "field_sigma"
                 << YAML::Value << num(r.field_sigma);
               if (r.field_input > 0.0) e << YAML::Key << "field_input" << YAML::Value << num(r.field_input);
+              if (!r.top_inputs.empty()) {
+                std::vector<double> tg, tx;
+                for (const auto& [gsd, x] : r.top_inputs) tg.push_back(gsd), tx.push_back(x);
+                e << YAML::Key << "top_input_gsd_cm" << YAML::Value;
+                emit_numbers(e, tg);
+                e << YAML::Key << "top_input" << YAML::Value;
+                emit_numbers(e, tx);
+              }
               e << YAML::Key << "gsd_cm" << YAML::Value;
               emit_numbers(e, g);
               e << YAML::Key << "miou" << YAML::Value;
@@ -481,6 +489,13 @@ struct DecisionModel {
           ReferenceCurve curve{c.text("field"), {}, c.has("field_sigma") ? c.number("field_sigma") : 0.0,
                                c.has("field_input") ? c.number("field_input") : 0.0};
           for (std::size_t i = 0; i < g.size(); ++i) curve.points.push_back({g[i], v[i]});
+          if (c.has("top_input_gsd_cm") || c.has("top_input")) {
+            const auto tg = c.numbers("top_input_gsd_cm");
+            const auto tx = c.numbers("top_input");
+            if (tg.size() != tx.size())
+              detail::yaml_error(r.where(), "a 'rule.reference' curve needs as many 'top_input' as 'top_input_gsd_cm' values");
+            for (std::size_t i = 0; i < tg.size(); ++i) curve.top_inputs.emplace_back(tg[i], tx[i]);
+          }
           reference.push_back(std::move(curve));
         }
         return DecisionFunction(FrontAwarePolicy(std::move(model), std::move(reference),

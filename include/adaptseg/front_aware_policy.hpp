@@ -30,8 +30,21 @@ struct ReferenceCurve {
   double field_sigma = 0.0;
   /// The mean over the field's top-level images of the cell gain model's input (its value per
   /// field pixel); 0: unknown (models without cells). The mean over the reference curves is the
-  /// prior of a new field's (Params::field_curve).
+  /// prior of a new field's (Params::field_curve). At the nominal top-level GSD.
   double field_input = 0.0;
+  /// The same mean at every top-level GSD the cell gain model was calibrated for (the nominal
+  /// one and finer ones the rule may choose, ChoosesTopLevel), as (GSD, input) pairs: a finer
+  /// top level's map has less wrong, so its input is smaller. Empty (models before it):
+  /// `field_input` at every top.
+  std::vector<std::pair<double, double>> top_inputs{};
+
+  /// The field's mean input at top-level GSD `top_gsd_cm`: its `top_inputs` entry, else
+  /// `field_input`.
+  [[nodiscard]] double input_at(double top_gsd_cm) const {
+    for (const auto& [g, x] : top_inputs)
+      if (std::abs(g - top_gsd_cm) <= 1e-9 * top_gsd_cm) return x;
+    return field_input;
+  }
 };
 
 /// The front-aware rule over a GainModel; a DecisionPolicy.
@@ -152,7 +165,11 @@ class FrontAwarePolicy {
     for (const auto& r : reference_) {
       detail::require(std::isfinite(r.field_input) && r.field_input >= 0.0,
                       "FrontAwarePolicy: reference curve '" + r.field + "' needs field_input >= 0", r.field_input);
-      prior_input_ += r.field_input / static_cast<double>(reference_.size());
+      for (const auto& [g, x] : r.top_inputs)
+        detail::require(std::isfinite(g) && g > 0.0 && std::isfinite(x) && x >= 0.0,
+                        "FrontAwarePolicy: reference curve '" + r.field +
+                            "' needs top_inputs of GSD > 0 and input >= 0; GSD",
+                        g);
     }
     begin_mission();
   }
@@ -374,14 +391,16 @@ class FrontAwarePolicy {
   /// The lawnmower curve of this field as the cell gain model predicts it (Params::field_curve),
   /// relative to the top level's mIoU: at each lawnmower GSD g finer than the top level,
   /// s·β(top, g)·X̂·(1 / σ̂), X̂ the field's mean input (seen so far, the unseen part shrunk towards
-  /// the training fields' mean with σ̂'s weight k), `inv_sigma` = 1 / σ̂; 0 at the top level; its
+  /// the training fields' mean at this top level with σ̂'s weight k), `inv_sigma` = 1 / σ̂; 0 at the top level; its
   /// upper envelope. With a training field `corrected_by`, each rise times that field's real /
   /// predicted rise (Params::curve_ratio).
   [[nodiscard]] std::vector<CurvePoint> field_curve(const DecisionContext& c, double inv_sigma,
                                                     const ReferenceCurve* corrected_by) const {
     const double k = params_.sigma_prior_weight;
     const double unseen = std::max(0.0, 1.0 - seen_input_share_);
-    const double rest = prior_input_ > 0.0 ? (seen_input_ + k * prior_input_) / (seen_input_share_ + k)
+    double prior_input = 0.0;  // the training fields' mean input at this top level (0: unknown)
+    for (const auto& r : reference_) prior_input += r.input_at(c.top_gsd_cm) / static_cast<double>(reference_.size());
+    const double rest = prior_input > 0.0 ? (seen_input_ + k * prior_input) / (seen_input_share_ + k)
                         : seen_input_share_ > 0.0 ? seen_input_ / seen_input_share_
                                                   : 0.0;
     const double x = seen_input_ + unseen * rest;
@@ -396,10 +415,10 @@ class FrontAwarePolicy {
   }
 
   /// Params::curve_ratio's r_f: training field `r`'s real lawnmower rise from GSD `top` to `g`
-  /// over the one the cell gain model predicts for it, slope·X_f / σ_f; clamped to [1/4, 4];
+  /// over the one the cell gain model predicts for it, slope·X_f / σ_f (X_f at `top`); clamped to [1/4, 4];
   /// 1 where nothing is predicted.
   static double rise_ratio(const ReferenceCurve& r, double top, double g, double slope) {
-    const double predicted = r.field_sigma > 0.0 ? slope * r.field_input / r.field_sigma : 0.0;
+    const double predicted = r.field_sigma > 0.0 ? slope * r.input_at(top) / r.field_sigma : 0.0;
     if (!(predicted > 0.0)) return 1.0;
     const double real = miou_at_gsd(r.points, g) - miou_at_gsd(r.points, top);
     return std::clamp(real / predicted, 0.25, 4.0);
@@ -464,7 +483,6 @@ class FrontAwarePolicy {
   std::vector<ReferenceCurve> reference_;
   Params params_;
   double prior_sigma_ = 0.0;        ///< mean σ of the training fields (0: unknown)
-  double prior_input_ = 0.0;        ///< mean cell-model input of the training fields (0: unknown)
   // Per mission (reset by begin_mission):
   double sigma_sum_ = 0.0;          ///< σ of the top-level images so far
   std::size_t sigma_count_ = 0;
