@@ -391,9 +391,9 @@ class FrontAwarePolicy {
   /// The lawnmower curve of this field as the cell gain model predicts it (Params::field_curve),
   /// relative to the top level's mIoU: at each lawnmower GSD g finer than the top level,
   /// s·β(top, g)·X̂·(1 / σ̂), X̂ the field's mean input (seen so far, the unseen part shrunk towards
-  /// the training fields' mean at this top level with σ̂'s weight k), `inv_sigma` = 1 / σ̂; 0 at the top level; its
-  /// upper envelope. With a training field `corrected_by`, each rise times that field's real /
-  /// predicted rise (Params::curve_ratio).
+  /// the training fields' mean at this top level with σ̂'s weight k), `inv_sigma` = 1 / σ̂; 0 at
+  /// the top level; its upper envelope. With a training field `corrected_by`, each rise times
+  /// that field's real / predicted rise (Params::curve_ratio).
   [[nodiscard]] std::vector<CurvePoint> field_curve(const DecisionContext& c, double inv_sigma,
                                                     const ReferenceCurve* corrected_by) const {
     const double k = params_.sigma_prior_weight;
@@ -415,8 +415,8 @@ class FrontAwarePolicy {
   }
 
   /// Params::curve_ratio's r_f: training field `r`'s real lawnmower rise from GSD `top` to `g`
-  /// over the one the cell gain model predicts for it, slope·X_f / σ_f (X_f at `top`); clamped to [1/4, 4];
-  /// 1 where nothing is predicted.
+  /// over the one the cell gain model predicts for it, slope·X_f / σ_f (X_f at `top`); clamped
+  /// to [1/4, 4]; 1 where nothing is predicted.
   static double rise_ratio(const ReferenceCurve& r, double top, double g, double slope) {
     const double predicted = r.field_sigma > 0.0 ? slope * r.input_at(top) / r.field_sigma : 0.0;
     if (!(predicted > 0.0)) return 1.0;
