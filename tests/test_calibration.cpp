@@ -266,6 +266,16 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
   t::write_file(tmp.path() / "no_cells.yaml", text.substr(0, at) + text.substr(end + 1));
   CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "no_cells.yaml"), doctest::Contains("cell gain model"),
                        std::invalid_argument);
+  // A training field's inputs per top level: one per GSD, none negative.
+  const auto inputs = text.find("top_input: [");
+  REQUIRE(inputs != std::string::npos);
+  const auto line_end = text.find('\n', inputs);
+  for (const auto& [bad, message] : {std::pair{"top_input: [0.1]", "as many 'top_input' as 'top_input_gsd_cm'"},
+                                     std::pair{"top_input: [-0.1, 0.1]", "top_inputs of GSD > 0 and input >= 0"}}) {
+    t::write_file(tmp.path() / "bad_inputs.yaml", text.substr(0, inputs) + bad + text.substr(line_end));
+    CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "bad_inputs.yaml"), doctest::Contains(message),
+                         std::invalid_argument);
+  }
 }
 
 TEST_CASE("calibration: confidence levels the training fields cannot tell apart go to the more cautious") {
