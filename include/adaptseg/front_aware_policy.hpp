@@ -234,11 +234,12 @@ class FrontAwarePolicy {
     // The predicted curve's mIoU relative to the top level's (field_curve) or absolute.
     double curve_level = 0.0;
     if (params_.field_curve && model_.cells() && c.region_share > 0.0 && weight > 0.0) {
+      const double x = field_input_estimate(c);
       curves.clear();
       if (params_.curve_ratio)
-        for (const auto& r : reference_) curves.push_back(field_curve(c, weight / c.region_share, &r));
+        for (const auto& r : reference_) curves.push_back(field_curve(c, x, weight / c.region_share, &r));
       else
-        curves.push_back(field_curve(c, weight / c.region_share, nullptr));
+        curves.push_back(field_curve(c, x, weight / c.region_share, nullptr));
       curve_level = mean_top_miou(c);
     }
 
@@ -388,14 +389,10 @@ class FrontAwarePolicy {
     double sub_gsd_cm = 0.0;
   };
 
-  /// The lawnmower curve of this field as the cell gain model predicts it (Params::field_curve),
-  /// relative to the top level's mIoU: at each lawnmower GSD g finer than the top level,
-  /// s·β(top, g)·X̂·(1 / σ̂), X̂ the field's mean input (seen so far, the unseen part shrunk towards
-  /// the training fields' mean at this top level with σ̂'s weight k), `inv_sigma` = 1 / σ̂; 0 at
-  /// the top level; its upper envelope. With a training field `corrected_by`, each rise times
-  /// that field's real / predicted rise (Params::curve_ratio).
-  [[nodiscard]] std::vector<CurvePoint> field_curve(const DecisionContext& c, double inv_sigma,
-                                                    const ReferenceCurve* corrected_by) const {
+  /// X̂, the field's mean input per field pixel (Params::field_curve): the top-level regions
+  /// seen so far, the unseen part shrunk towards the training fields' mean at this top level
+  /// with σ̂'s weight k.
+  [[nodiscard]] double field_input_estimate(const DecisionContext& c) const {
     const double k = params_.sigma_prior_weight;
     const double unseen = std::max(0.0, 1.0 - seen_input_share_);
     double prior_input = 0.0;  // the training fields' mean input at this top level (0: unknown)
@@ -403,7 +400,16 @@ class FrontAwarePolicy {
     const double rest = prior_input > 0.0 ? (seen_input_ + k * prior_input) / (seen_input_share_ + k)
                         : seen_input_share_ > 0.0 ? seen_input_ / seen_input_share_
                                                   : 0.0;
-    const double x = seen_input_ + unseen * rest;
+    return seen_input_ + unseen * rest;
+  }
+
+  /// The lawnmower curve of this field as the cell gain model predicts it (Params::field_curve),
+  /// relative to the top level's mIoU: at each lawnmower GSD g finer than the top level,
+  /// s·β(top, g)·X̂·(1 / σ̂), `x` = X̂ (field_input_estimate), `inv_sigma` = 1 / σ̂; 0 at the top
+  /// level; its upper envelope. With a training field `corrected_by`, each rise times that
+  /// field's real / predicted rise (Params::curve_ratio).
+  [[nodiscard]] std::vector<CurvePoint> field_curve(const DecisionContext& c, double x, double inv_sigma,
+                                                    const ReferenceCurve* corrected_by) const {
     std::vector<CurvePoint> curve;
     for (const auto& l : c.lawnmowers) {
       if (l.gsd_cm > c.top_gsd_cm) continue;  // coarser than the top level: not what it compares with
