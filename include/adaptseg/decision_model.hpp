@@ -51,16 +51,16 @@ using ModelGp = GainModel::Gp;
 [[nodiscard]] inline DecisionFunction read_legacy_decision_function(std::istream& is, const std::string& field) {
   const auto token = [&](const std::string& what) {
     std::string t;
-    require(static_cast<bool>(is >> t), "DecisionFunction::load: input ends before " + what, "<end of input>");
+    require(static_cast<bool>(is >> t), "decision model of format 1: input ends before " + what, "<end of input>");
     return t;
   };
   const auto expect = [&](const std::string& key) {
     const std::string t = token("'" + key + "'");
-    require(t == key, "DecisionFunction::load: expected '" + key + "', found", t);
+    require(t == key, "decision model of format 1: expected '" + key + "', found", t);
   };
   const auto parse = [&](const std::string& t, const std::string& what) {
     const auto v = parse_number(t);
-    require(v.has_value(), "DecisionFunction::load: bad number for " + what, t);
+    require(v.has_value(), "decision model of format 1: bad number for " + what, t);
     return *v;
   };
   const auto number = [&](const std::string& key) {
@@ -69,7 +69,7 @@ using ModelGp = GainModel::Gp;
   };
   expect("adaptseg.decision_function");
   const std::string version = token("the format version");
-  require(version == "1" || version == "2" || version == "3", "DecisionFunction::load: unsupported format version",
+  require(version == "1" || version == "2" || version == "3", "decision model of format 1: unsupported format version",
           version);
   const double min_sigma = number("min_sigma");
   const double min_utility = number("min_utility");
@@ -78,14 +78,14 @@ using ModelGp = GainModel::Gp;
   const bool online = number("online") != 0.0;
   const double refit_every = number("refit_every");  // range-checked before the cast (UB otherwise)
   require(refit_every >= 0.0 && refit_every <= 1e9 && refit_every == std::floor(refit_every),
-          "DecisionFunction::load: refit_every must be an integer in [0, 1e9]", refit_every);
+          "decision model of format 1: refit_every must be an integer in [0, 1e9]", refit_every);
   const bool relative_utility = number("relative_utility") != 0.0;
   bool front_aware = false;
   std::vector<GsdPoint> reference;
   if (version != "1") {  // version 1 had neither
     front_aware = number("front_aware") != 0.0;
     const double n = number("reference_lawnmower");
-    require(n >= 0.0 && n <= 1000.0 && n == std::floor(n), "DecisionFunction::load: bad point count for 'reference_lawnmower'",
+    require(n >= 0.0 && n <= 1000.0 && n == std::floor(n), "decision model of format 1: bad point count for 'reference_lawnmower'",
             n);
     const auto value = [&](const char* what) {
       const std::string name = std::string("a reference_lawnmower ") + what;
@@ -114,20 +114,20 @@ using ModelGp = GainModel::Gp;
         break;
       }
     }
-    require(ended, "DecisionFunction::load: input ends inside I's Gaussian process", "<end of input>");
+    require(ended, "decision model of format 1: input ends inside I's Gaussian process", "<end of input>");
     std::istringstream in(block);
     ModelGp gp = read_gp_text_v1<ModelGp::KernelType>(in);
-    require(gp.dimension() == 1, "DecisionFunction::load: I of a version 1-2 file must have 1 input; dimension",
+    require(gp.dimension() == 1, "decision model of format 1: I of a version 1-2 file must have 1 input; dimension",
             gp.dimension());
     return gp;
   }();
   expect("end");
   expect("adaptseg.decision_function");
   require(std::isfinite(min_sigma) && min_sigma >= 0.0 && min_sigma <= 1.0,
-          "DecisionFunction::load: min_sigma must be in [0, 1]", min_sigma);
+          "decision model of format 1: min_sigma must be in [0, 1]", min_sigma);
   GainModel model(std::move(o), std::move(i), std::nullopt, {}, static_cast<int>(refit_every));
   if (front_aware) {
-    require(!reference.empty(), "DecisionFunction::load: the front-aware rule needs reference_lawnmower points; count",
+    require(!reference.empty(), "decision model of format 1: the front-aware rule needs reference_lawnmower points; count",
             reference.size());
     return DecisionFunction(FrontAwarePolicy(std::move(model), {ReferenceCurve{field, std::move(reference)}},
                                              {.min_sigma = min_sigma, .weight_by_sigma = weight_by_sigma,

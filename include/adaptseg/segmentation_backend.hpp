@@ -58,7 +58,10 @@ concept SegmentsWithProbabilities = requires(B& backend, const Image& image) {
 };
 
 /// `backend.segment(image)`, checked against the contract (check_segmentation()) for a class
-/// set of `num_classes` classes; what every planner and calibration of the library calls.
+/// set of `num_classes` classes; what AdaptivePlanner and calibration call when they run the
+/// backend themselves (segment_with_probabilities_checked() for a backend with probabilities).
+/// AdaptivePlanner::report (labels segmented outside the library) and Mission (which times
+/// the backend alone) call check_segmentation() themselves.
 /// @throws std::invalid_argument naming the backend if its labels break the contract, and
 ///         whatever `segment` throws.
 template <SegmentationBackend B>
