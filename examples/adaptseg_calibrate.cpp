@@ -20,7 +20,7 @@
 int main(int argc, char** argv) {
   namespace fs = std::filesystem;
   CLI::App app{"Initialise the adaptive decision function on training fields and save it.", "adaptseg_calibrate"};
-  fs::path field_dir, out_file, samples_csv;
+  fs::path field_dir, out_file, samples_csv, cell_samples_csv;
   std::string region_text;
   std::vector<std::string> train_specs;
   double top_factor = 3.0;
@@ -37,6 +37,9 @@ int main(int argc, char** argv) {
       ->excludes(field_opt);
   app.add_option("--out", out_file, "model file to write (YAML)")->required();
   app.add_option("--samples-csv", samples_csv, "also write the region samples (one per region and candidate) here");
+  app.add_option("--cell-samples-csv", cell_samples_csv,
+                 "also write the cell samples (--coverage ranked: one per cell of every top-level image and descent "
+                 "GSD, with every decision input the top-level and the finer image give it) here");
   app.add_option("--top-factor", top_factor, "top-level GSD as a multiple of the field's GSD")->capture_default_str();
   app.add_option("--candidate-factors", candidate_factors, "candidate lower GSDs, multiples of the field's GSD")
       ->delimiter(',')
@@ -103,6 +106,22 @@ int main(int argc, char** argv) {
            << s.relabelled.share << ',' << s.relabelled.interest_share << ',' << s.region_share << ','
            << s.field_sigma << ',' << s.field_gain << '\n';
       adaptseg::examples::write_text(samples_csv, os.str());
+    }
+    if (!cell_samples_csv.empty()) {
+      std::ostringstream os;
+      os << "field,region,top_gsd_cm,sub_gsd_cm,field_px,field_share,field_sigma,relabelled,field_gain";
+      for (const auto& in : adaptseg::kDecisionInputs) os << ",top_" << in.name;
+      for (const auto& in : adaptseg::kDecisionInputs) os << ",fine_" << in.name;
+      os << '\n';
+      for (const auto& c : cal.cell_samples) {
+        os << fields[c.field].name() << ',' << c.region << ',' << c.top_gsd_cm << ',' << c.sub_gsd_cm << ','
+           << c.top.field_px << ',' << c.field_share << ',' << c.field_sigma << ',' << c.relabelled << ','
+           << c.field_gain;
+        for (double v : c.top.values) os << ',' << v;
+        for (double v : c.fine.values) os << ',' << v;
+        os << '\n';
+      }
+      adaptseg::examples::write_text(cell_samples_csv, os.str());
     }
 
     for (std::size_t k = 0; k < fields.size(); ++k) {

@@ -167,8 +167,10 @@ determinism)
   test="$field:0.5,0,1,0.2"
   fixed=(--seg-time-s 0.1 --plan-time-s 0.01)
   for run in a b; do
+    mkdir -p "$work/$run"
     "$calibrate" --field "$field" --region 0,0,0.5,0.2 --segmenter oracle --threshold-steps 2 "${fixed[@]}" \
-      --out "$work/$run/model.yaml" >/dev/null 2>&1 || fail "calibration $run failed"
+      --out "$work/$run/model.yaml" --cell-samples-csv "$work/$run/cells.csv" >"$work/$run/calibrate.log" 2>&1 ||
+      fail "calibration $run failed"
     "$mission" --field "$test" --strategy lawnmower --gsd 2 --segmenter oracle "${fixed[@]}" \
       --out "$work/$run/lawnmower" >/dev/null || fail "lawnmower $run failed"
     for s in adaptive linear; do
@@ -177,6 +179,14 @@ determinism)
     done
   done
   cmp "$work/a/model.yaml" "$work/b/model.yaml" || fail "model.yaml differs between two calibrations"
+  cmp "$work/a/cells.csv" "$work/b/cells.csv" || fail "the cell samples differ between two calibrations"
+  # --cell-samples-csv: one row per cell sample the calibration reports, every decision input
+  # of the top-level and the finer image as columns.
+  cells=$(sed -n 's/^\([0-9]*\) cell samples$/\1/p' "$work/a/calibrate.log")
+  [ -n "$cells" ] && [ "$cells" -gt 0 ] && [ "$(($(wc -l <"$work/a/cells.csv") - 1))" = "$cells" ] ||
+    fail "cells.csv does not hold the $cells cell samples reported"
+  head -1 "$work/a/cells.csv" | grep -q '^field,region,top_gsd_cm,sub_gsd_cm,field_px,field_share,field_sigma,relabelled,field_gain,top_sigma,.*,fine_expected_error,' ||
+    fail "cells.csv header: $(head -1 "$work/a/cells.csv")"
   for s in lawnmower adaptive linear; do
     for f in result.json path.png map.png; do
       cmp "$work/a/$s/$f" "$work/b/$s/$f" || fail "$s/$f differs between two runs"
@@ -186,7 +196,7 @@ determinism)
   # descends, so sub-lawnmowers and map fusion are covered too.
   grep -q '"predicted_delta_miou"' "$work/a/adaptive/result.json" || fail "the adaptive mission scored no candidate"
   grep -q '"action": "descend"' "$work/a/linear/result.json" || fail "the linear mission never descended"
-  echo "identical: model.yaml, {lawnmower,adaptive,linear}/{result.json,path.png,map.png}"
+  echo "identical: model.yaml, cells.csv, {lawnmower,adaptive,linear}/{result.json,path.png,map.png}"
   ;;
 *) fail "unknown case $case" ;;
 esac
