@@ -205,8 +205,10 @@ int main(int argc, char** argv) {
                      "forecast_delta_miou,forecast_delta_miou_std,forecast_relabelled_interest,forecast_field_gain,forecast_front_margin,"
                      "observed_sigma_sub,observed_relabelled,observed_relabelled_interest,realised_region_delta_miou,"
                      "realised_field_gain,flown,observed_top_input,observed_fine_input\n";
-    // The strategies that fly the model, after the lawnmowers, in this order on every test field.
-    const std::vector<std::string> model_strategies{"nonadaptive", "adaptive", "tour", "row", "linear"};
+    // The strategies that fly the model, after the lawnmowers, in the table's order on every
+    // test field; the table beside the results for the figures.
+    const std::vector<std::string> model_strategies = adaptseg::examples::strategy_names(true);
+    adaptseg::examples::write_text(out_dir / "strategies.csv", adaptseg::examples::strategies_csv());
     const std::size_t total_runs = tests.size() * (lawnmower_factors.size() + model_strategies.size());
     std::size_t run_index = 0;
     for (const auto& field : tests) {

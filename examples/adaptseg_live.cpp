@@ -258,15 +258,16 @@ void fly_strategy(const std::string& strategy, const adaptseg::DecisionModel& mo
                   const std::vector<PosedImage>& images, Backend& backend, const adaptseg::AdaptiveOptions& options,
                   const LiveSettings& s) {
   adaptseg::examples::check_segmenter(model, backend.name());
-  if (strategy == "linear") {
+  const adaptseg::examples::StrategyInfo& row = adaptseg::examples::strategy_info(strategy);
+  if (row.policy == adaptseg::examples::StrategyPolicy::linear) {
     adaptseg::LinearDecision policy(model.linear);
     fly(info, images, backend, policy, options, s);
     return;
   }
   adaptseg::DecisionFunction df = model.decision_function;
-  df.set_online(strategy != "nonadaptive");
+  df.set_online(row.online);
   adaptseg::AdaptiveOptions o = options;
-  o.schedule = adaptseg::examples::schedule_of(strategy);
+  o.schedule = row.schedule;
   fly(info, images, backend, df, o, s);
 }
 
@@ -293,7 +294,7 @@ int main(int argc, char** argv) {
       ->needs(record)
       ->capture_default_str();
   app.add_option("--strategy", strategy, "decision policy")
-      ->check(CLI::IsMember({"adaptive", "nonadaptive", "tour", "row", "linear"}))
+      ->check(CLI::IsMember(adaptseg::examples::strategy_names(true)))
       ->capture_default_str();
   app.add_option("--segmenter", segmenter, "oracle: ground-truth labels/ of the folder; erfnet: its RGB images")
       ->check(CLI::IsMember({"oracle", "erfnet"}))

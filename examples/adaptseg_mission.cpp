@@ -33,7 +33,7 @@ int main(int argc, char** argv) {
   app.add_option("--field", field_spec, "field directory (field.yaml, labels.png, [image]), optionally DIR:x0,y0,x1,y1")
       ->required();
   app.add_option("--strategy", strategy, "mission strategy")
-      ->check(CLI::IsMember(adaptseg::examples::kStrategies))
+      ->check(CLI::IsMember(adaptseg::examples::strategy_names()))
       ->capture_default_str();
   app.add_option("--gsd", gsd_cm, "lawnmower GSD [cm/px] (>= the field's GSD)");
   app.add_option("--model", model_file, "decision model from adaptseg_calibrate (adaptive, nonadaptive, linear)");

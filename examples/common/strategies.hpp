@@ -15,25 +15,81 @@
 #include <filesystem>
 #include <locale>
 #include <optional>
+#include <stdexcept>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace adaptseg::examples {
 
-/// lawnmower: one fixed GSD; adaptive / nonadaptive: the decision model with online updates on /
-/// off, descents flown at once (the paper); tour: adaptive, but the whole top level first and the
-/// chosen descents after it as one low-altitude tour where that is cheaper (DescentSchedule::tour);
-/// row: the same per lawnmower row, staying low between a row's inspections
-/// (DescentSchedule::row); linear: the conference version's rule.
-inline const std::vector<std::string> kStrategies{"lawnmower", "adaptive", "nonadaptive", "tour", "row", "linear"};
+/// What a strategy flies.
+enum class StrategyPolicy {
+  lawnmower,          ///< one fixed GSD (`--gsd`), no decision
+  decision_function,  ///< the calibrated decision function of the model (paper §3.2)
+  linear,             ///< the conference version's linear rule, from the model's σ range
+};
 
-/// When a model-based strategy flies its descents: tour and row defer where cheaper, the others
-/// descend at once.
-inline DescentSchedule schedule_of(const std::string& strategy) {
-  if (strategy == "tour") return DescentSchedule::tour;
-  if (strategy == "row") return DescentSchedule::row;
-  return DescentSchedule::immediate;
+/// One row of the table of strategies: everything a program or a figure needs to know about a
+/// strategy. To add one, add its row here; adaptseg_mission, adaptseg_evaluate, adaptseg_live
+/// and examples/tools/plot_evaluation.py (through the `strategies.csv` adaptseg_evaluate writes)
+/// read it.
+struct StrategyInfo {
+  std::string_view name;     ///< on the command line and in results.csv
+  StrategyPolicy policy;
+  DescentSchedule schedule;  ///< when the chosen descents are flown (not lawnmower)
+  bool online;               ///< decision_function: learns in flight (DecisionFunction::set_online)
+  std::string_view label;    ///< in the figures' legends
+};
+
+/// Every strategy, in the order adaptseg_evaluate flies them on a test field (the lawnmowers
+/// first). adaptive / nonadaptive: the decision model with online updates on / off, descents
+/// flown at once (the paper); tour: adaptive, but the whole top level first and the chosen
+/// descents after it as one low-altitude tour where that is cheaper; row: the same per
+/// lawnmower row, staying low between a row's inspections.
+inline constexpr std::array<StrategyInfo, 6> kStrategyTable{{
+    {"lawnmower", StrategyPolicy::lawnmower, DescentSchedule::immediate, false, "lawnmower (fixed altitude)"},
+    {"nonadaptive", StrategyPolicy::decision_function, DescentSchedule::immediate, false, "non-adaptive"},
+    {"adaptive", StrategyPolicy::decision_function, DescentSchedule::immediate, true, "adaptive"},
+    {"tour", StrategyPolicy::decision_function, DescentSchedule::tour, true, "tour (at once or after the survey)"},
+    {"row", StrategyPolicy::decision_function, DescentSchedule::row, true, "row (at once or after each row)"},
+    {"linear", StrategyPolicy::linear, DescentSchedule::immediate, false, "linear (ECMR 2021)"},
+}};
+
+/// The names of the strategies of `kStrategyTable` (all of them, or only those that fly a
+/// calibrated model: every one but the lawnmower), in its order.
+inline std::vector<std::string> strategy_names(bool model_based_only = false) {
+  std::vector<std::string> names;
+  for (const auto& s : kStrategyTable)
+    if (!model_based_only || s.policy != StrategyPolicy::lawnmower) names.emplace_back(s.name);
+  return names;
+}
+
+/// The row of strategy `name`.
+/// @throws std::invalid_argument naming every strategy for an unknown name.
+inline const StrategyInfo& strategy_info(std::string_view name) {
+  for (const auto& s : kStrategyTable)
+    if (s.name == name) return s;
+  std::string known;
+  for (const auto& s : kStrategyTable) known += (known.empty() ? "" : ", ") + std::string(s.name);
+  throw std::invalid_argument("unknown strategy '" + std::string(name) + "' (one of: " + known + ")");
+}
+
+/// The table as CSV (`name,policy,schedule,online,label`), which adaptseg_evaluate writes beside
+/// results.csv for the figures.
+inline std::string strategies_csv() {
+  std::string out = "name,policy,schedule,online,label\n";
+  for (const auto& s : kStrategyTable) {
+    const char* policy = s.policy == StrategyPolicy::lawnmower           ? "lawnmower"
+                         : s.policy == StrategyPolicy::decision_function ? "decision_function"
+                                                                         : "linear";
+    const char* schedule = s.schedule == DescentSchedule::tour  ? "tour"
+                           : s.schedule == DescentSchedule::row ? "row"
+                                                                : "immediate";
+    out += std::string(s.name) + ',' + policy + ',' + schedule + ',' + (s.online ? "true" : "false") + ",\"" +
+           std::string(s.label) + "\"\n";
+  }
+  return out;
 }
 
 /// "a,b,c,d" -> four numbers; `what` describes the expected text in the error.
@@ -151,7 +207,8 @@ template <SegmentationBackend Backend>
 StrategyRun run_strategy(const Field& field, Backend& backend, const std::string& strategy, double gsd_cm,
                          const DecisionModel* model, MissionOptions options, std::optional<double> budget_s,
                          LawnmowerOverlap overlap = {}) {
-  if (strategy == "lawnmower") {
+  const StrategyInfo& info = strategy_info(strategy);
+  if (info.policy == StrategyPolicy::lawnmower) {
     if (gsd_cm == 0.0) throw std::invalid_argument("--strategy lawnmower needs --gsd (a positive GSD in cm/px)");
     if (!(gsd_cm > 0.0) || !std::isfinite(gsd_cm))
       throw std::invalid_argument("--gsd must be a finite positive GSD in cm/px (got " + fmt(gsd_cm, 3) + ")");
@@ -170,16 +227,14 @@ StrategyRun run_strategy(const Field& field, Backend& backend, const std::string
   if (options.interest.empty()) options.interest = field.class_indices(model->interest);
   model->check_compatible(field, options.interest);
   AdaptiveOptions ao = model->adaptive_options(std::move(options), budget_s);
-  if (strategy == "linear") {
+  if (info.policy == StrategyPolicy::linear) {
     LinearDecision policy(model->linear);
     auto r = run_adaptive_mission(field, backend, policy, ao, policy.name());
     return {std::move(r.mission), std::move(r.decisions), std::move(r.realised)};
   }
-  if (strategy != "adaptive" && strategy != "nonadaptive" && strategy != "tour" && strategy != "row")
-    throw std::invalid_argument("unknown strategy '" + strategy + "'");
   DecisionFunction df = model->decision_function;
-  df.set_online(strategy != "nonadaptive");
-  ao.schedule = schedule_of(strategy);
+  df.set_online(info.online);
+  ao.schedule = info.schedule;
   auto r = run_adaptive_mission(field, backend, df, ao, strategy);
   return {std::move(r.mission), std::move(r.decisions), std::move(r.realised)};
 }

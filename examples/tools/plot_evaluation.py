@@ -3,11 +3,13 @@
 
 Usage: /usr/bin/python3 examples/tools/plot_evaluation.py OUTDIR
 
-Reads OUTDIR/results.csv, per_image.csv and decisions.csv (written by adaptseg_evaluate) and writes
+Reads OUTDIR/results.csv, per_image.csv, decisions.csv and strategies.csv (written by
+adaptseg_evaluate) and writes
   OUTDIR/miou_vs_time.png       field mIoU over the labels of interest vs execution time
   OUTDIR/per_image_miou.png     per-image mIoU vs image GSD, mean and standard deviation
   OUTDIR/decisions.png          per descent: forecast vs realised field gain (simulation)
-  OUTDIR/paths.png              top views of the paths (lawnmower, non-adaptive, adaptive, tour, row, linear), 2 per row
+  OUTDIR/paths.png              top views of the paths (the coarsest lawnmower, then every strategy of the
+                                table of strategies, OUTDIR/strategies.csv), 2 per row
   OUTDIR/maps.png               fused maps vs ground truth (coarsest lawnmower, adaptive)
 Needs matplotlib (Debian: python3-matplotlib).
 """
@@ -27,15 +29,34 @@ import matplotlib.image as mpimg  # noqa: E402
 from lawnmower_envelope import upper_envelope  # noqa: E402
 from per_image_table import MIN_TRUTH_SIGMA, by_gsd  # noqa: E402
 
+# How each strategy is drawn (its legend label comes from the table of strategies,
+# OUTDIR/strategies.csv, written by adaptseg_evaluate from examples/common/strategies.hpp).
+# Hollow ones are drawn over the filled ones: the non-adaptive, tour and row strategies often fly
+# adaptive's mission, and both stay visible where they coincide. A strategy without a style here
+# is drawn with DEFAULT_STYLE.
 STYLE = {
-    "adaptive": dict(color="tab:red", marker="*", s=220, label="adaptive"),
-    # Hollow and drawn over the adaptive star: both stay visible when the two coincide.
-    "nonadaptive": dict(color="tab:blue", marker="s", s=260, label="non-adaptive"),
-    # Hollow too: the tour and row strategies often fly adaptive's mission.
-    "tour": dict(color="tab:purple", marker="D", s=150, label="tour (at once or after the survey)"),
-    "row": dict(color="tab:orange", marker="o", s=90, label="row (at once or after each row)"),
-    "linear": dict(color="tab:green", marker="^", s=110, label="linear (ECMR 2021)"),
+    "adaptive": dict(color="tab:red", marker="*", s=220),
+    "nonadaptive": dict(color="tab:blue", marker="s", s=260, hollow=True),
+    "tour": dict(color="tab:purple", marker="D", s=150, hollow=True),
+    "row": dict(color="tab:orange", marker="o", s=90, hollow=True),
+    "linear": dict(color="tab:green", marker="^", s=110),
 }
+DEFAULT_STYLE = dict(color="tab:gray", marker="P", s=130)
+
+
+def strategy_table(out):
+    """The table of strategies of OUTDIR/strategies.csv in its order: [(name, label)]. Outputs of
+    older versions have none: then the names of results.csv, labelled by their names."""
+    path = os.path.join(out, "strategies.csv")
+    if os.path.exists(path):
+        return [(r["name"], r["label"]) for r in read_csv(path)]
+    names = dict.fromkeys(r["strategy"] for r in read_csv(os.path.join(out, "results.csv")))
+    return [(n, n) for n in names]
+
+
+def style(strategy, labels):
+    """STYLE of `strategy` with its label from the table (`labels`: name -> label)."""
+    return dict(DEFAULT_STYLE | STYLE.get(strategy, {}), label=labels.get(strategy, strategy))
 
 
 def slug(name):
@@ -65,6 +86,8 @@ def num(v):
 def main(out):
     rows = read_csv(os.path.join(out, "results.csv"))
     fields = list(dict.fromkeys(r["field"] for r in rows))
+    table = strategy_table(out)
+    labels = dict(table)
 
     # Field mIoU vs execution time (paper Fig. results).
     fig, axes = plt.subplots(1, len(fields), figsize=(6.5 * len(fields), 6.2), squeeze=False)
@@ -72,7 +95,7 @@ def main(out):
         fr = [r for r in rows if r["field"] == field]
         lm = sorted((r for r in fr if r["strategy"] == "lawnmower"), key=lambda r: num(r["time_total"]))
         ax.plot([num(r["time_total"]) for r in lm], [num(r["miou_interest"]) for r in lm], "-o", color="0.3",
-                label="lawnmower (fixed altitude)")
+                label=labels.get("lawnmower", "lawnmower"))
         env = upper_envelope([(num(r["time_total"]), num(r["miou_interest"])) for r in lm])
         if len(env) != len(lm) or any(e != (num(r["time_total"]), num(r["miou_interest"])) for e, r in zip(env, lm)):
             last = max(num(r["time_total"]) for r in lm)
@@ -84,9 +107,9 @@ def main(out):
             ax.annotate(f"{num(r['gsd_cm']):.1f} cm/px", (num(r["time_total"]), num(r["miou_interest"])),
                         textcoords="offset points", xytext=(6, -12), fontsize=8, color="0.3")
         for r in fr:
-            if r["strategy"] in STYLE:
-                st = STYLE[r["strategy"]]
-                hollow = r["strategy"] in ("nonadaptive", "tour", "row")
+            if r["strategy"] != "lawnmower":
+                st = style(r["strategy"], labels)
+                hollow = st.get("hollow", False)
                 ax.scatter([num(r["time_total"])], [num(r["miou_interest"])], zorder=4 if hollow else 3,
                            label=f"{st['label']} (margin {num(r['front_margin']):+.3f})", marker=st["marker"],
                            s=st["s"], facecolors="none" if hollow else st["color"], edgecolors=st["color"],
@@ -107,8 +130,8 @@ def main(out):
         # The lawnmower images twice: all of them, and those whose footprint really contains L
         # (truth_sigma >= MIN_TRUTH_SIGMA): an image without L scores 0 for any false positive
         # of L, whatever its GSD.
-        series = (("nonadaptive", "tab:blue", "o-", -0.09, None, "nonadaptive"),
-                  ("adaptive", "tab:red", "o-", -0.03, None, "adaptive"),
+        series = (("nonadaptive", "tab:blue", "o-", -0.09, None, labels.get("nonadaptive", "nonadaptive")),
+                  ("adaptive", "tab:red", "o-", -0.03, None, labels.get("adaptive", "adaptive")),
                   ("lawnmower", "0.4", "o-", 0.03, None, "lawnmowers (all images)"),
                   ("lawnmower", "tab:green", "s--", 0.09, MIN_TRUTH_SIGMA,
                    f"lawnmowers (images with L >= {MIN_TRUTH_SIGMA:.0%} of the truth)"))
@@ -145,7 +168,7 @@ def main(out):
                 f = [num(d["forecast_field_gain"]) for d in sel]
                 r = [num(d["realised_field_gain"]) for d in sel]
                 lim = max(lim, max(f), max(r))
-                st = STYLE[strategy]
+                st = style(strategy, labels)
                 ax.scatter(f, r, color=st["color"], marker=st["marker"], s=st["s"] * 0.5,
                            facecolors="none" if strategy == "nonadaptive" else st["color"],
                            label=f"{st['label']} ({len(sel)} descents)")
@@ -169,8 +192,9 @@ def main(out):
         for field in fields:
             lm = sorted((r for r in rows if r["field"] == field and r["strategy"] == "lawnmower"),
                         key=lambda r: num(r["gsd_cm"]))
-            wanted = ([f"lawnmower-{num(lm[-1]['gsd_cm']):.2f}", "nonadaptive", "adaptive", "tour", "row", "linear"]
-                      if name == "paths.png" else [f"lawnmower-{num(lm[-1]['gsd_cm']):.2f}", "adaptive"])
+            coarsest = f"lawnmower-{num(lm[-1]['gsd_cm']):.2f}"
+            wanted = ([coarsest] + [n for n, _ in table if n != "lawnmower"]
+                      if name == "paths.png" else [coarsest, "adaptive"])
             for w in wanted:
                 p = os.path.join(out, slug(field), w, picks[0] + ".png")
                 if os.path.exists(p):

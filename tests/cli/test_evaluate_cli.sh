@@ -11,10 +11,22 @@ source "$(dirname "$0")/cli_common.sh"
 fixed=(--seg-time-s 0.1 --plan-time-s 0)
 "$evaluate" --train "$examples/data/dubai-tile-3" --test "$examples/data/dubai-tile-6" --interest road \
   "${fixed[@]}" --out "$work/e" >"$work/log" 2>&1 || fail "evaluate failed: $(tail -5 "$work/log")"
-for f in results.csv per_image.csv decisions.csv model.yaml miou_vs_time.png per_image_miou.png decisions.png paths.png \
+for f in results.csv per_image.csv decisions.csv strategies.csv model.yaml miou_vs_time.png per_image_miou.png decisions.png paths.png \
   maps.png; do
   [ -s "$work/e/$f" ] || fail "missing $f"
 done
+# strategies.csv: the table of strategies the figures read (examples/common/strategies.hpp), in
+# the order results.csv has them on the test field, each with its legend label.
+[ "$(head -1 "$work/e/strategies.csv")" = "name,policy,schedule,online,label" ] ||
+  fail "strategies.csv header: $(head -1 "$work/e/strategies.csv")"
+[ "$(awk -F, 'NR > 1 {print $1}' "$work/e/strategies.csv" | paste -sd,)" = \
+  "$(awk -F, 'NR > 1 && !seen[$2]++ {print $2}' "$work/e/results.csv" | paste -sd,)" ] ||
+  fail "strategies.csv does not list results.csv's strategies in their order"
+grep -qx 'adaptive,decision_function,immediate,true,"adaptive"' "$work/e/strategies.csv" &&
+  grep -qx 'nonadaptive,decision_function,immediate,false,"non-adaptive"' "$work/e/strategies.csv" &&
+  grep -qx 'tour,decision_function,tour,true,.*' "$work/e/strategies.csv" ||
+  fail "strategies.csv rows: $(cat "$work/e/strategies.csv")"
+echo "ok: strategies.csv lists the strategies flown"
 header=$(head -1 "$work/e/results.csv")
 want="field,strategy,gsd_cm,miou_interest,miou_all,time_total,time_flight,time_segmentation,time_planning,images,front_margin"
 [ "${header#"$want"}" != "$header" ] || fail "results.csv header: $header"
