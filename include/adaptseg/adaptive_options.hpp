@@ -8,6 +8,7 @@
 
 #include <adaptseg/decision.hpp>
 #include <adaptseg/decision_inputs.hpp>
+#include <adaptseg/descent_coverage.hpp>
 #include <adaptseg/lawnmower_planner.hpp>
 #include <adaptseg/mission_options.hpp>
 

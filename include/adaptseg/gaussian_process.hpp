@@ -16,7 +16,6 @@
 
 #include <adaptseg/detail/gp_numerics.hpp>
 #include <adaptseg/detail/gp_optimize.hpp>
-#include <adaptseg/detail/lbfgs.hpp>
 #include <adaptseg/error.hpp>
 #include <adaptseg/gp_kernel.hpp>
 #include <adaptseg/gp_options.hpp>

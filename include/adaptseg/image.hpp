@@ -6,7 +6,7 @@
 /// (segmentation_backend.hpp) and the live planner need nothing else.
 
 #include <adaptseg/error.hpp>
-#include <adaptseg/lawnmower_planner.hpp>
+#include <adaptseg/area.hpp>
 
 #include <opencv2/core.hpp>
 

@@ -4,6 +4,7 @@
 /// method.md §2): the top-level plan `W^{h_max}` and the sub-lawnmower `W^{h'}` that re-maps
 /// one top-level footprint at a lower altitude.
 
+#include <adaptseg/area.hpp>
 #include <adaptseg/camera.hpp>
 #include <adaptseg/error.hpp>
 
@@ -17,61 +18,12 @@
 
 namespace adaptseg {
 
-/// Axis-aligned rectangle in the field frame [m] (x east along the orthomosaic's columns,
-/// y north up its rows, origin at the orthomosaic's bottom-left corner).
-struct Area {
-  double x_min_m = 0.0;
-  double y_min_m = 0.0;
-  double x_max_m = 0.0;
-  double y_max_m = 0.0;
-
-  [[nodiscard]] double width_m() const noexcept { return x_max_m - x_min_m; }
-  [[nodiscard]] double height_m() const noexcept { return y_max_m - y_min_m; }
-  [[nodiscard]] Eigen::Vector2d centre() const noexcept {
-    return {0.5 * (x_min_m + x_max_m), 0.5 * (y_min_m + y_max_m)};
-  }
-  friend bool operator==(const Area&, const Area&) = default;
-};
-
 /// A place to stop, take an image and decide (paper §3.2.1: zero velocity there).
 struct Waypoint {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< x, y [m] field frame; z altitude [m]
   double gsd_cm = 0.0;                                 ///< GSD of the image taken here [cm/px]
   Area footprint;                                      ///< ground seen from here [m]
 };
-
-/// What a descent's sub-lawnmower W^{h'} covers (AdaptiveOptions::coverage).
-/// - `region`: the whole top-level footprint (paper §3.2.1), cells without field skipped.
-/// - `interest` (beyond the paper): only the cells where the top-level image's segmentation
-///   shows a label of interest within one top-level pixel of the cell. For a spatially
-///   localised class the errors of the top-level map lie on the class's edges, so a descent
-///   that re-maps only those cells buys most of the gain for a fraction of the time. Cells
-///   where a small instance vanished at h_max are not re-mapped.
-/// - `ranked` (beyond the paper): the region's cells ranked by their own expected gain, the mass
-///   of one decision input of the top-level image over the cell (AdaptiveOptions::cell_input,
-///   e.g. its expected error about L from the backend's class probabilities; decision_inputs.hpp),
-///   and the descent re-maps the k best, k chosen by the decision: one candidate per k. Cells
-///   with none of the input are never re-mapped.
-enum class DescentCoverage { region, interest, ranked };
-
-/// The name used in files and on the command line: "region", "interest" or "ranked".
-[[nodiscard]] inline const char* to_string(DescentCoverage c) noexcept {
-  switch (c) {
-    case DescentCoverage::interest: return "interest";
-    case DescentCoverage::ranked: return "ranked";
-    case DescentCoverage::region: break;
-  }
-  return "region";
-}
-
-/// Parses "region", "interest" or "ranked".
-/// @throws std::invalid_argument for anything else.
-[[nodiscard]] inline DescentCoverage parse_descent_coverage(const std::string& s) {
-  if (s == "region") return DescentCoverage::region;
-  if (s == "interest") return DescentCoverage::interest;
-  if (s == "ranked") return DescentCoverage::ranked;
-  throw std::invalid_argument("descent coverage must be 'region', 'interest' or 'ranked', not '" + s + "'");
-}
 
 /// Image overlap of a lawnmower (beyond the paper, whose footprints tile the area without
 /// overlap: the default). `along`: the fraction of a footprint's width shared with the next

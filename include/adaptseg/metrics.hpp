@@ -4,6 +4,7 @@
 /// mIoU (paper Eq. `eq:iou`) over a class set, per image and over the fused field.
 
 #include <adaptseg/decision.hpp>
+#include <adaptseg/detail/label_lut.hpp>
 #include <adaptseg/image.hpp>
 #include <adaptseg/lawnmower_curve.hpp>
 
@@ -21,16 +22,6 @@
 #include <vector>
 
 namespace adaptseg {
-
-namespace detail {
-/// lut[v] is true for the label values v in `labels` (values outside 0..255 are ignored).
-[[nodiscard]] inline std::array<bool, 256> label_lut(std::span<const int> labels) {
-  std::array<bool, 256> lut{};
-  for (int c : labels)
-    if (c >= 0 && c < 256) lut[static_cast<std::size_t>(c)] = true;
-  return lut;
-}
-}  // namespace detail
 
 /// Semantic ratio σ of a label image (paper Eq. `eq:vr`): pixels labelled with a class in
 /// `interest` over valid pixels (those not equal to `ignore_label`). The paper divides by all
@@ -51,29 +42,6 @@ namespace detail {
     }
   }
   return valid == 0 ? 0.0 : static_cast<double>(hits) / static_cast<double>(valid);
-}
-
-/// The DescentCoverage::interest rule for one sub-lawnmower cell: true if some pixel of
-/// `labels` (the region's top-level segmentation on a grid of `grid_gsd_cm`) inside `cell`,
-/// grown by one top-level pixel (`top_gsd_cm`) on every side and clipped to the image, carries
-/// a class in `interest`. One rule for the planner and for calibration, so that a model's
-/// samples are taken as its missions fly.
-/// @throws std::invalid_argument unless `labels` is CV_8UC1 and both GSDs are finite and > 0.
-[[nodiscard]] inline bool cell_shows_interest(const cv::Mat& labels, cv::Rect cell, double top_gsd_cm,
-                                              double grid_gsd_cm, std::span<const int> interest) {
-  detail::require(labels.type() == CV_8UC1, "cell_shows_interest: labels must be CV_8UC1", labels.type());
-  detail::require(std::isfinite(top_gsd_cm) && top_gsd_cm > 0.0 && std::isfinite(grid_gsd_cm) && grid_gsd_cm > 0.0,
-                  "cell_shows_interest: GSDs must be finite and > 0; top", top_gsd_cm);
-  const int m = static_cast<int>(std::ceil(top_gsd_cm / grid_gsd_cm - 1e-9));  // one top-level pixel
-  const cv::Rect rect =
-      cv::Rect(cell.x - m, cell.y - m, cell.width + 2 * m, cell.height + 2 * m) & cv::Rect(0, 0, labels.cols, labels.rows);
-  const auto lut = detail::label_lut(interest);
-  for (int r = rect.y; r < rect.y + rect.height; ++r) {
-    const auto* row = labels.ptr<std::uint8_t>(r);
-    for (int c = rect.x; c < rect.x + rect.width; ++c)
-      if (lut[row[c]]) return true;
-  }
-  return false;
 }
 
 /// Pixel counts of (true class, predicted class) over valid pixels. A prediction that is

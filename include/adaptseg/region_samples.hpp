@@ -7,6 +7,7 @@
 
 #include <adaptseg/cell_gain_model.hpp>
 #include <adaptseg/decision.hpp>
+#include <adaptseg/descent_coverage.hpp>
 #include <adaptseg/image_summary.hpp>
 #include <adaptseg/lawnmower_planner.hpp>
 #include <adaptseg/metrics.hpp>
