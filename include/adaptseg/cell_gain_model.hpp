@@ -6,6 +6,7 @@
 /// chosen by on the training fields.
 
 #include <adaptseg/decision_inputs.hpp>
+#include <adaptseg/detail/gsd.hpp>
 #include <adaptseg/detail/interpolate.hpp>
 #include <adaptseg/error.hpp>
 
@@ -139,7 +140,7 @@ class CellGainModel {
                           std::isfinite(s.field_share) && std::isfinite(s.field_sigma),
                       "CellGainModel::fit: samples must be finite; field gain", s.field_gain);
       std::size_t k = 0;
-      while (k < groups.size() && !(same(groups[k].top, s.top_gsd_cm) && same(groups[k].sub, s.sub_gsd_cm))) ++k;
+      while (k < groups.size() && !(detail::same_gsd(groups[k].top, s.top_gsd_cm) && detail::same_gsd(groups[k].sub, s.sub_gsd_cm))) ++k;
       if (k == groups.size()) groups.push_back(Group{s.top_gsd_cm, s.sub_gsd_cm, {}});
       groups[k].cells.push_back(&s);
     }
@@ -248,7 +249,6 @@ class CellGainModel {
   [[nodiscard]] const std::vector<Point>& points() const noexcept { return points_; }
 
  private:
-  static bool same(double a, double b) noexcept { return std::abs(a - b) <= 1e-9 * std::max(std::abs(a), std::abs(b)); }
   [[nodiscard]] double x_of(const CellInputs& c) const noexcept { return value_of(c, input_); }
   static double value_of(const CellInputs& c, DecisionInput input) noexcept {
     const double v = c.value(input);

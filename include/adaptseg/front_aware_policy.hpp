@@ -5,6 +5,7 @@
 /// with the forecasts corrected in flight from what the descents actually changed.
 
 #include <adaptseg/decision.hpp>
+#include <adaptseg/detail/gsd.hpp>
 #include <adaptseg/detail/interpolate.hpp>
 #include <adaptseg/error.hpp>
 #include <adaptseg/gain_model.hpp>
@@ -42,7 +43,7 @@ struct ReferenceCurve {
   /// `field_input`.
   [[nodiscard]] double input_at(double top_gsd_cm) const {
     for (const auto& [g, x] : top_inputs)
-      if (std::abs(g - top_gsd_cm) <= 1e-9 * top_gsd_cm) return x;
+      if (detail::same_gsd(g, top_gsd_cm)) return x;
     return field_input;
   }
 };
@@ -319,7 +320,7 @@ class FrontAwarePolicy {
     if (model_.cells())
       for (double g : model_.cells()->top_gsds())
         for (const auto& l : lawnmowers)
-          if (std::abs(l.gsd_cm - g) <= 1e-9 * g) allowed.push_back(l.gsd_cm);
+          if (detail::same_gsd(l.gsd_cm, g)) allowed.push_back(l.gsd_cm);
     if (std::find(allowed.begin(), allowed.end(), nominal) == allowed.end()) allowed.push_back(nominal);
     std::sort(allowed.begin(), allowed.end(), std::greater<>());
     const auto predicted = [&](double g) {
