@@ -22,6 +22,8 @@
 #include <adaptseg/image_summary.hpp>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <numeric>
@@ -235,12 +237,14 @@ int main(int argc, char** argv) {
     for (const auto& [f, cls, g] : groups) {
       std::vector<double> gain;
       std::vector<std::vector<double>> mass(kDecisionInputCount);
+      std::array<bool, kDecisionInputCount> known{};  // the backend gives the input (some cell has it)
       for (const Cell& c : cells) {
         if (c.field != f || c.cls != cls || c.gsd_cm != g) continue;
         gain.push_back(c.gain);
         for (std::size_t k = 0; k < kDecisionInputCount; ++k) {
           const double v = c.top.values[k];
           mass[k].push_back(std::isfinite(v) ? v * c.top.field_px : 0.0);
+          known[k] = known[k] || std::isfinite(v);
         }
       }
       double positive = 0.0, total = 0.0;
@@ -248,9 +252,11 @@ int main(int argc, char** argv) {
       std::printf("| %s | %s | %.1f | %zu | %.4f | %.2f | %.2f |", f.c_str(), cls.c_str(), g, gain.size(), positive,
                   positive > 0.0 ? top_gain(gain, gain, 0.2) / positive : NAN, positive > 0.0 ? 0.2 * total / positive : NAN);
       for (std::size_t k = 0; k < kDecisionInputCount; ++k) {
-        const double rho = spearman(mass[k], gain);
-        const double c10 = positive > 0.0 ? top_gain(mass[k], gain, 0.1) / positive : NAN;
-        const double c20 = positive > 0.0 ? top_gain(mass[k], gain, 0.2) / positive : NAN;
+        // An input the backend cannot give (e.g. the members' split of a single network) ranks
+        // nothing: unknown, not the order the cells happen to come in.
+        const double rho = known[k] ? spearman(mass[k], gain) : NAN;
+        const double c10 = known[k] && positive > 0.0 ? top_gain(mass[k], gain, 0.1) / positive : NAN;
+        const double c20 = known[k] && positive > 0.0 ? top_gain(mass[k], gain, 0.2) / positive : NAN;
         std::printf(" %+.2f / %.2f / %.2f |", rho, c10, c20);
         if (std::isfinite(rho) && std::isfinite(c20)) rho_sum[k] += rho, c10_sum[k] += c10, c20_sum[k] += c20, ++counted[k];
       }

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Black-box test of adaptseg_cell_study and examples/tools/cell_study_table.py on the bundled
+# WeedMap field with the oracle: every decision input ranks the cells, the oracle's purity ranks
+# them as well as the truth allows (rank correlation near 1 for σ), and an input the backend
+# cannot give (the ensemble members' split, from a single backend) is unknown (nan), not ranked
+# by the order the cells come in, and left out of the table.
+#   test_cell_study_cli.sh CELL_STUDY_BINARY EXAMPLES_DIR [PYTHON]
+set -uo pipefail
+study=$1 examples=$2 python=${3:-}
+source "$(dirname "$0")/cli_common.sh"
+"$study" --field "$examples/data/weedmap-000:0,0,0.5,1" --top-gsd 3 --gsd 1 --segmenter oracle \
+  --csv "$work/cells.csv" >"$work/table.md" 2>"$work/log" || fail "cell study failed: $(tail -3 "$work/log")"
+# One row per class of interest (crop, weed), then their mean.
+rows=$(grep -c '^| weedmap-rededge-000\[0,0,0.5,1\] |' "$work/table.md")
+[ "$rows" = 2 ] || fail "want 2 class rows, got $rows: $(cat "$work/table.md")"
+# Column 8 is σ (rho / 10 % / 20 %), the last is split.
+awk -F'|' '/^\| weedmap/ { split($9, s, "/"); if (!(s[1] + 0 > 0.8)) bad++; if ($(NF-1) !~ /nan \/ nan \/ nan/) bad++ }
+  END {exit bad}' "$work/table.md" || fail "σ's rank correlation not > 0.8, or split not unknown: $(cat "$work/table.md")"
+echo "ok: σ ranks the oracle's cells, split is unknown from one backend"
+# --csv: every cell of both classes, with the top-level inputs.
+[ "$(($(wc -l <"$work/cells.csv") - 1))" -gt 50 ] || fail "cells.csv holds $(($(wc -l <"$work/cells.csv") - 1)) cells"
+head -1 "$work/cells.csv" | grep -q '^field,class,region,gsd_cm,field_px,field_share,field_sigma,relabelled,gain,top_sigma,' ||
+  fail "cells.csv header: $(head -1 "$work/cells.csv")"
+if [ -n "$python" ]; then
+  "$python" "$examples/tools/cell_study_table.py" <"$work/table.md" >"$work/summary.md" || fail "cell_study_table.py failed"
+  grep -q '^| sigma | +' "$work/summary.md" || fail "no sigma row: $(cat "$work/summary.md")"
+  ! grep -q '^| split |' "$work/summary.md" || fail "the unknown input split has a row: $(cat "$work/summary.md")"
+  echo "ok: the table lists the inputs the backend gives, and only those"
+fi
