@@ -83,11 +83,8 @@ inline std::string strategies_csv() {
     const char* policy = s.policy == StrategyPolicy::lawnmower           ? "lawnmower"
                          : s.policy == StrategyPolicy::decision_function ? "decision_function"
                                                                          : "linear";
-    const char* schedule = s.schedule == DescentSchedule::tour  ? "tour"
-                           : s.schedule == DescentSchedule::row ? "row"
-                                                                : "immediate";
-    out += std::string(s.name) + ',' + policy + ',' + schedule + ',' + (s.online ? "true" : "false") + ",\"" +
-           std::string(s.label) + "\"\n";
+    out += std::string(s.name) + ',' + policy + ',' + to_string(s.schedule) + ',' + (s.online ? "true" : "false") +
+           ",\"" + std::string(s.label) + "\"\n";
   }
   return out;
 }
