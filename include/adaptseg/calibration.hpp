@@ -7,6 +7,7 @@
 #include <adaptseg/adaptive_mission.hpp>
 #include <adaptseg/decision_function.hpp>
 #include <adaptseg/decision_model.hpp>
+#include <adaptseg/detail/gsd.hpp>
 #include <adaptseg/linear_decision.hpp>
 #include <adaptseg/metrics.hpp>
 #include <adaptseg/mission.hpp>
@@ -357,12 +358,13 @@ template <SegmentationBackend Backend>
       for (const double top : model.cells()->top_gsds()) {
         double sub = 0.0;  // the coarsest descent GSD sampled from this top
         for (const CellSample& c : cells_by_field[f])
-          if (c.top_gsd_cm == top) sub = std::max(sub, c.sub_gsd_cm);
+          if (detail::same_gsd(c.top_gsd_cm, top)) sub = std::max(sub, c.sub_gsd_cm);
         double mass = 0.0, px = 0.0;
         for (const CellSample& c : cells_by_field[f])
-          if (c.top_gsd_cm == top && c.sub_gsd_cm == sub) mass += c.top.mass(adaptive.cell_input), px += c.top.field_px;
+          if (detail::same_gsd(c.top_gsd_cm, top) && detail::same_gsd(c.sub_gsd_cm, sub))
+            mass += c.top.mass(adaptive.cell_input), px += c.top.field_px;
         const double input = px > 0.0 ? mass / px : 0.0;
-        if (top == adaptive.top_gsd_cm) reference[f].field_input = input;
+        if (detail::same_gsd(top, adaptive.top_gsd_cm)) reference[f].field_input = input;
         reference[f].top_inputs.emplace_back(top, input);
       }
     }
