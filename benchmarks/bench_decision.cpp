@@ -2,9 +2,9 @@
 // paper's utility rule and of the front-aware rule, for sample counts seen in practice and
 // after many online updates.
 //   build/release/benchmarks/bench_decision
-#include <adaptseg/front_aware_policy.hpp>
-#include <adaptseg/utility_policy.hpp>
-#include <adaptseg/lawnmower_curve.hpp>
+#include <adaptseg/core/front_aware_policy.hpp>
+#include <adaptseg/core/lawnmower_curve.hpp>
+#include <adaptseg/core/utility_policy.hpp>
 
 #include <algorithm>
 #include <chrono>

@@ -10,9 +10,9 @@
 
 #include "bench_timing.hpp"
 
-#include <adaptseg/ensemble_segmenter.hpp>
-#include <adaptseg/lawnmower_planner.hpp>
-#include <adaptseg/simulated_sensor.hpp>
+#include <adaptseg/core/lawnmower_planner.hpp>
+#include <adaptseg/erfnet/ensemble_segmenter.hpp>
+#include <adaptseg/vision/simulated_sensor.hpp>
 
 #include <cstdio>
 #include <exception>

@@ -12,7 +12,7 @@
 
 #include "bench_timing.hpp"
 
-#include <adaptseg/erfnet_segmenter.hpp>
+#include <adaptseg/erfnet/erfnet_segmenter.hpp>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>

@@ -6,7 +6,7 @@
 // "init sf2 ls sn2" / n training rows "x_1..x_D y" / m query rows "x_1..x_D" / one row "x_1..x_D y"
 // (the online observation). Prints one line of JSON: median times [s], LML and hyperparameters.
 // D = 1 uses the isotropic kernel, D > 1 the ARD kernel (scikit-learn: RBF with a vector length scale).
-#include <adaptseg/gaussian_process.hpp>
+#include <adaptseg/core/gaussian_process.hpp>
 
 #include <Eigen/Core>
 

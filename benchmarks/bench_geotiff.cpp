@@ -1,7 +1,7 @@
 // Loading a GeoTIFF field and writing its fused map as GeoTIFF: wall time and peak memory.
 //   bench_geotiff FIELD_DIR OUT_DIR
 // benchmarks/bench_geotiff.sh makes a 20000 x 20000 field from a bundled tile and runs this.
-#include <adaptseg/gdal_io.hpp>
+#include <adaptseg/gdal/gdal_io.hpp>
 
 #include <sys/resource.h>
 

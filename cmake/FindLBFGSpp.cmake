@@ -1,6 +1,6 @@
 # Finds LBFGSpp (header-only L-BFGS-B, https://github.com/yixuan/LBFGSpp; Debian:
 # liblbfgspp-dev), which adaptseg's Gaussian process uses through
-# include/adaptseg/detail/lbfgs.hpp. Supported: 0.1.0 (see that header).
+# include/adaptseg/core/detail/lbfgs.hpp. Supported: 0.1.0 (see that header).
 #
 # Defines the imported target LBFGSpp::LBFGSpp (its headers and Eigen3::Eigen) and
 # LBFGSpp_FOUND, LBFGSpp_INCLUDE_DIR. Set LBFGSpp_ROOT or CMAKE_PREFIX_PATH to point at

@@ -34,11 +34,11 @@
 #include "common/segmenters.hpp"
 #include "common/strategies.hpp"
 
-#include <adaptseg/adaptive_planner.hpp>
-#include <adaptseg/erfnet_segmenter.hpp>
+#include <adaptseg/erfnet/erfnet_segmenter.hpp>
 #include <adaptseg/planner.hpp>
+#include <adaptseg/vision/adaptive_planner.hpp>
 #ifdef ADAPTSEG_HAVE_GDAL
-#include <adaptseg/survey_site.hpp>
+#include <adaptseg/gdal/survey_site.hpp>
 #endif
 
 #include <opencv2/imgcodecs.hpp>

@@ -14,8 +14,8 @@
 #include "common/cli.hpp"
 #include "common/export.hpp"
 
-#include <adaptseg/survey_site.hpp>
-#include <adaptseg/visualization.hpp>
+#include <adaptseg/gdal/survey_site.hpp>
+#include <adaptseg/vision/visualization.hpp>
 
 #include <cmath>
 #include <cstdio>

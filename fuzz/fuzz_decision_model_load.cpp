@@ -3,7 +3,7 @@
 
 #include "fuzz_support.hpp"
 
-#include <adaptseg/decision_model.hpp>
+#include <adaptseg/vision/decision_model.hpp>
 
 #include <cstddef>
 #include <cstdint>

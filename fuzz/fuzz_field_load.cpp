@@ -4,7 +4,7 @@
 
 #include "fuzz_support.hpp"
 
-#include <adaptseg/field.hpp>
+#include <adaptseg/vision/field.hpp>
 
 #include <opencv2/imgcodecs.hpp>
 

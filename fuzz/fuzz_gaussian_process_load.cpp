@@ -4,9 +4,9 @@
 
 #include "fuzz_support.hpp"
 
-#include <adaptseg/decision_model.hpp>
-#include <adaptseg/gaussian_process.hpp>
-#include <adaptseg/gp_io.hpp>
+#include <adaptseg/core/gaussian_process.hpp>
+#include <adaptseg/vision/decision_model.hpp>
+#include <adaptseg/vision/gp_io.hpp>
 
 #include <cstddef>
 #include <cstdint>

@@ -1,10 +1,10 @@
 #pragma once
 // The conformance suite every SegmentationBackend model runs (see the concept's contract in
-// include/adaptseg/segmentation_backend.hpp).
+// include/adaptseg/vision/segmentation_backend.hpp).
 
-#include <adaptseg/lawnmower_planner.hpp>
-#include <adaptseg/segmentation_backend.hpp>
-#include <adaptseg/simulated_sensor.hpp>
+#include <adaptseg/core/lawnmower_planner.hpp>
+#include <adaptseg/vision/segmentation_backend.hpp>
+#include <adaptseg/vision/simulated_sensor.hpp>
 
 #include <doctest/doctest.h>
 

@@ -4,7 +4,7 @@
 // format, only reads it (detail/gp_text_v1.hpp), so the tests of that reader make their files
 // here.
 
-#include <adaptseg/gaussian_process.hpp>
+#include <adaptseg/core/gaussian_process.hpp>
 
 #include <Eigen/Core>
 

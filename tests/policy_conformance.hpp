@@ -1,8 +1,8 @@
 #pragma once
 // The conformance suite every DecisionPolicy model runs (the concept's laws are written beside
-// it in include/adaptseg/decision.hpp).
+// it in include/adaptseg/core/decision.hpp).
 
-#include <adaptseg/decision.hpp>
+#include <adaptseg/core/decision.hpp>
 
 #include <doctest/doctest.h>
 

@@ -1,9 +1,9 @@
 #include "test_support.hpp"
 
-#include <adaptseg/adaptive_mission.hpp>
-#include <adaptseg/adaptive_planner.hpp>
-#include <adaptseg/front_aware_policy.hpp>
-#include <adaptseg/oracle_segmenter.hpp>
+#include <adaptseg/core/front_aware_policy.hpp>
+#include <adaptseg/vision/adaptive_mission.hpp>
+#include <adaptseg/vision/adaptive_planner.hpp>
+#include <adaptseg/vision/oracle_segmenter.hpp>
 
 #include <doctest/doctest.h>
 

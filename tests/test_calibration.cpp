@@ -1,9 +1,9 @@
 #include "comma_locale.hpp"
 #include "test_support.hpp"
 
-#include <adaptseg/calibration.hpp>
-#include <adaptseg/decision_model.hpp>
-#include <adaptseg/oracle_segmenter.hpp>
+#include <adaptseg/vision/calibration.hpp>
+#include <adaptseg/vision/decision_model.hpp>
+#include <adaptseg/vision/oracle_segmenter.hpp>
 
 #include <doctest/doctest.h>
 

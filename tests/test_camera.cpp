@@ -1,4 +1,4 @@
-#include <adaptseg/camera.hpp>
+#include <adaptseg/core/camera.hpp>
 
 #include <doctest/doctest.h>
 

@@ -1,4 +1,4 @@
-#include <adaptseg/cell_gain_model.hpp>
+#include <adaptseg/core/cell_gain_model.hpp>
 
 #include <doctest/doctest.h>
 

@@ -4,12 +4,12 @@
 
 #include "policy_conformance.hpp"
 
-#include <adaptseg/decision_function.hpp>
-#include <adaptseg/front_aware_policy.hpp>
-#include <adaptseg/gain_model.hpp>
-#include <adaptseg/lawnmower_curve.hpp>
-#include <adaptseg/linear_decision.hpp>
-#include <adaptseg/utility_policy.hpp>
+#include <adaptseg/core/decision_function.hpp>
+#include <adaptseg/core/front_aware_policy.hpp>
+#include <adaptseg/core/gain_model.hpp>
+#include <adaptseg/core/lawnmower_curve.hpp>
+#include <adaptseg/core/linear_decision.hpp>
+#include <adaptseg/core/utility_policy.hpp>
 
 #include <doctest/doctest.h>
 

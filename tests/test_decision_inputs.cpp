@@ -1,5 +1,5 @@
-#include <adaptseg/decision_inputs.hpp>
-#include <adaptseg/image_summary.hpp>
+#include <adaptseg/core/decision_inputs.hpp>
+#include <adaptseg/vision/image_summary.hpp>
 
 #include <doctest/doctest.h>
 

@@ -1,4 +1,4 @@
-// Tests of the ensemble backend (include/adaptseg/ensemble_segmenter.hpp) with the bundled
+// Tests of the ensemble backend (include/adaptseg/erfnet/ensemble_segmenter.hpp) with the bundled
 // ensemble examples/models/ensemble-dubai (MobileNetV2 + ERFNet) and member lists made here:
 // the mean is the weighted mean of what each member gives alone, disagreement and class splits
 // follow the members' labels, the contract holds, the mean maps the held-out tile better than
@@ -7,10 +7,10 @@
 #include "backend_conformance.hpp"
 #include "test_support.hpp"
 
-#include <adaptseg/ensemble_segmenter.hpp>
-#include <adaptseg/image_summary.hpp>
-#include <adaptseg/lawnmower_planner.hpp>
-#include <adaptseg/metrics.hpp>
+#include <adaptseg/core/lawnmower_planner.hpp>
+#include <adaptseg/erfnet/ensemble_segmenter.hpp>
+#include <adaptseg/vision/image_summary.hpp>
+#include <adaptseg/vision/metrics.hpp>
 
 #include <doctest/doctest.h>
 

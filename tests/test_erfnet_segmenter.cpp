@@ -1,4 +1,4 @@
-// Tests of the ONNX backend (include/adaptseg/erfnet_segmenter.hpp) with every bundled model:
+// Tests of the ONNX backend (include/adaptseg/erfnet/erfnet_segmenter.hpp) with every bundled model:
 // examples/models/erfnet-dubai (ERFNet, input = camera size, stride 1) and
 // examples/models/mobilenetv2-dubai (MobileNetV2 + decoder, input 512x384 for the 480x360
 // camera, logits at stride 4), each with its fixture in tests/data/<fixture> (written by
@@ -9,10 +9,10 @@
 #include "backend_conformance.hpp"
 #include "test_support.hpp"
 
-#include <adaptseg/erfnet_segmenter.hpp>
-#include <adaptseg/lawnmower_planner.hpp>
-#include <adaptseg/metrics.hpp>
-#include <adaptseg/oracle_segmenter.hpp>
+#include <adaptseg/core/lawnmower_planner.hpp>
+#include <adaptseg/erfnet/erfnet_segmenter.hpp>
+#include <adaptseg/vision/metrics.hpp>
+#include <adaptseg/vision/oracle_segmenter.hpp>
 
 #include <doctest/doctest.h>
 #include <yaml-cpp/yaml.h>

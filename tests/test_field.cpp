@@ -1,6 +1,6 @@
 #include "test_support.hpp"
 
-#include <adaptseg/field.hpp>
+#include <adaptseg/vision/field.hpp>
 
 #include <doctest/doctest.h>
 

@@ -1,8 +1,8 @@
-// Tests for adaptseg/gaussian_process.hpp: kernel concept, a conformance suite run on every
+// Tests for adaptseg/core/gaussian_process.hpp: kernel concept, a conformance suite run on every
 // kernel model, agreement with scikit-learn (fixtures from tests/tools/make_gp_fixtures.py),
 // and properties (gradient, online updates, degenerate data, persistence).
 
-#include <adaptseg/gaussian_process.hpp>
+#include <adaptseg/core/gaussian_process.hpp>
 
 #include <doctest/doctest.h>
 

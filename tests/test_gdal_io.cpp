@@ -1,8 +1,8 @@
 // GeoTIFF fields and georeferenced maps (adaptseg::gdal): a bundled tile written to GeoTIFF by
 // gdal_translate's own code (GDALTranslate) under a UTM georeference, loaded back, its frame
 // checked against GDAL's transformation of the CRS, its map written and read back by GDAL.
-#include <adaptseg/gdal_io.hpp>
-#include <adaptseg/survey_site.hpp>
+#include <adaptseg/gdal/gdal_io.hpp>
+#include <adaptseg/gdal/survey_site.hpp>
 
 #include "test_support.hpp"
 

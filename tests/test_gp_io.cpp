@@ -6,8 +6,8 @@
 #include "gp_text_v1_writer.hpp"
 #include "test_support.hpp"
 
-#include <adaptseg/gaussian_process.hpp>
-#include <adaptseg/gp_io.hpp>
+#include <adaptseg/core/gaussian_process.hpp>
+#include <adaptseg/vision/gp_io.hpp>
 
 #include <doctest/doctest.h>
 #include <Eigen/Core>

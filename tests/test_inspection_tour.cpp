@@ -1,4 +1,4 @@
-#include <adaptseg/inspection_tour.hpp>
+#include <adaptseg/core/inspection_tour.hpp>
 
 #include <doctest/doctest.h>
 

@@ -1,4 +1,4 @@
-#include <adaptseg/lawnmower_planner.hpp>
+#include <adaptseg/core/lawnmower_planner.hpp>
 
 #include <doctest/doctest.h>
 

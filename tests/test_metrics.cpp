@@ -1,4 +1,4 @@
-#include <adaptseg/metrics.hpp>
+#include <adaptseg/vision/metrics.hpp>
 
 #include <doctest/doctest.h>
 

@@ -1,7 +1,7 @@
 #include "test_support.hpp"
 
-#include <adaptseg/mission.hpp>
-#include <adaptseg/oracle_segmenter.hpp>
+#include <adaptseg/vision/mission.hpp>
+#include <adaptseg/vision/oracle_segmenter.hpp>
 
 #include <doctest/doctest.h>
 

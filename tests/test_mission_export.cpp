@@ -1,7 +1,7 @@
 #include "test_support.hpp"
 
-#include <adaptseg/geo.hpp>
-#include <adaptseg/mission_export.hpp>
+#include <adaptseg/geo/georeference.hpp>
+#include <adaptseg/geo/mission_export.hpp>
 
 #include <GeographicLib/Geodesic.hpp>
 #include <doctest/doctest.h>

@@ -1,9 +1,9 @@
 #include "backend_conformance.hpp"
 #include "test_support.hpp"
 
-#include <adaptseg/metrics.hpp>
-#include <adaptseg/oracle_segmenter.hpp>
-#include <adaptseg/simulated_sensor.hpp>
+#include <adaptseg/vision/metrics.hpp>
+#include <adaptseg/vision/oracle_segmenter.hpp>
+#include <adaptseg/vision/simulated_sensor.hpp>
 
 #include <doctest/doctest.h>
 

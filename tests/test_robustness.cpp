@@ -7,14 +7,14 @@
 #include "gp_text_v1_writer.hpp"
 #include "test_support.hpp"
 
-#include <adaptseg/adaptive_mission.hpp>
-#include <adaptseg/decision_function.hpp>
-#include <adaptseg/decision_model.hpp>
-#include <adaptseg/erfnet_segmenter.hpp>
-#include <adaptseg/gaussian_process.hpp>
-#include <adaptseg/gp_io.hpp>
-#include <adaptseg/oracle_segmenter.hpp>
-#include <adaptseg/region_samples.hpp>
+#include <adaptseg/core/decision_function.hpp>
+#include <adaptseg/core/gaussian_process.hpp>
+#include <adaptseg/erfnet/erfnet_segmenter.hpp>
+#include <adaptseg/vision/adaptive_mission.hpp>
+#include <adaptseg/vision/decision_model.hpp>
+#include <adaptseg/vision/gp_io.hpp>
+#include <adaptseg/vision/oracle_segmenter.hpp>
+#include <adaptseg/vision/region_samples.hpp>
 
 #include <doctest/doctest.h>
 

@@ -1,8 +1,8 @@
 #include "test_support.hpp"
 
-#include <adaptseg/oracle_segmenter.hpp>
-#include <adaptseg/semantic_map.hpp>
-#include <adaptseg/simulated_sensor.hpp>
+#include <adaptseg/vision/oracle_segmenter.hpp>
+#include <adaptseg/vision/semantic_map.hpp>
+#include <adaptseg/vision/simulated_sensor.hpp>
 
 #include <doctest/doctest.h>
 

@@ -1,6 +1,6 @@
 #include "test_support.hpp"
 
-#include <adaptseg/simulated_sensor.hpp>
+#include <adaptseg/vision/simulated_sensor.hpp>
 
 #include <doctest/doctest.h>
 

@@ -1,7 +1,7 @@
 #pragma once
 // Helpers shared by the tests: synthetic fields, temporary directories, bundled data paths.
 
-#include <adaptseg/field.hpp>
+#include <adaptseg/vision/field.hpp>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>

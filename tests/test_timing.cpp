@@ -1,4 +1,4 @@
-#include <adaptseg/timing.hpp>
+#include <adaptseg/core/timing.hpp>
 
 #include <doctest/doctest.h>
 

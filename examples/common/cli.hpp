@@ -2,9 +2,9 @@
 // Shared command-line plumbing of the example programs: camera/timing options, error
 // reporting, and the result.json writer. Not part of the library.
 
-#include <adaptseg/calibration.hpp>
-#include <adaptseg/decision_model.hpp>
 #include <adaptseg/planner.hpp>
+#include <adaptseg/vision/calibration.hpp>
+#include <adaptseg/vision/decision_model.hpp>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>

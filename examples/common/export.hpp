@@ -1,11 +1,11 @@
 #pragma once
 // `--export FORMAT` of adaptseg_mission: the geo-reference of the flown field (field.yaml's
 // `geo:` section or --geo-origin) and the mission files of the flown path. Not part of the
-// library; the formats are adaptseg/mission_export.hpp's.
+// library; the formats are adaptseg/geo/mission_export.hpp's.
 
 #include "strategies.hpp"
 
-#include <adaptseg/mission_export.hpp>
+#include <adaptseg/geo/mission_export.hpp>
 
 #include <CLI/CLI.hpp>
 

@@ -5,13 +5,13 @@
 
 #include "common/cli.hpp"
 
-#include <adaptseg/adaptive_options.hpp>
-#include <adaptseg/decision_model.hpp>
-#include <adaptseg/field.hpp>
-#include <adaptseg/geo.hpp>
-#include <adaptseg/simulated_sensor.hpp>
+#include <adaptseg/geo/georeference.hpp>
+#include <adaptseg/vision/adaptive_options.hpp>
+#include <adaptseg/vision/decision_model.hpp>
+#include <adaptseg/vision/field.hpp>
+#include <adaptseg/vision/simulated_sensor.hpp>
 #ifdef ADAPTSEG_HAVE_GDAL
-#include <adaptseg/gdal_io.hpp>
+#include <adaptseg/gdal/gdal_io.hpp>
 #endif
 
 #include <opencv2/imgcodecs.hpp>

@@ -2,15 +2,15 @@
 // Choosing the segmentation backend by name (--segmenter oracle|erfnet --model-file PATH) for
 // the example programs. Not part of the library.
 
-#include <adaptseg/calibration.hpp>
-#include <adaptseg/camera.hpp>
-#include <adaptseg/ensemble_segmenter.hpp>
-#include <adaptseg/erfnet_segmenter.hpp>
-#include <adaptseg/field.hpp>
-#include <adaptseg/lawnmower_planner.hpp>
-#include <adaptseg/oracle_segmenter.hpp>
-#include <adaptseg/segmentation_backend.hpp>
-#include <adaptseg/simulated_sensor.hpp>
+#include <adaptseg/core/camera.hpp>
+#include <adaptseg/core/lawnmower_planner.hpp>
+#include <adaptseg/erfnet/ensemble_segmenter.hpp>
+#include <adaptseg/erfnet/erfnet_segmenter.hpp>
+#include <adaptseg/vision/calibration.hpp>
+#include <adaptseg/vision/field.hpp>
+#include <adaptseg/vision/oracle_segmenter.hpp>
+#include <adaptseg/vision/segmentation_backend.hpp>
+#include <adaptseg/vision/simulated_sensor.hpp>
 
 #include <CLI/CLI.hpp>
 

@@ -3,11 +3,11 @@
 
 #include "cli.hpp"
 
-#include <adaptseg/adaptive_mission.hpp>
-#include <adaptseg/decision_model.hpp>
-#include <adaptseg/linear_decision.hpp>
+#include <adaptseg/core/linear_decision.hpp>
+#include <adaptseg/vision/adaptive_mission.hpp>
+#include <adaptseg/vision/decision_model.hpp>
 #ifdef ADAPTSEG_HAVE_GDAL
-#include <adaptseg/gdal_io.hpp>
+#include <adaptseg/gdal/gdal_io.hpp>
 #endif
 
 #include <array>

@@ -5,7 +5,7 @@
 // and fused; then, for each top-level region and each candidate GSD, every cell of the region's
 // sub-lawnmower is flown, and its realised gain is the field IoU of the top-level map with only
 // that cell's pixels re-mapped, minus the top-level map's. Per (field, class, GSD) it prints,
-// for every input of the table in include/adaptseg/decision_inputs.hpp, the rank correlation of
+// for every input of the table in include/adaptseg/core/decision_inputs.hpp, the rank correlation of
 // the cells' input mass (value x field pixels) with their gain and the share of the achievable
 // positive gain that re-mapping the top 10 % / 20 % of cells by that mass captures, beside a
 // random choice and the best possible (hindsight), and their means over the groups; with --model,
@@ -18,8 +18,8 @@
 #include "common/segmenters.hpp"
 #include "common/strategies.hpp"
 
-#include <adaptseg/decision_model.hpp>
-#include <adaptseg/image_summary.hpp>
+#include <adaptseg/vision/decision_model.hpp>
+#include <adaptseg/vision/image_summary.hpp>
 
 #include <algorithm>
 #include <array>

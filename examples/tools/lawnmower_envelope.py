@@ -1,5 +1,5 @@
 """The lawnmower curve's upper envelope, as the library computes it and reads the front margin
-against it (include/adaptseg/lawnmower_curve.hpp: upper_envelope, front_margin), for the Python
+against it (include/adaptseg/core/lawnmower_curve.hpp: upper_envelope, front_margin), for the Python
 tools that read results.csv (plot_evaluation.py, backend_compare.py)."""
 
 

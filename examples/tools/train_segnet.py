@@ -4,11 +4,11 @@ export it: ERFNet from scratch (--arch erfnet) or MobileNetV2 with ImageNet weig
 light decoder (--arch mobilenetv2, examples/tools/mobilenet_v2.py).
 
 The network sees exactly what adaptseg's simulated camera produces (SimulatedSensor,
-include/adaptseg/simulated_sensor.hpp): the footprint of a camera (default 480x360 px) at a
+include/adaptseg/vision/simulated_sensor.hpp): the footprint of a camera (default 480x360 px) at a
 GSD drawn uniformly from [gsd_min_factor, gsd_max_factor] x the field's gsd_cm is cut from the
 orthomosaic, edges snapped to whole orthomosaic pixels, parts outside the orthomosaic filled
 black / ignore, and the RGB resampled with cv::INTER_AREA to the camera size. The training
-target is the oracle's label map (include/adaptseg/oracle_segmenter.hpp): per camera pixel the
+target is the oracle's label map (include/adaptseg/vision/oracle_segmenter.hpp): per camera pixel the
 area-weighted majority of the orthomosaic labels it covers, ignore pixels not voting, ties to
 the lower class index, 255 where no valid pixel is covered. CrossEntropy ignores label 255.
 
@@ -192,7 +192,7 @@ def lawnmower_rects(field: FieldData, gsd_cm: float, cam_wh: tuple[int, int]):
 
 # ---------------------------------------------------------------------------------------------
 # The backend's path: camera image -> network input -> logits at camera size
-# (mirrors ErfnetSegmenter::logits in include/adaptseg/erfnet_segmenter.hpp)
+# (mirrors ErfnetSegmenter::logits in include/adaptseg/erfnet/erfnet_segmenter.hpp)
 # ---------------------------------------------------------------------------------------------
 @dataclass
 class NetSpec:

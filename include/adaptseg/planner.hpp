@@ -1,18 +1,10 @@
 #pragma once
 /// @file
-/// Umbrella header: every component. Backends that need heavy integrations (the ERFNet
-/// backend through OpenCV DNN) stay out of it, behind their own header and CMake component.
+/// Umbrella header of everything CMake target adaptseg::vision gives: the core
+/// (<adaptseg/core.hpp>: camera, flight time, lawnmower planner, Gaussian process, decision rules)
+/// and the vision component (<adaptseg/vision.hpp>: fields, sensor, oracle, map, metrics, missions,
+/// the adaptive planner, calibration). The components with further dependencies have their own
+/// umbrella header and CMake target: <adaptseg/erfnet.hpp> (adaptseg::erfnet, OpenCV DNN),
+/// <adaptseg/geo.hpp> (adaptseg::geo, GeographicLib) and <adaptseg/gdal.hpp> (adaptseg::gdal).
 
-#include <adaptseg/camera.hpp>
-#include <adaptseg/error.hpp>
-#include <adaptseg/field.hpp>
-#include <adaptseg/lawnmower_planner.hpp>
-#include <adaptseg/metrics.hpp>
-#include <adaptseg/mission.hpp>
-#include <adaptseg/oracle_segmenter.hpp>
-#include <adaptseg/segmentation_backend.hpp>
-#include <adaptseg/semantic_map.hpp>
-#include <adaptseg/simulated_sensor.hpp>
-#include <adaptseg/timing.hpp>
-#include <adaptseg/version.hpp>
-#include <adaptseg/visualization.hpp>
+#include <adaptseg/vision.hpp>

@@ -1,7 +1,7 @@
 // The Eigen-only core needs no OpenCV: camera, timing, lawnmower planning.
-#include <adaptseg/camera.hpp>
-#include <adaptseg/lawnmower_planner.hpp>
-#include <adaptseg/timing.hpp>
+#include <adaptseg/core/camera.hpp>
+#include <adaptseg/core/lawnmower_planner.hpp>
+#include <adaptseg/core/timing.hpp>
 
 #include <cstdio>
 

@@ -1,5 +1,5 @@
 // The network backend component: its header and target from the installed package.
-#include <adaptseg/erfnet_segmenter.hpp>
+#include <adaptseg/erfnet/erfnet_segmenter.hpp>
 
 #include <cstdio>
 

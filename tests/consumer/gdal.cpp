@@ -1,6 +1,6 @@
 // adaptseg::gdal from the installed package: GDAL found through it. A field georeferenced by
 // geo: writes its map as a GeoTIFF, whose grid GDAL reads back.
-#include <adaptseg/gdal_io.hpp>
+#include <adaptseg/gdal/gdal_io.hpp>
 
 #include <cstdio>
 #include <filesystem>

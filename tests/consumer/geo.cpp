@@ -1,5 +1,5 @@
 // adaptseg::geo from the installed package: GeographicLib and nlohmann-json found through it.
-#include <adaptseg/mission_export.hpp>
+#include <adaptseg/geo/mission_export.hpp>
 
 #include <cstdio>
 

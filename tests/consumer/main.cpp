@@ -1,7 +1,7 @@
 // Uses the installed package: plan and fly a lawnmower over a synthetic field with the oracle,
 // and write and read back a Gaussian process as a YAML file (the vision component's formats).
-#include <adaptseg/gp_io.hpp>
 #include <adaptseg/planner.hpp>
+#include <adaptseg/vision/gp_io.hpp>
 
 #include <cstdio>
 #include <sstream>

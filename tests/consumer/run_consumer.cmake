@@ -32,7 +32,7 @@ set(hidden -DCMAKE_DISABLE_FIND_PACKAGE_OpenCV=ON -DCMAKE_DISABLE_FIND_PACKAGE_y
 step("configuring the core consumer with the other dependencies hidden" "${CMAKE_COMMAND}" -S "${SOURCE_DIR}/core"
      -B "${WORK_DIR}/core" ${prefix} -DCMAKE_BUILD_TYPE=Release ${hidden})
 step("building the core consumer" "${CMAKE_COMMAND}" --build "${WORK_DIR}/core")
-step("gp_only" "${WORK_DIR}/core/gp_only")
+step("core_only" "${WORK_DIR}/core/core_only")
 
 execute_process(COMMAND "${CMAKE_COMMAND}" -S "${SOURCE_DIR}/core" -B "${WORK_DIR}/core-vision" ${prefix}
                         -DASK_VISION=ON ${hidden}

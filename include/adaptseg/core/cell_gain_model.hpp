@@ -1,0 +1,296 @@
+#pragma once
+/// @file
+/// What re-mapping chosen cells of a region gains, forecast from one decision input of the
+/// top-level image (beyond the paper; docs/method.md, "Cells that pay"): the cell gain model,
+/// fitted to calibration samples of single cells re-mapped alone, and the score its input is
+/// chosen by on the training fields.
+
+#include <adaptseg/core/decision_inputs.hpp>
+#include <adaptseg/core/detail/gsd.hpp>
+#include <adaptseg/core/detail/interpolate.hpp>
+#include <adaptseg/core/error.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <numeric>
+#include <span>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+namespace adaptseg {
+
+/// One cell of a top-level region, re-mapped alone from a lower altitude on a training field
+/// (calibration knows the truth): a row of the cell gain model.
+struct CellSample {
+  std::size_t field = 0;      ///< which calibration field it comes from (index)
+  std::size_t region = 0;     ///< its region (top-level waypoint index) on that field
+  double top_gsd_cm = 0.0;    ///< the GSD of the top-level image that saw it [cm/px]
+  double sub_gsd_cm = 0.0;    ///< the GSD it was re-mapped at [cm/px]
+  CellInputs top;             ///< the cell as the top-level image saw it
+  /// The same quantities from the finer image over the cell (NaN values where unknown): what a
+  /// descent shows in flight about how much surer the finer look is.
+  CellInputs fine;
+  double field_share = 0.0;   ///< the cell's field pixels / the field's
+  double field_sigma = 0.0;   ///< σ of the field's top-level map (share of L over its field pixels)
+  /// Share of the cell's field pixels whose label the re-mapping changed with L involved
+  /// (observable in flight: no truth needed).
+  double relabelled = 0.0;
+  /// Field mIoU over L of the top-level map with only this cell re-mapped, minus without.
+  double field_gain = 0.0;
+
+  /// The field gain per unit of the cell's field share and of the field's σ (≈ the share of
+  /// the cell's pixels corrected; RegionSample::normalized_field_gain for a region).
+  [[nodiscard]] double normalized_gain() const noexcept {
+    return field_share > 0.0 ? field_gain * field_sigma / field_share : 0.0;
+  }
+};
+
+/// The cell gain model: per pair of top-level and descent GSD, how much of a cell's input x (a
+/// decision input of the top-level image, e.g. its expected error about L) a re-mapping turns
+/// into gain, and into relabelled pixels.
+///
+/// For a cell c with input value x_c seen at GSD g_top and re-mapped at g:
+/// - its normalised gain ν_c (CellSample::normalized_gain) = β·x_c + ε, Var ε = κ·x_c;
+/// - its relabelled share χ_c = α·x_c + ε', Var ε' = κ_χ·x_c;
+/// β, α per (g_top, g): weighted least squares through the origin over the calibration cells
+/// of that pair (weights: the cells' field pixels); κ, κ_χ: the weighted mean squared residual
+/// per unit of x. The variance grows with x because a cell's errors are what a re-mapping can
+/// change: the ground-truth oracle's expected error is exactly the share of pixels its
+/// top-level map has wrong, and a re-mapping at the orthomosaic's GSD corrects all of them
+/// (β ≈ 1, κ ≈ 0). A network's cells scatter about β·x (its confidence is only partly honest),
+/// and β is smaller: a finer image of a cell corrects part of what the network got wrong and
+/// gets some of the rest wrong. Between the calibrated descent GSDs of a top-level GSD the four
+/// numbers are linear in g; beyond them, constant; a top-level GSD that was not calibrated
+/// reads the nearest one that was.
+///
+/// A descent re-mapping a set S of cells of a region of R field pixels forecasts (as shares of
+/// the region: the same units as GainModel's relabelled share)
+/// gain = β·Σ_S w_c·x_c, Var = κ·Σ_S w_c²·x_c, and likewise the relabelled share, w_c = px_c / R.
+///
+/// What a descent shows, without ground truth (the scene check, FrontAwarePolicy::observe): the
+/// finer images' own value of the input over the same cells, x'_c. Where the finer look is surer
+/// (x' < x) the re-mapping corrected something, where it is less sure it likely did harm:
+/// ν_c ≈ γ·(x_c − x'_c) on the training cells (γ by least squares through the origin), so
+/// y = γ·Σ_S w_c·(x_c − x'_c) estimates the descent's realised gain. As a measurement of the
+/// forecast β·Σ_S w_c·x_c its spread is κ_p·Σ_S w_c²·x_c, κ_p the weighted mean squared
+/// difference per unit of x over the training cells: it holds how far the proxy misses and how
+/// far the training fields' own gains scatter, so that the scene check learns no faster than the
+/// training fields show it can. γ = κ_p = 0 where no fine inputs were known (labels-only backends).
+class CellGainModel {
+ public:
+  /// The model for one pair of top-level and descent GSDs.
+  struct Point {
+    double top_gsd_cm = 0.0;
+    double sub_gsd_cm = 0.0;
+    double gain_slope = 0.0;      ///< β
+    double gain_noise = 0.0;      ///< κ >= 0
+    double relabel_slope = 0.0;   ///< α
+    double relabel_noise = 0.0;   ///< κ_χ >= 0
+    double proxy_slope = 0.0;     ///< γ: gain per unit of the input the finer look removes
+    double proxy_noise = 0.0;     ///< κ_p >= 0
+  };
+
+  /// A forecast for a set of cells, in shares of the region's field pixels.
+  struct Forecast {
+    double gain = 0.0;            ///< normalised gain (× region share / field σ = field gain)
+    double gain_var = 0.0;
+    double relabelled = 0.0;      ///< relabelled share of the region with L involved
+    double relabelled_var = 0.0;
+    double input = 0.0;           ///< Σ w_c·x_c: the cells' input, what the finer look is compared with
+    double proxy_var = 0.0;       ///< κ_p·Σ w_c²·x_c: the spread of the scene check's measurement
+  };
+
+  /// @throws std::invalid_argument for no point, GSDs that are not finite and positive with the
+  ///         descent's finer than the top's, pairs not in increasing (top, descent) order, or a
+  ///         slope or noise that is not finite (noise < 0).
+  CellGainModel(DecisionInput input, std::vector<Point> points) : input_(input), points_(std::move(points)) {
+    detail::require(!points_.empty(), "CellGainModel: at least one point is needed; count", points_.size());
+    for (std::size_t k = 0; k < points_.size(); ++k) {
+      const Point& p = points_[k];
+      detail::require(std::isfinite(p.top_gsd_cm) && std::isfinite(p.sub_gsd_cm) && p.sub_gsd_cm > 0.0 &&
+                          p.sub_gsd_cm < p.top_gsd_cm,
+                      "CellGainModel: a point needs finite GSDs, the descent's finer than the top's; descent GSD",
+                      p.sub_gsd_cm);
+      detail::require(k == 0 || p.top_gsd_cm > points_[k - 1].top_gsd_cm ||
+                          (p.top_gsd_cm == points_[k - 1].top_gsd_cm && p.sub_gsd_cm > points_[k - 1].sub_gsd_cm),
+                      "CellGainModel: points must be in increasing (top, descent) GSD order; descent GSD", p.sub_gsd_cm);
+      detail::require(std::isfinite(p.gain_slope) && std::isfinite(p.relabel_slope) && std::isfinite(p.gain_noise) &&
+                          std::isfinite(p.relabel_noise) && p.gain_noise >= 0.0 && p.relabel_noise >= 0.0 &&
+                          std::isfinite(p.proxy_slope) && std::isfinite(p.proxy_noise) && p.proxy_noise >= 0.0,
+                      "CellGainModel: slopes must be finite and noises finite and >= 0; at descent GSD", p.sub_gsd_cm);
+    }
+  }
+
+  /// Fits the model of input `input` to `samples` (cells of every pair of GSDs).
+  /// @throws std::invalid_argument for no sample, or a sample that is not finite.
+  [[nodiscard]] static CellGainModel fit(std::span<const CellSample> samples, DecisionInput input) {
+    detail::require(!samples.empty(), "CellGainModel::fit: number of samples must be > 0", 0);
+    struct Group {
+      double top = 0.0, sub = 0.0;
+      std::vector<const CellSample*> cells;
+    };
+    std::vector<Group> groups;
+    for (const CellSample& s : samples) {
+      detail::require(std::isfinite(s.top_gsd_cm) && std::isfinite(s.sub_gsd_cm) && std::isfinite(s.field_gain) &&
+                          std::isfinite(s.relabelled) && std::isfinite(s.top.field_px) &&
+                          std::isfinite(s.field_share) && std::isfinite(s.field_sigma),
+                      "CellGainModel::fit: samples must be finite; field gain", s.field_gain);
+      std::size_t k = 0;
+      while (k < groups.size() && !(detail::same_gsd(groups[k].top, s.top_gsd_cm) && detail::same_gsd(groups[k].sub, s.sub_gsd_cm))) ++k;
+      if (k == groups.size()) groups.push_back(Group{s.top_gsd_cm, s.sub_gsd_cm, {}});
+      groups[k].cells.push_back(&s);
+    }
+    std::vector<Point> points;
+    for (const Group& g : groups) {
+      double px = 0.0;
+      for (const CellSample* c : g.cells) px += c->top.field_px;
+      const double mean_px = px > 0.0 ? px / static_cast<double>(g.cells.size()) : 1.0;
+      double wxx = 0.0, wxg = 0.0, wxr = 0.0, wx = 0.0;
+      for (const CellSample* c : g.cells) {
+        const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
+        wxx += w * x * x;
+        wxg += w * x * c->normalized_gain();
+        wxr += w * x * c->relabelled;
+        wx += w * x;
+      }
+      Point p{g.top, g.sub, wxx > 0.0 ? wxg / wxx : 0.0, 0.0, wxx > 0.0 ? wxr / wxx : 0.0, 0.0, 0.0, 0.0};
+      double eg = 0.0, er = 0.0, wdd = 0.0, wdg = 0.0;
+      bool proxy = true;
+      for (const CellSample* c : g.cells) {
+        const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
+        eg += w * std::pow(c->normalized_gain() - p.gain_slope * x, 2);
+        er += w * std::pow(c->relabelled - p.relabel_slope * x, 2);
+        const double xf = c->fine.value(input);
+        proxy = proxy && std::isfinite(c->top.value(input)) && std::isfinite(xf);
+        if (!proxy) continue;
+        wdd += w * (x - xf) * (x - xf);
+        wdg += w * (x - xf) * c->normalized_gain();
+      }
+      p.gain_noise = wx > 0.0 ? eg / wx : 0.0;
+      p.relabel_noise = wx > 0.0 ? er / wx : 0.0;
+      if (proxy && wdd > 0.0 && wx > 0.0) {
+        p.proxy_slope = wdg / wdd;
+        double ep = 0.0;
+        for (const CellSample* c : g.cells) {
+          const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
+          ep += w * std::pow(p.proxy_slope * (x - c->fine.value(input)) - p.gain_slope * x, 2);
+        }
+        p.proxy_noise = ep / wx;
+      }
+      points.push_back(p);
+    }
+    std::sort(points.begin(), points.end(), [](const Point& a, const Point& b) {
+      return a.top_gsd_cm < b.top_gsd_cm || (a.top_gsd_cm == b.top_gsd_cm && a.sub_gsd_cm < b.sub_gsd_cm);
+    });
+    return CellGainModel(input, std::move(points));
+  }
+
+  /// The forecast of re-mapping `cells`, seen at `top_gsd_cm`, at `sub_gsd_cm`, in shares of a
+  /// region of `region_px` field pixels (see the class comment).
+  /// @throws std::invalid_argument for `region_px` <= 0.
+  [[nodiscard]] Forecast forecast(double top_gsd_cm, double sub_gsd_cm, std::span<const CellInputs> cells,
+                                  double region_px) const {
+    detail::require(region_px > 0.0, "CellGainModel::forecast: region_px must be > 0", region_px);
+    const Point p = at(top_gsd_cm, sub_gsd_cm);
+    double sx = 0.0, sxx = 0.0;
+    for (const CellInputs& c : cells) {
+      const double w = c.field_px / region_px;
+      sx += w * x_of(c);
+      sxx += w * w * x_of(c);
+    }
+    return {p.gain_slope * sx, p.gain_noise * sxx, std::max(0.0, p.relabel_slope * sx), p.relabel_noise * sxx,
+            sx, p.proxy_noise * sxx};
+  }
+
+  /// The scene check's estimate of a descent's normalised gain (in shares of its region) from
+  /// the input its cells held at the top (`top_input`, Forecast::input) and in the finer images
+  /// (`fine_input`, the same sum): γ·(top − fine); 0 where the model has no proxy.
+  [[nodiscard]] double proxy_gain(double top_gsd_cm, double sub_gsd_cm, double top_input, double fine_input) const {
+    return at(top_gsd_cm, sub_gsd_cm).proxy_slope * (top_input - fine_input);
+  }
+
+  /// The normalised gain one cell is forecast (β·x).
+  [[nodiscard]] double cell_gain(double top_gsd_cm, double sub_gsd_cm, const CellInputs& cell) const {
+    return at(top_gsd_cm, sub_gsd_cm).gain_slope * x_of(cell);
+  }
+
+  /// The model for a pair of GSDs (see the class comment).
+  [[nodiscard]] Point at(double top_gsd_cm, double sub_gsd_cm) const {
+    // The calibrated top-level GSD nearest `top_gsd_cm`, and its points.
+    double top = points_.front().top_gsd_cm;
+    for (const Point& p : points_)
+      if (std::abs(p.top_gsd_cm - top_gsd_cm) < std::abs(top - top_gsd_cm)) top = p.top_gsd_cm;
+    std::vector<Point> row;
+    for (const Point& p : points_)
+      if (p.top_gsd_cm == top) row.push_back(p);
+    Point out{top_gsd_cm, sub_gsd_cm, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    out.gain_slope = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::gain_slope);
+    out.gain_noise = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::gain_noise);
+    out.relabel_slope = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::relabel_slope);
+    out.relabel_noise = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::relabel_noise);
+    out.proxy_slope = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::proxy_slope);
+    out.proxy_noise = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::proxy_noise);
+    return out;
+  }
+
+  /// The top-level GSDs the model was calibrated for, ascending.
+  [[nodiscard]] std::vector<double> top_gsds() const {
+    std::vector<double> out;
+    for (const Point& p : points_)
+      if (out.empty() || out.back() != p.top_gsd_cm) out.push_back(p.top_gsd_cm);
+    return out;
+  }
+
+  [[nodiscard]] DecisionInput input() const noexcept { return input_; }
+  [[nodiscard]] const std::vector<Point>& points() const noexcept { return points_; }
+
+ private:
+  [[nodiscard]] double x_of(const CellInputs& c) const noexcept { return value_of(c, input_); }
+  static double value_of(const CellInputs& c, DecisionInput input) noexcept {
+    const double v = c.value(input);
+    return std::isfinite(v) ? v : 0.0;
+  }
+
+  DecisionInput input_;
+  std::vector<Point> points_;
+};
+
+/// How well an input ranks the cells of the training fields by what re-mapping them gains:
+/// on each field and pair of top-level and candidate GSD in turn, the share of the achievable positive field gain
+/// (Σ max(gain, 0)) that re-mapping the `share` of cells with the most input mass
+/// (CellInputs::mass) captures; the mean over the (field, GSD) pairs with a positive
+/// achievable gain. No fitting is involved (the cell gain model only rescales the ranking), so
+/// each field is scored without the others: a leave-one-field-out score. NaN without such a pair.
+[[nodiscard]] inline double cell_ranking_capture(std::span<const CellSample> samples, DecisionInput input,
+                                                 double share = 0.2) {
+  std::vector<std::tuple<std::size_t, double, double>> groups;  // (field, top GSD, GSD)
+  for (const CellSample& s : samples)
+    if (std::find(groups.begin(), groups.end(), std::tuple{s.field, s.top_gsd_cm, s.sub_gsd_cm}) == groups.end())
+      groups.emplace_back(s.field, s.top_gsd_cm, s.sub_gsd_cm);
+  double sum = 0.0;
+  int count = 0;
+  for (const auto& [field, top, gsd] : groups) {
+    std::vector<const CellSample*> cells;
+    double positive = 0.0;
+    for (const CellSample& s : samples)
+      if (s.field == field && s.top_gsd_cm == top && s.sub_gsd_cm == gsd) {
+        cells.push_back(&s);
+        positive += std::max(0.0, s.field_gain);
+      }
+    if (!(positive > 0.0)) continue;
+    std::stable_sort(cells.begin(), cells.end(),
+                     [&](const CellSample* a, const CellSample* b) { return a->top.mass(input) > b->top.mass(input); });
+    const auto n = static_cast<std::size_t>(std::lround(share * static_cast<double>(cells.size())));
+    double captured = 0.0;
+    for (std::size_t k = 0; k < n; ++k) captured += cells[k]->field_gain;
+    sum += captured / positive;
+    ++count;
+  }
+  return count > 0 ? sum / count : std::numeric_limits<double>::quiet_NaN();
+}
+
+}  // namespace adaptseg

@@ -1,0 +1,126 @@
+#pragma once
+/// @file
+/// The adaptive strategy in simulation (paper §4-5): AdaptivePlanner decides, a Mission flies
+/// the simulated sensor and the segmentation backend and keeps the time account; in the end,
+/// what each descent gained against the ground truth.
+
+#include <adaptseg/core/decision.hpp>
+#include <adaptseg/vision/adaptive_planner.hpp>
+#include <adaptseg/vision/field.hpp>
+#include <adaptseg/vision/metrics.hpp>
+#include <adaptseg/vision/mission.hpp>
+#include <adaptseg/vision/segmentation_backend.hpp>
+#include <adaptseg/vision/semantic_map.hpp>
+
+#include <opencv2/core.hpp>
+
+#include <algorithm>
+#include <cstddef>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+namespace adaptseg {
+
+/// What a descent gained, measured against the ground truth (simulation only).
+struct RealisedDescent {
+  std::size_t decision = 0;      ///< index into AdaptiveResult::decisions
+  double region_miou_before = 0.0;  ///< mIoU over L of the region's map before the descent (paired_miou)
+  double region_miou_after = 0.0;   ///< ... after it
+  /// Field mIoU over L at the end of the mission minus the same with the pixels this descent
+  /// mapped last (also beyond its region, where its images overhang) labelled as the top-level
+  /// images labelled them: the descent's contribution to the mission's result.
+  double field_gain = 0.0;
+  /// Region ΔmIoU in the sense of the decision function's I: before − after (< 0: it helped).
+  [[nodiscard]] double region_delta_miou() const noexcept { return region_miou_before - region_miou_after; }
+};
+
+/// An adaptive mission's result: the mission plus every decision.
+struct AdaptiveResult {
+  MissionResult mission;
+  std::vector<DecisionRecord> decisions;
+  std::vector<RealisedDescent> realised;  ///< one per descent, in decision order (simulation)
+  [[nodiscard]] int descents() const {
+    return static_cast<int>(std::count_if(decisions.begin(), decisions.end(),
+                                           [](const DecisionRecord& d) { return d.decision.descend; }));
+  }
+};
+
+/// Runs the adaptive strategy with `policy` over `field` in simulation: AdaptivePlanner
+/// decides, a Mission flies (SimulatedSensor image, segmentation by `backend`, scoring, time
+/// accounting) and reports each image with the mission's elapsed time; the planner's fused
+/// map is the mission's map.
+///
+/// Holds references to `backend` and `policy` for the call's duration only.
+/// @throws std::invalid_argument for a top GSD finer than the field's, candidates that are not
+///         finer than the top, a budget too small for the top-level coverage alone, and the
+///         reasons of Mission's constructor.
+template <SegmentationBackend Backend, DecisionPolicy Policy>
+[[nodiscard]] AdaptiveResult run_adaptive_mission(const Field& field, Backend& backend, Policy& policy,
+                                                  const AdaptiveOptions& options, std::string strategy) {
+  Mission<Backend> mission(field, backend, options.mission, std::move(strategy));
+  AdaptiveOptions planner_options = options;
+  planner_options.mission.interest = mission.interest();
+  AdaptivePlanner<Backend, Policy> planner(SurveyArea::of(field), backend, policy, std::move(planner_options));
+  // What each descent gained is scored at the end against the ground truth: its region's map
+  // before it, the map pixels its images covered, and the top-level images alone.
+  struct Pending {
+    std::size_t decision;
+    cv::Rect region;
+    cv::Mat before;
+    cv::Rect covered;  ///< bounding box of the descent's footprints on the map
+    double gsd_cm;
+  };
+  std::vector<Pending> descents;
+  SemanticMap top_only(field.labels().size(), field.ignore_label());
+  while (const auto w = planner.next()) {
+    mission.charge_planning(planner.take_planning_s());
+    if (w->level == 1 && w->step == 0) {  // a descent starts: its region's map before it
+      const cv::Rect region = planner.region_rect(w->top_index);
+      cv::Rect covered;
+      for (const Waypoint& s : planner.descent()) covered |= planner.pixel_rect(s.footprint);
+      descents.push_back({w->decision, region, planner.map().labels()(region).clone(),
+                          covered & cv::Rect(0, 0, field.width_px(), field.height_px()), w->waypoint.gsd_cm});
+    }
+    // With the backend's class probabilities where the decision reads them (ranked: the top-level
+    // images' decision inputs, a descent's scene check).
+    const bool probabilities = options.coverage == DescentCoverage::ranked;
+    auto visit = mission.visit_without_fusion(w->waypoint, w->level, probabilities);
+    planner.report(visit.image, Segmentation{visit.labels, std::move(visit.probabilities), std::move(visit.member_votes)},
+                   visit.record->segmentation_s, mission.elapsed_s());
+    if (w->level == 0) top_only.fuse(visit.image, visit.labels);
+  }
+  // In decision order (a tour flies them in its own).
+  std::sort(descents.begin(), descents.end(), [](const Pending& a, const Pending& b) { return a.decision < b.decision; });
+  // The last decision's measured time (a fixed planning time is charged per waypoint only).
+  if (!mission.options().fixed_planning_time_s) mission.charge_planning(planner.take_planning_s());
+  AdaptiveResult result{std::move(mission).finish(planner.map()), planner.decisions(), {}};
+  const auto& interest = result.mission.interest;
+  const int n = field.num_classes();
+  const auto region_confusion = [&](const cv::Rect& region, const cv::Mat& labels) {
+    ConfusionMatrix cm(n);
+    cm.add(field.labels()(region), labels, field.ignore_label());
+    return cm;
+  };
+  const double final_miou = result.mission.miou_interest().value_or(0.0);
+  const cv::Mat& final_labels = result.mission.fused_labels;
+  for (const Pending& d : descents) {
+    RealisedDescent r;
+    r.decision = d.decision;
+    std::tie(r.region_miou_before, r.region_miou_after) =
+        paired_miou(region_confusion(d.region, d.before), region_confusion(d.region, final_labels(d.region)), interest);
+    // The pixels this descent mapped last: covered by it and still holding its GSD.
+    const cv::Mat owned = planner.map().gsd_cm()(d.covered) == static_cast<float>(d.gsd_cm);
+    cv::Mat reverted = final_labels(d.covered).clone();
+    top_only.labels()(d.covered).copyTo(reverted, owned);
+    ConfusionMatrix without = result.mission.confusion;
+    without -= region_confusion(d.covered, final_labels(d.covered));
+    without += region_confusion(d.covered, reverted);
+    r.field_gain = final_miou - without.miou(interest).value_or(0.0);
+    result.realised.push_back(r);
+  }
+  return result;
+}
+
+}  // namespace adaptseg

@@ -1,0 +1,154 @@
+#pragma once
+/// @file
+/// The adaptive planner's vocabulary (adaptive_planner.hpp): its settings (AdaptiveOptions,
+/// DescentSchedule), the ground it covers (SurveyArea), and what it hands out step by step
+/// (PlannedWaypoint, PlannerStep, DecisionRecord). Apart from the planner so that code that
+/// only configures or records missions (model files, exports, result writers) need not
+/// compile it.
+
+#include <adaptseg/core/decision.hpp>
+#include <adaptseg/core/decision_inputs.hpp>
+#include <adaptseg/core/lawnmower_planner.hpp>
+#include <adaptseg/core/mission_options.hpp>
+#include <adaptseg/vision/descent_coverage.hpp>
+
+#include <opencv2/core.hpp>
+
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+namespace adaptseg {
+
+/// Where the top-level lawnmower's grid is laid on the area.
+enum class GridAnchor {
+  /// From the area's corner (x_min, y_min), the whole overhang of the last column and row on the
+  /// far sides (the paper's grid, LawnmowerPlanner::plan).
+  corner,
+  /// Centred on the area, the overhang split evenly between opposite sides, so that every
+  /// waypoint lies inside the area (LawnmowerPlanner::centred_grid; the grid adaptseg_plan lays
+  /// on a new site, plan_site_survey).
+  centred,
+};
+
+/// When the chosen descents are flown.
+enum class DescentSchedule {
+  /// At once (the paper): down from the region's top-level waypoint, the sub-lawnmower, back up
+  /// to the next top-level waypoint: two altitude changes per descent (one for the last region's).
+  immediate,
+  /// Inspect at once or after the survey, whichever is cheaper (beyond the paper): each region
+  /// is decided as it is seen; a chosen descent is flown at once if that adds less time, else
+  /// deferred to a tour flown after the whole top-level lawnmower, every deferred sub-lawnmower
+  /// back to back at low altitude in the order that takes least time (inspection_tour.hpp: one
+  /// descent for all of them, no climb back). A deferred descent is charged what it adds to the
+  /// tour chosen so far (cheapest insertion); the tour is reordered once the survey is flown,
+  /// never longer, so the budget holds. Candidate::deferred says which way each was costed.
+  tour,
+  /// Inspect at once or after the lawnmower row, whichever is cheaper (beyond the paper: stay
+  /// low between neighbouring regions): as `tour`, but a tour is flown after each row of the
+  /// top-level lawnmower (rows run along x), from the row's last top-level waypoint through the
+  /// row's deferred sub-lawnmowers, back to back at low altitude, up to the next row's first
+  /// top-level waypoint. Regions of one row that all want a descent share one descent and one
+  /// climb, without the flight back from the survey's end that `tour` needs; each is still
+  /// decided on its own top-level image. A deferred descent is charged what it adds to the row's
+  /// tour, its leg up to the next row included.
+  row,
+};
+
+/// The name used in results and on the command line: "immediate", "tour" or "row".
+[[nodiscard]] inline const char* to_string(DescentSchedule s) noexcept {
+  switch (s) {
+    case DescentSchedule::tour: return "tour";
+    case DescentSchedule::row: return "row";
+    case DescentSchedule::immediate: break;
+  }
+  return "immediate";
+}
+
+/// Settings of an adaptive mission.
+struct AdaptiveOptions {
+  /// Camera, timing, labels of interest, fixed per-image/waypoint times. AdaptivePlanner needs
+  /// `interest` set; run_adaptive_mission fills an empty one from the field.
+  MissionOptions mission{};
+  double top_gsd_cm = 3.0;                ///< GSD at h_max [cm/px]
+  /// Lower GSDs a sub-lawnmower may fly [cm/px]; at least one not finer than the map is
+  /// required (AdaptivePlanner rejects an empty list: it could never descend).
+  std::vector<double> candidate_gsd_cm{};
+  /// Mission-time budget [s] (flight + segmentation + planning). The planner only descends
+  /// when the descent and the rest of the top-level coverage still fit. Exact with fixed
+  /// segmentation and planning times; with measured times the remaining work is estimated
+  /// from the slowest image so far plus 25 %.
+  std::optional<double> budget_s{};
+  /// What a descent re-maps: the whole region (the paper) or only its cells that show a label
+  /// of interest (DescentCoverage). A decision model must be calibrated with the same.
+  DescentCoverage coverage = DescentCoverage::region;
+  /// Where the top-level grid (and the lawnmowers the front-aware rule compares with) is laid on
+  /// the area: a mission time choice, not part of a decision model.
+  GridAnchor grid_anchor = GridAnchor::corner;
+  /// DescentCoverage::ranked: the decision input whose mass over a cell ranks the cells
+  /// (decision_inputs.hpp); a decision model sets the one it was calibrated with.
+  DecisionInput cell_input = DecisionInput::expected_error;
+  /// When the chosen descents are flown: at once (the paper), or deferred to a tour after the
+  /// survey or after each lawnmower row where that is cheaper.
+  DescentSchedule schedule = DescentSchedule::immediate;
+};
+
+/// The decision taken at one top-level waypoint.
+struct DecisionRecord {
+  std::size_t waypoint_index = 0;  ///< index into the path (= MissionResult::waypoints in simulation)
+  double sigma = 0.0;              ///< σ of the top-level image
+  Decision decision;
+  std::vector<Candidate> candidates;  ///< what was affordable, with exact costs
+  std::optional<DescentOutcome> outcome;  ///< after a descent
+  bool budget_limited = false;     ///< some candidate was dropped because of the budget
+};
+
+/// The ground a mission covers, as a real mission knows it: no labels, only where the field is.
+///
+/// The map grid is the field frame's (docs/data_format.md): origin at the grid's bottom-left
+/// corner, x along its columns, y up its rows, `map_gsd_cm` per pixel; it is what the planner
+/// fuses segmentations into and what `valid_mask` is drawn on.
+struct SurveyArea {
+  Area area{};               ///< the rectangle to cover [m], x_min, y_min >= 0
+  double map_gsd_cm = 1.0;   ///< resolution of the fused map (and of `valid_mask`) [cm/px]
+  /// Optional CV_8UC1 over the map grid, non-zero where there is field; its size sets the
+  /// grid's. Empty: every pixel under `area` is field, and the grid just covers `area`.
+  cv::Mat valid_mask{};
+  int ignore_label = 255;    ///< "no class" in segmentations and in the map (0..255)
+  /// Size of the class set the backend labels with (1..255; labels 0 .. num_classes - 1).
+  /// Required: every segmentation reported to the planner is checked against it
+  /// (check_segmentation()); 0, the default, is rejected by the planner with a message.
+  int num_classes = 0;
+
+  /// A Field's area, GSD, valid mask, ignore label and class count (what the simulation
+  /// knows). A template so that the live planner does not depend on field.hpp (and its YAML
+  /// and image-file readers): any type with Field's five accessors will do.
+  template <typename FieldLike>
+  [[nodiscard]] static SurveyArea of(const FieldLike& field) {
+    return {field.area(), field.gsd_cm(), field.valid_mask(), field.ignore_label(), field.num_classes()};
+  }
+};
+
+/// One waypoint the planner asks the UAV to fly to and take an image at.
+struct PlannedWaypoint {
+  Waypoint waypoint;
+  int level = 0;              ///< 0: top-level lawnmower W^{h_max}; 1: sub-lawnmower W^{h'} (a descent)
+  std::size_t index = 0;      ///< visiting order: 0, 1, ... over the whole path
+  std::size_t top_index = 0;  ///< the top-level waypoint whose region it maps
+  /// Level 1: the index of the decision (AdaptivePlanner::decisions()) whose descent it flies,
+  /// and its place in that descent's sub-lawnmower (0: the first waypoint).
+  std::size_t decision = 0;
+  std::size_t step = 0;
+};
+
+/// What the planner made of one reported image.
+struct PlannerStep {
+  PlannedWaypoint waypoint;  ///< the waypoint the image was reported for
+  double sigma = 0.0;        ///< semantic ratio σ of the image's segmentation (paper Eq. `eq:vr`)
+  /// At a top-level waypoint: the decision taken (descend or continue).
+  std::optional<DecisionRecord> decision;
+  /// After the last image of a descent: what the region showed, fed back to the policy.
+  std::optional<DescentOutcome> outcome;
+};
+
+}  // namespace adaptseg

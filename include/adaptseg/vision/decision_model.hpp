@@ -1,0 +1,554 @@
+#pragma once
+/// @file
+/// The initialised decision model as a file (`adaptseg_calibrate --out model.yaml`): the
+/// decision function (gain model and rule), the linear baseline's parameters, and what they
+/// were calibrated for (fields, class set, labels of interest, camera, GSDs, backend). Plain
+/// YAML: every fitted quantity, the Gaussian processes' data and hyperparameters included, is
+/// a key that any YAML tool reads and edits; numbers are written and read by one
+/// locale-independent codec (detail/number_text.hpp). Files of format 1 (adaptseg 0.1, with
+/// the decision function as an embedded text block) still load, with identical predictions.
+
+#include <adaptseg/core/camera.hpp>
+#include <adaptseg/core/decision_function.hpp>
+#include <adaptseg/core/lawnmower_planner.hpp>
+#include <adaptseg/core/linear_decision.hpp>
+#include <adaptseg/core/timing.hpp>
+#include <adaptseg/vision/adaptive_options.hpp>
+#include <adaptseg/vision/detail/number_text.hpp>
+#include <adaptseg/vision/detail/yaml_io.hpp>
+#include <adaptseg/vision/field.hpp>
+#include <adaptseg/vision/gp_io.hpp>
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <istream>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <variant>
+#include <vector>
+
+namespace adaptseg {
+
+namespace detail {
+
+using ModelGp = GainModel::Gp;
+
+/// Reads the decision-function text of adaptseg 0.1 (`adaptseg.decision_function` versions
+/// 1-3, embedded in decision-model files of format 1). `field` names the calibration field
+/// (the front-aware rule's reference curve). The rule's parameters map one to one, except
+/// that the front-aware rule of that version ignores `min_utility` and `exploration` (every
+/// calibrated file had -max and 0).
+/// @throws std::invalid_argument naming what is wrong for truncated or garbled input.
+[[nodiscard]] inline DecisionFunction read_legacy_decision_function(std::istream& is, const std::string& field) {
+  const auto token = [&](const std::string& what) {
+    std::string t;
+    require(static_cast<bool>(is >> t), "decision model of format 1: input ends before " + what, "<end of input>");
+    return t;
+  };
+  const auto expect = [&](const std::string& key) {
+    const std::string t = token("'" + key + "'");
+    require(t == key, "decision model of format 1: expected '" + key + "', found", t);
+  };
+  const auto parse = [&](const std::string& t, const std::string& what) {
+    const auto v = parse_number(t);
+    require(v.has_value(), "decision model of format 1: bad number for " + what, t);
+    return *v;
+  };
+  const auto number = [&](const std::string& key) {
+    expect(key);
+    return parse(token("the value of '" + key + "'"), "'" + key + "'");
+  };
+  expect("adaptseg.decision_function");
+  const std::string version = token("the format version");
+  require(version == "1" || version == "2" || version == "3", "decision model of format 1: unsupported format version",
+          version);
+  const double min_sigma = number("min_sigma");
+  const double min_utility = number("min_utility");
+  const double exploration = number("exploration");
+  const bool weight_by_sigma = number("weight_by_sigma") != 0.0;
+  const bool online = number("online") != 0.0;
+  const double refit_every = number("refit_every");  // range-checked before the cast (UB otherwise)
+  require(refit_every >= 0.0 && refit_every <= 1e9 && refit_every == std::floor(refit_every),
+          "decision model of format 1: refit_every must be an integer in [0, 1e9]", refit_every);
+  const bool relative_utility = number("relative_utility") != 0.0;
+  bool front_aware = false;
+  std::vector<GsdPoint> reference;
+  if (version != "1") {  // version 1 had neither
+    front_aware = number("front_aware") != 0.0;
+    const double n = number("reference_lawnmower");
+    require(n >= 0.0 && n <= 1000.0 && n == std::floor(n), "decision model of format 1: bad point count for 'reference_lawnmower'",
+            n);
+    const auto value = [&](const char* what) {
+      const std::string name = std::string("a reference_lawnmower ") + what;
+      return parse(token(name), name);
+    };
+    for (int k = 0; k < static_cast<int>(n); ++k) {
+      const double g = value("GSD");
+      reference.push_back({g, value("mIoU")});
+    }
+  }
+  is >> std::ws;
+  ModelGp o = read_gp_text_v1<ModelGp::KernelType>(is);
+  is >> std::ws;
+  ModelGp i = [&] {
+    if (version == "3") return read_gp_text_v1<ModelGp::KernelType>(is);
+    // Versions 1-2 stored I with the isotropic kernel, which for its one input is the ARD
+    // kernel with one length scale (same parameters, same layout).
+    std::string block, line;
+    bool ended = false;
+    while (std::getline(is, line)) {
+      if (line == "kernel " + std::string(SquaredExponentialKernel::kName))
+        line = "kernel " + std::string(ArdSquaredExponentialKernel::kName);
+      block += line + '\n';
+      if (line.rfind("end ", 0) == 0) {
+        ended = true;
+        break;
+      }
+    }
+    require(ended, "decision model of format 1: input ends inside I's Gaussian process", "<end of input>");
+    std::istringstream in(block);
+    ModelGp gp = read_gp_text_v1<ModelGp::KernelType>(in);
+    require(gp.dimension() == 1, "decision model of format 1: I of a version 1-2 file must have 1 input; dimension",
+            gp.dimension());
+    return gp;
+  }();
+  expect("end");
+  expect("adaptseg.decision_function");
+  require(std::isfinite(min_sigma) && min_sigma >= 0.0 && min_sigma <= 1.0,
+          "decision model of format 1: min_sigma must be in [0, 1]", min_sigma);
+  GainModel model(std::move(o), std::move(i), std::nullopt, {}, static_cast<int>(refit_every));
+  if (front_aware) {
+    require(!reference.empty(), "decision model of format 1: the front-aware rule needs reference_lawnmower points; count",
+            reference.size());
+    return DecisionFunction(FrontAwarePolicy(std::move(model), {ReferenceCurve{field, std::move(reference)}},
+                                             {.min_sigma = min_sigma, .weight_by_sigma = weight_by_sigma,
+                                              .online = online}));
+  }
+  return DecisionFunction(UtilityPolicy(std::move(model), {.min_sigma = min_sigma,
+                                                           .min_utility = min_utility,
+                                                           .exploration = exploration,
+                                                           .weight_by_sigma = weight_by_sigma,
+                                                           .online = online,
+                                                           .relative_utility = relative_utility}));
+}
+
+}  // namespace detail
+
+/// The keys of the cell gain model's points in a model file (`gain_model.cells`), one list each.
+inline constexpr std::array<std::pair<const char*, double CellGainModel::Point::*>, 8> kCellPointKeys{{
+    {"top_gsd_cm", &CellGainModel::Point::top_gsd_cm},
+    {"sub_gsd_cm", &CellGainModel::Point::sub_gsd_cm},
+    {"gain_slope", &CellGainModel::Point::gain_slope},
+    {"gain_noise", &CellGainModel::Point::gain_noise},
+    {"relabel_slope", &CellGainModel::Point::relabel_slope},
+    {"relabel_noise", &CellGainModel::Point::relabel_noise},
+    {"proxy_slope", &CellGainModel::Point::proxy_slope},
+    {"proxy_noise", &CellGainModel::Point::proxy_noise},
+}};
+
+/// A calibrated decision model and its provenance.
+struct DecisionModel {
+  std::vector<std::string> calibration_fields;  ///< names of the training fields (with regions)
+  std::string segmenter;                  ///< backend used for calibration
+  /// Segmentation time charged per image during calibration [s]: declared, not measured, so
+  /// that the model is a function of its inputs (format 1 files: 0, unknown).
+  double calibration_segmentation_time_s = 0.0;
+  std::vector<std::string> classes;       ///< class names, index order
+  std::vector<std::string> interest;      ///< labels of interest L
+  CameraParams camera{};
+  TimingParams timing{};
+  double top_gsd_cm = 0.0;
+  std::vector<double> candidate_gsd_cm;
+  /// What the model's descents re-map (its samples were taken so); files of format 1
+  /// without the key are `region`, the paper's.
+  DescentCoverage coverage = DescentCoverage::region;
+  DecisionFunction decision_function;
+  LinearDecision::Params linear{};
+  std::size_t samples = 0;                ///< region samples the GPs were fitted to
+  double train_front_margin = 0.0;        ///< of the chosen rule, on the training fields (mean)
+
+  /// The planner options of a mission flown with this model: its camera, timing, top and
+  /// candidate GSDs and descent coverage, with `mission`'s labels of interest and fixed times.
+  [[nodiscard]] AdaptiveOptions adaptive_options(MissionOptions mission,
+                                                 std::optional<double> budget_s = std::nullopt) const {
+    mission.camera = camera;
+    mission.timing = timing;
+    AdaptiveOptions o{std::move(mission), top_gsd_cm, candidate_gsd_cm, budget_s, coverage};
+    if (const auto& cells = decision_function.model().cells()) o.cell_input = cells->input();
+    return o;
+  }
+
+  /// The labels of interest as class indices of the model's class set (the labels the
+  /// backend it was calibrated with gives): what MissionOptions::interest takes.
+  [[nodiscard]] std::vector<int> interest_indices() const {
+    std::vector<int> out;
+    for (const auto& n : interest) {
+      const auto it = std::find(classes.begin(), classes.end(), n);
+      detail::require(it != classes.end(), "DecisionModel: a label of interest is not one of its classes", n);
+      out.push_back(static_cast<int>(it - classes.begin()));
+    }
+    return out;
+  }
+
+  /// The model's class set is the field's (same names, same order): a model calibrated on
+  /// one class set cannot score or fly another.
+  /// @throws std::invalid_argument naming both class sets.
+  void check_classes(const Field& field) const {
+    std::vector<std::string> names;
+    for (const auto& c : field.classes()) names.push_back(c.name);
+    if (names != classes)
+      throw std::invalid_argument("decision model was calibrated for classes [" + join(classes) +
+                                  "] but field '" + field.name() + "' has [" + join(names) +
+                                  "]: calibrate a model on a field with the same classes");
+  }
+
+  /// Throws unless `field` has the model's class set and `interest` (class indices of
+  /// `field`) equals the model's labels of interest.
+  /// @throws std::invalid_argument naming the mismatch.
+  void check_compatible(const Field& field, const std::vector<int>& interest_indices) const {
+    check_classes(field);
+    std::vector<std::string> names;
+    for (const auto& c : field.classes()) names.push_back(c.name);
+    std::vector<std::string> in;
+    for (int i : interest_indices) in.push_back(names.at(static_cast<std::size_t>(i)));
+    if (in != interest)
+      throw std::invalid_argument("decision model was calibrated for labels of interest [" + join(interest) +
+                                  "] but the mission uses [" + join(in) + "]");
+  }
+
+  /// Writes the model as YAML (format 2).
+  /// @throws std::runtime_error if the file cannot be written.
+  void save(const std::filesystem::path& path) const {
+    using detail::emit_number;
+    using detail::emit_numbers;
+    const auto num = [](double v) { return detail::format_number(v); };
+    YAML::Emitter e;
+    e << YAML::BeginMap;
+    e << YAML::Key << "format" << YAML::Value << "adaptseg.decision_model/2";
+    e << YAML::Key << "calibration" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "fields" << YAML::Value << YAML::Flow << calibration_fields;
+    e << YAML::Key << "segmenter" << YAML::Value << segmenter;
+    e << YAML::Key << "segmentation_time_s" << YAML::Value << num(calibration_segmentation_time_s);
+    e << YAML::Key << "samples" << YAML::Value << std::to_string(samples);
+    e << YAML::Key << "train_front_margin" << YAML::Value << num(train_front_margin);
+    e << YAML::EndMap;
+    e << YAML::Key << "classes" << YAML::Value << YAML::Flow << classes;
+    e << YAML::Key << "interest" << YAML::Value << YAML::Flow << interest;
+    e << YAML::Key << "camera" << YAML::Value << YAML::Flow << YAML::BeginMap
+      << YAML::Key << "image_width_px" << YAML::Value << std::to_string(camera.image_width_px)
+      << YAML::Key << "image_height_px" << YAML::Value << std::to_string(camera.image_height_px)
+      << YAML::Key << "sensor_width_mm" << YAML::Value << num(camera.sensor_width_mm)
+      << YAML::Key << "focal_length_mm" << YAML::Value << num(camera.focal_length_mm) << YAML::EndMap;
+    e << YAML::Key << "timing" << YAML::Value << YAML::Flow << YAML::BeginMap
+      << YAML::Key << "max_speed_mps" << YAML::Value << num(timing.max_speed_mps)
+      << YAML::Key << "max_accel_mps2" << YAML::Value << num(timing.max_accel_mps2);
+    // Written only when set, so that models of the isotropic model keep their bytes.
+    if (timing.max_vertical_speed_mps > 0.0)
+      e << YAML::Key << "max_vertical_speed_mps" << YAML::Value << num(timing.max_vertical_speed_mps);
+    e << YAML::EndMap;
+    e << YAML::Key << "top_gsd_cm" << YAML::Value << num(top_gsd_cm);
+    e << YAML::Key << "candidate_gsd_cm" << YAML::Value;
+    emit_numbers(e, candidate_gsd_cm);
+    e << YAML::Key << "descent_coverage" << YAML::Value << to_string(coverage);
+    e << YAML::Key << "linear" << YAML::Value << YAML::Flow << YAML::BeginMap
+      << YAML::Key << "sigma_low" << YAML::Value << num(linear.sigma_low)
+      << YAML::Key << "sigma_high" << YAML::Value << num(linear.sigma_high) << YAML::EndMap;
+    const GainModel& gm = decision_function.model();
+    e << YAML::Key << "gain_model" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "gain_inputs" << YAML::Value
+      << (gm.gain_inputs() == GainModel::GainInputs::delta_sigma ? "delta-sigma" : "delta-sigma-height");
+    e << YAML::Key << "refit_every" << YAML::Value << std::to_string(gm.refit_every());
+    e << YAML::Key << "O" << YAML::Value;
+    detail::emit_gp(e, gm.o_model());
+    e << YAML::Key << "I" << YAML::Value;
+    detail::emit_gp(e, gm.i_model());
+    if (gm.c_model()) {
+      e << YAML::Key << "C" << YAML::Value;
+      detail::emit_gp(e, *gm.c_model());
+      std::vector<double> h, v;
+      for (const auto& p : gm.efficiency_points()) h.push_back(p.delta_h_m), v.push_back(p.efficiency);
+      e << YAML::Key << "efficiency" << YAML::Value << YAML::BeginMap << YAML::Key << "delta_h_m" << YAML::Value;
+      emit_numbers(e, h);
+      e << YAML::Key << "eta" << YAML::Value;
+      emit_numbers(e, v);
+      e << YAML::EndMap;
+    }
+    if (const auto& cells = gm.cells()) {
+      e << YAML::Key << "cells" << YAML::Value << YAML::BeginMap;
+      e << YAML::Key << "input" << YAML::Value << to_string(cells->input());
+      for (const auto& [key, member] : kCellPointKeys) {
+        std::vector<double> v;
+        for (const auto& p : cells->points()) v.push_back(p.*member);
+        e << YAML::Key << key << YAML::Value;
+        emit_numbers(e, v);
+      }
+      e << YAML::EndMap;
+    }
+    e << YAML::EndMap;
+    e << YAML::Key << "rule" << YAML::Value << YAML::BeginMap;
+    std::visit(
+        [&](const auto& rule) {
+          using R = std::decay_t<decltype(rule)>;
+          const auto& p = rule.params();
+          e << YAML::Key << "kind" << YAML::Value
+            << (std::is_same_v<R, FrontAwarePolicy> ? "front-aware" : "utility");
+          e << YAML::Key << "online" << YAML::Value << detail::flag_text(p.online);
+          e << YAML::Key << "min_sigma" << YAML::Value << num(p.min_sigma);
+          e << YAML::Key << "weight_by_sigma" << YAML::Value << detail::flag_text(p.weight_by_sigma);
+          if constexpr (std::is_same_v<R, FrontAwarePolicy>) {
+            e << YAML::Key << "confidence" << YAML::Value << num(p.confidence);
+            e << YAML::Key << "scale_prior_sd" << YAML::Value << num(p.scale_prior_sd);
+            e << YAML::Key << "sigma_prior_weight" << YAML::Value << num(p.sigma_prior_weight);
+            e << YAML::Key << "sigma_prior_sd" << YAML::Value << num(p.sigma_prior_sd);
+            if (p.field_curve) e << YAML::Key << "field_curve" << YAML::Value << detail::flag_text(true);
+            if (p.curve_ratio) e << YAML::Key << "curve_ratio" << YAML::Value << detail::flag_text(true);
+            e << YAML::Key << "reference" << YAML::Value << YAML::BeginSeq;
+            for (const auto& r : rule.reference()) {
+              std::vector<double> g, m;
+              for (const auto& pt : r.points) g.push_back(pt.gsd_cm), m.push_back(pt.miou);
+              e << YAML::BeginMap << YAML::Key << "field" << YAML::Value << r.field << YAML::Key << "field_sigma"
+                << YAML::Value << num(r.field_sigma);
+              if (r.field_input > 0.0) e << YAML::Key << "field_input" << YAML::Value << num(r.field_input);
+              if (!r.top_inputs.empty()) {
+                std::vector<double> tg, tx;
+                for (const auto& [gsd, x] : r.top_inputs) tg.push_back(gsd), tx.push_back(x);
+                e << YAML::Key << "top_input_gsd_cm" << YAML::Value;
+                emit_numbers(e, tg);
+                e << YAML::Key << "top_input" << YAML::Value;
+                emit_numbers(e, tx);
+              }
+              e << YAML::Key << "gsd_cm" << YAML::Value;
+              emit_numbers(e, g);
+              e << YAML::Key << "miou" << YAML::Value;
+              emit_numbers(e, m);
+              e << YAML::EndMap;
+            }
+            e << YAML::EndSeq;
+          } else {
+            e << YAML::Key << "min_utility" << YAML::Value << num(p.min_utility);
+            e << YAML::Key << "exploration" << YAML::Value << num(p.exploration);
+            e << YAML::Key << "relative_utility" << YAML::Value << detail::flag_text(p.relative_utility);
+          }
+        },
+        decision_function.rule());
+    e << YAML::EndMap;
+    e << YAML::EndMap;
+    std::ofstream os(path);
+    if (!os) throw std::runtime_error("cannot write " + path.string());
+    os << e.c_str() << '\n';
+    if (!os) throw std::runtime_error("error writing " + path.string());
+  }
+
+  /// Reads a model written by save() (format 2) or by adaptseg 0.1 (format 1).
+  /// @throws std::invalid_argument naming the file and the problem (missing, not YAML,
+  ///         another format, a missing or mistyped key, a broken decision function).
+  [[nodiscard]] static DecisionModel load(const std::filesystem::path& path) {
+    const std::string where = path.string();
+    if (!std::filesystem::is_regular_file(path)) detail::yaml_error(where, "decision model file not found");
+    const YAML::Node root =
+        detail::yaml_mapping(where, "a decision model", [&] { return YAML::LoadFile(path.string()); });
+    return detail::naming_file(where, [&] {
+      const std::string format = root["format"] && root["format"].IsScalar() ? root["format"].Scalar() : "";
+      const detail::YamlReader r(root, where);
+      DecisionModel m = format == "adaptseg.decision_model/2"   ? read_v2(r)
+                        : format == "adaptseg.decision_model/1" ? read_v1(r)
+                                                                : throw std::invalid_argument(
+                                                                      where +
+                                                                      ": not an adaptseg decision model (format must "
+                                                                      "be adaptseg.decision_model/2 or /1)");
+      m.check(where);
+      return m;
+    });
+  }
+
+ private:
+  static std::string join(const std::vector<std::string>& v) {
+    std::string s;
+    for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+    return s;
+  }
+
+  /// The keys both formats share, read into `m`.
+  static void read_common(const detail::YamlReader& r, DecisionModel& m) {
+    m.classes = r.texts("classes");
+    m.interest = r.texts("interest");
+    const auto cam = r.map("camera");
+    m.camera = {static_cast<int>(cam.integer("image_width_px", 1, 1'000'000)),
+                static_cast<int>(cam.integer("image_height_px", 1, 1'000'000)), cam.number("sensor_width_mm"),
+                cam.number("focal_length_mm")};
+    (void)CameraModel(m.camera);
+    const auto tim = r.map("timing");
+    m.timing = {tim.number("max_speed_mps"), tim.number("max_accel_mps2"),
+                tim.has("max_vertical_speed_mps") ? tim.number("max_vertical_speed_mps") : 0.0};
+    (void)TimingModel(m.timing);
+    m.top_gsd_cm = r.number("top_gsd_cm");
+    m.candidate_gsd_cm = r.numbers("candidate_gsd_cm");
+    if (r.has("descent_coverage")) m.coverage = parse_descent_coverage(r.text("descent_coverage"));
+    const auto lin = r.map("linear");
+    m.linear = {lin.number("sigma_low"), lin.number("sigma_high")};
+    (void)LinearDecision(m.linear);
+  }
+
+  /// A model of what a reader parsed first (the calibration record and the decision function),
+  /// the rest default until read_common fills it in.
+  static DecisionModel parsed(std::vector<std::string> fields, std::string segmenter, double segmentation_time_s,
+                              DecisionFunction function, std::size_t samples, double train_front_margin) {
+    return {.calibration_fields = std::move(fields),
+            .segmenter = std::move(segmenter),
+            .calibration_segmentation_time_s = segmentation_time_s,
+            .classes = {},
+            .interest = {},
+            .camera = {},
+            .timing = {},
+            .top_gsd_cm = 0.0,
+            .candidate_gsd_cm = {},
+            .coverage = DescentCoverage::region,
+            .decision_function = std::move(function),
+            .linear = {},
+            .samples = samples,
+            .train_front_margin = train_front_margin};
+  }
+
+  // Both readers read keys in the order of the model's members: a file with several faults
+  // reports the first in that order.
+  static DecisionModel read_v1(const detail::YamlReader& r) {
+    const std::string field = r.text("calibration_field");
+    std::istringstream df(r.text("decision_function"));
+    std::string segmenter = r.text("segmenter");
+    DecisionFunction function = detail::read_legacy_decision_function(df, field);
+    const auto samples = static_cast<std::size_t>(r.integer("samples", 0, 1'000'000'000));
+    DecisionModel m = parsed({field}, std::move(segmenter), 0.0, std::move(function), samples,
+                             r.number("train_front_margin"));
+    read_common(r, m);
+    return m;
+  }
+
+  static DecisionModel read_v2(const detail::YamlReader& r) {
+    const auto cal = r.map("calibration");
+    const auto gm = r.map("gain_model");
+    const std::string inputs = gm.text("gain_inputs");
+    if (inputs != "delta-sigma" && inputs != "delta-sigma-height")
+      detail::yaml_error(r.where(), "'gain_model.gain_inputs' must be delta-sigma or delta-sigma-height (got '" +
+                                         inputs + "')");
+    const bool with_c = gm.has("C");
+    std::vector<GainModel::EfficiencyPoint> efficiency;
+    if (with_c) {
+      const auto eff = gm.map("efficiency");
+      const auto h = eff.numbers("delta_h_m");
+      const auto v = eff.numbers("eta");
+      if (h.size() != v.size() || h.empty())
+        detail::yaml_error(r.where(), "'gain_model.efficiency' needs as many 'eta' as 'delta_h_m' values (>= 1)");
+      for (std::size_t k = 0; k < h.size(); ++k) efficiency.push_back({h[k], v[k]});
+    }
+    const auto gp = [&](const char* key, Eigen::Index dimension) {
+      return detail::read_gp<detail::ModelGp::KernelType>(gm.map(key), dimension);
+    };
+    GainModel model(gp("O", 2), gp("I", inputs == "delta-sigma" ? 1 : 2), with_c ? std::optional(gp("C", 2)) : std::nullopt,
+                    std::move(efficiency), static_cast<int>(gm.integer("refit_every", 0, 1'000'000'000)));
+    if (gm.has("cells")) {
+      const auto c = gm.map("cells");
+      const DecisionInput input = parse_decision_input(c.text("input"));
+      std::vector<CellGainModel::Point> points;
+      for (const auto& [key, member] : kCellPointKeys) {
+        const auto v = c.numbers(key);
+        if (points.empty()) points.resize(v.size());
+        if (v.empty() || v.size() != points.size())
+          detail::yaml_error(r.where(), "'gain_model.cells' needs one top_gsd_cm, sub_gsd_cm, gain_slope, gain_noise, "
+                                        "relabel_slope, relabel_noise, proxy_slope and proxy_noise value per point "
+                                        "(>= 1 point)");
+        for (std::size_t j = 0; j < v.size(); ++j) points[j].*member = v[j];
+      }
+      model.set_cells(CellGainModel(input, std::move(points)));
+    }
+    const auto rule = r.map("rule");
+    const std::string kind = rule.text("kind");
+    const bool online = rule.flag("online");
+    const double min_sigma = rule.number("min_sigma");
+    const bool weight_by_sigma = rule.flag("weight_by_sigma");
+    const auto make_function = [&]() -> DecisionFunction {
+      if (kind == "front-aware") {
+        const YAML::Node refs = rule.node("reference");
+        if (!refs.IsSequence()) detail::yaml_error(r.where(), "'rule.reference' must be a list of curves");
+        std::vector<ReferenceCurve> reference;
+        for (std::size_t k = 0; k < refs.size(); ++k) {
+          if (!refs[k].IsMap()) detail::yaml_error(r.where(), "'rule.reference' entries must be mappings");
+          const detail::YamlReader c(refs[k], r.where());
+          const auto g = c.numbers("gsd_cm");
+          const auto v = c.numbers("miou");
+          if (g.size() != v.size())
+            detail::yaml_error(r.where(), "a 'rule.reference' curve needs as many 'miou' as 'gsd_cm' values");
+          ReferenceCurve curve{c.text("field"), {}, c.has("field_sigma") ? c.number("field_sigma") : 0.0,
+                               c.has("field_input") ? c.number("field_input") : 0.0};
+          for (std::size_t i = 0; i < g.size(); ++i) curve.points.push_back({g[i], v[i]});
+          if (c.has("top_input_gsd_cm") || c.has("top_input")) {
+            const auto tg = c.numbers("top_input_gsd_cm");
+            const auto tx = c.numbers("top_input");
+            if (tg.size() != tx.size())
+              detail::yaml_error(r.where(), "a 'rule.reference' curve needs as many 'top_input' as 'top_input_gsd_cm' values");
+            for (std::size_t i = 0; i < tg.size(); ++i) curve.top_inputs.emplace_back(tg[i], tx[i]);
+          }
+          reference.push_back(std::move(curve));
+        }
+        return DecisionFunction(FrontAwarePolicy(std::move(model), std::move(reference),
+                                                 {.min_sigma = min_sigma,
+                                                  .weight_by_sigma = weight_by_sigma,
+                                                  .online = online,
+                                                  .confidence = rule.number("confidence"),
+                                                  .scale_prior_sd = rule.number("scale_prior_sd"),
+                                                  .sigma_prior_weight = rule.number("sigma_prior_weight"),
+                                                  .sigma_prior_sd = rule.has("sigma_prior_sd")
+                                                                        ? rule.number("sigma_prior_sd")
+                                                                        : 0.0,
+                                                  .field_curve = rule.has("field_curve") && rule.flag("field_curve"),
+                                                  .curve_ratio = rule.has("curve_ratio") && rule.flag("curve_ratio")}));
+      }
+      if (kind == "utility")
+        return DecisionFunction(UtilityPolicy(std::move(model), {.min_sigma = min_sigma,
+                                                                 .min_utility = rule.number("min_utility"),
+                                                                 .exploration = rule.number("exploration"),
+                                                                 .weight_by_sigma = weight_by_sigma,
+                                                                 .online = online,
+                                                                 .relative_utility = rule.flag("relative_utility")}));
+      detail::yaml_error(r.where(), "'rule.kind' must be front-aware or utility (got '" + kind + "')");
+    };
+    std::vector<std::string> fields = cal.texts("fields");
+    std::string segmenter = cal.text("segmenter");
+    const double segmentation_time_s = cal.number("segmentation_time_s");
+    DecisionFunction function = make_function();
+    const auto samples = static_cast<std::size_t>(cal.integer("samples", 0, 1'000'000'000));
+    DecisionModel m = parsed(std::move(fields), std::move(segmenter), segmentation_time_s, std::move(function),
+                             samples, cal.number("train_front_margin"));
+    read_common(r, m);
+    return m;
+  }
+
+  /// What the model must satisfy whatever its format.
+  void check(const std::string& where) const {
+    if (calibration_fields.empty()) detail::yaml_error(where, "no calibration field is named");
+    if (classes.empty()) detail::yaml_error(where, "'classes' is empty");
+    if (interest.empty()) detail::yaml_error(where, "'interest' is empty");
+    for (const auto& n : interest)
+      if (std::find(classes.begin(), classes.end(), n) == classes.end())
+        detail::yaml_error(where, "label of interest '" + n + "' is not among the classes");
+    if (!(top_gsd_cm > 0.0)) detail::yaml_error(where, "'top_gsd_cm' must be > 0");
+    if (candidate_gsd_cm.empty()) detail::yaml_error(where, "'candidate_gsd_cm' is empty");
+    for (double g : candidate_gsd_cm)
+      if (!(g > 0.0 && g < top_gsd_cm))
+        detail::yaml_error(where, "candidate GSDs must be positive and finer than top_gsd_cm");
+    if (!(calibration_segmentation_time_s >= 0.0))
+      detail::yaml_error(where, "'calibration.segmentation_time_s' must be >= 0");
+    if (coverage == DescentCoverage::ranked && !decision_function.model().cells())
+      detail::yaml_error(where, "descent_coverage 'ranked' needs a cell gain model ('gain_model.cells')");
+  }
+};
+
+}  // namespace adaptseg

@@ -1,0 +1,544 @@
+#pragma once
+/// @file
+/// A field to survey: the orthomosaic's label map (and RGB image, when there is one), its
+/// GSD and class set, loaded from the project's field directory format (docs/data_format.md),
+/// and where it lies on the Earth (FieldGeo; FieldCrs for a field read from GeoTIFFs).
+
+#include <adaptseg/core/error.hpp>
+#include <adaptseg/core/lawnmower_planner.hpp>
+#include <adaptseg/vision/image.hpp>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <iterator>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace adaptseg {
+
+/// One semantic class: its name and display colour (RGB).
+struct ClassInfo {
+  std::string name;
+  std::array<std::uint8_t, 3> color_rgb{0, 0, 0};
+};
+
+/// Where a field lies on the Earth: the optional `geo:` section of `field.yaml`
+/// (docs/data_format.md). Plain data; the conversions live in `<adaptseg/geo/georeference.hpp>`
+/// (adaptseg::geo, GeographicLib).
+///
+/// The anchor point (`anchor_x_m`, `anchor_y_m`) of the field frame is at (`latitude_deg`,
+/// `longitude_deg`) on the field plane, whose height is `altitude_m`. The field's +x axis
+/// points to the compass bearing `heading_deg` (degrees clockwise from north), +y 90 degrees
+/// counter-clockwise from it seen from above (the frame is right-handed with z up): heading
+/// 90 puts +x east and +y north, heading 0 puts +x north and +y west.
+struct FieldGeo {
+  double latitude_deg = 0.0;   ///< WGS84 latitude of the anchor [deg], in [-90, 90]
+  double longitude_deg = 0.0;  ///< WGS84 longitude of the anchor [deg], in [-180, 180]
+  double altitude_m = 0.0;     ///< height of the field plane above the WGS84 ellipsoid [m]
+  double heading_deg = 90.0;   ///< compass bearing of the field's +x axis [deg clockwise from north]
+  /// Field-frame position of the anchor [m]: (0, 0), the frame origin, for a loaded field;
+  /// Field::sub_field moves the frame origin and shifts the anchor accordingly.
+  double anchor_x_m = 0.0;
+  double anchor_y_m = 0.0;  ///< see anchor_x_m
+  /// Field-frame metres per metre on the ground at the anchor: 1 for a `geo:` section; a
+  /// projected grid's scale factor (e.g. 0.9996 on a UTM zone's central meridian) for a field
+  /// georeferenced by its raster (<adaptseg/gdal/gdal_io.hpp>), whose frame is in the grid's metres.
+  double scale = 1.0;
+
+  friend bool operator==(const FieldGeo&, const FieldGeo&) = default;
+};
+
+/// The projected coordinate reference system of a field georeferenced by its raster (a
+/// GeoTIFF, read by <adaptseg/gdal/gdal_io.hpp>): the field frame is the CRS's grid shifted to the
+/// orthomosaic's bottom-left corner, +x along the easting axis, +y along the northing axis
+/// (north-up grids only). Plain data; written back into the fused map's GeoTIFF.
+struct FieldCrs {
+  std::string wkt;                ///< the CRS as WKT (what GDAL read from the raster)
+  double origin_easting_m = 0.0;  ///< CRS easting of the field frame's origin [m]
+  double origin_northing_m = 0.0; ///< CRS northing of the field frame's origin [m]
+
+  friend bool operator==(const FieldCrs&, const FieldCrs&) = default;
+};
+
+namespace detail {
+
+/// Checks a FieldGeo; `where` prefixes the message (e.g. "geo").
+/// @throws std::invalid_argument naming the member and its value.
+inline void validate_field_geo(const FieldGeo& g, const std::string& where) {
+  require(std::isfinite(g.latitude_deg) && g.latitude_deg >= -90.0 && g.latitude_deg <= 90.0,
+          where + ".latitude_deg must be in [-90, 90]", g.latitude_deg);
+  require(std::isfinite(g.longitude_deg) && g.longitude_deg >= -180.0 && g.longitude_deg <= 180.0,
+          where + ".longitude_deg must be in [-180, 180]", g.longitude_deg);
+  require_finite(g.altitude_m, where + ".altitude_m");
+  require_finite(g.heading_deg, where + ".heading_deg");
+  require_finite(g.anchor_x_m, where + ".anchor_x_m");
+  require_finite(g.anchor_y_m, where + ".anchor_y_m");
+  require(std::isfinite(g.scale) && g.scale > 0.5 && g.scale < 2.0, where + ".scale must be in (0.5, 2)", g.scale);
+}
+
+}  // namespace detail
+
+/// Fraction rectangle of a field along the image axes: `x` along columns (left to right),
+/// `y` along rows (top to bottom), each in [0, 1]. `{0, 0, 0.5, 1}` is the left half.
+struct FieldRegion {
+  double x0 = 0.0, y0 = 0.0, x1 = 1.0, y1 = 1.0;
+};
+
+/// An orthomosaic with class labels (method.md §1). The field frame has its origin at the
+/// orthomosaic's bottom-left corner, x along the columns, y up the rows, in metres; pixel
+/// (row r, col c) covers x in [c, c+1) * g0/100 and y in [H-r-1, H-r) * g0/100.
+///
+/// A Field is immutable; copies are cheap (the cv::Mat buffers are shared).
+class Field {
+ public:
+  /// @param name field name (reports, figures).
+  /// @param gsd_cm ground sampling distance of `labels` (and `image`) [cm/px], > 0.
+  /// @param labels 8-bit single-channel class indices; `ignore_label` marks pixels outside
+  ///        the field or unlabelled.
+  /// @param classes the classes, index order (names unique and non-empty).
+  /// @param interest class indices of the labels of interest L.
+  /// @param ignore_label label value of "no class" (0..255, not a class index).
+  /// @param image optional 8-bit 3-channel BGR image of the same size (empty if none).
+  /// @throws std::invalid_argument for an empty/mistyped label map, a GSD that is not
+  ///         positive, no classes, duplicate or empty class names, an ignore label that is
+  ///         also a class index, labels of interest out of range, an image of another size,
+  ///         or a label value that is neither a class index nor the ignore label.
+  Field(std::string name, double gsd_cm, cv::Mat labels, std::vector<ClassInfo> classes,
+        std::vector<int> interest, int ignore_label = 255, cv::Mat image = {})
+      : name_(std::move(name)),
+        gsd_cm_(gsd_cm),
+        labels_(std::move(labels)),
+        image_(std::move(image)),
+        classes_(std::move(classes)),
+        interest_(std::move(interest)),
+        ignore_label_(ignore_label) {
+    validate();
+    valid_ = labels_ != ignore_label_;
+  }
+
+  /// Loads a field directory: `field.yaml`, the label PNG it names and the optional image.
+  /// `gsd_cm` is required here; a field whose rasters carry their georeference (GeoTIFFs)
+  /// loads with gdal::load_field (<adaptseg/gdal/gdal_io.hpp>), which may take it from them.
+  /// @throws std::invalid_argument naming the file and the problem (missing file, YAML
+  ///         syntax error, missing or mistyped key, unknown key, unknown class of interest,
+  ///         wrong image type, size mismatch, out-of-range label value, a `geo:` section
+  ///         with a missing, unknown, mistyped or out-of-range key).
+  static Field load(const std::filesystem::path& dir);
+
+  [[nodiscard]] const std::string& name() const noexcept { return name_; }
+  /// Orthomosaic GSD g0 [cm/px].
+  [[nodiscard]] double gsd_cm() const noexcept { return gsd_cm_; }
+  /// Class indices, CV_8UC1.
+  [[nodiscard]] const cv::Mat& labels() const noexcept { return labels_; }
+  /// BGR image, CV_8UC3, or empty when the field has none.
+  [[nodiscard]] const cv::Mat& image() const noexcept { return image_; }
+  [[nodiscard]] bool has_image() const noexcept { return !image_.empty(); }
+  /// 255 where the label is a class, 0 where it is the ignore label; CV_8UC1.
+  [[nodiscard]] const cv::Mat& valid_mask() const noexcept { return valid_; }
+  [[nodiscard]] const std::vector<ClassInfo>& classes() const noexcept { return classes_; }
+  [[nodiscard]] int num_classes() const noexcept { return static_cast<int>(classes_.size()); }
+  /// Default labels of interest L (class indices, ascending).
+  [[nodiscard]] const std::vector<int>& interest() const noexcept { return interest_; }
+  [[nodiscard]] int ignore_label() const noexcept { return ignore_label_; }
+  /// Where the field lies on the Earth, if known (`geo:` in field.yaml, or with_geo()).
+  [[nodiscard]] const std::optional<FieldGeo>& geo() const noexcept { return geo_; }
+  /// A copy of this field with `geo` as its geo-reference (nullopt: none).
+  /// @throws std::invalid_argument for a latitude outside [-90, 90], a longitude outside
+  ///         [-180, 180], or a non-finite altitude, heading or anchor.
+  [[nodiscard]] Field with_geo(std::optional<FieldGeo> geo) const {
+    if (geo) detail::validate_field_geo(*geo, "Field '" + name_ + "': geo");
+    Field out = *this;
+    out.geo_ = std::move(geo);
+    return out;
+  }
+  /// The projected CRS the field frame is a shifted copy of, for a field georeferenced by its
+  /// raster (<adaptseg/gdal/gdal_io.hpp>); nullopt otherwise.
+  [[nodiscard]] const std::optional<FieldCrs>& crs() const noexcept { return crs_; }
+  /// A copy of this field whose frame is the grid of `crs` (nullopt: none).
+  /// @throws std::invalid_argument for an empty WKT or a non-finite origin.
+  [[nodiscard]] Field with_crs(std::optional<FieldCrs> crs) const {
+    if (crs) {
+      detail::require(!crs->wkt.empty(), "Field '" + name_ + "': crs.wkt must not be empty", "''");
+      detail::require_finite(crs->origin_easting_m, "Field '" + name_ + "': crs.origin_easting_m");
+      detail::require_finite(crs->origin_northing_m, "Field '" + name_ + "': crs.origin_northing_m");
+    }
+    Field out = *this;
+    out.crs_ = std::move(crs);
+    return out;
+  }
+  [[nodiscard]] int width_px() const noexcept { return labels_.cols; }
+  [[nodiscard]] int height_px() const noexcept { return labels_.rows; }
+
+  /// The whole orthomosaic in the field frame [m].
+  [[nodiscard]] Area area() const noexcept {
+    return {0.0, 0.0, width_px() * gsd_cm_ / 100.0, height_px() * gsd_cm_ / 100.0};
+  }
+
+  /// Orthomosaic pixels under `a` (raster_rect: edges on pixel boundaries, may extend beyond
+  /// the orthomosaic, clamped against overflow).
+  [[nodiscard]] cv::Rect pixel_rect(const Area& a) const { return raster_rect(a, gsd_cm_, height_px()); }
+
+  /// Number of valid (non-ignore) pixels under `a` (the part of `a` outside the raster has none).
+  [[nodiscard]] int valid_pixels(const Area& a) const {
+    const cv::Rect r = pixel_rect(a) & cv::Rect(0, 0, width_px(), height_px());
+    return r.area() > 0 ? cv::countNonZero(valid_(r)) : 0;
+  }
+  /// Number of valid (non-ignore) pixels of the whole field.
+  [[nodiscard]] int valid_pixels() const { return cv::countNonZero(valid_); }
+
+  /// True if any valid (non-ignore) pixel lies under `a`.
+  [[nodiscard]] bool has_valid(const Area& a) const { return valid_pixels(a) > 0; }
+
+  /// Index of the class called `class_name`, if any.
+  [[nodiscard]] std::optional<int> class_index(std::string_view class_name) const {
+    for (std::size_t i = 0; i < classes_.size(); ++i)
+      if (classes_[i].name == class_name) return static_cast<int>(i);
+    return std::nullopt;
+  }
+
+  /// Class indices of `names` (sorted, unique).
+  /// @throws std::invalid_argument for an unknown class name, listing the known ones.
+  [[nodiscard]] std::vector<int> class_indices(const std::vector<std::string>& names) const {
+    std::set<int> out;
+    for (const auto& n : names) {
+      const auto i = class_index(n);
+      if (!i) {
+        std::string known;
+        for (const auto& c : classes_) known += (known.empty() ? "" : ", ") + c.name;
+        throw std::invalid_argument("unknown class '" + n + "' in field '" + name_ +
+                                    "' (classes: " + known + ")");
+      }
+      out.insert(*i);
+    }
+    return {out.begin(), out.end()};
+  }
+
+  /// The part of the field inside `region` (fractions along the image axes) as a field of
+  /// its own, named "<name>[x0,y0,x1,y1]"; pixel edges are rounded to the nearest pixel.
+  /// Its frame origin is the region's bottom-left corner; a geo-reference is kept, its
+  /// anchor (and a CRS origin) shifted into the new frame, so every ground point keeps its
+  /// WGS84 position.
+  /// @throws std::invalid_argument unless 0 <= x0 < x1 <= 1 and 0 <= y0 < y1 <= 1 and the
+  ///         region holds at least one pixel.
+  [[nodiscard]] Field sub_field(const FieldRegion& region) const {
+    const auto in01 = [](double v) { return std::isfinite(v) && v >= 0.0 && v <= 1.0; };
+    std::ostringstream desc;
+    desc << region.x0 << ',' << region.y0 << ',' << region.x1 << ',' << region.y1;
+    detail::require(in01(region.x0) && in01(region.x1) && in01(region.y0) && in01(region.y1) &&
+                        region.x0 < region.x1 && region.y0 < region.y1,
+                    "Field::sub_field: region must satisfy 0 <= x0 < x1 <= 1, 0 <= y0 < y1 <= 1",
+                    desc.str());
+    const int c0 = static_cast<int>(std::lround(region.x0 * width_px()));
+    const int c1 = static_cast<int>(std::lround(region.x1 * width_px()));
+    const int r0 = static_cast<int>(std::lround(region.y0 * height_px()));
+    const int r1 = static_cast<int>(std::lround(region.y1 * height_px()));
+    detail::require(c1 > c0 && r1 > r0, "Field::sub_field: region holds no pixel", desc.str());
+    const cv::Rect roi(c0, r0, c1 - c0, r1 - r0);
+    Field out(name_ + "[" + desc.str() + "]", gsd_cm_, labels_(roi).clone(), classes_, interest_, ignore_label_,
+              image_.empty() ? cv::Mat() : image_(roi).clone());
+    if (geo_) {
+      // The new origin, the region's bottom-left corner, lies at (c0, height - r1) pixels in this frame.
+      out.geo_ = geo_;
+      out.geo_->anchor_x_m -= c0 * gsd_cm_ / 100.0;
+      out.geo_->anchor_y_m -= (height_px() - r1) * gsd_cm_ / 100.0;
+    }
+    if (crs_) {
+      out.crs_ = crs_;
+      out.crs_->origin_easting_m += c0 * gsd_cm_ / 100.0;
+      out.crs_->origin_northing_m += (height_px() - r1) * gsd_cm_ / 100.0;
+    }
+    return out;
+  }
+
+ private:
+  void validate() const {
+    detail::require_positive(gsd_cm_, "Field '" + name_ + "': gsd_cm");
+    detail::require(!labels_.empty(), "Field '" + name_ + "': the label map is empty", "0x0");
+    detail::require(labels_.type() == CV_8UC1,
+                    "Field '" + name_ + "': the label map must be 8-bit single channel (CV_8UC1)",
+                    "channels=" + std::to_string(labels_.channels()) +
+                        " depth=" + std::to_string(labels_.depth()));
+    detail::require(!classes_.empty(), "Field '" + name_ + "': at least one class is required", 0);
+    detail::require(ignore_label_ >= 0 && ignore_label_ <= 255,
+                    "Field '" + name_ + "': ignore_label must be in 0..255", ignore_label_);
+    detail::require(ignore_label_ >= num_classes(),
+                    "Field '" + name_ + "': ignore_label must not be a class index (there are " +
+                        std::to_string(num_classes()) + " classes)",
+                    ignore_label_);
+    std::set<std::string> names;
+    for (const auto& c : classes_) {
+      detail::require(!c.name.empty(), "Field '" + name_ + "': a class has an empty name", "''");
+      detail::require(names.insert(c.name).second,
+                      "Field '" + name_ + "': class name listed twice", c.name);
+    }
+    for (int i : interest_)
+      detail::require(i >= 0 && i < num_classes(),
+                      "Field '" + name_ + "': label of interest out of range", i);
+    if (!image_.empty()) {
+      detail::require(image_.type() == CV_8UC3,
+                      "Field '" + name_ + "': the image must be 8-bit 3-channel",
+                      "channels=" + std::to_string(image_.channels()));
+      detail::require(image_.size() == labels_.size(),
+                      "Field '" + name_ + "': image and label map differ in size",
+                      std::to_string(image_.cols) + "x" + std::to_string(image_.rows) + " vs " +
+                          std::to_string(labels_.cols) + "x" + std::to_string(labels_.rows));
+    }
+    // Every pixel must be a class index or the ignore label.
+    for (int r = 0; r < labels_.rows; ++r) {
+      const auto* row = labels_.ptr<std::uint8_t>(r);
+      for (int c = 0; c < labels_.cols; ++c) {
+        const int v = row[c];
+        if (v >= num_classes() && v != ignore_label_) {
+          throw std::invalid_argument("Field '" + name_ + "': label value " + std::to_string(v) +
+                                      " at row " + std::to_string(r) + ", col " +
+                                      std::to_string(c) + " is neither a class index (0.." +
+                                      std::to_string(num_classes() - 1) +
+                                      ") nor the ignore label " + std::to_string(ignore_label_));
+        }
+      }
+    }
+  }
+
+  std::string name_;
+  double gsd_cm_;
+  cv::Mat labels_;
+  cv::Mat image_;
+  std::vector<ClassInfo> classes_;
+  std::vector<int> interest_;
+  int ignore_label_;
+  cv::Mat valid_;
+  std::optional<FieldGeo> geo_;
+  std::optional<FieldCrs> crs_;
+};
+
+namespace detail {
+
+[[noreturn]] inline void field_error(const std::filesystem::path& file, const std::string& what) {
+  throw std::invalid_argument(file.string() + ": " + what);
+}
+
+inline YAML::Node field_key(const YAML::Node& root, const char* key,
+                            const std::filesystem::path& file) {
+  const YAML::Node n = root[key];
+  if (!n) field_error(file, std::string("missing key '") + key + "'");
+  return n;
+}
+
+template <typename T>
+T field_scalar(const YAML::Node& n, const char* what, const std::filesystem::path& file) {
+  if (!n.IsScalar()) field_error(file, std::string("'") + what + "' must be a scalar");
+  try {
+    return n.as<T>();
+  } catch (const YAML::Exception&) {
+    field_error(file, std::string("'") + what + "' has the wrong type (value '" + n.Scalar() + "')");
+  }
+}
+
+/// The `geo:` section of field.yaml: a mapping of exactly latitude_deg, longitude_deg,
+/// altitude_m and heading_deg (numbers); `anchored` (a live folder's area.yaml, which
+/// --record-from writes for a region or a GeoTIFF field) also allows FieldGeo's anchor_x_m,
+/// anchor_y_m (default 0) and scale (default 1).
+inline FieldGeo field_read_geo(const YAML::Node& n, const std::filesystem::path& file, bool anchored = false) {
+  static const char* const kGeoKeys[] = {"latitude_deg", "longitude_deg", "altitude_m", "heading_deg",
+                                         "anchor_x_m",   "anchor_y_m",    "scale"};
+  const int required = 4, known = anchored ? 7 : 4;
+  const std::string names = anchored ? "latitude_deg, longitude_deg, altitude_m, heading_deg, anchor_x_m, anchor_y_m, scale"
+                                     : "latitude_deg, longitude_deg, altitude_m, heading_deg";
+  if (!n.IsMap()) field_error(file, "'geo' must be a mapping {" + names + "}");
+  for (const auto& kv : n) {
+    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "<non-scalar>";
+    if (std::none_of(kGeoKeys, kGeoKeys + known, [&](const char* k) { return key == k; }))
+      field_error(file, "geo: unknown key '" + key + "' (known: " + names + ")");
+  }
+  double v[7] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0};
+  for (int k = 0; k < known; ++k) {
+    const std::string what = std::string("geo.") + kGeoKeys[k];
+    if (!n[kGeoKeys[k]]) {
+      if (k < required) field_error(file, "missing key '" + what + "'");
+      continue;
+    }
+    v[k] = field_scalar<double>(n[kGeoKeys[k]], what.c_str(), file);
+  }
+  const FieldGeo g{v[0], v[1], v[2], v[3], v[4], v[5], v[6]};
+  try {
+    validate_field_geo(g, "geo");
+  } catch (const std::invalid_argument& e) {
+    field_error(file, e.what());
+  }
+  return g;
+}
+
+inline cv::Mat field_read_image(const std::filesystem::path& file, int flags,
+                                const std::filesystem::path& yaml) {
+  if (!std::filesystem::is_regular_file(file))
+    field_error(yaml, "file not found: " + file.string());
+  cv::Mat m = cv::imread(file.string(), flags);
+  if (m.empty()) field_error(yaml, "cannot decode image: " + file.string());
+  return m;
+}
+
+/// field.yaml read and checked, the rasters not yet loaded (Field::load, gdal::load_field).
+struct FieldYaml {
+  std::filesystem::path yaml;                  ///< the field.yaml file
+  std::string name;
+  std::optional<double> gsd_cm;                ///< absent: the rasters must carry it
+  std::string labels_file;                     ///< as written, relative to the directory
+  std::optional<std::string> image_file;       ///< as written, relative to the directory
+  int ignore_label = 255;
+  std::vector<ClassInfo> classes;
+  std::vector<int> interest;
+  std::optional<FieldGeo> geo;
+};
+
+/// Reads `dir`/field.yaml (docs/data_format.md); `gsd_cm` may be absent (the caller decides).
+/// @throws std::invalid_argument naming the file and the problem.
+inline FieldYaml read_field_yaml(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  if (!fs::is_directory(dir))
+    throw std::invalid_argument("field directory not found: " + dir.string());
+  const fs::path yaml = dir / "field.yaml";
+  if (!fs::is_regular_file(yaml)) throw std::invalid_argument("missing " + yaml.string());
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(yaml.string());
+  } catch (const YAML::Exception& e) {
+    field_error(yaml, std::string("YAML error: ") + e.what());
+  }
+  if (!root.IsMap()) field_error(yaml, "the document must be a mapping");
+  static const std::set<std::string> kKeys{"name", "gsd_cm", "labels", "image", "ignore_label",
+                                           "classes", "interest", "geo"};
+  for (const auto& kv : root) {
+    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "<non-scalar>";
+    if (!kKeys.count(key))
+      field_error(yaml, "unknown key '" + key +
+                            "' (known: name, gsd_cm, labels, image, ignore_label, "
+                            "classes, interest, geo)");
+  }
+  FieldYaml out;
+  out.yaml = yaml;
+  out.name = field_scalar<std::string>(field_key(root, "name", yaml), "name", yaml);
+  if (root["gsd_cm"]) {
+    const auto gsd = field_scalar<double>(root["gsd_cm"], "gsd_cm", yaml);
+    if (!std::isfinite(gsd) || gsd <= 0.0)
+      field_error(yaml, "'gsd_cm' must be finite and > 0 (got " + std::to_string(gsd) + ")");
+    out.gsd_cm = gsd;
+  }
+  out.labels_file = field_scalar<std::string>(field_key(root, "labels", yaml), "labels", yaml);
+  if (root["image"]) out.image_file = field_scalar<std::string>(root["image"], "image", yaml);
+  if (root["ignore_label"]) {
+    out.ignore_label = field_scalar<int>(root["ignore_label"], "ignore_label", yaml);
+    if (out.ignore_label < 0 || out.ignore_label > 255)
+      field_error(yaml, "'ignore_label' must be in 0..255 (got " + std::to_string(out.ignore_label) + ")");
+  }
+  const YAML::Node classes_node = field_key(root, "classes", yaml);
+  if (!classes_node.IsSequence() || classes_node.size() == 0)
+    field_error(yaml, "'classes' must be a non-empty list");
+  std::vector<ClassInfo> classes;
+  for (std::size_t i = 0; i < classes_node.size(); ++i) {
+    const YAML::Node c = classes_node[i];
+    const std::string where = "classes[" + std::to_string(i) + "]";
+    if (!c.IsMap()) field_error(yaml, where + " must be a mapping {name, color}");
+    for (const auto& kv : c) {
+      const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "<non-scalar>";
+      if (key != "name" && key != "color")
+        field_error(yaml, where + ": unknown key '" + key + "' (known: name, color)");
+    }
+    if (!c["name"]) field_error(yaml, where + ": missing key 'name'");
+    ClassInfo info;
+    info.name = field_scalar<std::string>(c["name"], (where + ".name").c_str(), yaml);
+    if (c["color"]) {
+      const YAML::Node col = c["color"];
+      if (!col.IsSequence() || col.size() != 3)
+        field_error(yaml, where + ".color must be a list of 3 integers [r, g, b]");
+      for (std::size_t k = 0; k < 3; ++k) {
+        const int v = field_scalar<int>(col[k], (where + ".color").c_str(), yaml);
+        if (v < 0 || v > 255)
+          field_error(yaml, where + ".color values must be in 0..255 (got " + std::to_string(v) + ")");
+        info.color_rgb[k] = static_cast<std::uint8_t>(v);
+      }
+    } else {
+      field_error(yaml, where + ": missing key 'color'");
+    }
+    for (const auto& earlier : classes)
+      if (earlier.name == info.name) field_error(yaml, where + ": class name '" + info.name + "' listed twice");
+    classes.push_back(std::move(info));
+  }
+
+  std::vector<std::string> interest_names;
+  if (root["interest"]) {
+    const YAML::Node in = root["interest"];
+    if (!in.IsSequence()) field_error(yaml, "'interest' must be a list of class names");
+    for (std::size_t i = 0; i < in.size(); ++i)
+      interest_names.push_back(field_scalar<std::string>(in[i], "interest[]", yaml));
+  }
+  std::vector<int> interest;
+  for (const auto& n : interest_names) {
+    bool found = false;
+    for (std::size_t i = 0; i < classes.size(); ++i) {
+      if (classes[i].name == n) {
+        interest.push_back(static_cast<int>(i));
+        found = true;
+      }
+    }
+    if (!found) field_error(yaml, "'interest' names unknown class '" + n + "'");
+  }
+  std::sort(interest.begin(), interest.end());
+  interest.erase(std::unique(interest.begin(), interest.end()), interest.end());
+
+  if (root["geo"]) out.geo = field_read_geo(root["geo"], yaml);
+  out.classes = std::move(classes);
+  out.interest = std::move(interest);
+  return out;
+}
+
+/// The label map as read from `file`: it must be 8-bit single channel.
+inline cv::Mat field_check_labels(cv::Mat labels, const FieldYaml& y) {
+  if (labels.type() != CV_8UC1)
+    field_error(y.yaml, "'" + y.labels_file + "' must be an 8-bit single-channel PNG (got " +
+                            std::to_string(labels.channels()) + " channels, depth " +
+                            std::to_string(labels.depth()) + ")");
+  return labels;
+}
+
+/// The Field of `y` with these rasters; a violation of Field's rules names field.yaml.
+inline Field field_from_yaml(const FieldYaml& y, double gsd_cm, cv::Mat labels, cv::Mat image) {
+  try {
+    Field f = Field(y.name, gsd_cm, std::move(labels), y.classes, y.interest, y.ignore_label, std::move(image))
+                  .with_geo(y.geo);
+    // A field without a labelled pixel would fly no image and score NaN: say so instead.
+    if (f.valid_pixels() == 0)
+      throw std::invalid_argument("the field has no valid pixel: every label is the ignore label " +
+                                  std::to_string(y.ignore_label) + " (or, in a GeoTIFF orthomosaic, transparent)");
+    return f;
+  } catch (const std::invalid_argument& e) {
+    field_error(y.yaml, e.what());
+  }
+}
+
+}  // namespace detail
+
+inline Field Field::load(const std::filesystem::path& dir) {
+  const detail::FieldYaml y = detail::read_field_yaml(dir);
+  if (!y.gsd_cm)
+    detail::field_error(y.yaml, "missing key 'gsd_cm' (a field whose rasters carry their georeference, "
+                                "e.g. GeoTIFFs, loads with adaptseg::gdal::load_field, <adaptseg/gdal/gdal_io.hpp>)");
+  cv::Mat labels = detail::field_check_labels(
+      detail::field_read_image(dir / y.labels_file, cv::IMREAD_UNCHANGED, y.yaml), y);
+  cv::Mat image;
+  if (y.image_file) image = detail::field_read_image(dir / *y.image_file, cv::IMREAD_COLOR, y.yaml);
+  return detail::field_from_yaml(y, *y.gsd_cm, std::move(labels), std::move(image));
+}
+
+}  // namespace adaptseg
