@@ -1,11 +1,9 @@
-// Fuzz target: the file readers of the Gaussian processes (both kernels; YAML and adaptseg
-// 0.1's text format) and of the decision function of format-1 model files that embeds them,
-// from memory.
+// Fuzz target: the file reader of the Gaussian processes (both kernels; YAML, and the refusal
+// of adaptseg 0.1's line format), from memory.
 
 #include "fuzz_support.hpp"
 
 #include <adaptseg/core/gaussian_process.hpp>
-#include <adaptseg/vision/decision_model.hpp>
 #include <adaptseg/vision/gp_io.hpp>
 
 #include <cstddef>
@@ -23,10 +21,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   fuzz::expect_clean([&] {
     std::istringstream is(text);
     (void)load_gaussian_process<ArdSquaredExponentialKernel>(is);
-  });
-  fuzz::expect_clean([&] {
-    std::istringstream is(text);
-    (void)detail::read_legacy_decision_function(is, "fuzz");
   });
   return 0;
 }

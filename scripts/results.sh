@@ -83,7 +83,7 @@ calibrate_bin=build/release/examples/adaptseg_calibrate
 root=out/results
 classes="building road vegetation water"
 fixed=(--seg-time-s 0.1 --plan-time-s 0)
-paper=(--rule threshold --gain-inputs delta-sigma --coverage region --no-plots)
+paper=(--rule utility --gain-inputs delta-sigma --coverage region --no-plots)
 # A bundled network (--model-file examples/models/NET), one thread per run; calibration keeps the
 # network's segmentations on disk, so that the runs over the same tiles segment each image once.
 network=(--segmenter erfnet --threads 1 --segmentation-cache "out/results/segmentation-cache")

@@ -483,79 +483,15 @@ TEST_CASE("decision model: file round trip and compatibility checks") {
                        std::invalid_argument);
 }
 
-namespace {
-/// The rows of an *.expected.csv of tests/data/decision_model_v1 (README there).
-struct OldRow {
-  double sigma, gsd_cm, delta_sigma, delta_miou, delta_miou_std, utility, front_margin;
-  bool descend;
-  double chosen;
-};
-std::vector<OldRow> read_expected(const std::filesystem::path& p) {
-  std::ifstream is(p);
-  std::string line;
-  std::getline(is, line);  // header
-  std::vector<OldRow> rows;
-  while (std::getline(is, line)) {
-    std::vector<double> v;
-    std::istringstream ls(line);
-    for (std::string cell; std::getline(ls, cell, ',');) v.push_back(std::stod(cell));  // "nan" included
-    REQUIRE(v.size() == 9);
-    rows.push_back({v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7] != 0.0, v[8]});
-  }
-  return rows;
-}
-}  // namespace
-
-TEST_CASE("decision model: files of format 1 load with the forecasts and decisions of adaptseg 0.1") {
-  const std::filesystem::path dir = std::filesystem::path(ADAPTSEG_TEST_DATA_DIR) / "decision_model_v1";
-  for (const char* name : {"weedmap_utility_v1", "dubai_road_front_aware_v3"}) {
-    CAPTURE(name);
-    const DecisionModel m = DecisionModel::load(dir / (std::string(name) + ".yaml"));
-    CHECK(m.calibration_fields.size() == 1);
-    CHECK_FALSE(m.decision_function.model().c_model().has_value());
-    const auto rows = read_expected(dir / (std::string(name) + ".expected.csv"));
-    REQUIRE(rows.size() == 8 * m.candidate_gsd_cm.size());
-    // The contexts dump_old.cpp.txt decided on, in its order.
-    DecisionFunction df = m.decision_function;
-    df.begin_mission();
-    const CameraModel camera(m.camera);
-    std::vector<Candidate> cands;
-    for (double g : m.candidate_gsd_cm) cands.push_back({g, camera.altitude_m(g), 4, 30.0 + 10.0 * g});
-    std::vector<LawnmowerForecast> lm;
-    for (double g : m.candidate_gsd_cm) lm.push_back({g, 400.0 / g});
-    lm.push_back({m.top_gsd_cm, 400.0 / m.top_gsd_cm});
-    for (int k = 0; k < 8; ++k) {
-      const double sigma = 0.01 + 0.07 * k;
-      const DecisionContext c{.sigma = sigma, .valid_fraction = 0.9, .top_gsd_cm = m.top_gsd_cm,
-                              .top_altitude_m = camera.altitude_m(m.top_gsd_cm), .candidates = cands,
-                              .elapsed_s = 10.0 + 20.0 * k, .rest_s = 200.0 - 20.0 * k, .region_share = 0.1,
-                              .lawnmowers = lm};
-      const Decision d = df.decide(c);
-      for (std::size_t i = 0; i < cands.size(); ++i) {
-        const OldRow& r = rows[static_cast<std::size_t>(k) * cands.size() + i];
-        const CandidateScore& s = d.scores[i];
-        CHECK(r.sigma == doctest::Approx(sigma));
-        CHECK(s.predicted_delta_sigma == doctest::Approx(r.delta_sigma).epsilon(1e-12));
-        CHECK(s.predicted_delta_miou == doctest::Approx(r.delta_miou).epsilon(1e-12));
-        CHECK(s.predicted_delta_miou_std == doctest::Approx(r.delta_miou_std).epsilon(1e-12));
-        // The front-aware rule reports its field-level gain per second as the utility (0.1:
-        // the paper's σ-weighted one, which that rule did not use).
-        if (!m.decision_function.front_aware()) CHECK(s.utility == doctest::Approx(r.utility).epsilon(1e-12));
-        if (std::isfinite(r.front_margin)) CHECK(s.predicted_front_margin == doctest::Approx(r.front_margin).epsilon(1e-12));
-        CHECK(d.descend == r.descend);
-        if (r.descend) CHECK(d.gsd_cm == r.chosen);
-      }
-    }
-  }
-  // A format-1 file whose I block (decision-function text of version 1: isotropic I) is cut
-  // before its end line says so.
-  std::string text = t::read_file(dir / "weedmap_utility_v1.yaml");
-  const auto i_end = text.rfind("end adaptseg.gaussian_process");
-  REQUIRE(i_end != std::string::npos);
+TEST_CASE("decision model: a file of format 1 (adaptseg 0.1) is refused, saying to calibrate again") {
+  // Its keys as adaptseg 0.1 wrote them (a decision function as an embedded text block).
   t::TempDir tmp;
-  t::write_file(tmp.path() / "cut.yaml", text.erase(i_end));
-  CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "cut.yaml"),
-                       doctest::Contains("input ends inside I's Gaussian process"), std::invalid_argument);
+  t::write_file(tmp.path() / "old.yaml", "format: adaptseg.decision_model/1\ncalibration_field: weedmap-000\n"
+                                         "segmenter: oracle\ndecision_function: |\n  adaptseg.decision_function 1\n");
+  CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "old.yaml"),
+                       doctest::Contains("old.yaml: a decision model of format 1 (adaptseg 0.1) is no longer read since "
+                                         "adaptseg 0.2.0; calibrate the model again (adaptseg_calibrate)"),
+                       std::invalid_argument);
 }
 
 TEST_CASE("decision model: a plain YAML file, every fitted number a key, written and read under any locale") {

@@ -53,9 +53,6 @@ const GainModel& fitted() {
   return m;
 }
 
-/// `m` without C (what a file of format 1 holds).
-GainModel without_c(const GainModel& m) { return GainModel(m.o_model(), m.i_model()); }
-
 DecisionContext context(std::span<const Candidate> c, double sigma = 0.2) {
   return {.sigma = sigma, .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5, .candidates = c};
 }
@@ -205,56 +202,6 @@ TEST_CASE("utility policy: online updates extend O only when adaptive, and a new
 // ---------------------------------------------------------------------------------------------
 // FrontAwarePolicy
 // ---------------------------------------------------------------------------------------------
-TEST_CASE("front-aware policy: a model without C descends while descents beat the lawnmower curve (adaptseg 0.1)") {
-  // Training lawnmower by GSD, and this field's lawnmower times at the same GSDs.
-  const std::vector<ReferenceCurve> reference{
-      {"train", {{1.0, 1.0}, {1.5, 0.85}, {2.0, 0.82}, {2.5, 0.77}, {3.0, 0.75}}, 0.0}};
-  FrontAwarePolicy policy(without_c(fitted()), reference, {.weight_by_sigma = false});
-  const std::vector<LawnmowerForecast> lawnmowers{{1.0, 185.0}, {1.5, 107.0}, {2.0, 101.0}, {2.5, 96.0}, {3.0, 40.0}};
-  const std::vector<CurvePoint> curve{{185.0, 1.0}, {107.0, 0.85}, {101.0, 0.82}, {96.0, 0.77}, {40.0, 0.75}};
-  const auto c = candidates();
-  DecisionContext ctx = context(c);
-  ctx.elapsed_s = 5.7;
-  ctx.rest_s = 34.3;
-  ctx.region_share = 1.0 / 7.0;
-  ctx.lawnmowers = lawnmowers;
-  // First region: the mission's end point is the top-level lawnmower's (40 s, 0.75), margin 0.
-  // Re-mapping the region (1/7 of the field) from 1.0 cm/px gains about 0.275 / 7 = 0.039 for
-  // 40 s: (80 s, 0.789) lies above the curve (0.764 there).
-  const Decision first = policy.decide(ctx);
-  REQUIRE(first.descend);
-  double best = -1.0;
-  for (std::size_t k = 0; k < c.size(); ++k) {
-    const auto& s = first.scores[k];
-    const double expected = front_margin(curve, 40.0 + c[k].extra_time_s, 0.75 - s.predicted_delta_miou / 7.0);
-    CHECK(s.predicted_front_margin == doctest::Approx(expected).epsilon(1e-9));
-    CHECK(s.predicted_field_gain == doctest::Approx(-s.predicted_delta_miou / 7.0).epsilon(1e-12));
-    CHECK(std::isnan(s.predicted_relabelled));
-    best = std::max(best, s.predicted_front_margin);
-  }
-  CHECK(best > 0.015);
-  for (std::size_t k = 0; k < c.size(); ++k)
-    if (first.scores[k].predicted_front_margin == best) CHECK(first.gsd_cm == c[k].gsd_cm);
-  // A later region, after that descent (end point now about 85 s): another descent would end
-  // in the curve's steep part (2.5 -> 1.5 cm/px costs only 11 s there), below it: continue.
-  DecisionContext next = ctx;
-  next.elapsed_s = 5.7 + 40.0 + 5.7;
-  next.rest_s = 33.6;
-  const Decision second = policy.decide(next);
-  CHECK_FALSE(second.descend);
-  for (const auto& s : second.scores) CHECK(s.predicted_front_margin < 0.0);
-  // A new mission forgets the forecast: the first region descends again.
-  policy.begin_mission();
-  CHECK(policy.decide(ctx).descend);
-  // The rule needs the forecasts and a valid reference.
-  DecisionContext blind = ctx;
-  blind.lawnmowers = {};
-  CHECK_THROWS_WITH_AS((void)policy.decide(blind), doctest::Contains("lawnmower forecasts"), std::invalid_argument);
-  CHECK_THROWS_AS(FrontAwarePolicy(fitted(), {}, {}), std::invalid_argument);
-  CHECK_THROWS_AS(FrontAwarePolicy(fitted(), {{"x", {{0.0, 0.5}}, 0.1}}, {}), std::invalid_argument);
-  CHECK_THROWS_AS(FrontAwarePolicy(fitted(), reference, {.confidence = -1.0}), std::invalid_argument);
-}
-
 namespace {
 // One candidate 1.0 cm/px (Δh = 11 m, η = 1) for 40 s; the field's lawnmowers at 3.0 cm/px
 // (40 s) and 1.0 cm/px (185 s); regions of 1/7 of the field; the training fields' σ 0.2. With
@@ -289,6 +236,35 @@ struct Scenario {
   }
 };
 }  // namespace
+
+TEST_CASE("front-aware policy: a descent's forecast margin is against the curve at its end; a new mission forgets") {
+  const Scenario s;
+  // The curve rises 0.01 per 40 s from the top level (40 s, 0.75); a descent of 40 s from
+  // region 0 (T0 = 40 s) is forecast to gain about 0.0143: it ends above the curve.
+  const std::vector<CurvePoint> curve{{40.0, 0.75}, {185.0, 0.75 + 0.01 * 145.0 / 40.0}};
+  FrontAwarePolicy policy(fitted(), s.reference(0.01), {.confidence = 0.0});
+  const Decision first = policy.decide(s.region(0));
+  REQUIRE(first.scores.size() == 1);
+  const CandidateScore& sc = first.scores[0];
+  CHECK(sc.predicted_front_margin ==
+        doctest::Approx(front_margin(curve, 40.0 + s.one[0].extra_time_s, 0.75 + sc.predicted_field_gain)).epsilon(1e-9));
+  CHECK(sc.predicted_front_margin > 0.0);
+  CHECK(first.descend);
+  // A new mission forgets what the last one chose and saw.
+  (void)policy.decide(s.region(1));
+  policy.begin_mission();
+  const Decision again = policy.decide(s.region(0));
+  CHECK(again.scores[0].predicted_front_margin == doctest::Approx(sc.predicted_front_margin).epsilon(1e-12));
+  // The rule needs the forecasts, a valid reference and a model that forecasts relabelling.
+  DecisionContext blind = s.region(0);
+  blind.lawnmowers = {};
+  CHECK_THROWS_WITH_AS((void)policy.decide(blind), doctest::Contains("lawnmower forecasts"), std::invalid_argument);
+  CHECK_THROWS_AS(FrontAwarePolicy(fitted(), {}, {}), std::invalid_argument);
+  CHECK_THROWS_AS(FrontAwarePolicy(fitted(), {{"x", {{0.0, 0.5}}, 0.1}}, {}), std::invalid_argument);
+  CHECK_THROWS_AS(FrontAwarePolicy(fitted(), s.reference(0.0), {.confidence = -1.0}), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(FrontAwarePolicy(GainModel(fitted().o_model(), fitted().i_model()), s.reference(0.0), {}),
+                       doctest::Contains("needs C or a cell gain model"), std::invalid_argument);
+}
 
 TEST_CASE("front-aware policy: the field gain comes from C's relabelling, η and the field's estimated σ") {
   const Scenario s;
@@ -681,9 +657,6 @@ TEST_CASE("decision policies: every policy passes the conformance suite") {
   SUBCASE("front-aware") {
     test::check_policy_conformance(FrontAwarePolicy(fitted(), s.reference(0.001, 0.002), {.confidence = 0.5}),
                                    mission, outcome);
-  }
-  SUBCASE("front-aware without C") {
-    test::check_policy_conformance(FrontAwarePolicy(without_c(fitted()), s.reference(0.001), {}), mission, outcome);
   }
   SUBCASE("decision function") {
     test::check_policy_conformance(DecisionFunction(FrontAwarePolicy(fitted(), s.reference(0.0), {})), mission,

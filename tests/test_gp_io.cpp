@@ -1,9 +1,7 @@
 // GP files (gp_io.hpp): the YAML format written and read back with identical predictions,
-// read by a plain YAML parser, locale-proof; adaptseg 0.1's line format still read
-// (detail/gp_text_v1.hpp) with identical predictions, and rejected when broken.
+// read by a plain YAML parser, locale-proof; adaptseg 0.1's line format refused by name.
 
 #include "comma_locale.hpp"
-#include "gp_text_v1_writer.hpp"
 #include "test_support.hpp"
 
 #include <adaptseg/core/gaussian_process.hpp>
@@ -171,58 +169,14 @@ TEST_CASE("gp file: broken YAML files are rejected, naming the key") {
                        Contains("does not accept inputs of dimension 3"), std::invalid_argument);
 }
 
-TEST_CASE("gp file: adaptseg 0.1's text format still loads, with identical predictions") {
-  const Ard gp = fitted_model();
-  const std::string text = adaptseg::test::gp_text_v1(gp);
-  const Ard from_text = load_text(text);
-  check_same(gp, from_text);
-  // As the same model saved as YAML: the two formats restore the same state.
-  std::stringstream yaml;
-  adaptseg::save_gaussian_process(gp, yaml);
-  check_identical(from_text, load_text(yaml.str()));
-  CHECK_NOTHROW((void)load_text("# decision-function model\n\n" + text));  // comments, blank lines
-
-  // Embedded in a larger stream, the reader stops after its own 'end' line.
-  std::istringstream embedded("header\n" + text + "trailer\n");
-  std::string first;
-  std::getline(embedded, first);
-  check_identical(from_text, adaptseg::detail::read_gp_text_v1<ArdSquaredExponentialKernel>(embedded));
-  std::string rest;
-  std::getline(embedded, rest);
-  CHECK(rest == "trailer");
-
-  // The isotropic kernel too, and an empty model.
-  const GaussianProcess<SquaredExponentialKernel> empty(SquaredExponentialKernel(0.5));
-  std::istringstream es(adaptseg::test::gp_text_v1(empty));
-  CHECK(adaptseg::load_gaussian_process<SquaredExponentialKernel>(es).size() == 0);
-}
-
-TEST_CASE("gp file: truncated, garbled and mismatched text-format files are rejected") {
-  const std::string text = adaptseg::test::gp_text_v1(fitted_model());
-  // Every truncation at a line boundary, and a few inside lines.
-  std::vector<std::size_t> cuts;
-  for (std::size_t i = 0; i < text.size(); ++i)
-    if (text[i] == '\n' && i + 1 < text.size()) cuts.push_back(i + 1);
-  cuts.push_back(text.size() / 2);
-  for (const std::size_t cut : cuts) {
-    CAPTURE(cut);
-    CHECK_THROWS_AS((void)load_text(text.substr(0, cut)), std::invalid_argument);
-  }
-  CHECK_THROWS_WITH_AS((void)load_text(text.substr(0, text.size() / 2)), Contains("line"), std::invalid_argument);
-  CHECK_THROWS_WITH_AS((void)load_text(replaced(text, "adaptseg.gaussian_process 1", "adaptseg.gaussian_process 2")),
-                       Contains("version"), std::invalid_argument);
-  CHECK_THROWS_WITH_AS((void)load_text(replaced(text, "squared_exponential_ard", "squared_exponential_isotropic")),
-                       Contains("kernel"), std::invalid_argument);
-  CHECK_THROWS_WITH_AS((void)load_text(replaced(text, "dimension 2", "dimension two")), Contains("integer"),
+TEST_CASE("gp file: adaptseg 0.1's line format is refused, saying to fit and save again") {
+  // The first lines of a GP as adaptseg 0.1 wrote it (after comments and blank lines).
+  const std::string old = "# decision-function model\n\nadaptseg.gaussian_process 1\nkernel squared_exponential_ard\n";
+  CHECK_THROWS_WITH_AS((void)load_text(old),
+                       Contains("a Gaussian process in adaptseg 0.1's line format is no longer read since adaptseg "
+                                "0.2.0; fit it again and save it with save_gaussian_process"),
                        std::invalid_argument);
-  CHECK_THROWS_WITH_AS((void)load_text(replaced(text, "normalize_y 1", "normalise_y 1")), Contains("normalize_y"),
+  // A YAML file whose format names another version is not mistaken for it.
+  CHECK_THROWS_WITH_AS((void)load_text("format: adaptseg.gaussian_process 1\n"), Contains("format"),
                        std::invalid_argument);
-  CHECK_THROWS_AS((void)load_text(replaced(text, "log_parameters 4", "log_parameters 5")), std::invalid_argument);
-  CHECK_THROWS_AS((void)load_text(replaced(text, "y_std ", "y_std -")), std::invalid_argument);
-  CHECK_THROWS_AS((void)load_text(replaced(text, "samples 21", "samples 22")), std::invalid_argument);
-  CHECK_THROWS_AS((void)load_text(replaced(text, "samples 21", "samples 20")), std::invalid_argument);
-  CHECK_THROWS_AS((void)load_text(replaced(text, "\nend ", "\nnan ")), std::invalid_argument);
-  const auto sample_line = text.find('\n', text.find("samples 21")) + 1;
-  const std::string garbled = text.substr(0, sample_line) + std::string(1, 'x') + text.substr(sample_line);
-  CHECK_THROWS_WITH_AS((void)load_text(garbled), Contains("finite number"), std::invalid_argument);
 }

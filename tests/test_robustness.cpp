@@ -4,7 +4,6 @@
 // broken, and must give the documented exception type and message fragment: no crash, no
 // sanitizer report, no silent acceptance. Also the library half of item 5 (determinism).
 
-#include "gp_text_v1_writer.hpp"
 #include "test_support.hpp"
 
 #include <adaptseg/core/decision_function.hpp>
@@ -126,14 +125,16 @@ DecisionModel load_model_text(const t::TempDir& dir, const std::string& text) {
   return DecisionModel::load(p);
 }
 
-/// A fitted 1-D GP in adaptseg 0.1's text format (what the text reader must survive).
+/// A fitted 1-D GP as a GP file (YAML; what the reader must survive).
 std::string gp_text() {
   Eigen::MatrixXd x(5, 1);
   x << 0.0, 0.5, 1.0, 1.5, 2.0;
   const Eigen::VectorXd y = x.col(0).array().sin();
   GaussianProcess<SquaredExponentialKernel> gp(SquaredExponentialKernel(1.0, 1.0, 0.01));
   gp.condition(x, y);
-  return t::gp_text_v1(gp);
+  std::ostringstream os;
+  save_gaussian_process(gp, os);
+  return os.str();
 }
 
 GaussianProcess<SquaredExponentialKernel> load_gp(const std::string& text) {
@@ -703,39 +704,41 @@ TEST_CASE("robustness: GP: duplicate inputs are accepted") {
 }
 
 TEST_CASE("robustness: GP file: NaN value") {
-  const std::string text = replaced(gp_text(), "y_mean 0", "y_mean nan");
-  CHECK_THROWS_WITH_AS(load_gp(text), Contains("line 7: expected a finite number"), std::invalid_argument);
+  const std::string text = replaced(gp_text(), "y_mean: 0", "y_mean: nan");
+  CHECK_THROWS_WITH_AS(load_gp(text), Contains("'y_mean' must be a finite number"), std::invalid_argument);
 }
 
 TEST_CASE("robustness: GP file: truncated") {
   const std::string text = gp_text();
-  const std::string head = text.substr(0, text.rfind('\n', text.size() / 2) + 1);  // whole lines
-  CHECK_THROWS_WITH_AS(load_gp(head), Contains("unexpected end of input"), std::invalid_argument);
-  // A line cut in the middle: the count announced does not match.
-  CHECK_THROWS_WITH_AS(load_gp(text.substr(0, text.find("log_upper_bounds") + 22)), Contains("announces"),
+  // Cut after the inputs: the targets are missing.
+  CHECK_THROWS_WITH_AS(load_gp(text.substr(0, text.find("targets:"))), Contains("missing key 'targets'"),
+                       std::invalid_argument);
+  // Cut inside the targets' list: YAML itself fails, named as such.
+  CHECK_THROWS_WITH_AS(load_gp(text.substr(0, text.find("targets:") + 14)), Contains("YAML error"),
                        std::invalid_argument);
 }
 
 TEST_CASE("robustness: GP file: another kernel") {
   std::istringstream is(gp_text());
   CHECK_THROWS_WITH_AS((void)load_gaussian_process<ArdSquaredExponentialKernel>(is),
-                       Contains("kernel type does not match"), std::invalid_argument);
+                       Contains("'kernel' must be squared_exponential_ard"), std::invalid_argument);
 }
 
-TEST_CASE("robustness: GP file: huge announced sizes") {
-  // Sizes in the file must not be trusted for allocation: announcing 1e8 samples of 1e6
-  // inputs must fail on the data (or the kernel's dimension), not try to allocate 800 TB.
-  const std::string big = replaced(replaced(gp_text(), "dimension 1", "dimension 1000000"), "samples 5",
-                                   "samples 100000000");
-  CHECK_THROWS_WITH_AS(load_gp(big), Contains("a sample line needs 1000001 numbers"), std::invalid_argument);
-  std::string many = replaced(gp_text(), "samples 5", "samples 100000000");
-  many = many.substr(0, many.find("end adaptseg.gaussian_process"));
-  CHECK_THROWS_WITH_AS(load_gp(many), Contains("unexpected end of input"), std::invalid_argument);
-  // An ARD kernel has as many length scales as inputs: another dimension is refused up front.
-  std::istringstream is(
-      replaced(t::gp_text_v1(small_model().decision_function.model().o_model()), "dimension 2", "dimension 1000000"));
+TEST_CASE("robustness: GP file: huge or false announced dimension") {
+  // The rows are the data: a `dimension` key that disagrees with them is refused, whatever its
+  // size (nothing is allocated from it), and beyond 1e6 it is out of range.
+  CHECK_THROWS_WITH_AS(load_gp(replaced(gp_text(), "dimension: 1", "dimension: 1000000")),
+                       Contains("'dimension' is 1000000 but the rows of 'inputs' have 1 values"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(load_gp(replaced(gp_text(), "dimension: 1", "dimension: 100000000")), Contains("dimension"),
+                       std::invalid_argument);
+  // An ARD kernel has as many length scales as inputs: an empty model of another dimension is
+  // refused up front.
+  std::ostringstream os;
+  save_gaussian_process(GaussianProcess<ArdSquaredExponentialKernel>(ArdSquaredExponentialKernel(Eigen::VectorXd::Ones(2))),
+                        os);
+  std::istringstream is(replaced(os.str(), "dimension: 0", "dimension: 1000000"));
   CHECK_THROWS_WITH_AS((void)load_gaussian_process<ArdSquaredExponentialKernel>(is),
-                       Contains("the kernel does not accept dimension"), std::invalid_argument);
+                       Contains("does not accept inputs of dimension 1000000"), std::invalid_argument);
 }
 
 TEST_CASE("robustness: decision function: no samples or a NaN sample") {

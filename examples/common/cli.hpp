@@ -186,8 +186,8 @@ struct CalibrationCli {
     options_ = {
         app.add_option("--rule", rule,
                        "decision rule: front-aware (descend while descents beat the lawnmower curve; no threshold) "
-                       "or threshold (the paper's utility with the threshold calibrated on the training field)")
-            ->check(CLI::IsMember({"front-aware", "threshold"}))
+                       "or utility (the paper's: utility against a threshold calibrated on the training fields)")
+            ->check(CLI::IsMember({"front-aware", "utility"}))
             ->capture_default_str(),
         app.add_option("--threshold-steps", threshold_steps, "utility thresholds tried per weighting")
             ->capture_default_str(),

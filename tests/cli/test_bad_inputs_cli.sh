@@ -9,7 +9,7 @@ mission=$1 examples=$2 program=$3
 source "$(dirname "$0")/cli_common.sh"
 weedmap="$examples/data/weedmap-000"
 dubai="$examples/data/dubai-tile-1"
-weedmap_model="$examples/../tests/data/decision_model_v1/weedmap_utility_v1.yaml"
+weedmap_model="$examples/../tests/data/decision_model/weedmap_utility.yaml"
 
 # An unknown flag named as such, in one line with the pointer to --help (each program's case
 # adds a misspelt flag, for which the likely one is named; calibrate a flag without its value,

@@ -36,15 +36,15 @@ bad_inputs)
   # A decision model of another class set (WeedMap's, flown on Dubai).
   expect_error "decision model was calibrated for classes [soil, crop, weed] but field 'dubai-tile-1' has" \
     --field "$examples/data/dubai-tile-1" --strategy adaptive \
-    --model "$examples/../tests/data/decision_model_v1/weedmap_utility_v1.yaml" --out "$work/o"
+    --model "$examples/../tests/data/decision_model/weedmap_utility.yaml" --out "$work/o"
   # A model calibrated with one backend flown with another: refused, naming both (a network by its
   # folder and the hash of its weights and metadata).
   expect_error "decision model was calibrated with segmenter 'oracle' but the mission uses 'erfnet:erfnet-dubai-" \
     --field "$examples/data/dubai-tile-1" --strategy adaptive --segmenter erfnet \
     --model-file "$examples/models/erfnet-dubai" \
-    --model "$examples/../tests/data/decision_model_v1/dubai_road_front_aware_v3.yaml" --out "$work/o"
-  sed 's/^segmenter: oracle/segmenter: "erfnet:mobilenetv2-dubai-0123456789abcdef"/' \
-    "$examples/../tests/data/decision_model_v1/dubai_road_front_aware_v3.yaml" >"$work/mobilenet-model.yaml"
+    --model "$examples/../tests/data/decision_model/dubai_road_front_aware.yaml" --out "$work/o"
+  sed 's/^  segmenter: oracle/  segmenter: "erfnet:mobilenetv2-dubai-0123456789abcdef"/' \
+    "$examples/../tests/data/decision_model/dubai_road_front_aware.yaml" >"$work/mobilenet-model.yaml"
   expect_error "calibrated with segmenter 'erfnet:mobilenetv2-dubai-0123456789abcdef' but the mission uses 'erfnet:erfnet-dubai-" \
     --field "$examples/data/dubai-tile-1" --strategy adaptive --segmenter erfnet \
     --model-file "$examples/models/erfnet-dubai" --model "$work/mobilenet-model.yaml" --out "$work/o"

@@ -26,8 +26,8 @@ namespace adaptseg {
 struct ReferenceCurve {
   std::string field;              ///< the training field's name
   std::vector<GsdPoint> points;   ///< field mIoU over L by lawnmower GSD
-  /// σ of the field's top-level map (its share of L as the UAV sees it); 0: unknown (files of
-  /// format 1). The mean over the reference curves is the prior of a new field's σ.
+  /// σ of the field's top-level map (its share of L as the UAV sees it); 0: unknown. The mean
+  /// over the reference curves is the prior of a new field's σ.
   double field_sigma = 0.0;
   /// The mean over the field's top-level images of the cell gain model's input (its value per
   /// field pixel); 0: unknown (models without cells). The mean over the reference curves is the
@@ -90,18 +90,14 @@ struct ReferenceCurve {
 /// posterior is updated (conjugate Gaussian): descents that change less than forecast lower
 /// ĝ and the UAV stops earlier; descents that change more raise it; each observation narrows
 /// Var(s), so the lower bound rises as evidence accrues. Also the paper's update of O.
-/// `online = false` (non-adaptive) keeps s = 1, Var(s) = ω² and O as initialised. Models
-/// without C (files of format 1) keep s = 1, Var(s) = 0.
-///
-/// Models without C (files of format 1) forecast the gain as adaptseg 0.1 did: ĝ = (−μ_I) · a · w,
-/// w = σ / mean σ of this mission's top-level images if `weight_by_sigma`, else 1; with one
-/// reference curve and z = 0 the rule is then exactly that version's.
+/// `online = false` (non-adaptive) keeps s = 1, Var(s) = ω² and O as initialised. The rule
+/// needs C or a cell gain model (every calibrated model has C; models of adaptseg 0.1, which
+/// forecast the gain from I alone, are no longer read since 0.2.0).
 class FrontAwarePolicy {
  public:
   /// Behaviour; validated by the constructor.
   struct Params {
     double min_sigma = 0.0;         ///< σ below which the UAV never descends
-    bool weight_by_sigma = true;    ///< models without C: gain weighted by σ / mean σ (see class comment)
     bool online = true;             ///< field correction and O's update (false: non-adaptive)
     double confidence = 0.0;        ///< z >= 0 of the lower bound (see class comment)
     double scale_prior_sd = 0.5;    ///< ω > 0, prior spread of the field factor s
@@ -139,11 +135,15 @@ class FrontAwarePolicy {
     }
   };
 
-  /// @throws std::invalid_argument for invalid params, no reference curve, a curve without
-  ///         points, or a point with a GSD <= 0 or a non-finite value.
+  /// @throws std::invalid_argument for invalid params, a model without C and without a cell gain
+  ///         model, no reference curve, a curve without points, or a point with a GSD <= 0 or
+  ///         a non-finite value.
   FrontAwarePolicy(GainModel model, std::vector<ReferenceCurve> reference, Params params)
       : initial_(std::move(model)), model_(initial_), reference_(std::move(reference)), params_(params) {
     params_.validate();
+    detail::require(model_.c_model().has_value() || model_.cells().has_value(),
+                    "FrontAwarePolicy: the gain model needs C or a cell gain model (what a descent relabels); C",
+                    "absent");
     std::size_t with_sigma = 0;
     detail::require(!reference_.empty(), "FrontAwarePolicy: at least one reference lawnmower curve is needed; count",
                     reference_.size());
@@ -202,7 +202,7 @@ class FrontAwarePolicy {
     forecast_gain_ = 0.0;
     chosen_.clear();
     scale_mean_ = 1.0;
-    scale_var_ = model_.c_model() || model_.cells() ? params_.scale_prior_sd * params_.scale_prior_sd : 0.0;
+    scale_var_ = params_.scale_prior_sd * params_.scale_prior_sd;
     scale_precision_sum_ = 0.0;
     scale_evidence_sum_ = 0.0;
   }
@@ -229,8 +229,7 @@ class FrontAwarePolicy {
       seen_input_ += c.region_share * c.region_input;
       seen_input_share_ += c.region_share;
     }
-    const bool by_relabelling = model_.c_model().has_value() || model_.cells().has_value();
-    const auto [weight, sigma_cv2] = by_relabelling ? gain_weight(c) : std::pair{legacy_gain_weight(c), 0.0};
+    const auto [weight, sigma_cv2] = gain_weight(c);
     const double t0 = c.elapsed_s + c.rest_s;
     // The predicted curve's mIoU relative to the top level's (field_curve) or absolute.
     double curve_level = 0.0;
@@ -255,7 +254,7 @@ class FrontAwarePolicy {
       const GainForecast f = model_.forecast(delta_h, c.sigma);
       CandidateScore s = scored(cand, f);
       // The descent's gain in shares of the region (its sd, and what it relabels): from its
-      // cells (DescentCoverage::ranked), from C and η, or as adaptseg 0.1 did (−μ_I).
+      // cells (DescentCoverage::ranked), else from C and η.
       double base = 0.0, base_sd = 0.0;
       Relabelled relabelled;
       if (!cand.cells.empty() && model_.cells() && c.region_px > 0.0) {
@@ -268,9 +267,6 @@ class FrontAwarePolicy {
         base = f.relabelled * eta * weight;
         base_sd = f.relabelled_std * eta * weight;
         relabelled = {f.relabelled, f.relabelled_noisy_std, 0.0, 0.0, 0.0, 0.0};
-      } else {
-        base = -f.delta_miou * weight;
-        base_sd = f.delta_miou_std * weight;
       }
       const double gain = scale_mean_ * base;
       const double gain_var =
@@ -448,12 +444,6 @@ class FrontAwarePolicy {
     }
     if (!(sigma > 0.0)) return {0.0, 0.0};
     return {c.region_share / sigma, sigma_var / (sigma * sigma)};
-  }
-
-  /// a · w of adaptseg 0.1 (models without C).
-  [[nodiscard]] double legacy_gain_weight(const DecisionContext& c) const {
-    const double mean_sigma = sigma_sum_ / static_cast<double>(sigma_count_);
-    return c.region_share * (params_.weight_by_sigma && mean_sigma > 0.0 ? c.sigma / mean_sigma : 1.0);
   }
 
   /// mIoU of a predicted curve (sorted by time) at time t: linear between its points, flat

@@ -30,7 +30,7 @@ struct GainForecast {
   double delta_miou = 0.0;       ///< μ_I: mIoU_{h_max} − mIoU_{h'} over L on the region (< 0: lower is better)
   double delta_miou_std = 0.0;   ///< I's predictive standard deviation
   /// μ_C: share of the region's field pixels whose label will change with L involved
-  /// (Relabelling::interest_share); NaN for a model without C (files of format 1).
+  /// (Relabelling::interest_share); NaN for a model without C.
   double relabelled = std::numeric_limits<double>::quiet_NaN();
   /// C's predictive standard deviation of its mean (latent: the model's uncertainty).
   double relabelled_std = std::numeric_limits<double>::quiet_NaN();
@@ -248,7 +248,7 @@ class GainModel {
 
   [[nodiscard]] const Gp& o_model() const noexcept { return o_; }
   [[nodiscard]] const Gp& i_model() const noexcept { return i_; }
-  /// C, absent in models read from files of format 1.
+  /// C, absent in a model built without it (the paper's utility rule needs only O and I).
   [[nodiscard]] const std::optional<Gp>& c_model() const noexcept { return c_; }
   /// What I predicts from (its input dimension).
   [[nodiscard]] GainInputs gain_inputs() const noexcept {

@@ -73,7 +73,7 @@ struct CalibrationOptions {
   enum class Rule { front_aware, utility };
   Rule rule = Rule::front_aware;
 
-  /// Front-aware rule: `min_sigma`, `weight_by_sigma`, `scale_prior_sd`, `sigma_prior_weight`
+  /// Front-aware rule: `min_sigma`, `scale_prior_sd`, `sigma_prior_weight`
   /// and `sigma_prior_sd` as given (with several fields `scale_prior_sd` is estimated from
   /// their spread instead, and the last two as `sigma_prior` says); `confidence`
   /// chosen among `confidences` by the mean front margin over the training fields, each flown

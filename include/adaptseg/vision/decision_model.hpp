@@ -6,7 +6,8 @@
 /// YAML: every fitted quantity, the Gaussian processes' data and hyperparameters included, is
 /// a key that any YAML tool reads and edits; numbers are written and read by one
 /// locale-independent codec (detail/number_text.hpp). Files of format 1 (adaptseg 0.1, with
-/// the decision function as an embedded text block) still load, with identical predictions.
+/// the decision function as an embedded text block) are no longer read (since 0.2.0): load()
+/// says so, and the model is calibrated again.
 
 #include <adaptseg/core/camera.hpp>
 #include <adaptseg/core/decision_function.hpp>
@@ -26,10 +27,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <istream>
 #include <limits>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -41,105 +40,6 @@ namespace adaptseg {
 namespace detail {
 
 using ModelGp = GainModel::Gp;
-
-/// Reads the decision-function text of adaptseg 0.1 (`adaptseg.decision_function` versions
-/// 1-3, embedded in decision-model files of format 1). `field` names the calibration field
-/// (the front-aware rule's reference curve). The rule's parameters map one to one, except
-/// that the front-aware rule of that version ignores `min_utility` and `exploration` (every
-/// calibrated file had -max and 0).
-/// @throws std::invalid_argument naming what is wrong for truncated or garbled input.
-[[nodiscard]] inline DecisionFunction read_legacy_decision_function(std::istream& is, const std::string& field) {
-  const auto token = [&](const std::string& what) {
-    std::string t;
-    require(static_cast<bool>(is >> t), "decision model of format 1: input ends before " + what, "<end of input>");
-    return t;
-  };
-  const auto expect = [&](const std::string& key) {
-    const std::string t = token("'" + key + "'");
-    require(t == key, "decision model of format 1: expected '" + key + "', found", t);
-  };
-  const auto parse = [&](const std::string& t, const std::string& what) {
-    const auto v = parse_number(t);
-    require(v.has_value(), "decision model of format 1: bad number for " + what, t);
-    return *v;
-  };
-  const auto number = [&](const std::string& key) {
-    expect(key);
-    return parse(token("the value of '" + key + "'"), "'" + key + "'");
-  };
-  expect("adaptseg.decision_function");
-  const std::string version = token("the format version");
-  require(version == "1" || version == "2" || version == "3", "decision model of format 1: unsupported format version",
-          version);
-  const double min_sigma = number("min_sigma");
-  const double min_utility = number("min_utility");
-  const double exploration = number("exploration");
-  const bool weight_by_sigma = number("weight_by_sigma") != 0.0;
-  const bool online = number("online") != 0.0;
-  const double refit_every = number("refit_every");  // range-checked before the cast (UB otherwise)
-  require(refit_every >= 0.0 && refit_every <= 1e9 && refit_every == std::floor(refit_every),
-          "decision model of format 1: refit_every must be an integer in [0, 1e9]", refit_every);
-  const bool relative_utility = number("relative_utility") != 0.0;
-  bool front_aware = false;
-  std::vector<GsdPoint> reference;
-  if (version != "1") {  // version 1 had neither
-    front_aware = number("front_aware") != 0.0;
-    const double n = number("reference_lawnmower");
-    require(n >= 0.0 && n <= 1000.0 && n == std::floor(n), "decision model of format 1: bad point count for 'reference_lawnmower'",
-            n);
-    const auto value = [&](const char* what) {
-      const std::string name = std::string("a reference_lawnmower ") + what;
-      return parse(token(name), name);
-    };
-    for (int k = 0; k < static_cast<int>(n); ++k) {
-      const double g = value("GSD");
-      reference.push_back({g, value("mIoU")});
-    }
-  }
-  is >> std::ws;
-  ModelGp o = read_gp_text_v1<ModelGp::KernelType>(is);
-  is >> std::ws;
-  ModelGp i = [&] {
-    if (version == "3") return read_gp_text_v1<ModelGp::KernelType>(is);
-    // Versions 1-2 stored I with the isotropic kernel, which for its one input is the ARD
-    // kernel with one length scale (same parameters, same layout).
-    std::string block, line;
-    bool ended = false;
-    while (std::getline(is, line)) {
-      if (line == "kernel " + std::string(SquaredExponentialKernel::kName))
-        line = "kernel " + std::string(ArdSquaredExponentialKernel::kName);
-      block += line + '\n';
-      if (line.rfind("end ", 0) == 0) {
-        ended = true;
-        break;
-      }
-    }
-    require(ended, "decision model of format 1: input ends inside I's Gaussian process", "<end of input>");
-    std::istringstream in(block);
-    ModelGp gp = read_gp_text_v1<ModelGp::KernelType>(in);
-    require(gp.dimension() == 1, "decision model of format 1: I of a version 1-2 file must have 1 input; dimension",
-            gp.dimension());
-    return gp;
-  }();
-  expect("end");
-  expect("adaptseg.decision_function");
-  require(std::isfinite(min_sigma) && min_sigma >= 0.0 && min_sigma <= 1.0,
-          "decision model of format 1: min_sigma must be in [0, 1]", min_sigma);
-  GainModel model(std::move(o), std::move(i), std::nullopt, {}, static_cast<int>(refit_every));
-  if (front_aware) {
-    require(!reference.empty(), "decision model of format 1: the front-aware rule needs reference_lawnmower points; count",
-            reference.size());
-    return DecisionFunction(FrontAwarePolicy(std::move(model), {ReferenceCurve{field, std::move(reference)}},
-                                             {.min_sigma = min_sigma, .weight_by_sigma = weight_by_sigma,
-                                              .online = online}));
-  }
-  return DecisionFunction(UtilityPolicy(std::move(model), {.min_sigma = min_sigma,
-                                                           .min_utility = min_utility,
-                                                           .exploration = exploration,
-                                                           .weight_by_sigma = weight_by_sigma,
-                                                           .online = online,
-                                                           .relative_utility = relative_utility}));
-}
 
 }  // namespace detail
 
@@ -160,7 +60,7 @@ struct DecisionModel {
   std::vector<std::string> calibration_fields;  ///< names of the training fields (with regions)
   std::string segmenter;                  ///< backend used for calibration
   /// Segmentation time charged per image during calibration [s]: declared, not measured, so
-  /// that the model is a function of its inputs (format 1 files: 0, unknown).
+  /// that the model is a function of its inputs.
   double calibration_segmentation_time_s = 0.0;
   std::vector<std::string> classes;       ///< class names, index order
   std::vector<std::string> interest;      ///< labels of interest L
@@ -168,8 +68,8 @@ struct DecisionModel {
   TimingParams timing{};
   double top_gsd_cm = 0.0;
   std::vector<double> candidate_gsd_cm;
-  /// What the model's descents re-map (its samples were taken so); files of format 1
-  /// without the key are `region`, the paper's.
+  /// What the model's descents re-map (its samples were taken so); files without the key are
+  /// `region`, the paper's.
   DescentCoverage coverage = DescentCoverage::region;
   DecisionFunction decision_function;
   LinearDecision::Params linear{};
@@ -303,7 +203,8 @@ struct DecisionModel {
             << (std::is_same_v<R, FrontAwarePolicy> ? "front-aware" : "utility");
           e << YAML::Key << "online" << YAML::Value << detail::flag_text(p.online);
           e << YAML::Key << "min_sigma" << YAML::Value << num(p.min_sigma);
-          e << YAML::Key << "weight_by_sigma" << YAML::Value << detail::flag_text(p.weight_by_sigma);
+          if constexpr (std::is_same_v<R, UtilityPolicy>)
+            e << YAML::Key << "weight_by_sigma" << YAML::Value << detail::flag_text(p.weight_by_sigma);
           if constexpr (std::is_same_v<R, FrontAwarePolicy>) {
             e << YAML::Key << "confidence" << YAML::Value << num(p.confidence);
             e << YAML::Key << "scale_prior_sd" << YAML::Value << num(p.scale_prior_sd);
@@ -348,7 +249,8 @@ struct DecisionModel {
     if (!os) throw std::runtime_error("error writing " + path.string());
   }
 
-  /// Reads a model written by save() (format 2) or by adaptseg 0.1 (format 1).
+  /// Reads a model written by save() (format 2). A file of format 1 (adaptseg 0.1) is refused
+  /// with a message saying to calibrate the model again.
   /// @throws std::invalid_argument naming the file and the problem (missing, not YAML,
   ///         another format, a missing or mistyped key, a broken decision function).
   [[nodiscard]] static DecisionModel load(const std::filesystem::path& path) {
@@ -359,12 +261,12 @@ struct DecisionModel {
     return detail::naming_file(where, [&] {
       const std::string format = root["format"] && root["format"].IsScalar() ? root["format"].Scalar() : "";
       const detail::YamlReader r(root, where);
-      DecisionModel m = format == "adaptseg.decision_model/2"   ? read_v2(r)
-                        : format == "adaptseg.decision_model/1" ? read_v1(r)
-                                                                : throw std::invalid_argument(
-                                                                      where +
-                                                                      ": not an adaptseg decision model (format must "
-                                                                      "be adaptseg.decision_model/2 or /1)");
+      if (format == "adaptseg.decision_model/1")
+        throw std::invalid_argument(where + ": a decision model of format 1 (adaptseg 0.1) is no longer read since "
+                                            "adaptseg 0.2.0; calibrate the model again (adaptseg_calibrate)");
+      if (format != "adaptseg.decision_model/2")
+        throw std::invalid_argument(where + ": not an adaptseg decision model (format must be adaptseg.decision_model/2)");
+      DecisionModel m = read_v2(r);
       m.check(where);
       return m;
     });
@@ -377,8 +279,9 @@ struct DecisionModel {
     return s;
   }
 
-  /// The keys both formats share, read into `m`.
-  static void read_common(const detail::YamlReader& r, DecisionModel& m) {
+  /// The keys after the calibration record and the decision function (class set, camera,
+  /// timing, GSDs, coverage, linear baseline), read into `m`.
+  static void read_setup(const detail::YamlReader& r, DecisionModel& m) {
     m.classes = r.texts("classes");
     m.interest = r.texts("interest");
     const auto cam = r.map("camera");
@@ -398,8 +301,8 @@ struct DecisionModel {
     (void)LinearDecision(m.linear);
   }
 
-  /// A model of what a reader parsed first (the calibration record and the decision function),
-  /// the rest default until read_common fills it in.
+  /// A model of what the reader parsed first (the calibration record and the decision
+  /// function), the rest default until read_setup fills it in.
   static DecisionModel parsed(std::vector<std::string> fields, std::string segmenter, double segmentation_time_s,
                               DecisionFunction function, std::size_t samples, double train_front_margin) {
     return {.calibration_fields = std::move(fields),
@@ -418,20 +321,8 @@ struct DecisionModel {
             .train_front_margin = train_front_margin};
   }
 
-  // Both readers read keys in the order of the model's members: a file with several faults
+  // The reader reads keys in the order of the model's members: a file with several faults
   // reports the first in that order.
-  static DecisionModel read_v1(const detail::YamlReader& r) {
-    const std::string field = r.text("calibration_field");
-    std::istringstream df(r.text("decision_function"));
-    std::string segmenter = r.text("segmenter");
-    DecisionFunction function = detail::read_legacy_decision_function(df, field);
-    const auto samples = static_cast<std::size_t>(r.integer("samples", 0, 1'000'000'000));
-    DecisionModel m = parsed({field}, std::move(segmenter), 0.0, std::move(function), samples,
-                             r.number("train_front_margin"));
-    read_common(r, m);
-    return m;
-  }
-
   static DecisionModel read_v2(const detail::YamlReader& r) {
     const auto cal = r.map("calibration");
     const auto gm = r.map("gain_model");
@@ -473,7 +364,6 @@ struct DecisionModel {
     const std::string kind = rule.text("kind");
     const bool online = rule.flag("online");
     const double min_sigma = rule.number("min_sigma");
-    const bool weight_by_sigma = rule.flag("weight_by_sigma");
     const auto make_function = [&]() -> DecisionFunction {
       if (kind == "front-aware") {
         const YAML::Node refs = rule.node("reference");
@@ -500,7 +390,6 @@ struct DecisionModel {
         }
         return DecisionFunction(FrontAwarePolicy(std::move(model), std::move(reference),
                                                  {.min_sigma = min_sigma,
-                                                  .weight_by_sigma = weight_by_sigma,
                                                   .online = online,
                                                   .confidence = rule.number("confidence"),
                                                   .scale_prior_sd = rule.number("scale_prior_sd"),
@@ -515,8 +404,7 @@ struct DecisionModel {
         return DecisionFunction(UtilityPolicy(std::move(model), {.min_sigma = min_sigma,
                                                                  .min_utility = rule.number("min_utility"),
                                                                  .exploration = rule.number("exploration"),
-                                                                 .weight_by_sigma = weight_by_sigma,
-                                                                 .online = online,
+                                                                                .online = online,
                                                                  .relative_utility = rule.flag("relative_utility")}));
       detail::yaml_error(r.where(), "'rule.kind' must be front-aware or utility (got '" + kind + "')");
     };
@@ -527,11 +415,11 @@ struct DecisionModel {
     const auto samples = static_cast<std::size_t>(cal.integer("samples", 0, 1'000'000'000));
     DecisionModel m = parsed(std::move(fields), std::move(segmenter), segmentation_time_s, std::move(function),
                              samples, cal.number("train_front_margin"));
-    read_common(r, m);
+    read_setup(r, m);
     return m;
   }
 
-  /// What the model must satisfy whatever its format.
+  /// What the model must satisfy beyond each key's own check.
   void check(const std::string& where) const {
     if (calibration_fields.empty()) detail::yaml_error(where, "no calibration field is named");
     if (classes.empty()) detail::yaml_error(where, "'classes' is empty");

@@ -6,8 +6,8 @@
 /// decision-model file holds for each of its GPs (decision_model.hpp). The GP itself
 /// (gaussian_process.hpp, Eigen only) has no file format: it gives and takes its `State`.
 ///
-/// Files of adaptseg 0.1's line format (`adaptseg.gaussian_process 1`,
-/// detail/gp_text_v1.hpp) still load, with identical predictions.
+/// Files of adaptseg 0.1's line format (`adaptseg.gaussian_process 1`) are no longer read (since
+/// 0.2.0): load_gaussian_process says so.
 ///
 /// @code
 ///   adaptseg::save_gaussian_process(gp, "o.yaml");
@@ -34,7 +34,6 @@
 /// @endcode
 
 #include <adaptseg/core/gaussian_process.hpp>
-#include <adaptseg/vision/detail/gp_text_v1.hpp>
 #include <adaptseg/vision/detail/number_text.hpp>
 #include <adaptseg/vision/detail/yaml_io.hpp>
 
@@ -98,7 +97,7 @@ void emit_gp(YAML::Emitter& e, const GaussianProcess<K>& gp) {
 
 /// Reads what emit_gp_keys wrote. `dimension`: the number of inputs the caller needs (any
 /// the kernel accepts if unset). Without samples (`allow_empty` only) the dimension is the
-/// mapping's `dimension` key, 0 if absent.
+/// mapping's `dimension` key, 0 if absent; with samples, a `dimension` key must match their rows.
 /// @throws std::invalid_argument naming the key; NumericalError if the data do not factorise.
 template <Kernel K>
 [[nodiscard]] GaussianProcess<K> read_gp(const YamlReader& r, std::optional<Eigen::Index> dimension,
@@ -125,10 +124,17 @@ template <Kernel K>
     yaml_error(r.where(), "'" + r.path("inputs") + "' must be a list of as many input rows as 'targets' has values" +
                               (allow_empty ? "" : " (>= 1)"));
   Eigen::Index dims = 0;
-  if (rows.size() > 0)
+  // The `dimension` key, -1 if absent.
+  const Eigen::Index announced =
+      r.has("dimension") ? static_cast<Eigen::Index>(r.integer("dimension", 0, 1'000'000)) : Eigen::Index{-1};
+  if (rows.size() > 0) {
     dims = rows[0].IsSequence() ? static_cast<Eigen::Index>(rows[0].size()) : 0;
-  else if (r.has("dimension"))
-    dims = static_cast<Eigen::Index>(r.integer("dimension", 0, 1'000'000));
+    if (announced >= 0 && announced != dims)
+      yaml_error(r.where(), "'" + r.path("dimension") + "' is " + std::to_string(announced) + " but the rows of '" +
+                                r.path("inputs") + "' have " + std::to_string(dims) + " values");
+  } else if (announced >= 0) {
+    dims = announced;
+  }
   if (dimension && dims != *dimension)
     yaml_error(r.where(), "'" + r.path("inputs") + "' rows must have " + std::to_string(*dimension) + " values");
   if ((rows.size() > 0 || dims > 0) && !s.kernel.accepts_dimension(dims))
@@ -145,15 +151,17 @@ template <Kernel K>
   return GaussianProcess<K>::from_state(std::move(s));
 }
 
-/// True if `text` starts (after blank and comment lines) with adaptseg 0.1's GP text header.
+/// True if `text` starts (after blank and comment lines) with the header of adaptseg 0.1's GP
+/// line format (`adaptseg.gaussian_process 1`), which is no longer read.
 [[nodiscard]] inline bool is_gp_text_v1(const std::string& text) {
+  constexpr std::string_view magic = "adaptseg.gaussian_process";
   std::istringstream is(text);
   std::string line;
   while (std::getline(is, line)) {
-    const std::string t = gp_trim(line);
-    if (t.empty() || t.front() == '#') continue;
-    return t.rfind(kGpTextV1Magic, 0) == 0 && t.size() > kGpTextV1Magic.size() &&
-           (t[kGpTextV1Magic.size()] == ' ' || t[kGpTextV1Magic.size()] == '\t');
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    const std::string_view t = std::string_view(line).substr(first);
+    return t.starts_with(magic) && t.size() > magic.size() && (t[magic.size()] == ' ' || t[magic.size()] == '\t');
   }
   return false;
 }
@@ -183,18 +191,18 @@ void save_gaussian_process(const GaussianProcess<K>& gp, const std::filesystem::
   save_gaussian_process(gp, f);
 }
 
-/// Reads a GP written by save_gaussian_process, or by adaptseg 0.1's `GaussianProcess::save`
-/// (its line format), from the rest of `is`; `where` names the source in errors.
+/// Reads a GP written by save_gaussian_process from the rest of `is`; `where` names the source
+/// in errors.
 /// @throws std::invalid_argument naming the source and the problem (not YAML, another format or
-///         kernel, a missing or mistyped key, a truncated file); NumericalError.
+///         kernel, a missing or mistyped key, a truncated file, adaptseg 0.1's line format);
+///         NumericalError.
 template <Kernel K>
 [[nodiscard]] GaussianProcess<K> load_gaussian_process(std::istream& is, const std::string& where = "<stream>") {
   const std::string text{std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>()};
   return detail::naming_file(where, [&] {
-    if (detail::is_gp_text_v1(text)) {
-      std::istringstream in(text);
-      return detail::read_gp_text_v1<K>(in);
-    }
+    if (detail::is_gp_text_v1(text))
+      throw std::invalid_argument(where + ": a Gaussian process in adaptseg 0.1's line format is no longer read "
+                                          "since adaptseg 0.2.0; fit it again and save it with save_gaussian_process");
     const detail::YamlReader r(detail::yaml_mapping(where, "a Gaussian process", [&] { return YAML::Load(text); }),
                                where);
     const std::string format = r.text("format");
