@@ -9,6 +9,7 @@
 //   adaptseg_calibrate --field examples/data/dubai-tile-4 --segmenter erfnet
 //                      --model-file examples/models/ensemble-dubai --out ensemble-model.yaml
 
+#include "common/cell_csv.hpp"
 #include "common/segmenters.hpp"
 #include "common/strategies.hpp"
 
@@ -110,15 +111,13 @@ int main(int argc, char** argv) {
     if (!cell_samples_csv.empty()) {
       std::ostringstream os;
       os << "field,region,top_gsd_cm,sub_gsd_cm,field_px,field_share,field_sigma,relabelled,field_gain";
-      for (const auto& in : adaptseg::kDecisionInputs) os << ",top_" << in.name;
-      for (const auto& in : adaptseg::kDecisionInputs) os << ",fine_" << in.name;
+      adaptseg::examples::write_input_columns_header(os);
       os << '\n';
       for (const auto& c : cal.cell_samples) {
         os << fields[c.field].name() << ',' << c.region << ',' << c.top_gsd_cm << ',' << c.sub_gsd_cm << ','
            << c.top.field_px << ',' << c.field_share << ',' << c.field_sigma << ',' << c.relabelled << ','
            << c.field_gain;
-        for (double v : c.top.values) os << ',' << v;
-        for (double v : c.fine.values) os << ',' << v;
+        adaptseg::examples::write_input_columns(os, c.top, c.fine);
         os << '\n';
       }
       adaptseg::examples::write_text(cell_samples_csv, os.str());

@@ -15,6 +15,7 @@
 //       --classes building,road,vegetation,water --segmenter erfnet
 //       --model-file examples/models/mobilenetv2-dubai --csv out/cells.csv
 
+#include "common/cell_csv.hpp"
 #include "common/segmenters.hpp"
 #include "common/strategies.hpp"
 
@@ -209,14 +210,12 @@ int main(int argc, char** argv) {
     if (!csv_path.empty()) {
       std::ofstream os(csv_path);
       os << "field,class,region,gsd_cm,field_px,field_share,field_sigma,relabelled,gain";
-      for (const auto& in : kDecisionInputs) os << ",top_" << in.name;
-      for (const auto& in : kDecisionInputs) os << ",fine_" << in.name;
+      adaptseg::examples::write_input_columns_header(os);
       os << '\n';
       for (const Cell& c : cells) {
         os << c.field << ',' << c.cls << ',' << c.region << ',' << c.gsd_cm << ',' << c.top.field_px << ','
            << c.field_share << ',' << c.field_sigma << ',' << c.relabelled << ',' << c.gain;
-        for (double v : c.top.values) os << ',' << v;
-        for (double v : c.fine.values) os << ',' << v;
+        adaptseg::examples::write_input_columns(os, c.top, c.fine);
         os << '\n';
       }
       if (!os) throw std::runtime_error("cannot write " + csv_path);
