@@ -14,7 +14,9 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <variant>
+#include <vector>
 
 using namespace adaptseg;
 namespace t = adaptseg::test;
@@ -108,11 +110,29 @@ TEST_CASE("calibration: region samples carry what the descent relabelled and wha
   CHECK(sum == doctest::Approx(lawnmower_gain).epsilon(0.1));
 }
 
+TEST_CASE("calibration: the rules by name, one entry each, an unknown name refused up front") {
+  CHECK(rule_names() == std::vector<std::string>{"front-aware", "utility"});
+  CHECK(rule_names_text() == "front-aware or utility");
+  static_assert(std::is_same_v<RuleFor<FrontAwarePolicy>, FrontAwareRule>);
+  static_assert(std::is_same_v<RuleFor<UtilityPolicy>, UtilityRule>);
+  const Field f = t::blob_field(400, 300, 1.0, 4, 15);
+  OracleSegmenter oracle(f.num_classes());
+  CalibrationOptions options = small_options();
+  options.rule = "threshold";  // the name of 0.1.0
+  CHECK_THROWS_WITH_AS((void)calibrate(f, oracle, options),
+                       doctest::Contains("calibrate: the rule must be front-aware or utility; rule (got threshold)"),
+                       std::invalid_argument);
+  options.rule = "front-aware";
+  options.confidences.clear();
+  CHECK_THROWS_WITH_AS((void)calibrate(f, oracle, options), doctest::Contains("confidences must not be empty"),
+                       std::invalid_argument);
+}
+
 TEST_CASE("calibration: the paper's rule takes the threshold with the best worst-case training margin") {
   const Field f = t::blob_field(1300, 1000, 1.0, 4, 15);
   OracleSegmenter oracle(f.num_classes());
   CalibrationOptions options = small_options();
-  options.rule = CalibrationOptions::Rule::utility;
+  options.rule = "utility";
   const CalibrationResult cal = calibrate(f, oracle, options);
   CHECK(cal.samples.size() == 2u * 2u * 2u);
   REQUIRE(cal.lawnmower_curves.size() == 1);
@@ -137,7 +157,7 @@ TEST_CASE("calibration: by default the front-aware rule, its confidence chosen o
   const Field f = t::blob_field(1300, 1000, 1.0, 4, 15);
   OracleSegmenter oracle(f.num_classes());
   const CalibrationOptions options = small_options();
-  REQUIRE(options.rule == CalibrationOptions::Rule::front_aware);
+  REQUIRE(options.rule == "front-aware");
   const CalibrationResult cal = calibrate(f, oracle, options);
   REQUIRE(cal.decision_function.front_aware());
   const auto& rule = std::get<FrontAwarePolicy>(cal.decision_function.rule());

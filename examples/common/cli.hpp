@@ -187,7 +187,7 @@ struct CalibrationCli {
         app.add_option("--rule", rule,
                        "decision rule: front-aware (descend while descents beat the lawnmower curve; no threshold) "
                        "or utility (the paper's: utility against a threshold calibrated on the training fields)")
-            ->check(CLI::IsMember({"front-aware", "utility"}))
+            ->check(CLI::IsMember(rule_names()))
             ->capture_default_str(),
         app.add_option("--threshold-steps", threshold_steps, "utility thresholds tried per weighting")
             ->capture_default_str(),
@@ -244,7 +244,7 @@ struct CalibrationCli {
   /// charged per image of `options` (`common`: the programs' --seg-time-s and --plan-time-s).
   void apply(CalibrationOptions& options, const CommonOptions& common) const {
     options.threshold_steps = threshold_steps;
-    options.rule = rule == "front-aware" ? CalibrationOptions::Rule::front_aware : CalibrationOptions::Rule::utility;
+    options.rule = rule;
     options.confidences = confidences;
     options.sigma_prior = sigma_prior == "spread"      ? CalibrationOptions::SigmaPriorSource::spread
                           : sigma_prior == "estimated" ? CalibrationOptions::SigmaPriorSource::estimated

@@ -11,9 +11,12 @@
 #include <adaptseg/vision/adaptive_options.hpp>
 #include <adaptseg/vision/adaptive_planner.hpp>
 #include <adaptseg/vision/calibration.hpp>
+#include <adaptseg/vision/calibration_options.hpp>
 #include <adaptseg/vision/decision_model.hpp>
+#include <adaptseg/vision/decision_rules.hpp>
 #include <adaptseg/vision/descent_coverage.hpp>
 #include <adaptseg/vision/field.hpp>
+#include <adaptseg/vision/front_aware_rule.hpp>
 #include <adaptseg/vision/gp_io.hpp>
 #include <adaptseg/vision/image.hpp>
 #include <adaptseg/vision/image_summary.hpp>
@@ -24,4 +27,5 @@
 #include <adaptseg/vision/segmentation_backend.hpp>
 #include <adaptseg/vision/semantic_map.hpp>
 #include <adaptseg/vision/simulated_sensor.hpp>
+#include <adaptseg/vision/utility_rule.hpp>
 #include <adaptseg/vision/visualization.hpp>

@@ -15,6 +15,7 @@
 #include <adaptseg/core/linear_decision.hpp>
 #include <adaptseg/core/timing.hpp>
 #include <adaptseg/vision/adaptive_options.hpp>
+#include <adaptseg/vision/decision_rules.hpp>
 #include <adaptseg/vision/detail/number_text.hpp>
 #include <adaptseg/vision/detail/yaml_io.hpp>
 #include <adaptseg/vision/field.hpp>
@@ -197,48 +198,11 @@ struct DecisionModel {
     e << YAML::Key << "rule" << YAML::Value << YAML::BeginMap;
     std::visit(
         [&](const auto& rule) {
-          using R = std::decay_t<decltype(rule)>;
-          const auto& p = rule.params();
-          e << YAML::Key << "kind" << YAML::Value
-            << (std::is_same_v<R, FrontAwarePolicy> ? "front-aware" : "utility");
-          e << YAML::Key << "online" << YAML::Value << detail::flag_text(p.online);
-          e << YAML::Key << "min_sigma" << YAML::Value << num(p.min_sigma);
-          if constexpr (std::is_same_v<R, UtilityPolicy>)
-            e << YAML::Key << "weight_by_sigma" << YAML::Value << detail::flag_text(p.weight_by_sigma);
-          if constexpr (std::is_same_v<R, FrontAwarePolicy>) {
-            e << YAML::Key << "confidence" << YAML::Value << num(p.confidence);
-            e << YAML::Key << "scale_prior_sd" << YAML::Value << num(p.scale_prior_sd);
-            e << YAML::Key << "sigma_prior_weight" << YAML::Value << num(p.sigma_prior_weight);
-            e << YAML::Key << "sigma_prior_sd" << YAML::Value << num(p.sigma_prior_sd);
-            if (p.field_curve) e << YAML::Key << "field_curve" << YAML::Value << detail::flag_text(true);
-            if (p.curve_ratio) e << YAML::Key << "curve_ratio" << YAML::Value << detail::flag_text(true);
-            e << YAML::Key << "reference" << YAML::Value << YAML::BeginSeq;
-            for (const auto& r : rule.reference()) {
-              std::vector<double> g, m;
-              for (const auto& pt : r.points) g.push_back(pt.gsd_cm), m.push_back(pt.miou);
-              e << YAML::BeginMap << YAML::Key << "field" << YAML::Value << r.field << YAML::Key << "field_sigma"
-                << YAML::Value << num(r.field_sigma);
-              if (r.field_input > 0.0) e << YAML::Key << "field_input" << YAML::Value << num(r.field_input);
-              if (!r.top_inputs.empty()) {
-                std::vector<double> tg, tx;
-                for (const auto& [gsd, x] : r.top_inputs) tg.push_back(gsd), tx.push_back(x);
-                e << YAML::Key << "top_input_gsd_cm" << YAML::Value;
-                emit_numbers(e, tg);
-                e << YAML::Key << "top_input" << YAML::Value;
-                emit_numbers(e, tx);
-              }
-              e << YAML::Key << "gsd_cm" << YAML::Value;
-              emit_numbers(e, g);
-              e << YAML::Key << "miou" << YAML::Value;
-              emit_numbers(e, m);
-              e << YAML::EndMap;
-            }
-            e << YAML::EndSeq;
-          } else {
-            e << YAML::Key << "min_utility" << YAML::Value << num(p.min_utility);
-            e << YAML::Key << "exploration" << YAML::Value << num(p.exploration);
-            e << YAML::Key << "relative_utility" << YAML::Value << detail::flag_text(p.relative_utility);
-          }
+          using Rule = RuleFor<std::decay_t<decltype(rule)>>;
+          e << YAML::Key << "kind" << YAML::Value << std::string(Rule::kName);
+          e << YAML::Key << "online" << YAML::Value << detail::flag_text(rule.params().online);
+          e << YAML::Key << "min_sigma" << YAML::Value << num(rule.params().min_sigma);
+          Rule::write_keys(e, rule);
         },
         decision_function.rule());
     e << YAML::EndMap;
@@ -364,56 +328,18 @@ struct DecisionModel {
     const std::string kind = rule.text("kind");
     const bool online = rule.flag("online");
     const double min_sigma = rule.number("min_sigma");
-    const auto make_function = [&]() -> DecisionFunction {
-      if (kind == "front-aware") {
-        const YAML::Node refs = rule.node("reference");
-        if (!refs.IsSequence()) detail::yaml_error(r.where(), "'rule.reference' must be a list of curves");
-        std::vector<ReferenceCurve> reference;
-        for (std::size_t k = 0; k < refs.size(); ++k) {
-          if (!refs[k].IsMap()) detail::yaml_error(r.where(), "'rule.reference' entries must be mappings");
-          const detail::YamlReader c(refs[k], r.where());
-          const auto g = c.numbers("gsd_cm");
-          const auto v = c.numbers("miou");
-          if (g.size() != v.size())
-            detail::yaml_error(r.where(), "a 'rule.reference' curve needs as many 'miou' as 'gsd_cm' values");
-          ReferenceCurve curve{c.text("field"), {}, c.has("field_sigma") ? c.number("field_sigma") : 0.0,
-                               c.has("field_input") ? c.number("field_input") : 0.0};
-          for (std::size_t i = 0; i < g.size(); ++i) curve.points.push_back({g[i], v[i]});
-          if (c.has("top_input_gsd_cm") || c.has("top_input")) {
-            const auto tg = c.numbers("top_input_gsd_cm");
-            const auto tx = c.numbers("top_input");
-            if (tg.size() != tx.size())
-              detail::yaml_error(r.where(), "a 'rule.reference' curve needs as many 'top_input' as 'top_input_gsd_cm' values");
-            for (std::size_t i = 0; i < tg.size(); ++i) curve.top_inputs.emplace_back(tg[i], tx[i]);
-          }
-          reference.push_back(std::move(curve));
-        }
-        return DecisionFunction(FrontAwarePolicy(std::move(model), std::move(reference),
-                                                 {.min_sigma = min_sigma,
-                                                  .online = online,
-                                                  .confidence = rule.number("confidence"),
-                                                  .scale_prior_sd = rule.number("scale_prior_sd"),
-                                                  .sigma_prior_weight = rule.number("sigma_prior_weight"),
-                                                  .sigma_prior_sd = rule.has("sigma_prior_sd")
-                                                                        ? rule.number("sigma_prior_sd")
-                                                                        : 0.0,
-                                                  .field_curve = rule.has("field_curve") && rule.flag("field_curve"),
-                                                  .curve_ratio = rule.has("curve_ratio") && rule.flag("curve_ratio")}));
-      }
-      if (kind == "utility")
-        return DecisionFunction(UtilityPolicy(std::move(model), {.min_sigma = min_sigma,
-                                                                 .min_utility = rule.number("min_utility"),
-                                                                 .exploration = rule.number("exploration"),
-                                                                                .online = online,
-                                                                 .relative_utility = rule.flag("relative_utility")}));
-      detail::yaml_error(r.where(), "'rule.kind' must be front-aware or utility (got '" + kind + "')");
-    };
     std::vector<std::string> fields = cal.texts("fields");
     std::string segmenter = cal.text("segmenter");
     const double segmentation_time_s = cal.number("segmentation_time_s");
-    DecisionFunction function = make_function();
+    std::optional<DecisionFunction> function;
+    for_each_rule([&]<class Rule>() {
+      if (!function && kind == Rule::kName)
+        function.emplace(Rule::read_keys(rule, std::move(model), min_sigma, online));
+    });
+    if (!function)
+      detail::yaml_error(r.where(), "'rule.kind' must be " + rule_names_text() + " (got '" + kind + "')");
     const auto samples = static_cast<std::size_t>(cal.integer("samples", 0, 1'000'000'000));
-    DecisionModel m = parsed(std::move(fields), std::move(segmenter), segmentation_time_s, std::move(function),
+    DecisionModel m = parsed(std::move(fields), std::move(segmenter), segmentation_time_s, std::move(*function),
                              samples, cal.number("train_front_margin"));
     read_setup(r, m);
     return m;

@@ -1,0 +1,171 @@
+#pragma once
+/// @file
+/// What calibration is told (CalibrationOptions) and what a decision rule's calibration search
+/// works from and gives (RuleSearchInputs, RuleTrial, RuleSearchResult): shared by calibrate()
+/// (calibration.hpp) and each rule's own search (front_aware_rule.hpp, utility_rule.hpp).
+
+#include <adaptseg/core/decision_function.hpp>
+#include <adaptseg/core/lawnmower_curve.hpp>
+#include <adaptseg/core/linear_decision.hpp>
+#include <adaptseg/vision/adaptive_mission.hpp>
+#include <adaptseg/vision/field.hpp>
+#include <adaptseg/vision/region_samples.hpp>
+
+#include <algorithm>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace adaptseg {
+
+/// The confidence levels z the front-aware rule's calibration tries by default.
+inline const std::vector<double> kDefaultConfidences{0.0, 0.5, 1.0, 1.5, 2.0};
+
+/// How to calibrate.
+struct CalibrationOptions {
+  /// Camera, timing, labels of interest (empty: the first field's), top and candidate GSDs,
+  /// descent coverage. Its fixed segmentation and planning times are replaced by the two below.
+  AdaptiveOptions adaptive{};
+  /// GSDs of the training fields' lawnmower curves; empty: the candidate GSDs and the top GSD
+  /// (lawnmower_gsds()), the curve the adaptive mission is compared with.
+  std::vector<double> lawnmower_gsd_cm{};
+  /// Segmentation time charged per image during calibration [s]: declared, not measured, so
+  /// that the same inputs give the same model on any machine (recorded in the model file).
+  double segmentation_time_s = 0.1;
+  double planning_time_s = 0.0;            ///< planning time charged per waypoint [s]
+
+  /// The lawnmower curve's GSDs: `lawnmower_gsd_cm`, or if it is empty the candidate GSDs
+  /// and the top GSD, ascending.
+  [[nodiscard]] std::vector<double> lawnmower_gsds() const {
+    if (!lawnmower_gsd_cm.empty()) return lawnmower_gsd_cm;
+    std::vector<double> g = adaptive.candidate_gsd_cm;
+    g.push_back(adaptive.top_gsd_cm);
+    std::sort(g.begin(), g.end());
+    g.erase(std::unique(g.begin(), g.end()), g.end());
+    return g;
+  }
+  /// DescentCoverage::ranked (`adaptive.coverage`): the decision inputs the cells may be ranked
+  /// and forecast by; the one whose ranking captures most of the training fields' achievable
+  /// gain is chosen (cell_ranking_capture(), each field scored on its own) and set as
+  /// `adaptive.cell_input`; those the backend does not give (probabilities from a labels-only
+  /// backend) are left out. Empty: the inputs about L (sigma, boundary, ambiguity,
+  /// expected_error, second_choice); the generic ones, blind to which errors matter for L, are
+  /// tried only when named.
+  std::vector<DecisionInput> cell_inputs{};
+  /// DescentCoverage::ranked: other top-level GSDs the cell gain model is calibrated for, so
+  /// that a mission may fly its top level at one of them where the predicted lawnmower curve
+  /// shows the model's top lawnmower dominated by a faster one on the field flown
+  /// (FrontAwarePolicy::top_gsd). nullopt: the coarsest candidate GSD (the one that can be
+  /// faster than the top where its grid fits the field better). Each must be a candidate GSD
+  /// with a finer candidate below it.
+  std::optional<std::vector<double>> alternative_top_gsd_cm{};
+  GainModel::FitOptions fit{};             ///< what I predicts from, hyperparameter restarts
+  int refit_every = 0;                     ///< O's scheduled re-optimisation (GainModel)
+
+  /// Which rule the model holds, by name (decision_rules.hpp): `front-aware`, the
+  /// FrontAwarePolicy (default; its confidence level z is chosen below), or `utility`, the
+  /// paper's UtilityPolicy (its threshold chosen below).
+  std::string rule = "front-aware";
+
+  /// Front-aware rule: `min_sigma`, `scale_prior_sd`, `sigma_prior_weight`
+  /// and `sigma_prior_sd` as given (with several fields `scale_prior_sd` is estimated from
+  /// their spread instead, and the last two as `sigma_prior` says); `confidence`
+  /// chosen among `confidences` by the mean front margin over the training fields, each flown
+  /// with a model fitted without it (one field: the field and its halves, with the model of
+  /// the whole field). Ties (several z at which no training fold descends, or which take the
+  /// same descents there) go to the larger z, the more cautious of settings the training
+  /// fields cannot tell apart: whatever a smaller z would add on a new field has not been seen
+  /// to pay on any of them (docs/results.md, "What any choice of z can buy").
+  FrontAwarePolicy::Params front_aware{};
+  std::vector<double> confidences = kDefaultConfidences;
+  /// Front-aware rule, σ̂'s prior (FrontAwarePolicy `sigma_prior_weight` k, `sigma_prior_sd` τ)
+  /// with several training fields: `given` keeps `front_aware`'s; `spread` estimates τ on the
+  /// training fields (estimate_sigma_prior) and keeps k; `estimated` estimates both. Each fold
+  /// of the z choice uses the values estimated without its field. One field: as given.
+  enum class SigmaPriorSource { given, spread, estimated };
+  SigmaPriorSource sigma_prior = SigmaPriorSource::given;
+
+  /// Utility rule: `exploration` and `min_sigma` as given; thresholds searched (quantiles of
+  /// the utilities seen, absolute and relative, σ weighting on and off, "never descend"), each
+  /// flown over every layout (the fields; one field: the field and its halves) and scored by
+  /// its worst front margin (ties: larger mean margin, then the relative rule, then shorter time).
+  UtilityPolicy::Params utility{};
+  int threshold_steps = 10;                ///< utility thresholds tried per weighting
+};
+
+/// One setting of the rule tried on the training fields.
+struct RuleTrial {
+  std::string description;      ///< e.g. "front-aware z=1" or "utility weight=1 relative=0 min_utility=..."
+  double time_s = 0.0;          ///< mean over the layouts
+  double miou_interest = 0.0;   ///< mean over the layouts
+  double front_margin = 0.0;    ///< mean over the layouts
+  double worst_margin = 0.0;    ///< smallest over the layouts
+  int descents = 0;             ///< total over the layouts
+  std::vector<double> margins;  ///< per layout
+};
+
+/// Everything calibration produced.
+struct CalibrationResult {
+  std::vector<RegionSample> samples;               ///< pooled over the fields (RegionSample::field)
+  /// DescentCoverage::ranked: the cell samples, pooled (CellSample::field), and every input
+  /// tried with its capture on the training fields (the chosen one first).
+  std::vector<CellSample> cell_samples{};
+  std::vector<std::pair<DecisionInput, double>> cell_input_scores{};
+  DecisionFunction decision_function;              ///< fitted, with the chosen rule and settings
+  LinearDecision::Params linear{};                 ///< σ range of the training fields' top-level images
+  std::vector<std::vector<CurvePoint>> lawnmower_curves;  ///< per training field, at lawnmower_gsds()
+  std::vector<RuleTrial> trials;                   ///< every setting tried, the chosen one first
+};
+
+/// What a rule's calibration search works from (calibrate() fills it, the rule's `search`
+/// reads it): the training fields, their lawnmower curves and samples, the gain model fitted on
+/// all of them and the fields' reference curves.
+struct RuleSearchInputs {
+  const CalibrationOptions& options;
+  /// The options the missions are flown with (labels of interest, fixed times, the cell input
+  /// chosen).
+  const AdaptiveOptions& adaptive;
+  std::span<const Field> fields;
+  std::span<const std::vector<CurvePoint>> curves;  ///< per field, at lawnmower_gsds()
+  /// One training field: its halves across the longer axis and their curves (the layouts the
+  /// utility rule is scored on, the folds of the front-aware rule's z); otherwise empty.
+  std::span<const Field> halves;
+  std::span<const std::vector<CurvePoint>> half_curves;
+  std::span<const std::vector<RegionSample>> samples;  ///< per field
+  std::span<const std::vector<CellSample>> cells;      ///< per field (DescentCoverage::ranked)
+  const GainModel& model;                             ///< fitted on every field
+  std::span<const ReferenceCurve> reference;          ///< per field
+};
+
+/// What a rule's calibration search gives.
+struct RuleSearchResult {
+  DecisionFunction chosen;         ///< the rule with the settings chosen
+  std::vector<RuleTrial> trials;   ///< every setting tried, the chosen one first
+};
+
+namespace detail {
+
+/// An adaptive mission of `policy` over `field`, scored against `curve`.
+template <SegmentationBackend Backend, DecisionPolicy Policy>
+AdaptiveResult fly_scored(const Field& field, Backend& backend, Policy& policy, const AdaptiveOptions& options,
+                          const std::vector<CurvePoint>& curve, double& margin) {
+  AdaptiveResult r = run_adaptive_mission(field, backend, policy, options, policy.name());
+  margin = front_margin(curve, r.mission.total_s(), r.mission.miou_interest().value_or(0.0));
+  return r;
+}
+
+/// Adds one layout's run to a trial.
+inline void add_to_trial(RuleTrial& t, const AdaptiveResult& r, double margin) {
+  const double k = static_cast<double>(t.margins.size());
+  t.time_s = (t.time_s * k + r.mission.total_s()) / (k + 1.0);
+  t.miou_interest = (t.miou_interest * k + r.mission.miou_interest().value_or(0.0)) / (k + 1.0);
+  t.front_margin = (t.front_margin * k + margin) / (k + 1.0);
+  t.worst_margin = t.margins.empty() ? margin : std::min(t.worst_margin, margin);
+  t.descents += r.descents();
+  t.margins.push_back(margin);
+}
+
+}  // namespace detail
+
+}  // namespace adaptseg
