@@ -162,7 +162,8 @@ struct FrontAwareRule {
         const auto tg = c.numbers("top_input_gsd_cm");
         const auto tx = c.numbers("top_input");
         if (tg.size() != tx.size())
-          detail::yaml_error(rule.where(), "a 'rule.reference' curve needs as many 'top_input' as 'top_input_gsd_cm' values");
+          detail::yaml_error(rule.where(),
+                             "a 'rule.reference' curve needs as many 'top_input' as 'top_input_gsd_cm' values");
         for (std::size_t i = 0; i < tg.size(); ++i) curve.top_inputs.emplace_back(tg[i], tx[i]);
       }
       reference.push_back(std::move(curve));
@@ -202,7 +203,8 @@ struct FrontAwareRule {
     // What each training field's top-level images show along the flight, where σ̂'s prior is
     // estimated from them (one top-level mission per field).
     std::vector<TopLevelTrace> traces;
-    const bool fit_sigma_prior = fields.size() >= 2 && options.sigma_prior != CalibrationOptions::SigmaPriorSource::given;
+    const bool fit_sigma_prior =
+        fields.size() >= 2 && options.sigma_prior != CalibrationOptions::SigmaPriorSource::given;
     for (std::size_t f = 0; fit_sigma_prior && f < fields.size(); ++f) {
       detail::TopLevelRecorder recorder;
       double unused = 0.0;

@@ -87,8 +87,10 @@ struct UtilityRule {
     std::vector<RuleTrial> trials;
     std::vector<const Field*> layouts;
     std::vector<const std::vector<CurvePoint>*> layout_curves;
-    for (std::size_t k = 0; k < in.fields.size(); ++k) layouts.push_back(&in.fields[k]), layout_curves.push_back(&in.curves[k]);
-    for (std::size_t k = 0; k < in.halves.size(); ++k) layouts.push_back(&in.halves[k]), layout_curves.push_back(&in.half_curves[k]);
+    for (std::size_t k = 0; k < in.fields.size(); ++k)
+      layouts.push_back(&in.fields[k]), layout_curves.push_back(&in.curves[k]);
+    for (std::size_t k = 0; k < in.halves.size(); ++k)
+      layouts.push_back(&in.halves[k]), layout_curves.push_back(&in.half_curves[k]);
     struct Tried {
       RuleTrial trial;
       UtilityPolicy::Params params;
