@@ -8,6 +8,7 @@
 #include <adaptseg/geo/georeference.hpp>
 #include <adaptseg/vision/adaptive_options.hpp>
 #include <adaptseg/vision/decision_model.hpp>
+#include <adaptseg/vision/detail/yaml_io.hpp>
 #include <adaptseg/vision/field.hpp>
 #include <adaptseg/vision/simulated_sensor.hpp>
 #ifdef ADAPTSEG_HAVE_GDAL
@@ -146,7 +147,8 @@ inline ImageSetInfo read_image_set_info(const std::filesystem::path& dir, bool a
     detail_image_set::fail(file, "not found (is --images a folder written by --record-from? docs/data_format.md, "
                                  "\"The live image folder\")");
   try {
-    const YAML::Node root = YAML::LoadFile(file.string());
+    const YAML::Node root = adaptseg::detail::yaml_mapping(file.string(), "an image set description",
+                                                           [&] { return YAML::LoadFile(file.string()); });
     if (!root["format"] || root["format"].as<std::string>() != "adaptseg.image_set/1")
       detail_image_set::fail(file, "format must be adaptseg.image_set/1");
     ImageSetInfo info;

@@ -25,6 +25,7 @@
 #include <adaptseg/core/decision_inputs.hpp>
 #include <adaptseg/core/error.hpp>
 #include <adaptseg/erfnet/erfnet_segmenter.hpp>
+#include <adaptseg/vision/detail/yaml_io.hpp>
 #include <adaptseg/vision/field.hpp>
 #include <adaptseg/vision/segmentation_backend.hpp>
 
@@ -78,13 +79,9 @@ struct EnsembleSegmentation {
   if (!std::filesystem::is_directory(dir))
     throw std::invalid_argument("EnsembleSegmenter: ensemble directory not found: " + dir.string());
   if (!std::filesystem::is_regular_file(file)) fail("file not found (an ensemble directory holds ensemble.yaml)");
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(file.string());
-  } catch (const YAML::Exception& e) {
-    fail(std::string("YAML error: ") + e.what());
-  }
-  if (!root.IsMap()) fail("the document must be a mapping with a list 'members'");
+  const YAML::Node root = detail::yaml_mapping("EnsembleSegmenter: " + file.string(),
+                                               "an ensemble description with a list 'members'",
+                                               [&] { return YAML::LoadFile(file.string()); });
   for (const auto& kv : root) {
     const auto key = kv.first.as<std::string>();
     if (key != "members" && key != "description") fail("unknown key '" + key + "' (expected members, description)");

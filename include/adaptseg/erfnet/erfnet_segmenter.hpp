@@ -13,6 +13,7 @@
 
 #include <adaptseg/core/camera.hpp>
 #include <adaptseg/core/error.hpp>
+#include <adaptseg/vision/detail/yaml_io.hpp>
 #include <adaptseg/vision/field.hpp>
 #include <adaptseg/vision/segmentation_backend.hpp>
 
@@ -316,13 +317,8 @@ class ErfnetSegmenter {
   static ErfnetModelInfo read_metadata(const std::filesystem::path& file) {
     if (!std::filesystem::is_regular_file(file))
       throw std::invalid_argument("ErfnetSegmenter: metadata file not found: " + file.string());
-    YAML::Node root;
-    try {
-      root = YAML::LoadFile(file.string());
-    } catch (const YAML::Exception& e) {
-      meta_error(file, std::string("YAML error: ") + e.what());
-    }
-    if (!root.IsMap()) meta_error(file, "the document must be a mapping");
+    const YAML::Node root = detail::yaml_mapping("ErfnetSegmenter: " + file.string(), "network metadata",
+                                                 [&] { return YAML::LoadFile(file.string()); });
     ErfnetModelInfo info;
     try {
       const YAML::Node classes = root["classes"];

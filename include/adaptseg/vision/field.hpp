@@ -6,6 +6,7 @@
 
 #include <adaptseg/core/error.hpp>
 #include <adaptseg/core/lawnmower_planner.hpp>
+#include <adaptseg/vision/detail/yaml_io.hpp>
 #include <adaptseg/vision/image.hpp>
 
 #include <opencv2/core.hpp>
@@ -410,13 +411,8 @@ inline FieldYaml read_field_yaml(const std::filesystem::path& dir) {
     throw std::invalid_argument("field directory not found: " + dir.string());
   const fs::path yaml = dir / "field.yaml";
   if (!fs::is_regular_file(yaml)) throw std::invalid_argument("missing " + yaml.string());
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(yaml.string());
-  } catch (const YAML::Exception& e) {
-    field_error(yaml, std::string("YAML error: ") + e.what());
-  }
-  if (!root.IsMap()) field_error(yaml, "the document must be a mapping");
+  const YAML::Node root =
+      yaml_mapping(yaml.string(), "a field description", [&] { return YAML::LoadFile(yaml.string()); });
   static const std::set<std::string> kKeys{"name", "gsd_cm", "labels", "image", "ignore_label",
                                            "classes", "interest", "geo"};
   for (const auto& kv : root) {
