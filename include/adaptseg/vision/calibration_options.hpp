@@ -1,8 +1,9 @@
 #pragma once
 /// @file
-/// What calibration is told (CalibrationOptions) and what a decision rule's calibration search
-/// works from and gives (RuleSearchInputs, RuleTrial, RuleSearchResult): shared by calibrate()
-/// (calibration.hpp) and each rule's own search (front_aware_rule.hpp, utility_rule.hpp).
+/// What calibration is told and gives (CalibrationOptions, CalibrationResult) and what a
+/// decision rule's calibration search works from and gives (RuleSearchInputs, RuleTrial,
+/// RuleSearchResult): shared by calibrate() (calibration.hpp) and each rule's own search
+/// (front_aware_rule.hpp, utility_rule.hpp).
 
 #include <adaptseg/core/decision_function.hpp>
 #include <adaptseg/core/lawnmower_curve.hpp>
