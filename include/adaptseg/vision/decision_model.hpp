@@ -244,7 +244,7 @@ struct DecisionModel {
   }
 
   /// The keys after the calibration record and the decision function (class set, camera,
-  /// timing, GSDs, coverage, linear baseline), read into `m`.
+  /// timing, GSDs, coverage, linear baseline), read into `m` (read_v2).
   static void read_setup(const detail::YamlReader& r, DecisionModel& m) {
     m.classes = r.texts("classes");
     m.interest = r.texts("interest");
@@ -263,26 +263,6 @@ struct DecisionModel {
     const auto lin = r.map("linear");
     m.linear = {lin.number("sigma_low"), lin.number("sigma_high")};
     (void)LinearDecision(m.linear);
-  }
-
-  /// A model of what the reader parsed first (the calibration record and the decision
-  /// function), the rest default until read_setup fills it in.
-  static DecisionModel parsed(std::vector<std::string> fields, std::string segmenter, double segmentation_time_s,
-                              DecisionFunction function, std::size_t samples, double train_front_margin) {
-    return {.calibration_fields = std::move(fields),
-            .segmenter = std::move(segmenter),
-            .calibration_segmentation_time_s = segmentation_time_s,
-            .classes = {},
-            .interest = {},
-            .camera = {},
-            .timing = {},
-            .top_gsd_cm = 0.0,
-            .candidate_gsd_cm = {},
-            .coverage = DescentCoverage::region,
-            .decision_function = std::move(function),
-            .linear = {},
-            .samples = samples,
-            .train_front_margin = train_front_margin};
   }
 
   // The reader reads keys in the order of the model's members: a file with several faults
@@ -339,8 +319,21 @@ struct DecisionModel {
     if (!function)
       detail::yaml_error(r.where(), "'rule.kind' must be " + rule_names_text() + " (got '" + kind + "')");
     const auto samples = static_cast<std::size_t>(cal.integer("samples", 0, 1'000'000'000));
-    DecisionModel m = parsed(std::move(fields), std::move(segmenter), segmentation_time_s, std::move(*function),
-                             samples, cal.number("train_front_margin"));
+    // The calibration record and the decision function; read_setup fills in the rest.
+    DecisionModel m{.calibration_fields = std::move(fields),
+                    .segmenter = std::move(segmenter),
+                    .calibration_segmentation_time_s = segmentation_time_s,
+                    .classes = {},
+                    .interest = {},
+                    .camera = {},
+                    .timing = {},
+                    .top_gsd_cm = 0.0,
+                    .candidate_gsd_cm = {},
+                    .coverage = DescentCoverage::region,
+                    .decision_function = std::move(*function),
+                    .linear = {},
+                    .samples = samples,
+                    .train_front_margin = cal.number("train_front_margin")};
     read_setup(r, m);
     return m;
   }
