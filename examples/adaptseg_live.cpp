@@ -167,9 +167,7 @@ void fly(const ImageSetInfo& info, const std::vector<PosedImage>& images, Backen
               planner.top_level().size(), options.top_gsd_cm);
   for (double g : planner.candidate_gsd_cm()) std::printf(" %.2f", g);
   std::printf(" cm/px, policy %s, descents %s, segmenter %s\n", std::string(policy.name()).c_str(),
-              options.schedule == adaptseg::DescentSchedule::tour  ? "at once or toured after the survey"
-              : options.schedule == adaptseg::DescentSchedule::row ? "at once or toured after each row"
-                                                                   : "at once",
+              adaptseg::descent_schedule_rule(options.schedule).description,
               std::string(backend.name()).c_str());
 
   nlohmann::json wps = nlohmann::json::array();

@@ -151,6 +151,30 @@ TEST_CASE("adaptive planner: coverage 'interest' re-maps only the sub-cells that
   CHECK(focused.mission.waypoints.size() == 2 + 1);
 }
 
+TEST_CASE("descent coverages: each rule says which cells it flies and whether it ranks them; names parse back") {
+  const cv::Mat labels(30, 30, CV_8UC1, cv::Scalar(0));
+  cv::Mat crop = labels.clone();
+  crop(cv::Rect(12, 12, 2, 2)).setTo(1);
+  const std::vector<int> interest{1};
+  const auto& interest_rule = descent_coverage_rule(DescentCoverage::interest);
+  REQUIRE(static_cast<bool>(interest_rule.flies));
+  // One top-level pixel (3 px of the 1 cm/px grid) around the cell: the patch 2 px off is seen.
+  CHECK(interest_rule.flies(crop, cv::Rect(0, 0, 10, 10), 3.0, 1.0, interest));
+  CHECK_FALSE(interest_rule.flies(crop, cv::Rect(20, 20, 10, 10), 3.0, 1.0, interest));
+  CHECK_FALSE(interest_rule.flies(labels, cv::Rect(0, 0, 10, 10), 3.0, 1.0, interest));
+  CHECK_FALSE(static_cast<bool>(descent_coverage_rule(DescentCoverage::region).flies));  // every cell with field
+  CHECK_FALSE(static_cast<bool>(descent_coverage_rule(DescentCoverage::ranked).flies));
+  CHECK(descent_coverage_rule(DescentCoverage::ranked).ranks_cells);
+  CHECK_FALSE(interest_rule.ranks_cells);
+  for (const auto& rule : kDescentCoverages) {
+    CHECK(parse_descent_coverage(rule.name) == rule.coverage);
+    CHECK(std::string(to_string(rule.coverage)) == rule.name);
+  }
+  CHECK_THROWS_WITH_AS(static_cast<void>(parse_descent_coverage("everywhere")),
+                       "descent coverage must be 'region', 'interest' or 'ranked', not 'everywhere'",
+                       std::invalid_argument);
+}
+
 TEST_CASE("adaptive planner: coverage 'ranked' offers the best k cells by their expected error, for every k") {
   // Two top-level regions of 3 x 3 sub-cells at 1 cm/px; in the first, a small crop patch in
   // the top-left cell and a larger one in the bottom-right cell, both with edges off the 3 cm/px

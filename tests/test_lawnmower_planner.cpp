@@ -1,9 +1,12 @@
+#include <adaptseg/core/descent_schedule.hpp>
 #include <adaptseg/core/lawnmower_planner.hpp>
 
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 using adaptseg::Area;
 using adaptseg::CameraModel;
@@ -143,4 +146,26 @@ TEST_CASE("lawnmower: overlap along and across the rows") {
   CHECK_THROWS_AS(LawnmowerPlanner(CameraModel{}, LawnmowerOverlap{0.95, 0.0}), std::invalid_argument);
   CHECK_THROWS_AS(LawnmowerPlanner(CameraModel{}, LawnmowerOverlap{0.0, -0.1}), std::invalid_argument);
   CHECK_THROWS_AS(LawnmowerPlanner(CameraModel{}, LawnmowerOverlap{NAN, 0.0}), std::invalid_argument);
+}
+
+TEST_CASE("descent schedules: the windows of a lawnmower, and every name parses back") {
+  using adaptseg::DescentSchedule;
+  using adaptseg::descent_schedule_rule;
+  const LawnmowerPlanner planner(CameraModel{});
+  const auto plan = planner.plan(Area{0, 0, 40.0, 30.0}, 3.0);  // 3 rows of 3
+  REQUIRE(plan.size() == 9);
+  using Last = std::vector<std::size_t>;
+  CHECK(descent_schedule_rule(DescentSchedule::immediate).window_last(plan) == Last{0, 1, 2, 3, 4, 5, 6, 7, 8});
+  CHECK(descent_schedule_rule(DescentSchedule::tour).window_last(plan) == Last(9, 8));
+  CHECK(descent_schedule_rule(DescentSchedule::row).window_last(plan) == Last{2, 2, 2, 5, 5, 5, 8, 8, 8});
+  CHECK(descent_schedule_rule(DescentSchedule::row).window_last({}).empty());
+  CHECK_FALSE(descent_schedule_rule(DescentSchedule::immediate).defers);
+  CHECK(descent_schedule_rule(DescentSchedule::tour).defers);
+  for (const auto& rule : adaptseg::kDescentSchedules) {
+    CHECK(adaptseg::parse_descent_schedule(rule.name) == rule.schedule);
+    CHECK(std::string(to_string(rule.schedule)) == rule.name);
+  }
+  CHECK_THROWS_WITH_AS(static_cast<void>(adaptseg::parse_descent_schedule("later")),
+                       "descent schedule must be 'immediate', 'tour' or 'row', not 'later'", std::invalid_argument);
+  CHECK_THROWS_AS(static_cast<void>(to_string(static_cast<DescentSchedule>(7))), std::invalid_argument);
 }

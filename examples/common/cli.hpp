@@ -183,6 +183,8 @@ struct CalibrationCli {
   std::string curve = "corrected";
 
   void add_to(CLI::App& app) {
+    std::vector<std::string> coverages;
+    for (const DescentCoverageRule& c : kDescentCoverages) coverages.emplace_back(c.name);
     options_ = {
         app.add_option("--rule", rule,
                        "decision rule: front-aware (descend while descents beat the lawnmower curve; no threshold) "
@@ -196,7 +198,7 @@ struct CalibrationCli {
                        "(only the cells where the top-level image shows a label of interest) or ranked (the cells "
                        "ranked by a decision input of the top-level image, e.g. the network's expected error about "
                        "L; the number of cells chosen in flight); saved in the model")
-            ->check(CLI::IsMember({"region", "interest", "ranked"}))
+            ->check(CLI::IsMember(coverages))
             ->capture_default_str(),
         app.add_option("--cell-input", cell_inputs,
                        "coverage ranked: the decision inputs tried for ranking and forecasting cells, comma-separated "

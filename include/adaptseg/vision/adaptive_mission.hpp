@@ -83,9 +83,9 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
       descents.push_back({w->decision, region, planner.map().labels()(region).clone(),
                           covered & cv::Rect(0, 0, field.width_px(), field.height_px()), w->waypoint.gsd_cm});
     }
-    // With the backend's class probabilities where the decision reads them (ranked: the top-level
-    // images' decision inputs, a descent's scene check).
-    const bool probabilities = options.coverage == DescentCoverage::ranked;
+    // With the backend's class probabilities where the decision reads them (a coverage that ranks
+    // cells: the top-level images' decision inputs, a descent's scene check).
+    const bool probabilities = descent_coverage_rule(options.coverage).ranks_cells;
     auto visit = mission.visit_without_fusion(w->waypoint, w->level, probabilities);
     planner.report(visit.image, Segmentation{visit.labels, std::move(visit.probabilities), std::move(visit.member_votes)},
                    visit.record->segmentation_s, mission.elapsed_s());

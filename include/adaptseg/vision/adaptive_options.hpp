@@ -1,13 +1,14 @@
 #pragma once
 /// @file
-/// The adaptive planner's vocabulary (adaptive_planner.hpp): its settings (AdaptiveOptions,
-/// DescentSchedule), the ground it covers (SurveyArea), and what it hands out step by step
+/// The adaptive planner's vocabulary (adaptive_planner.hpp): its settings (AdaptiveOptions),
+/// the ground it covers (SurveyArea), and what it hands out step by step
 /// (PlannedWaypoint, PlannerStep, DecisionRecord). Apart from the planner so that code that
 /// only configures or records missions (model files, exports, result writers) need not
 /// compile it.
 
 #include <adaptseg/core/decision.hpp>
 #include <adaptseg/core/decision_inputs.hpp>
+#include <adaptseg/core/descent_schedule.hpp>
 #include <adaptseg/core/lawnmower_planner.hpp>
 #include <adaptseg/core/mission_options.hpp>
 #include <adaptseg/vision/descent_coverage.hpp>
@@ -30,40 +31,6 @@ enum class GridAnchor {
   /// on a new site, plan_site_survey).
   centred,
 };
-
-/// When the chosen descents are flown.
-enum class DescentSchedule {
-  /// At once (the paper): down from the region's top-level waypoint, the sub-lawnmower, back up
-  /// to the next top-level waypoint: two altitude changes per descent (one for the last region's).
-  immediate,
-  /// Inspect at once or after the survey, whichever is cheaper (beyond the paper): each region
-  /// is decided as it is seen; a chosen descent is flown at once if that adds less time, else
-  /// deferred to a tour flown after the whole top-level lawnmower, every deferred sub-lawnmower
-  /// back to back at low altitude in the order that takes least time (inspection_tour.hpp: one
-  /// descent for all of them, no climb back). A deferred descent is charged what it adds to the
-  /// tour chosen so far (cheapest insertion); the tour is reordered once the survey is flown,
-  /// never longer, so the budget holds. Candidate::deferred says which way each was costed.
-  tour,
-  /// Inspect at once or after the lawnmower row, whichever is cheaper (beyond the paper: stay
-  /// low between neighbouring regions): as `tour`, but a tour is flown after each row of the
-  /// top-level lawnmower (rows run along x), from the row's last top-level waypoint through the
-  /// row's deferred sub-lawnmowers, back to back at low altitude, up to the next row's first
-  /// top-level waypoint. Regions of one row that all want a descent share one descent and one
-  /// climb, without the flight back from the survey's end that `tour` needs; each is still
-  /// decided on its own top-level image. A deferred descent is charged what it adds to the row's
-  /// tour, its leg up to the next row included.
-  row,
-};
-
-/// The name used in results and on the command line: "immediate", "tour" or "row".
-[[nodiscard]] inline const char* to_string(DescentSchedule s) noexcept {
-  switch (s) {
-    case DescentSchedule::tour: return "tour";
-    case DescentSchedule::row: return "row";
-    case DescentSchedule::immediate: break;
-  }
-  return "immediate";
-}
 
 /// Settings of an adaptive mission.
 struct AdaptiveOptions {

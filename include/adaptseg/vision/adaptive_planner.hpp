@@ -88,7 +88,9 @@ class AdaptivePlanner {
         map_(grid_size(area_), area_.ignore_label),
         backend_(backend),
         policy_(policy),
-        options_(std::move(options)) {
+        options_(std::move(options)),
+        schedule_(descent_schedule_rule(options_.schedule)),
+        coverage_(descent_coverage_rule(options_.coverage)) {
     const auto t0 = std::chrono::steady_clock::now();
     policy_.begin_mission();
     if (area_.valid_mask.empty()) {
@@ -150,15 +152,13 @@ class AdaptivePlanner {
     top_ = top_level_plan(top_gsd_cm_);
     valid_px_ = cv::countNonZero(area_.valid_mask);
     charge_measured_planning(seconds_since(t0));
-    window_last_.resize(top_.size());
-    for (std::size_t i = top_.size(); i-- > 0;) {
-      const bool row_ends = i + 1 == top_.size() || std::abs(top_[i + 1].position.y() - top_[i].position.y()) > 1e-6;
-      switch (options_.schedule) {
-        case DescentSchedule::immediate: window_last_[i] = i; break;
-        case DescentSchedule::tour: window_last_[i] = top_.size() - 1; break;
-        case DescentSchedule::row: window_last_[i] = row_ends ? i : window_last_[i + 1]; break;
-      }
-    }
+    window_last_ = schedule_.window_last(top_);
+    // A schedule's windows must cut the lawnmower into runs of consecutive waypoints.
+    for (std::size_t i = 0; i < top_.size(); ++i)
+      if (window_last_.size() != top_.size() || window_last_[i] < i || window_last_[i] >= top_.size() ||
+          (i > 0 && window_last_[i - 1] >= i && window_last_[i - 1] != window_last_[i]))
+        throw std::logic_error(std::string("descent schedule '") + schedule_.name +
+                               "': its windows are not runs of consecutive top-level waypoints");
     flight_after_.assign(top_.size() + 1, 0.0);
     for (std::size_t i = top_.size(); i-- > 1;)
       flight_after_[i - 1] = flight_after_[i] + timing_.segment_time_s(top_[i - 1].position, top_[i].position);
@@ -210,11 +210,11 @@ class AdaptivePlanner {
     check_report(image, elapsed_s);
     const auto t0 = std::chrono::steady_clock::now();
     // With the backend's class probabilities where it gives them and the decision reads them
-    // (DescentCoverage::ranked: the cells' decision inputs at the top level, image_summary.hpp,
-    // and in a descent's images the scene check's); otherwise the labels alone.
-    const bool probabilities = options_.coverage == DescentCoverage::ranked;
-    Segmentation s = probabilities ? segment_with_probabilities_checked(backend_, image, area_.num_classes)
-                                   : Segmentation{segment_checked(backend_, image, area_.num_classes), {}};
+    // (a coverage that ranks cells: the cells' decision inputs at the top level,
+    // image_summary.hpp, and in a descent's images the scene check's); otherwise the labels alone.
+    Segmentation s = coverage_.ranks_cells
+                         ? segment_with_probabilities_checked(backend_, image, area_.num_classes)
+                         : Segmentation{segment_checked(backend_, image, area_.num_classes), {}};
     const double segmentation_s = seconds_since(t0);  // the network's time, as Mission measures it
     return accept(image, s, segmentation_s, elapsed_s);
   }
@@ -292,19 +292,20 @@ class AdaptivePlanner {
   }
 
   /// The sub-lawnmower a descent at top-level waypoint `top_index` flies at `gsd_cm` once the
-  /// region's top-level image is fused: sub_plan() with `options().coverage` applied
-  /// (DescentCoverage::interest: only the cells whose ground, grown by one top-level pixel and
-  /// clipped to the region, shows a label of interest in the map; visiting order unchanged).
+  /// region's top-level image is fused: sub_plan() with the cells `options().coverage` flies
+  /// (DescentCoverageRule::flies, given the region's map; DescentCoverage::interest: only the
+  /// cells whose ground, grown by one top-level pixel and clipped to the region, shows a label of
+  /// interest; visiting order unchanged). A coverage that ranks cells offers subsets of it.
   /// @throws std::invalid_argument as sub_plan().
   [[nodiscard]] std::vector<Waypoint> descent_plan(std::size_t top_index, double gsd_cm) const {
-    if (options_.coverage == DescentCoverage::region) return sub_plan(top_index, gsd_cm);
+    if (!coverage_.flies) return sub_plan(top_index, gsd_cm);
     detail::require(top_index < top_.size(), "AdaptivePlanner::descent_plan: top_index out of range", top_index);
     const Waypoint& t = top_[top_index];
     const cv::Rect region = region_rect(top_index);
     const cv::Mat labels = map_.labels()(region);
     const auto keep_cell = [&](const Area& a) {
-      return valid_pixels(a) > 0 && cell_shows_interest(labels, pixel_rect(a) - region.tl(), top_gsd_cm_,
-                                                         area_.map_gsd_cm, options_.mission.interest);
+      return valid_pixels(a) > 0 &&
+             coverage_.flies(labels, pixel_rect(a) - region.tl(), top_gsd_cm_, area_.map_gsd_cm, options_.mission.interest);
     };
     return LawnmowerPlanner(camera_).plan(t.footprint, gsd_cm, Eigen::Vector2d(t.position.x(), t.position.y()),
                                           keep_cell);
@@ -418,8 +419,8 @@ class AdaptivePlanner {
       fine_mass_ = 0.0;
       fine_known_ = true;
     }
-    // Ranked: the finer image's own value of the ranking input over its cell (the scene check).
-    if (p.level == 1 && options_.coverage == DescentCoverage::ranked) {
+    // Ranked cells: the finer image's own value of the ranking input over its cell (the scene check).
+    if (p.level == 1 && coverage_.ranks_cells) {
       const cv::Rect region = region_rect(p.top_index);
       const cv::Rect cell = pixel_rect(p.waypoint.footprint) & region;
       if (cell.area() > 0) {
@@ -535,8 +536,8 @@ class AdaptivePlanner {
     return t;
   }
 
-  /// What a descent at top-level waypoint i may fly at one GSD: its sub-lawnmower and, for
-  /// DescentCoverage::ranked, the cells it re-maps.
+  /// What a descent at top-level waypoint i may fly at one GSD: its sub-lawnmower and, for a
+  /// coverage that ranks cells, the cells it re-maps.
   struct DescentOption {
     double gsd_cm = 0.0;
     std::vector<Waypoint> plan;
@@ -544,23 +545,23 @@ class AdaptivePlanner {
   };
 
   /// The decision inputs of the top-level image of waypoint i (`image`, `segmentation`) over its
-  /// region on the map grid (pixel_inputs(), planes_on_grid()); none unless
-  /// DescentCoverage::ranked.
+  /// region on the map grid (pixel_inputs(), planes_on_grid()); none unless the coverage ranks
+  /// cells.
   [[nodiscard]] std::vector<cv::Mat> region_inputs(std::size_t i, const Image& image,
                                                    const Segmentation& segmentation) const {
     const cv::Rect region = region_rect(i);
-    if (options_.coverage != DescentCoverage::ranked || region.area() == 0) return {};
+    if (!coverage_.ranks_cells || region.area() == 0) return {};
     return planes_on_grid(image, pixel_inputs(segmentation, options_.mission.interest, area_.ignore_label), region);
   }
 
   /// Every descent the decision at top-level waypoint i may choose from, per candidate GSD:
-  /// descent_plan() (DescentCoverage::region, interest), or for DescentCoverage::ranked the
-  /// cells of the region's sub-lawnmower ranked by their mass of `options().cell_input` in the
-  /// region's inputs (`planes`, region_inputs()), one option per number k of the best cells
-  /// (cells without any of the input left out), each flown in the sub-lawnmower's order.
+  /// descent_plan(), or for a coverage that ranks cells (DescentCoverage::ranked) its cells
+  /// ranked by their mass of `options().cell_input` in the region's inputs (`planes`,
+  /// region_inputs()), one option per number k of the best cells (cells without any of the
+  /// input left out), each flown in the sub-lawnmower's order.
   [[nodiscard]] std::vector<DescentOption> descent_options(std::size_t i, const std::vector<cv::Mat>& planes) const {
     std::vector<DescentOption> out;
-    if (options_.coverage != DescentCoverage::ranked) {
+    if (!coverage_.ranks_cells) {
       for (double g : candidates_) out.push_back({g, descent_plan(i, g), {}});
       return out;
     }
@@ -569,7 +570,7 @@ class AdaptivePlanner {
     const cv::Mat field = area_.valid_mask(region);
     const DecisionInput input = options_.cell_input;
     for (double g : candidates_) {
-      const std::vector<Waypoint> all = sub_plan(i, g);
+      const std::vector<Waypoint> all = descent_plan(i, g);
       std::vector<CellInputs> cells;
       std::vector<std::size_t> ranked;
       for (std::size_t k = 0; k < all.size(); ++k) {
@@ -599,7 +600,7 @@ class AdaptivePlanner {
     rec.sigma = sigma;
     const Eigen::Vector3d here = top_[i].position;
     const bool last = i + 1 == top_.size();
-    const bool tour = options_.schedule != DescentSchedule::immediate;
+    const bool tour = schedule_.defers;
     const bool window_last = i == window_last_[i];  // the tour (of the survey / row) starts here
     const double per_image = segmentation_estimate() + planning_estimate();
     const double direct = last ? 0.0 : timing_.segment_time_s(here, top_[i + 1].position);
@@ -743,7 +744,7 @@ class AdaptivePlanner {
     if (region.area() > 0)
       out.relabelled = relabelling(descent_before_, map_.labels()(region), area_.valid_mask(region),
                                    options_.mission.interest);
-    if (options_.coverage == DescentCoverage::ranked) {
+    if (coverage_.ranks_cells) {
       const Candidate& chosen = rec.candidates[chosen_candidate(rec.decision, rec.candidates, policy_.name())];
       const double region_px = static_cast<double>(valid_pixels(top_[top_index].footprint));
       double top_mass = 0.0;
@@ -768,6 +769,8 @@ class AdaptivePlanner {
   Backend& backend_;
   Policy& policy_;
   AdaptiveOptions options_;
+  const DescentScheduleRule& schedule_;  ///< options_.schedule's
+  const DescentCoverageRule& coverage_;  ///< options_.coverage's
   std::vector<double> candidates_;
   double top_gsd_cm_ = 0.0;  ///< the GSD the top level is flown at
   std::vector<Waypoint> top_;
@@ -790,9 +793,9 @@ class AdaptivePlanner {
   double fine_mass_ = 0.0;            ///< ranked: Σ over its images so far of the finer look's input mass
   bool fine_known_ = true;            ///< ... every image of it gave the input
   /// Per top-level waypoint, the last top-level waypoint of its window: where the window's tour
-  /// starts (immediate: itself; tour: the survey's last; row: its row's last).
+  /// starts (DescentScheduleRule::window_last).
   std::vector<std::size_t> window_last_;
-  // DescentSchedule::tour and row (the tour of the window being flown):
+  // A schedule that defers descents (DescentSchedule::tour, row): the tour of the window being flown.
   std::vector<ChosenDescent> queued_;     ///< every descent deferred in the window, in decision order
   std::vector<TourStop> tour_stops_;      ///< ... as tour stops (same order)
   std::vector<std::size_t> tour_order_;   ///< indices into queued_, in flight order

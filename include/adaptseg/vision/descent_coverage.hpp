@@ -1,14 +1,17 @@
 #pragma once
 /// @file
-/// What a descent re-maps (DescentCoverage, an AdaptiveOptions setting) and the rule of its
-/// `interest` coverage for one cell (cell_shows_interest), shared by the adaptive planner and
-/// calibration.
+/// What a descent re-maps (DescentCoverage, an AdaptiveOptions setting), one place per
+/// coverage: its name, which cells it flies (cell_shows_interest for `interest`) and whether it
+/// ranks them (DescentCoverageRule). The adaptive planner and calibration ask a coverage's rule,
+/// never the coverage's name; a new coverage is a new row of kDescentCoverages.
 
+#include <adaptseg/core/detail/named_rows.hpp>
 #include <adaptseg/core/error.hpp>
 #include <adaptseg/vision/detail/label_lut.hpp>
 
 #include <opencv2/core.hpp>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <span>
@@ -31,25 +34,6 @@ namespace adaptseg {
 ///   with none of the input are never re-mapped.
 enum class DescentCoverage { region, interest, ranked };
 
-/// The name used in files and on the command line: "region", "interest" or "ranked".
-[[nodiscard]] inline const char* to_string(DescentCoverage c) noexcept {
-  switch (c) {
-    case DescentCoverage::interest: return "interest";
-    case DescentCoverage::ranked: return "ranked";
-    case DescentCoverage::region: break;
-  }
-  return "region";
-}
-
-/// Parses "region", "interest" or "ranked".
-/// @throws std::invalid_argument for anything else.
-[[nodiscard]] inline DescentCoverage parse_descent_coverage(const std::string& s) {
-  if (s == "region") return DescentCoverage::region;
-  if (s == "interest") return DescentCoverage::interest;
-  if (s == "ranked") return DescentCoverage::ranked;
-  throw std::invalid_argument("descent coverage must be 'region', 'interest' or 'ranked', not '" + s + "'");
-}
-
 /// The DescentCoverage::interest rule for one sub-lawnmower cell: true if some pixel of
 /// `labels` (the region's top-level segmentation on a grid of `grid_gsd_cm`) inside `cell`,
 /// grown by one top-level pixel (`top_gsd_cm`) on every side and clipped to the image, carries
@@ -71,6 +55,47 @@ enum class DescentCoverage { region, interest, ranked };
       if (lut[row[c]]) return true;
   }
   return false;
+}
+
+/// A coverage as the adaptive planner and calibration use it. A descent re-maps cells of its
+/// region's sub-lawnmower: those with field that the coverage `flies`, and, where it
+/// `ranks_cells`, the k best of those (one candidate per k, the decision chooses k).
+struct DescentCoverageRule {
+  DescentCoverage coverage;
+  const char* name;  ///< in model files and on the command line
+  /// Whether a sub-lawnmower cell with field is flown, given the region's top-level labels
+  /// (`labels`, on a grid of `grid_gsd_cm` over the region), the cell's pixels on that grid
+  /// (`cell`), the top-level GSD and the labels of interest; nullptr: every cell with field. A
+  /// cell it leaves out keeps its top-level labels in the map.
+  bool (*flies)(const cv::Mat& labels, cv::Rect cell, double top_gsd_cm, double grid_gsd_cm,
+                std::span<const int> interest);
+  /// The cells are ranked by their mass of a decision input of the top-level image
+  /// (AdaptiveOptions::cell_input), best first, cells without any left out, and the decision
+  /// is offered one descent per number k of best cells; the backend's class probabilities are
+  /// read (the inputs need them), each Candidate carries its cells and each DescentOutcome the
+  /// input before and after (the scene check).
+  bool ranks_cells;
+};
+
+/// Every coverage, one row each.
+inline constexpr std::array<DescentCoverageRule, 3> kDescentCoverages{{
+    {DescentCoverage::region, "region", nullptr, false},
+    {DescentCoverage::interest, "interest", cell_shows_interest, false},
+    {DescentCoverage::ranked, "ranked", nullptr, true},
+}};
+
+/// The rule of coverage `c`.
+[[nodiscard]] inline const DescentCoverageRule& descent_coverage_rule(DescentCoverage c) {
+  return detail::row_of(kDescentCoverages, &DescentCoverageRule::coverage, c, "descent coverage");
+}
+
+/// The name used in files and on the command line: "region", "interest" or "ranked".
+[[nodiscard]] inline const char* to_string(DescentCoverage c) { return descent_coverage_rule(c).name; }
+
+/// Parses a coverage's name.
+/// @throws std::invalid_argument for anything else.
+[[nodiscard]] inline DescentCoverage parse_descent_coverage(const std::string& s) {
+  return detail::row_named(kDescentCoverages, s, "descent coverage").coverage;
 }
 
 }  // namespace adaptseg

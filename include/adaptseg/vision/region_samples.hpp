@@ -34,10 +34,10 @@ struct CalibrationSamples {
 /// Flies every top-level region of `field` at `top_gsd_cm` and at each of `candidate_gsd_cm`
 /// and returns one RegionSample per (region, candidate). Regions without a valid pixel are
 /// skipped; candidates finer than the field's GSD are skipped. `coverage`: what each
-/// sub-lawnmower covers, as AdaptivePlanner::descent_plan (with DescentCoverage::interest, a
+/// sub-lawnmower covers, as AdaptivePlanner::descent_plan (DescentCoverageRule::flies; a
 /// (region, candidate) whose sub-lawnmower has no cell is skipped: the planner offers no such
-/// descent; with DescentCoverage::ranked every cell with field is flown, as for `region`, and
-/// every cell also gives a CellSample: its decision inputs in the top-level image, segmented
+/// descent; with a coverage that ranks cells, DescentCoverage::ranked, every cell it flies is
+/// flown, and every cell also gives a CellSample: its decision inputs in the top-level image, segmented
 /// with the backend's class probabilities where it gives them, and what re-mapping it alone
 /// changes). Each sample's `field` is `field_index`.
 /// @throws std::invalid_argument for a top GSD finer than the field's or candidates not finer
@@ -60,7 +60,8 @@ template <SegmentationBackend Backend>
   const int n = field.num_classes();
   // The top-level lawnmower over the whole field: every sample's field terms are measured
   // against its map.
-  const bool ranked = coverage == DescentCoverage::ranked;
+  const DescentCoverageRule& rule = descent_coverage_rule(coverage);
+  const bool ranked = rule.ranks_cells;
   const auto tops = planner.plan(field.area(), top_gsd_cm, {0.0, 0.0}, keep);
   std::vector<Image> top_images;
   std::vector<Segmentation> top_segmentations;
@@ -102,9 +103,8 @@ template <SegmentationBackend Backend>
       field_without_region -= here;
     }
     const auto keep_cell = [&](const Area& a) {
-      return keep(a) && (coverage != DescentCoverage::interest ||
-                         cell_shows_interest(top_map.labels(), field.pixel_rect(a) - region.tl(), top_gsd_cm,
-                                             field.gsd_cm(), interest));
+      return keep(a) && (!rule.flies || rule.flies(top_map.labels(), field.pixel_rect(a) - region.tl(), top_gsd_cm,
+                                                   field.gsd_cm(), interest));
     };
     // The decision inputs of the top-level image on the region's map grid (ranked only).
     const std::vector<cv::Mat> top_planes =
@@ -116,8 +116,8 @@ template <SegmentationBackend Backend>
       const auto sub = planner.plan(top.footprint, g, Eigen::Vector2d(top.position.x(), top.position.y()), keep_cell);
       if (sub.empty()) continue;
       SemanticMap local(region.size(), field.ignore_label());
-      // Cells a focused descent skips keep their top-level labels, as in the mission's map.
-      if (coverage == DescentCoverage::interest) local.fuse(top_local, top_labels);
+      // Cells a coverage leaves out keep their top-level labels, as in the mission's map.
+      if (rule.flies) local.fuse(top_local, top_labels);
       // Ranked: each finer image's own decision inputs over its cell (the scene check's proxy).
       std::vector<CellInputs> fine_inputs;
       for (const auto& w : sub) {
