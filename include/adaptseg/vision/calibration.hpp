@@ -26,11 +26,125 @@
 
 namespace adaptseg {
 
+namespace detail {
+
+/// calibrate()'s settings of the adaptive missions it flies: `options.adaptive` with the labels
+/// of interest filled from the first field, and the declared segmentation and planning times.
+/// @throws std::invalid_argument for no field, fields with other class sets than the first's,
+///         an unknown rule, invalid options (the rule's check_options) or no label of interest.
+[[nodiscard]] inline AdaptiveOptions calibration_settings(std::span<const Field> fields,
+                                                          const CalibrationOptions& options) {
+  require(!fields.empty(), "calibrate: at least one training field is needed; count", fields.size());
+  require(std::isfinite(options.segmentation_time_s) && options.segmentation_time_s >= 0.0,
+          "calibrate: segmentation_time_s must be finite and >= 0", options.segmentation_time_s);
+  require(is_rule_name(options.rule), "calibrate: the rule must be " + rule_names_text() + "; rule", options.rule);
+  for_each_rule([&]<class Rule>() {
+    if (options.rule == Rule::kName) Rule::check_options(options);
+  });
+  const auto names = [](const Field& f) {
+    std::vector<std::string> v;
+    for (const auto& c : f.classes()) v.push_back(c.name);
+    return v;
+  };
+  for (const Field& f : fields)
+    require(names(f) == names(fields.front()),
+            "calibrate: every training field must have the first field's classes; field", f.name());
+  AdaptiveOptions adaptive = options.adaptive;
+  if (adaptive.mission.interest.empty()) adaptive.mission.interest = fields.front().interest();
+  require(!adaptive.mission.interest.empty(), "calibrate: no labels of interest", 0);
+  adaptive.mission.fixed_segmentation_time_s = options.segmentation_time_s;
+  adaptive.mission.fixed_planning_time_s = options.planning_time_s;
+  return adaptive;
+}
+
+/// A coverage that ranks cells: the other top levels its cells are also sampled from
+/// (CalibrationOptions::alternative_top_gsd_cm, by default the coarsest candidate when there
+/// are two or more).
+/// @throws std::invalid_argument for one that is not a candidate with a finer candidate below it.
+[[nodiscard]] inline std::vector<double> alternative_top_gsds(const CalibrationOptions& options) {
+  std::vector<double> c = options.adaptive.candidate_gsd_cm;
+  std::sort(c.begin(), c.end());
+  std::vector<double> tops;
+  if (options.alternative_top_gsd_cm)
+    tops = *options.alternative_top_gsd_cm;
+  else if (c.size() >= 2)
+    tops = {c.back()};
+  for (double a : tops)
+    require(std::find(c.begin(), c.end(), a) != c.end() && a > c.front(),
+            "calibrate: an alternative top GSD must be a candidate GSD with a finer candidate below it", a);
+  return tops;
+}
+
+/// The decision inputs `tried` (empty: the inputs about L) that the pooled training cells know,
+/// each with the share of the achievable gain its ranking captures (cell_ranking_capture), best
+/// first; ties keep the order tried, an input without a score comes last.
+/// @throws std::invalid_argument for no cell, or no input the backend gives.
+[[nodiscard]] inline std::vector<std::pair<DecisionInput, double>> score_cell_inputs(
+    const std::vector<CellSample>& cells, std::vector<DecisionInput> tried, const std::string& field) {
+  require(!cells.empty(), "calibrate: the training fields gave no cell sample", field);
+  if (tried.empty())
+    tried = {DecisionInput::sigma, DecisionInput::boundary, DecisionInput::ambiguity, DecisionInput::expected_error,
+             DecisionInput::second_choice};
+  std::vector<std::pair<DecisionInput, double>> scores;
+  for (DecisionInput i : tried) {
+    // An input the backend cannot give (probabilities from a labels-only backend) is unknown
+    // on every cell.
+    const bool known =
+        std::any_of(cells.begin(), cells.end(), [&](const CellSample& c) { return std::isfinite(c.top.value(i)); });
+    if (known) scores.emplace_back(i, cell_ranking_capture(cells, i));
+  }
+  require(!scores.empty(), "calibrate: no decision input to rank the cells by is known from this backend; inputs tried",
+          tried.size());
+  const auto score = [](double v) { return std::isnan(v) ? -std::numeric_limits<double>::infinity() : v; };
+  std::stable_sort(scores.begin(), scores.end(),
+                   [&](const auto& a, const auto& b) { return score(a.second) > score(b.second); });
+  return scores;
+}
+
+/// Each training field's mean `input` at each top level its cells were sampled from (the cell
+/// gain model's top GSDs; the prior of a new field's), into `reference` (ReferenceCurve::
+/// top_inputs, and field_input at `top_gsd_cm`): over the cells of the coarsest descent GSD,
+/// which tile the field's regions.
+inline void set_field_inputs(std::vector<ReferenceCurve>& reference,
+                             const std::vector<std::vector<CellSample>>& cells_by_field, const CellGainModel& cells,
+                             DecisionInput input, double top_gsd_cm) {
+  for (std::size_t f = 0; f < reference.size(); ++f) {
+    for (const double top : cells.top_gsds()) {
+      double sub = 0.0;  // the coarsest descent GSD sampled from this top
+      for (const CellSample& c : cells_by_field[f])
+        if (same_gsd(c.top_gsd_cm, top)) sub = std::max(sub, c.sub_gsd_cm);
+      double mass = 0.0, px = 0.0;
+      for (const CellSample& c : cells_by_field[f])
+        if (same_gsd(c.top_gsd_cm, top) && same_gsd(c.sub_gsd_cm, sub)) mass += c.top.mass(input), px += c.top.field_px;
+      const double value = px > 0.0 ? mass / px : 0.0;
+      if (same_gsd(top, top_gsd_cm)) reference[f].field_input = value;
+      reference[f].top_inputs.emplace_back(top, value);
+    }
+  }
+}
+
+/// The linear baseline's σ range: the 5th and 95th percentiles of σ at h_max over `samples`
+/// (non-empty).
+[[nodiscard]] inline LinearDecision::Params linear_sigma_range(const std::vector<RegionSample>& samples) {
+  std::vector<double> sig;
+  for (const auto& s : samples) sig.push_back(s.sigma_top);
+  std::sort(sig.begin(), sig.end());
+  const auto pct = [&](double q) { return sig[static_cast<std::size_t>(q * static_cast<double>(sig.size() - 1))]; };
+  LinearDecision::Params linear{pct(0.05), pct(0.95)};
+  if (!(linear.sigma_high > linear.sigma_low)) linear = {0.0, std::max(1e-6, sig.back())};
+  linear.sigma_high = std::min(1.0, linear.sigma_high);
+  return linear;
+}
+
+}  // namespace detail
+
 /// Calibrates on the training `fields` with `backend` (the backend the missions will use).
 ///
 /// 1. Region samples at every top-level region × candidate GSD of every field, pooled
-///    (collect_region_samples).
-/// 2. The gain model fitted to them (GainModel::fit).
+///    (collect_samples); with a coverage that ranks cells also cell samples, from the top level
+///    and the alternative ones (detail::alternative_top_gsds), and the input that ranks them
+///    best (detail::score_cell_inputs).
+/// 2. The gain model fitted to them (GainModel::fit; CellGainModel::fit for the cells).
 /// 3. Each field's lawnmower curve at `lawnmower_gsds()`: the front-aware rule's reference curves.
 /// 4. The rule's settings chosen on the training fields by its own search (the entry of
 ///    DecisionRules named by CalibrationOptions::rule: FrontAwareRule::search,
@@ -42,44 +156,13 @@ namespace adaptseg {
 template <SegmentationBackend Backend>
 [[nodiscard]] CalibrationResult calibrate(std::span<const Field> fields, Backend& backend,
                                           const CalibrationOptions& options) {
-  detail::require(!fields.empty(), "calibrate: at least one training field is needed; count", fields.size());
+  AdaptiveOptions adaptive = detail::calibration_settings(fields, options);
   const std::vector<double> lawnmower_gsd = options.lawnmower_gsds();
-  detail::require(std::isfinite(options.segmentation_time_s) && options.segmentation_time_s >= 0.0,
-                  "calibrate: segmentation_time_s must be finite and >= 0", options.segmentation_time_s);
-  detail::require(is_rule_name(options.rule), "calibrate: the rule must be " + rule_names_text() + "; rule",
-                  options.rule);
-  for_each_rule([&]<class Rule>() {
-    if (options.rule == Rule::kName) Rule::check_options(options);
-  });
-  const auto names = [](const Field& f) {
-    std::vector<std::string> v;
-    for (const auto& c : f.classes()) v.push_back(c.name);
-    return v;
-  };
-  for (const Field& f : fields)
-    detail::require(names(f) == names(fields.front()),
-                    "calibrate: every training field must have the first field's classes; field", f.name());
-  AdaptiveOptions adaptive = options.adaptive;
-  if (adaptive.mission.interest.empty()) adaptive.mission.interest = fields.front().interest();
-  detail::require(!adaptive.mission.interest.empty(), "calibrate: no labels of interest", 0);
-  adaptive.mission.fixed_segmentation_time_s = options.segmentation_time_s;
-  adaptive.mission.fixed_planning_time_s = options.planning_time_s;
   const std::vector<int>& interest = adaptive.mission.interest;
   const CameraModel camera(adaptive.mission.camera);
 
-  const bool ranked = adaptive.coverage == DescentCoverage::ranked;
-  std::vector<double> alternative_tops;
-  if (ranked) {
-    std::vector<double> c = adaptive.candidate_gsd_cm;
-    std::sort(c.begin(), c.end());
-    if (options.alternative_top_gsd_cm)
-      alternative_tops = *options.alternative_top_gsd_cm;
-    else if (c.size() >= 2)
-      alternative_tops = {c.back()};
-    for (double a : alternative_tops)
-      detail::require(std::find(c.begin(), c.end(), a) != c.end() && a > c.front(),
-                      "calibrate: an alternative top GSD must be a candidate GSD with a finer candidate below it", a);
-  }
+  const bool ranked = descent_coverage_rule(adaptive.coverage).ranks_cells;
+  const std::vector<double> alternative_tops = ranked ? detail::alternative_top_gsds(options) : std::vector<double>{};
   std::vector<RegionSample> samples;
   std::vector<std::vector<RegionSample>> by_field;
   std::vector<CellSample> cell_samples;
@@ -92,7 +175,7 @@ template <SegmentationBackend Backend>
     samples.insert(samples.end(), by_field.back().begin(), by_field.back().end());
     cells_by_field.push_back(std::move(c.cells));
     // The cells as seen from the alternative top levels, re-mapped at the candidates below them.
-    for (double top : ranked ? alternative_tops : std::vector<double>{}) {
+    for (double top : alternative_tops) {
       std::vector<double> below;
       for (double g : adaptive.candidate_gsd_cm)
         if (g < top) below.push_back(g);
@@ -101,27 +184,10 @@ template <SegmentationBackend Backend>
     }
     cell_samples.insert(cell_samples.end(), cells_by_field.back().begin(), cells_by_field.back().end());
   }
-  // DescentCoverage::ranked: the input that ranks the training fields' cells best.
+  // A coverage that ranks cells: the input that ranks the training fields' cells best.
   std::vector<std::pair<DecisionInput, double>> input_scores;
   if (ranked) {
-    detail::require(!cell_samples.empty(), "calibrate: the training fields gave no cell sample", fields.front().name());
-    std::vector<DecisionInput> tried = options.cell_inputs;
-    if (tried.empty())
-      tried = {DecisionInput::sigma, DecisionInput::boundary, DecisionInput::ambiguity, DecisionInput::expected_error,
-               DecisionInput::second_choice};
-    for (DecisionInput i : tried) {
-      // An input the backend cannot give (probabilities from a labels-only backend) is unknown
-      // on every cell.
-      const bool known = std::any_of(cell_samples.begin(), cell_samples.end(),
-                                     [&](const CellSample& c) { return std::isfinite(c.top.value(i)); });
-      if (known) input_scores.emplace_back(i, cell_ranking_capture(cell_samples, i));
-    }
-    detail::require(!input_scores.empty(), "calibrate: no decision input to rank the cells by is known from this backend; inputs tried",
-                    tried.size());
-    // Best capture first; ties keep the table's order; an input without a score last.
-    const auto score = [](double v) { return std::isnan(v) ? -std::numeric_limits<double>::infinity() : v; };
-    std::stable_sort(input_scores.begin(), input_scores.end(),
-                     [&](const auto& a, const auto& b) { return score(a.second) > score(b.second); });
+    input_scores = detail::score_cell_inputs(cell_samples, options.cell_inputs, fields.front().name());
     adaptive.cell_input = input_scores.front().first;
   }
   const auto curve_of = [&](const Field& f) {
@@ -146,22 +212,7 @@ template <SegmentationBackend Backend>
   model.set_refit_every(options.refit_every);
   if (ranked) {
     model.set_cells(CellGainModel::fit(cell_samples, adaptive.cell_input));
-    // Each training field's mean input at each top level the cells were sampled from (the
-    // prior of a new field's): the cells of one descent GSD tile its regions.
-    for (std::size_t f = 0; f < fields.size(); ++f) {
-      for (const double top : model.cells()->top_gsds()) {
-        double sub = 0.0;  // the coarsest descent GSD sampled from this top
-        for (const CellSample& c : cells_by_field[f])
-          if (detail::same_gsd(c.top_gsd_cm, top)) sub = std::max(sub, c.sub_gsd_cm);
-        double mass = 0.0, px = 0.0;
-        for (const CellSample& c : cells_by_field[f])
-          if (detail::same_gsd(c.top_gsd_cm, top) && detail::same_gsd(c.sub_gsd_cm, sub))
-            mass += c.top.mass(adaptive.cell_input), px += c.top.field_px;
-        const double input = px > 0.0 ? mass / px : 0.0;
-        if (detail::same_gsd(top, adaptive.top_gsd_cm)) reference[f].field_input = input;
-        reference[f].top_inputs.emplace_back(top, input);
-      }
-    }
+    detail::set_field_inputs(reference, cells_by_field, *model.cells(), adaptive.cell_input, adaptive.top_gsd_cm);
   }
 
   // Layouts of a single field: the field and its halves across the longer axis.
@@ -186,13 +237,7 @@ template <SegmentationBackend Backend>
     if (options.rule == Rule::kName) searched.emplace(Rule::search(inputs, fly));
   });
 
-  std::vector<double> sig;
-  for (const auto& s : samples) sig.push_back(s.sigma_top);
-  std::sort(sig.begin(), sig.end());
-  const auto pct = [&](double q) { return sig[static_cast<std::size_t>(q * static_cast<double>(sig.size() - 1))]; };
-  LinearDecision::Params linear{pct(0.05), pct(0.95)};
-  if (!(linear.sigma_high > linear.sigma_low)) linear = {0.0, std::max(1e-6, sig.back())};
-  linear.sigma_high = std::min(1.0, linear.sigma_high);
+  const LinearDecision::Params linear = detail::linear_sigma_range(samples);
   return CalibrationResult{std::move(samples),          std::move(cell_samples), std::move(input_scores),
                            std::move(searched->chosen), linear,                  std::move(curves),
                            std::move(searched->trials)};
