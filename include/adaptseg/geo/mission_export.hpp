@@ -269,6 +269,18 @@ inline std::vector<MissionItem> mission_items(const ExportPath& path, const Expo
 
 namespace detail {
 
+/// [lon, lat, h] (GeoJSON position order) -> GeoPoint, validated.
+inline GeoPoint json_position(const nlohmann::json& j, const char* format, const std::string& where) {
+  if (!j.is_array() || j.size() != 3) export_parse_error(format, where + " must be [longitude, latitude, height]");
+  const GeoPoint g{json_number(j[1], format, where + "[1]"), json_number(j[0], format, where + "[0]"),
+                   json_number(j[2], format, where + "[2]")};
+  if (!(std::isfinite(g.latitude_deg) && g.latitude_deg >= -90.0 && g.latitude_deg <= 90.0 &&
+        std::isfinite(g.longitude_deg) && g.longitude_deg >= -180.0 && g.longitude_deg <= 180.0 &&
+        std::isfinite(g.altitude_m)))
+    export_parse_error(format, where + ": latitude must be in [-90, 90], longitude in [-180, 180], height finite");
+  return g;
+}
+
 inline void require_exportable(const ExportPath& path, const char* who) {
   if (path.waypoints.empty()) throw std::invalid_argument(std::string(who) + ": the path has no waypoint");
 }
@@ -396,7 +408,7 @@ inline std::string write_wpl(const ExportPath& path, const ExportOptions& option
   const auto line = [&](std::size_t seq, bool current, const MissionItem& item) {
     out += std::to_string(seq) + '\t' + (current ? '1' : '0') + '\t' + std::to_string(item.frame) + '\t' +
            std::to_string(item.command);
-    for (double p : item.params) out += '\t' + detail::wpl_number(p);
+    for (double p : item.params) out += '\t' + detail::format_number(p);
     out += item.autocontinue ? "\t1\n" : "\t0\n";
   };
   line(0, true,
@@ -450,7 +462,9 @@ inline MissionFile read_wpl(std::string_view text) {
     static constexpr const char* kIntNames[] = {"seq", "current", "frame", "command"};
     static constexpr long long kIntMax[] = {65535, 1, 255, 65535};
     for (int k = 0; k < 4; ++k)
-      if (!detail::wpl_parse(fields[static_cast<std::size_t>(k)], ints[k]) || ints[k] < 0 || ints[k] > kIntMax[k])
+      if (const auto v = detail::parse_integer(fields[static_cast<std::size_t>(k)], 0, kIntMax[k]))
+        ints[k] = *v;
+      else
         detail::export_parse_error(kFmt, at + ": " + kIntNames[k] + " must be an integer in 0.." +
                                              std::to_string(kIntMax[k]) + " (got '" +
                                              std::string(fields[static_cast<std::size_t>(k)]) + "')");

@@ -2,9 +2,9 @@
 /// @file
 /// Text helpers of the mission-file readers and writers (mission_export.hpp): errors that name
 /// the format and the offending member, JSON member access with those errors, and the WPL
-/// number codec (locale-independent, shortest round-trip text). Internal.
+/// number reader (numbers are written by number_text.hpp's codec). Internal.
 
-#include <adaptseg/geo/georeference.hpp>
+#include <adaptseg/vision/detail/number_text.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -69,32 +69,11 @@ inline nlohmann::json json_parse(std::string_view text, const char* format) {
   return j;
 }
 
-/// [lon, lat, h] (GeoJSON position order) -> GeoPoint, validated.
-inline GeoPoint json_position(const nlohmann::json& j, const char* format, const std::string& where) {
-  if (!j.is_array() || j.size() != 3) export_parse_error(format, where + " must be [longitude, latitude, height]");
-  const GeoPoint g{json_number(j[1], format, where + "[1]"), json_number(j[0], format, where + "[0]"),
-                   json_number(j[2], format, where + "[2]")};
-  if (!(std::isfinite(g.latitude_deg) && g.latitude_deg >= -90.0 && g.latitude_deg <= 90.0 &&
-        std::isfinite(g.longitude_deg) && g.longitude_deg >= -180.0 && g.longitude_deg <= 180.0 &&
-        std::isfinite(g.altitude_m)))
-    export_parse_error(format, where + ": latitude must be in [-90, 90], longitude in [-180, 180], height finite");
-  return g;
-}
+// --- WPL numbers: written by format_number (number_text.hpp); read as below ---
 
-// --- WPL numbers: locale-independent, shortest round-trip text ---
-
-inline std::string wpl_number(double v) {
-  char buf[64];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
-
+/// `token` as a double, locale-independent; unlike parse_number() a MAVLink parameter may be
+/// NaN or infinite ("nan": not used by the command).
 inline bool wpl_parse(std::string_view token, double& out) {
-  const auto r = std::from_chars(token.data(), token.data() + token.size(), out);
-  return r.ec == std::errc() && r.ptr == token.data() + token.size();
-}
-
-inline bool wpl_parse(std::string_view token, long long& out) {
   const auto r = std::from_chars(token.data(), token.data() + token.size(), out);
   return r.ec == std::errc() && r.ptr == token.data() + token.size();
 }
