@@ -202,10 +202,13 @@ TEST_CASE("ensemble: bad member lists are refused with one line naming the probl
   };
   refused(with("members: [\n"), "YAML error");
   refused(with("members: []\n"), "'members' must be a non-empty list");
-  refused(with("models:\n  - model: x\n"), "unknown key 'models'");
-  refused(with("members:\n  - path: x\n"), "member 1: expected a mapping with 'model: DIR'");
-  refused(with("members:\n  - model: x\n    wieght: 2\n"), "unknown key 'wieght'");
-  refused(with("members:\n  - model: x\n    weight: heavy\n"), "member 1: malformed value");
+  refused(with("models:\n  - model: x\n"), "unknown key 'models' (known: members, description)");
+  refused(with("description: x\n"), "missing key 'members'");
+  refused(with("members:\n  - path: x\n"), "unknown key 'members[0].path' (known: model, weight)");
+  refused(with("members:\n  - weight: 2\n"), "missing key 'members[0].model'");
+  refused(with("members:\n  - x\n"), "'members[0]' must be a mapping");
+  refused(with("members:\n  - model: x\n    wieght: 2\n"), "unknown key 'members[0].wieght'");
+  refused(with("members:\n  - model: x\n    weight: heavy\n"), "'members[0].weight' must be a finite number (got 'heavy')");
   refused(with("members:\n  - model: " + mnv2().string() + "\n  - model: ../none\n"), "member 2 (");
   // Relative member paths are resolved against the ensemble directory.
   t::write_file(dir / "ensemble.yaml", "members:\n  - model: ../renamed\n    weight: 2\n");

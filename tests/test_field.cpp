@@ -74,13 +74,18 @@ TEST_CASE("field: bad field directories give clear errors") {
   expect_error("- just\n- a list\n", "mapping");
   expect_error(ok + "colour_map: x\n", "unknown key 'colour_map'");
   expect_error("gsd_cm: 1\nlabels: labels.png\nclasses: [{name: a, color: [0,0,0]}]\n", "missing key 'name'");
+  expect_error("name: x\ngsd_cm: 1\nlabels: labels.png\nclasses: [{name: a, colour: [0,0,0]}]\n",
+               "unknown key 'classes[0].colour' (known: name, color)");
+  expect_error("name: x\ngsd_cm: 1\nlabels: labels.png\nclasses: [a, b]\n", "'classes[0]' must be a mapping");
   expect_error("name: x\ngsd_cm: -1\nlabels: labels.png\nclasses: [{name: a, color: [0,0,0]}]\n", "gsd_cm");
-  expect_error("name: x\ngsd_cm: fast\nlabels: labels.png\nclasses: [{name: a, color: [0,0,0]}]\n", "wrong type");
+  expect_error("name: x\ngsd_cm: fast\nlabels: labels.png\nclasses: [{name: a, color: [0,0,0]}]\n",
+               "'gsd_cm' must be a finite number (got 'fast')");
   expect_error("name: x\ngsd_cm: 1\nlabels: missing.png\nclasses: [{name: a, color: [0,0,0]}]\n", "file not found");
   expect_error("name: x\ngsd_cm: 1\nlabels: labels.png\nclasses: []\n", "non-empty list");
   expect_error("name: x\ngsd_cm: 1\nlabels: labels.png\nclasses: [{name: a, color: [0,0]}]\n", "3 integers");
-  expect_error("name: x\ngsd_cm: 1\nlabels: labels.png\nclasses: [{name: a, color: [0,0,300]}]\n", "0..255");
-  expect_error("name: x\ngsd_cm: 1\nlabels: labels.png\nclasses: [{name: a}]\n", "missing key 'color'");
+  expect_error("name: x\ngsd_cm: 1\nlabels: labels.png\nclasses: [{name: a, color: [0,0,300]}]\n",
+               "'classes[0].color[2]' must be an integer in [0, 255] (got '300')");
+  expect_error("name: x\ngsd_cm: 1\nlabels: labels.png\nclasses: [{name: a}]\n", "missing key 'classes[0].color'");
   expect_error(std::string(t::kWeedYaml).replace(std::string(t::kWeedYaml).find("ignore_label: 255"), 17,
                                                  "ignore_label: 1"),
                "ignore_label must not be a class index");

@@ -187,13 +187,14 @@ TEST_CASE("geo: bad geo sections and values are rejected, naming the file and ke
                "geo.longitude_deg");
   expect_error("geo: {latitude_deg: 50, longitude_deg: 7, altitude_m: .inf, heading_deg: 0}\n", "geo.altitude_m");
   expect_error("geo: {latitude_deg: 50, longitude_deg: 7, altitude_m: 0, heading_deg: .nan}\n", "geo.heading_deg");
-  expect_error("geo: {latitude_deg: north, longitude_deg: 7, altitude_m: 0, heading_deg: 0}\n", "wrong type");
+  expect_error("geo: {latitude_deg: north, longitude_deg: 7, altitude_m: 0, heading_deg: 0}\n",
+               "'geo.latitude_deg' must be a finite number (got 'north')");
   expect_error("geo: {latitude_deg: 50, longitude_deg: 7, altitude_m: 0}\n", "missing key 'geo.heading_deg'");
   expect_error("geo: {latitude_deg: 50, longitude_deg: 7, altitude_m: 0, heading_deg: 0, datum: wgs84}\n",
-               "unknown key 'datum'");
+               "unknown key 'geo.datum' (known: latitude_deg, longitude_deg, altitude_m, heading_deg)");
   expect_error("geo: [50, 7, 0, 0]\n", "'geo' must be a mapping");
   expect_error("geo: {latitude_deg: [50], longitude_deg: 7, altitude_m: 0, heading_deg: 0}\n",
-               "'geo.latitude_deg' must be a scalar");
+               "'geo.latitude_deg' must be a finite number");
   const cv::Mat labels(4, 6, CV_8UC1, cv::Scalar(0));
   const Field f("f", 1.0, labels, t::soil_crop_weed(), {1});
   CHECK_THROWS_WITH_AS((void)f.with_geo(FieldGeo{-90.5, 0.0, 0.0, 0.0}), doctest::Contains("latitude_deg"),

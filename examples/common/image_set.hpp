@@ -146,48 +146,43 @@ inline ImageSetInfo read_image_set_info(const std::filesystem::path& dir, bool a
   if (!std::filesystem::is_regular_file(file))
     detail_image_set::fail(file, "not found (is --images a folder written by --record-from? docs/data_format.md, "
                                  "\"The live image folder\")");
-  try {
-    const YAML::Node root = adaptseg::detail::yaml_mapping(file.string(), "an image set description",
-                                                           [&] { return YAML::LoadFile(file.string()); });
-    if (!root["format"] || root["format"].as<std::string>() != "adaptseg.image_set/1")
-      detail_image_set::fail(file, "format must be adaptseg.image_set/1");
-    ImageSetInfo info;
-    info.name = root["name"] ? root["name"].as<std::string>() : dir.filename().string();
-    if (root["area_m"]) {
-      const auto a = root["area_m"].as<std::vector<double>>();
-      if (a.size() != 4) detail_image_set::fail(file, "area_m must be [x_min, y_min, x_max, y_max]");
-      info.area.area = {a[0], a[1], a[2], a[3]};
-    } else if (!area_from_elsewhere) {
-      detail_image_set::fail(file, "missing key 'area_m' (or give the area as --area FILE)");
-    }
-    if (root["map_gsd_cm"]) info.area.map_gsd_cm = root["map_gsd_cm"].as<double>();
-    else if (!area_from_elsewhere) detail_image_set::fail(file, "missing key 'map_gsd_cm'");
-    info.area.ignore_label = root["ignore_label"] ? root["ignore_label"].as<int>() : 255;
-    if (root["valid_mask"] && !area_from_elsewhere) {
-      const std::filesystem::path mask = dir / root["valid_mask"].as<std::string>();
-      info.area.valid_mask = cv::imread(mask.string(), cv::IMREAD_UNCHANGED);
-      if (info.area.valid_mask.empty() || info.area.valid_mask.type() != CV_8UC1)
-        detail_image_set::fail(mask, "cannot read an 8-bit single-channel mask");
-    }
-    if (!root["classes"] || !root["classes"].IsSequence()) detail_image_set::fail(file, "missing the 'classes' list");
-    for (const auto& c : root["classes"]) {
-      const auto rgb = c["color"].as<std::vector<int>>();
-      if (rgb.size() != 3) detail_image_set::fail(file, "a class colour must be [r, g, b]");
-      info.classes.push_back({c["name"].as<std::string>(),
-                              {static_cast<std::uint8_t>(rgb[0]), static_cast<std::uint8_t>(rgb[1]),
-                               static_cast<std::uint8_t>(rgb[2])}});
-    }
-    info.area.num_classes = static_cast<int>(info.classes.size());
-    info.interest = root["interest"].as<std::vector<std::string>>();
-    const YAML::Node cam = root["camera"];
-    info.camera = {cam["image_width_px"].as<int>(), cam["image_height_px"].as<int>(),
-                   cam["sensor_width_mm"].as<double>(), cam["focal_length_mm"].as<double>()};
-    if (root["geo"]) info.geo = adaptseg::detail::field_read_geo(root["geo"], file, /*anchored=*/true);
-    if (root["crs"]) info.crs = root["crs"].as<std::string>();
-    return info;
-  } catch (const YAML::Exception& e) {
-    detail_image_set::fail(file, std::string("YAML error: ") + e.what());
+  namespace d = adaptseg::detail;
+  const d::YamlReader r(
+      d::yaml_mapping(file.string(), "an image set description", [&] { return YAML::LoadFile(file.string()); }),
+      file.string());
+  r.only_keys({"format", "name", "area_m", "map_gsd_cm", "valid_mask", "ignore_label", "classes", "interest", "camera",
+               "geo", "crs"});
+  if (!r.has("format") || r.text("format") != "adaptseg.image_set/1")
+    detail_image_set::fail(file, "format must be adaptseg.image_set/1");
+  ImageSetInfo info;
+  info.name = r.has("name") ? r.text("name") : dir.filename().string();
+  if (r.has("area_m")) {
+    const auto a = r.numbers("area_m");
+    if (a.size() != 4) detail_image_set::fail(file, "area_m must be [x_min, y_min, x_max, y_max]");
+    info.area.area = {a[0], a[1], a[2], a[3]};
+  } else if (!area_from_elsewhere) {
+    detail_image_set::fail(file, "missing key 'area_m' (or give the area as --area FILE)");
   }
+  if (r.has("map_gsd_cm")) info.area.map_gsd_cm = r.number("map_gsd_cm");
+  else if (!area_from_elsewhere) detail_image_set::fail(file, "missing key 'map_gsd_cm'");
+  info.area.ignore_label = r.has("ignore_label") ? static_cast<int>(r.integer("ignore_label", 0, 255)) : 255;
+  if (r.has("valid_mask") && !area_from_elsewhere) {
+    const std::filesystem::path mask = dir / r.text("valid_mask");
+    info.area.valid_mask = cv::imread(mask.string(), cv::IMREAD_UNCHANGED);
+    if (info.area.valid_mask.empty() || info.area.valid_mask.type() != CV_8UC1)
+      detail_image_set::fail(mask, "cannot read an 8-bit single-channel mask");
+  }
+  info.classes = d::field_read_classes(r);
+  info.area.num_classes = static_cast<int>(info.classes.size());
+  info.interest = r.texts("interest");
+  const d::YamlReader cam = r.map("camera");
+  cam.only_keys({"image_width_px", "image_height_px", "sensor_width_mm", "focal_length_mm"});
+  info.camera = {static_cast<int>(cam.integer("image_width_px", 1, 1000000)),
+                 static_cast<int>(cam.integer("image_height_px", 1, 1000000)), cam.number("sensor_width_mm"),
+                 cam.number("focal_length_mm")};
+  if (r.has("geo")) info.geo = d::field_read_geo(r.map("geo"), /*anchored=*/true);
+  if (r.has("crs")) info.crs = r.text("crs");
+  return info;
 }
 
 /// Reads poses.csv in any of its three forms (kPoseHeaders) into the area's frame: GNSS poses

@@ -79,6 +79,14 @@ adaptseg_live)
   expect_error "GNSS poses need the area's geo-reference" --images "$work/images" --model "$weedmap_model"
   printf 'file,lat,lon\n' >"$work/images/poses.csv"
   expect_error "the header must be one of file,x,y,z[,yaw_deg]" --images "$work/images" --model "$weedmap_model"
+  # area.yaml is read as field.yaml is: a misspelt key or a bad class colour is named.
+  cp "$work/images/area.yaml" "$work/area.yaml.orig"
+  echo "colour_map: x" >>"$work/images/area.yaml"
+  expect_error "area.yaml: unknown key 'colour_map' (known: format, name," --images "$work/images" \
+    --model "$weedmap_model"
+  sed 's/color: \[0, 255, 0\]/color: [0, 256, 0]/' "$work/area.yaml.orig" >"$work/images/area.yaml"
+  expect_error "'classes[1].color[1]' must be an integer in [0, 255] (got '256')" --images "$work/images" \
+    --model "$weedmap_model"
   ;;
 *)
   fail "unknown program $program"

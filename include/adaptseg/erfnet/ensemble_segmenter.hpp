@@ -79,33 +79,20 @@ struct EnsembleSegmentation {
   if (!std::filesystem::is_directory(dir))
     throw std::invalid_argument("EnsembleSegmenter: ensemble directory not found: " + dir.string());
   if (!std::filesystem::is_regular_file(file)) fail("file not found (an ensemble directory holds ensemble.yaml)");
-  const YAML::Node root = detail::yaml_mapping("EnsembleSegmenter: " + file.string(),
-                                               "an ensemble description with a list 'members'",
-                                               [&] { return YAML::LoadFile(file.string()); });
-  for (const auto& kv : root) {
-    const auto key = kv.first.as<std::string>();
-    if (key != "members" && key != "description") fail("unknown key '" + key + "' (expected members, description)");
-  }
-  const YAML::Node list = root["members"];
-  if (!list || !list.IsSequence() || list.size() == 0) fail("'members' must be a non-empty list of {model: DIR, weight: W}");
+  const std::string where = "EnsembleSegmenter: " + file.string();
+  const detail::YamlReader r(detail::yaml_mapping(where, "an ensemble description with a list 'members'",
+                                                  [&] { return YAML::LoadFile(file.string()); }),
+                             where);
+  r.only_keys({"members", "description"});
   std::vector<EnsembleMember> members;
-  for (std::size_t k = 0; k < list.size(); ++k) {
-    const YAML::Node m = list[k];
-    const std::string at = "member " + std::to_string(k + 1) + ": ";
-    if (!m.IsMap() || !m["model"]) fail(at + "expected a mapping with 'model: DIR' (and optionally 'weight: W')");
-    for (const auto& kv : m) {
-      const auto key = kv.first.as<std::string>();
-      if (key != "model" && key != "weight") fail(at + "unknown key '" + key + "' (expected model, weight)");
-    }
+  for (const detail::YamlReader& m : r.maps("members")) {
+    m.only_keys({"model", "weight"});
     EnsembleMember member;
-    try {
-      member.model_dir = dir / m["model"].as<std::string>();
-      if (m["weight"]) member.weight = m["weight"].as<double>();
-    } catch (const YAML::Exception& e) {
-      fail(at + "malformed value: " + e.what());
-    }
+    member.model_dir = dir / m.text("model");
+    if (m.has("weight")) member.weight = m.number("weight");
     members.push_back(std::move(member));
   }
+  if (members.empty()) fail("'members' must be a non-empty list of {model: DIR, weight: W}");
   return members;
 }
 

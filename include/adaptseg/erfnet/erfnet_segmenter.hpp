@@ -41,7 +41,10 @@ inline std::string class_list(const std::vector<std::string>& classes) {
 }
 }  // namespace detail
 
-/// What a model's metadata YAML (model.yaml) says; read by ErfnetSegmenter.
+/// What a model's metadata YAML (model.yaml) says; read by ErfnetSegmenter. The keys below are
+/// read (`classes`, `input.{width, height, channel_order, mean, std}`, optional `output.stride`,
+/// `width`, `temperature`); the others the export writes (training, validation, check ...) are
+/// provenance for people and are not read.
 struct ErfnetModelInfo {
   std::vector<std::string> classes;  ///< class names, label-index order
   int input_width_px = 0;            ///< network input W [px] (multiple of 8)
@@ -317,58 +320,44 @@ class ErfnetSegmenter {
   static ErfnetModelInfo read_metadata(const std::filesystem::path& file) {
     if (!std::filesystem::is_regular_file(file))
       throw std::invalid_argument("ErfnetSegmenter: metadata file not found: " + file.string());
-    const YAML::Node root = detail::yaml_mapping("ErfnetSegmenter: " + file.string(), "network metadata",
-                                                 [&] { return YAML::LoadFile(file.string()); });
+    // The keys read below; the others (training, validation, check ...) are provenance.
+    const std::string where = "ErfnetSegmenter: " + file.string();
+    const detail::YamlReader r(
+        detail::yaml_mapping(where, "network metadata", [&] { return YAML::LoadFile(file.string()); }), where);
     ErfnetModelInfo info;
-    try {
-      const YAML::Node classes = root["classes"];
-      if (!classes || !classes.IsSequence() || classes.size() == 0)
-        meta_error(file, "'classes' must be a non-empty list of class names");
-      for (const auto& c : classes) info.classes.push_back(c.as<std::string>());
-      if (info.classes.size() > 255) meta_error(file, "more than 255 classes");
-      const YAML::Node input = root["input"];
-      if (!input || !input.IsMap()) meta_error(file, "missing mapping 'input'");
-      for (const char* key : {"width", "height", "channel_order", "mean", "std"})
-        if (!input[key]) meta_error(file, std::string("missing key 'input.") + key + "'");
-      info.input_width_px = input["width"].as<int>();
-      info.input_height_px = input["height"].as<int>();
-      if (info.input_width_px <= 0 || info.input_height_px <= 0 || info.input_width_px % 8 != 0 ||
-          info.input_height_px % 8 != 0)
-        meta_error(file, "input width and height must be positive multiples of 8 (got " +
-                             std::to_string(info.input_width_px) + "x" +
-                             std::to_string(info.input_height_px) + ")");
-      const auto order = input["channel_order"].as<std::string>();
-      if (order != "RGB" && order != "BGR")
-        meta_error(file, "input.channel_order must be RGB or BGR (got '" + order + "')");
-      info.rgb_order = order == "RGB";
-      for (const char* key : {"mean", "std"}) {
-        const YAML::Node v = input[key];
-        if (!v.IsSequence() || v.size() != 3)
-          meta_error(file, std::string("input.") + key + " must be a list of 3 numbers");
-        for (std::size_t k = 0; k < 3; ++k) {
-          const double x = v[k].as<double>();
-          if (!std::isfinite(x) || (std::string(key) == "std" && x <= 0.0))
-            meta_error(file, std::string("input.") + key + " values must be finite" +
-                                 (std::string(key) == "std" ? " and > 0" : "") + " (got " +
-                                 std::to_string(x) + ")");
-          (std::string(key) == "mean" ? info.mean : info.std)[k] = static_cast<float>(x);
-        }
+    info.classes = r.texts("classes");
+    if (info.classes.empty() || info.classes.size() > 255)
+      meta_error(file, "'classes' must be a list of 1 to 255 class names (got " + std::to_string(info.classes.size()) + ")");
+    const detail::YamlReader input = r.map("input");
+    info.input_width_px = static_cast<int>(input.integer("width", 8, 1 << 16));
+    info.input_height_px = static_cast<int>(input.integer("height", 8, 1 << 16));
+    if (info.input_width_px % 8 != 0 || info.input_height_px % 8 != 0)
+      meta_error(file, "input width and height must be positive multiples of 8 (got " +
+                           std::to_string(info.input_width_px) + "x" + std::to_string(info.input_height_px) + ")");
+    const std::string order = input.text("channel_order");
+    if (order != "RGB" && order != "BGR") meta_error(file, "input.channel_order must be RGB or BGR (got '" + order + "')");
+    info.rgb_order = order == "RGB";
+    for (const char* key : {"mean", "std"}) {
+      const bool std_dev = std::string(key) == "std";
+      const std::vector<double> v = input.numbers(key);
+      if (v.size() != 3) meta_error(file, "'" + input.path(key) + "' must be a list of 3 numbers");
+      for (std::size_t k = 0; k < 3; ++k) {
+        if (std_dev && !(v[k] > 0.0))
+          meta_error(file, "input.std values must be > 0 (got " + std::to_string(v[k]) + ")");
+        (std_dev ? info.std : info.mean)[k] = static_cast<float>(v[k]);
       }
-      if (const YAML::Node output = root["output"]; output && output["stride"]) {
-        info.output_stride = output["stride"].as<int>();
-        if (info.output_stride < 1 || info.output_stride > 32 ||
-            info.input_width_px % info.output_stride != 0 || info.input_height_px % info.output_stride != 0)
-          meta_error(file, "output.stride must be 1..32 and divide the input width and height (got " +
-                               std::to_string(info.output_stride) + ")");
-      }
-      if (root["width"]) info.width_multiplier = root["width"].as<double>();
-      if (root["temperature"]) {
-        info.temperature = root["temperature"].as<double>();
-        if (!std::isfinite(info.temperature) || info.temperature < 0.01 || info.temperature > 100.0)
-          meta_error(file, "temperature must be a number in [0.01, 100] (got " + std::to_string(info.temperature) + ")");
-      }
-    } catch (const YAML::Exception& e) {
-      meta_error(file, std::string("malformed value: ") + e.what());
+    }
+    if (r.has("output") && r.map("output").has("stride")) {
+      info.output_stride = static_cast<int>(r.map("output").integer("stride", 1, 32));
+      if (info.input_width_px % info.output_stride != 0 || info.input_height_px % info.output_stride != 0)
+        meta_error(file, "output.stride must divide the input width and height (got " +
+                             std::to_string(info.output_stride) + ")");
+    }
+    if (r.has("width")) info.width_multiplier = r.number("width");
+    if (r.has("temperature")) {
+      info.temperature = r.number("temperature");
+      if (info.temperature < 0.01 || info.temperature > 100.0)
+        meta_error(file, "temperature must be a number in [0.01, 100] (got " + std::to_string(info.temperature) + ")");
     }
     return info;
   }

@@ -330,55 +330,48 @@ namespace detail {
   throw std::invalid_argument(file.string() + ": " + what);
 }
 
-inline YAML::Node field_key(const YAML::Node& root, const char* key,
-                            const std::filesystem::path& file) {
-  const YAML::Node n = root[key];
-  if (!n) field_error(file, std::string("missing key '") + key + "'");
-  return n;
-}
-
-template <typename T>
-T field_scalar(const YAML::Node& n, const char* what, const std::filesystem::path& file) {
-  if (!n.IsScalar()) field_error(file, std::string("'") + what + "' must be a scalar");
-  try {
-    return n.as<T>();
-  } catch (const YAML::Exception&) {
-    field_error(file, std::string("'") + what + "' has the wrong type (value '" + n.Scalar() + "')");
-  }
-}
-
-/// The `geo:` section of field.yaml: a mapping of exactly latitude_deg, longitude_deg,
-/// altitude_m and heading_deg (numbers); `anchored` (a live folder's area.yaml, which
-/// --record-from writes for a region or a GeoTIFF field) also allows FieldGeo's anchor_x_m,
-/// anchor_y_m (default 0) and scale (default 1).
-inline FieldGeo field_read_geo(const YAML::Node& n, const std::filesystem::path& file, bool anchored = false) {
-  static const char* const kGeoKeys[] = {"latitude_deg", "longitude_deg", "altitude_m", "heading_deg",
-                                         "anchor_x_m",   "anchor_y_m",    "scale"};
-  const int required = 4, known = anchored ? 7 : 4;
-  const std::string names = anchored ? "latitude_deg, longitude_deg, altitude_m, heading_deg, anchor_x_m, anchor_y_m, scale"
-                                     : "latitude_deg, longitude_deg, altitude_m, heading_deg";
-  if (!n.IsMap()) field_error(file, "'geo' must be a mapping {" + names + "}");
-  for (const auto& kv : n) {
-    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "<non-scalar>";
-    if (std::none_of(kGeoKeys, kGeoKeys + known, [&](const char* k) { return key == k; }))
-      field_error(file, "geo: unknown key '" + key + "' (known: " + names + ")");
-  }
-  double v[7] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0};
-  for (int k = 0; k < known; ++k) {
-    const std::string what = std::string("geo.") + kGeoKeys[k];
-    if (!n[kGeoKeys[k]]) {
-      if (k < required) field_error(file, "missing key '" + what + "'");
-      continue;
-    }
-    v[k] = field_scalar<double>(n[kGeoKeys[k]], what.c_str(), file);
-  }
-  const FieldGeo g{v[0], v[1], v[2], v[3], v[4], v[5], v[6]};
+/// The `geo:` section of field.yaml (`geo`, a reader of its mapping): exactly latitude_deg,
+/// longitude_deg, altitude_m and heading_deg (numbers); `anchored` (a live folder's area.yaml,
+/// which --record-from writes for a region or a GeoTIFF field) also allows FieldGeo's
+/// anchor_x_m, anchor_y_m (default 0) and scale (default 1).
+/// @throws std::invalid_argument naming the file and the key.
+inline FieldGeo field_read_geo(const YamlReader& geo, bool anchored = false) {
+  if (anchored)
+    geo.only_keys({"latitude_deg", "longitude_deg", "altitude_m", "heading_deg", "anchor_x_m", "anchor_y_m", "scale"});
+  else
+    geo.only_keys({"latitude_deg", "longitude_deg", "altitude_m", "heading_deg"});
+  FieldGeo g{geo.number("latitude_deg"), geo.number("longitude_deg"), geo.number("altitude_m"),
+             geo.number("heading_deg")};
+  if (geo.has("anchor_x_m")) g.anchor_x_m = geo.number("anchor_x_m");
+  if (geo.has("anchor_y_m")) g.anchor_y_m = geo.number("anchor_y_m");
+  if (geo.has("scale")) g.scale = geo.number("scale");
   try {
     validate_field_geo(g, "geo");
   } catch (const std::invalid_argument& e) {
-    field_error(file, e.what());
+    yaml_error(geo.where(), e.what());
   }
   return g;
+}
+
+/// The `classes:` list of field.yaml (and of a live folder's area.yaml) from the reader `r` of
+/// the file's mapping: a non-empty list of {name, color: [r, g, b]}, names unique.
+/// @throws std::invalid_argument naming the file and the key.
+inline std::vector<ClassInfo> field_read_classes(const YamlReader& r) {
+  std::vector<ClassInfo> classes;
+  for (const YamlReader& c : r.maps("classes")) {
+    c.only_keys({"name", "color"});
+    ClassInfo info;
+    info.name = c.text("name");
+    const std::vector<long long> rgb = c.integers("color", 0, 255);
+    if (rgb.size() != 3) yaml_error(r.where(), "'" + c.path("color") + "' must be a list of 3 integers [r, g, b]");
+    for (std::size_t k = 0; k < 3; ++k) info.color_rgb[k] = static_cast<std::uint8_t>(rgb[k]);
+    for (const auto& earlier : classes)
+      if (earlier.name == info.name)
+        yaml_error(r.where(), "'" + c.path("name") + "': class name '" + info.name + "' listed twice");
+    classes.push_back(std::move(info));
+  }
+  if (classes.empty()) yaml_error(r.where(), "'classes' must be a non-empty list");
+  return classes;
 }
 
 inline cv::Mat field_read_image(const std::filesystem::path& file, int flags,
@@ -411,89 +404,31 @@ inline FieldYaml read_field_yaml(const std::filesystem::path& dir) {
     throw std::invalid_argument("field directory not found: " + dir.string());
   const fs::path yaml = dir / "field.yaml";
   if (!fs::is_regular_file(yaml)) throw std::invalid_argument("missing " + yaml.string());
-  const YAML::Node root =
-      yaml_mapping(yaml.string(), "a field description", [&] { return YAML::LoadFile(yaml.string()); });
-  static const std::set<std::string> kKeys{"name", "gsd_cm", "labels", "image", "ignore_label",
-                                           "classes", "interest", "geo"};
-  for (const auto& kv : root) {
-    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "<non-scalar>";
-    if (!kKeys.count(key))
-      field_error(yaml, "unknown key '" + key +
-                            "' (known: name, gsd_cm, labels, image, ignore_label, "
-                            "classes, interest, geo)");
-  }
+  const YamlReader r(yaml_mapping(yaml.string(), "a field description", [&] { return YAML::LoadFile(yaml.string()); }),
+                     yaml.string());
+  r.only_keys({"name", "gsd_cm", "labels", "image", "ignore_label", "classes", "interest", "geo"});
   FieldYaml out;
   out.yaml = yaml;
-  out.name = field_scalar<std::string>(field_key(root, "name", yaml), "name", yaml);
-  if (root["gsd_cm"]) {
-    const auto gsd = field_scalar<double>(root["gsd_cm"], "gsd_cm", yaml);
-    if (!std::isfinite(gsd) || gsd <= 0.0)
-      field_error(yaml, "'gsd_cm' must be finite and > 0 (got " + std::to_string(gsd) + ")");
-    out.gsd_cm = gsd;
+  out.name = r.text("name");
+  if (r.has("gsd_cm")) {
+    out.gsd_cm = r.number("gsd_cm");
+    if (!(*out.gsd_cm > 0.0)) field_error(yaml, "'gsd_cm' must be > 0 (got " + r.text("gsd_cm") + ")");
   }
-  out.labels_file = field_scalar<std::string>(field_key(root, "labels", yaml), "labels", yaml);
-  if (root["image"]) out.image_file = field_scalar<std::string>(root["image"], "image", yaml);
-  if (root["ignore_label"]) {
-    out.ignore_label = field_scalar<int>(root["ignore_label"], "ignore_label", yaml);
-    if (out.ignore_label < 0 || out.ignore_label > 255)
-      field_error(yaml, "'ignore_label' must be in 0..255 (got " + std::to_string(out.ignore_label) + ")");
-  }
-  const YAML::Node classes_node = field_key(root, "classes", yaml);
-  if (!classes_node.IsSequence() || classes_node.size() == 0)
-    field_error(yaml, "'classes' must be a non-empty list");
-  std::vector<ClassInfo> classes;
-  for (std::size_t i = 0; i < classes_node.size(); ++i) {
-    const YAML::Node c = classes_node[i];
-    const std::string where = "classes[" + std::to_string(i) + "]";
-    if (!c.IsMap()) field_error(yaml, where + " must be a mapping {name, color}");
-    for (const auto& kv : c) {
-      const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "<non-scalar>";
-      if (key != "name" && key != "color")
-        field_error(yaml, where + ": unknown key '" + key + "' (known: name, color)");
-    }
-    if (!c["name"]) field_error(yaml, where + ": missing key 'name'");
-    ClassInfo info;
-    info.name = field_scalar<std::string>(c["name"], (where + ".name").c_str(), yaml);
-    if (c["color"]) {
-      const YAML::Node col = c["color"];
-      if (!col.IsSequence() || col.size() != 3)
-        field_error(yaml, where + ".color must be a list of 3 integers [r, g, b]");
-      for (std::size_t k = 0; k < 3; ++k) {
-        const int v = field_scalar<int>(col[k], (where + ".color").c_str(), yaml);
-        if (v < 0 || v > 255)
-          field_error(yaml, where + ".color values must be in 0..255 (got " + std::to_string(v) + ")");
-        info.color_rgb[k] = static_cast<std::uint8_t>(v);
-      }
-    } else {
-      field_error(yaml, where + ": missing key 'color'");
-    }
-    for (const auto& earlier : classes)
-      if (earlier.name == info.name) field_error(yaml, where + ": class name '" + info.name + "' listed twice");
-    classes.push_back(std::move(info));
-  }
+  out.labels_file = r.text("labels");
+  if (r.has("image")) out.image_file = r.text("image");
+  if (r.has("ignore_label")) out.ignore_label = static_cast<int>(r.integer("ignore_label", 0, 255));
+  std::vector<ClassInfo> classes = field_read_classes(r);
 
-  std::vector<std::string> interest_names;
-  if (root["interest"]) {
-    const YAML::Node in = root["interest"];
-    if (!in.IsSequence()) field_error(yaml, "'interest' must be a list of class names");
-    for (std::size_t i = 0; i < in.size(); ++i)
-      interest_names.push_back(field_scalar<std::string>(in[i], "interest[]", yaml));
-  }
   std::vector<int> interest;
-  for (const auto& n : interest_names) {
-    bool found = false;
-    for (std::size_t i = 0; i < classes.size(); ++i) {
-      if (classes[i].name == n) {
-        interest.push_back(static_cast<int>(i));
-        found = true;
-      }
-    }
-    if (!found) field_error(yaml, "'interest' names unknown class '" + n + "'");
+  for (const std::string& n : r.has("interest") ? r.texts("interest") : std::vector<std::string>{}) {
+    const auto it = std::find_if(classes.begin(), classes.end(), [&](const ClassInfo& c) { return c.name == n; });
+    if (it == classes.end()) field_error(yaml, "'interest' names unknown class '" + n + "'");
+    interest.push_back(static_cast<int>(it - classes.begin()));
   }
   std::sort(interest.begin(), interest.end());
   interest.erase(std::unique(interest.begin(), interest.end()), interest.end());
 
-  if (root["geo"]) out.geo = field_read_geo(root["geo"], yaml);
+  if (r.has("geo")) out.geo = field_read_geo(r.map("geo"));
   out.classes = std::move(classes);
   out.interest = std::move(interest);
   return out;

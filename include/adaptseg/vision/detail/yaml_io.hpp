@@ -1,16 +1,19 @@
 #pragma once
 /// @file
-/// The YAML reading and writing shared by adaptseg's model files (gp_io.hpp,
-/// decision_model.hpp): a reader of mappings whose errors name the key, and emitters that write
-/// numbers through the one locale-independent codec (number_text.hpp), so that a file written
-/// under any global locale reads back under any other.
+/// The YAML reading and writing shared by every file adaptseg reads (field.yaml, model files,
+/// network metadata, ensemble.yaml, a live folder's area.yaml): a reader of mappings whose
+/// errors name the file and the key, and emitters that write numbers through the one
+/// locale-independent codec (number_text.hpp), so that a file written under any global locale
+/// reads back under any other.
 
 #include <adaptseg/vision/detail/number_text.hpp>
 
 #include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cstddef>
+#include <initializer_list>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -56,10 +59,22 @@ template <class F>
 }
 
 /// A reader of one YAML mapping of an adaptseg file: every value read through the number codec
-/// (number_text.hpp), every error naming the file and the key's path (`gain_model.O.y_std`).
+/// (number_text.hpp), every error naming the file and the key's path (`gain_model.O.y_std`,
+/// `classes[2].color`).
 class YamlReader {
  public:
   YamlReader(YAML::Node node, std::string where) : node_(std::move(node)), where_(std::move(where)) {}
+
+  /// Refuses a key that is not one of `known`: "unknown key '<path>' (known: a, b, c)".
+  void only_keys(std::initializer_list<const char*> known) const {
+    for (const auto& kv : node_) {
+      const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "<non-scalar>";
+      if (std::any_of(known.begin(), known.end(), [&](const char* k) { return key == k; })) continue;
+      std::string names;
+      for (const char* k : known) names += (names.empty() ? "" : ", ") + std::string(k);
+      yaml_error(where_, "unknown key '" + path(key.c_str()) + "' (known: " + names + ")");
+    }
+  }
 
   [[nodiscard]] bool has(const char* key) const { return static_cast<bool>(node_[key]); }
   [[nodiscard]] YAML::Node node(const char* key) const {
@@ -79,12 +94,7 @@ class YamlReader {
   }
   [[nodiscard]] double number(const char* key) const { return number_of(node(key), path(key)); }
   [[nodiscard]] long long integer(const char* key, long long lo, long long hi) const {
-    const YAML::Node n = node(key);
-    const auto v = n.IsScalar() ? parse_integer(n.Scalar(), lo, hi) : std::nullopt;
-    if (!v)
-      yaml_error(where_, "'" + path(key) + "' must be an integer in [" + std::to_string(lo) + ", " +
-                              std::to_string(hi) + "]");
-    return *v;
+    return integer_of(node(key), path(key), lo, hi);
   }
   [[nodiscard]] bool flag(const char* key) const {
     const std::string t = text(key);
@@ -96,6 +106,27 @@ class YamlReader {
     if (!n.IsSequence()) yaml_error(where_, "'" + path(key) + "' must be a list of numbers");
     std::vector<double> out;
     for (std::size_t k = 0; k < n.size(); ++k) out.push_back(number_of(n[k], path(key) + "[" + std::to_string(k) + "]"));
+    return out;
+  }
+  /// The list `key` of mappings, a reader for each (`key[i]` in its errors).
+  [[nodiscard]] std::vector<YamlReader> maps(const char* key) const {
+    const YAML::Node n = node(key);
+    if (!n.IsSequence()) yaml_error(where_, "'" + path(key) + "' must be a list of mappings");
+    std::vector<YamlReader> out;
+    for (std::size_t k = 0; k < n.size(); ++k) {
+      const std::string at = path(key) + "[" + std::to_string(k) + "]";
+      if (!n[k].IsMap()) yaml_error(where_, "'" + at + "' must be a mapping");
+      out.push_back(YamlReader(n[k], where_, at));
+    }
+    return out;
+  }
+  /// The list `key` of integers, each in [lo, hi].
+  [[nodiscard]] std::vector<long long> integers(const char* key, long long lo, long long hi) const {
+    const YAML::Node n = node(key);
+    if (!n.IsSequence()) yaml_error(where_, "'" + path(key) + "' must be a list of integers");
+    std::vector<long long> out;
+    for (std::size_t k = 0; k < n.size(); ++k)
+      out.push_back(integer_of(n[k], path(key) + "[" + std::to_string(k) + "]", lo, hi));
     return out;
   }
   [[nodiscard]] std::vector<std::string> texts(const char* key) const {
@@ -113,6 +144,13 @@ class YamlReader {
   [[nodiscard]] double number_of(const YAML::Node& n, const std::string& what) const {
     const auto v = n.IsScalar() ? parse_number(n.Scalar()) : std::nullopt;
     if (!v) yaml_error(where_, "'" + what + "' must be a finite number" + (n.IsScalar() ? " (got '" + n.Scalar() + "')" : ""));
+    return *v;
+  }
+  [[nodiscard]] long long integer_of(const YAML::Node& n, const std::string& what, long long lo, long long hi) const {
+    const auto v = n.IsScalar() ? parse_integer(n.Scalar(), lo, hi) : std::nullopt;
+    if (!v)
+      yaml_error(where_, "'" + what + "' must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                              "]" + (n.IsScalar() ? " (got '" + n.Scalar() + "')" : ""));
     return *v;
   }
 
