@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# Leave-one-tile-out estimate of the deployment MobileNetV2's accuracy on new ground (issue 31,
+# item 3): six trainings of examples/models/mobilenetv2-dubai-all's recipe, each on five of the
+# six bundled Dubai tiles, each scored on the tile it never saw (field mIoU of whole-field
+# lawnmowers at 5, 10 and 15 cm/px, examples/tools/eval_ensemble.py).
+#
+#   bash scripts/loto.sh weights
+#       here (npm and node needed): the ImageNet encoder weights into .device/mnv2_enc.pt, the
+#       folder a device call carries (it reaches no network).
+#   bash scripts/loto.sh train MINUTES [TILES] [STEPS]
+#       on a CUDA machine (the `device` tool: carry .device): the trainings side by side on its
+#       one GPU, each fitting its learning-rate cycle into MINUTES (train_segnet.py --minutes),
+#       checkpoints to $OUT/loto-<k>.pt and the logs to $OUT/loto-logs.tar.gz. TILES: the
+#       held-out tiles (default 1,2,3,4,5,6). STEPS > 0 trains that many steps instead of
+#       fitting MINUTES, on the CPU if there is no GPU (a rehearsal of the call here).
+#   bash scripts/loto.sh eval DIR
+#       here: exports every DIR/loto-<k>.pt (PyTorch 1.13 and OpenCV 4.6 check it loads and
+#       matches) to out/loto/model-<k>/ and prints its field mIoU on tile k.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+py=${PYTHON:-/usr/bin/python3}
+tiles_all=(1 2 3 4 5 6)
+train_fields() {  # every bundled tile but $1, comma-separated
+  local k=$1 out=""
+  for t in "${tiles_all[@]}"; do [ "$t" = "$k" ] || out+="${out:+,}dubai-tile-$t"; done
+  echo "$out"
+}
+
+case "${1:-}" in
+weights)
+  mkdir -p .device
+  grep -qx '/.device/' .git/info/exclude 2>/dev/null || echo '/.device/' >>.git/info/exclude
+  "$py" examples/tools/mobilenet_v2.py --out .device/mnv2_enc.pt
+  ;;
+train)
+  minutes=${2:?minutes}
+  IFS=, read -r -a tiles <<<"${3:-1,2,3,4,5,6}"
+  steps=${4:-0}
+  out=${OUT:?set OUT (the device tool sets it)}
+  [ -s .device/mnv2_enc.pt ] || { echo "no .device/mnv2_enc.pt: run 'bash $0 weights' here first" >&2; exit 2; }
+  if [ "$steps" -gt 0 ]; then
+    schedule=(--steps "$steps" --warmup 1 --batch 2 --crop 150 --val-max-images 2)
+    device=$("$py" -c 'import torch; print("cuda" if torch.cuda.is_available() else "cpu")')
+  else
+    schedule=(--steps 30000 --minutes "$minutes" --max-minutes "$(awk -v m="$minutes" 'BEGIN { print m * 1.08 }')" --batch 32 --crop 300
+              --warmup 100)
+    device=cuda
+  fi
+  sampler=cpu
+  [ "$device" = cuda ] && sampler=device
+  work=$(mktemp -d)
+  pids=()
+  for k in "${tiles[@]}"; do
+    "$py" examples/tools/train_segnet.py --arch mobilenetv2 --encoder-weights .device/mnv2_enc.pt \
+      --frozen-blocks 4 --no-image-pooling --lr 1e-3 --weight-decay 0.01 --ema 0.998 --augment altitude --seed 0 \
+      --sampler "$sampler" --device "$device" --train-fields "$(train_fields "$k")" --val-field "dubai-tile-$k" \
+      --test-field none --threads 1 --val-every 0 --ckpt-every 100 --log-every 50 --no-export \
+      "${schedule[@]}" --work-dir "$work/loto-$k" --model-dir "$work/unused-$k" >"$work/loto-$k.log" 2>&1 &
+    pids+=($!)
+  done
+  status=0
+  for p in "${pids[@]}"; do wait "$p" || status=1; done
+  for k in "${tiles[@]}"; do
+    [ -s "$work/loto-$k/checkpoint.pt" ] && cp "$work/loto-$k/checkpoint.pt" "$out/loto-$k.pt"
+    tail -n 3 "$work/loto-$k.log"
+  done
+  tar czf "$out/loto-logs.tar.gz" -C "$work" --exclude='*.pt' .
+  exit "$status"
+  ;;
+eval)
+  dir=${2:?directory with loto-<k>.pt}
+  mkdir -p out/loto
+  for ckpt in "$dir"/loto-*.pt; do
+    k=${ckpt##*/loto-}
+    k=${k%.pt}
+    work=out/loto/work-$k
+    mkdir -p "$work"
+    cp "$ckpt" "$work/checkpoint.pt"
+    "$py" examples/tools/train_segnet.py --arch mobilenetv2 --work-dir "$work" --model-dir "out/loto/model-$k" \
+      --export-only --train-fields "$(train_fields "$k")" --val-field "dubai-tile-$k" --test-field none \
+      >"out/loto/export-$k.log" 2>&1 || { echo "export of $ckpt failed: out/loto/export-$k.log" >&2; exit 1; }
+    echo "== held out dubai-tile-$k (trained on $(train_fields "$k"))"
+    "$py" examples/tools/eval_ensemble.py --members "loto$k=out/loto/model-$k" \
+      --fields "examples/data/dubai-tile-$k" --bands 1,2,3 --json "out/loto/eval-$k.json"
+  done
+  ;;
+*)
+  sed -n '2,19p' "$0" >&2
+  exit 2
+  ;;
+esac
