@@ -18,7 +18,8 @@
 #       matches) to out/loto/model-<k>/ and prints its field mIoU on tile k.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-py=${PYTHON:-/usr/bin/python3}
+# The interpreter with PyTorch: a device machine's plain python3, else Debian's (this machine's).
+py=${PYTHON:-$(python3 -c 'import torch, cv2' 2>/dev/null && echo python3 || echo /usr/bin/python3)}
 tiles_all=(1 2 3 4 5 6)
 train_fields() {  # every bundled tile but $1, comma-separated
   local k=$1 out=""
