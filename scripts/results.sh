@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reproduces docs/results.md.
-#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]
+#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|vertical-speed] [JOBS]
 #   (default: all, one job per core)
 #
 # oracle: the paper's experiment with the ground-truth oracle, deterministic (fixed 0.1 s per
@@ -60,6 +60,10 @@
 #   (adaptseg_calibrate) and the test field flown with the run's model at every z: how much any
 #   choice of z could buy (docs/results.md). Needs out/results/oracle-default; about 8 minutes
 #   on 2 cores.
+# z-choice-network: the same for the runs of part network (NETS as there; default the two single
+#   networks), their calibrations rerun with the runs' flags (segmentations from the cache),
+#   missions with measured segmentation times. Needs network; MobileNetV2's 8 runs took about
+#   20 minutes with one job on 2 cores (beside another job); ERFNet's take longer.
 # vertical-speed: the defaults' sweep (calibration included) with climbs and descents limited to
 #   1 m/s against 2 m/s level (--vertical-speed 1; the paper's model climbs at the level speed):
 #   what the immediate descent, the survey-first tour and staying low along a row are worth
@@ -68,9 +72,9 @@
 set -euo pipefail
 part=${1:-all}
 jobs=${2:-$(nproc 2>/dev/null || echo 2)}
-case "$part" in all | oracle | oracle-default | paper | network | ensemble | ensemble-split | cells | curve-check | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | \
+case "$part" in all | oracle | oracle-default | paper | network | ensemble | ensemble-split | cells | curve-check | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | z-choice-network | \
   vertical-speed) ;;
-  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|vertical-speed] [JOBS]" >&2
+  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|vertical-speed] [JOBS]" >&2
     exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
@@ -170,42 +174,67 @@ if [ "$part" = sigma-prior ]; then
   exit 0
 fi
 
-if [ "$part" = z-choice ]; then
-  [ -d "$root/oracle-default" ] || { echo "run 'bash $0 oracle-default' first" >&2; exit 1; }
-  out=$root/z-choice
-  rm -rf "${out:?}"
-  mkdir -p "$out"
-  w=examples/data/weedmap-000
-  # One run: its training folds' trials, then its test field at every z (sequential, one core).
+if [ "$part" = z-choice ] || [ "$part" = z-choice-network ]; then
+  # One run NAME of configuration $src: its training folds' trials (adaptseg_calibrate with the
+  # run's flags: train, interest, flags), then its test field at every z (sequential, one core).
   z_run() {
-    local name=$1 d=$root/oracle-default/$1 train=() test=() interest=()
-    case $name in
-      weedmap-train-left) train=(--train "$w:0,0,0.5,1") test=(--test "$w:0.5,0,1,1") ;;
-      weedmap-train-right) train=(--train "$w:0.5,0,1,1") test=(--test "$w:0,0,0.5,1") ;;
-      *)
-        local cls=${name#dubai-} t=${name##*-}
-        cls=${cls%%-*}
-        interest=(--interest "$cls")
-        train_except "$t"  # the caller's local train
-        test=(--test "$(dubai "$t")")
-        ;;
-    esac
-    "$calibrate_bin" "${train[@]}" "${interest[@]}" "${fixed[@]}" --out "$out/$name.model.yaml" >"$out/$name.trials.txt" 2>&1
+    local name=$1 d=$root/$src/$1
+    "$calibrate_bin" "${train[@]}" "${interest[@]}" "${flags[@]}" --out "$out/$name.model.yaml" >"$out/$name.trials.txt" 2>&1
     for z in 0 0.5 1 1.5 2; do
       sed "s/^\(  *confidence:\) .*/\1 $z/" "$d/model.yaml" >"$out/$name.z$z.yaml"
-      "$eval_bin" --model "$out/$name.z$z.yaml" "${test[@]}" "${interest[@]}" "${fixed[@]}" --no-plots \
+      "$eval_bin" --model "$out/$name.z$z.yaml" "${test[@]}" "${interest[@]}" "${flags[@]}" --no-plots \
         --out "$out/$name.z$z" >"$out/$name.z$z.log" 2>&1
     done
   }
-  running=0
-  for d in "$root"/oracle-default/*/; do
-    z_run "$(basename "$d")" &
+  z_launch() {  # z_run in the background, at most $jobs at a time
+    z_run "$1" &
     running=$((running + 1))
     if [ "$running" -ge "$jobs" ]; then
       wait -n || true
       running=$((running - 1))
     fi
-  done
+  }
+  running=0
+  if [ "$part" = z-choice ]; then
+    src=oracle-default
+    flags=("${fixed[@]}")
+  else
+    src=network
+  fi
+  [ -d "$root/$src" ] || { echo "run 'bash $0 $src' first" >&2; exit 1; }
+  out=$root/$part
+  rm -rf "${out:?}"
+  mkdir -p "$out"
+  w=examples/data/weedmap-000
+  if [ "$part" = z-choice ]; then
+    for d in "$root"/oracle-default/*/; do
+      name=$(basename "$d") interest=()
+      case $name in
+        weedmap-train-left) train=(--train "$w:0,0,0.5,1") test=(--test "$w:0.5,0,1,1") ;;
+        weedmap-train-right) train=(--train "$w:0.5,0,1,1") test=(--test "$w:0,0,0.5,1") ;;
+        *)
+          cls=${name#dubai-} t=${name##*-}
+          cls=${cls%%-*}
+          interest=(--interest "$cls")
+          train_except "$t"
+          test=(--test "$(dubai "$t")")
+          ;;
+      esac
+      z_launch "$name"
+    done
+  else
+    for net in ${NETS:-erfnet-dubai mobilenetv2-dubai}; do
+      flags=(--model-file "examples/models/$net" "${network[@]}")
+      for cls in $classes; do
+        for t in 4 6; do
+          [ -d "$root/network/$net-$cls-fly$t" ] || continue
+          train_except "$t"
+          interest=(--interest "$cls") test=(--test "$(dubai "$t")")
+          z_launch "$net-$cls-fly$t"
+        done
+      done
+    done
+  fi
   wait
   /usr/bin/python3 examples/tools/z_choice_table.py "$out"
   exit 0
