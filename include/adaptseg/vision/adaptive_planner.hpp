@@ -153,12 +153,15 @@ class AdaptivePlanner {
     valid_px_ = cv::countNonZero(area_.valid_mask);
     charge_measured_planning(seconds_since(t0));
     window_last_ = schedule_.window_last(top_);
-    // A schedule's windows must cut the lawnmower into runs of consecutive waypoints.
-    for (std::size_t i = 0; i < top_.size(); ++i)
-      if (window_last_.size() != top_.size() || window_last_[i] < i || window_last_[i] >= top_.size() ||
-          (i > 0 && window_last_[i - 1] >= i && window_last_[i - 1] != window_last_[i]))
-        throw std::logic_error(std::string("descent schedule '") + schedule_.name +
-                               "': its windows are not runs of consecutive top-level waypoints");
+    // A schedule's windows must cut the lawnmower into runs of consecutive waypoints: each
+    // waypoint's window ends at or after it, and where the previous window reaches it, it is that one.
+    bool runs = window_last_.size() == top_.size();
+    for (std::size_t i = 0; runs && i < top_.size(); ++i)
+      runs = window_last_[i] >= i && window_last_[i] < top_.size() &&
+             (i == 0 || window_last_[i - 1] < i || window_last_[i - 1] == window_last_[i]);
+    if (!runs)
+      throw std::logic_error(std::string("descent schedule '") + schedule_.name +
+                             "': its windows are not runs of consecutive top-level waypoints");
     flight_after_.assign(top_.size() + 1, 0.0);
     for (std::size_t i = top_.size(); i-- > 1;)
       flight_after_[i - 1] = flight_after_[i] + timing_.segment_time_s(top_[i - 1].position, top_[i].position);
