@@ -52,6 +52,7 @@ int main(int argc, char** argv) {
   calibration.add_to(app);
   common.add_to(app);
   segmenter.add_to(app);
+  segmenter.add_calibration_networks_to(app);
   if (const auto code = adaptseg::examples::parse_command_line(app, argc, argv)) return *code;
 
   try {
@@ -64,6 +65,8 @@ int main(int argc, char** argv) {
     }
     for (const auto& spec : train_specs) fields.push_back(adaptseg::examples::load_field_spec(spec));
     if (fields.empty()) throw std::invalid_argument("give a training field: --field DIR or --train DIR (repeatable)");
+    segmenter.validate();
+    (void)segmenter.calibration_networks(fields);  // its mistakes before any work
     const adaptseg::Field& field = fields.front();
     const adaptseg::MissionOptions mission = common.resolve(field);
     const double g0 = field.gsd_cm();
@@ -91,11 +94,12 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "calibrating on %s (%dx%d px, %.2f cm/px) with %s ...\n", f.name().c_str(), f.width_px(),
                    f.height_px(), g0, segmenter.name.c_str());
     const auto [cal, model] = segmenter.with_backend(field, mission.camera, [&](auto& backend) {
-      adaptseg::CalibrationResult c = adaptseg::examples::calibrate_cached(fields, backend, options, segmenter.calibration_cache());
+      adaptseg::CalibrationResult c = adaptseg::examples::calibrate_fields(segmenter, fields, backend, options);
       adaptseg::DecisionModel m = adaptseg::make_decision_model(fields, backend.name(), options, c);
       return std::pair{std::move(c), std::move(m)};
     });
     if (out_file.has_parent_path()) fs::create_directories(out_file.parent_path());
+    adaptseg::examples::print_field_segmenters(model);
     model.save(out_file);
     if (!samples_csv.empty()) {
       std::ostringstream os;

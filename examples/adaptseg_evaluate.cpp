@@ -139,6 +139,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-plots", no_plots, "do not run the plotting script");
   common.add_to(app);
   segmenter.add_to(app);
+  segmenter.add_calibration_networks_to(app)->excludes(model_opt);
   if (const auto code = adaptseg::examples::parse_command_line(app, argc, argv)) return *code;
 
   bool progress_open = false;  // a progress line on stderr waits for its end
@@ -173,6 +174,8 @@ int main(int argc, char** argv) {
     } else {
       std::vector<adaptseg::Field> trains;
       for (const auto& spec : train_specs) trains.push_back(adaptseg::examples::load_field_spec(spec));
+      segmenter.validate();
+      (void)segmenter.calibration_networks(trains);  // its mistakes before any work
       const adaptseg::Field& train = trains.front();
       adaptseg::CalibrationOptions co;
       co.adaptive.mission = common.resolve(train);
@@ -185,13 +188,14 @@ int main(int argc, char** argv) {
       for (const auto& f : trains) names += (names.empty() ? "" : ", ") + f.name();
       std::fprintf(stderr, "[%6.1f s] calibrating on %s ...\n", elapsed(), names.c_str());
       const auto cal = segmenter.with_backend(train, co.adaptive.mission.camera, [&](auto& backend) {
-        adaptseg::CalibrationResult c = adaptseg::examples::calibrate_cached(trains, backend, co, segmenter.calibration_cache());
+        adaptseg::CalibrationResult c = adaptseg::examples::calibrate_fields(segmenter, trains, backend, co);
         loaded = adaptseg::make_decision_model(trains, backend.name(), co, c);
         return c;
       });
       std::fprintf(stderr, "[%6.1f s] calibrated: %zu samples, %s, train front margin %+.4f, %d descents\n",
                    elapsed(), cal.samples.size(), cal.trials.front().description.c_str(), loaded->train_front_margin,
                    cal.trials.front().descents);
+      adaptseg::examples::print_field_segmenters(*loaded);
     }
     const adaptseg::DecisionModel& model = *loaded;
     model.save(out_dir / "model.yaml");

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <span>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -378,6 +379,90 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
   const Field other("o", 1.0, a.labels(), {{"a", {0, 0, 0}}, {"b", {1, 1, 1}}, {"c", {2, 2, 2}}}, {1});
   const std::vector<Field> mixed{a, other};
   CHECK_THROWS_WITH_AS((void)calibrate(mixed, oracle, options), doctest::Contains("classes"), std::invalid_argument);
+}
+
+namespace {
+/// The oracle under another name, and one that sees one class less (its pixels as the class
+/// before it): two backends of one type for a cross-fitted calibration.
+class NamedOracle {
+ public:
+  NamedOracle(int num_classes, std::string name, bool blind) : oracle_(num_classes), name_(std::move(name)), blind_(blind) {}
+  [[nodiscard]] std::string name() const { return name_; }
+  [[nodiscard]] cv::Mat segment(const Image& image) {
+    ++images;
+    cv::Mat labels = oracle_.segment(image);
+    if (blind_) labels.setTo(1, labels == 2);
+    return labels;
+  }
+  int images = 0;
+
+ private:
+  OracleSegmenter oracle_;
+  std::string name_;
+  bool blind_;
+};
+}  // namespace
+
+TEST_CASE("calibration: each training field segmented by its own backend (cross-fitting)") {
+  const Field a = t::blob_field(1300, 1000, 1.0, 4, 15);
+  const Field b = t::blob_field(1000, 1300, 1.0, 11, 15).sub_field({0, 0, 1, 0.8});
+  const std::vector<Field> fields{a, b};
+  const CalibrationOptions options = small_options();
+  NamedOracle plain(a.num_classes(), "oracle", false), blind(a.num_classes(), "blind oracle", true);
+  const std::vector<NamedOracle*> backends{&plain, &blind};
+  const CalibrationResult cal = calibrate(std::span<const Field>(fields), std::span<NamedOracle* const>(backends), options);
+  CHECK(plain.images > 0);
+  CHECK(blind.images > 0);
+  CHECK(cal.field_backends == std::vector<std::string>{"oracle", "blind oracle"});
+  // Field a's samples are those its own backend gives, field b's those of the blind one.
+  NamedOracle plain_again(a.num_classes(), "oracle", false), blind_again(a.num_classes(), "blind oracle", true);
+  const auto only_a = collect_region_samples(a, plain_again, CameraModel(kSmallCamera), 3.0, {1.0, 2.0}, a.interest(),
+                                             DescentCoverage::region, 0);
+  const auto only_b = collect_region_samples(b, blind_again, CameraModel(kSmallCamera), 3.0, {1.0, 2.0}, b.interest(),
+                                             DescentCoverage::region, 1);
+  REQUIRE(cal.samples.size() == only_a.size() + only_b.size());
+  for (std::size_t k = 0; k < cal.samples.size(); ++k) {
+    const RegionSample& want = k < only_a.size() ? only_a[k] : only_b[k - only_a.size()];
+    CHECK(cal.samples[k].field == want.field);
+    CHECK(cal.samples[k].sigma_top == want.sigma_top);
+    CHECK(cal.samples[k].miou_sub == want.miou_sub);
+  }
+  // The blind backend changes what b's samples say: it is not the plain oracle's calibration.
+  const auto plain_b = collect_region_samples(b, plain_again, CameraModel(kSmallCamera), 3.0, {1.0, 2.0}, b.interest(),
+                                              DescentCoverage::region, 1);
+  bool differs = false;
+  for (std::size_t k = 0; k < plain_b.size(); ++k) differs = differs || plain_b[k].miou_sub != only_b[k].miou_sub;
+  CHECK(differs);
+  // The model records the field's backends where one differs from the missions'; the file keeps them.
+  const DecisionModel model = make_decision_model(fields, "oracle", options, cal);
+  CHECK(model.field_segmenters == std::vector<std::string>{"oracle", "blind oracle"});
+  t::TempDir tmp;
+  model.save(tmp.path() / "model.yaml");
+  CHECK(DecisionModel::load(tmp.path() / "model.yaml").field_segmenters == model.field_segmenters);
+  // One backend for every field: nothing recorded, no key in the file.
+  const std::vector<NamedOracle*> same{&plain, &plain};
+  const CalibrationResult one = calibrate(std::span<const Field>(fields), std::span<NamedOracle* const>(same), options);
+  const DecisionModel one_model = make_decision_model(fields, "oracle", options, one);
+  CHECK(one_model.field_segmenters.empty());
+  one_model.save(tmp.path() / "one.yaml");
+  std::stringstream text;
+  text << std::ifstream(tmp.path() / "one.yaml").rdbuf();
+  CHECK(text.str().find("field_segmenters") == std::string::npos);
+  // A backend per field, no fewer, none null.
+  const std::vector<NamedOracle*> short_list{&plain};
+  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), std::span<NamedOracle* const>(short_list), options),
+                       doctest::Contains("one backend per training field"), std::invalid_argument);
+  const std::vector<NamedOracle*> with_null{&plain, nullptr};
+  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), std::span<NamedOracle* const>(with_null), options),
+                       doctest::Contains("null"), std::invalid_argument);
+  // A file whose field_segmenters do not name one per field is refused.
+  std::string bad = text.str();
+  const auto at = bad.find("  segmenter:");
+  REQUIRE(at != std::string::npos);
+  bad.insert(at, "  field_segmenters: [oracle]\n");
+  std::ofstream(tmp.path() / "bad.yaml") << bad;
+  CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "bad.yaml"), doctest::Contains("field_segmenters"),
+                       std::invalid_argument);
 }
 
 TEST_CASE("calibration: σ̂'s prior from the training fields' σ and how it varies along each flight") {

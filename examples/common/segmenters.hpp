@@ -21,9 +21,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <map>
+#include <memory>
 #include <optional>
+#include <span>
 #include <tuple>
 #include <stdexcept>
 #include <string>
@@ -260,12 +263,51 @@ CalibrationResult calibrate_cached(std::span<const Field> fields, Backend& backe
   return calibrate(fields, cached, options);
 }
 
+/// A backend with probabilities behind one type (it borrows `backend`): calibrate() takes one
+/// backend type for all training fields, and cross-fitting segments them with several networks.
+class AnyBackend {
+ public:
+  template <SegmentationBackend B>
+    requires SegmentsWithProbabilities<B>
+  explicit AnyBackend(B& backend)
+      : name_(backend.name()),
+        segment_([&backend](const Image& image) { return backend.segment(image); }),
+        probabilities_([&backend](const Image& image) { return backend.segment_with_probabilities(image); }) {}
+  [[nodiscard]] std::string name() const { return name_; }
+  [[nodiscard]] cv::Mat segment(const Image& image) { return segment_(image); }
+  [[nodiscard]] Segmentation segment_with_probabilities(const Image& image) { return probabilities_(image); }
+
+ private:
+  std::string name_;
+  std::function<cv::Mat(const Image&)> segment_;
+  std::function<Segmentation(const Image&)> probabilities_;
+};
+
+/// The fields the network of `model_file` was trained on (its metadata's training.fields; an
+/// ensemble's: every member's), empty where the metadata names none.
+inline std::vector<std::string> network_training_fields(const std::filesystem::path& model_file) {
+  std::vector<std::filesystem::path> metadata;
+  if (EnsembleSegmenter::is_ensemble_dir(model_file)) {
+    for (const EnsembleMember& m : read_ensemble_file(model_file)) metadata.push_back(model_paths(m.model_dir).second);
+  } else {
+    metadata.push_back(model_paths(model_file).second);
+  }
+  std::vector<std::string> out;
+  for (const auto& file : metadata)
+    for (std::string& f : ErfnetSegmenter::read_model_info(file).training_fields)
+      if (std::find(out.begin(), out.end(), f) == out.end()) out.push_back(std::move(f));
+  return out;
+}
+
 /// The backend options shared by adaptseg_mission, adaptseg_calibrate and adaptseg_evaluate.
 struct SegmenterOptions {
   std::string name = "oracle";
   std::filesystem::path model_file;  ///< ERFNet: model directory, or the .onnx (metadata: same stem .yaml)
   int threads = 0;                   ///< ERFNet: OpenCV threads (0: OpenCV's default)
   std::filesystem::path cache_root;  ///< ERFNet: where calibration keeps segmentations on disk (empty: nowhere)
+  /// ERFNet, calibration: networks for the training fields --model-file was trained on, each such
+  /// field segmented by the first of them that never saw it (cross-fitting, calibrate()).
+  std::vector<std::filesystem::path> calibration_model_files;
 
   void add_to(CLI::App& app) {
     app.add_option("--segmenter", name,
@@ -286,6 +328,16 @@ struct SegmenterOptions {
                    "always segment (their time is measured)");
   }
 
+  /// The calibrating programs' --calibration-model-file (cross-fitting).
+  CLI::Option* add_calibration_networks_to(CLI::App& app) {
+    return app.add_option("--calibration-model-file", calibration_model_files,
+                   "ERFNet, calibration (repeatable): networks of --model-file's recipe for the training fields it "
+                   "was trained on (training.fields of its model.yaml), each such field segmented by the first of "
+                   "them that was not trained on it: a network knows its training fields so well that, calibrated "
+                   "there, the decision learns that flying lower gains little (cross-fitting; the missions fly "
+                   "--model-file)");
+  }
+
   /// Where calibration keeps the network's segmentations (--segmentation-cache), if anywhere:
   /// a folder named by the network and the hash of its files (model_file_digest()).
   [[nodiscard]] std::optional<std::filesystem::path> calibration_cache() const {
@@ -299,6 +351,46 @@ struct SegmenterOptions {
       throw std::invalid_argument("--segmenter erfnet needs --model-file (e.g. examples/models/erfnet-dubai)");
     if (name == "oracle" && !model_file.empty())
       throw std::invalid_argument("--model-file applies to --segmenter erfnet only");
+    if (name == "oracle" && !calibration_model_files.empty())
+      throw std::invalid_argument("--calibration-model-file applies to --segmenter erfnet only");
+  }
+
+  /// Per training field, the network that segments it in calibration: --model-file where it was
+  /// not trained on the field, else the first --calibration-model-file that was not (empty path:
+  /// --model-file). Without --calibration-model-file, --model-file for every field.
+  /// @throws std::invalid_argument for a network whose metadata names no training fields (it
+  ///         cannot be told whether it saw a field), or a field no given network is new to.
+  [[nodiscard]] std::vector<std::filesystem::path> calibration_networks(std::span<const Field> fields) const {
+    std::vector<std::filesystem::path> out(fields.size());
+    if (calibration_model_files.empty()) return out;
+    const auto trained_on = [](const std::filesystem::path& file) {
+      std::vector<std::string> t = network_training_fields(file);
+      if (t.empty())
+        throw std::invalid_argument("--calibration-model-file: " + file.string() +
+                                    " names no training fields (training.fields in its model.yaml), so whether it "
+                                    "saw a calibration field cannot be told");
+      return t;
+    };
+    const auto knows = [](const std::vector<std::string>& trained, const std::string& field) {
+      return std::find(trained.begin(), trained.end(), field) != trained.end();
+    };
+    const std::vector<std::string> mission = trained_on(model_file);
+    std::vector<std::vector<std::string>> pool;
+    for (const auto& file : calibration_model_files) pool.push_back(trained_on(file));
+    for (std::size_t k = 0; k < fields.size(); ++k) {
+      // A part of a field ("dubai-tile-1[0,0,0.5,1]", Field::sub_field) is that field's ground.
+      const std::string& full = fields[k].name();
+      const std::string field = full.back() == ']' ? full.substr(0, full.rfind('[')) : full;
+      if (!knows(mission, field)) continue;
+      std::size_t j = 0;
+      while (j < pool.size() && knows(pool[j], field)) ++j;
+      if (j == pool.size())
+        throw std::invalid_argument("--calibration-model-file: every network given was trained on calibration field '" +
+                                    full + "' (as --model-file " + model_file.string() +
+                                    " was): give one that never saw it");
+      out[k] = calibration_model_files[j];
+    }
+    return out;
   }
 
   /// Calls `f(backend)` with the chosen backend built for `field` seen by `camera` (the
@@ -318,5 +410,72 @@ struct SegmenterOptions {
     return with_network(model_file, std::move(p), std::forward<F>(f));
   }
 };
+
+/// To stderr, for a cross-fitted model: which network segmented each calibration field.
+inline void print_field_segmenters(const DecisionModel& model) {
+  for (std::size_t k = 0; k < model.field_segmenters.size(); ++k)
+    std::fprintf(stderr, "  calibration field %s segmented by %s\n", model.calibration_fields[k].c_str(),
+                 model.field_segmenters[k].c_str());
+}
+
+/// A network of a cross-fitted calibration with its segmentation cache, behind AnyBackend.
+class CalibrationNetwork {
+ public:
+  virtual ~CalibrationNetwork() = default;
+  [[nodiscard]] virtual AnyBackend& backend() = 0;
+};
+
+template <class Net>
+class OwnedCalibrationNetwork final : public CalibrationNetwork {
+ public:
+  template <class... Args>
+  explicit OwnedCalibrationNetwork(std::optional<std::filesystem::path> cache, Args&&... args)
+      : net_(std::forward<Args>(args)...), cached_(net_, std::move(cache)), any_(cached_) {}
+  [[nodiscard]] AnyBackend& backend() override { return any_; }
+
+ private:
+  Net net_;
+  CachedBackend<Net> cached_;
+  AnyBackend any_;
+};
+
+/// adaptseg::calibrate for the programs: every field segmented by `backend` (--model-file, cached
+/// as calibrate_cached()) or, where it was trained on the field, by the network
+/// SegmenterOptions::calibration_networks() gives it (built for `fields.front()` seen by
+/// `camera`, cached in its own folder of --segmentation-cache).
+template <SegmentationBackend Backend>
+CalibrationResult calibrate_fields(const SegmenterOptions& segmenter, std::span<const Field> fields, Backend& backend,
+                                   const CalibrationOptions& options) {
+  const std::vector<std::filesystem::path> networks = segmenter.calibration_networks(fields);
+  if (std::all_of(networks.begin(), networks.end(), [](const auto& n) { return n.empty(); }))
+    return calibrate_cached(fields, backend, options, segmenter.calibration_cache());
+  CachedBackend<Backend> cached(backend, segmenter.calibration_cache());
+  AnyBackend mission(cached);
+  std::map<std::filesystem::path, std::unique_ptr<CalibrationNetwork>> built;
+  std::vector<AnyBackend*> backends;
+  for (const auto& file : networks) {
+    if (file.empty()) {
+      backends.push_back(&mission);
+      continue;
+    }
+    auto& net = built[file];
+    if (!net) {
+      ErfnetParams p = ErfnetSegmenter::for_field(fields.front(), CameraModel(options.adaptive.mission.camera));
+      p.num_threads = segmenter.threads;
+      p.resize_to_network = true;
+      p.name = network_name(file);
+      std::optional<std::filesystem::path> cache;
+      if (!segmenter.cache_root.empty()) cache = segmenter.cache_root / model_file_digest(file);
+      if (EnsembleSegmenter::is_ensemble_dir(file)) {
+        net = std::make_unique<OwnedCalibrationNetwork<EnsembleSegmenter>>(std::move(cache), file, std::move(p));
+      } else {
+        const auto [onnx, metadata] = model_paths(file);
+        net = std::make_unique<OwnedCalibrationNetwork<ErfnetSegmenter>>(std::move(cache), onnx, metadata, std::move(p));
+      }
+    }
+    backends.push_back(&net->backend());
+  }
+  return calibrate(fields, std::span<AnyBackend* const>(backends), options);
+}
 
 }  // namespace adaptseg::examples

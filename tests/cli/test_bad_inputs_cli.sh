@@ -37,6 +37,12 @@ adaptseg_calibrate)
   expect_error "field directory not found" --train "$work/none" --out "$work/m.yaml"
   expect_error "max_vertical_speed_mps must be finite and >= 0" --field "$weedmap" --out "$work/m.yaml" \
     --vertical-speed -1
+  # Cross-fitting: a field every network given was trained on, a flag the oracle has no use for.
+  expect_error "every network given was trained on calibration field 'dubai-tile-1' (as --model-file" \
+    --train "$dubai" --out "$work/m.yaml" --segmenter erfnet --model-file "$examples/models/mobilenetv2-dubai" \
+    --calibration-model-file "$examples/models/erfnet-dubai"
+  expect_error "--calibration-model-file applies to --segmenter erfnet only" --field "$weedmap" --out "$work/m.yaml" \
+    --calibration-model-file "$examples/models/erfnet-dubai"
   # None of them wrote a model.
   [ ! -e "$work/m.yaml" ] || fail "a refused calibration wrote $work/m.yaml"
   ;;
@@ -51,6 +57,11 @@ adaptseg_evaluate)
     --out "$work/o" --no-plots --lawnmower-factors 0.5,1
   expect_error "write DIR:x0,y0,x1,y1" --test "$weedmap:0,0,1" --model "$weedmap_model" --out "$work/o" --no-plots
   expect_error "give exactly one of --train (calibrate) and --model (load)" --test "$weedmap" --out "$work/o"
+  expect_error "--model excludes --calibration-model-file" --test "$dubai" --model "$weedmap_model" --out "$work/o" \
+    --calibration-model-file "$examples/models/erfnet-dubai"
+  expect_error "every network given was trained on calibration field 'dubai-tile-1[0,0,0.5,1]'" \
+    --train "$dubai:0,0,0.5,1" --test "$dubai" --out "$work/o" --no-plots --segmenter erfnet \
+    --model-file "$examples/models/mobilenetv2-dubai" --calibration-model-file "$examples/models/erfnet-dubai"
   # The lawnmowers fly the model's camera and speed limits too: explicit ones must agree.
   expect_error "--vertical-speed 1.0000 differs from the decision model's 0.0000" --test "$weedmap" \
     --model "$weedmap_model" --out "$work/o" --no-plots --vertical-speed 1

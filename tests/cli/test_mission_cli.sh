@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Black-box tests of adaptseg_mission: bad input gives one clear error line and exit code 2
 # (never a crash); good input writes result.json with the documented keys and the figures;
-# on the bundled WeedMap field the GSD sweep behaves as the issue demands.
+# on the bundled WeedMap field the GSD sweep behaves as the issue demands; adaptseg_calibrate
+# (5th argument) is deterministic and cross-fits its calibration fields.
 #   test_mission_cli.sh MISSION_BINARY EXAMPLES_DIR PYTHON CASE [CALIBRATE_BINARY]
 set -uo pipefail
 mission=$1 examples=$2 python=$3 case=$4 calibrate=${5:-}
@@ -158,6 +159,29 @@ for k, g in enumerate((5, 15)):
     members = max(runs[n][k]["miou_all"] for n in ("erfnet-dubai", "mobilenetv2-dubai"))
     assert runs["ensemble-dubai"][k]["miou_all"] > members + 0.005, (g, runs["ensemble-dubai"][k]["miou_all"], members)
 PY
+  ;;
+cross_fit)
+  # A calibration field the missions' network was trained on (the deployment MobileNetV2 saw every
+  # tile) is segmented by the first --calibration-model-file that never saw it: not the deployment
+  # network given again, the evaluation MobileNetV2 (tiles 1, 2, 3, 5). The model names the
+  # missions' network and, per field, the one that segmented it; without the flag no field_segmenters.
+  [ -x "$calibrate" ] || fail "cross_fit needs the adaptseg_calibrate binary as 5th argument"
+  common=(--field "$examples/data/dubai-tile-4" --region 0,0,0.5,0.5 --segmenter erfnet --threads 1
+          --model-file "$examples/models/mobilenetv2-dubai-all" --seg-time-s 0.1 --plan-time-s 0 --confidence 1
+          --interest water --top-factor 3 --candidate-factors 1 --lawnmower-factors 1,3)
+  "$calibrate" "${common[@]}" --calibration-model-file "$examples/models/mobilenetv2-dubai-all" \
+    --calibration-model-file "$examples/models/mobilenetv2-dubai" --out "$work/cross.yaml" 2>"$work/cross.log" ||
+    fail "cross-fitted calibration failed: $(tail -3 "$work/cross.log")"
+  grep -q '^  segmenter: erfnet:mobilenetv2-dubai-all-' "$work/cross.yaml" || fail "the model names another segmenter"
+  grep -q '^  field_segmenters: \[erfnet:mobilenetv2-dubai-[0-9a-f]*\]$' "$work/cross.yaml" ||
+    fail "tile 4 not segmented by mobilenetv2-dubai: $(grep segmenter "$work/cross.yaml")"
+  grep -q 'calibration field dubai-tile-4\[0,0,0.5,0.5\] segmented by erfnet:mobilenetv2-dubai-' "$work/cross.log" ||
+    fail "no line names the field's network: $(cat "$work/cross.log")"
+  "$calibrate" "${common[@]}" --out "$work/plain.yaml" 2>"$work/plain.log" || fail "calibration failed"
+  ! grep -q field_segmenters "$work/plain.yaml" || fail "a model of one network names field_segmenters"
+  # The same network for the missions and the field: other segmentations, another model.
+  ! cmp -s "$work/cross.yaml" "$work/plain.yaml" || fail "cross-fitting changed nothing"
+  echo "ok: cross-fitted calibration"
   ;;
 determinism)
   # Issue 6 item 5: the same inputs and seed give byte-identical outputs (times fixed by

@@ -43,8 +43,8 @@ inline std::string class_list(const std::vector<std::string>& classes) {
 
 /// What a model's metadata YAML (model.yaml) says; read by ErfnetSegmenter. The keys below are
 /// read (`classes`, `input.{width, height, channel_order, mean, std}`, optional `output.stride`,
-/// `width`, `temperature`); the others the export writes (training, validation, check ...) are
-/// provenance for people and are not read.
+/// `width`, `temperature`, `training.fields`); the others the export writes (the rest of
+/// training, validation, check ...) are provenance for people and are not read.
 struct ErfnetModelInfo {
   std::vector<std::string> classes;  ///< class names, label-index order
   int input_width_px = 0;            ///< network input W [px] (multiple of 8)
@@ -58,6 +58,10 @@ struct ErfnetModelInfo {
   /// network's validation data so that its confidence matches its accuracy
   /// (examples/tools/eval_segnet.py --fit-temperature); labels do not depend on it.
   double temperature = 1.0;
+  /// The fields the network was trained on, by name (`training.fields`, optional; empty: not
+  /// stated): a network maps them nearly as well from high up as from low down, so a decision
+  /// calibrated there learns that flying lower gains little (calibrate(), cross-fitting).
+  std::vector<std::string> training_fields;
 };
 
 /// Options of ErfnetSegmenter, validated once by its constructor.
@@ -170,6 +174,10 @@ class ErfnetSegmenter {
   [[nodiscard]] std::string name() const { return params_.name; }
   [[nodiscard]] const Params& params() const noexcept { return params_; }
   [[nodiscard]] const ErfnetModelInfo& model_info() const noexcept { return info_; }
+
+  /// The metadata YAML `file` as the constructor reads it, without loading the network.
+  /// @throws std::invalid_argument as the constructor does for bad metadata.
+  [[nodiscard]] static ErfnetModelInfo read_model_info(const std::filesystem::path& file) { return read_metadata(file); }
   [[nodiscard]] int num_classes() const noexcept { return static_cast<int>(info_.classes.size()); }
   [[nodiscard]] const std::vector<std::string>& classes() const noexcept { return info_.classes; }
   /// The network's input size [px].
@@ -320,7 +328,7 @@ class ErfnetSegmenter {
   static ErfnetModelInfo read_metadata(const std::filesystem::path& file) {
     if (!std::filesystem::is_regular_file(file))
       throw std::invalid_argument("ErfnetSegmenter: metadata file not found: " + file.string());
-    // The keys read below; the others (training, validation, check ...) are provenance.
+    // The keys read below; the others (the rest of training, validation, check ...) are provenance.
     const std::string where = "ErfnetSegmenter: " + file.string();
     const detail::YamlReader r(
         detail::yaml_mapping(where, "network metadata", [&] { return YAML::LoadFile(file.string()); }), where);
@@ -359,6 +367,7 @@ class ErfnetSegmenter {
       if (info.temperature < 0.01 || info.temperature > 100.0)
         meta_error(file, "temperature must be a number in [0.01, 100] (got " + std::to_string(info.temperature) + ")");
     }
+    if (r.has("training") && r.map("training").has("fields")) info.training_fields = r.map("training").texts("fields");
     return info;
   }
 

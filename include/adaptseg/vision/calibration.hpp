@@ -138,7 +138,7 @@ inline void set_field_inputs(std::vector<ReferenceCurve>& reference,
 
 }  // namespace detail
 
-/// Calibrates on the training `fields` with `backend` (the backend the missions will use).
+/// Calibrates on the training `fields`, `backends[k]` segmenting `fields[k]`.
 ///
 /// 1. Region samples at every top-level region × candidate GSD of every field, pooled
 ///    (collect_samples); with a coverage that ranks cells also cell samples, from the top level
@@ -150,12 +150,23 @@ inline void set_field_inputs(std::vector<ReferenceCurve>& reference,
 ///    DecisionRules named by CalibrationOptions::rule: FrontAwareRule::search,
 ///    UtilityRule::search).
 /// 5. The linear baseline's σ range: the 5th and 95th percentiles of σ at h_max.
-/// @throws std::invalid_argument for no field, fields with other class sets, an unknown rule,
-///         invalid options (see the rule's check_options, run_adaptive_mission and
-///         collect_region_samples), or fields without a sample.
+///
+/// One backend per field, of one type (the overload below gives every field the backend the
+/// missions will use). A network maps the fields it was trained on nearly as well from high up
+/// as from low down, so calibrated there the decision learns that flying lower gains little,
+/// which on new ground is false; a field may therefore be segmented by a network of the same
+/// recipe that never saw it (cross-fitting, docs/method.md "Calibration fields the network
+/// never saw"). The missions fly the model with the one backend it names.
+/// @throws std::invalid_argument for no field, a backend count other than the field count, a
+///         null backend, fields with other class sets, an unknown rule, invalid options (see the
+///         rule's check_options, run_adaptive_mission and collect_region_samples), or fields
+///         without a sample.
 template <SegmentationBackend Backend>
-[[nodiscard]] CalibrationResult calibrate(std::span<const Field> fields, Backend& backend,
+[[nodiscard]] CalibrationResult calibrate(std::span<const Field> fields, std::span<Backend* const> backends,
                                           const CalibrationOptions& options) {
+  detail::require(backends.size() == fields.size(), "calibrate: one backend per training field is needed, backends",
+                  backends.size());
+  for (Backend* b : backends) detail::require(b != nullptr, "calibrate: a training field's backend is null", "nullptr");
   AdaptiveOptions adaptive = detail::calibration_settings(fields, options);
   const std::vector<double> lawnmower_gsd = options.lawnmower_gsds();
   const std::vector<int>& interest = adaptive.mission.interest;
@@ -168,7 +179,7 @@ template <SegmentationBackend Backend>
   std::vector<CellSample> cell_samples;
   std::vector<std::vector<CellSample>> cells_by_field;
   for (std::size_t k = 0; k < fields.size(); ++k) {
-    CalibrationSamples c = collect_samples(fields[k], backend, camera, adaptive.top_gsd_cm, adaptive.candidate_gsd_cm,
+    CalibrationSamples c = collect_samples(fields[k], *backends[k], camera, adaptive.top_gsd_cm, adaptive.candidate_gsd_cm,
                                            interest, adaptive.coverage, k);
     by_field.push_back(std::move(c.regions));
     detail::require(!by_field.back().empty(), "calibrate: the training field gave no region sample", fields[k].name());
@@ -179,7 +190,7 @@ template <SegmentationBackend Backend>
       std::vector<double> below;
       for (double g : adaptive.candidate_gsd_cm)
         if (g < top) below.push_back(g);
-      CalibrationSamples alt = collect_samples(fields[k], backend, camera, top, below, interest, adaptive.coverage, k);
+      CalibrationSamples alt = collect_samples(fields[k], *backends[k], camera, top, below, interest, adaptive.coverage, k);
       cells_by_field.back().insert(cells_by_field.back().end(), alt.cells.begin(), alt.cells.end());
     }
     cell_samples.insert(cell_samples.end(), cells_by_field.back().begin(), cells_by_field.back().end());
@@ -190,10 +201,17 @@ template <SegmentationBackend Backend>
     input_scores = detail::score_cell_inputs(cell_samples, options.cell_inputs, fields.front().name());
     adaptive.cell_input = input_scores.front().first;
   }
+  // The backend of a field the rule search flies: its own, or the single field's for its halves.
+  const auto backend_of = [&](const Field& f) -> Backend& {
+    for (std::size_t k = 0; k < fields.size(); ++k)
+      if (&f == &fields[k]) return *backends[k];
+    detail::require(fields.size() == 1, "calibrate: the rule search flew a field that is not a training field", f.name());
+    return *backends.front();
+  };
   const auto curve_of = [&](const Field& f) {
     std::vector<CurvePoint> c;
     for (double g : lawnmower_gsd) {
-      const MissionResult r = run_lawnmower_mission(f, g, backend, adaptive.mission);
+      const MissionResult r = run_lawnmower_mission(f, g, backend_of(f), adaptive.mission);
       c.push_back({r.total_s(), r.miou_interest().value_or(0.0)});
     }
     return c;
@@ -230,7 +248,7 @@ template <SegmentationBackend Backend>
   const RuleSearchInputs inputs{options, adaptive, fields, curves, halves, half_curves, by_field, cells_by_field,
                                 model, reference};
   const auto fly = [&](const Field& f, auto& policy, const std::vector<CurvePoint>& curve, double& margin) {
-    return detail::fly_scored(f, backend, policy, adaptive, curve, margin);
+    return detail::fly_scored(f, backend_of(f), policy, adaptive, curve, margin);
   };
   std::optional<RuleSearchResult> searched;
   for_each_rule([&]<class Rule>() {
@@ -238,9 +256,20 @@ template <SegmentationBackend Backend>
   });
 
   const LinearDecision::Params linear = detail::linear_sigma_range(samples);
-  return CalibrationResult{std::move(samples),          std::move(cell_samples), std::move(input_scores),
+  CalibrationResult result{std::move(samples),          std::move(cell_samples), std::move(input_scores),
                            std::move(searched->chosen), linear,                  std::move(curves),
                            std::move(searched->trials)};
+  for (Backend* b : backends) result.field_backends.push_back(b->name());
+  return result;
+}
+
+/// Calibrates on the training `fields`, each segmented by `backend` (the backend the missions
+/// will use); see the overload above.
+template <SegmentationBackend Backend>
+[[nodiscard]] CalibrationResult calibrate(std::span<const Field> fields, Backend& backend,
+                                          const CalibrationOptions& options) {
+  const std::vector<Backend*> backends(fields.size(), &backend);
+  return calibrate(fields, std::span<Backend* const>(backends), options);
 }
 
 /// The single-field case (the paper's).
@@ -270,6 +299,9 @@ template <SegmentationBackend Backend>
                   .train_front_margin = calibration.trials.empty() ? 0.0 : calibration.trials.front().front_margin};
   const Field& first = fields.front();
   for (const Field& f : fields) m.calibration_fields.push_back(f.name());
+  // Recorded only where a field was segmented by another backend than the missions' (cross-fitting).
+  for (const std::string& name : calibration.field_backends)
+    if (name != segmenter) m.field_segmenters = calibration.field_backends;
   for (const auto& c : first.classes()) m.classes.push_back(c.name);
   const auto& interest = options.adaptive.mission.interest.empty() ? first.interest() : options.adaptive.mission.interest;
   for (int i : interest) m.interest.push_back(first.classes().at(static_cast<std::size_t>(i)).name);

@@ -117,6 +117,8 @@ struct CalibrationResult {
   LinearDecision::Params linear{};                 ///< σ range of the training fields' top-level images
   std::vector<std::vector<CurvePoint>> lawnmower_curves;  ///< per training field, at lawnmower_gsds()
   std::vector<RuleTrial> trials;                   ///< every setting tried, the chosen one first
+  /// Per training field, the name of the backend that segmented it (calibrate()'s `backends`).
+  std::vector<std::string> field_backends{};
 };
 
 /// What a rule's calibration search works from (calibrate() fills it, the rule's `search`

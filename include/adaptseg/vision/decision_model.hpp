@@ -76,6 +76,10 @@ struct DecisionModel {
   LinearDecision::Params linear{};
   std::size_t samples = 0;                ///< region samples the GPs were fitted to
   double train_front_margin = 0.0;        ///< of the chosen rule, on the training fields (mean)
+  /// Cross-fitted calibration: per calibration field, the backend that segmented it, where one
+  /// differs from `segmenter` (a network that never saw that field; calibrate()); empty when
+  /// `segmenter` segmented every field (the file then has no `field_segmenters`).
+  std::vector<std::string> field_segmenters{};
 
   /// The planner options of a mission flown with this model: its camera, timing, top and
   /// candidate GSDs and descent coverage, with `mission`'s labels of interest and fixed times.
@@ -138,6 +142,8 @@ struct DecisionModel {
     e << YAML::Key << "calibration" << YAML::Value << YAML::BeginMap;
     e << YAML::Key << "fields" << YAML::Value << YAML::Flow << calibration_fields;
     e << YAML::Key << "segmenter" << YAML::Value << segmenter;
+    if (!field_segmenters.empty())
+      e << YAML::Key << "field_segmenters" << YAML::Value << YAML::Flow << field_segmenters;
     e << YAML::Key << "segmentation_time_s" << YAML::Value << num(calibration_segmentation_time_s);
     e << YAML::Key << "samples" << YAML::Value << std::to_string(samples);
     e << YAML::Key << "train_front_margin" << YAML::Value << num(train_front_margin);
@@ -334,6 +340,7 @@ struct DecisionModel {
                     .linear = {},
                     .samples = samples,
                     .train_front_margin = cal.number("train_front_margin")};
+    if (cal.has("field_segmenters")) m.field_segmenters = cal.texts("field_segmenters");
     read_setup(r, m);
     return m;
   }
@@ -341,6 +348,10 @@ struct DecisionModel {
   /// What the model must satisfy beyond each key's own check.
   void check(const std::string& where) const {
     if (calibration_fields.empty()) detail::yaml_error(where, "no calibration field is named");
+    if (!field_segmenters.empty() && field_segmenters.size() != calibration_fields.size())
+      detail::yaml_error(where, "'calibration.field_segmenters' needs one backend per calibration field (" +
+                                    std::to_string(calibration_fields.size()) + "), got " +
+                                    std::to_string(field_segmenters.size()));
     if (classes.empty()) detail::yaml_error(where, "'classes' is empty");
     if (interest.empty()) detail::yaml_error(where, "'interest' is empty");
     for (const auto& n : interest)
