@@ -133,6 +133,8 @@ check() {
   done
   [ "$bad" = 0 ] || exit 1
 }
+# The run directories DIR/ ... given, comma-separated, as sweep_table.py takes them.
+dir_list() { ls -d "$@" | sed 's:/$::' | paste -sd, -; }
 # Leave-one-tile-out over the Dubai tiles for every class, each run with ARGS...: CONFIG ARGS...
 sweep_dubai() {
   local config=$1 cls t k
@@ -356,8 +358,7 @@ if [ "$part" = ensemble-split ]; then
   wait
   check
   /usr/bin/python3 examples/tools/sweep_table.py \
-    "ensemble-dubai=$(ls -d "$root/network/ensemble-dubai"-*/ | sed 's:/$::' | paste -sd, -)" \
-    "with-split=$(ls -d "$root/$config"/*/ | sed 's:/$::' | paste -sd, -)"
+    "ensemble-dubai=$(dir_list "$root/network/ensemble-dubai"-*/)" "with-split=$(dir_list "$root/$config"/*/)"
   exit 0
 fi
 
@@ -384,9 +385,8 @@ if [ "$part" = cross-fit ]; then
   wait
   check
   /usr/bin/python3 examples/tools/sweep_table.py \
-    "five-tiles=$(ls -d "$root/network/mobilenetv2-dubai"-*/ | sed 's:/$::' | paste -sd, -)" \
-    "same-network=$(ls -d "$root/network-fields"/*/ | sed 's:/$::' | paste -sd, -)" \
-    "cross-fit=$(ls -d "$root/network-cross-fit"/*/ | sed 's:/$::' | paste -sd, -)"
+    "five-tiles=$(dir_list "$root/network/mobilenetv2-dubai"-*/)" "same-network=$(dir_list "$root/network-fields"/*/)" \
+    "cross-fit=$(dir_list "$root/network-cross-fit"/*/)"
   exit 0
 fi
 
