@@ -363,10 +363,10 @@ struct SegmenterOptions {
   [[nodiscard]] std::vector<std::filesystem::path> calibration_networks(std::span<const Field> fields) const {
     std::vector<std::filesystem::path> out(fields.size());
     if (calibration_model_files.empty()) return out;
-    const auto trained_on = [](const std::filesystem::path& file) {
+    const auto trained_on = [](const std::filesystem::path& file, const char* flag) {
       std::vector<std::string> t = network_training_fields(file);
       if (t.empty())
-        throw std::invalid_argument("--calibration-model-file: " + file.string() +
+        throw std::invalid_argument(std::string("--calibration-model-file: ") + flag + " " + file.string() +
                                     " names no training fields (training.fields in its model.yaml), so whether it "
                                     "saw a calibration field cannot be told");
       return t;
@@ -374,9 +374,9 @@ struct SegmenterOptions {
     const auto knows = [](const std::vector<std::string>& trained, const std::string& field) {
       return std::find(trained.begin(), trained.end(), field) != trained.end();
     };
-    const std::vector<std::string> mission = trained_on(model_file);
+    const std::vector<std::string> mission = trained_on(model_file, "--model-file");
     std::vector<std::vector<std::string>> pool;
-    for (const auto& file : calibration_model_files) pool.push_back(trained_on(file));
+    for (const auto& file : calibration_model_files) pool.push_back(trained_on(file, "network"));
     for (std::size_t k = 0; k < fields.size(); ++k) {
       // A part of a field ("dubai-tile-1[0,0,0.5,1]", Field::sub_field) is that field's ground.
       const std::string& full = fields[k].name();
@@ -441,8 +441,8 @@ class OwnedCalibrationNetwork final : public CalibrationNetwork {
 
 /// adaptseg::calibrate for the programs: every field segmented by `backend` (--model-file, cached
 /// as calibrate_cached()) or, where it was trained on the field, by the network
-/// SegmenterOptions::calibration_networks() gives it (built for `fields.front()` seen by
-/// `camera`, cached in its own folder of --segmentation-cache).
+/// SegmenterOptions::calibration_networks() gives it (built for `fields.front()` seen by the
+/// missions' camera, cached in its own folder of --segmentation-cache).
 template <SegmentationBackend Backend>
 CalibrationResult calibrate_fields(const SegmenterOptions& segmenter, std::span<const Field> fields, Backend& backend,
                                    const CalibrationOptions& options) {

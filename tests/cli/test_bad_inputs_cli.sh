@@ -43,6 +43,14 @@ adaptseg_calibrate)
     --calibration-model-file "$examples/models/erfnet-dubai"
   expect_error "--calibration-model-file applies to --segmenter erfnet only" --field "$weedmap" --out "$work/m.yaml" \
     --calibration-model-file "$examples/models/erfnet-dubai"
+  # A network whose model.yaml names no training fields: whether it saw a field cannot be told.
+  mkdir -p "$work/unnamed"
+  cp "$examples/models/mobilenetv2-dubai/model.onnx" "$work/unnamed/"
+  awk '/^training:/ { skip = 1; next } skip && /^[^ ]/ { skip = 0 } !skip' \
+    "$examples/models/mobilenetv2-dubai/model.yaml" >"$work/unnamed/model.yaml"
+  expect_error "--calibration-model-file: --model-file $work/unnamed names no training fields" --train "$dubai" \
+    --out "$work/m.yaml" --segmenter erfnet --model-file "$work/unnamed" \
+    --calibration-model-file "$examples/models/erfnet-dubai"
   # None of them wrote a model.
   [ ! -e "$work/m.yaml" ] || fail "a refused calibration wrote $work/m.yaml"
   ;;
