@@ -370,17 +370,20 @@ if [ "$part" = cross-fit ]; then
     [ -s "out/loto-cpu/model-$k/model.onnx" ] || { echo "no out/loto-cpu/model-$k: bash scripts/loto.sh cpu $k" >&2; exit 1; }
     crossed+=(--calibration-model-file "out/loto-cpu/model-$k")
   done
-  # With all four tiles the network trained on, the evaluation network's runs are part network's.
-  configs=(network-fields network-cross-fit)
-  [ "$(printf '%s\n' $cross_tiles | sort | paste -sd' ')" = "1 2 3 5" ] && configs=(network-cross-fit)
-  rm -rf "${root:?}/network-fields" "${root:?}/network-cross-fit"
+  # One pair of configurations per set of tiles (network-fields-123, network-cross-fit-123). With
+  # all four tiles the network trained on, the evaluation network's runs are part network's.
+  tag=$(printf '%s\n' $cross_tiles | sort | paste -sd '' -)
+  fields=network-fields-$tag crossfit=network-cross-fit-$tag
+  configs=("$fields" "$crossfit")
+  [ "$tag" = 1235 ] && configs=("$crossfit")
+  rm -rf "${root:?}/$fields" "${root:?}/$crossfit"
   for cls in $classes; do
     for t in 4 6; do
       train=()
       for k in $cross_tiles $((10 - t)); do train+=(--train "$(dubai "$k")"); done
       for config in "${configs[@]}"; do
         extra=()
-        [ "$config" = network-cross-fit ] && extra=("${crossed[@]}")
+        [ "$config" = "$crossfit" ] && extra=("${crossed[@]}")
         run "$config" "mobilenetv2-dubai-$cls-fly$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
           --model-file examples/models/mobilenetv2-dubai "${network[@]}" --no-plots "${extra[@]}"
       done
@@ -389,9 +392,9 @@ if [ "$part" = cross-fit ]; then
   wait
   check
   same=()
-  [ -d "$root/network-fields" ] && same=("same-network=$(dir_list "$root/network-fields"/*/)")
+  [ -d "$root/$fields" ] && same=("same-network=$(dir_list "$root/$fields"/*/)")
   /usr/bin/python3 examples/tools/sweep_table.py "five-tiles=$(dir_list "$root/network/mobilenetv2-dubai"-*/)" \
-    "${same[@]}" "cross-fit=$(dir_list "$root/network-cross-fit"/*/)"
+    "${same[@]}" "cross-fit=$(dir_list "$root/$crossfit"/*/)"
   exit 0
 fi
 
