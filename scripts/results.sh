@@ -70,7 +70,7 @@
 #   CROSS_TILES by a network of the same recipe that never saw it (--calibration-model-file
 #   out/loto-cpu/model-K, `bash scripts/loto.sh cpu K`, its temperature fitted on tile K as the
 #   evaluation network's was on its validation tile): whether calibrating on ground the network
-#   knows is what keeps its decision from descending. About 20 minutes on 2 cores. With
+#   knows is what keeps its decision from descending. Needs network; about 20 minutes on 2 cores. With
 #   CROSS_TILES="1 2 3 5" only the cross-fitted runs are flown (the others are part network's).
 # vertical-speed: the defaults' sweep (calibration included) with climbs and descents limited to
 #   1 m/s against 2 m/s level (--vertical-speed 1; the paper's model climbs at the level speed):
@@ -364,6 +364,7 @@ if [ "$part" = ensemble-split ]; then
 fi
 
 if [ "$part" = cross-fit ]; then
+  [ -d "$root/network" ] || { echo "run 'bash $0 network' first" >&2; exit 1; }
   cross_tiles=${CROSS_TILES:-1 2 3}
   crossed=()
   for k in $cross_tiles; do
