@@ -300,8 +300,9 @@ template <SegmentationBackend Backend>
   const Field& first = fields.front();
   for (const Field& f : fields) m.calibration_fields.push_back(f.name());
   // Recorded only where a field was segmented by another backend than the missions' (cross-fitting).
-  for (const std::string& name : calibration.field_backends)
-    if (name != segmenter) m.field_segmenters = calibration.field_backends;
+  const auto& backends = calibration.field_backends;
+  if (std::any_of(backends.begin(), backends.end(), [&](const std::string& b) { return b != segmenter; }))
+    m.field_segmenters = backends;
   for (const auto& c : first.classes()) m.classes.push_back(c.name);
   const auto& interest = options.adaptive.mission.interest.empty() ? first.interest() : options.adaptive.mission.interest;
   for (int i : interest) m.interest.push_back(first.classes().at(static_cast<std::size_t>(i)).name);
