@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
     for (const auto& spec : train_specs) fields.push_back(adaptseg::examples::load_field_spec(spec));
     if (fields.empty()) throw std::invalid_argument("give a training field: --field DIR or --train DIR (repeatable)");
     segmenter.validate();
-    (void)segmenter.calibration_networks(fields);  // its mistakes before any work
+    const auto networks = segmenter.calibration_networks(fields);  // its mistakes before any work
     const adaptseg::Field& field = fields.front();
     const adaptseg::MissionOptions mission = common.resolve(field);
     const double g0 = field.gsd_cm();
@@ -94,7 +94,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "calibrating on %s (%dx%d px, %.2f cm/px) with %s ...\n", f.name().c_str(), f.width_px(),
                    f.height_px(), g0, segmenter.name.c_str());
     const auto [cal, model] = segmenter.with_backend(field, mission.camera, [&](auto& backend) {
-      adaptseg::CalibrationResult c = adaptseg::examples::calibrate_fields(segmenter, fields, backend, options);
+      adaptseg::CalibrationResult c = adaptseg::examples::calibrate_fields(segmenter, fields, networks, backend, options);
       adaptseg::DecisionModel m = adaptseg::make_decision_model(fields, backend.name(), options, c);
       return std::pair{std::move(c), std::move(m)};
     });

@@ -175,7 +175,7 @@ int main(int argc, char** argv) {
       std::vector<adaptseg::Field> trains;
       for (const auto& spec : train_specs) trains.push_back(adaptseg::examples::load_field_spec(spec));
       segmenter.validate();
-      (void)segmenter.calibration_networks(trains);  // its mistakes before any work
+      const auto networks = segmenter.calibration_networks(trains);  // its mistakes before any work
       const adaptseg::Field& train = trains.front();
       adaptseg::CalibrationOptions co;
       co.adaptive.mission = common.resolve(train);
@@ -188,7 +188,7 @@ int main(int argc, char** argv) {
       for (const auto& f : trains) names += (names.empty() ? "" : ", ") + f.name();
       std::fprintf(stderr, "[%6.1f s] calibrating on %s ...\n", elapsed(), names.c_str());
       const auto cal = segmenter.with_backend(train, co.adaptive.mission.camera, [&](auto& backend) {
-        adaptseg::CalibrationResult c = adaptseg::examples::calibrate_fields(segmenter, trains, backend, co);
+        adaptseg::CalibrationResult c = adaptseg::examples::calibrate_fields(segmenter, trains, networks, backend, co);
         loaded = adaptseg::make_decision_model(trains, backend.name(), co, c);
         return c;
       });

@@ -440,13 +440,18 @@ class OwnedCalibrationNetwork final : public CalibrationNetwork {
 };
 
 /// adaptseg::calibrate for the programs: every field segmented by `backend` (--model-file, cached
-/// as calibrate_cached()) or, where it was trained on the field, by the network
-/// SegmenterOptions::calibration_networks() gives it (built for `fields.front()` seen by the
-/// missions' camera, cached in its own folder of --segmentation-cache).
+/// as calibrate_cached()) or, where `networks` (SegmenterOptions::calibration_networks(fields),
+/// resolved once by the program before any work) names one, by that network (built for
+/// `fields.front()` seen by the missions' camera, cached in its own folder of
+/// --segmentation-cache).
+/// @throws std::invalid_argument if `networks` does not hold one entry per field.
 template <SegmentationBackend Backend>
-CalibrationResult calibrate_fields(const SegmenterOptions& segmenter, std::span<const Field> fields, Backend& backend,
+CalibrationResult calibrate_fields(const SegmenterOptions& segmenter, std::span<const Field> fields,
+                                   std::span<const std::filesystem::path> networks, Backend& backend,
                                    const CalibrationOptions& options) {
-  const std::vector<std::filesystem::path> networks = segmenter.calibration_networks(fields);
+  if (networks.size() != fields.size())
+    throw std::invalid_argument("calibrate_fields: one calibration network entry per field is needed (" +
+                                std::to_string(networks.size()) + " for " + std::to_string(fields.size()) + " fields)");
   if (std::all_of(networks.begin(), networks.end(), [](const auto& n) { return n.empty(); }))
     return calibrate_cached(fields, backend, options, segmenter.calibration_cache());
   CachedBackend<Backend> cached(backend, segmenter.calibration_cache());
