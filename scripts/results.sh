@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reproduces docs/results.md.
-#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|vertical-speed] [JOBS]
+#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|vertical-speed] [JOBS]
 #   (default: all, one job per core)
 #
 # oracle: the paper's experiment with the ground-truth oracle, deterministic (fixed 0.1 s per
@@ -46,7 +46,17 @@
 #   alone (the one scene the network never trained on either) instead of the five other tiles:
 #   whether calibrating only where the network is as new to the ground as on the test field makes
 #   better decisions (docs/results.md: none below -0.002, but fewer gains and a lower mean). About
-#   9 minutes on 2 cores.
+#   9 minutes on 2 cores. NETS (environment; default erfnet-dubai) flies other networks: each
+#   network's runs go to network-held-out-<network> (ERFNet's to network-held-out), about 6
+#   minutes for MobileNetV2.
+# network-variants: part network's runs of NETS (default mobilenetv2-dubai) flown twice more,
+#   each with one change a reader might expect to make MobileNetV2's descents pay: the top level at
+#   10 cm/px (--lawnmower-factors 1,1.5,2: the descents start where the network's lawnmower
+#   curve flattens), and the cells ranked by the expected error about L alone (--cell-input
+#   expected_error, the input of the cell study's best mean capture) instead of the input chosen
+#   on the training fields; side by side with part network's runs (docs/results.md, "Three
+#   more changes that do not make MobileNetV2's descents pay"). Needs network; about 20
+#   minutes on 2 cores.
 # sigma-prior: the previous defaults' runs (part previous) flown again with the models
 #   `oracle-previous` saved, only the front-aware rule's sigma_prior_weight changed (0.01 and 1;
 #   the calibrated models have 0.25): how much the prior on the field's share of L holds the
@@ -81,8 +91,8 @@ set -euo pipefail
 part=${1:-all}
 jobs=${2:-$(nproc 2>/dev/null || echo 2)}
 case "$part" in all | oracle | oracle-default | paper | network | ensemble | ensemble-split | cells | curve-check | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | z-choice-network | \
-  cross-fit | vertical-speed) ;;
-  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|vertical-speed] [JOBS]" >&2
+  cross-fit | network-variants | vertical-speed) ;;
+  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|vertical-speed] [JOBS]" >&2
     exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
@@ -400,17 +410,51 @@ if [ "$part" = cross-fit ]; then
 fi
 
 if [ "$part" = network-held-out ]; then
-  config=network-held-out
-  rm -rf "${root:?}/$config"
-  for cls in $classes; do
-    for t in 4 6; do
-      run "$config" "erfnet-dubai-$cls-fly$t" --train "$(dubai $((10 - t)))" --test "$(dubai "$t")" \
-        --interest "$cls" --model-file examples/models/erfnet-dubai "${network[@]}" --no-plots
+  labels=()
+  for net in ${NETS:-erfnet-dubai}; do
+    config=network-held-out
+    [ "$net" = erfnet-dubai ] || config=network-held-out-$net
+    rm -rf "${root:?}/$config"
+    for cls in $classes; do
+      for t in 4 6; do
+        run "$config" "$net-$cls-fly$t" --train "$(dubai $((10 - t)))" --test "$(dubai "$t")" \
+          --interest "$cls" --model-file "examples/models/$net" "${network[@]}" --no-plots
+      done
+    done
+    labels+=("$net-held-out=$(dir_list "$root/$config"/*/)")
+  done
+  wait
+  check
+  /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
+  exit 0
+fi
+
+if [ "$part" = network-variants ]; then
+  [ -d "$root/network" ] || { echo "run 'bash $0 network' first" >&2; exit 1; }
+  labels=()
+  for net in ${NETS:-mobilenetv2-dubai}; do
+    ls -d "$root/network/$net"-*/ >/dev/null 2>&1 || { echo "part network has no runs of $net" >&2; exit 1; }
+    labels+=("$net-five-tiles=$(dir_list "$root/network/$net"-*/)")
+    for variant in top10 expected-error; do
+      config=network-$variant
+      case $variant in
+        top10) extra=(--lawnmower-factors 1,1.5,2) ;;
+        expected-error) extra=(--cell-input expected_error) ;;
+      esac
+      rm -rf "${root:?}/$config/$net"-*
+      for cls in $classes; do
+        for t in 4 6; do
+          train_except "$t"
+          run "$config" "$net-$cls-fly$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
+            --model-file "examples/models/$net" "${network[@]}" --no-plots "${extra[@]}"
+        done
+      done
+      labels+=("$net-$variant=$(dir_list "$root/$config/$net"-*/)")
     done
   done
   wait
   check
-  /usr/bin/python3 examples/tools/sweep_table.py "held-out=$(ls -d "$root/$config"/*/ | sed 's:/$::' | paste -sd, -)"
+  /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
   exit 0
 fi
 
