@@ -421,10 +421,12 @@ if [ "$part" = network-held-out ]; then
           --interest "$cls" --model-file "examples/models/$net" "${network[@]}" --no-plots
       done
     done
-    labels+=("$net-held-out=$(dir_list "$root/$config"/*/)")
+    labels+=("$net-held-out=$config")
   done
   wait
   check
+  # The tables' runs, listed once every run has written its directory.
+  for k in "${!labels[@]}"; do labels[k]="${labels[k]%%=*}=$(dir_list "$root/${labels[k]#*=}"/*/)"; done
   /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
   exit 0
 fi
@@ -449,11 +451,16 @@ if [ "$part" = network-variants ]; then
             --model-file "examples/models/$net" "${network[@]}" --no-plots "${extra[@]}"
         done
       done
-      labels+=("$net-$variant=$(dir_list "$root/$config/$net"-*/)")
+      labels+=("$net-$variant=$config/$net")
     done
   done
   wait
   check
+  # The tables' runs, listed once every run has written its directory.
+  for k in "${!labels[@]}"; do
+    [[ ${labels[k]} == *-five-tiles=* ]] && continue
+    labels[k]="${labels[k]%%=*}=$(dir_list "$root/${labels[k]#*=}"-*/)"
+  done
   /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
   exit 0
 fi
