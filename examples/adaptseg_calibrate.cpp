@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
       os << "field,top_gsd_cm,sub_gsd_cm,delta_h_m,sigma_top,sigma_sub,miou_top,miou_sub,relabelled,"
             "relabelled_interest,region_share,field_sigma,field_gain\n";
       for (const auto& s : cal.samples)
-        os << fields[s.field].name() << ',' << s.top_gsd_cm << ',' << s.sub_gsd_cm << ',' << s.delta_h_m << ','
+        os << adaptseg::examples::csv_field(fields[s.field].name()) << ',' << s.top_gsd_cm << ',' << s.sub_gsd_cm << ',' << s.delta_h_m << ','
            << s.sigma_top << ',' << s.sigma_sub << ',' << s.miou_top << ',' << s.miou_sub << ','
            << s.relabelled.share << ',' << s.relabelled.interest_share << ',' << s.region_share << ','
            << s.field_sigma << ',' << s.field_gain << '\n';
@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
       adaptseg::examples::write_input_columns_header(os);
       os << '\n';
       for (const auto& c : cal.cell_samples) {
-        os << fields[c.field].name() << ',' << c.region << ',' << c.top_gsd_cm << ',' << c.sub_gsd_cm << ','
+        os << adaptseg::examples::csv_field(fields[c.field].name()) << ',' << c.region << ',' << c.top_gsd_cm << ',' << c.sub_gsd_cm << ','
            << c.top.field_px << ',' << c.field_share << ',' << c.field_sigma << ',' << c.relabelled << ','
            << c.field_gain;
         adaptseg::examples::write_input_columns(os, c.top, c.fine);

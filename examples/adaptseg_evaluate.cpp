@@ -7,6 +7,7 @@
 //   adaptseg_evaluate --train examples/data/dubai-tile-4 --test examples/data/dubai-tile-6
 //                     --segmenter erfnet --model-file examples/models/ensemble-dubai --out out/eval-ensemble
 
+#include "common/cell_csv.hpp"
 #include "common/segmenters.hpp"
 #include "common/strategies.hpp"
 
@@ -22,12 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 using adaptseg::examples::fmt;
 
-std::string csv(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
+std::string csv(const std::string& s) { return adaptseg::examples::csv_field(s); }
 
 std::string csv(const std::optional<double>& v) { return v ? fmt(*v, 6) : ""; }
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reproduces docs/results.md.
-#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|vertical-speed] [JOBS]
+#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed] [JOBS]
 #   (default: all, one job per core)
 #
 # oracle: the paper's experiment with the ground-truth oracle, deterministic (fixed 0.1 s per
@@ -57,6 +57,12 @@
 #   on the training fields; side by side with part network's runs (docs/results.md, "Three
 #   more changes that do not make MobileNetV2's descents pay"). Needs network; about 20
 #   minutes on 2 cores.
+# proxy-check: whether what the scene check measures after a descent (each decision input's drop
+#   from the top-level image to the finer one over the re-mapped cells) tracks what re-mapping
+#   them gained, on the tiles each network (NETS, default erfnet-dubai mobilenetv2-dubai) was
+#   trained on (1, 2, 3, 5) and on those it never saw (4, 6): adaptseg_cell_study --csv at 12.5,
+#   10 and 5 cm/px, then examples/tools/proxy_table.py. Independent of the other parts; about
+#   20 minutes on 2 cores for the two networks.
 # sigma-prior: the previous defaults' runs (part previous) flown again with the models
 #   `oracle-previous` saved, only the front-aware rule's sigma_prior_weight changed (0.01 and 1;
 #   the calibrated models have 0.25): how much the prior on the field's share of L holds the
@@ -91,8 +97,8 @@ set -euo pipefail
 part=${1:-all}
 jobs=${2:-$(nproc 2>/dev/null || echo 2)}
 case "$part" in all | oracle | oracle-default | paper | network | ensemble | ensemble-split | cells | curve-check | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | z-choice-network | \
-  cross-fit | network-variants | vertical-speed) ;;
-  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|vertical-speed] [JOBS]" >&2
+  cross-fit | network-variants | proxy-check | vertical-speed) ;;
+  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed] [JOBS]" >&2
     exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
@@ -428,6 +434,37 @@ if [ "$part" = network-held-out ]; then
   # The tables' runs, listed once every run has written its directory.
   for k in "${!labels[@]}"; do labels[k]="${labels[k]%%=*}=$(dir_list "$root/${labels[k]#*=}"/*/)"; done
   /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
+  exit 0
+fi
+
+if [ "$part" = proxy-check ]; then
+  out=$root/proxy-check
+  rm -rf "${out:?}"
+  mkdir -p "$out"
+  for net in ${NETS:-erfnet-dubai mobilenetv2-dubai}; do
+    for set in trained-on never-seen; do
+      tiles="1 2 3 5"
+      [ "$set" = never-seen ] && tiles="4 6"
+      fields=()
+      for t in $tiles; do fields+=(--field "$(dubai "$t")"); done
+      build/release/examples/adaptseg_cell_study "${fields[@]}" --classes "${classes// /,}" --gsd 12.5,10,5 --segmenter erfnet \
+        --model-file "examples/models/$net" --threads 1 --seg-time-s 0.1 --plan-time-s 0 \
+        --csv "$out/$net-$set.csv" >"$out/$net-$set.md" 2>"$out/$net-$set.log" &
+      running=$((running + 1))
+      if [ "$running" -ge "$jobs" ]; then
+        wait -n || true
+        running=$((running - 1))
+      fi
+    done
+  done
+  wait
+  for net in ${NETS:-erfnet-dubai mobilenetv2-dubai}; do
+    for set in trained-on never-seen; do
+      [ -s "$out/$net-$set.csv" ] || { echo "FAILED: $net $set (see $out/$net-$set.log)" >&2; exit 1; }
+    done
+    /usr/bin/python3 examples/tools/proxy_table.py "$net, tiles it was trained on=$out/$net-trained-on.csv" \
+      "$net, tiles it never saw=$out/$net-never-seen.csv"
+  done
   exit 0
 fi
 

@@ -213,7 +213,7 @@ int main(int argc, char** argv) {
       adaptseg::examples::write_input_columns_header(os);
       os << '\n';
       for (const Cell& c : cells) {
-        os << c.field << ',' << c.cls << ',' << c.region << ',' << c.gsd_cm << ',' << c.top.field_px << ','
+        os << adaptseg::examples::csv_field(c.field) << ',' << c.cls << ',' << c.region << ',' << c.gsd_cm << ',' << c.top.field_px << ','
            << c.field_share << ',' << c.field_sigma << ',' << c.relabelled << ',' << c.gain;
         adaptseg::examples::write_input_columns(os, c.top, c.fine);
         os << '\n';

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Black-box test of adaptseg_cell_study and examples/tools/cell_study_table.py on the bundled
+# Black-box test of adaptseg_cell_study, examples/tools/cell_study_table.py and proxy_table.py on the bundled
 # WeedMap field with the oracle: every decision input ranks the cells, the oracle's purity ranks
 # them as well as the truth allows (rank correlation near 1 for σ), and an input the backend
 # cannot give (the ensemble members' split, from a single backend) is unknown (nan), not ranked
@@ -26,4 +26,15 @@ if [ -n "$python" ]; then
   grep -q '^| sigma | +' "$work/summary.md" || fail "no sigma row: $(cat "$work/summary.md")"
   ! grep -q '^| split |' "$work/summary.md" || fail "the unknown input split has a row: $(cat "$work/summary.md")"
   echo "ok: the table lists the inputs the backend gives, and only those"
+  # The region's name holds commas: quoted, every row has the header's columns.
+  "$python" -c 'import csv, sys; r = list(csv.reader(open(sys.argv[1]))); sys.exit(any(len(x) != len(r[0]) for x in r))' \
+    "$work/cells.csv" || fail "cells.csv rows differ from its header in columns: $(sed -n 2p "$work/cells.csv")"
+  # proxy_table.py: the oracle's finer look at the field's GSD is exact, so the drop of its
+  # expected error over a cell is the top level's error there, which the cell's gain follows.
+  "$python" "$examples/tools/proxy_table.py" "oracle=$work/cells.csv" >"$work/proxy.md" || fail "proxy_table.py failed"
+  awk -F'|' 'NR == 1 || !/^\| (crop|weed|all classes) \|/ { next } { n++; if (!($8 + 0 > 0.9)) bad++ }
+    END { exit !(n == 3 && bad == 0) }' "$work/proxy.md" ||
+    fail "want 3 rows with the expected error's drop ranking the gain (rho > 0.9): $(cat "$work/proxy.md")"
+  ! grep -q 'split drop' "$work/proxy.md" || fail "the unknown input split has a column: $(cat "$work/proxy.md")"
+  echo "ok: proxy_table.py ranks the oracle's gains by the drop of its expected error"
 fi

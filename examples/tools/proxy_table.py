@@ -1,0 +1,94 @@
+#!/usr/bin/env python3
+"""How well the scene check's measurement tracks what a descent gains, cell by cell.
+
+After a descent the planner sees, without ground truth, each decision input over the re-mapped
+cells twice: as the top-level image gave it and as the finer image gives it. The scene check
+(FrontAwarePolicy::observe, docs/method.md) reads the drop, top minus fine, as evidence of the
+gain. This tool reads the cells written by `adaptseg_cell_study --csv` (every cell re-mapped
+alone, with its realised field-IoU gain) and prints, per class and GSD and over all classes,
+the rank correlation (Spearman) of the realised gain with each input's drop, each drop weighted
+as the gain is (the cell's share of the field over the field's share of the class), and with
+the top-level input itself (what ranks the cells before the descent), beside the cells' summed
+gain and the summed drop of the expected error (the drop read as a gain, unfitted).
+
+  proxy_table.py LABEL=CELLS.csv [LABEL=CELLS.csv ...]
+
+e.g. the fields a network was trained on against fields it never saw (docs/results.md).
+"""
+import csv
+import math
+import sys
+from collections import defaultdict
+
+
+def ranks(v):
+    order = sorted(range(len(v)), key=lambda k: v[k])
+    r = [0.0] * len(v)
+    i = 0
+    while i < len(order):
+        j = i
+        while j + 1 < len(order) and v[order[j + 1]] == v[order[i]]:
+            j += 1
+        for k in range(i, j + 1):
+            r[order[k]] = 0.5 * (i + j) + 1.0
+        i = j + 1
+    return r
+
+
+def spearman(a, b):
+    if len(a) < 3:
+        return math.nan
+    ra, rb = ranks(a), ranks(b)
+    n = float(len(a))
+    ma, mb = sum(ra) / n, sum(rb) / n
+    sab = sum((x - ma) * (y - mb) for x, y in zip(ra, rb))
+    saa = sum((x - ma) ** 2 for x in ra)
+    sbb = sum((y - mb) ** 2 for y in rb)
+    return sab / math.sqrt(saa * sbb) if saa > 0 and sbb > 0 else math.nan
+
+
+def fmt(x):
+    return "nan" if math.isnan(x) else f"{x:+.2f}"
+
+
+def main(args):
+    if not args or any("=" not in a for a in args):
+        sys.exit("usage: proxy_table.py LABEL=CELLS.csv [LABEL=CELLS.csv ...]")
+    for arg in args:
+        label, path = arg.split("=", 1)
+        with open(path, newline="") as f:
+            rows = list(csv.DictReader(f))
+        if not rows:
+            sys.exit(f"proxy_table.py: {path} holds no cells")
+        inputs = [c[len("top_"):] for c in rows[0] if c.startswith("top_")]
+        # Only the inputs the backend gave (a labels-only or single backend writes nan).
+        inputs = [i for i in inputs if any(not math.isnan(float(r["top_" + i])) for r in rows)]
+        groups = defaultdict(list)
+        for r in rows:
+            groups[(r["class"], float(r["gsd_cm"]))].append(r)
+            groups[("all classes", float(r["gsd_cm"]))].append(r)
+        print(f"\n{label} ({path}): rank correlation of the realised gain with each input's drop "
+              "(top - fine) over the cell, then with the top-level expected error")
+        print("| class | GSD [cm/px] | cells | " + " | ".join(f"{i} drop" for i in inputs) +
+              " | expected_error at the top | gain (sum) | expected-error drop (sum) |")
+        print("| --- | ---: | ---: | " + " | ".join("---:" for _ in inputs) + " | ---: | ---: | ---: |")
+        for (cls, gsd), rs in sorted(groups.items(), key=lambda kv: (kv[0][0] == "all classes", kv[0])):
+            gain = [float(r["gain"]) for r in rs]
+            weight = [float(r["field_share"]) / float(r["field_sigma"]) if float(r["field_sigma"]) > 0 else 0.0
+                      for r in rs]
+
+            def value(r, name):
+                x = float(r[name])
+                return 0.0 if math.isnan(x) else x
+
+            drops = {i: [(value(r, "top_" + i) - value(r, "fine_" + i)) * w for r, w in zip(rs, weight)]
+                     for i in inputs}
+            top_ee = [value(r, "top_expected_error") * w for r, w in zip(rs, weight)] \
+                if "expected_error" in inputs else []
+            ee_drop = sum(drops["expected_error"]) if "expected_error" in inputs else math.nan
+            print(f"| {cls} | {gsd:g} | {len(rs)} | " + " | ".join(fmt(spearman(drops[i], gain)) for i in inputs) +
+                  f" | {fmt(spearman(top_ee, gain)) if top_ee else 'nan'} | {sum(gain):+.4f} | {ee_drop:+.4f} |")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
