@@ -94,7 +94,8 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "calibrating on %s (%dx%d px, %.2f cm/px) with %s ...\n", f.name().c_str(), f.width_px(),
                    f.height_px(), g0, segmenter.name.c_str());
     const auto [cal, model] = segmenter.with_backend(field, mission.camera, [&](auto& backend) {
-      adaptseg::CalibrationResult c = adaptseg::examples::calibrate_fields(segmenter, fields, networks, backend, options);
+      adaptseg::CalibrationResult c =
+          adaptseg::examples::calibrate_fields(segmenter, fields, networks, backend, options);
       adaptseg::DecisionModel m = adaptseg::make_decision_model(fields, backend.name(), options, c);
       return std::pair{std::move(c), std::move(m)};
     });
@@ -106,10 +107,10 @@ int main(int argc, char** argv) {
       os << "field,top_gsd_cm,sub_gsd_cm,delta_h_m,sigma_top,sigma_sub,miou_top,miou_sub,relabelled,"
             "relabelled_interest,region_share,field_sigma,field_gain\n";
       for (const auto& s : cal.samples)
-        os << adaptseg::examples::csv_field(fields[s.field].name()) << ',' << s.top_gsd_cm << ',' << s.sub_gsd_cm << ',' << s.delta_h_m << ','
-           << s.sigma_top << ',' << s.sigma_sub << ',' << s.miou_top << ',' << s.miou_sub << ','
-           << s.relabelled.share << ',' << s.relabelled.interest_share << ',' << s.region_share << ','
-           << s.field_sigma << ',' << s.field_gain << '\n';
+        os << adaptseg::examples::csv_field(fields[s.field].name()) << ',' << s.top_gsd_cm << ',' << s.sub_gsd_cm
+           << ',' << s.delta_h_m << ',' << s.sigma_top << ',' << s.sigma_sub << ',' << s.miou_top << ','
+           << s.miou_sub << ',' << s.relabelled.share << ',' << s.relabelled.interest_share << ','
+           << s.region_share << ',' << s.field_sigma << ',' << s.field_gain << '\n';
       adaptseg::examples::write_text(samples_csv, os.str());
     }
     if (!cell_samples_csv.empty()) {
@@ -118,9 +119,9 @@ int main(int argc, char** argv) {
       adaptseg::examples::write_input_columns_header(os);
       os << '\n';
       for (const auto& c : cal.cell_samples) {
-        os << adaptseg::examples::csv_field(fields[c.field].name()) << ',' << c.region << ',' << c.top_gsd_cm << ',' << c.sub_gsd_cm << ','
-           << c.top.field_px << ',' << c.field_share << ',' << c.field_sigma << ',' << c.relabelled << ','
-           << c.field_gain;
+        os << adaptseg::examples::csv_field(fields[c.field].name()) << ',' << c.region << ',' << c.top_gsd_cm << ','
+           << c.sub_gsd_cm << ',' << c.top.field_px << ',' << c.field_share << ',' << c.field_sigma << ','
+           << c.relabelled << ',' << c.field_gain;
         adaptseg::examples::write_input_columns(os, c.top, c.fine);
         os << '\n';
       }

@@ -184,7 +184,8 @@ int main(int argc, char** argv) {
       for (const auto& f : trains) names += (names.empty() ? "" : ", ") + f.name();
       std::fprintf(stderr, "[%6.1f s] calibrating on %s ...\n", elapsed(), names.c_str());
       const auto cal = segmenter.with_backend(train, co.adaptive.mission.camera, [&](auto& backend) {
-        adaptseg::CalibrationResult c = adaptseg::examples::calibrate_fields(segmenter, trains, networks, backend, co);
+        adaptseg::CalibrationResult c =
+            adaptseg::examples::calibrate_fields(segmenter, trains, networks, backend, co);
         loaded = adaptseg::make_decision_model(trains, backend.name(), co, c);
         return c;
       });

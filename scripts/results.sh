@@ -121,6 +121,14 @@ nets=${NETS:-erfnet-dubai mobilenetv2-dubai ensemble-dubai}
 
 # One adaptseg_evaluate run: CONFIG RUN ARGS... -> $root/CONFIG/RUN (log: RUN.log beside it).
 running=0
+# After launching a job in the background: wait for one to end while $jobs are running.
+throttle() {
+  running=$((running + 1))
+  if [ "$running" -ge "$jobs" ]; then
+    wait -n || true
+    running=$((running - 1))
+  fi
+}
 launched=()
 run() {
   local config=$1 name=$2
@@ -128,11 +136,7 @@ run() {
   mkdir -p "$root/$config"
   launched+=("$config/$name")
   "$eval_bin" "$@" --out "$root/$config/$name" >"$root/$config/$name.log" 2>&1 &
-  running=$((running + 1))
-  if [ "$running" -ge "$jobs" ]; then
-    wait -n || true
-    running=$((running - 1))
-  fi
+  throttle
 }
 dubai() { echo examples/data/dubai-tile-$1; }
 # The --train arguments of every Dubai tile but tile $1 (leave one out), into the array `train`.
@@ -214,11 +218,7 @@ if [ "$part" = z-choice ] || [ "$part" = z-choice-network ]; then
   }
   z_launch() {  # z_run in the background, at most $jobs at a time
     z_run "$1" &
-    running=$((running + 1))
-    if [ "$running" -ge "$jobs" ]; then
-      wait -n || true
-      running=$((running - 1))
-    fi
+    throttle
   }
   running=0
   if [ "$part" = z-choice ]; then
@@ -416,10 +416,9 @@ if [ "$part" = cross-fit ]; then
 fi
 
 if [ "$part" = network-held-out ]; then
-  labels=()
+  held_out_config() { if [ "$1" = erfnet-dubai ]; then echo network-held-out; else echo "network-held-out-$1"; fi; }
   for net in ${NETS:-erfnet-dubai}; do
-    config=network-held-out
-    [ "$net" = erfnet-dubai ] || config=network-held-out-$net
+    config=$(held_out_config "$net")
     rm -rf "${root:?}/$config"
     for cls in $classes; do
       for t in 4 6; do
@@ -427,12 +426,11 @@ if [ "$part" = network-held-out ]; then
           --interest "$cls" --model-file "examples/models/$net" "${network[@]}" --no-plots
       done
     done
-    labels+=("$net-held-out=$config")
   done
   wait
   check
-  # The tables' runs, listed once every run has written its directory.
-  for k in "${!labels[@]}"; do labels[k]="${labels[k]%%=*}=$(dir_list "$root/${labels[k]#*=}"/*/)"; done
+  labels=()
+  for net in ${NETS:-erfnet-dubai}; do labels+=("$net-held-out=$(dir_list "$root/$(held_out_config "$net")"/*/)"); done
   /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
   exit 0
 fi
@@ -450,11 +448,7 @@ if [ "$part" = proxy-check ]; then
       build/release/examples/adaptseg_cell_study "${fields[@]}" --classes "${classes// /,}" --gsd 12.5,10,5 --segmenter erfnet \
         --model-file "examples/models/$net" --threads 1 --seg-time-s 0.1 --plan-time-s 0 \
         --csv "$out/$net-$set.csv" >"$out/$net-$set.md" 2>"$out/$net-$set.log" &
-      running=$((running + 1))
-      if [ "$running" -ge "$jobs" ]; then
-        wait -n || true
-        running=$((running - 1))
-      fi
+      throttle
     done
   done
   wait
@@ -470,10 +464,8 @@ fi
 
 if [ "$part" = network-variants ]; then
   [ -d "$root/network" ] || { echo "run 'bash $0 network' first" >&2; exit 1; }
-  labels=()
   for net in ${NETS:-mobilenetv2-dubai}; do
     ls -d "$root/network/$net"-*/ >/dev/null 2>&1 || { echo "part network has no runs of $net" >&2; exit 1; }
-    labels+=("$net-five-tiles=$(dir_list "$root/network/$net"-*/)")
     for variant in top10 expected-error; do
       config=network-$variant
       case $variant in
@@ -488,15 +480,14 @@ if [ "$part" = network-variants ]; then
             --model-file "examples/models/$net" "${network[@]}" --no-plots "${extra[@]}"
         done
       done
-      labels+=("$net-$variant=$config/$net")
     done
   done
   wait
   check
-  # The tables' runs, listed once every run has written its directory.
-  for k in "${!labels[@]}"; do
-    [[ ${labels[k]} == *-five-tiles=* ]] && continue
-    labels[k]="${labels[k]%%=*}=$(dir_list "$root/${labels[k]#*=}"-*/)"
+  labels=()
+  for net in ${NETS:-mobilenetv2-dubai}; do
+    labels+=("$net-five-tiles=$(dir_list "$root/network/$net"-*/)")
+    for variant in top10 expected-error; do labels+=("$net-$variant=$(dir_list "$root/network-$variant/$net"-*/)"); done
   done
   /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
   exit 0

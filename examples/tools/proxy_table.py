@@ -47,6 +47,12 @@ def spearman(a, b):
     return sab / math.sqrt(saa * sbb) if saa > 0 and sbb > 0 else math.nan
 
 
+def value(row, name):
+    """An input's value in a CSV row, 0 where the backend could not give it (nan)."""
+    x = float(row[name])
+    return 0.0 if math.isnan(x) else x
+
+
 def fmt(x):
     return "nan" if math.isnan(x) else f"{x:+.2f}"
 
@@ -76,10 +82,6 @@ def main(args):
             gain = [float(r["gain"]) for r in rs]
             weight = [float(r["field_share"]) / float(r["field_sigma"]) if float(r["field_sigma"]) > 0 else 0.0
                       for r in rs]
-
-            def value(r, name):
-                x = float(r[name])
-                return 0.0 if math.isnan(x) else x
 
             drops = {i: [(value(r, "top_" + i) - value(r, "fine_" + i)) * w for r, w in zip(rs, weight)]
                      for i in inputs}
