@@ -255,7 +255,20 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
   for (std::size_t k = 0; k < cells->points().size(); ++k) {
     CHECK(back_cells.points()[k].gain_slope == cells->points()[k].gain_slope);
     CHECK(back_cells.points()[k].relabel_noise == cells->points()[k].relabel_noise);
+    CHECK(back_cells.points()[k].proxy_slope_sd == cells->points()[k].proxy_slope_sd);
   }
+  // Two fields whose finer looks both change the input: the proxy slope's spread between them.
+  CHECK(cells->at(3.0, 1.0).proxy_slope_sd >= 0.0);
+  CHECK(cells->at(3.0, 1.0).proxy_slope_sd < cells->at(3.0, 1.0).proxy_slope);
+  // A file written before proxy_slope_sd existed loads with 0 (the scene check as it was).
+  {
+    std::ifstream in(tmp.path() / "model.yaml");
+    std::ofstream old(tmp.path() / "old.yaml");
+    for (std::string line; std::getline(in, line);)
+      if (line.find("proxy_slope_sd:") == std::string::npos) old << line << '\n';
+  }
+  const DecisionModel before = DecisionModel::load(tmp.path() / "old.yaml");
+  for (const auto& p : before.decision_function.model().cells()->points()) CHECK(p.proxy_slope_sd == 0.0);
   // Each training field's mean input at both top levels: the nominal one's is field_input, and
   // the finer top level's map has less wrong (the oracle's expected error is its share of
   // wrong pixels), so less of it. The file keeps both.

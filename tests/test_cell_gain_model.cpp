@@ -101,3 +101,35 @@ TEST_CASE("cell gain model: an input is scored by how much of each field's gain 
   CHECK(worst == doctest::Approx(3.0 / 55.0));
   CHECK(std::isnan(cell_ranking_capture({}, DecisionInput::sigma)));
 }
+
+TEST_CASE("cell gain model: the scene check's proxy slope, and how far it differs between the training fields") {
+  // Cells whose finer look removes a share `removed` of the top's expected error, on field f,
+  // gaining `gain` per unit of what was removed (γ_f).
+  const auto looked = [](std::size_t f, double x, double removed, double gamma_f) {
+    CellSample c = cell(f, 15.0, 5.0, x, 1000.0, gamma_f * removed * x, 0.0);
+    c.fine.values.fill(NAN);
+    c.fine.values[index_of(DecisionInput::expected_error)] = (1.0 - removed) * x;
+    return c;
+  };
+  std::vector<CellSample> agree, disagree, one;
+  for (double x : {0.02, 0.05, 0.1})
+    for (double removed : {0.3, 0.6}) {
+      agree.push_back(looked(0, x, removed, 0.8));
+      agree.push_back(looked(1, x, removed, 0.8));
+      disagree.push_back(looked(0, x, removed, 0.8));
+      disagree.push_back(looked(1, x, removed, -0.4));
+      one.push_back(looked(0, x, removed, 0.8));
+    }
+  const CellGainModel::Point a = CellGainModel::fit(agree, DecisionInput::expected_error).at(15.0, 5.0);
+  CHECK(a.proxy_slope == doctest::Approx(0.8));
+  CHECK(a.proxy_slope_sd == doctest::Approx(0.0).epsilon(1e-12));
+  // Two fields of slopes 0.8 and -0.4: pooled 0.2, each 0.6 from it.
+  const CellGainModel::Point d = CellGainModel::fit(disagree, DecisionInput::expected_error).at(15.0, 5.0);
+  CHECK(d.proxy_slope == doctest::Approx(0.2));
+  CHECK(d.proxy_slope_sd == doctest::Approx(std::sqrt(2.0 * 0.36)));
+  // One field: how far its slope transfers is unknown, as far as the slope itself.
+  const CellGainModel::Point o = CellGainModel::fit(one, DecisionInput::expected_error).at(15.0, 5.0);
+  CHECK(o.proxy_slope_sd == doctest::Approx(o.proxy_slope));
+  CHECK_THROWS_AS(CellGainModel(DecisionInput::sigma, {{15.0, 5.0, 1.0, 0.0, 1.0, 0.0, 1.0, 0.0, -0.1}}),
+                  std::invalid_argument);
+}

@@ -530,6 +530,53 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     CHECK_FALSE(adaptive.decide(s.region(1, 0.1)).descend);
     CHECK(fixed.decide(s.region(1, 0.1)).descend);
   }
+  SUBCASE("the scene check: trusted no further than the training fields agree on its slope") {
+    // The same finer look, less sure than the coarse one, read through a proxy whose slope the
+    // training fields disagree on (τ_γ twice γ): one such look is weak evidence, s stays
+    // positive and the next region is still worth a descent.
+    GainModel doubted = fitted();
+    doubted.set_cells(CellGainModel(DecisionInput::expected_error,
+                                    {{2.0, 1.0, 1.0, 1e-4, 1.0, 1e-4, 1.0, 4e-3, 2.0},
+                                     {3.0, 1.0, 1.0, 1e-4, 1.0, 1e-4, 1.0, 4e-3, 2.0}}));
+    FrontAwarePolicy trusting(with_cells(1.0), flat, {.online = true});
+    FrontAwarePolicy doubting(doubted, flat, {.online = true});
+    for (FrontAwarePolicy* p : {&trusting, &doubting}) {
+      const Decision d = p->decide(s.region(0, 0.1));
+      REQUIRE(d.descend);
+      const double top = d.candidate == 0 ? 0.05 : 0.1;
+      p->observe(cell_outcome(top, 1.6 * top));
+    }
+    CHECK(trusting.field_scale() < 0.0);
+    CHECK(doubting.field_scale() > 0.5);
+    CHECK(doubting.field_scale() < 1.0);
+    CHECK(doubting.decide(s.region(1, 0.1)).descend);
+  }
+  SUBCASE("the scene check: where descending loses, a descent the training fields saw lose is no gain") {
+    // From 3 cm/px the training fields gained at 1 cm/px (β = 1) and lost at 2 cm/px (β < 0).
+    // Once the scene check finds the finer look worse on this field (s < 0), no descent may be
+    // forecast to gain: a loss on the training fields times a field that loses is not a gain,
+    // and the predicted curve of this field does not rise to 2 cm/px by it either.
+    GainModel m = fitted();
+    m.set_cells(CellGainModel(DecisionInput::expected_error, {{3.0, 1.0, 1.0, 1e-4, 1.0, 1e-4, 1.0, 4e-3},
+                                                              {3.0, 2.0, -0.5, 1e-4, 1.0, 1e-4, 0.0, 0.0}}));
+    CellScenario two_gsds(0.1);
+    Candidate coarser{2.0, 11.0, 1, 15.0};
+    coarser.cells = cells(2, 0.1);
+    two_gsds.offers.push_back(coarser);
+    two_gsds.lawnmowers = {{1.0, 185.0}, {2.0, 90.0}, {3.0, 40.0}};
+    for (const bool field_curve : {false, true}) {
+      FrontAwarePolicy adaptive(m, flat, {.online = true, .field_curve = field_curve});
+      const Decision d = adaptive.decide(two_gsds.region(0, 0.1));
+      REQUIRE(d.descend);
+      REQUIRE(d.gsd_cm == 1.0);
+      const double top = d.candidate == 0 ? 0.05 : 0.1;
+      adaptive.observe(cell_outcome(top, 1.6 * top));
+      REQUIRE(adaptive.field_scale() < 0.0);
+      const Decision next = adaptive.decide(two_gsds.region(1, 0.1));
+      for (const CandidateScore& c : next.scores) CHECK(c.predicted_field_gain <= 0.0);
+      CHECK_FALSE(next.descend);
+    }
+  }
   SUBCASE("the scene check: a finer look that clears what the top doubted keeps descending") {
     FrontAwarePolicy adaptive(with_cells(1.0), flat, {.online = true});
     const Decision d = adaptive.decide(s.region(0, 0.1));

@@ -11,6 +11,7 @@
 #include <adaptseg/core/error.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -79,7 +80,14 @@ struct CellSample {
 /// forecast β·Σ_S w_c·x_c its spread is κ_p·Σ_S w_c²·x_c, κ_p the weighted mean squared
 /// difference per unit of x over the training cells: it holds how far the proxy misses and how
 /// far the training fields' own gains scatter, so that the scene check learns no faster than the
-/// training fields show it can. γ = κ_p = 0 where no fine inputs were known (labels-only backends).
+/// training fields show it can. And the proxy's slope is a property of the field, not only of
+/// the network: fitted on each training field alone, γ_f may even change sign between fields
+/// (MobileNetV2's water: negative on three of the tiles it was trained on, positive on the one it
+/// never saw). τ_γ, the spread of the γ_f about γ, adds τ_γ²·d² to the measurement's variance,
+/// d = Σ_S w_c·(x_c − x'_c): a scene check on a field whose slope is any of the training fields'
+/// is trusted no further than they agree. With one training field τ_γ = |γ| (how far the slope
+/// transfers to another field is unknown). γ = κ_p = τ_γ = 0 where no fine inputs were known
+/// (labels-only backends).
 class CellGainModel {
  public:
   /// The model for one pair of top-level and descent GSDs.
@@ -92,6 +100,7 @@ class CellGainModel {
     double relabel_noise = 0.0;   ///< κ_χ >= 0
     double proxy_slope = 0.0;     ///< γ: gain per unit of the input the finer look removes
     double proxy_noise = 0.0;     ///< κ_p >= 0
+    double proxy_slope_sd = 0.0;  ///< τ_γ >= 0: the spread of γ between the training fields
   };
 
   /// A forecast for a set of cells, in shares of the region's field pixels.
@@ -120,7 +129,8 @@ class CellGainModel {
                       "CellGainModel: points must be in increasing (top, descent) GSD order; descent GSD", p.sub_gsd_cm);
       detail::require(std::isfinite(p.gain_slope) && std::isfinite(p.relabel_slope) && std::isfinite(p.gain_noise) &&
                           std::isfinite(p.relabel_noise) && p.gain_noise >= 0.0 && p.relabel_noise >= 0.0 &&
-                          std::isfinite(p.proxy_slope) && std::isfinite(p.proxy_noise) && p.proxy_noise >= 0.0,
+                          std::isfinite(p.proxy_slope) && std::isfinite(p.proxy_noise) && p.proxy_noise >= 0.0 &&
+                          std::isfinite(p.proxy_slope_sd) && p.proxy_slope_sd >= 0.0,
                       "CellGainModel: slopes must be finite and noises finite and >= 0; at descent GSD", p.sub_gsd_cm);
     }
   }
@@ -180,6 +190,7 @@ class CellGainModel {
           ep += w * std::pow(p.proxy_slope * (x - c->fine.value(input)) - p.gain_slope * x, 2);
         }
         p.proxy_noise = ep / wx;
+        p.proxy_slope_sd = field_slope_spread(g.cells, input, mean_px, p.proxy_slope);
       }
       points.push_back(p);
     }
@@ -227,13 +238,14 @@ class CellGainModel {
     std::vector<Point> row;
     for (const Point& p : points_)
       if (p.top_gsd_cm == top) row.push_back(p);
-    Point out{top_gsd_cm, sub_gsd_cm, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    Point out{top_gsd_cm, sub_gsd_cm, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
     out.gain_slope = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::gain_slope);
     out.gain_noise = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::gain_noise);
     out.relabel_slope = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::relabel_slope);
     out.relabel_noise = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::relabel_noise);
     out.proxy_slope = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::proxy_slope);
     out.proxy_noise = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::proxy_noise);
+    out.proxy_slope_sd = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::proxy_slope_sd);
     return out;
   }
 
@@ -250,6 +262,30 @@ class CellGainModel {
 
  private:
   [[nodiscard]] double x_of(const CellInputs& c) const noexcept { return value_of(c, input_); }
+
+  /// τ_γ of one pair of GSDs (see the class comment): the proxy's slope fitted on each training
+  /// field's cells alone, γ_f, and their spread about the pooled `slope`, Σ_f (γ_f − γ)² / (n − 1)
+  /// over the n fields whose finer looks changed the input; |γ| where n < 2.
+  template <class Cells>
+  static double field_slope_spread(const Cells& cells, DecisionInput input, double mean_px, double slope) {
+    std::vector<std::pair<std::size_t, std::array<double, 2>>> fields;  // field, {Σ w·d·ν, Σ w·d²}
+    for (const CellSample* c : cells) {
+      const double d = value_of(c->top, input) - c->fine.value(input), w = c->top.field_px / mean_px;
+      auto it = std::find_if(fields.begin(), fields.end(), [&](const auto& f) { return f.first == c->field; });
+      if (it == fields.end()) it = fields.insert(fields.end(), {c->field, {0.0, 0.0}});
+      it->second[0] += w * d * c->normalized_gain();
+      it->second[1] += w * d * d;
+    }
+    double sq = 0.0;
+    std::size_t n = 0;
+    for (const auto& [field, sums] : fields)
+      if (sums[1] > 0.0) {
+        sq += std::pow(sums[0] / sums[1] - slope, 2);
+        ++n;
+      }
+    return n >= 2 ? std::sqrt(sq / static_cast<double>(n - 1)) : std::abs(slope);
+  }
+
   static double value_of(const CellInputs& c, DecisionInput input) noexcept {
     const double v = c.value(input);
     return std::isfinite(v) ? v : 0.0;

@@ -268,11 +268,11 @@ class FrontAwarePolicy {
         base_sd = f.relabelled_std * eta * weight;
         relabelled = {f.relabelled, f.relabelled_noisy_std, 0.0, 0.0, 0.0, 0.0};
       }
-      const double gain = scale_mean_ * base;
+      const double gain = scaled(base);
       const double gain_var =
           scale_mean_ * scale_mean_ * base_sd * base_sd + scale_var_ * base * base + gain * gain * sigma_cv2;
       s.predicted_field_gain = gain;
-      if (std::isfinite(relabelled.mean)) s.predicted_relabelled = scale_mean_ * relabelled.mean;
+      if (std::isfinite(relabelled.mean)) s.predicted_relabelled = std::abs(scale_mean_) * relabelled.mean;
       s.utility = utility(gain, cand.extra_time_s);
       // The curve's rise over the descent's extra time, on every training field's curve.
       double rise_sum = 0.0, rise_sq = 0.0;
@@ -347,15 +347,18 @@ class FrontAwarePolicy {
     const Relabelled& f = chosen_[out.descent];
     if (model_.cells() && f.sub_gsd_cm > 0.0) {
       // The scene check (cell gain model): the descent's gain as the finer look estimates it,
-      // y = γ·(top − fine input) = s·μ + ε, ε ~ N(0, κ_p·Σ w²x), μ the forecast before s. Without
+      // y = γ·d = s·μ + ε, d = top − fine input, ε ~ N(0, κ_p·Σ w²x + τ_γ²·d²), μ the forecast
+      // before s (τ_γ: how far the proxy's slope differs between the training fields). Without
       // the finer images' input, or a proxy, nothing is learnt.
       const CellGainModel::Point p = model_.cells()->at(f.top_gsd_cm, f.sub_gsd_cm);
       if (!std::isfinite(out.fine_input) || !std::isfinite(out.top_input) || !(p.proxy_slope > 0.0) ||
           !(f.proxy_var > 0.0) || !(f.gain > 0.0))
         return;
       const double y = model_.cells()->proxy_gain(f.top_gsd_cm, f.sub_gsd_cm, out.top_input, out.fine_input);
-      scale_precision_sum_ += f.gain * f.gain / f.proxy_var;
-      scale_evidence_sum_ += f.gain * y / f.proxy_var;
+      const double d = out.top_input - out.fine_input;
+      const double var = f.proxy_var + p.proxy_slope_sd * p.proxy_slope_sd * d * d;
+      scale_precision_sum_ += f.gain * f.gain / var;
+      scale_evidence_sum_ += f.gain * y / var;
     } else {
       if (!std::isfinite(f.mean) || !model_.c_model()) return;
       // Conjugate update of s in χ_obs = s·μ_C + ε, ε ~ N(0, sd_C²), prior s ~ N(1, ω²).
@@ -386,6 +389,16 @@ class FrontAwarePolicy {
     double sub_gsd_cm = 0.0;
   };
 
+  /// A forecast gain (of a descent, or of the field's curve) `base` before the field factor s,
+  /// times s. A gain the training fields saw (base >= 0) scales with s and turns into a loss
+  /// where the scene check found the finer look worse (s < 0); a loss the training fields saw
+  /// (base < 0: a descent GSD that lost there) stays a loss whatever s: |s|·base. Without it, a
+  /// field where descending loses would forecast a gain for exactly the descents the training
+  /// fields saw lose.
+  [[nodiscard]] double scaled(double base) const noexcept {
+    return base >= 0.0 ? scale_mean_ * base : std::abs(scale_mean_) * base;
+  }
+
   /// X̂, the field's mean input per field pixel (Params::field_curve): the top-level regions
   /// seen so far, the unseen part shrunk towards the training fields' mean at this top level
   /// with σ̂'s weight k.
@@ -402,9 +415,9 @@ class FrontAwarePolicy {
 
   /// The lawnmower curve of this field as the cell gain model predicts it (Params::field_curve),
   /// relative to the top level's mIoU: at each lawnmower GSD g finer than the top level,
-  /// s·β(top, g)·X̂·(1 / σ̂), `x` = X̂ (field_input_estimate), `inv_sigma` = 1 / σ̂; 0 at the top
-  /// level; its upper envelope. With a training field `corrected_by`, each rise times that
-  /// field's real / predicted rise (Params::curve_ratio).
+  /// s·β(top, g)·X̂·(1 / σ̂) (s applied by scaled()), `x` = X̂ (field_input_estimate),
+  /// `inv_sigma` = 1 / σ̂; 0 at the top level; its upper envelope. With a training field
+  /// `corrected_by`, each rise times that field's real / predicted rise (Params::curve_ratio).
   [[nodiscard]] std::vector<CurvePoint> field_curve(const DecisionContext& c, double x, double inv_sigma,
                                                     const ReferenceCurve* corrected_by) const {
     std::vector<CurvePoint> curve;
@@ -412,7 +425,7 @@ class FrontAwarePolicy {
       if (l.gsd_cm > c.top_gsd_cm) continue;  // coarser than the top level: not what it compares with
       const double slope = l.gsd_cm < c.top_gsd_cm ? model_.cells()->at(c.top_gsd_cm, l.gsd_cm).gain_slope : 0.0;
       const double ratio = corrected_by ? rise_ratio(*corrected_by, c.top_gsd_cm, l.gsd_cm, slope) : 1.0;
-      curve.push_back({l.time_s, scale_mean_ * slope * x * inv_sigma * ratio});
+      curve.push_back({l.time_s, scaled(slope * x * inv_sigma * ratio)});
     }
     return upper_envelope(std::move(curve));
   }

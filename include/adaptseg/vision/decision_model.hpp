@@ -45,7 +45,8 @@ using ModelGp = GainModel::Gp;
 }  // namespace detail
 
 /// The keys of the cell gain model's points in a model file (`gain_model.cells`), one list each.
-inline constexpr std::array<std::pair<const char*, double CellGainModel::Point::*>, 8> kCellPointKeys{{
+/// The last, `proxy_slope_sd` (since 2026-11-27), may be missing: 0, the scene check as before it.
+inline constexpr std::array<std::pair<const char*, double CellGainModel::Point::*>, 9> kCellPointKeys{{
     {"top_gsd_cm", &CellGainModel::Point::top_gsd_cm},
     {"sub_gsd_cm", &CellGainModel::Point::sub_gsd_cm},
     {"gain_slope", &CellGainModel::Point::gain_slope},
@@ -54,6 +55,7 @@ inline constexpr std::array<std::pair<const char*, double CellGainModel::Point::
     {"relabel_noise", &CellGainModel::Point::relabel_noise},
     {"proxy_slope", &CellGainModel::Point::proxy_slope},
     {"proxy_noise", &CellGainModel::Point::proxy_noise},
+    {"proxy_slope_sd", &CellGainModel::Point::proxy_slope_sd},
 }};
 
 /// A calibrated decision model and its provenance.
@@ -300,12 +302,13 @@ struct DecisionModel {
       const DecisionInput input = parse_decision_input(c.text("input"));
       std::vector<CellGainModel::Point> points;
       for (const auto& [key, member] : kCellPointKeys) {
+        if (member == &CellGainModel::Point::proxy_slope_sd && !c.has(key)) continue;
         const auto v = c.numbers(key);
         if (points.empty()) points.resize(v.size());
         if (v.empty() || v.size() != points.size())
           detail::yaml_error(r.where(), "'gain_model.cells' needs one top_gsd_cm, sub_gsd_cm, gain_slope, gain_noise, "
-                                        "relabel_slope, relabel_noise, proxy_slope and proxy_noise value per point "
-                                        "(>= 1 point)");
+                                        "relabel_slope, relabel_noise, proxy_slope, proxy_noise and (optional) "
+                                        "proxy_slope_sd value per point (>= 1 point)");
         for (std::size_t j = 0; j < v.size(); ++j) points[j].*member = v[j];
       }
       model.set_cells(CellGainModel(input, std::move(points)));
