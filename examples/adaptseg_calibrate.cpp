@@ -146,6 +146,14 @@ int main(int argc, char** argv) {
       for (const auto& [input, score] : cal.cell_input_scores)
         std::printf("  %-16s %+.3f\n", adaptseg::to_string(input).c_str(), score);
       std::printf("%zu cell samples\n", cal.cell_samples.size());
+      if (const auto& cells = cal.decision_function.model().cells()) {
+        std::printf("cell gain model of %s per pair of GSDs (gain slope beta; the scene check's proxy slope gamma "
+                    "and its spread between the training fields tau):\n",
+                    adaptseg::to_string(cells->input()).c_str());
+        for (const auto& p : cells->points())
+          std::printf("  %5.2f -> %5.2f cm/px  beta %+.3f  gamma %+.3f  tau %.3f\n", p.top_gsd_cm, p.sub_gsd_cm,
+                      p.gain_slope, p.proxy_slope, p.proxy_slope_sd);
+      }
     }
     std::printf("%zu region samples; linear sigma range [%.4f, %.4f]; model -> %s\n", cal.samples.size(),
                 cal.linear.sigma_low, cal.linear.sigma_high, out_file.string().c_str());

@@ -211,6 +211,28 @@ determinism)
     fail "cells.csv does not hold the $cells cell samples reported"
   head -1 "$work/a/cells.csv" | grep -q '^field,region,top_gsd_cm,sub_gsd_cm,field_px,field_share,field_sigma,relabelled,field_gain,top_sigma,.*,fine_expected_error,' ||
     fail "cells.csv header: $(head -1 "$work/a/cells.csv")"
+  # The scene check's slopes: proxy_slopes.py refits from cells.csv the gain slope, the proxy
+  # slope and its spread between the fields that the calibration printed (CellGainModel::fit).
+  input=$(sed -n 's/^cell gain model of \([a-z_]*\) per pair.*/\1/p' "$work/a/calibrate.log")
+  [ -n "$input" ] || fail "the calibration printed no cell gain model"
+  "$python" "$examples/tools/proxy_slopes.py" "$work/a/cells.csv" "$input" >"$work/slopes.md" ||
+    fail "proxy_slopes.py failed"
+  "$python" - "$work/a/calibrate.log" "$work/slopes.md" <<'EOF' || fail "proxy_slopes.py disagrees with the calibration"
+import re, sys
+printed = {}
+for line in open(sys.argv[1]):
+    m = re.match(r"\s*([\d.]+) -> +([\d.]+) cm/px  beta (\S+)  gamma (\S+)  tau (\S+)", line)
+    if m:
+        printed[(float(m[1]), float(m[2]))] = [float(v) for v in m.groups()[2:]]
+tool = {}
+for line in open(sys.argv[2]):
+    m = re.match(r"\| ([\d.]+) -> ([\d.]+) \| (\S+) \| (\S+) \| (\S+) \|", line)
+    if m:
+        tool[(float(m[1]), float(m[2]))] = [float(v) for v in m.groups()[2:]]
+assert printed and printed.keys() == tool.keys(), (printed, tool)
+for k in printed:
+    assert all(abs(a - b) <= 0.0015 for a, b in zip(printed[k], tool[k])), (k, printed[k], tool[k])
+EOF
   for s in lawnmower adaptive linear; do
     for f in result.json path.png map.png; do
       cmp "$work/a/$s/$f" "$work/b/$s/$f" || fail "$s/$f differs between two runs"
