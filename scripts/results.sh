@@ -62,7 +62,8 @@
 #   them gained, on the tiles each network (NETS, default erfnet-dubai mobilenetv2-dubai) was
 #   trained on (1, 2, 3, 5) and on those it never saw (4, 6): adaptseg_cell_study --csv at 12.5,
 #   10 and 5 cm/px, then examples/tools/proxy_table.py. Independent of the other parts; about
-#   20 minutes on 2 cores for the two networks.
+#   20 minutes on 2 cores for the two networks. NETS=ensemble-dubai adds the ensemble's tables
+#   (with its members' split among the inputs) and keeps the other networks'.
 # sigma-prior: the previous defaults' runs (part previous) flown again with the models
 #   `oracle-previous` saved, only the front-aware rule's sigma_prior_weight changed (0.01 and 1;
 #   the calibrated models have 0.25): how much the prior on the field's share of L holds the
@@ -437,8 +438,8 @@ fi
 
 if [ "$part" = proxy-check ]; then
   out=$root/proxy-check
-  rm -rf "${out:?}"
   mkdir -p "$out"
+  for net in ${NETS:-erfnet-dubai mobilenetv2-dubai}; do rm -f "$out/$net"-*; done  # other networks' tables stay
   for net in ${NETS:-erfnet-dubai mobilenetv2-dubai}; do
     for set in trained-on never-seen; do
       tiles="1 2 3 5"
