@@ -169,6 +169,7 @@ class CellGainModel {
       }
       Point p{g.top, g.sub, wxx > 0.0 ? wxg / wxx : 0.0, 0.0, wxx > 0.0 ? wxr / wxx : 0.0, 0.0, 0.0, 0.0};
       double eg = 0.0, er = 0.0, wdd = 0.0, wdg = 0.0;
+      FieldProxySums per_field;  // the same two sums per training field (τ_γ)
       bool proxy = true;
       for (const CellSample* c : g.cells) {
         const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
@@ -179,6 +180,10 @@ class CellGainModel {
         if (!proxy) continue;
         wdd += w * (x - xf) * (x - xf);
         wdg += w * (x - xf) * c->normalized_gain();
+        auto it = std::find_if(per_field.begin(), per_field.end(), [&](const auto& f) { return f.first == c->field; });
+        if (it == per_field.end()) it = per_field.insert(per_field.end(), {c->field, {0.0, 0.0}});
+        it->second[0] += w * (x - xf) * c->normalized_gain();
+        it->second[1] += w * (x - xf) * (x - xf);
       }
       p.gain_noise = wx > 0.0 ? eg / wx : 0.0;
       p.relabel_noise = wx > 0.0 ? er / wx : 0.0;
@@ -190,7 +195,7 @@ class CellGainModel {
           ep += w * std::pow(p.proxy_slope * (x - c->fine.value(input)) - p.gain_slope * x, 2);
         }
         p.proxy_noise = ep / wx;
-        p.proxy_slope_sd = field_slope_spread(g.cells, input, mean_px, p.proxy_slope);
+        p.proxy_slope_sd = field_slope_spread(per_field, p.proxy_slope);
       }
       points.push_back(p);
     }
@@ -263,19 +268,14 @@ class CellGainModel {
  private:
   [[nodiscard]] double x_of(const CellInputs& c) const noexcept { return value_of(c, input_); }
 
+  /// Per training field (index), the proxy fit's sums over its cells: {Σ w·d·ν, Σ w·d²}.
+  using FieldProxySums = std::vector<std::pair<std::size_t, std::array<double, 2>>>;
+
   /// τ_γ of one pair of GSDs (see the class comment): the proxy's slope fitted on each training
-  /// field's cells alone, γ_f, and their spread about the pooled `slope`, Σ_f (γ_f − γ)² / (n − 1)
-  /// over the n fields whose finer looks changed the input; |γ| where n < 2.
-  template <class Cells>
-  static double field_slope_spread(const Cells& cells, DecisionInput input, double mean_px, double slope) {
-    std::vector<std::pair<std::size_t, std::array<double, 2>>> fields;  // field, {Σ w·d·ν, Σ w·d²}
-    for (const CellSample* c : cells) {
-      const double d = value_of(c->top, input) - c->fine.value(input), w = c->top.field_px / mean_px;
-      auto it = std::find_if(fields.begin(), fields.end(), [&](const auto& f) { return f.first == c->field; });
-      if (it == fields.end()) it = fields.insert(fields.end(), {c->field, {0.0, 0.0}});
-      it->second[0] += w * d * c->normalized_gain();
-      it->second[1] += w * d * d;
-    }
+  /// field's cells alone, γ_f (from `fields`, the sums fit() collects), and their spread about
+  /// the pooled `slope`, Σ_f (γ_f − γ)² / (n − 1) over the n fields whose finer looks changed the
+  /// input; |γ| where n < 2.
+  static double field_slope_spread(const FieldProxySums& fields, double slope) {
     double sq = 0.0;
     std::size_t n = 0;
     for (const auto& [field, sums] : fields)
