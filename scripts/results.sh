@@ -61,7 +61,9 @@
 #   from the top-level image to the finer one over the re-mapped cells) tracks what re-mapping
 #   them gained, on the tiles each network (NETS, default erfnet-dubai mobilenetv2-dubai) was
 #   trained on (1, 2, 3, 5) and on those it never saw (4, 6): adaptseg_cell_study --csv at 12.5,
-#   10 and 5 cm/px, then examples/tools/proxy_table.py. Independent of the other parts; about
+#   10 and 5 cm/px, then examples/tools/proxy_table.py; and, from the same cells, how well the
+#   cell gain model's slope fitted on five tiles forecasts the sixth's best cells
+#   (examples/tools/slope_transfer.py). Independent of the other parts; about
 #   20 minutes on 2 cores for the two networks. NETS=ensemble-dubai adds the ensemble's tables
 #   (with its members' split among the inputs) and keeps the other networks'.
 # sigma-prior: the previous defaults' runs (part previous) flown again with the models
@@ -460,6 +462,11 @@ if [ "$part" = proxy-check ]; then
     /usr/bin/python3 examples/tools/proxy_table.py "$net, tiles it was trained on=$out/$net-trained-on.csv" \
       "$net, tiles it never saw=$out/$net-never-seen.csv"
   done
+  # The cell gain model's slope fitted on five tiles against the sixth's best cells: pooled
+  # over the cells, or the tiles' own slopes pooled as random effects (CellGainModel::fit).
+  transfer=()
+  for net in ${NETS:-erfnet-dubai mobilenetv2-dubai}; do transfer+=("$out/$net-trained-on.csv" "$out/$net-never-seen.csv"); done
+  /usr/bin/python3 examples/tools/slope_transfer.py "${transfer[@]}"
   exit 0
 fi
 
