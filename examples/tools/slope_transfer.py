@@ -69,7 +69,7 @@ def field_mean(cells, inp, mean_px):
 
 def random_effects(cells, inp, mean_px):
     """CellGainModel::field_slope: each field's slope b_f and its variance v_f = s_f^2 / sum w x^2
-    (fields of two cells or more holding input), tau^2 by the method of moments (Cochran's Q about
+    (fields of two cells or more whose cells hold input), tau^2 by the method of moments (Cochran's Q about
     the precision-weighted mean), then the mean of the b_f weighted by 1 / (v_f + tau^2)."""
     est = []
     for own in by_field(cells):

@@ -300,8 +300,9 @@ class CellGainModel {
   /// spread of the true slopes between fields, by the method of moments from Cochran's Q about
   /// the precision-weighted mean; then the mean of the b_f weighted by 1 / (v_f + τ²). Fields
   /// that agree within their cells' scatter weigh by their precision (near the fit pooled over
-  /// the cells); fields that disagree weigh alike (near the mean of their slopes). Fields with
-  /// fewer than two cells holding input, or none, do not count; with none, the pooled fit.
+  /// the cells); fields that disagree weigh alike (near the mean of their slopes). A field of
+  /// fewer than two cells, or whose cells hold no input, does not count; without any field that
+  /// counts, the fit pooled over the cells.
   static double field_slope(const std::vector<std::pair<std::size_t, FieldSlopeSums>>& fields) {
     std::vector<std::pair<double, double>> slopes;  // (b_f, v_f)
     double xy = 0.0, xx = 0.0;
@@ -311,7 +312,8 @@ class CellGainModel {
       if (!(f.xx > 0.0) || f.n < 2) continue;
       const double b = f.xy / f.xx;
       const double rss = std::max(0.0, f.yy - b * f.xy);
-      // A field its line fits exactly (the oracle at the field's GSD) still has a finite weight.
+      // A field whose line fits its cells exactly (the oracle at the field's GSD) still has a
+      // finite weight.
       slopes.emplace_back(b, std::max(rss / static_cast<double>(f.n - 1), 1e-12) / f.xx);
     }
     if (slopes.empty()) return xx > 0.0 ? xy / xx : 0.0;
