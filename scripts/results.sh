@@ -463,7 +463,7 @@ if [ "$part" = proxy-check ]; then
       "$net, tiles it never saw=$out/$net-never-seen.csv"
   done
   # The cell gain model's slope fitted on five tiles against the sixth's best cells: pooled
-  # over the cells, or the tiles' own slopes pooled as random effects (CellGainModel::fit).
+  # over the cells (CellGainModel::fit), the mean of the tiles' own slopes, or those pooled as random effects.
   transfer=()
   for net in ${NETS:-erfnet-dubai mobilenetv2-dubai}; do transfer+=("$out/$net-trained-on.csv" "$out/$net-never-seen.csv"); done
   /usr/bin/python3 examples/tools/slope_transfer.py "${transfer[@]}"

@@ -7,11 +7,9 @@ gamma * d. CellGainModel::fit fits gamma over the cells of all the training fiel
 squares through the origin, cells weighted by their field pixels) and tau, the spread of the
 slopes fitted on each field alone about it. This tool reads the cell samples that
 `adaptseg_calibrate --cell-samples-csv` writes and prints, per pair of GSDs, the gain slope
-beta (the fields' own slopes pooled as random effects, as CellGainModel::fit takes it since
-2026-11-27; slope_transfer.py), the proxy slope gamma pooled, tau, and both slopes per field,
-so that a reader sees where the fields disagree, and each field's share of the pooled gamma
-fit's weight (its cells' summed w * d^2: a field where the finer look barely changes the input
-says little about gamma).
+beta and the proxy slope gamma pooled, tau, and both slopes per field, so that a reader sees
+where the fields disagree, and each field's share of the pooled fit's weight (its cells'
+summed w * d^2: a field where the finer look barely changes the input says little about gamma).
 
   proxy_slopes.py CELLS.csv INPUT
 
@@ -20,8 +18,6 @@ INPUT: the model's `gain_model.cells.input` (sigma, expected_error, second_choic
 import csv
 import math
 import sys
-
-from slope_transfer import random_effects
 from collections import defaultdict
 
 
@@ -61,13 +57,11 @@ def main():
     for key in sorted(pairs):
         cells = pairs[key]
         mean_px = sum(float(c["field_px"]) for c in cells) / len(cells)
-        gamma, _, weight = slopes(cells, inp, mean_px)
+        gamma, beta, weight = slopes(cells, inp, mean_px)
         per = {}
         for name in fields:
             own = [c for c in cells if c["field"] == name]
             per[name] = slopes(own, inp, mean_px) if own else (math.nan, math.nan, 0.0)
-        # beta: the fields' own slopes pooled as random effects (CellGainModel::fit, since 2026-11-27).
-        beta = random_effects(cells, inp, mean_px)
         known = [g for g, _, _ in per.values() if math.isfinite(g)]
         tau = (math.sqrt(sum((g - gamma) ** 2 for g in known) / (len(known) - 1)) if len(known) >= 2
                else abs(gamma))

@@ -6,11 +6,12 @@ gain as beta * x, x a decision input of the top-level image. This tool compares 
 fitting beta on the training fields, leave one field out: on the cells of every field but one,
 
   pooled          least squares through the origin over all their cells (weights: field
-                  pixels), as CellGainModel::fit did until 2026-11-27;
+                  pixels), what CellGainModel::fit does;
   field mean      the same fit on each field alone, then the mean of the fields' slopes;
   random effects  the fields' slopes pooled as random effects (DerSimonian-Laird: weights
                   1 / (v_f + tau^2), v_f the variance of a field's slope from its cells' scatter,
-                  tau^2 the spread between fields), what CellGainModel::fit does now;
+                  tau^2 the spread between fields); flown on 2026-11-27 and not adopted
+                  (docs/results.md, "Slopes pooled over the training fields as random effects");
 
 then forecasts the field gain of the held-out field's best 20 % of cells (ranked by the input's
 mass, as the planner ranks them) and compares it with what re-mapping those cells alone gained.
@@ -68,7 +69,7 @@ def field_mean(cells, inp, mean_px):
 
 
 def random_effects(cells, inp, mean_px):
-    """CellGainModel::field_slope: each field's slope b_f and its variance v_f = s_f^2 / sum w x^2
+    """Each field's slope b_f and its variance v_f = s_f^2 / sum w x^2
     (fields of two cells or more whose cells hold input), tau^2 by the method of moments (Cochran's Q about
     the precision-weighted mean), then the mean of the b_f weighted by 1 / (v_f + tau^2)."""
     est = []

@@ -57,15 +57,9 @@ struct CellSample {
 /// For a cell c with input value x_c seen at GSD g_top and re-mapped at g:
 /// - its normalised gain ν_c (CellSample::normalized_gain) = β·x_c + ε, Var ε = κ·x_c;
 /// - its relabelled share χ_c = α·x_c + ε', Var ε' = κ_χ·x_c;
-/// β, α per (g_top, g): on each training field, weighted least squares through the origin over
-/// its calibration cells of that pair (weights: the cells' field pixels), then the fields'
-/// slopes pooled as random effects (field_slope): by their precision where they agree, alike
-/// where they disagree beyond their cells' scatter; κ, κ_χ: the weighted mean squared residual
-/// about them per unit of x, over every cell. A new field is one more field, not more cells of
-/// the training fields': a fit pooled over the cells follows the field with the most input (its
-/// weight grows with x²), and on the bundled Dubai tiles it forecast a held-out field's best
-/// cells about twice as far off (docs/results.md, "Slopes pooled over the training fields as
-/// random effects"). The variance grows with x because a cell's errors are what a re-mapping can
+/// β, α per (g_top, g): weighted least squares through the origin over the calibration cells
+/// of that pair (weights: the cells' field pixels); κ, κ_χ: the weighted mean squared residual
+/// per unit of x. The variance grows with x because a cell's errors are what a re-mapping can
 /// change: the ground-truth oracle's expected error is exactly the share of pixels its
 /// top-level map has wrong, and a re-mapping at the orthomosaic's GSD corrects all of them
 /// (β ≈ 1, κ ≈ 0). A network's cells scatter about β·x (its confidence is only partly honest),
@@ -165,17 +159,15 @@ class CellGainModel {
       double px = 0.0;
       for (const CellSample* c : g.cells) px += c->top.field_px;
       const double mean_px = px > 0.0 ? px / static_cast<double>(g.cells.size()) : 1.0;
-      // Per training field, the sums of its own slopes' fits (β and α: pooled over the fields as
-      // random effects, field_slope).
-      std::vector<std::pair<std::size_t, FieldSlopeSums>> gain_sums, relabel_sums;
-      double wx = 0.0;
+      double wxx = 0.0, wxg = 0.0, wxr = 0.0, wx = 0.0;
       for (const CellSample* c : g.cells) {
         const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
-        sums_of(gain_sums, c->field).add(w, x, c->normalized_gain());
-        sums_of(relabel_sums, c->field).add(w, x, c->relabelled);
+        wxx += w * x * x;
+        wxg += w * x * c->normalized_gain();
+        wxr += w * x * c->relabelled;
         wx += w * x;
       }
-      Point p{g.top, g.sub, field_slope(gain_sums), 0.0, field_slope(relabel_sums), 0.0, 0.0, 0.0};
+      Point p{g.top, g.sub, wxx > 0.0 ? wxg / wxx : 0.0, 0.0, wxx > 0.0 ? wxr / wxx : 0.0, 0.0, 0.0, 0.0};
       double eg = 0.0, er = 0.0, wdd = 0.0, wdg = 0.0;
       FieldProxySums per_field;  // the same two sums per training field (τ_γ)
       bool proxy = true;
@@ -275,66 +267,6 @@ class CellGainModel {
 
  private:
   [[nodiscard]] double x_of(const CellInputs& c) const noexcept { return value_of(c, input_); }
-
-  /// One training field's sums for the slope through the origin of y on x (weights w).
-  struct FieldSlopeSums {
-    double xy = 0.0, xx = 0.0, yy = 0.0;
-    std::size_t n = 0;
-    void add(double w, double x, double y) {
-      xy += w * x * y;
-      xx += w * x * x;
-      yy += w * y * y;
-      ++n;
-    }
-  };
-
-  static FieldSlopeSums& sums_of(std::vector<std::pair<std::size_t, FieldSlopeSums>>& fields, std::size_t field) {
-    auto it = std::find_if(fields.begin(), fields.end(), [&](const auto& f) { return f.first == field; });
-    if (it == fields.end()) it = fields.insert(fields.end(), {field, FieldSlopeSums{}});
-    return it->second;
-  }
-
-  /// β or α of one pair of GSDs from each training field's sums (see the class comment): each
-  /// field's own slope b_f = Σ w·x·y / Σ w·x² and its variance v_f = s_f² / Σ w·x² (s_f² the
-  /// field's residual variance), pooled as random effects (DerSimonian and Laird 1986): τ², the
-  /// spread of the true slopes between fields, by the method of moments from Cochran's Q about
-  /// the precision-weighted mean; then the mean of the b_f weighted by 1 / (v_f + τ²). Fields
-  /// that agree within their cells' scatter weigh by their precision (near the fit pooled over
-  /// the cells); fields that disagree weigh alike (near the mean of their slopes). A field of
-  /// fewer than two cells, or whose cells hold no input, does not count; without any field that
-  /// counts, the fit pooled over the cells.
-  static double field_slope(const std::vector<std::pair<std::size_t, FieldSlopeSums>>& fields) {
-    std::vector<std::pair<double, double>> slopes;  // (b_f, v_f)
-    double xy = 0.0, xx = 0.0;
-    for (const auto& [field, f] : fields) {
-      xy += f.xy;
-      xx += f.xx;
-      if (!(f.xx > 0.0) || f.n < 2) continue;
-      const double b = f.xy / f.xx;
-      const double rss = std::max(0.0, f.yy - b * f.xy);
-      // A field whose line fits its cells exactly (the oracle at the field's GSD) still has a
-      // finite weight.
-      slopes.emplace_back(b, std::max(rss / static_cast<double>(f.n - 1), 1e-12) / f.xx);
-    }
-    if (slopes.empty()) return xx > 0.0 ? xy / xx : 0.0;
-    double sw = 0.0, sww = 0.0, swb = 0.0;
-    for (const auto& [b, v] : slopes) {
-      sw += 1.0 / v;
-      sww += 1.0 / (v * v);
-      swb += b / v;
-    }
-    const double fixed = swb / sw;
-    double q = 0.0;
-    for (const auto& [b, v] : slopes) q += (b - fixed) * (b - fixed) / v;
-    const double c = sw - sww / sw;
-    const double tau2 = c > 0.0 ? std::max(0.0, (q - static_cast<double>(slopes.size() - 1)) / c) : 0.0;
-    double num = 0.0, den = 0.0;
-    for (const auto& [b, v] : slopes) {
-      num += b / (v + tau2);
-      den += 1.0 / (v + tau2);
-    }
-    return num / den;
-  }
 
   /// Per training field (index), the proxy fit's sums over its cells: {Σ w·d·ν, Σ w·d²}.
   using FieldProxySums = std::vector<std::pair<std::size_t, std::array<double, 2>>>;
