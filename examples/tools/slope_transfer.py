@@ -22,9 +22,10 @@ right, over every (held-out field, pair of GSDs), and with --pairs the sums per 
 
 CELLS.csv: the cell samples `adaptseg_calibrate --cell-samples-csv` writes (one file per
 network and class), or the cells `adaptseg_cell_study --csv` writes (columns class, gsd_cm and
-gain instead: each class on its own; the top level, the study's, is printed as 0). Fields of several files of
-one network and class may be given together (e.g. the study's tiles a network was trained on and
-those it never saw); each group needs at least two fields.
+gain instead: each class on its own; the top level, the study's, is printed as 0). The study's
+files of one network (NAME-trained-on.csv, NAME-never-seen.csv) join one group per class; a
+group needs at least two fields. An input a backend does not give (nan) counts as 0, as in
+CellGainModel.
 """
 import argparse
 import csv
@@ -32,6 +33,12 @@ import math
 from collections import defaultdict
 
 INPUTS = ["sigma", "boundary", "ambiguity", "expected_error", "second_choice"]
+
+
+def x_of(c, inp):
+    """The cell's top-level input; 0 where unknown (CellGainModel::value_of)."""
+    x = float(c["top_" + inp])
+    return x if math.isfinite(x) else 0.0
 
 
 def normalised_gain(c):
@@ -43,7 +50,7 @@ def slope_sums(cells, inp, mean_px):
     """(sum w x nu, sum w x^2) of `cells`, w = field pixels / mean_px."""
     a = b = 0.0
     for c in cells:
-        x = float(c["top_" + inp])
+        x = x_of(c, inp)
         w = float(c["field_px"]) / mean_px
         a += w * x * normalised_gain(c)
         b += w * x * x
@@ -78,7 +85,7 @@ def random_effects(cells, inp, mean_px):
         if b <= 0 or len(own) < 2:
             continue
         beta = a / b
-        rss = sum(float(c["field_px"]) / mean_px * (normalised_gain(c) - beta * float(c["top_" + inp])) ** 2
+        rss = sum(float(c["field_px"]) / mean_px * (normalised_gain(c) - beta * x_of(c, inp)) ** 2
                   for c in own)
         est.append((beta, max(rss / (len(own) - 1), 1e-12) / b))
     if not est:
@@ -145,11 +152,11 @@ def main():
                 for held in fields:
                     train = [c for c in cells if c["field"] != held]
                     test = sorted((c for c in cells if c["field"] == held),
-                                  key=lambda c: -float(c["top_" + inp]) * float(c["field_share"]))
+                                  key=lambda c: -x_of(c, inp) * float(c["field_share"]))
                     best = test[:round(args.share * len(test))]
                     realised = sum(float(c["field_gain"]) for c in best)
                     # Field gain per unit of beta: x * share / field sigma (CellSample::normalized_gain).
-                    per_beta = sum(float(c["top_" + inp]) * float(c["field_share"]) / float(c["field_sigma"])
+                    per_beta = sum(x_of(c, inp) * float(c["field_share"]) / float(c["field_sigma"])
                                    for c in best if float(c["field_sigma"]) > 0)
                     realised_sum += realised
                     for fit_name, fit in FITS.items():
