@@ -462,8 +462,9 @@ if [ "$part" = proxy-check ]; then
     /usr/bin/python3 examples/tools/proxy_table.py "$net, tiles it was trained on=$out/$net-trained-on.csv" \
       "$net, tiles it never saw=$out/$net-never-seen.csv"
   done
-  # The cell gain model's slope fitted on five tiles against the sixth's best cells: pooled
-  # over the cells (CellGainModel::fit), the mean of the tiles' own slopes, or those pooled as random effects.
+  # The cell gain model's slope fitted on five tiles against the sixth's best cells: pooled over
+  # the cells (CellGainModel::fit), the mean of the tiles' own slopes, or those pooled as random
+  # effects.
   transfer=()
   for net in ${NETS:-erfnet-dubai mobilenetv2-dubai}; do transfer+=("$out/$net-trained-on.csv" "$out/$net-never-seen.csv"); done
   /usr/bin/python3 examples/tools/slope_transfer.py "${transfer[@]}"

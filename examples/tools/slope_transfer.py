@@ -76,9 +76,9 @@ def field_mean(cells, inp, mean_px):
 
 
 def random_effects(cells, inp, mean_px):
-    """Each field's slope b_f and its variance v_f = s_f^2 / sum w x^2
-    (fields of two cells or more whose cells hold input), tau^2 by the method of moments (Cochran's Q about
-    the precision-weighted mean), then the mean of the b_f weighted by 1 / (v_f + tau^2)."""
+    """Each field's slope b_f and its variance v_f = s_f^2 / sum w x^2 (fields of two cells or
+    more whose cells hold input), tau^2 by the method of moments (Cochran's Q about the
+    precision-weighted mean), then the mean of the b_f weighted by 1 / (v_f + tau^2)."""
     est = []
     for own in by_field(cells):
         a, b = slope_sums(own, inp, mean_px)
@@ -119,7 +119,8 @@ def main():
     ap.add_argument("--share", type=float, default=0.2, help="share of the held-out field's cells taken (0.2)")
     args = ap.parse_args()
     inputs = args.inputs.split(",")
-    total = {inp: {k: [0.0, 0, 0] for k in FITS} for inp in inputs}  # squared error, sign right, count
+    # Per input and over all of them: per fit, squared error, forecasts of the right sign, count.
+    total = {inp: {k: [0.0, 0, 0] for k in FITS} for inp in inputs + ["all"]}
     pair_rows = []
     groups_of = defaultdict(list)  # (network, class) -> cells of every file given for it
     for path in args.cells:
@@ -130,11 +131,8 @@ def main():
         for r in rows:  # adaptseg_cell_study's columns
             if "sub_gsd_cm" not in r:
                 r["top_gsd_cm"], r["sub_gsd_cm"], r["field_gain"] = "0", r["gsd_cm"], r["gain"]
-        by_class = defaultdict(list)
         for r in rows:
-            by_class[r.get("class", "")].append(r)
-        for cls, rows in sorted(by_class.items()):
-            groups_of[(path_key(path), cls)].extend(rows)
+            groups_of[(path_key(path), r.get("class", ""))].append(r)
     for (name, cls), rows in sorted(groups_of.items()):
         path = name + (f" ({cls})" if cls else "")
         groups = defaultdict(list)
@@ -162,23 +160,18 @@ def main():
                     for fit_name, fit in FITS.items():
                         forecast = fit(train, inp, mean_px) * per_beta
                         forecast_sum[fit_name] += forecast
-                        t = total[inp][fit_name]
-                        t[0] += (forecast - realised) ** 2
-                        t[1] += (forecast > 0) == (realised > 0)
-                        t[2] += 1
+                        for t in (total[inp][fit_name], total["all"][fit_name]):
+                            t[0] += (forecast - realised) ** 2
+                            t[1] += (forecast > 0) == (realised > 0)
+                            t[2] += 1
                 pair_rows.append((path, inp, key, realised_sum, forecast_sum))
     print(f"Leave one field out: forecast field gain of the held-out field's best {args.share:.0%} of cells "
           f"against what re-mapping them gained, over {len(groups_of)} (network, class) group(s) and every "
           "(field, pair of GSDs): root mean squared error / share of the forecasts of the right sign")
     print("| input | cases | " + " | ".join(FITS) + " |")
     print("| --- | ---: | " + " | ".join("---:" for _ in FITS) + " |")
-    all_ = {k: [0.0, 0, 0] for k in FITS}
     for inp in inputs + ["all"]:
-        t = all_ if inp == "all" else total[inp]
-        if inp != "all":
-            for k in FITS:
-                for i in range(3):
-                    all_[k][i] += t[k][i]
+        t = total[inp]
         n = t["pooled"][2]
         if n:
             cols = " | ".join(f"{math.sqrt(t[k][0] / n):.4f} / {t[k][1] / n:.2f}" for k in FITS)
