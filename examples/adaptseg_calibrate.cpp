@@ -134,12 +134,16 @@ int main(int argc, char** argv) {
       std::printf("\n");
     }
     std::printf("settings tried on the training fields, the chosen one first (time, mIoU and front margin: "
-                "means over the fields flown; descents: all of them):\n");
-    std::printf("  %-52s %9s %8s %13s %13s %8s\n", "setting", "time [s]", "mIoU", "front margin", "worst margin",
-                "descents");
-    for (const auto& t : cal.trials)
-      std::printf("  %-52s %9.1f %8.4f %+13.4f %+13.4f %8d\n", t.description.c_str(), t.time_s, t.miou_interest,
+                "means over the fields flown; descents: all of them; then each field's front margin, in the "
+                "order flown):\n");
+    std::printf("  %-52s %9s %8s %13s %13s %8s  %s\n", "setting", "time [s]", "mIoU", "front margin", "worst margin",
+                "descents", "per field");
+    for (const auto& t : cal.trials) {
+      std::printf("  %-52s %9.1f %8.4f %+13.4f %+13.4f %8d ", t.description.c_str(), t.time_s, t.miou_interest,
                   t.front_margin, t.worst_margin, t.descents);
+      for (double m : t.margins) std::printf(" %+.4f", m);
+      std::printf("\n");
+    }
     if (!cal.cell_input_scores.empty()) {
       std::printf("decision inputs tried for ranking the cells (share of the achievable gain the best 20 %% of the "
                   "training fields' cells capture), the chosen one first:\n");

@@ -192,6 +192,13 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "[%6.1f s] calibrated: %zu samples, %s, train front margin %+.4f, %d descents\n",
                    elapsed(), cal.samples.size(), cal.trials.front().description.c_str(), loaded->train_front_margin,
                    cal.trials.front().descents);
+      // Every setting the calibration tried, with each training field's margin: why this one.
+      for (const auto& t : cal.trials) {
+        std::fprintf(stderr, "           tried %s: front margin %+.4f, %d descents, per field", t.description.c_str(),
+                     t.front_margin, t.descents);
+        for (double m : t.margins) std::fprintf(stderr, " %+.4f", m);
+        std::fprintf(stderr, "\n");
+      }
       adaptseg::examples::print_field_segmenters(*loaded);
     }
     const adaptseg::DecisionModel& model = *loaded;
