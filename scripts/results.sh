@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reproduces docs/results.md.
-#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed] [JOBS]
+#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed|all-tiles] [JOBS]
 #   (default: all, one job per core)
 #
 # oracle: the paper's experiment with the ground-truth oracle, deterministic (fixed 0.1 s per
@@ -95,13 +95,20 @@
 #   1 m/s against 2 m/s level (--vertical-speed 1; the paper's model climbs at the level speed):
 #   what the immediate descent, the survey-first tour and staying low along a row are worth
 #   when altitude is expensive, as on real multicopters (issue 17). About 8 minutes on 2 cores.
+# all-tiles: calibrated on all six Dubai tiles, as a user with every bundled tile calibrates
+#   for new ground (and as acceptance does), per class, with the oracle and the networks NETS
+#   (default mobilenetv2-dubai): the training folds of the z choice (each tile flown with the
+#   model fitted on the other five) with the cell gain model's slopes pooled over the cells and
+#   over the fields, each alone (--slope-pooling), and which the default, trying both, keeps
+#   (examples/tools/fold_table.py). Nothing flown beyond the folds; about 15 minutes on 2 cores
+#   for the oracle and MobileNetV2.
 # Outputs: out/results/<configuration>/<run>/ (adaptseg_evaluate's files); prints the tables.
 set -euo pipefail
 part=${1:-all}
 jobs=${2:-$(nproc 2>/dev/null || echo 2)}
 case "$part" in all | oracle | oracle-default | paper | network | ensemble | ensemble-split | cells | curve-check | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | z-choice-network | \
-  cross-fit | network-variants | proxy-check | vertical-speed) ;;
-  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed] [JOBS]" >&2
+  cross-fit | network-variants | proxy-check | vertical-speed | all-tiles) ;;
+  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed|all-tiles] [JOBS]" >&2
     exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
@@ -435,6 +442,31 @@ if [ "$part" = network-held-out ]; then
   labels=()
   for net in ${NETS:-erfnet-dubai}; do labels+=("$net-held-out=$(dir_list "$root/$(held_out_config "$net")"/*/)"); done
   /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
+  exit 0
+fi
+
+if [ "$part" = all-tiles ]; then
+  out=$root/all-tiles
+  rm -rf "${out:?}"
+  mkdir -p "$out"
+  train=()
+  for k in 1 2 3 4 5 6; do train+=(--train "$(dubai "$k")"); done
+  for net in oracle ${NETS:-mobilenetv2-dubai}; do
+    flags=("${fixed[@]}")
+    [ "$net" = oracle ] || flags=(--model-file "examples/models/$net" "${network[@]}")
+    for cls in $classes; do
+      for pooling in cells fields; do
+        "$calibrate_bin" "${train[@]}" --interest "$cls" "${flags[@]}" --slope-pooling "$pooling" \
+          --out "$out/$net-$cls.$pooling.yaml" >"$out/$net-$cls.$pooling.txt" 2>&1 &
+        throttle
+      done
+    done
+  done
+  wait
+  for f in "$out"/*.txt; do
+    [ -s "${f%.txt}.yaml" ] || { echo "FAILED: $f" >&2; exit 1; }
+  done
+  /usr/bin/python3 examples/tools/fold_table.py --order cells,fields "$out"
   exit 0
 fi
 

@@ -215,6 +215,20 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
   const auto& cells = cal.decision_function.model().cells();
   REQUIRE(cells.has_value());
   CHECK(cells->input() == cal.cell_input_scores.front().first);
+  // Each z tried with the slopes pooled over the cells and over the fields; the chosen one
+  // first, the best mean margin of its pooling, and the model's cell gain model pooled as it says.
+  REQUIRE(cal.trials.size() == 2 * options.confidences.size());
+  const std::string chosen = " slopes=" + to_string(cells->pooling());
+  CHECK(cal.trials.front().description.ends_with(chosen));
+  int by_fields = 0;
+  for (const auto& trial : cal.trials) {
+    if (trial.description.ends_with(chosen)) CHECK(trial.front_margin <= cal.trials.front().front_margin);
+    by_fields += trial.description.ends_with(" slopes=fields");
+  }
+  CHECK(by_fields == static_cast<int>(options.confidences.size()));
+  const CellGainModel refit = CellGainModel::fit(cal.cell_samples, cells->input(), cells->pooling());
+  for (std::size_t k = 0; k < cells->points().size(); ++k)
+    CHECK(refit.points()[k].gain_slope == cells->points()[k].gain_slope);
   // Cells of both fields at both candidate GSDs; each re-mapped alone.
   std::size_t at_g0 = 0;
   for (const CellSample& c : cal.cell_samples) {
@@ -269,6 +283,28 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
   }
   const DecisionModel before = DecisionModel::load(tmp.path() / "old.yaml");
   for (const auto& p : before.decision_function.model().cells()->points()) CHECK(p.proxy_slope_sd == 0.0);
+  // The pooling: kept where it is `fields`, absent (cells, as files before it) otherwise; any
+  // other value refused naming the key.
+  CHECK(back_cells.pooling() == cells->pooling());
+  {
+    std::string text = t::read_file(tmp.path() / "model.yaml");
+    const auto line = text.find("    slope_pooling: fields\n");
+    if (line != std::string::npos) text.erase(line, std::string("    slope_pooling: fields\n").size());
+    const auto input = text.find("    input: ");
+    REQUIRE(input != std::string::npos);
+    const auto next = text.find('\n', input) + 1;
+    t::write_file(tmp.path() / "cells.yaml", text);
+    CHECK(DecisionModel::load(tmp.path() / "cells.yaml").decision_function.model().cells()->pooling() ==
+          SlopePooling::cells);
+    const auto with = [&](const std::string& value) {
+      t::write_file(tmp.path() / "pooling.yaml",
+                    text.substr(0, next) + "    slope_pooling: " + value + "\n" + text.substr(next));
+      return tmp.path() / "pooling.yaml";
+    };
+    CHECK(DecisionModel::load(with("fields")).decision_function.model().cells()->pooling() == SlopePooling::fields);
+    CHECK_THROWS_WITH_AS((void)DecisionModel::load(with("both")), doctest::Contains("slope_pooling' must be cells or fields"),
+                         std::invalid_argument);
+  }
   // Each training field's mean input at both top levels: the nominal one's is field_input, and
   // the finer top level's map has less wrong (the oracle's expected error is its share of
   // wrong pixels), so less of it. The file keeps both.
@@ -290,8 +326,19 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
   CHECK(ao.cell_input == cells->input());
   // A labels-only choice: only the inputs the labels give are tried.
   options.cell_inputs = {DecisionInput::sigma, DecisionInput::boundary};
+  options.slope_poolings = {SlopePooling::fields};  // and one pooling only: no name in the trials
   const CalibrationResult labels_only = calibrate(std::span<const Field>(fields), oracle, options);
   REQUIRE(labels_only.cell_input_scores.size() == 2);
+  REQUIRE(labels_only.trials.size() == options.confidences.size());
+  CHECK(labels_only.trials.front().description.find("slopes") == std::string::npos);
+  CHECK(labels_only.decision_function.model().cells()->pooling() == SlopePooling::fields);
+  // Poolings the search cannot use are refused before anything is sampled.
+  for (const std::vector<SlopePooling>& bad : {std::vector<SlopePooling>{},
+                                               std::vector<SlopePooling>{SlopePooling::cells, SlopePooling::cells}}) {
+    options.slope_poolings = bad;
+    CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
+                         doctest::Contains("slope_poolings"), std::invalid_argument);
+  }
   // A ranked model without its cell model is refused when read.
   std::string text = t::read_file(tmp.path() / "model.yaml");
   const auto at = text.find("  cells:");
@@ -310,6 +357,33 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
     CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "bad_inputs.yaml"), doctest::Contains(message),
                          std::invalid_argument);
   }
+}
+
+TEST_CASE("calibration: another slope pooling replaces the first only where the folds prefer it beyond their noise") {
+  const auto trial = [](std::vector<double> margins) {
+    RuleTrial t;
+    for (double m : margins) t.front_margin += m / static_cast<double>(margins.size());
+    t.margins = std::move(margins);
+    return t;
+  };
+  const auto select = [](const std::vector<RuleTrial>& trials) {
+    std::vector<const RuleTrial*> p;
+    for (const auto& t : trials) p.push_back(&t);
+    return adaptseg::detail::select_pooling(p);
+  };
+  // Better on every fold by 0.002 to 0.004: mean difference 0.003, standard error 0.0003.
+  CHECK(select({trial({0.0, 0.01, 0.0, 0.02, 0.0}), trial({0.002, 0.013, 0.004, 0.023, 0.003})}) == 1);
+  // Better on average by 0.0008, from one fold of five (+0.005, another -0.001): standard error
+  // 0.0011, not beyond it.
+  CHECK(select({trial({0.0, 0.01, 0.0, 0.02, 0.0}), trial({0.0, 0.009, 0.0, 0.025, 0.0})}) == 0);
+  // Just beyond it: +0.006 on one fold and +0.001 on another (mean 0.0014, standard error 0.0012).
+  CHECK(select({trial({0.0, 0.01, 0.0, 0.02, 0.0}), trial({0.001, 0.01, 0.0, 0.026, 0.0})}) == 1);
+  // Equal, or worse: the first.
+  CHECK(select({trial({0.0, 0.01}), trial({0.0, 0.01})}) == 0);
+  CHECK(select({trial({0.0, 0.01}), trial({-0.001, 0.005})}) == 0);
+  // Of several beyond the noise, the best mean; one alone is the one.
+  CHECK(select({trial({0.0, 0.0, 0.0}), trial({0.01, 0.011, 0.012}), trial({0.02, 0.021, 0.022})}) == 2);
+  CHECK(select({trial({0.0, 0.01})}) == 0);
 }
 
 TEST_CASE("calibration: confidence levels the training fields cannot tell apart go to the more cautious") {

@@ -133,3 +133,61 @@ TEST_CASE("cell gain model: the scene check's proxy slope, and how far it differ
   CHECK_THROWS_AS(CellGainModel(DecisionInput::sigma, {{15.0, 5.0, 1.0, 0.0, 1.0, 0.0, 1.0, 0.0, -0.1}}),
                   std::invalid_argument);
 }
+
+TEST_CASE("cell gain model: slopes pooled over the training fields' cells, or the fields' own slopes as random effects") {
+  // Field 0 holds much input (x up to 0.9) and loses by re-mapping (-0.4 x, relabelling 0.2 x);
+  // field 1 holds little (x <= 0.05) and gains (0.8 x, relabelling 1.0 x).
+  std::vector<CellSample> s;
+  for (double x : {0.5, 0.7, 0.9}) s.push_back(cell(0, 15.0, 5.0, x, 1000.0, -0.4 * x, 0.2 * x));
+  for (double x : {0.01, 0.03, 0.05}) s.push_back(cell(1, 15.0, 5.0, x, 1000.0, 0.8 * x, 1.0 * x));
+  // Pooled over the cells (the default), field 0's x^2 outweighs field 1's by about 300 to 1.
+  const CellGainModel by_cells = CellGainModel::fit(s, DecisionInput::expected_error);
+  CHECK(by_cells.pooling() == SlopePooling::cells);
+  double wxy = 0.0, wxx = 0.0;
+  for (const CellSample& c : s) {
+    const double x = c.top.value(DecisionInput::expected_error);
+    wxy += x * c.normalized_gain();
+    wxx += x * x;
+  }
+  CHECK(by_cells.at(15.0, 5.0).gain_slope == doctest::Approx(wxy / wxx));
+  CHECK(by_cells.at(15.0, 5.0).gain_slope < -0.39);
+  // Each field's own line is exact, so the two disagree far beyond their cells' scatter: as
+  // random effects they weigh alike, and the slope is the mean of theirs.
+  const CellGainModel by_fields = CellGainModel::fit(s, DecisionInput::expected_error, SlopePooling::fields);
+  CHECK(by_fields.pooling() == SlopePooling::fields);
+  const CellGainModel::Point p = by_fields.at(15.0, 5.0);
+  CHECK(p.gain_slope == doctest::Approx(0.2));
+  CHECK(p.relabel_slope == doctest::Approx(0.6));
+  // The residuals about the pooled slope are the noise: each field is 0.6 or 0.4 off it.
+  double ex = 0.0, e2 = 0.0;
+  for (const CellSample& c : s) {
+    const double x = c.top.value(DecisionInput::expected_error);
+    ex += x;
+    e2 += std::pow(c.normalized_gain() - 0.2 * x, 2);
+  }
+  CHECK(p.gain_noise == doctest::Approx(e2 / ex));
+  // A field whose cells hold no input says nothing about the slope.
+  s.push_back(cell(2, 15.0, 5.0, 0.0, 1000.0, 0.0, 0.0));
+  s.push_back(cell(2, 15.0, 5.0, 0.0, 1000.0, 0.0, 0.0));
+  CHECK(CellGainModel::fit(s, DecisionInput::expected_error, SlopePooling::fields).at(15.0, 5.0).gain_slope ==
+        doctest::Approx(0.2));
+  // One field: its own slope, whichever the pooling.
+  const std::vector<CellSample> one(s.begin(), s.begin() + 3);
+  CHECK(CellGainModel::fit(one, DecisionInput::expected_error, SlopePooling::fields).at(15.0, 5.0).gain_slope ==
+        CellGainModel::fit(one, DecisionInput::expected_error).at(15.0, 5.0).gain_slope);
+
+  // Fields that agree within their cells' scatter weigh by their precision: field 0's slope,
+  // 0.5 from cells of much input and little scatter, against field 1's, about 0.56 from cells
+  // of little input and scatter of half their gain, gives about 0.5 (their plain mean: 0.53).
+  std::vector<CellSample> agree;
+  int k = 0;
+  for (double x : {0.5, 0.7, 0.9, 0.6}) agree.push_back(cell(0, 15.0, 5.0, x, 1000.0, 0.5 * x * (k++ % 2 ? 1.01 : 0.99), 0.0));
+  for (double x : {0.01, 0.03, 0.05, 0.02})
+    agree.push_back(cell(1, 15.0, 5.0, x, 1000.0, 0.56 * x * (k++ % 2 ? 1.5 : 0.5), 0.0));
+  CHECK(CellGainModel::fit(agree, DecisionInput::expected_error, SlopePooling::fields).at(15.0, 5.0).gain_slope ==
+        doctest::Approx(0.5).epsilon(0.004));
+
+  CHECK(parse_slope_pooling(to_string(SlopePooling::fields)) == SlopePooling::fields);
+  CHECK(parse_slope_pooling(to_string(SlopePooling::cells)) == SlopePooling::cells);
+  CHECK_THROWS_WITH_AS((void)parse_slope_pooling("field"), doctest::Contains("cells, fields"), std::invalid_argument);
+}

@@ -180,6 +180,7 @@ struct CalibrationCli {
   std::string sigma_prior = "given";
   std::optional<double> segmentation_time_s;
   std::vector<std::string> cell_inputs;
+  std::vector<std::string> slope_poolings{"cells", "fields"};
   std::string curve = "corrected";
 
   void add_to(CLI::App& app) {
@@ -205,6 +206,14 @@ struct CalibrationCli {
                        "(default: sigma, boundary, ambiguity, expected_error, second_choice, those the backend gives; "
                        "the one that ranks the training fields' cells best is saved in the model)")
             ->delimiter(','),
+        app.add_option("--slope-pooling", slope_poolings,
+                       "coverage ranked, several training fields: how the cell gain model's slopes may pool the "
+                       "fields, tried with every confidence level on the training fields, comma-separated: cells "
+                       "(one fit over every field's cells) and fields (each field's own slope, pooled as random "
+                       "effects); the best is saved in the model")
+            ->delimiter(',')
+            ->check(CLI::IsMember({"cells", "fields"}))
+            ->capture_default_str(),
         app.add_option("--curve", curve,
                        "front-aware rule with --coverage ranked: the lawnmower curve a descent is compared with, "
                        "the training fields' (training), this field's as the cell gain model predicts it from "
@@ -256,6 +265,8 @@ struct CalibrationCli {
     options.front_aware.curve_ratio = curve == "corrected";
     options.cell_inputs.clear();
     for (const auto& name : cell_inputs) options.cell_inputs.push_back(parse_decision_input(name));
+    options.slope_poolings.clear();
+    for (const auto& name : slope_poolings) options.slope_poolings.push_back(parse_slope_pooling(name));
     options.fit.gain_inputs = gain_inputs == "delta-sigma-height" ? GainModel::GainInputs::delta_sigma_and_height
                                                                   : GainModel::GainInputs::delta_sigma;
     options.segmentation_time_s = segmentation_time_s.value_or(common.seg_time_s.value_or(0.1));

@@ -5,7 +5,8 @@ Usage: /usr/bin/python3 examples/tools/z_choice_table.py DIR
 
 DIR holds, per run NAME (written by `bash scripts/results.sh z-choice`):
   NAME.trials.txt  adaptseg_calibrate's output: per z, the mean and worst front margin over the
-                   training folds;
+                   training folds (where it tried several slope poolings, those of the one it
+                   chose: the model the test field is flown with);
   NAME.zZ/         adaptseg_evaluate's output with the run's model, its z replaced by Z.
 Prints, as Markdown, per way of choosing z (on the training folds only, a fixed z, and the best
 z per run read off the test field, which no rule can know: the ceiling), the runs with margin
@@ -27,13 +28,16 @@ def load(root):
     for path in sorted(glob.glob(os.path.join(root, "*.trials.txt"))):
         name = os.path.basename(path)[: -len(".trials.txt")]
         folds = {}
-        chosen = None  # adaptseg_calibrate lists the chosen z first
+        chosen = None  # adaptseg_calibrate lists the chosen setting first
+        pooling = None  # the chosen slope pooling, where several were tried: its trials only
         with open(path) as f:
             for line in f:
-                m = re.match(r"\s+front-aware z=(\S+)\s+\S+\s+\S+\s+(\S+)\s+(\S+)\s+\d+", line)
+                m = re.match(r"\s+front-aware z=(\S+)(?: slopes=(\S+))?\s+\S+\s+\S+\s+(\S+)\s+(\S+)\s+\d+", line)
                 if m:
-                    folds[m.group(1)] = (float(m.group(2)), float(m.group(3)))
-                    chosen = chosen or m.group(1)
+                    if chosen is None:
+                        chosen, pooling = m.group(1), m.group(2)
+                    if m.group(2) == pooling:
+                        folds[m.group(1)] = (float(m.group(3)), float(m.group(4)))
         test = {}
         for z in ZS:
             with open(os.path.join(root, f"{name}.z{z}", "results.csv"), newline="") as f:

@@ -17,12 +17,37 @@
 #include <limits>
 #include <numeric>
 #include <span>
+#include <stdexcept>
 #include <string>
+#include <string_view>
 #include <tuple>
 #include <utility>
 #include <vector>
 
 namespace adaptseg {
+
+/// How the cell gain model's slopes β and α pool the training fields (CellGainModel::fit):
+/// - `cells`: one weighted least-squares fit over every field's cells together. A field weighs
+///   by its cells' Σ w·x², so the field where the input is largest sets the slope (MobileNetV2's
+///   vegetation on the bundled Dubai tiles: tile 6, 86 % of that weight, whose cells lose when
+///   re-mapped, made β(15, 10) negative while the best cells of every training field gained).
+/// - `fields`: each field's own slope, pooled as random effects (DerSimonian and Laird 1986):
+///   by the fields' precision where they agree within their cells' scatter, alike where they
+///   disagree beyond it. A new field is one more field, not more cells of the training fields'.
+/// Which one a model uses is a calibration choice (CalibrationOptions::slope_poolings, chosen
+/// with the confidence level z by leave-one-field-out); docs/method.md, "Cells that pay".
+enum class SlopePooling { cells, fields };
+
+/// The name of a pooling (`slope_pooling` in the model file, `--slope-pooling` of the programs).
+[[nodiscard]] inline std::string to_string(SlopePooling p) { return p == SlopePooling::fields ? "fields" : "cells"; }
+
+/// Parses a pooling's name.
+/// @throws std::invalid_argument for anything but `cells` or `fields`.
+[[nodiscard]] inline SlopePooling parse_slope_pooling(std::string_view name) {
+  if (name == "cells") return SlopePooling::cells;
+  if (name == "fields") return SlopePooling::fields;
+  throw std::invalid_argument("slope pooling must be one of cells, fields, not '" + std::string(name) + "'");
+}
 
 /// One cell of a top-level region, re-mapped alone from a lower altitude on a training field
 /// (calibration knows the truth): a row of the cell gain model.
@@ -57,9 +82,11 @@ struct CellSample {
 /// For a cell c with input value x_c seen at GSD g_top and re-mapped at g:
 /// - its normalised gain ν_c (CellSample::normalized_gain) = β·x_c + ε, Var ε = κ·x_c;
 /// - its relabelled share χ_c = α·x_c + ε', Var ε' = κ_χ·x_c;
-/// β, α per (g_top, g): weighted least squares through the origin over the calibration cells
-/// of that pair (weights: the cells' field pixels); κ, κ_χ: the weighted mean squared residual
-/// per unit of x. The variance grows with x because a cell's errors are what a re-mapping can
+/// β, α per (g_top, g): weighted least squares through the origin (weights: the cells' field
+/// pixels) over the calibration cells of that pair, pooled over the training fields as
+/// SlopePooling says (over their cells, or each field's own slope pooled as random effects:
+/// field_slope); κ, κ_χ: the weighted mean squared residual about them per unit of x, over
+/// every cell. The variance grows with x because a cell's errors are what a re-mapping can
 /// change: the ground-truth oracle's expected error is exactly the share of pixels its
 /// top-level map has wrong, and a re-mapping at the orthomosaic's GSD corrects all of them
 /// (β ≈ 1, κ ≈ 0). A network's cells scatter about β·x (its confidence is only partly honest),
@@ -116,7 +143,8 @@ class CellGainModel {
   /// @throws std::invalid_argument for no point, GSDs that are not finite and positive with the
   ///         descent's finer than the top's, pairs not in increasing (top, descent) order, or a
   ///         slope or noise that is not finite (noise < 0).
-  CellGainModel(DecisionInput input, std::vector<Point> points) : input_(input), points_(std::move(points)) {
+  CellGainModel(DecisionInput input, std::vector<Point> points, SlopePooling pooling = SlopePooling::cells)
+      : input_(input), pooling_(pooling), points_(std::move(points)) {
     detail::require(!points_.empty(), "CellGainModel: at least one point is needed; count", points_.size());
     for (std::size_t k = 0; k < points_.size(); ++k) {
       const Point& p = points_[k];
@@ -135,9 +163,11 @@ class CellGainModel {
     }
   }
 
-  /// Fits the model of input `input` to `samples` (cells of every pair of GSDs).
+  /// Fits the model of input `input` to `samples` (cells of every pair of GSDs), its slopes
+  /// pooled over the training fields as `pooling` says.
   /// @throws std::invalid_argument for no sample, or a sample that is not finite.
-  [[nodiscard]] static CellGainModel fit(std::span<const CellSample> samples, DecisionInput input) {
+  [[nodiscard]] static CellGainModel fit(std::span<const CellSample> samples, DecisionInput input,
+                                         SlopePooling pooling = SlopePooling::cells) {
     detail::require(!samples.empty(), "CellGainModel::fit: number of samples must be > 0", 0);
     struct Group {
       double top = 0.0, sub = 0.0;
@@ -159,15 +189,18 @@ class CellGainModel {
       double px = 0.0;
       for (const CellSample* c : g.cells) px += c->top.field_px;
       const double mean_px = px > 0.0 ? px / static_cast<double>(g.cells.size()) : 1.0;
-      double wxx = 0.0, wxg = 0.0, wxr = 0.0, wx = 0.0;
+      // Per training field, the sums of its own fits of β and α (pooled by field_slope).
+      std::vector<std::pair<std::size_t, FieldSlopeSums>> gain_sums, relabel_sums;
+      double wx = 0.0;
       for (const CellSample* c : g.cells) {
         const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
-        wxx += w * x * x;
-        wxg += w * x * c->normalized_gain();
-        wxr += w * x * c->relabelled;
+        // `cells`: every cell in one field's sums, one fit.
+        const std::size_t field = pooling == SlopePooling::fields ? c->field : 0;
+        sums_of(gain_sums, field).add(w, x, c->normalized_gain());
+        sums_of(relabel_sums, field).add(w, x, c->relabelled);
         wx += w * x;
       }
-      Point p{g.top, g.sub, wxx > 0.0 ? wxg / wxx : 0.0, 0.0, wxx > 0.0 ? wxr / wxx : 0.0, 0.0, 0.0, 0.0};
+      Point p{g.top, g.sub, field_slope(gain_sums), 0.0, field_slope(relabel_sums), 0.0, 0.0, 0.0};
       double eg = 0.0, er = 0.0, wdd = 0.0, wdg = 0.0;
       FieldProxySums per_field;  // the same two sums per training field (τ_γ)
       bool proxy = true;
@@ -202,7 +235,7 @@ class CellGainModel {
     std::sort(points.begin(), points.end(), [](const Point& a, const Point& b) {
       return a.top_gsd_cm < b.top_gsd_cm || (a.top_gsd_cm == b.top_gsd_cm && a.sub_gsd_cm < b.sub_gsd_cm);
     });
-    return CellGainModel(input, std::move(points));
+    return CellGainModel(input, std::move(points), pooling);
   }
 
   /// The forecast of re-mapping `cells`, seen at `top_gsd_cm`, at `sub_gsd_cm`, in shares of a
@@ -263,10 +296,76 @@ class CellGainModel {
   }
 
   [[nodiscard]] DecisionInput input() const noexcept { return input_; }
+  /// How the slopes were pooled over the training fields (what fit was told; saved in the model file).
+  [[nodiscard]] SlopePooling pooling() const noexcept { return pooling_; }
   [[nodiscard]] const std::vector<Point>& points() const noexcept { return points_; }
 
  private:
   [[nodiscard]] double x_of(const CellInputs& c) const noexcept { return value_of(c, input_); }
+
+  /// One training field's sums for the slope through the origin of y on x (weights w).
+  struct FieldSlopeSums {
+    double xy = 0.0, xx = 0.0, yy = 0.0;
+    std::size_t n = 0;
+    void add(double w, double x, double y) {
+      xy += w * x * y;
+      xx += w * x * x;
+      yy += w * y * y;
+      ++n;
+    }
+  };
+
+  static FieldSlopeSums& sums_of(std::vector<std::pair<std::size_t, FieldSlopeSums>>& fields, std::size_t field) {
+    auto it = std::find_if(fields.begin(), fields.end(), [&](const auto& f) { return f.first == field; });
+    if (it == fields.end()) it = fields.insert(fields.end(), {field, FieldSlopeSums{}});
+    return it->second;
+  }
+
+  /// β or α of one pair of GSDs from each training field's sums (see the class comment): each
+  /// field's own slope b_f = Σ w·x·y / Σ w·x² and its variance v_f = s_f² / Σ w·x² (s_f² the
+  /// field's residual variance), pooled as random effects (DerSimonian and Laird 1986): τ², the
+  /// spread of the true slopes between fields, by the method of moments from Cochran's Q about
+  /// the precision-weighted mean; then the mean of the b_f weighted by 1 / (v_f + τ²). Fields
+  /// that agree within their cells' scatter weigh by their precision (near the fit pooled over
+  /// the cells); fields that disagree weigh alike (near the mean of their slopes). A field of
+  /// fewer than two cells, or whose cells hold no input, does not count; without any field that
+  /// counts, the fit pooled over the cells (also the result for one field's sums: its own fit).
+  static double field_slope(const std::vector<std::pair<std::size_t, FieldSlopeSums>>& fields) {
+    if (fields.size() == 1) {  // one field's (or SlopePooling::cells: all cells') own fit
+      const FieldSlopeSums& f = fields.front().second;
+      return f.xx > 0.0 ? f.xy / f.xx : 0.0;
+    }
+    std::vector<std::pair<double, double>> slopes;  // (b_f, v_f)
+    double xy = 0.0, xx = 0.0;
+    for (const auto& [field, f] : fields) {
+      xy += f.xy;
+      xx += f.xx;
+      if (!(f.xx > 0.0) || f.n < 2) continue;
+      const double b = f.xy / f.xx;
+      const double rss = std::max(0.0, f.yy - b * f.xy);
+      // A field whose line fits its cells exactly (the oracle at the field's GSD) still has a
+      // finite weight.
+      slopes.emplace_back(b, std::max(rss / static_cast<double>(f.n - 1), 1e-12) / f.xx);
+    }
+    if (slopes.empty()) return xx > 0.0 ? xy / xx : 0.0;
+    double sw = 0.0, sww = 0.0, swb = 0.0;
+    for (const auto& [b, v] : slopes) {
+      sw += 1.0 / v;
+      sww += 1.0 / (v * v);
+      swb += b / v;
+    }
+    const double fixed = swb / sw;
+    double q = 0.0;
+    for (const auto& [b, v] : slopes) q += (b - fixed) * (b - fixed) / v;
+    const double c = sw - sww / sw;
+    const double tau2 = c > 0.0 ? std::max(0.0, (q - static_cast<double>(slopes.size() - 1)) / c) : 0.0;
+    double num = 0.0, den = 0.0;
+    for (const auto& [b, v] : slopes) {
+      num += b / (v + tau2);
+      den += 1.0 / (v + tau2);
+    }
+    return num / den;
+  }
 
   /// Per training field (index), the proxy fit's sums over its cells: {Σ w·d·ν, Σ w·d²}.
   using FieldProxySums = std::vector<std::pair<std::size_t, std::array<double, 2>>>;
@@ -292,6 +391,7 @@ class CellGainModel {
   }
 
   DecisionInput input_;
+  SlopePooling pooling_ = SlopePooling::cells;
   std::vector<Point> points_;
 };
 

@@ -5,6 +5,7 @@
 /// RuleSearchResult): shared by calibrate() (calibration.hpp) and each rule's own search
 /// (front_aware_rule.hpp, utility_rule.hpp).
 
+#include <adaptseg/core/cell_gain_model.hpp>
 #include <adaptseg/core/decision_function.hpp>
 #include <adaptseg/core/lawnmower_curve.hpp>
 #include <adaptseg/core/linear_decision.hpp>
@@ -80,6 +81,14 @@ struct CalibrationOptions {
   /// to pay on any of them (docs/results.md, "What any choice of z can buy").
   FrontAwarePolicy::Params front_aware{};
   std::vector<double> confidences = kDefaultConfidences;
+  /// Front-aware rule, DescentCoverage::ranked, several training fields: how the cell gain
+  /// model may pool its slopes over the fields (SlopePooling), each tried with every z of
+  /// `confidences`, each fold's model fitted without its field with that pooling (and the field
+  /// factor's prior spread estimated with it), each with its z of best mean front margin. The
+  /// first pooling is kept unless another beats it on the folds by more than one standard error
+  /// of their paired margins (detail::select_pooling). One training field: the first only (a
+  /// field's own slope either way).
+  std::vector<SlopePooling> slope_poolings{SlopePooling::cells, SlopePooling::fields};
   /// Front-aware rule, σ̂'s prior (FrontAwarePolicy `sigma_prior_weight` k, `sigma_prior_sd` τ)
   /// with several training fields: `given` keeps `front_aware`'s; `spread` estimates τ on the
   /// training fields (estimate_sigma_prior) and keeps k; `estimated` estimates both. Each fold

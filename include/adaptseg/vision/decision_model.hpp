@@ -194,6 +194,8 @@ struct DecisionModel {
     if (const auto& cells = gm.cells()) {
       e << YAML::Key << "cells" << YAML::Value << YAML::BeginMap;
       e << YAML::Key << "input" << YAML::Value << to_string(cells->input());
+      if (cells->pooling() != SlopePooling::cells)
+        e << YAML::Key << "slope_pooling" << YAML::Value << to_string(cells->pooling());
       for (const auto& [key, member] : kCellPointKeys) {
         std::vector<double> v;
         for (const auto& p : cells->points()) v.push_back(p.*member);
@@ -311,7 +313,13 @@ struct DecisionModel {
                                         "proxy_slope_sd value per point (>= 1 point)");
         for (std::size_t j = 0; j < v.size(); ++j) points[j].*member = v[j];
       }
-      model.set_cells(CellGainModel(input, std::move(points)));
+      // Absent (files of adaptseg before 2026-11-27, or pooled over the cells): cells.
+      const std::string pooling_name = c.has("slope_pooling") ? c.text("slope_pooling") : "cells";
+      if (pooling_name != "cells" && pooling_name != "fields")
+        detail::yaml_error(r.where(), "'gain_model.cells.slope_pooling' must be cells or fields (got '" + pooling_name +
+                                          "')");
+      const SlopePooling pooling = parse_slope_pooling(pooling_name);
+      model.set_cells(CellGainModel(input, std::move(points), pooling));
     }
     const auto rule = r.map("rule");
     const std::string kind = rule.text("kind");

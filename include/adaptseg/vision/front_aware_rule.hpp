@@ -92,9 +92,35 @@ struct TopLevelRecorder {
   [[nodiscard]] std::string name() const { return "top-level"; }
 };
 
-inline std::string z_text(double z) {
-  std::string s = format_number(z);
-  return "front-aware z=" + s;
+/// Which of several settings of the same folds to keep (`trials`, the best of each slope
+/// pooling, CalibrationOptions::slope_poolings' order): the first, unless another beats it on
+/// the folds by more than one standard error of their paired differences, m̄ − m̄₁ >
+/// sd(m − m₁) / sqrt(n) over the n folds (the one-standard-error rule of cross-validation,
+/// Breiman et al. 1984, towards the first, the default); of those that do, the best mean.
+/// Five training fields tell two poolings apart poorly, and a setting the folds prefer by less
+/// than their own scatter is as likely to lose on a new field (docs/results.md, "Slopes pooled
+/// over the cells or over the fields, chosen by the folds").
+inline std::size_t select_pooling(std::span<const RuleTrial* const> trials) {
+  std::size_t best = 0;
+  const std::vector<double>& first = trials.front()->margins;
+  for (std::size_t k = 1; k < trials.size(); ++k) {
+    const std::vector<double>& m = trials[k]->margins;
+    if (m.size() != first.size() || m.size() < 2) continue;
+    const double n = static_cast<double>(m.size());
+    double mean = 0.0;
+    for (std::size_t f = 0; f < m.size(); ++f) mean += (m[f] - first[f]) / n;
+    double ss = 0.0;
+    for (std::size_t f = 0; f < m.size(); ++f) ss += std::pow(m[f] - first[f] - mean, 2);
+    if (mean > std::sqrt(ss / (n - 1.0) / n) && trials[k]->front_margin > trials[best]->front_margin) best = k;
+  }
+  return best;
+}
+
+/// A trial's name: its z, and its slope pooling where the search tried several.
+inline std::string z_text(double z, const SlopePooling* pooling = nullptr) {
+  std::string s = "front-aware z=" + format_number(z);
+  if (pooling) s += " slopes=" + to_string(*pooling);
+  return s;
 }
 
 }  // namespace detail
@@ -180,9 +206,15 @@ struct FrontAwareRule {
   }
 
   /// Refuses options its search cannot use (before calibrate() samples anything).
-  /// @throws std::invalid_argument if `confidences` is empty.
+  /// @throws std::invalid_argument if `confidences` or `slope_poolings` is empty, or names a
+  ///         pooling twice.
   static void check_options(const CalibrationOptions& options) {
     detail::require(!options.confidences.empty(), "calibrate: confidences must not be empty", 0);
+    detail::require(!options.slope_poolings.empty(), "calibrate: slope_poolings must not be empty", 0);
+    for (std::size_t k = 0; k < options.slope_poolings.size(); ++k)
+      for (std::size_t j = 0; j < k; ++j)
+        detail::require(options.slope_poolings[j] != options.slope_poolings[k],
+                        "calibrate: slope_poolings names a pooling twice:", to_string(options.slope_poolings[k]));
   }
 
   /// The calibration search (CalibrationOptions: `front_aware`, `confidences`, `sigma_prior`):
@@ -190,9 +222,11 @@ struct FrontAwareRule {
   /// estimated from their spread instead, and the prior as `sigma_prior` says); z chosen among
   /// `confidences` by the mean front margin over the training fields, each flown with a model
   /// fitted without it (one field: the field and its halves, with the model of the whole
-  /// field). Ties go to the larger z. `fly(field, policy, curve, margin)` flies an adaptive
+  /// field), ties to the larger z; with ranked cells and several fields this for each of
+  /// `slope_poolings`, and the first pooling kept unless another beats it by more than the
+  /// folds' noise (detail::select_pooling). `fly(field, policy, curve, margin)` flies an adaptive
   /// mission of `policy` and scores it against `curve` (detail::fly_scored).
-  /// @throws std::invalid_argument if `confidences` is empty.
+  /// @throws std::invalid_argument as check_options.
   template <class Fly>
   [[nodiscard]] static RuleSearchResult search(const RuleSearchInputs& in, Fly&& fly) {
     const CalibrationOptions& options = in.options;
@@ -212,68 +246,41 @@ struct FrontAwareRule {
       recorder.trace.field_sigma = reference[f].field_sigma;
       traces.push_back(std::move(recorder.trace));
     }
-    std::vector<RuleTrial> trials;
     FrontAwarePolicy::Params base = options.front_aware;
     base.online = true;
     // One fold per training field, its model fitted without it (one field: its layouts, the
-    // whole field's model).
+    // whole field's model), the cell gain model (ranked) fitted below with each pooling tried.
     struct Fold {
       const Field* field;
       const std::vector<CurvePoint>* curve;
       GainModel model;
       std::vector<ReferenceCurve> reference;
       std::optional<SigmaPrior> sigma_prior;  ///< estimated without the field
+      std::vector<CellSample> cells;          ///< the other fields' (ranked, several fields)
     };
     std::vector<Fold> folds;
-    std::vector<double> field_scales;
     if (fields.size() == 1) {
-      folds.push_back({&fields.front(), &in.curves.front(), in.model, reference, std::nullopt});
+      folds.push_back({&fields.front(), &in.curves.front(), in.model, reference, std::nullopt, {}});
       for (std::size_t k = 0; k < in.halves.size(); ++k)
-        folds.push_back({&in.halves[k], &in.half_curves[k], in.model, reference, std::nullopt});
+        folds.push_back({&in.halves[k], &in.half_curves[k], in.model, reference, std::nullopt, {}});
     } else {
       for (std::size_t k = 0; k < fields.size(); ++k) {
         std::vector<RegionSample> rest;
         std::vector<ReferenceCurve> rest_reference;
         std::vector<TopLevelTrace> rest_traces;
+        std::vector<CellSample> rest_cells;
         for (std::size_t j = 0; j < fields.size(); ++j)
           if (j != k) {
             rest.insert(rest.end(), in.samples[j].begin(), in.samples[j].end());
             rest_reference.push_back(reference[j]);
             if (fit_sigma_prior) rest_traces.push_back(traces[j]);
+            if (ranked) rest_cells.insert(rest_cells.end(), in.cells[j].begin(), in.cells[j].end());
           }
         GainModel m = GainModel::fit(rest, options.fit);
         m.set_refit_every(options.refit_every);
-        double num = 0.0, den = 0.0;
-        if (ranked) {
-          // The field factor s of this field under the cell model that did not see it: the
-          // least-squares scale of the cells' forecast gains onto their realised gains.
-          std::vector<CellSample> rest_cells;
-          for (std::size_t j = 0; j < fields.size(); ++j)
-            if (j != k) rest_cells.insert(rest_cells.end(), in.cells[j].begin(), in.cells[j].end());
-          m.set_cells(CellGainModel::fit(rest_cells, in.adaptive.cell_input));
-          for (const CellSample& c : in.cells[k]) {
-            const double f = m.cells()->cell_gain(c.top_gsd_cm, c.sub_gsd_cm, c.top) * c.top.field_px;
-            num += f * c.normalized_gain() * c.top.field_px;
-            den += f * f;
-          }
-        } else {
-          // The field factor s of this field under the model that did not see it: the
-          // least-squares scale of C's forecasts onto what its descents relabelled.
-          for (const RegionSample& s : in.samples[k]) {
-            const GainForecast f = m.forecast(s.delta_h_m, s.sigma_top);
-            num += f.relabelled * s.relabelled.interest_share;
-            den += f.relabelled * f.relabelled;
-          }
-        }
-        if (den > 0.0) field_scales.push_back(num / den);
         folds.push_back({&fields[k], &in.curves[k], std::move(m), std::move(rest_reference),
-                         estimate_sigma_prior(rest_traces)});
+                         estimate_sigma_prior(rest_traces), std::move(rest_cells)});
       }
-    }
-    if (field_scales.size() >= 2) {  // ω: the spread of s about 1 over the training fields
-      double ss = 0.0;
-      for (double s : field_scales) ss += (s - 1.0) * (s - 1.0);
-      base.scale_prior_sd = std::max(0.1, std::sqrt(ss / static_cast<double>(field_scales.size())));
     }
     const auto apply_prior = [&](FrontAwarePolicy::Params& p, const std::optional<SigmaPrior>& prior) {
       if (!prior || options.sigma_prior == CalibrationOptions::SigmaPriorSource::given) return;
@@ -281,30 +288,93 @@ struct FrontAwareRule {
       if (options.sigma_prior == CalibrationOptions::SigmaPriorSource::estimated) p.sigma_prior_weight = prior->weight;
     };
     apply_prior(base, estimate_sigma_prior(traces));
-    for (double z : options.confidences) {
-      RuleTrial t;
-      t.description = detail::z_text(z);
-      FrontAwarePolicy::Params p = base;
-      p.confidence = z;
-      for (const Fold& fold : folds) {
-        FrontAwarePolicy::Params fold_params = p;  // σ̂'s prior: the fold's estimate replaces all fields'
-        apply_prior(fold_params, fold.sigma_prior);
-        FrontAwarePolicy policy(fold.model, fold.reference, fold_params);
-        double margin = 0.0;
-        const AdaptiveResult r = fly(*fold.field, policy, *fold.curve, margin);
-        detail::add_to_trial(t, r, margin);
+    // The poolings tried: several only where the cell gain model pools several fields.
+    const bool pools = ranked && fields.size() >= 2;
+    const std::vector<SlopePooling> poolings =
+        pools ? options.slope_poolings : std::vector<SlopePooling>{options.slope_poolings.front()};
+    struct Setting {
+      std::size_t pooling;  ///< index into poolings
+      double z;
+      FrontAwarePolicy::Params params;
+    };
+    std::vector<RuleTrial> trials;
+    std::vector<Setting> settings;
+    for (std::size_t pi = 0; pi < poolings.size(); ++pi) {
+      FrontAwarePolicy::Params pooled = base;
+      std::vector<GainModel> models;
+      std::vector<double> field_scales;
+      for (std::size_t k = 0; k < folds.size(); ++k) {
+        GainModel m = folds[k].model;
+        if (pools) {
+          m.set_cells(CellGainModel::fit(folds[k].cells, in.adaptive.cell_input, poolings[pi]));
+          // The field factor s of this field under the cell model that did not see it: the
+          // least-squares scale of the cells' forecast gains onto their realised gains.
+          double num = 0.0, den = 0.0;
+          for (const CellSample& c : in.cells[k]) {
+            const double f = m.cells()->cell_gain(c.top_gsd_cm, c.sub_gsd_cm, c.top) * c.top.field_px;
+            num += f * c.normalized_gain() * c.top.field_px;
+            den += f * f;
+          }
+          if (den > 0.0) field_scales.push_back(num / den);
+        } else if (fields.size() >= 2) {
+          // The field factor s of this field under the model that did not see it: the
+          // least-squares scale of C's forecasts onto what its descents relabelled.
+          double num = 0.0, den = 0.0;
+          for (const RegionSample& s : in.samples[k]) {
+            const GainForecast f = m.forecast(s.delta_h_m, s.sigma_top);
+            num += f.relabelled * s.relabelled.interest_share;
+            den += f.relabelled * f.relabelled;
+          }
+          if (den > 0.0) field_scales.push_back(num / den);
+        }
+        models.push_back(std::move(m));
       }
-      trials.push_back(std::move(t));
+      if (field_scales.size() >= 2) {  // ω: the spread of s about 1 over the training fields
+        double ss = 0.0;
+        for (double s : field_scales) ss += (s - 1.0) * (s - 1.0);
+        pooled.scale_prior_sd = std::max(0.1, std::sqrt(ss / static_cast<double>(field_scales.size())));
+      }
+      for (double z : options.confidences) {
+        RuleTrial t;
+        t.description = detail::z_text(z, poolings.size() > 1 ? &poolings[pi] : nullptr);
+        FrontAwarePolicy::Params p = pooled;
+        p.confidence = z;
+        for (std::size_t k = 0; k < folds.size(); ++k) {
+          FrontAwarePolicy::Params fold_params = p;  // σ̂'s prior: the fold's estimate replaces all fields'
+          apply_prior(fold_params, folds[k].sigma_prior);
+          FrontAwarePolicy policy(models[k], folds[k].reference, fold_params);
+          double margin = 0.0;
+          const AdaptiveResult r = fly(*folds[k].field, policy, *folds[k].curve, margin);
+          detail::add_to_trial(t, r, margin);
+        }
+        trials.push_back(std::move(t));
+        settings.push_back({pi, z, p});
+      }
     }
-    std::size_t best = 0;
-    for (std::size_t k = 1; k < trials.size(); ++k)
-      if (trials[k].front_margin > trials[best].front_margin ||
-          (trials[k].front_margin == trials[best].front_margin && options.confidences[k] > options.confidences[best]))
-        best = k;
-    base.confidence = options.confidences[best];
+    // Per pooling, its z of best mean margin (ties to the larger z); then the first pooling's,
+    // unless another beats it by more than the noise of the folds (select_pooling).
+    std::vector<std::size_t> best_of(poolings.size(), trials.size());
+    for (std::size_t k = 0; k < trials.size(); ++k) {
+      std::size_t& b = best_of[settings[k].pooling];
+      if (b == trials.size() || trials[k].front_margin > trials[b].front_margin ||
+          (trials[k].front_margin == trials[b].front_margin && settings[k].z > settings[b].z))
+        b = k;
+    }
+    std::vector<const RuleTrial*> candidates;
+    for (std::size_t b : best_of) candidates.push_back(&trials[b]);
+    const std::size_t best = best_of[detail::select_pooling(candidates)];
+    base = settings[best].params;
     std::rotate(trials.begin(), trials.begin() + static_cast<std::ptrdiff_t>(best),
                 trials.begin() + static_cast<std::ptrdiff_t>(best) + 1);
-    return {DecisionFunction(FrontAwarePolicy(in.model, reference, base)), std::move(trials)};
+    // The model of every field, its cell gain model pooled as chosen.
+    GainModel model = in.model;
+    const SlopePooling pooling = poolings[settings[best].pooling];
+    if (ranked && model.cells() && model.cells()->pooling() != pooling) {
+      std::vector<CellSample> all;
+      for (const auto& c : in.cells) all.insert(all.end(), c.begin(), c.end());
+      model.set_cells(CellGainModel::fit(all, in.adaptive.cell_input, pooling));
+    }
+    return {DecisionFunction(FrontAwarePolicy(std::move(model), reference, base)), std::move(trials)};
   }
 };
 
