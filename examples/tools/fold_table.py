@@ -8,13 +8,14 @@ all-tiles`: RUN a network or the oracle and a class, CHOICE e.g. a slope pooling
 Each lists the settings tried with their mean front margin over the training folds (each
 training field flown with the model fitted without it) and each fold's margin, the chosen one
 first. Prints, as Markdown, per run and choice: the setting chosen, its mean margin and
-descents, and each fold's margin at z = 0 (the setting that descends most), and which choice
-the best mean margin picks (what a calibration trying all of them keeps); then per choice the
-mean over the runs of the chosen setting's margin. The picked choice's mean is optimistic: the
-largest of estimates from the same folds.
+descents, and each fold's margin at z = 0 (the setting that descends most), and which choice a
+calibration trying all of them keeps: the first, unless another's chosen setting beats it by
+more than one standard error of their paired fold margins (as detail::select_pooling does;
+of several, the best mean); then per choice the mean over the runs of the chosen setting's
+margin. The kept choice's mean is optimistic: picked on the same folds.
 
-  --order A,B   the choices, ties to the earlier (default: sorted names; cells before fields,
-                as calibration breaks ties between slope poolings)
+  --order A,B   the choices, the first the default (default: sorted names; cells before fields,
+                as calibration orders the slope poolings)
 """
 import glob
 import os
@@ -36,6 +37,16 @@ def read(path):
     if not out:
         sys.exit(f"{path}: no front-aware setting listed (an adaptseg_calibrate output?)")
     return out
+
+
+def beats(folds, first):
+    """Whether `folds` beat `first` (paired) by more than one standard error of the differences."""
+    if len(folds) != len(first) or len(folds) < 2:
+        return False
+    d = [a - b for a, b in zip(folds, first)]
+    n = len(d)
+    mean = sum(d) / n
+    return mean > (sum((x - mean) ** 2 for x in d) / (n - 1) / n) ** 0.5
 
 
 def main():
@@ -61,12 +72,13 @@ def main():
             sys.exit(f"{run}: expected the choices {', '.join(choices)}, found {', '.join(sorted(by_choice))}")
         best = None
         for c in choices:
-            name, z, mean, descents, _ = by_choice[c][0]
+            name, z, mean, descents, folds = by_choice[c][0]
             zero = next((t for t in by_choice[c] if t[1] == 0.0), None)
-            folds = " ".join(f"{v:+.4f}" for v in zero[4]) if zero else ""
-            print(f"| {run} | {c} | {name} | {mean:+.4f} | {descents} | {folds} |")
+            at_zero = " ".join(f"{v:+.4f}" for v in zero[4]) if zero else ""
+            print(f"| {run} | {c} | {name} | {mean:+.4f} | {descents} | {at_zero} |")
             totals[c].append(mean)
-            if best is None or mean > best[1]:  # ties: the earlier choice
+            first = by_choice[choices[0]][0][4]
+            if best is None or (beats(folds, first) and mean > best[1]):
                 best = (c, mean)
         totals["chosen by the folds"].append(best[1])
         print(f"| {run} | chosen by the folds | {best[0]} | {best[1]:+.4f} | | |")
