@@ -210,7 +210,8 @@ struct CalibrationCli {
                        "coverage ranked, several training fields: how the cell gain model's slopes may pool the "
                        "fields, tried with every confidence level on the training fields, comma-separated: cells "
                        "(one fit over every field's cells) and fields (each field's own slope, pooled as random "
-                       "effects); the best is saved in the model")
+                       "effects); cells is kept unless fields beats it on the folds beyond their noise (one standard "
+                       "error), and the one kept is saved in the model")
             ->delimiter(',')
             ->check(CLI::IsMember({"cells", "fields"}))
             ->capture_default_str(),
