@@ -30,6 +30,7 @@
 #include <fstream>
 #include <limits>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -314,11 +315,15 @@ struct DecisionModel {
         for (std::size_t j = 0; j < v.size(); ++j) points[j].*member = v[j];
       }
       // Absent (files of adaptseg before 2026-11-27, or pooled over the cells): cells.
-      const std::string pooling_name = c.has("slope_pooling") ? c.text("slope_pooling") : "cells";
-      if (pooling_name != "cells" && pooling_name != "fields")
-        detail::yaml_error(r.where(), "'gain_model.cells.slope_pooling' must be cells or fields (got '" + pooling_name +
-                                          "')");
-      const SlopePooling pooling = parse_slope_pooling(pooling_name);
+      SlopePooling pooling = SlopePooling::cells;
+      if (c.has("slope_pooling")) {
+        const std::string name = c.text("slope_pooling");
+        try {
+          pooling = parse_slope_pooling(name);
+        } catch (const std::invalid_argument&) {
+          detail::yaml_error(r.where(), "'gain_model.cells.slope_pooling' must be cells or fields (got '" + name + "')");
+        }
+      }
       model.set_cells(CellGainModel(input, std::move(points), pooling));
     }
     const auto rule = r.map("rule");
