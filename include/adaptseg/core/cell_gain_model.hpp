@@ -11,7 +11,6 @@
 #include <adaptseg/core/error.hpp>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -190,7 +189,7 @@ class CellGainModel {
       for (const CellSample* c : g.cells) px += c->top.field_px;
       const double mean_px = px > 0.0 ? px / static_cast<double>(g.cells.size()) : 1.0;
       // Per training field, the sums of its own fits of β and α (pooled by field_slope).
-      std::vector<std::pair<std::size_t, FieldSlopeSums>> gain_sums, relabel_sums;
+      PerField gain_sums, relabel_sums;
       double wx = 0.0;
       for (const CellSample* c : g.cells) {
         const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
@@ -202,7 +201,7 @@ class CellGainModel {
       }
       Point p{g.top, g.sub, field_slope(gain_sums), 0.0, field_slope(relabel_sums), 0.0, 0.0, 0.0};
       double eg = 0.0, er = 0.0, wdd = 0.0, wdg = 0.0;
-      FieldProxySums per_field;  // the same two sums per training field (τ_γ)
+      PerField proxy_sums;  // per training field, the proxy's own fit of ν on d = x − x' (τ_γ)
       bool proxy = true;
       for (const CellSample* c : g.cells) {
         const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
@@ -213,10 +212,7 @@ class CellGainModel {
         if (!proxy) continue;
         wdd += w * (x - xf) * (x - xf);
         wdg += w * (x - xf) * c->normalized_gain();
-        auto it = std::find_if(per_field.begin(), per_field.end(), [&](const auto& f) { return f.first == c->field; });
-        if (it == per_field.end()) it = per_field.insert(per_field.end(), {c->field, {0.0, 0.0}});
-        it->second[0] += w * (x - xf) * c->normalized_gain();
-        it->second[1] += w * (x - xf) * (x - xf);
+        sums_of(proxy_sums, c->field).add(w, x - xf, c->normalized_gain());
       }
       p.gain_noise = wx > 0.0 ? eg / wx : 0.0;
       p.relabel_noise = wx > 0.0 ? er / wx : 0.0;
@@ -228,7 +224,7 @@ class CellGainModel {
           ep += w * std::pow(p.proxy_slope * (x - c->fine.value(input)) - p.gain_slope * x, 2);
         }
         p.proxy_noise = ep / wx;
-        p.proxy_slope_sd = field_slope_spread(per_field, p.proxy_slope);
+        p.proxy_slope_sd = field_slope_spread(proxy_sums, p.proxy_slope);
       }
       points.push_back(p);
     }
@@ -315,7 +311,11 @@ class CellGainModel {
     }
   };
 
-  static FieldSlopeSums& sums_of(std::vector<std::pair<std::size_t, FieldSlopeSums>>& fields, std::size_t field) {
+  /// Each training field's sums (field index, sums), in the order the fields first occur.
+  using PerField = std::vector<std::pair<std::size_t, FieldSlopeSums>>;
+
+  /// The sums of `field` in `fields`, added (zero) if it has none yet.
+  static FieldSlopeSums& sums_of(PerField& fields, std::size_t field) {
     auto it = std::find_if(fields.begin(), fields.end(), [&](const auto& f) { return f.first == field; });
     if (it == fields.end()) it = fields.insert(fields.end(), {field, FieldSlopeSums{}});
     return it->second;
@@ -330,7 +330,7 @@ class CellGainModel {
   /// the cells); fields that disagree weigh alike (near the mean of their slopes). A field of
   /// fewer than two cells, or whose cells hold no input, does not count; without any field that
   /// counts, the fit pooled over the cells (also the result for one field's sums: its own fit).
-  static double field_slope(const std::vector<std::pair<std::size_t, FieldSlopeSums>>& fields) {
+  static double field_slope(const PerField& fields) {
     if (fields.size() == 1) {  // one field's (or SlopePooling::cells: all cells') own fit
       const FieldSlopeSums& f = fields.front().second;
       return f.xx > 0.0 ? f.xy / f.xx : 0.0;
@@ -367,19 +367,17 @@ class CellGainModel {
     return num / den;
   }
 
-  /// Per training field (index), the proxy fit's sums over its cells: {Σ w·d·ν, Σ w·d²}.
-  using FieldProxySums = std::vector<std::pair<std::size_t, std::array<double, 2>>>;
-
   /// τ_γ of one pair of GSDs (see the class comment): the proxy's slope fitted on each training
-  /// field's cells alone, γ_f (from `fields`, the sums fit() collects), and their spread about
+  /// field's cells alone, γ_f = Σ w·d·ν / Σ w·d² (from `fields`, the sums fit() collects of ν on
+  /// d = x − x'), and their spread about
   /// the pooled `slope`, Σ_f (γ_f − γ)² / (n − 1) over the n fields whose finer looks changed the
   /// input; |γ| where n < 2.
-  static double field_slope_spread(const FieldProxySums& fields, double slope) {
+  static double field_slope_spread(const PerField& fields, double slope) {
     double sq = 0.0;
     std::size_t n = 0;
     for (const auto& [field, sums] : fields)
-      if (sums[1] > 0.0) {
-        sq += std::pow(sums[0] / sums[1] - slope, 2);
+      if (sums.xx > 0.0) {
+        sq += std::pow(sums.xy / sums.xx - slope, 2);
         ++n;
       }
     return n >= 2 ? std::sqrt(sq / static_cast<double>(n - 1)) : std::abs(slope);
