@@ -62,8 +62,8 @@
 #   them gained, on the tiles each network (NETS, default erfnet-dubai mobilenetv2-dubai) was
 #   trained on (1, 2, 3, 5) and on those it never saw (4, 6): adaptseg_cell_study --csv at 12.5,
 #   10 and 5 cm/px, then examples/tools/proxy_table.py; and, from the same cells, how well the
-#   cell gain model's slope fitted on five tiles forecasts the sixth's best cells
-#   (examples/tools/slope_transfer.py). Independent of the other parts; about
+#   cell gain model's slope fitted on five tiles forecasts the sixth's best cells, and each
+#   tile's own slope (examples/tools/slope_transfer.py). Independent of the other parts; about
 #   20 minutes on 2 cores for the two networks. NETS=ensemble-dubai adds the ensemble's tables
 #   (with its members' split among the inputs) and keeps the other networks'.
 # sigma-prior: the previous defaults' runs (part previous) flown again with the models
@@ -496,10 +496,10 @@ if [ "$part" = proxy-check ]; then
   done
   # The cell gain model's slope fitted on five tiles against the sixth's best cells: pooled over
   # the cells (CellGainModel::fit), the mean of the tiles' own slopes, or those pooled as random
-  # effects.
+  # effects; and each tile's own slope (--field-slopes).
   transfer=()
   for net in ${NETS:-erfnet-dubai mobilenetv2-dubai}; do transfer+=("$out/$net-trained-on.csv" "$out/$net-never-seen.csv"); done
-  /usr/bin/python3 examples/tools/slope_transfer.py "${transfer[@]}"
+  /usr/bin/python3 examples/tools/slope_transfer.py --field-slopes "${transfer[@]}"
   exit 0
 fi
 

@@ -16,9 +16,11 @@ fitting beta on the training fields, leave one field out: on the cells of every 
 then forecasts the field gain of the held-out field's best 20 % of cells (ranked by the input's
 mass, as the planner ranks them) and compares it with what re-mapping those cells alone gained.
 It prints, per input, the root mean squared error of that forecast and how often its sign is
-right, over every (held-out field, pair of GSDs), and with --pairs the sums per pair of GSDs.
+right, over every (held-out field, pair of GSDs), with --pairs the sums per pair of GSDs, and
+with --field-slopes each field's own slope (the fit on its cells alone) per (network, class,
+input, pair of GSDs): how far apart the fields are that any pooling has to bridge.
 
-  slope_transfer.py [--pairs] [--inputs a,b,...] CELLS.csv [CELLS.csv ...]
+  slope_transfer.py [--pairs] [--field-slopes] [--inputs a,b,...] CELLS.csv [CELLS.csv ...]
 
 CELLS.csv: the cell samples `adaptseg_calibrate --cell-samples-csv` writes (one file per
 network and class), or the cells `adaptseg_cell_study --csv` writes (columns class, gsd_cm and
@@ -116,12 +118,15 @@ def main():
     ap.add_argument("cells", nargs="+", help="cell sample CSVs")
     ap.add_argument("--inputs", default=",".join(INPUTS), help="decision inputs to compare (comma-separated)")
     ap.add_argument("--pairs", action="store_true", help="also print the sums per file, input and pair of GSDs")
+    ap.add_argument("--field-slopes", action="store_true",
+                    help="also print each field's own slope per file, input and pair of GSDs")
     ap.add_argument("--share", type=float, default=0.2, help="share of the held-out field's cells taken (0.2)")
     args = ap.parse_args()
     inputs = args.inputs.split(",")
     # Per input and over all of them: per fit, squared error, forecasts of the right sign, count.
     total = {inp: {k: [0.0, 0, 0] for k in FITS} for inp in inputs + ["all"]}
     pair_rows = []
+    slope_rows = []  # (group, input, pair of GSDs, {field: own slope})
     groups_of = defaultdict(list)  # (network, class) -> cells of every file given for it
     for path in args.cells:
         with open(path, newline="") as f:
@@ -145,6 +150,8 @@ def main():
                 fields = sorted({c["field"] for c in cells})
                 if len(fields) < 2:
                     continue
+                slope_rows.append((path, inp, key, {f: pooled([c for c in cells if c["field"] == f], inp, mean_px)
+                                                    for f in fields}))
                 realised_sum = 0.0
                 forecast_sum = {k: 0.0 for k in FITS}
                 for held in fields:
@@ -184,6 +191,15 @@ def main():
         for path, inp, key, realised, forecast in pair_rows:
             cols = " | ".join(f"{forecast[k]:+.4f}" for k in FITS)
             print(f"| {path} | {inp} | {key[0]:g} -> {key[1]:g} | {realised:+.4f} | {cols} |")
+    if args.field_slopes:
+        names = sorted({f for *_, slopes in slope_rows for f in slopes})
+        print()
+        print("Each field's own slope (normalised gain per unit of the input, its cells alone):")
+        print("| cells | input | top -> descent [cm/px] | " + " | ".join(names) + " |")
+        print("| --- | --- | --- | " + " | ".join("---:" for _ in names) + " |")
+        for path, inp, key, slopes in slope_rows:
+            cols = " | ".join(f"{slopes[f]:+.3f}" if f in slopes else "" for f in names)
+            print(f"| {path} | {inp} | {key[0]:g} -> {key[1]:g} | {cols} |")
 
 
 if __name__ == "__main__":

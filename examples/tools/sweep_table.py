@@ -23,6 +23,8 @@ import os
 import statistics
 import sys
 
+from proxy_table import ranks  # the same tool folder
+
 
 def read_csv(path):
     with open(path, newline="") as f:
@@ -62,6 +64,11 @@ def correlation(x, y):
     sx = sum((a - mx) ** 2 for a in x) ** 0.5
     sy = sum((b - my) ** 2 for b in y) ** 0.5
     return sum((a - mx) * (b - my) for a, b in zip(x, y)) / (sx * sy) if sx > 0 and sy > 0 else float("nan")
+
+
+def rank_correlation(x, y):
+    """Spearman's: the correlation of the ranks (less swayed than correlation() by a few large gains)."""
+    return correlation(ranks(x), ranks(y))
 
 
 def main(args):
@@ -113,8 +120,9 @@ def main(args):
 
     print()
     print("| configuration | strategy | descent GSD [cm/px] | descents | forecast field gain (sum) | "
-          "realised (sum) | correlation | forecast relabelled (sum) | observed (sum) |")
-    print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+          "realised (sum) | correlation | rank correlation | correlation, scaled by the run's other descents | "
+          "forecast relabelled (sum) | observed (sum) |")
+    print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
     for label, _, decisions in configs:
         for strategy in ("adaptive", "nonadaptive"):
             rows = [d for d in decisions if d["strategy"] == strategy and d["action"] == "descend"
@@ -125,10 +133,23 @@ def main(args):
                     continue
                 f = [float(d["forecast_field_gain"]) for d in sel]
                 r = [float(d["realised_field_gain"]) for d in sel]
+                # Hindsight: each forecast times realised / forecast summed over the *other* descents
+                # of its run (selected here; none: unscaled), what a scene check that knew the truth of
+                # the field's other descents would forecast: whether the forecasts miss a field's scale
+                # or the order of its descents.
+                sums = {}
+                for v, w, d in zip(f, r, sel):
+                    fs, rs = sums.get(d["run"], (0.0, 0.0))
+                    sums[d["run"]] = (fs + v, rs + w)
+                known = []
+                for v, w, d in zip(f, r, sel):
+                    fs, rs = sums[d["run"]][0] - v, sums[d["run"]][1] - w
+                    known.append(v * rs / fs if fs > 1e-12 else v)
                 fr = [float(d["forecast_relabelled_interest"]) for d in sel if d["forecast_relabelled_interest"] != ""]
                 ob = [float(d["observed_relabelled_interest"]) for d in sel if d["forecast_relabelled_interest"] != ""]
                 print(f"| {label} | {strategy} | {g} | {len(sel)} | {sum(f):.4f} | {sum(r):.4f} | "
-                      f"{correlation(f, r):.2f} | {sum(fr):.4f} | {sum(ob):.4f} |")
+                      f"{correlation(f, r):.2f} | {rank_correlation(f, r):.2f} | {correlation(known, r):.2f} | "
+                      f"{sum(fr):.4f} | {sum(ob):.4f} |")
     schedule_table(configs, keys)
 
 
