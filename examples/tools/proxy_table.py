@@ -9,7 +9,9 @@ alone, with its realised field-IoU gain) and prints, per class and GSD and over 
 the rank correlation (Spearman) of the realised gain with each input's drop, each drop weighted
 as the gain is (the cell's share of the field over the field's share of the class), and with
 the top-level input itself (what ranks the cells before the descent), beside the cells' summed
-gain and the summed drop of the expected error (the drop read as a gain, unfitted).
+gain and the summed drop of the expected error (the drop read as a gain, unfitted); then, per
+input about the class, what the cells gain per unit of their top-level input where the finer
+look was less sure, about as sure, or surer (drop_bins).
 
   proxy_table.py LABEL=CELLS.csv [LABEL=CELLS.csv ...]
 
@@ -90,6 +92,42 @@ def main(args):
             ee_drop = sum(drops["expected_error"]) if "expected_error" in inputs else math.nan
             print(f"| {cls} | {gsd:g} | {len(rs)} | " + " | ".join(fmt(spearman(drops[i], gain)) for i in inputs) +
                   f" | {fmt(spearman(top_ee, gain)) if top_ee else 'nan'} | {sum(gain):+.4f} | {ee_drop:+.4f} |")
+        drop_bins(label, rows, [i for i in ABOUT_L if i in inputs])
+
+
+ABOUT_L = ("ambiguity", "expected_error", "second_choice")  # the inputs about the class
+# Relative drop of an input from the top-level to the finer look, (top - fine) / top: the finer
+# look less sure (rose by more than 10 %), about as sure, surer, much surer.
+BINS = ((-math.inf, -0.1, "rose > 10 %"), (-0.1, 0.1, "within 10 %"), (0.1, 0.3, "fell 10-30 %"),
+        (0.3, math.inf, "fell > 30 %"))
+
+
+def drop_bins(label, rs_all, inputs):
+    """What a cell gains per unit of its top-level input, by how far the finer look moved that
+    input: Σ ν / Σ x over the cells (all classes) with x > 0.01 in each bin of the relative drop,
+    ν the cell's normalised gain (field gain × the field's σ / the cell's field share, the share
+    of its pixels corrected; CellSample::normalized_gain). The scene check reads a drop as gain
+    and a rise as loss; where a rise comes with the largest gains, it reads the field backwards."""
+    print(f"\n{label}: gain per unit of the top-level input by the relative drop (top - fine) / top of that "
+          "input (cells with input > 0.01; all classes): Σ ν / Σ x (cells)")
+    print("| input | GSD [cm/px] | " + " | ".join(b[2] for b in BINS) + " |")
+    print("| --- | ---: | " + " | ".join("---:" for _ in BINS) + " |")
+    for inp in inputs:
+        for gsd in sorted({float(r["gsd_cm"]) for r in rs_all}):
+            cols = []
+            for lo, hi, _ in BINS:
+                num = den = 0.0
+                n = 0
+                for r in rs_all:
+                    x, xf = value(r, "top_" + inp), value(r, "fine_" + inp)
+                    share, sigma = float(r["field_share"]), float(r["field_sigma"])
+                    if float(r["gsd_cm"]) != gsd or x <= 0.01 or share <= 0 or not lo <= (x - xf) / x < hi:
+                        continue
+                    num += float(r["gain"]) * sigma / share
+                    den += x
+                    n += 1
+                cols.append(f"{num / den:+.3f} ({n})" if n else "—")
+            print(f"| {inp} | {gsd:g} | " + " | ".join(cols) + " |")
 
 
 if __name__ == "__main__":
