@@ -23,7 +23,7 @@ import os
 import statistics
 import sys
 
-from proxy_table import ranks  # the same tool folder
+from proxy_table import spearman  # the same tool folder
 
 
 def read_csv(path):
@@ -64,11 +64,6 @@ def correlation(x, y):
     sx = sum((a - mx) ** 2 for a in x) ** 0.5
     sy = sum((b - my) ** 2 for b in y) ** 0.5
     return sum((a - mx) * (b - my) for a, b in zip(x, y)) / (sx * sy) if sx > 0 and sy > 0 else float("nan")
-
-
-def rank_correlation(x, y):
-    """Spearman's: the correlation of the ranks (less swayed than correlation() by a few large gains)."""
-    return correlation(ranks(x), ranks(y))
 
 
 def main(args):
@@ -148,7 +143,7 @@ def main(args):
                 fr = [float(d["forecast_relabelled_interest"]) for d in sel if d["forecast_relabelled_interest"] != ""]
                 ob = [float(d["observed_relabelled_interest"]) for d in sel if d["forecast_relabelled_interest"] != ""]
                 print(f"| {label} | {strategy} | {g} | {len(sel)} | {sum(f):.4f} | {sum(r):.4f} | "
-                      f"{correlation(f, r):.2f} | {rank_correlation(f, r):.2f} | {correlation(known, r):.2f} | "
+                      f"{correlation(f, r):.2f} | {spearman(f, r):.2f} | {correlation(known, r):.2f} | "
                       f"{sum(fr):.4f} | {sum(ob):.4f} |")
     schedule_table(configs, keys)
 
