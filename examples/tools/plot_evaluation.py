@@ -158,7 +158,7 @@ def main(out):
     decisions = [d for d in decisions if d["action"] == "descend" and d["forecast_field_gain"] != ""
                  and d["realised_field_gain"] != ""]
     if decisions:
-        fig, axes = plt.subplots(1, len(fields), figsize=(5.5 * len(fields), 5), squeeze=False)
+        fig, axes = plt.subplots(1, len(fields), figsize=(5.5 * len(fields), 5.6), squeeze=False)
         for ax, field in zip(axes[0], fields):
             lim = 0.0
             for strategy in ("nonadaptive", "adaptive"):
@@ -172,8 +172,11 @@ def main(out):
                 ax.scatter(f, r, color=st["color"], marker=st["marker"], s=st["s"] * 0.5,
                            facecolors="none" if strategy == "nonadaptive" else st["color"],
                            label=f"{st['label']} ({len(sel)} descents)")
+                # Adaptive's labels above its points, non-adaptive's below: the two often take the
+                # same descents, and their labels would print over each other.
+                offset = (5, -9) if strategy == "nonadaptive" else (5, 3)
                 for x, y, d in zip(f, r, sel):
-                    ax.annotate(f"{num(d['gsd_cm']):g}", (x, y), textcoords="offset points", xytext=(5, 3),
+                    ax.annotate(f"{num(d['gsd_cm']):g}", (x, y), textcoords="offset points", xytext=offset,
                                 fontsize=7, color=st["color"])
             lim = lim * 1.1 if lim > 0 else 1.0
             ax.plot([0, lim], [0, lim], "--", color="0.5", label="realised = forecast")
@@ -182,7 +185,8 @@ def main(out):
             ax.set_ylabel("realised field gain")
             ax.set_title(f"{field}\n(label: descent GSD [cm/px])", fontsize=10)
             ax.grid(alpha=0.3)
-            ax.legend(fontsize=8, loc="upper left")
+            # Below the axes: descents forecast far below what they gained sit in the upper left.
+            ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
         fig.suptitle("Each descent: the gain it was forecast\nto add to the field mIoU, and what it added", fontsize=11)
         save(fig, os.path.join(out, "decisions.png"))
 
