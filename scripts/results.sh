@@ -496,7 +496,7 @@ if [ "$part" = proxy-check ]; then
   done
   # The cell gain model's slope fitted on five tiles against the sixth's best cells: pooled over
   # the cells (CellGainModel::fit), the mean of the tiles' own slopes, or those pooled as random
-  # effects; and each tile's own slope (--field-slopes).
+  # effects; and each tile's own slope and mean input at the top (--field-slopes).
   transfer=()
   for net in ${NETS:-erfnet-dubai mobilenetv2-dubai}; do transfer+=("$out/$net-trained-on.csv" "$out/$net-never-seen.csv"); done
   /usr/bin/python3 examples/tools/slope_transfer.py --field-slopes "${transfer[@]}"

@@ -18,7 +18,10 @@ mass, as the planner ranks them) and compares it with what re-mapping those cell
 It prints, per input, the root mean squared error of that forecast and how often its sign is
 right, over every (held-out field, pair of GSDs), with --pairs the sums per pair of GSDs, and
 with --field-slopes each field's own slope (the fit on its cells alone) per (network, class,
-input, pair of GSDs): how far apart the fields are that any pooling has to bridge.
+input, pair of GSDs): how far apart the fields are that any pooling has to bridge; and beside
+it each field's mean input at the top (weighted by the cells' field pixels): whether a field
+whose top-level images are less sure also gains more per unit of input (a statistic of the field
+a decision could read before any descent).
 
   slope_transfer.py [--pairs] [--field-slopes] [--inputs a,b,...] CELLS.csv [CELLS.csv ...]
 
@@ -62,6 +65,12 @@ def slope_sums(cells, inp, mean_px):
 def pooled(cells, inp, mean_px):
     a, b = slope_sums(cells, inp, mean_px)
     return a / b if b > 0 else 0.0
+
+
+def mean_input(cells, inp):
+    """The field-pixel weighted mean of the cells' top-level input."""
+    w = sum(float(c["field_px"]) for c in cells)
+    return sum(float(c["field_px"]) * x_of(c, inp) for c in cells) / w if w > 0 else 0.0
 
 
 def by_field(cells):
@@ -126,7 +135,7 @@ def main():
     # Per input and over all of them: per fit, squared error, forecasts of the right sign, count.
     total = {inp: {k: [0.0, 0, 0] for k in FITS} for inp in inputs + ["all"]}
     pair_rows = []
-    slope_rows = []  # (group, input, pair of GSDs, {field: own slope})
+    slope_rows = []  # (group, input, pair of GSDs, {field: own slope}, {field: mean input})
     groups_of = defaultdict(list)  # (network, class) -> cells of every file given for it
     for path in args.cells:
         with open(path, newline="") as f:
@@ -150,8 +159,9 @@ def main():
                 fields = sorted({c["field"] for c in cells})
                 if len(fields) < 2:
                     continue
-                slope_rows.append((path, inp, key, {f: pooled([c for c in cells if c["field"] == f], inp, mean_px)
-                                                    for f in fields}))
+                own = {f: [c for c in cells if c["field"] == f] for f in fields}
+                slope_rows.append((path, inp, key, {f: pooled(own[f], inp, mean_px) for f in fields},
+                                   {f: mean_input(own[f], inp) for f in fields}))
                 realised_sum = 0.0
                 forecast_sum = {k: 0.0 for k in FITS}
                 for held in fields:
@@ -192,14 +202,25 @@ def main():
             cols = " | ".join(f"{forecast[k]:+.4f}" for k in FITS)
             print(f"| {path} | {inp} | {key[0]:g} -> {key[1]:g} | {realised:+.4f} | {cols} |")
     if args.field_slopes:
-        names = sorted({f for *_, slopes in slope_rows for f in slopes})
+        names = sorted({f for *_, slopes, _ in slope_rows for f in slopes})
         print()
         print("Each field's own slope (normalised gain per unit of the input, its cells alone):")
         print("| cells | input | top -> descent [cm/px] | " + " | ".join(names) + " |")
         print("| --- | --- | --- | " + " | ".join("---:" for _ in names) + " |")
-        for path, inp, key, slopes in slope_rows:
+        for path, inp, key, slopes, _ in slope_rows:
             cols = " | ".join(f"{slopes[f]:+.3f}" if f in slopes else "" for f in names)
             print(f"| {path} | {inp} | {key[0]:g} -> {key[1]:g} | {cols} |")
+        print()
+        print("Each field's mean input at the top (its cells, weighted by their field pixels; the cells of "
+              "the first pair of GSDs: the same top-level images at every pair):")
+        print("| cells | input | " + " | ".join(names) + " |")
+        print("| --- | --- | " + " | ".join("---:" for _ in names) + " |")
+        printed = set()
+        for path, inp, _, _, means in slope_rows:
+            if (path, inp) not in printed:
+                printed.add((path, inp))
+                cols = " | ".join(f"{means[f]:.3f}" if f in means else "" for f in names)
+                print(f"| {path} | {inp} | {cols} |")
 
 
 if __name__ == "__main__":

@@ -37,4 +37,25 @@ if [ -n "$python" ]; then
     fail "want 3 rows with the expected error's drop ranking the gain (rho > 0.9): $(cat "$work/proxy.md")"
   ! grep -q 'split drop' "$work/proxy.md" || fail "the unknown input split has a column: $(cat "$work/proxy.md")"
   echo "ok: proxy_table.py ranks the oracle's gains by the drop of its expected error"
+  # slope_transfer.py --field-slopes on two fields (the field's halves): each field's own slope of
+  # the oracle's gain on its expected error is positive (its doubt is real error), and each field's
+  # mean input is the field-pixel weighted mean of its cells' input, recomputed here.
+  "$study" --field "$examples/data/weedmap-000:0,0,0.5,1" --field "$examples/data/weedmap-000:0.5,0,1,1" \
+    --top-gsd 3 --gsd 1 --segmenter oracle --csv "$work/halves.csv" >/dev/null 2>"$work/log" ||
+    fail "cell study of two fields failed: $(tail -3 "$work/log")"
+  "$python" "$examples/tools/slope_transfer.py" --field-slopes "$work/halves.csv" >"$work/slopes.md" ||
+    fail "slope_transfer.py failed"
+  grep -E '^\| halves \((crop|weed)\) \| expected_error \| 0 -> 1 \| \+0\.[0-9]+ \| \+0\.[0-9]+ \|$' "$work/slopes.md" |
+    wc -l | grep -qx 2 || fail "want both classes' own slopes on expected_error positive on both fields: $(cat "$work/slopes.md")"
+  "$python" - "$work/halves.csv" "$work/slopes.md" <<'PY' || fail "a field's mean input differs from its cells': $(cat "$work/slopes.md")"
+import csv, sys
+cells = [r for r in csv.DictReader(open(sys.argv[1])) if r["class"] == "weed"]
+fields = sorted({r["field"] for r in cells})
+want = [sum(float(r["field_px"]) * float(r["top_expected_error"]) for r in cells if r["field"] == f)
+        / sum(float(r["field_px"]) for r in cells if r["field"] == f) for f in fields]
+rows = [l for l in open(sys.argv[2]) if l.startswith("| halves (weed) | expected_error | ") and l.count("|") == 5]
+got = [float(v) for v in rows[0].strip().strip("|").split("|")[2:]]
+sys.exit(not (len(rows) == 1 and all(abs(g - w) < 6e-4 for g, w in zip(got, want)) and len(got) == 2))
+PY
+  echo "ok: slope_transfer.py prints each field's own slope and mean input"
 fi
