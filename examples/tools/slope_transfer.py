@@ -74,15 +74,15 @@ def mean_input(cells, inp):
 
 
 def by_field(cells):
-    """The cells of each field."""
+    """The cells of each field, by field."""
     out = defaultdict(list)
     for c in cells:
         out[c["field"]].append(c)
-    return out.values()
+    return out
 
 
 def field_mean(cells, inp, mean_px):
-    slopes = [a / b for a, b in (slope_sums(own, inp, mean_px) for own in by_field(cells)) if b > 0]
+    slopes = [a / b for a, b in (slope_sums(own, inp, mean_px) for own in by_field(cells).values()) if b > 0]
     return sum(slopes) / len(slopes) if slopes else 0.0
 
 
@@ -91,7 +91,7 @@ def random_effects(cells, inp, mean_px):
     more whose cells hold input), tau^2 by the method of moments (Cochran's Q about the
     precision-weighted mean), then the mean of the b_f weighted by 1 / (v_f + tau^2)."""
     est = []
-    for own in by_field(cells):
+    for own in by_field(cells).values():
         a, b = slope_sums(own, inp, mean_px)
         if b <= 0 or len(own) < 2:
             continue
@@ -135,7 +135,8 @@ def main():
     # Per input and over all of them: per fit, squared error, forecasts of the right sign, count.
     total = {inp: {k: [0.0, 0, 0] for k in FITS} for inp in inputs + ["all"]}
     pair_rows = []
-    slope_rows = []  # (group, input, pair of GSDs, {field: own slope}, {field: mean input})
+    slope_rows = []  # (group, input, pair of GSDs, {field: own slope})
+    mean_inputs = {}  # (group, input) -> {field: mean input}, from the first pair of GSDs
     groups_of = defaultdict(list)  # (network, class) -> cells of every file given for it
     for path in args.cells:
         with open(path, newline="") as f:
@@ -159,9 +160,10 @@ def main():
                 fields = sorted({c["field"] for c in cells})
                 if len(fields) < 2:
                     continue
-                own = {f: [c for c in cells if c["field"] == f] for f in fields}
-                slope_rows.append((path, inp, key, {f: pooled(own[f], inp, mean_px) for f in fields},
-                                   {f: mean_input(own[f], inp) for f in fields}))
+                own = by_field(cells)
+                slope_rows.append((path, inp, key, {f: pooled(own[f], inp, mean_px) for f in fields}))
+                if (path, inp) not in mean_inputs:
+                    mean_inputs[(path, inp)] = {f: mean_input(own[f], inp) for f in fields}
                 realised_sum = 0.0
                 forecast_sum = {k: 0.0 for k in FITS}
                 for held in fields:
@@ -202,12 +204,12 @@ def main():
             cols = " | ".join(f"{forecast[k]:+.4f}" for k in FITS)
             print(f"| {path} | {inp} | {key[0]:g} -> {key[1]:g} | {realised:+.4f} | {cols} |")
     if args.field_slopes:
-        names = sorted({f for *_, slopes, _ in slope_rows for f in slopes})
+        names = sorted({f for *_, slopes in slope_rows for f in slopes})
         print()
         print("Each field's own slope (normalised gain per unit of the input, its cells alone):")
         print("| cells | input | top -> descent [cm/px] | " + " | ".join(names) + " |")
         print("| --- | --- | --- | " + " | ".join("---:" for _ in names) + " |")
-        for path, inp, key, slopes, _ in slope_rows:
+        for path, inp, key, slopes in slope_rows:
             cols = " | ".join(f"{slopes[f]:+.3f}" if f in slopes else "" for f in names)
             print(f"| {path} | {inp} | {key[0]:g} -> {key[1]:g} | {cols} |")
         print()
@@ -215,12 +217,9 @@ def main():
               "the first pair of GSDs: the same top-level images at every pair):")
         print("| cells | input | " + " | ".join(names) + " |")
         print("| --- | --- | " + " | ".join("---:" for _ in names) + " |")
-        printed = set()
-        for path, inp, _, _, means in slope_rows:
-            if (path, inp) not in printed:
-                printed.add((path, inp))
-                cols = " | ".join(f"{means[f]:.3f}" if f in means else "" for f in names)
-                print(f"| {path} | {inp} | {cols} |")
+        for (path, inp), means in mean_inputs.items():
+            cols = " | ".join(f"{means[f]:.3f}" if f in means else "" for f in names)
+            print(f"| {path} | {inp} | {cols} |")
 
 
 if __name__ == "__main__":
