@@ -28,7 +28,8 @@ Augmentations (--augment):
 Samples are a function of (seed, step, index in batch) only, so a run resumed from a checkpoint
 sees the same batches, however many data workers (--workers) produce them. --sampler device
 makes the `altitude` batches on the training device instead of in CPU workers (device_sampler.py:
-the same draws and resampling, different rounding; for a GPU, whose pace the CPU workers set).
+the same draws and resampling, different rounding; for a GPU, whose pace the CPU workers set),
+a whole batch at a time, --prefetch steps ahead by a thread on a CUDA stream of its own.
 
 Devices: --device cuda runs the network in bfloat16 autocast with channels-last tensors and
 data workers; --device cpu in float32. A checkpoint written on one continues on the other.
@@ -642,6 +643,9 @@ def main(argv=None):
     ap.add_argument("--sampler", choices=("cpu", "device"), default="cpu",
                     help="new runs: make the batches in CPU workers (cpu) or on the training device "
                          "(device; augmentation altitude only; examples/tools/device_sampler.py)")
+    ap.add_argument("--prefetch", type=int, default=2,
+                    help="--sampler device on CUDA: batches made ahead by a thread on a stream of its own (0: each "
+                         "made when the step asks for it)")
     ap.add_argument("--width", type=float, default=0.5, help="ERFNet width multiplier")
     ap.add_argument("--encoder-weights", default="",
                     help="MobileNetV2 encoder state_dict from mobilenet_v2.py (default: import with npm)")
@@ -957,8 +961,8 @@ def main(argv=None):
               f"validation -> the cycle ends at step {total_steps}", flush=True)
 
     if ckpt.get("sampler", "cpu") == "device":  # resumed runs keep the sampler they started with
-        on_device = device_sampler.DeviceSampler(sampler, device)
-        loader = (on_device.batch(s, ckpt["batch"]) for s in range(ckpt["step"], total_steps))
+        loader = device_sampler.Prefetcher(device_sampler.DeviceSampler(sampler, device), ckpt["step"], total_steps,
+                                           ckpt["batch"], depth=args.prefetch)
     else:
         workers = args.workers if args.workers >= 0 else (min(12, max(0, (os.cpu_count() or 1) - 2)) if cuda else 0)
         loader = torch.utils.data.DataLoader(
@@ -1027,6 +1031,8 @@ def main(argv=None):
         if args.max_minutes > 0 and time.time() - t_start > 60.0 * args.max_minutes and step < total_steps:
             paused = True
             break
+    if isinstance(loader, device_sampler.Prefetcher):
+        loader.close()  # its thread may be making batches past the end
     if paused:
         save_checkpoint()
         print(f"stopped at step {step}/{total_steps} after {args.max_minutes:g} min (--max-minutes); "
