@@ -9,10 +9,13 @@
 #       folder a device call carries (it reaches no network).
 #   bash scripts/loto.sh train MINUTES [TILES] [STEPS]
 #       on a CUDA machine (the `device` tool: carry .device): the trainings side by side on its
-#       one GPU, each fitting its learning-rate cycle into MINUTES (train_segnet.py --minutes),
-#       checkpoints to $OUT/loto-<k>.pt and the logs to $OUT/loto-logs.tar.gz. TILES: the
-#       held-out tiles (default 1,2,3,4,5,6). STEPS > 0 trains that many steps instead of
-#       fitting MINUTES, on the CPU if there is no GPU (a rehearsal of the call here).
+#       one GPU, each fitting its learning-rate cycle into MINUTES (train_segnet.py --minutes) but
+#       at most LOTO_STEP_CAP steps (environment; default 1784, the deployment network's
+#       schedule), batches made on the GPU (--sampler device, PREFETCH batches ahead, default 2),
+#       checkpoints to $OUT/loto-<k>.pt (7.5 MB each) and the logs
+#       to $OUT/loto-logs.tar.gz. TILES: the held-out tiles (default 1,2,3,4,5,6). STEPS > 0
+#       trains that many steps instead of fitting MINUTES, on the CPU if there is no GPU (a
+#       rehearsal of the call here).
 #   bash scripts/loto.sh eval DIR
 #       here: exports every DIR/loto-<k>.pt (PyTorch 1.13 and OpenCV 4.6 check it loads and
 #       matches) to out/loto/model-<k>/ and prints its field mIoU on tile k.
@@ -51,8 +54,8 @@ train)
     schedule=(--steps "$steps" --warmup 1 --batch 2 --crop 150 --val-max-images 2)
     device=$("$py" -c 'import torch; print("cuda" if torch.cuda.is_available() else "cpu")')
   else
-    schedule=(--steps 30000 --minutes "$minutes" --max-minutes "$(awk -v m="$minutes" 'BEGIN { print m * 1.08 }')" --batch 32 --crop 300
-              --warmup 100)
+    schedule=(--steps "${LOTO_STEP_CAP:-1784}" --minutes "$minutes" --max-minutes "$(awk -v m="$minutes" 'BEGIN { print m * 1.08 }')"
+              --batch 32 --crop 300 --warmup 100)
     device=cuda
   fi
   sampler=cpu
@@ -62,7 +65,7 @@ train)
   for k in "${tiles[@]}"; do
     "$py" examples/tools/train_segnet.py --arch mobilenetv2 --encoder-weights .device/mnv2_enc.pt \
       --frozen-blocks 4 --no-image-pooling --lr 1e-3 --weight-decay 0.01 --ema 0.998 --augment altitude --seed 0 \
-      --sampler "$sampler" --device "$device" --train-fields "$(train_fields "$k")" --val-field "dubai-tile-$k" \
+      --sampler "$sampler" --prefetch "${PREFETCH:-2}" --device "$device" --train-fields "$(train_fields "$k")" --val-field "dubai-tile-$k" \
       --test-field none --threads 1 --val-every 0 --ckpt-every 100 --log-every 50 --no-export \
       "${schedule[@]}" --work-dir "$work/loto-$k" --model-dir "$work/unused-$k" >"$work/loto-$k.log" 2>&1 &
     pids+=($!)
@@ -92,6 +95,27 @@ eval)
     "$py" examples/tools/eval_ensemble.py --members "loto$k=out/loto/model-$k" \
       --fields "examples/data/dubai-tile-$k" --bands 1,2,3 --json "out/loto/eval-$k.json"
   done
+  # The estimate: each held-out tile's field mIoU per GSD, their mean, and per class.
+  "$py" - out/loto/eval-*.json <<'PY'
+import json, sys
+rows, classes = [], None
+for path in sys.argv[1:]:
+    d = json.load(open(path))
+    classes = d["classes"]
+    (name, bands), = d["fields"].items()
+    (member,) = d["members"]
+    rows.append((name, {b["gsd_cm"]: b[member] for b in bands.values()}))
+gsds = sorted({g for _, r in rows for g in r})
+print("| held-out tile | " + " | ".join(f"{g:g} cm/px" for g in gsds) + " |")
+print("| --- |" + " ---: |" * len(gsds))
+for name, r in rows:
+    print(f"| {name} | " + " | ".join(f"{r[g]['miou']:.3f}" for g in gsds) + " |")
+print("| mean | " + " | ".join(f"{sum(r[g]['miou'] for _, r in rows) / len(rows):.3f}" for g in gsds) + " |")
+print("\nclass IoU, mean over the held-out tiles (tiles where the class occurs):")
+for c, cls in enumerate(classes):
+    vals = {g: [r[g]["iou"][c] for _, r in rows if r[g]["iou"][c] is not None] for g in gsds}
+    print(f"  {cls:<11}" + "  ".join(f"{g:g} cm/px {sum(v) / len(v):.3f} (n={len(v)})" for g, v in vals.items() if v))
+PY
   ;;
 cpu)
   k=${2:?held-out tile}
