@@ -1,5 +1,6 @@
 // Times the ensemble backend against its members, side by side in one run: per round, K
-// segment() calls of each member (ErfnetSegmenter), then K of the ensemble (EnsembleSegmenter:
+// segment() calls of each member (ErfnetSegmenter, as the ensemble runs it: with test-time
+// mirror where its `mirror` says so, and then also without), then K of the ensemble (EnsembleSegmenter:
 // every member, the weighted mean, its argmax) and K of segment_with_disagreement() (the same
 // plus disagreement and class splits), on one 480x360 camera image of held-out Dubai tile 6
 // at 2x its GSD; medians over all rounds. One OpenCV thread count per run.
@@ -44,8 +45,18 @@ int main(int argc, char** argv) {
     adaptseg::ErfnetParams p{.resize_to_network = true, .num_threads = threads};
     adaptseg::EnsembleSegmenter ensemble(argv[1], field, camera, p);
     std::vector<adaptseg::ErfnetSegmenter> members;
-    for (const auto& m : ensemble.member_list())
-      members.emplace_back(m.model_dir, field, camera, p);
+    std::vector<std::string> names;
+    for (const auto& m : ensemble.member_list()) {
+      const std::string name = m.model_dir.filename().string();
+      adaptseg::ErfnetParams pm = p;
+      pm.test_time_mirror = m.mirror;
+      members.emplace_back(m.model_dir, field, camera, pm);
+      names.push_back(name + (m.mirror ? " (member, with mirror)" : " (member)"));
+      if (m.mirror) {
+        members.emplace_back(m.model_dir, field, camera, p);
+        names.push_back(name + " (alone, one pass)");
+      }
+    }
     const auto plan = adaptseg::LawnmowerPlanner(camera).plan(field.area(), 2.0 * field.gsd_cm());
     const adaptseg::Image image = adaptseg::SimulatedSensor(field, camera).capture(plan.at(plan.size() / 2));
     std::vector<std::vector<double>> member_ms(members.size());
@@ -64,8 +75,7 @@ int main(int argc, char** argv) {
     }
     const auto median = [](const std::vector<double>& v) { return adaptseg::bench::stats(v).median; };
     for (std::size_t k = 0; k < members.size(); ++k)
-      std::printf("| %s (member) | %d | %.1f |\n", ensemble.member_list()[k].model_dir.filename().c_str(), threads,
-                  median(member_ms[k]));
+      std::printf("| %s | %d | %.1f |\n", names[k].c_str(), threads, median(member_ms[k]));
     std::printf("| ensemble segment() | %d | %.1f |\n", threads, median(ens_ms));
     std::printf("| ensemble segment_with_disagreement() | %d | %.1f |\n", threads, median(dis_ms));
   } catch (const std::exception& e) {

@@ -27,7 +27,9 @@
 #   per network and weights), so a rerun segments only what the missions need.
 # ensemble: field mIoU of the bundled networks and of their ensemble (examples/models/ensemble-dubai)
 #   on the same whole-field lawnmowers of tiles 4 and 6 at 5, 10 and 15 cm/px
-#   (examples/tools/eval_ensemble.py, PyTorch on the exported weights); about 2 minutes on 2 cores.
+#   (examples/tools/eval_ensemble.py, PyTorch on the exported weights), each network also with
+#   test-time mirror, and the ensembles with MobileNetV2 mirrored (examples/models/
+#   ensemble-dubai-mirror) and with both members mirrored; about 5 minutes on 2 cores.
 # ensemble-split: the ensemble's runs of part network again, calibration also offered the decision
 #   input split (the members split on a class of L) to rank cells by (--cell-input), side by side
 #   with the network part's ensemble runs. Needs network; about 26 minutes on 2 cores.
@@ -365,8 +367,9 @@ fi
 if [ "$part" = ensemble ]; then
   mkdir -p "$root/ensemble"
   /usr/bin/python3 examples/tools/eval_ensemble.py --threads "$jobs" --bands 1,2,3 \
-    --members mobilenetv2-dubai=examples/models/mobilenetv2-dubai,erfnet-dubai=examples/models/erfnet-dubai \
-    --ensembles ensemble-dubai=examples/models/ensemble-dubai --json "$root/ensemble/ensemble.json"
+    --members mobilenetv2-dubai=examples/models/mobilenetv2-dubai,erfnet-dubai=examples/models/erfnet-dubai,mobilenetv2-dubai-mirror=examples/models/mobilenetv2-dubai@mirror,erfnet-dubai-mirror=examples/models/erfnet-dubai@mirror \
+    --ensembles ensemble-dubai=examples/models/ensemble-dubai,ensemble-dubai-mirror=examples/models/ensemble-dubai-mirror,both-mirrored=mobilenetv2-dubai-mirror+erfnet-dubai-mirror \
+    --json "$root/ensemble/ensemble.json"
   exit 0
 fi
 

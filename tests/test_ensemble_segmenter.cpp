@@ -132,6 +132,70 @@ TEST_CASE("ensemble: the mean, its labels, disagreement and class splits follow 
   CHECK(cv::countNonZero(o.disagreement) == 0);
 }
 
+TEST_CASE("test-time mirror: a network's probabilities are the mean over the image and its mirror") {
+  // ErfnetParams::test_time_mirror, on MobileNetV2: the mean of the plain probabilities of the
+  // image and of its left-right mirror (flipped back), labels its argmax, no-data kept; and an
+  // ensemble member with `mirror` contributes exactly that.
+  const Image img = tile6_image();
+  Image mirrored = img;
+  mirrored.rgb = cv::Mat();
+  cv::flip(img.rgb, mirrored.rgb, 1);
+  ErfnetSegmenter plain(mnv2(), kParams);
+  ErfnetParams pm = kParams;
+  pm.test_time_mirror = true;
+  ErfnetSegmenter both(mnv2(), pm);
+  const Segmentation s = plain.segment_with_probabilities(img), f = plain.segment_with_probabilities(mirrored);
+  const Segmentation m = both.segment_with_probabilities(img);
+  CHECK(cv::countNonZero(m.labels != both.segment(img)) == 0);
+  check_probabilities(m.probabilities, m.labels, img, plain.num_classes(), "mirror");
+  const int nc = plain.num_classes();
+  int bad_mean = 0, bad_label = 0, changed = 0;
+  for (int r = 0; r < img.height_px; ++r)
+    for (int x = 0; x < img.width_px; ++x) {
+      const bool no_data = r < 30 && x < 40;
+      int best = 0;
+      for (int c = 0; c < nc; ++c) {
+        const auto k = static_cast<std::size_t>(c);
+        const float want = no_data ? 0.0f : 0.5f * (s.probabilities[k].at<float>(r, x) +
+                                                    f.probabilities[k].at<float>(r, img.width_px - 1 - x));
+        bad_mean += std::abs(m.probabilities[k].at<float>(r, x) - want) > 1e-6f ? 1 : 0;
+        if (m.probabilities[k].at<float>(r, x) > m.probabilities[static_cast<std::size_t>(best)].at<float>(r, x)) best = c;
+      }
+      const int got = m.labels.at<std::uint8_t>(r, x);
+      bad_label += got != (no_data ? img.ignore_label : best) ? 1 : 0;
+      changed += got != s.labels.at<std::uint8_t>(r, x) ? 1 : 0;
+    }
+  CHECK(bad_mean == 0);
+  CHECK(bad_label == 0);
+  // The network does not answer the mirror exactly as the image: some labels change, few.
+  CAPTURE(changed);
+  CHECK(changed > 50);
+  CHECK(changed < img.width_px * img.height_px / 10);
+  // An ensemble member with `mirror: true` (the file's key) is that segmenter.
+  t::TempDir tmp;
+  t::write_file(tmp.path() / "ensemble.yaml", "members:\n  - model: " + mnv2().string() + "\n    mirror: true\n  - model: " +
+                                                 erfnet().string() + "\n    mirror: false\n");
+  const auto list = read_ensemble_file(tmp.path());
+  REQUIRE(list.size() == 2);
+  CHECK(list[0].mirror);
+  CHECK_FALSE(list[1].mirror);
+  // The bundled variant examples/models/ensemble-dubai-mirror is that ensemble.
+  const auto bundled = read_ensemble_file(models() / "ensemble-dubai-mirror");
+  REQUIRE(bundled.size() == 2);
+  CHECK((bundled[0].mirror && fs::equivalent(bundled[0].model_dir, mnv2())));
+  CHECK((!bundled[1].mirror && fs::equivalent(bundled[1].model_dir, erfnet())));
+  EnsembleSegmenter ens(tmp.path(), kParams);
+  ErfnetSegmenter erf(erfnet(), kParams);
+  const Segmentation e = ens.segment_with_probabilities(img), b = erf.segment_with_probabilities(img);
+  double worst = 0.0;
+  for (std::size_t k = 0; k < static_cast<std::size_t>(nc); ++k) {
+    cv::Mat want;
+    cv::addWeighted(m.probabilities[k], 0.5, b.probabilities[k], 0.5, 0.0, want);
+    worst = std::max(worst, cv::norm(e.probabilities[k], want, cv::NORM_INF));
+  }
+  CHECK(worst < 1e-6);
+}
+
 TEST_CASE("ensemble: the bundled ensemble passes the backend conformance suite on held-out tile 6") {
   const Field f = Field::load(t::example_field("dubai-tile-6"));
   const CameraModel camera;
@@ -204,7 +268,8 @@ TEST_CASE("ensemble: bad member lists are refused with one line naming the probl
   refused(with("members: []\n"), "'members' must be a non-empty list");
   refused(with("models:\n  - model: x\n"), "unknown key 'models' (known: members, description)");
   refused(with("description: x\n"), "missing key 'members'");
-  refused(with("members:\n  - path: x\n"), "unknown key 'members[0].path' (known: model, weight)");
+  refused(with("members:\n  - path: x\n"), "unknown key 'members[0].path' (known: model, weight, mirror)");
+  refused(with("members:\n  - model: x\n    mirror: yes please\n"), "'members[0].mirror' must be true or false (got 'yes please')");
   refused(with("members:\n  - weight: 2\n"), "missing key 'members[0].model'");
   refused(with("members:\n  - x\n"), "'members[0]' must be a mapping");
   refused(with("members:\n  - model: x\n    wieght: 2\n"), "unknown key 'members[0].wieght'");

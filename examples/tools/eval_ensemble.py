@@ -10,13 +10,17 @@ labels are the argmax of its members' weighted mean probabilities (ties to the l
 adaptseg::EnsembleSegmenter gives them. Labels are scored against the orthomosaic labels at
 orthomosaic resolution; field mIoU over the classes present in truth or prediction.
 
-Members are named NAME=MODEL_DIR; an ensemble is NAME=MEMBER+MEMBER[+...] (equal weights) or
-an ensemble directory (ensemble.yaml, its members resolved relative to it).
+Members are named NAME=MODEL_DIR, or NAME=MODEL_DIR@mirror for the network with test-time mirror
+(ErfnetParams::test_time_mirror: the mean of its probabilities over the image and its left-right
+mirror); an ensemble is NAME=MEMBER+MEMBER[+...] (equal weights) or an ensemble directory
+(ensemble.yaml, its members resolved relative to it, each matched to the member of that
+directory and mirror setting).
 
 Usage:
   /usr/bin/python3 examples/tools/eval_ensemble.py \\
       --members mnv2=examples/models/mobilenetv2-dubai,erf=examples/models/erfnet-dubai \\
       --ensembles both=mnv2+erf [--fields F1,F2] [--bands 1,3] [--json out.json]
+  (a mirrored member: mnv2m=examples/models/mobilenetv2-dubai@mirror)
 """
 
 from __future__ import annotations
@@ -38,13 +42,23 @@ import train_segnet as te  # noqa: E402
 REPO = Path(__file__).resolve().parent.parent.parent
 
 
-def member_probabilities(model, spec, meta, bgr: np.ndarray) -> np.ndarray:
-    """C x H x W probabilities of a camera image, the C++ backend's path."""
+def member_probabilities(model, spec, meta, bgr: np.ndarray, mirror: bool = False) -> np.ndarray:
+    """C x H x W probabilities of a camera image, the C++ backend's path; with `mirror` the mean
+    of those of the image and of its left-right mirror (flipped back)."""
+    if mirror:
+        back = member_probabilities(model, spec, meta, np.ascontiguousarray(bgr[:, ::-1]))[:, :, ::-1]
+        return 0.5 * (member_probabilities(model, spec, meta, bgr) + back)
     x = torch.from_numpy(te.to_tensor(te.to_network_size(bgr, spec.input_wh), spec.mean, spec.std))[None]
     with torch.no_grad():
         logits = te.logits_to(model(x).float(), bgr.shape[:2])[0]
     t = float(meta.get("temperature", 1.0))
     return torch.softmax(logits / t, dim=0).numpy()
+
+
+def member_dir(value: str) -> tuple[Path, bool]:
+    """NAME=VALUE's model directory and whether it is mirrored (VALUE ends in @mirror)."""
+    mirror = value.endswith("@mirror")
+    return Path(value[:-len("@mirror")] if mirror else value), mirror
 
 
 def parse_pairs(text: str) -> dict[str, str]:
@@ -64,10 +78,10 @@ def ensemble_members(spec: str, members: dict) -> list[tuple[str, float]]:
         doc = yaml.safe_load((path / "ensemble.yaml").read_text())
         out = []
         for m in doc["members"]:
-            d = str((path / m["model"]).resolve())
-            name = next((k for k, v in members.items() if str(Path(v).resolve()) == d), None)
+            want = ((path / m["model"]).resolve(), bool(m.get("mirror", False)))
+            name = next((k for k, v in members.items() if (member_dir(v)[0].resolve(), member_dir(v)[1]) == want), None)
             if name is None:
-                raise SystemExit(f"{spec}: member {m['model']} is not among --members")
+                raise SystemExit(f"{spec}: member {m['model']}{'@mirror' if want[1] else ''} is not among --members")
             out.append((name, float(m.get("weight", 1.0))))
         return out
     names = spec.split("+")
@@ -93,13 +107,14 @@ def main():
     ensembles = {name: ensemble_members(spec, member_dirs) for name, spec in parse_pairs(args.ensembles).items()}
     nets = {}
     for name, d in member_dirs.items():
-        model, spec, meta = te.load_exported(Path(d))
-        nets[name] = (model, spec, meta)
+        model_dir, mirror = member_dir(d)
+        model, spec, meta = te.load_exported(model_dir)
+        nets[name] = (model, spec, meta, mirror)
     classes = next(iter(nets.values()))[2]["classes"]
-    for name, (_, _, meta) in nets.items():
+    for name, (_, _, meta, _) in nets.items():
         if meta["classes"] != classes:
             raise SystemExit(f"member {name}: classes {meta['classes']} differ from {classes}")
-    cams = {tuple(s.camera_wh) for _, s, _ in nets.values()}
+    cams = {tuple(s.camera_wh) for _, s, _, _ in nets.values()}
     if len(cams) != 1:
         raise SystemExit(f"members trained for different cameras: {sorted(cams)}")
     cam_wh = cams.pop()
@@ -122,9 +137,9 @@ def main():
                 if (gt != te.IGNORE).sum() == 0:
                     continue
                 probs = {}
-                for name, (model, spec, meta) in nets.items():
+                for name, (model, spec, meta, mirror) in nets.items():
                     t0 = time.perf_counter()
-                    probs[name] = member_probabilities(model, spec, meta, rgb)
+                    probs[name] = member_probabilities(model, spec, meta, rgb, mirror)
                     seconds[name] += time.perf_counter() - t0
                 labels = {n: p.argmax(0) for n, p in probs.items()}
                 for ens, mem in ensembles.items():

@@ -17,6 +17,7 @@
 /// members:
 ///   - model: ../mobilenetv2-dubai
 ///     weight: 1        # optional, default 1; > 0; weights are normalised
+///     mirror: true     # optional, default false: ErfnetParams::test_time_mirror for this member
 ///   - model: ../erfnet-dubai
 /// description: free text  # optional
 /// @endcode
@@ -43,10 +44,13 @@
 namespace adaptseg {
 
 /// One member of an ensemble: a model directory (model.onnx + model.yaml, as ErfnetSegmenter
-/// loads it) and its weight in the mean.
+/// loads it), its weight in the mean, and whether it also segments the mirrored image.
 struct EnsembleMember {
   std::filesystem::path model_dir;
   double weight = 1.0;  ///< > 0, finite; the weights are normalised to sum to 1
+  /// ErfnetParams::test_time_mirror for this member (its probabilities: the mean over the image
+  /// and its mirror; it still counts once in the votes and the disagreement).
+  bool mirror = false;
 };
 
 /// An ensemble's segmentation of one image (EnsembleSegmenter::segment_with_disagreement()).
@@ -70,7 +74,7 @@ struct EnsembleSegmentation {
 /// comment above), member paths resolved relative to the directory.
 /// @throws std::invalid_argument naming the file and the problem: no such directory or file, a
 ///         YAML error, an unknown key, no members, a member without `model`, a weight that is
-///         not a number > 0.
+///         not a number > 0, a `mirror` that is not true or false.
 [[nodiscard]] inline std::vector<EnsembleMember> read_ensemble_file(const std::filesystem::path& dir) {
   const std::filesystem::path file = dir / "ensemble.yaml";
   const auto fail = [&](const std::string& what) {
@@ -86,10 +90,11 @@ struct EnsembleSegmentation {
   r.only_keys({"members", "description"});
   std::vector<EnsembleMember> members;
   for (const detail::YamlReader& m : r.maps("members")) {
-    m.only_keys({"model", "weight"});
+    m.only_keys({"model", "weight", "mirror"});
     EnsembleMember member;
     member.model_dir = dir / m.text("model");
     if (m.has("weight")) member.weight = m.number("weight");
+    if (m.has("mirror")) member.mirror = m.flag("mirror");
     members.push_back(std::move(member));
   }
   if (members.empty()) fail("'members' must be a non-empty list of {model: DIR, weight: W}");
@@ -117,9 +122,10 @@ struct EnsembleSegmentation {
 /// @endcode
 class EnsembleSegmenter {
  public:
-  /// Applied to every member (classes, camera size, resampling, no-data, threads, DNN backend);
-  /// `name` is the ensemble's (ErfnetParams' default, "erfnet", becomes "ensemble"; member k is
-  /// named `name/<its folder>`).
+  /// Applied to every member (classes, camera size, resampling, no-data, threads, DNN backend,
+  /// test-time mirror, which a member's own `mirror` adds to); `name` is the ensemble's
+  /// (ErfnetParams' default, "erfnet", becomes "ensemble"; member k is named
+  /// `name/<its folder>`).
   using Params = ErfnetParams;
 
   /// Loads every member.
@@ -148,6 +154,7 @@ class EnsembleSegmenter {
       weights_.push_back(static_cast<float>(specs_[k].weight / total));
       Params p = params_;
       p.name = params_.name + "/" + specs_[k].model_dir.filename().string();
+      p.test_time_mirror = params_.test_time_mirror || specs_[k].mirror;
       try {
         members_.emplace_back(specs_[k].model_dir, std::move(p));
       } catch (const std::invalid_argument& e) {
