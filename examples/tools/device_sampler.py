@@ -52,15 +52,22 @@ import torch.nn.functional as F
 IGNORE = 255
 
 
-def area_weights(n_out: int, n_in: int, device) -> torch.Tensor:
-    """n_out x n_in matrix of INTER_AREA's weights for shrinking n_in pixels to n_out: row j
-    averages the source interval [j s, (j + 1) s), s = n_in / n_out, each pixel by its overlap."""
+def area_weights(axes: torch.Tensor, n: int, tmax: int) -> torch.Tensor:
+    """B x n x tmax INTER_AREA weights, one matrix per row of `axes` (B x 7, float64): (n_out,
+    n_in, offset, count, reversed, a0, a1). Shrinking n_in pixels to n_out, camera pixel j
+    averages the source interval [j s, (j + 1) s), s = n_in / n_out, each pixel by its overlap;
+    row o of the result is camera pixel offset + o (rows from `count` on are 0), column w is
+    source pixel a0 + w (from a1 on 0), counted from the far end where `reversed` > 0."""
+    n_out, n_in, off, cnt, rev, a0, a1 = (axes[:, i].view(-1, 1, 1) for i in range(7))
+    o = torch.arange(n, dtype=torch.float64, device=axes.device).view(1, -1, 1)
+    w = torch.arange(tmax, dtype=torch.float64, device=axes.device).view(1, 1, -1)
     s = n_in / n_out
-    j = torch.arange(n_out, device=device, dtype=torch.float64)[:, None]
-    i = torch.arange(n_in, device=device, dtype=torch.float64)[None, :]
+    j = off + o                                   # camera pixel
+    a = a0 + w                                    # footprint pixel, before the reversal
+    i = torch.where(rev > 0, n_in - 1 - a, a)     # index of the resampled image's axis
     lo, hi = j * s, (j + 1) * s
-    w = (torch.minimum(hi, i + 1) - torch.maximum(lo, i)).clamp_min(0.0) / s
-    return w.float()
+    wts = (torch.minimum(hi, i + 1) - torch.maximum(lo, i)).clamp_min(0.0) / s
+    return torch.where((o < cnt) & (a < a1), wts, torch.zeros_like(wts)).float()
 
 
 def bgr_to_hsv(x: torch.Tensor):
@@ -155,19 +162,12 @@ class DeviceSampler:
         self.mean = torch.tensor(self.spec.mean, dtype=torch.float32, device=self.device).view(3, 1, 1)
         self.std = torch.tensor(self.spec.std, dtype=torch.float32, device=self.device).view(3, 1, 1)
         self.classes = torch.arange(self.nc, device=self.device, dtype=torch.uint8)
-        self._weights = {}
 
     def _dev(self, values, dtype=torch.float32) -> torch.Tensor:
         """Host values on the device without waiting for it: from pinned memory, asynchronously
         (a plain copy from pageable memory would wait for the work queued before it)."""
         t = torch.as_tensor(np.asarray(values), dtype=dtype)
         return t.pin_memory().to(self.device, non_blocking=True) if self.device.type == "cuda" else t.to(self.device)
-
-    def weights(self, n_out, n_in):
-        key = (n_out, n_in)
-        if key not in self._weights:
-            self._weights[key] = area_weights(n_out, n_in, self.device)
-        return self._weights[key]
 
     def crop_size(self):
         """(width, height) of a training crop in camera pixels."""
@@ -206,20 +206,7 @@ class DeviceSampler:
         reversed where the yaw and mirror reverse that source axis, zero-padded to the batch's
         longest window. axes: per sample (n_out, n_in, offset, count, reversed, a0, a1): camera
         pixels offset..offset+count of n_out, footprint pixels a0..a1 of n_in (the window)."""
-        t = self._dev(axes, torch.float64)
-        n_out, n_in, off, cnt, rev, a0, a1 = (t[:, i].view(-1, 1, 1) for i in range(7))
-        n = max(a[3] for a in axes)
-        tmax = max(a[6] - a[5] for a in axes)
-        o = torch.arange(n, dtype=torch.float64, device=self.device).view(1, -1, 1)
-        w = torch.arange(tmax, dtype=torch.float64, device=self.device).view(1, 1, -1)
-        s = n_in / n_out
-        j = off + o                                   # camera pixel
-        a = a0 + w                                    # footprint pixel, before the reversal
-        i = torch.where(rev > 0, n_in - 1 - a, a)     # index of the resampled image's axis
-        lo, hi = j * s, (j + 1) * s
-        wts = (torch.minimum(hi, i + 1) - torch.maximum(lo, i)).clamp_min(0.0) / s
-        wts = torch.where((o < cnt) & (a < a1), wts, torch.zeros_like(wts))
-        return wts.float()
+        return area_weights(self._dev(axes, torch.float64), max(a[3] for a in axes), max(a[6] - a[5] for a in axes))
 
     def cameras(self, geos, chunk: int = 8):
         """Camera crops (B x 3 x h x w float BGR, rounded to 8 bits) and oracle targets (B x h x w

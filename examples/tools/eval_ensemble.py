@@ -56,9 +56,9 @@ def member_probabilities(model, spec, meta, bgr: np.ndarray, mirror: bool = Fals
 
 
 def member_dir(value: str) -> tuple[Path, bool]:
-    """NAME=VALUE's model directory and whether it is mirrored (VALUE ends in @mirror)."""
+    """NAME=VALUE's model directory (resolved) and whether it is mirrored (VALUE ends in @mirror)."""
     mirror = value.endswith("@mirror")
-    return Path(value[:-len("@mirror")] if mirror else value), mirror
+    return Path(value[:-len("@mirror")] if mirror else value).resolve(), mirror
 
 
 def parse_pairs(text: str) -> dict[str, str]:
@@ -79,7 +79,7 @@ def ensemble_members(spec: str, members: dict) -> list[tuple[str, float]]:
         out = []
         for m in doc["members"]:
             want = ((path / m["model"]).resolve(), bool(m.get("mirror", False)))
-            name = next((k for k, v in members.items() if (member_dir(v)[0].resolve(), member_dir(v)[1]) == want), None)
+            name = next((k for k, v in members.items() if member_dir(v) == want), None)
             if name is None:
                 raise SystemExit(f"{spec}: member {m['model']}{'@mirror' if want[1] else ''} is not among --members")
             out.append((name, float(m.get("weight", 1.0))))

@@ -70,7 +70,9 @@ def main(argv=None):
         ref = cv2.resize(img, (480, 360) if w > h else (360, 480), interpolation=cv2.INTER_AREA).astype(np.float32)
         oh, ow = ref.shape[:2]
         t = torch.from_numpy(img).to(dev.device).float()
-        out = torch.einsum("oh,hwc,pw->opc", dev.weights(oh, h), t, dev.weights(ow, w))
+        wy, wx = (ds.area_weights(torch.tensor([[no, ni, 0, no, 0, 0, ni]], dtype=torch.float64, device=dev.device),
+                                  no, ni)[0] for no, ni in ((oh, h), (ow, w)))
+        out = torch.einsum("oh,hwc,pw->opc", wy, t, wx)
         out = torch.round(out).clamp(0, 255).cpu().numpy()
         worst = max(worst, float(np.abs(out - ref).max()))
     check(worst <= 1.0, f"INTER_AREA by weight matrices = cv2.resize to one level (max |diff| {worst:g})")
