@@ -151,7 +151,7 @@ TEST_CASE("adaptive planner: coverage 'interest' re-maps only the sub-cells that
   CHECK(focused.mission.waypoints.size() == 2 + 1);
 }
 
-TEST_CASE("descent coverages: each rule says which cells it flies and whether it ranks them; names parse back") {
+TEST_CASE("descent coverages: each rule says which cells it flies and whether it ranks them, their names parse back") {
   const cv::Mat labels(30, 30, CV_8UC1, cv::Scalar(0));
   cv::Mat crop = labels.clone();
   crop(cv::Rect(12, 12, 2, 2)).setTo(1);

@@ -237,7 +237,7 @@ struct Scenario {
 };
 }  // namespace
 
-TEST_CASE("front-aware policy: a descent's forecast margin is against the curve at its end; a new mission forgets") {
+TEST_CASE("front-aware policy: a descent's forecast margin is against the curve at its end, and a new mission forgets") {
   const Scenario s;
   // The curve rises 0.01 per 40 s from the top level (40 s, 0.75); a descent of 40 s from
   // region 0 (T0 = 40 s) is forecast to gain about 0.0143: it ends above the curve.
@@ -654,7 +654,7 @@ TEST_CASE("front-aware policy: unsure of the field's σ while little of it is se
 // ---------------------------------------------------------------------------------------------
 // DecisionFunction, LinearDecision, conformance
 // ---------------------------------------------------------------------------------------------
-TEST_CASE("decision function: forwards to its rule; online on and off") {
+TEST_CASE("decision function: forwards to its rule, online on and off") {
   const Scenario s;
   DecisionFunction df(FrontAwarePolicy(fitted(), s.reference(0.0), {}));
   CHECK(df.front_aware());
