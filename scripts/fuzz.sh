@@ -13,7 +13,7 @@ jobs=$(nproc 2>/dev/null || echo 2)
 
 CC=clang CXX=clang++ cmake -S . -B build/fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DADAPTSEG_BUILD_FUZZERS=ON \
   -DADAPTSEG_BUILD_TESTS=OFF -DADAPTSEG_BUILD_EXAMPLES=OFF -DADAPTSEG_BUILD_BENCHMARKS=OFF >/dev/null
-targets=(field_load decision_model_load gaussian_process_load wpl_read)
+targets=(field_load decision_model_load gaussian_process_load wpl_read mavlink)
 cmake --build build/fuzz -j"$jobs" --target "${targets[@]/#/fuzz_}"
 
 status=0
