@@ -298,7 +298,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"oracle", "erfnet"}))
       ->capture_default_str();
   app.add_option("--model-file", erfnet_dir, "network of --segmenter erfnet: a model directory (model.onnx, model.yaml) or an ensemble directory (ensemble.yaml)");
-  app.add_option("--budget-s", budget_s, "mission-time budget [s] (never exceeded)");
+  app.add_option("--budget-s", budget_s, "mission-time budget [s]: a descent is flown only where it and the rest fit, each image at a bound of its processing learned in flight, and cut short where they no longer do");
   app.add_option("--pose-tolerance-m", s.tolerance_m, "how far [m] a recorded pose may be from the waypoint")
       ->capture_default_str();
   app.add_option("--seg-time-s", seg_time_s, "fixed segmentation time per image [s] (default: measured)");

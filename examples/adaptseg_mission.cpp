@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--gsd", gsd_cm, "lawnmower GSD [cm/px] (>= the field's GSD)");
   app.add_option("--model", model_file, "decision model from adaptseg_calibrate (adaptive, nonadaptive, linear)");
-  app.add_option("--budget-s", budget_s, "mission-time budget [s] for adaptive strategies (never exceeded)");
+  app.add_option("--budget-s", budget_s, "mission-time budget [s] for adaptive strategies: a descent is flown only where it and the rest fit, each image at a bound of its processing learned in flight, and cut short where they no longer do");
   std::string overlap_text;
   app.add_option("--overlap", overlap_text,
                  "OVERLAP or ALONG,ACROSS: image overlap of the lawnmower strategy, fractions of a footprint in "

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds in Release, and runs the benchmarks:
-#   GaussianProcess vs scikit-learn, the per-waypoint decision time, and each bundled network
+#   GaussianProcess vs scikit-learn, the per-waypoint decision time, the planner's own time per
+#   waypoint over whole missions, and each bundled network
 #   through the ONNX backend (OpenCV DNN vs PyTorch), the bundled ensemble against its members, and a 20000 x 20000 GeoTIFF field loaded.
 #   Results: docs/benchmarks.md.
 set -euo pipefail
@@ -8,7 +9,7 @@ cd "$(dirname "$0")/.."
 bash scripts/deps.sh bench
 source scripts/configure.sh
 configure_for bench build/release
-cmake --build build/release -j"$(nproc 2>/dev/null || echo 2)" --target bench_gaussian_process bench_decision bench_erfnet \
+cmake --build build/release -j"$(nproc 2>/dev/null || echo 2)" --target bench_gaussian_process bench_decision bench_planner adaptseg_calibrate bench_erfnet \
   bench_ensemble bench_geotiff
 # GaussianProcess vs scikit-learn twice, side by side: numpy/scipy on Debian's reference BLAS and
 # LAPACK (single-threaded), then on OpenBLAS (multi-threaded; what a pip user's numpy brings).
@@ -20,6 +21,8 @@ for blas in "reference:$lib/blas:$lib/lapack" "openblas:$lib/openblas-pthread"; 
       build/release/benchmarks/bench_gaussian_process "$@"
 done
 build/release/benchmarks/bench_decision
+# The planner's own time per waypoint over whole missions (calibrates its models first, cached).
+bash benchmarks/bench_planner.sh build/release
 for m in erfnet-dubai mobilenetv2-dubai; do
   /usr/bin/python3 benchmarks/bench_erfnet.py --model-dir "examples/models/$m" \
       --bench-bin build/release/benchmarks/bench_erfnet --rounds 5 --iters 10

@@ -8,8 +8,11 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <limits>
 #include <map>
+#include <random>
+#include <thread>
 #include <utility>
 
 using namespace adaptseg;
@@ -860,4 +863,102 @@ TEST_CASE("AdaptivePlanner: a survey area without a mask covers the rectangle") 
   area.area.x_min_m = -1.0;
   CHECK_THROWS_WITH_AS(Planner(area, oracle, never, weedmap_options(f)), doctest::Contains("SurveyArea: area"),
                        std::invalid_argument);
+}
+
+TEST_CASE("AdaptivePlanner: the budget holds on a slow computer, images and decisions slowed at random") {
+  // A caller that keeps the mission clock itself (as a UAV's companion computer does): the flight
+  // model's legs, then per image a segmentation of a random 0-300 ms and the planner slowed by
+  // another random 0-300 ms (a busy computer). The planner learns a bound of a step's cost from
+  // its clock and reserves it for every step still to come: no mission ends over its budget, and
+  // the budgets that leave room still buy descents.
+  const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
+  OracleSegmenter oracle(f.num_classes());
+  AdaptiveOptions o = options();
+  o.top_gsd_cm = 6.0;
+  o.mission.fixed_segmentation_time_s.reset();
+  o.mission.fixed_planning_time_s.reset();
+  o.mission.interest = f.interest();
+  const SimulatedSensor sensor(f, CameraModel(o.mission.camera));
+  // The top level alone at the worst step (0.6 s per image), and with every descent at none.
+  double coverage_worst = 0.0, everything = 0.0;
+  {
+    Scripted never{.gsd = 0.5}, all{.gsd = 1.0};
+    AdaptiveOptions fixed = options();
+    fixed.top_gsd_cm = 6.0;
+    fixed.mission.fixed_segmentation_time_s = 0.6;
+    fixed.mission.fixed_planning_time_s = 0.0;
+    coverage_worst = run_adaptive_mission(f, oracle, never, fixed, "never").mission.total_s();
+    fixed.mission.fixed_segmentation_time_s = 0.0;
+    everything = run_adaptive_mission(f, oracle, all, fixed, "all").mission.total_s();
+  }
+  REQUIRE(everything > coverage_worst + 60.0);
+  int over = 0, descended = 0, runs = 0;
+  double worst_slack = 1e9;
+  for (unsigned seed = 0; seed < 50; ++seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> slow(0.0, 0.3);
+    const double budget = coverage_worst + (0.05 + 0.9 * (seed % 10) / 10.0) * (everything - coverage_worst);
+    o.budget_s = budget;
+    Scripted greedy{.gsd = 1.0};
+    AdaptivePlanner<OracleSegmenter, Scripted> planner(SurveyArea::of(f), oracle, greedy, o);
+    double clock = 0.0;
+    std::optional<Eigen::Vector3d> at;
+    while (const auto w = planner.next()) {
+      if (at) clock += planner.timing().segment_time_s(*at, w->waypoint.position);
+      at = w->waypoint.position;
+      const Image image = sensor.capture(w->waypoint);
+      const double segmentation_s = slow(rng);
+      clock += segmentation_s;
+      (void)planner.report(image, oracle.segment(image), segmentation_s, clock);
+      clock += slow(rng) + planner.take_planning_s();
+    }
+    CAPTURE(seed);
+    CAPTURE(budget);
+    CHECK(clock <= budget);
+    over += clock > budget ? 1 : 0;
+    worst_slack = std::min(worst_slack, budget - clock);
+    const auto n = std::count_if(planner.decisions().begin(), planner.decisions().end(),
+                                 [](const DecisionRecord& d) { return d.decision.descend; });
+    descended += n > 0 ? 1 : 0;
+    ++runs;
+  }
+  MESSAGE("runs over budget: " << over << " of " << runs << "; runs with descents: " << descended
+                               << "; least slack " << worst_slack << " s");
+  CHECK(over == 0);
+  CHECK(descended >= 40);  // every budget beyond the tightest buys descents
+}
+
+TEST_CASE("run_adaptive_mission: a backend and a policy that sleep keep the budget, measured time") {
+  // The simulation measures the segmentation and the planner's time with the clock, as a mission
+  // flown without fixed times does: both slowed by real sleeps, up to 40 ms each.
+  struct SleepyOracle {
+    OracleSegmenter oracle;
+    std::mt19937 rng{3};
+    std::string name() const { return "sleepy-oracle"; }
+    cv::Mat segment(const Image& image) {
+      std::this_thread::sleep_for(std::chrono::microseconds(std::uniform_int_distribution<int>(0, 40000)(rng)));
+      return oracle.segment(image);
+    }
+  };
+  struct SleepyScripted : Scripted {
+    std::mt19937 rng{4};
+    Decision decide(const DecisionContext& c) {
+      std::this_thread::sleep_for(std::chrono::microseconds(std::uniform_int_distribution<int>(0, 40000)(rng)));
+      return Scripted::decide(c);
+    }
+  };
+  const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
+  AdaptiveOptions o = options();
+  o.top_gsd_cm = 6.0;
+  o.mission.fixed_segmentation_time_s.reset();
+  o.mission.fixed_planning_time_s.reset();
+  SleepyOracle backend{OracleSegmenter(f.num_classes())};
+  SleepyScripted never;
+  never.gsd = 0.5;
+  const double coverage = run_adaptive_mission(f, backend, never, o, "never").mission.total_s();
+  o.budget_s = coverage + 40.0;
+  SleepyScripted greedy;
+  const AdaptiveResult r = run_adaptive_mission(f, backend, greedy, o, "greedy");
+  CHECK(r.mission.total_s() <= *o.budget_s);
+  CHECK(r.descents() >= 1);
 }

@@ -1,9 +1,14 @@
 #include <adaptseg/core/decision_inputs.hpp>
+#include <adaptseg/vision/grid_inputs.hpp>
 #include <adaptseg/vision/image_summary.hpp>
 
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cmath>
+#include <limits>
+#include <random>
+#include <span>
 #include <vector>
 
 using namespace adaptseg;
@@ -117,4 +122,166 @@ TEST_CASE("image summary: per-pixel planes onto the map grid, and a cell's means
   CHECK(none.field_px == 0.0);
   CHECK(std::isnan(none.value(DecisionInput::sigma)));
   CHECK(none.mass(DecisionInput::sigma) == 0.0);
+}
+
+TEST_CASE("GridInputs: every cell to the bit as cell_inputs of the planes on the grid, turned or not") {
+  // Random segmentations with probabilities over footprints of non-integer size ratios, partly
+  // outside the rect, some turned; random field masks; random cells (some outside the footprint).
+  cv::RNG rng(7);
+  const std::vector<int> interest{1, 3};
+  int compared = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    Image img;
+    img.width_px = 13 + rng.uniform(0, 20);
+    img.height_px = 9 + rng.uniform(0, 15);
+    img.ignore_label = 255;
+    const double ratio = rng.uniform(0.6, 3.3);
+    img.footprint_px = cv::Rect(rng.uniform(-10, 10), rng.uniform(-10, 10), static_cast<int>(img.width_px * ratio) + 1,
+                                static_cast<int>(img.height_px * ratio) + 1);
+    img.yaw_deg = trial % 3 == 0 ? rng.uniform(-180.0, 180.0) : (trial % 3 == 1 ? 90.0 * rng.uniform(0, 4) : 0.0);
+    Segmentation s;
+    s.labels = cv::Mat(img.height_px, img.width_px, CV_8UC1);
+    rng.fill(s.labels, cv::RNG::UNIFORM, 0, 5);
+    for (int k = 0; k < 6; ++k) s.labels.at<unsigned char>(rng.uniform(0, img.height_px), rng.uniform(0, img.width_px)) = 255;
+    cv::Mat sum(s.labels.size(), CV_32F, cv::Scalar(0.0f));
+    for (int c = 0; c < 5; ++c) {
+      cv::Mat p(s.labels.size(), CV_32F);
+      rng.fill(p, cv::RNG::UNIFORM, 0.0f, 1.0f);
+      cv::pow(p, 3.0, p);  // small probabilities too
+      s.probabilities.push_back(p);
+      sum += p;
+    }
+    for (cv::Mat& p : s.probabilities) p /= sum;
+    const cv::Rect rect(rng.uniform(-5, 15), rng.uniform(-5, 15), rng.uniform(10, 60), rng.uniform(10, 60));
+    cv::Mat field(rect.size(), CV_8UC1);
+    rng.fill(field, cv::RNG::UNIFORM, 0, 4);  // about a quarter not field
+    if (trial % 2 == 1) field.setTo(255);      // all field: summed by camera pixel, weighted
+    const auto grid = planes_on_grid(img, pixel_inputs(s, interest, 255), rect);
+    for (const auto& row : kDecisionInputs) {
+      const GridInputs fast(img, s, interest, 255, rect, std::array{row.input},
+                            trial % 4 < 2 ? GridInputs::Cells::many : GridInputs::Cells::one);
+      for (int c = 0; c < 6; ++c) {
+        const cv::Rect cell(rng.uniform(-3, rect.width), rng.uniform(-3, rect.height), rng.uniform(1, 30), rng.uniform(1, 30));
+        const CellInputs want = cell_inputs(grid, field, cell);
+        const CellInputs got = fast.cell(field, cell);
+        CHECK(got.field_px == want.field_px);
+        for (DecisionInput i : {DecisionInput::sigma, row.input}) {
+          const double a = got.value(i), b = want.value(i);
+          CHECK_MESSAGE(((std::isnan(a) && std::isnan(b)) || a == b), "input ", to_string(i), " trial ", trial);
+        }
+        if (row.input != DecisionInput::sigma && row.input != DecisionInput::boundary)
+          CHECK(std::isnan(got.value(DecisionInput::entropy == row.input ? DecisionInput::ambiguity : DecisionInput::entropy)));
+        compared += want.field_px > 0.0 ? 1 : 0;
+      }
+    }
+  }
+  CHECK(compared > 500);  // most cells saw something
+}
+
+namespace {
+// The per-pixel formulas as adaptseg wrote them one pixel at a time until pixel_input_rows
+// (adaptseg 0.2 before it): the reference the row kernel must equal to the bit.
+std::array<float, kDecisionInputCount> reference_values(int label, std::span<const float> p,
+                                                        const std::array<bool, 256>& in_interest,
+                                                        std::span<const float> votes) {
+  constexpr float nan = std::numeric_limits<float>::quiet_NaN();
+  std::array<float, kDecisionInputCount> v;
+  v.fill(nan);
+  const float in = label >= 0 && label < 256 && in_interest[static_cast<std::size_t>(label)] ? 1.0f : 0.0f;
+  v[index_of(DecisionInput::sigma)] = in;
+  v[index_of(DecisionInput::boundary)] = in;
+  float vote_sum = 0.0f, split = 0.0f;
+  for (std::size_t c = 0; c < votes.size() && c < 256; ++c) {
+    vote_sum += votes[c];
+    if (in_interest[c]) split += (votes[c] > kVoteShareTolerance && votes[c] < 1.0f - kVoteShareTolerance) ? 1.0f : 0.0f;
+  }
+  if (vote_sum > 0.0f) v[index_of(DecisionInput::split)] = split;
+  const std::size_t n = p.size();
+  if (n == 0) return v;
+  std::size_t first = 0, second = n > 1 ? 1 : 0;
+  if (n > 1 && p[1] > p[0]) first = 1, second = 0;
+  float sum = 0.0f, entropy = 0.0f;
+  for (std::size_t c = 0; c < n; ++c) {
+    sum += p[c];
+    if (p[c] > 0.0f) entropy -= p[c] * std::log(p[c]);
+    if (c < 2) continue;
+    if (p[c] > p[first]) {
+      second = first;
+      first = c;
+    } else if (p[c] > p[second]) {
+      second = c;
+    }
+  }
+  if (!(sum > 0.0f)) return v;
+  float ambiguity = 0.0f, expected_error = 0.0f, second_choice = 0.0f;
+  for (std::size_t c = 0; c < n && c < 256; ++c) {
+    if (!in_interest[c]) continue;
+    ambiguity += (p[c] > 0.2f && p[c] < 0.8f) ? 1.0f : 0.0f;
+    expected_error += static_cast<std::size_t>(label) == c ? 1.0f - p[c] : p[c];
+    second_choice += (c == second && c != first && p[c] > 0.2f) ? 1.0f : 0.0f;
+  }
+  v[index_of(DecisionInput::ambiguity)] = ambiguity;
+  v[index_of(DecisionInput::expected_error)] = expected_error;
+  v[index_of(DecisionInput::second_choice)] = second_choice;
+  v[index_of(DecisionInput::low_confidence)] = p[first] < 0.6f ? 1.0f : 0.0f;
+  v[index_of(DecisionInput::entropy)] = n > 1 ? entropy / std::log(static_cast<float>(n)) : 0.0f;
+  return v;
+}
+}  // namespace
+
+TEST_CASE("decision inputs: the row kernel equals the per-pixel formulas, every input alone or together") {
+  // Random rows of 1..200 pixels over 1..6 classes (ties and zeros included), with and without
+  // member votes, some pixels without probabilities; every input wanted, and each alone.
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  int compared = 0, differ = 0, touched = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const std::size_t classes = 1 + static_cast<std::size_t>(trial % 6), n = 1 + static_cast<std::size_t>(rng() % 200);
+    const bool with_votes = trial % 3 == 0;
+    std::vector<unsigned char> labels(n);
+    std::vector<std::vector<float>> p(classes, std::vector<float>(n)), v(with_votes ? classes : 0, std::vector<float>(n));
+    for (std::size_t x = 0; x < n; ++x) {
+      labels[x] = static_cast<unsigned char>(rng() % classes);
+      float total = 0.0f;
+      for (std::size_t c = 0; c < classes; ++c) total += (p[c][x] = rng() % 5 == 0 ? 0.0f : (rng() % 7 == 0 ? 0.25f : u(rng)));
+      const bool none = rng() % 10 == 0;  // a pixel without probabilities
+      for (std::size_t c = 0; c < classes; ++c) p[c][x] = none || total == 0.0f ? 0.0f : p[c][x] / total;
+      for (auto& vote : v) vote[x] = static_cast<float>(rng() % 3) / 2.0f;
+    }
+    std::array<bool, 256> in_l{};
+    for (std::size_t c = 0; c < classes; ++c) in_l[c] = rng() % 2 == 0;
+    std::vector<const float*> p_rows, v_rows;
+    for (const auto& row : p) p_rows.push_back(row.data());
+    for (const auto& row : v) v_rows.push_back(row.data());
+    for (int alone = -1; alone < static_cast<int>(kDecisionInputCount); ++alone) {
+      std::array<bool, kDecisionInputCount> wanted{};
+      for (std::size_t k = 0; k < kDecisionInputCount; ++k) wanted[k] = alone < 0 || static_cast<int>(k) == alone;
+      std::array<std::vector<float>, kDecisionInputCount> out;
+      std::array<float*, kDecisionInputCount> out_rows{};
+      for (std::size_t k = 0; k < kDecisionInputCount; ++k) {
+        out[k].assign(n, -7.0f);
+        out_rows[k] = out[k].data();
+      }
+      pixel_input_rows(n, labels.data(), p_rows, v_rows, in_l, wanted, out_rows);
+      for (std::size_t x = 0; x < n; ++x) {
+        std::vector<float> px(classes), vx(v.size());
+        for (std::size_t c = 0; c < classes; ++c) px[c] = p[c][x];
+        for (std::size_t c = 0; c < v.size(); ++c) vx[c] = v[c][x];
+        const auto want = reference_values(labels[x], px, in_l, vx);
+        for (std::size_t k = 0; k < kDecisionInputCount; ++k) {
+          if (!wanted[k]) {
+            touched += out[k][x] != -7.0f ? 1 : 0;
+            continue;
+          }
+          const bool same = std::isnan(want[k]) ? std::isnan(out[k][x]) : out[k][x] == want[k];
+          if (!same && ++differ <= 5)
+            FAIL_CHECK("input " << to_string(kDecisionInputs[k].input) << " pixel " << x << " trial " << trial);
+          ++compared;
+        }
+      }
+    }
+  }
+  CHECK(compared > 100000);
+  CHECK(differ == 0);
+  CHECK(touched == 0);  // inputs not wanted are left as they were
 }

@@ -128,3 +128,40 @@ TEST_CASE("map: a yaw that is not finite is refused") {
                        std::invalid_argument);
   CHECK(cv::countNonZero(map.labels() != 255) == 0);
 }
+
+TEST_CASE("semantic map: fuse writes what resampling the labels onto the footprint and masking writes") {
+  // The reference: the camera labels resampled onto the footprint (INTER_NEAREST_EXACT), written
+  // where not ignored and the image is at least as fine as the pixel's last write. Random sizes,
+  // footprints partly outside the map, non-integer ratios, GSDs in random order.
+  cv::RNG rng(5);
+  for (int trial = 0; trial < 30; ++trial) {
+    const cv::Size size(rng.uniform(20, 120), rng.uniform(20, 120));
+    SemanticMap map(size, 255);
+    cv::Mat ref_labels(size, CV_8UC1, cv::Scalar(255)), ref_gsd(size, CV_32F, cv::Scalar(1e30f));
+    for (int k = 0; k < 6; ++k) {
+      Image img;
+      img.width_px = rng.uniform(5, 40);
+      img.height_px = rng.uniform(5, 30);
+      img.ignore_label = 255;
+      img.gsd_cm = rng.uniform(1, 5);
+      const double ratio = rng.uniform(0.5, 3.5);
+      img.footprint_px = cv::Rect(rng.uniform(-20, size.width), rng.uniform(-20, size.height),
+                                  static_cast<int>(img.width_px * ratio) + 1, static_cast<int>(img.height_px * ratio) + 1);
+      cv::Mat labels(img.height_px, img.width_px, CV_8UC1);
+      rng.fill(labels, cv::RNG::UNIFORM, 0, 4);
+      labels.setTo(255, labels == 3);  // some ignored
+      map.fuse(img, labels);
+      const cv::Rect fp = img.footprint_px, inside = fp & cv::Rect(0, 0, size.width, size.height);
+      if (inside.area() == 0) continue;
+      cv::Mat up;
+      cv::resize(labels, up, fp.size(), 0, 0, cv::INTER_NEAREST_EXACT);
+      const cv::Mat up_in = up(inside - fp.tl());
+      const cv::Mat write = (ref_gsd(inside) >= static_cast<float>(img.gsd_cm)) & (up_in != 255);
+      up_in.copyTo(ref_labels(inside), write);
+      ref_gsd(inside).setTo(static_cast<float>(img.gsd_cm), write);
+    }
+    CHECK(cv::countNonZero(map.labels() != ref_labels) == 0);
+    ref_gsd.setTo(std::numeric_limits<float>::infinity(), ref_gsd == 1e30f);
+    CHECK(cv::countNonZero(map.gsd_cm() != ref_gsd) == 0);
+  }
+}

@@ -19,6 +19,7 @@
 #include <adaptseg/vision/front_aware_rule.hpp>
 #include <adaptseg/vision/gp_io.hpp>
 #include <adaptseg/vision/image.hpp>
+#include <adaptseg/vision/grid_inputs.hpp>
 #include <adaptseg/vision/image_summary.hpp>
 #include <adaptseg/vision/metrics.hpp>
 #include <adaptseg/vision/mission.hpp>

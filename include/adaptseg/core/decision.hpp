@@ -143,6 +143,10 @@ struct DescentOutcome {
   /// them in that order, except a survey-then-inspect tour (DescentSchedule::tour, row), which
   /// chooses them during the survey (or the row) and flies them in its own order.
   std::size_t descent = 0;
+  /// The budget ended the descent before its last planned image (a bound of the steps' time
+  /// learned in flight outgrew what was reserved when it was chosen): what it flew is what the
+  /// other members describe.
+  bool cut_short = false;
 };
 
 /// Decides at each top-level waypoint. Rationale: the planner owns geometry and time, the

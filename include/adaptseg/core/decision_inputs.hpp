@@ -12,6 +12,7 @@
 /// (cell_gain_model.hpp, calibration.hpp), the model file, the command line and the study tool
 /// (examples/tools/cell_study.cpp). No OpenCV here: the decision side compiles without it.
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -62,6 +63,15 @@ inline constexpr std::array<DecisionInputInfo, 8> kDecisionInputs{{
 
 inline constexpr std::size_t kDecisionInputCount = kDecisionInputs.size();
 
+namespace detail {
+/// Every decision input: pixel_input_values()'s default.
+inline constexpr std::array<bool, kDecisionInputCount> kEveryDecisionInput = [] {
+  std::array<bool, kDecisionInputCount> all{};
+  for (bool& w : all) w = true;
+  return all;
+}();
+}  // namespace detail
+
 /// The values of every decision input, in enum order (NaN where unknown: an input that needs
 /// probabilities from a labels-only backend, or a cell without field pixels seen).
 using DecisionInputValues = std::array<double, kDecisionInputCount>;
@@ -86,57 +96,132 @@ using DecisionInputValues = std::array<double, kDecisionInputCount>;
 /// split on it (input `split`, EnsembleSegmentation::class_split).
 inline constexpr float kVoteShareTolerance = 1e-4f;
 
-/// The per-pixel quantity behind every input at one labelled pixel: `label` l, the class
-/// probabilities `p` (empty for a labels-only backend: the inputs that need them are NaN),
-/// `in_interest[c]` true for the classes of L, and an ensemble's member vote shares `votes` per
-/// class (empty for one network: `split` is NaN). `boundary` holds the σ indicator (its cell
-/// value is σ(1 − σ) of the mean, cell_value()).
-[[nodiscard]] inline std::array<float, kDecisionInputCount> pixel_input_values(int label, std::span<const float> p,
-                                                                              const std::array<bool, 256>& in_interest,
-                                                                              std::span<const float> votes = {}) {
+/// The per-pixel quantity behind every input, for `n` labelled pixels at once (one row of an
+/// image, say): `labels[x]` the label l of pixel x (a class index; anything outside 0..255 is no
+/// class), `probabilities[c][x]` the class probabilities (no planes for a labels-only backend:
+/// the inputs that need them are NaN), `in_interest[c]` true for the classes of L, and an
+/// ensemble's member vote shares `votes[c][x]` per class (no planes for one network: `split` is
+/// NaN). `boundary` holds the σ indicator (its cell value is σ(1 − σ) of the mean,
+/// cell_value()). Writes `out[k][x]` for each input k `wanted` (each `out[k]` n floats; those not
+/// wanted are not touched, their work skipped: the entropy's logarithms, the two most likely
+/// classes). Every formula is written once, here, as loops over the pixels the compiler can
+/// vectorise; pixel_input_values() is the same for one pixel.
+template <class Label>
+inline void pixel_input_rows(std::size_t n, const Label* labels, std::span<const float* const> probabilities,
+                             std::span<const float* const> votes, const std::array<bool, 256>& in_interest,
+                             const std::array<bool, kDecisionInputCount>& wanted,
+                             const std::array<float*, kDecisionInputCount>& out) {
   constexpr float nan = std::numeric_limits<float>::quiet_NaN();
-  std::array<float, kDecisionInputCount> v;
-  v.fill(nan);
-  const float in = label >= 0 && label < 256 && in_interest[static_cast<std::size_t>(label)] ? 1.0f : 0.0f;
-  v[index_of(DecisionInput::sigma)] = in;
-  v[index_of(DecisionInput::boundary)] = in;
-  float vote_sum = 0.0f, split = 0.0f;
-  for (std::size_t c = 0; c < votes.size() && c < 256; ++c) {
-    vote_sum += votes[c];
-    if (in_interest[c])
-      split += (votes[c] > kVoteShareTolerance && votes[c] < 1.0f - kVoteShareTolerance) ? 1.0f : 0.0f;
-  }
-  if (vote_sum > 0.0f) v[index_of(DecisionInput::split)] = split;  // no votes at this pixel: unknown
-  const std::size_t n = p.size();
-  if (n == 0) return v;
-  // The two most likely classes, the probability mass, the entropy.
-  std::size_t first = 0, second = n > 1 ? 1 : 0;
-  if (n > 1 && p[1] > p[0]) first = 1, second = 0;
-  float sum = 0.0f, entropy = 0.0f;
-  for (std::size_t c = 0; c < n; ++c) {
-    sum += p[c];
-    if (p[c] > 0.0f) entropy -= p[c] * std::log(p[c]);
-    if (c < 2) continue;
-    if (p[c] > p[first]) {
-      second = first;
-      first = c;
-    } else if (p[c] > p[second]) {
-      second = c;
+  constexpr std::size_t kChunk = 64;
+  const auto want = [&](DecisionInput i) { return wanted[index_of(i)] && out[index_of(i)] != nullptr; };
+  const std::size_t classes = probabilities.size();
+  const bool with_entropy = want(DecisionInput::entropy);
+  const bool ranked = want(DecisionInput::second_choice) || want(DecisionInput::low_confidence);
+  const bool from_probabilities = classes > 0 && (want(DecisionInput::ambiguity) || want(DecisionInput::expected_error) ||
+                                                  ranked || with_entropy);
+  for (std::size_t x0 = 0; x0 < n; x0 += kChunk) {
+    const std::size_t m = std::min(kChunk, n - x0);
+    const Label* l = labels + x0;
+    // σ's indicator (and boundary's: the same pixel quantity).
+    for (DecisionInput i : {DecisionInput::sigma, DecisionInput::boundary})
+      if (want(i))
+        for (std::size_t x = 0; x < m; ++x)
+          out[index_of(i)][x0 + x] =
+              l[x] >= 0 && l[x] < 256 && in_interest[static_cast<std::size_t>(l[x])] ? 1.0f : 0.0f;
+    // split: the members' vote shares on the classes of L strictly between none and all.
+    if (want(DecisionInput::split)) {
+      std::array<float, kChunk> vote_sum{}, split{};
+      for (std::size_t c = 0; c < votes.size() && c < 256; ++c) {
+        const float* v = votes[c] + x0;
+        for (std::size_t x = 0; x < m; ++x) vote_sum[x] += v[x];
+        if (in_interest[c])
+          for (std::size_t x = 0; x < m; ++x)
+            split[x] += (v[x] > kVoteShareTolerance && v[x] < 1.0f - kVoteShareTolerance) ? 1.0f : 0.0f;
+      }
+      for (std::size_t x = 0; x < m; ++x)
+        out[index_of(DecisionInput::split)][x0 + x] = vote_sum[x] > 0.0f ? split[x] : nan;  // no votes: unknown
+    }
+    if (!from_probabilities) {
+      for (DecisionInput i : {DecisionInput::ambiguity, DecisionInput::expected_error, DecisionInput::second_choice,
+                              DecisionInput::low_confidence, DecisionInput::entropy})
+        if (want(i)) std::fill_n(out[index_of(i)] + x0, m, nan);
+      continue;
+    }
+    // The probability mass, the entropy, the two most likely classes (first, then second: of
+    // classes 0 and 1 the larger first, ties to class 0; then each class c >= 2 in turn).
+    std::array<float, kChunk> sum{}, entropy{}, p_first{}, p_second{};
+    std::array<std::size_t, kChunk> first{}, second{};
+    if (ranked) {
+      for (std::size_t x = 0; x < m; ++x) {
+        const float a = probabilities[0][x0 + x], b = classes > 1 ? probabilities[1][x0 + x] : a;
+        const bool one = classes > 1 && b > a;
+        first[x] = one ? 1 : 0;
+        second[x] = classes > 1 ? (one ? 0 : 1) : 0;
+        p_first[x] = one ? b : a;
+        p_second[x] = one ? a : b;
+      }
+    }
+    for (std::size_t c = 0; c < classes; ++c) {
+      const float* p = probabilities[c] + x0;
+      for (std::size_t x = 0; x < m; ++x) sum[x] += p[x];
+      if (with_entropy)
+        for (std::size_t x = 0; x < m; ++x)
+          if (p[x] > 0.0f) entropy[x] -= p[x] * std::log(p[x]);
+      if (ranked && c >= 2)
+        for (std::size_t x = 0; x < m; ++x) {
+          if (p[x] > p_first[x]) {
+            second[x] = first[x], p_second[x] = p_first[x];
+            first[x] = c, p_first[x] = p[x];
+          } else if (p[x] > p_second[x]) {
+            second[x] = c, p_second[x] = p[x];
+          }
+        }
+    }
+    std::array<float, kChunk> ambiguity{}, expected_error{}, second_choice{};
+    for (std::size_t c = 0; c < classes && c < 256; ++c) {
+      if (!in_interest[c]) continue;
+      const float* p = probabilities[c] + x0;
+      for (std::size_t x = 0; x < m; ++x) {
+        ambiguity[x] += (p[x] > 0.2f && p[x] < 0.8f) ? 1.0f : 0.0f;
+        expected_error[x] += static_cast<std::size_t>(l[x]) == c ? 1.0f - p[x] : p[x];
+      }
+      if (ranked)
+        for (std::size_t x = 0; x < m; ++x)
+          second_choice[x] += (c == second[x] && c != first[x] && p[x] > 0.2f) ? 1.0f : 0.0f;
+    }
+    // No probabilities at a pixel (no data): every input that needs them unknown.
+    const float log_classes = classes > 1 ? std::log(static_cast<float>(classes)) : 1.0f;
+    for (std::size_t x = 0; x < m; ++x) {
+      const bool data = sum[x] > 0.0f;
+      if (want(DecisionInput::ambiguity)) out[index_of(DecisionInput::ambiguity)][x0 + x] = data ? ambiguity[x] : nan;
+      if (want(DecisionInput::expected_error))
+        out[index_of(DecisionInput::expected_error)][x0 + x] = data ? expected_error[x] : nan;
+      if (want(DecisionInput::second_choice))
+        out[index_of(DecisionInput::second_choice)][x0 + x] = data ? second_choice[x] : nan;
+      if (want(DecisionInput::low_confidence))
+        out[index_of(DecisionInput::low_confidence)][x0 + x] = data ? (p_first[x] < 0.6f ? 1.0f : 0.0f) : nan;
+      if (with_entropy)
+        out[index_of(DecisionInput::entropy)][x0 + x] = data ? (classes > 1 ? entropy[x] / log_classes : 0.0f) : nan;
     }
   }
-  if (!(sum > 0.0f)) return v;  // no probabilities at this pixel (no data)
-  float ambiguity = 0.0f, expected_error = 0.0f, second_choice = 0.0f;
-  for (std::size_t c = 0; c < n && c < 256; ++c) {
-    if (!in_interest[c]) continue;
-    ambiguity += (p[c] > 0.2f && p[c] < 0.8f) ? 1.0f : 0.0f;
-    expected_error += static_cast<std::size_t>(label) == c ? 1.0f - p[c] : p[c];
-    second_choice += (c == second && c != first && p[c] > 0.2f) ? 1.0f : 0.0f;
-  }
-  v[index_of(DecisionInput::ambiguity)] = ambiguity;
-  v[index_of(DecisionInput::expected_error)] = expected_error;
-  v[index_of(DecisionInput::second_choice)] = second_choice;
-  v[index_of(DecisionInput::low_confidence)] = p[first] < 0.6f ? 1.0f : 0.0f;
-  v[index_of(DecisionInput::entropy)] = n > 1 ? entropy / std::log(static_cast<float>(n)) : 0.0f;
+}
+
+/// pixel_input_rows() at one labelled pixel: `label` l, the class probabilities `p` (empty for
+/// a labels-only backend), and an ensemble's member vote shares `votes` per class (empty for one
+/// network); the inputs not `wanted` NaN.
+[[nodiscard]] inline std::array<float, kDecisionInputCount> pixel_input_values(
+    int label, std::span<const float> p, const std::array<bool, 256>& in_interest, std::span<const float> votes = {},
+    const std::array<bool, kDecisionInputCount>& wanted = detail::kEveryDecisionInput) {
+  std::array<float, kDecisionInputCount> v;
+  v.fill(std::numeric_limits<float>::quiet_NaN());
+  std::array<float*, kDecisionInputCount> out{};
+  for (std::size_t k = 0; k < kDecisionInputCount; ++k) out[k] = &v[k];
+  std::array<const float*, 256> p_at{}, vote_at{};
+  for (std::size_t c = 0; c < p.size() && c < 256; ++c) p_at[c] = &p[c];
+  for (std::size_t c = 0; c < votes.size() && c < 256; ++c) vote_at[c] = &votes[c];
+  pixel_input_rows(1, &label, std::span<const float* const>(p_at.data(), std::min<std::size_t>(p.size(), 256)),
+                   std::span<const float* const>(vote_at.data(), std::min<std::size_t>(votes.size(), 256)), in_interest,
+                   wanted, out);
   return v;
 }
 

@@ -42,9 +42,10 @@ struct AdaptiveOptions {
   /// required (AdaptivePlanner rejects an empty list: it could never descend).
   std::vector<double> candidate_gsd_cm{};
   /// Mission-time budget [s] (flight + segmentation + planning). The planner only descends
-  /// when the descent and the rest of the top-level coverage still fit. Exact with fixed
-  /// segmentation and planning times; with measured times the remaining work is estimated
-  /// from the slowest image so far plus 25 %.
+  /// when the descent and the rest of the mission still fit, every image to come reserved at a
+  /// bound of one step's processing: with fixed segmentation and planning times their sum
+  /// (exact), otherwise learned from the mission clock in flight (the largest step so far, times
+  /// (k + 1) / k after k steps); and it cuts a descent short where the rest of it no longer fits.
   std::optional<double> budget_s{};
   /// What a descent re-maps: the whole region (the paper) or only its cells that show a label
   /// of interest (DescentCoverage). A decision model must be calibrated with the same.

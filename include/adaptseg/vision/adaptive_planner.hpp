@@ -18,6 +18,7 @@
 #include <adaptseg/core/mission_options.hpp>
 #include <adaptseg/core/timing.hpp>
 #include <adaptseg/vision/adaptive_options.hpp>
+#include <adaptseg/vision/grid_inputs.hpp>
 #include <adaptseg/vision/image_summary.hpp>
 #include <adaptseg/vision/metrics.hpp>
 #include <adaptseg/vision/segmentation_backend.hpp>
@@ -28,6 +29,7 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -218,8 +220,9 @@ class AdaptivePlanner {
     Segmentation s = coverage_.ranks_cells
                          ? segment_with_probabilities_checked(backend_, image, area_.num_classes)
                          : Segmentation{segment_checked(backend_, image, area_.num_classes), {}};
-    const double segmentation_s = seconds_since(t0);  // the network's time, as Mission measures it
-    return accept(image, s, segmentation_s, elapsed_s);
+    const auto segmented = std::chrono::steady_clock::now();
+    const double segmentation_s = std::chrono::duration<double>(segmented - t0).count();  // as Mission measures it
+    return accept(image, s, segmentation_s, elapsed_s, segmented);
   }
 
   /// Reports the image taken at the pending waypoint with its segmentation `labels`, which
@@ -244,6 +247,7 @@ class AdaptivePlanner {
   ///         that break their contract (check_probabilities()).
   PlannerStep report(const Image& image, const Segmentation& segmentation, double segmentation_s,
                      std::optional<double> elapsed_s = std::nullopt) {
+    const auto t0 = std::chrono::steady_clock::now();
     check_report(image, elapsed_s);
     check_segmentation(segmentation.labels, image, area_.num_classes, "AdaptivePlanner::report: the labels reported");
     check_probabilities(segmentation.probabilities, segmentation.labels, image, area_.num_classes,
@@ -252,7 +256,7 @@ class AdaptivePlanner {
                         "AdaptivePlanner::report: the member votes reported");
     detail::require(std::isfinite(segmentation_s) && segmentation_s >= 0.0,
                     "AdaptivePlanner::report: segmentation_s must be finite and >= 0", segmentation_s);
-    return accept(image, segmentation, segmentation_s, elapsed_s);
+    return accept(image, segmentation, segmentation_s, elapsed_s, t0);
   }
 
   /// The Image of a camera frame `rgb` (CV_8UC3 of the camera's size, or empty) taken at
@@ -402,20 +406,30 @@ class AdaptivePlanner {
     double altitude_m = 0.0;    ///< h'
     std::size_t ordinal = 0;    ///< 0, 1, ... in the order chosen (DescentOutcome::descent)
     std::vector<Waypoint> plan;
+    bool deferred = false;      ///< flown in a tour (DescentSchedule::tour, row), not at once
   };
 
   /// A reported image and its checked labels: the time account, the fused map, and at a
-  /// top-level waypoint the decision, after a descent's last image its outcome.
+  /// top-level waypoint the decision, after a descent's last image its outcome. The planner's
+  /// processing since `t0` is charged as planning time.
   PlannerStep accept(const Image& image, const Segmentation& segmentation, double segmentation_s,
-                     std::optional<double> elapsed_s) {
+                     std::optional<double> elapsed_s, std::chrono::steady_clock::time_point t0) {
     const cv::Mat& labels = segmentation.labels;
     pending_ = false;
     reported_elapsed_s_ = elapsed_s;
     const PlannedWaypoint& p = path_.back();
-    if (p.index > 0) flight_s_ += timing_.segment_time_s(path_[p.index - 1].waypoint.position, p.waypoint.position);
+    const double leg = p.index > 0 ? timing_.segment_time_s(path_[p.index - 1].waypoint.position, p.waypoint.position) : 0.0;
+    flight_s_ += leg;
     const double seg = options_.mission.fixed_segmentation_time_s.value_or(segmentation_s);
     segmentation_s_ += seg;
     slowest_segmentation_s_ = std::max(slowest_segmentation_s_, seg);
+    // What this step cost beyond the flight model's leg (the mission clock's advance since the
+    // last image: segmentation, the planner's own time, and whatever else the caller's clock
+    // counted), for the budget's bound of the steps to come.
+    const double now = this->elapsed_s();
+    slowest_step_s_ = std::max(slowest_step_s_, std::max(0.0, now - elapsed_at_last_image_s_ - leg));
+    elapsed_at_last_image_s_ = now;
+    ++steps_;
     // A descent's first image: the region's map before the descent (what its outcome compares).
     if (p.level == 1 && p.step == 0) {
       descent_before_ = map_.labels()(region_rect(p.top_index)).clone();
@@ -427,15 +441,21 @@ class AdaptivePlanner {
       const cv::Rect region = region_rect(p.top_index);
       const cv::Rect cell = pixel_rect(p.waypoint.footprint) & region;
       if (cell.area() > 0) {
-        const CellInputs c = cell_inputs(
-            planes_on_grid(image, pixel_inputs(segmentation, options_.mission.interest, area_.ignore_label), cell),
-            area_.valid_mask(cell), cv::Rect(0, 0, cell.width, cell.height));
+        scene_inputs_.assign(image, segmentation, options_.mission.interest, area_.ignore_label, cell,
+                             std::array{options_.cell_input}, GridInputs::Cells::one);
+        const CellInputs c = scene_inputs_.cell(area_.valid_mask(cell), cv::Rect(0, 0, cell.width, cell.height));
         fine_known_ = fine_known_ && (c.field_px == 0.0 || std::isfinite(c.value(options_.cell_input)));
         fine_mass_ += c.mass(options_.cell_input);
       }
     }
     map_.fuse(image, labels);
 
+    // A budget that can no longer afford the rest of the descent (the bound of a step, learned
+    // since the descent was chosen, may have grown) ends it here.
+    if (p.level == 1 && sub_next_ < sub_.size() && options_.budget_s && !descent_rest_fits()) {
+      sub_.resize(sub_next_);
+      cut_short_ = true;
+    }
     PlannerStep step;
     step.waypoint = p;
     step.sigma = semantic_ratio(labels, options_.mission.interest, image.ignore_label);
@@ -443,6 +463,7 @@ class AdaptivePlanner {
       step.decision = decide(p, step.sigma, image, segmentation);
     else if (sub_next_ == sub_.size())
       step.outcome = finish_descent();
+    charge_measured_planning(seconds_since(t0));
     return step;
   }
 
@@ -496,6 +517,22 @@ class AdaptivePlanner {
   }
   [[nodiscard]] double planning_estimate() const { return options_.mission.fixed_planning_time_s.value_or(0.0); }
 
+  /// What the budget reserves for each step still to come beyond its flight [s]: with fixed
+  /// segmentation and planning times, their sum (exact); otherwise a bound learned from the
+  /// steps so far, each step's advance of the mission clock beyond the flight model's leg: the
+  /// largest of k steps times (k + 1) / k (for processing times spread uniformly up to some
+  /// limit, an unbiased estimate of the limit; generous while few steps are seen), and never
+  /// less than segmentation_estimate(). 0 before the first image.
+  [[nodiscard]] double step_bound() const {
+    if (times_fixed()) return segmentation_estimate() + planning_estimate();
+    if (steps_ == 0) return segmentation_estimate();
+    const double k = static_cast<double>(steps_);
+    return std::max(segmentation_estimate(), slowest_step_s_ * (k + 1.0) / k);
+  }
+  [[nodiscard]] bool times_fixed() const {
+    return options_.mission.fixed_segmentation_time_s.has_value() && options_.mission.fixed_planning_time_s.has_value();
+  }
+
   void charge_measured_planning(double s) {
     untaken_planning_s_ += s;
     if (!options_.mission.fixed_planning_time_s) planning_s_ += s;
@@ -547,29 +584,30 @@ class AdaptivePlanner {
     std::vector<CellInputs> cells;
   };
 
-  /// The decision inputs of the top-level image of waypoint i (`image`, `segmentation`) over its
-  /// region on the map grid (pixel_inputs(), planes_on_grid()); none unless the coverage ranks
-  /// cells.
-  [[nodiscard]] std::vector<cv::Mat> region_inputs(std::size_t i, const Image& image,
-                                                   const Segmentation& segmentation) const {
+  /// The decision input the cells are ranked by (`options().cell_input`) of the top-level image
+  /// of waypoint i (`image`, `segmentation`) over its region on the map grid (GridInputs, its
+  /// buffers kept from image to image); none unless the coverage ranks cells.
+  [[nodiscard]] const GridInputs* region_inputs(std::size_t i, const Image& image, const Segmentation& segmentation) {
     const cv::Rect region = region_rect(i);
-    if (!coverage_.ranks_cells || region.area() == 0) return {};
-    return planes_on_grid(image, pixel_inputs(segmentation, options_.mission.interest, area_.ignore_label), region);
+    if (!coverage_.ranks_cells || region.area() == 0) return nullptr;
+    region_inputs_.assign(image, segmentation, options_.mission.interest, area_.ignore_label, region,
+                          std::array{options_.cell_input});
+    return &region_inputs_;
   }
 
   /// Every descent the decision at top-level waypoint i may choose from, per candidate GSD:
   /// descent_plan(), or for a coverage that ranks cells (DescentCoverage::ranked) its cells
-  /// ranked by their mass of `options().cell_input` in the region's inputs (`planes`,
+  /// ranked by their mass of `options().cell_input` in the region's inputs (`inputs`,
   /// region_inputs()), one option per number k of the best cells (cells without any of the
   /// input left out), each flown in the sub-lawnmower's order.
-  [[nodiscard]] std::vector<DescentOption> descent_options(std::size_t i, const std::vector<cv::Mat>& planes) const {
+  [[nodiscard]] std::vector<DescentOption> descent_options(std::size_t i, const GridInputs* inputs) const {
     std::vector<DescentOption> out;
     if (!coverage_.ranks_cells) {
       for (double g : candidates_) out.push_back({g, descent_plan(i, g), {}});
       return out;
     }
     const cv::Rect region = region_rect(i);
-    if (region.area() == 0) return out;
+    if (region.area() == 0 || !inputs) return out;
     const cv::Mat field = area_.valid_mask(region);
     const DecisionInput input = options_.cell_input;
     for (double g : candidates_) {
@@ -577,7 +615,7 @@ class AdaptivePlanner {
       std::vector<CellInputs> cells;
       std::vector<std::size_t> ranked;
       for (std::size_t k = 0; k < all.size(); ++k) {
-        cells.push_back(cell_inputs(planes, field, (pixel_rect(all[k].footprint) & region) - region.tl()));
+        cells.push_back(inputs->cell(field, (pixel_rect(all[k].footprint) & region) - region.tl()));
         if (cells.back().mass(input) > 0.0) ranked.push_back(k);
       }
       std::stable_sort(ranked.begin(), ranked.end(),
@@ -596,7 +634,6 @@ class AdaptivePlanner {
 
   /// The decision at top-level waypoint `p` (paper §3.2.2), its candidates with exact costs.
   DecisionRecord decide(const PlannedWaypoint& p, double sigma, const Image& image, const Segmentation& segmentation) {
-    const auto t0 = std::chrono::steady_clock::now();
     const std::size_t i = p.top_index;
     DecisionRecord rec;
     rec.waypoint_index = p.index;
@@ -609,13 +646,19 @@ class AdaptivePlanner {
     const double direct = last ? 0.0 : timing_.segment_time_s(here, top_[i + 1].position);
     // Time still needed after this waypoint's decision to finish the top-level coverage (and
     // the tour chosen so far: what it adds to the top-level legs).
-    double rest = (last ? 0.0 : direct + flight_after_[i + 1]) + static_cast<double>(top_.size() - i - 1) * per_image;
-    if (tour) rest += tour_extra_s(i) + static_cast<double>(tour_images_) * per_image;
+    double rest_flight = last ? 0.0 : direct + flight_after_[i + 1];
+    double rest_images = static_cast<double>(top_.size() - i - 1);
+    if (tour) rest_flight += tour_extra_s(i), rest_images += static_cast<double>(tour_images_);
+    const double rest = rest_flight + rest_images * per_image;
+    // The budget reserves a bound of each step's processing instead of the estimate, and, where
+    // times are measured, one for what is left of this step (this decision, not yet charged).
+    const double bound = step_bound();
+    const double reserved = rest_flight + rest_images * bound + (times_fixed() ? 0.0 : bound);
     const double elapsed = elapsed_s();
     std::vector<std::vector<Waypoint>> sub_plans;
     std::vector<std::pair<TourStop, TourInsertion>> stops;  // per candidate, for a deferred descent
-    const std::vector<cv::Mat> planes = region_inputs(i, image, segmentation);
-    for (DescentOption& option : descent_options(i, planes)) {
+    const GridInputs* inputs = region_inputs(i, image, segmentation);
+    for (DescentOption& option : descent_options(i, inputs)) {
       const double g = option.gsd_cm;
       std::vector<Waypoint>& sub = option.plan;
       if (sub.empty()) continue;
@@ -642,8 +685,10 @@ class AdaptivePlanner {
       c.images = static_cast<int>(sub.size());
       c.extra_time_s = flight + static_cast<double>(sub.size()) * per_image;
       c.cells = std::move(option.cells);
-      // Descending replaces the direct leg to i+1: elapsed + extra + rest must fit.
-      if (options_.budget_s && elapsed + c.extra_time_s + rest > *options_.budget_s + 1e-9) {
+      // Descending replaces the direct leg to i+1: elapsed + extra + rest must fit, each image
+      // reserved at the bound.
+      if (options_.budget_s &&
+          elapsed + flight + static_cast<double>(sub.size()) * bound + reserved > *options_.budget_s + 1e-9) {
         rec.budget_limited = true;
         continue;
       }
@@ -662,16 +707,17 @@ class AdaptivePlanner {
     ctx.rest_s = rest;
     ctx.region_share = valid_px_ > 0 ? static_cast<double>(valid_pixels(top_[i].footprint)) / valid_px_ : 0.0;
     ctx.region_px = static_cast<double>(valid_pixels(top_[i].footprint));
-    if (!planes.empty()) {
+    if (inputs) {
       const cv::Rect region = region_rect(i);
-      ctx.region_input = cell_inputs(planes, area_.valid_mask(region), cv::Rect(0, 0, region.width, region.height))
+      ctx.region_input = inputs->cell(area_.valid_mask(region), cv::Rect(0, 0, region.width, region.height))
                              .value(options_.cell_input);
     }
     ctx.lawnmowers = forecasts;
     rec.decision = policy_.decide(ctx);
     if (rec.decision.descend) {
       const std::size_t k = chosen_candidate(rec.decision, rec.candidates, policy_.name());
-      ChosenDescent chosen{decisions_.size(), i, rec.candidates[k].altitude_m, descents_chosen_++, std::move(sub_plans[k])};
+      ChosenDescent chosen{decisions_.size(), i, rec.candidates[k].altitude_m, descents_chosen_++, std::move(sub_plans[k]),
+                           rec.candidates[k].deferred};
       if (rec.candidates[k].deferred) {
         tour_stops_.push_back(stops[k].first);
         tour_order_.insert(tour_order_.begin() + static_cast<std::ptrdiff_t>(stops[k].second.position), queued_.size());
@@ -682,8 +728,39 @@ class AdaptivePlanner {
       }
     }
     decisions_.push_back(rec);
-    charge_measured_planning(seconds_since(t0));
     return rec;
+  }
+
+  /// Whether the budget still affords the rest of the descent in progress, from the image just
+  /// reported: its remaining images and flight, then what follows it (the next top-level
+  /// waypoint, or the rest of the tour being flown) and the rest of the mission, every image at
+  /// the step bound. Cutting it here flies straight on to what follows.
+  [[nodiscard]] bool descent_rest_fits() const {
+    const double bound = step_bound();
+    double inner = 0.0;  // from the image just reported through the descent's remaining waypoints
+    for (std::size_t k = sub_next_; k < sub_.size(); ++k) inner += timing_.segment_time_s(sub_[k - 1].position, sub_[k].position);
+    const double more_images = static_cast<double>(sub_.size() - sub_next_);
+    // What follows: the rest of the tour being flown (none for a descent flown at once), its end,
+    // and the top level from there on.
+    std::vector<std::size_t> order;
+    TourEnd end;
+    std::size_t next_top = current_.top_index + 1;
+    double after_images = 0.0, after_flight = 0.0;
+    if (current_.deferred) {
+      order.assign(tour_order_.begin() + static_cast<std::ptrdiff_t>(tour_next_), tour_order_.end());
+      for (std::size_t k : order) after_images += static_cast<double>(queued_[k].plan.size());
+      const std::size_t window_last = top_next_ - 1;
+      end = tour_end(window_last);
+      next_top = window_last + 1;
+    } else {
+      if (next_top < top_.size()) end = top_[next_top].position;
+      if (schedule_.defers) after_flight += tour_extra_s(current_.top_index), after_images += static_cast<double>(tour_images_);
+    }
+    if (next_top < top_.size()) after_flight += flight_after_[next_top];
+    after_images += static_cast<double>(top_.size() - std::min(next_top, top_.size()));
+    const double go_on = inner + tour_flight_s(timing_, sub_.back().position, tour_stops_, order, end);
+    const double mission_rest = after_flight + (more_images + after_images) * bound + (times_fixed() ? 0.0 : bound);
+    return elapsed_s() + go_on + mission_rest <= *options_.budget_s + 1e-9;
   }
 
   /// The descent chosen at a top-level waypoint: its waypoints come next.
@@ -732,7 +809,6 @@ class AdaptivePlanner {
 
   /// After a descent's last image: σ of the region at h' from the fused map, to the policy.
   DescentOutcome finish_descent() {
-    const auto t0 = std::chrono::steady_clock::now();
     DecisionRecord& rec = decisions_[current_.decision];
     const std::size_t top_index = current_.top_index;
     DescentOutcome out;
@@ -750,18 +826,19 @@ class AdaptivePlanner {
     if (coverage_.ranks_cells) {
       const Candidate& chosen = rec.candidates[chosen_candidate(rec.decision, rec.candidates, policy_.name())];
       const double region_px = static_cast<double>(valid_pixels(top_[top_index].footprint));
-      double top_mass = 0.0;
-      for (const CellInputs& c : chosen.cells) top_mass += c.mass(options_.cell_input);
+      double top_mass = 0.0;  // over the cells flown (a descent cut short flew the first ones)
+      for (std::size_t k = 0; k < chosen.cells.size() && k < sub_.size(); ++k)
+        top_mass += chosen.cells[k].mass(options_.cell_input);
       if (region_px > 0.0) {
         out.top_input = top_mass / region_px;
         if (fine_known_) out.fine_input = fine_mass_ / region_px;
       }
     }
+    out.cut_short = std::exchange(cut_short_, false);
     policy_.observe(out);
     rec.outcome = out;
     sub_.clear();
     sub_next_ = 0;
-    charge_measured_planning(seconds_since(t0));
     return out;
   }
 
@@ -795,6 +872,9 @@ class AdaptivePlanner {
   cv::Mat descent_before_;            ///< the region's map before the descent in progress
   double fine_mass_ = 0.0;            ///< ranked: Σ over its images so far of the finer look's input mass
   bool fine_known_ = true;            ///< ... every image of it gave the input
+  bool cut_short_ = false;            ///< the budget ended the descent in progress early
+  GridInputs region_inputs_;          ///< the last top-level image's inputs (buffers reused)
+  GridInputs scene_inputs_;           ///< the last descent image's inputs over its cell (the scene check)
   /// Per top-level waypoint, the last top-level waypoint of its window: where the window's tour
   /// starts (DescentScheduleRule::window_last).
   std::vector<std::size_t> window_last_;
@@ -812,6 +892,9 @@ class AdaptivePlanner {
   double segmentation_s_ = 0.0;
   double planning_s_ = 0.0;
   double slowest_segmentation_s_ = 0.0;
+  double slowest_step_s_ = 0.0;           ///< the largest advance of the clock beyond a leg's flight [s]
+  double elapsed_at_last_image_s_ = 0.0;  ///< elapsed_s() when the last image was reported
+  std::size_t steps_ = 0;                 ///< images reported
   double untaken_planning_s_ = 0.0;
   std::optional<double> reported_elapsed_s_;
 };

@@ -202,10 +202,27 @@ inline void check_probabilities(const std::vector<cv::Mat>& probabilities, const
     return std::string(buf);
   };
   std::vector<const float*> rows(probabilities.size());
+  // A row at a time: every value in [0, 1] and every pixel's float sum well within the
+  // tolerance of 1 (the common case, in loops the compiler vectorises); any other pixel is
+  // checked, and reported, exactly as below.
+  std::vector<float> row_sum(static_cast<std::size_t>(image.width_px));
+  const auto clearly_one = static_cast<float>(tolerance - 1e-5);
   for (int y = 0; y < image.height_px; ++y) {
     for (std::size_t c = 0; c < rows.size(); ++c) rows[c] = probabilities[c].ptr<float>(y);
     const auto* label = labels.ptr<unsigned char>(y);
+    std::fill(row_sum.begin(), row_sum.end(), 0.0f);
+    int out_of_range = 0;
+    for (std::size_t c = 0; c < rows.size(); ++c) {
+      const float* r = rows[c];
+      float* sum = row_sum.data();
+      for (int x = 0; x < image.width_px; ++x) {
+        sum[x] += r[x];
+        out_of_range |= static_cast<int>(!(r[x] >= 0.0f) | !(r[x] <= 1.0f));  // NaN fails
+      }
+    }
+    const bool in_range = out_of_range == 0;
     for (int x = 0; x < image.width_px; ++x) {
+      if (in_range && std::abs(row_sum[static_cast<std::size_t>(x)] - 1.0f) <= clearly_one) continue;
       double sum = 0.0;
       for (std::size_t c = 0; c < rows.size(); ++c) {
         const float v = rows[c][x];

@@ -5,15 +5,18 @@
 /// brought onto the map grid and summarised over the cells a descent may re-map.
 
 #include <adaptseg/core/decision_inputs.hpp>
+#include <adaptseg/core/detail/exact_sum.hpp>
 #include <adaptseg/core/error.hpp>
 #include <adaptseg/vision/image.hpp>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <span>
 #include <vector>
@@ -46,25 +49,18 @@ namespace adaptseg {
   std::array<bool, 256> in_l{};
   for (int c : interest)
     if (c >= 0 && c < 256) in_l[static_cast<std::size_t>(c)] = true;
-  const std::size_t n = probs.size();
-  std::vector<const float*> p_row(n);
-  std::vector<float> p(n);
-  const std::size_t nv = votes.size();
-  std::vector<const float*> v_row(nv);
-  std::vector<float> vote(nv);
+  std::vector<const float*> p_row(probs.size()), v_row(votes.size());
   std::array<float*, kDecisionInputCount> out{};
+  constexpr float nan = std::numeric_limits<float>::quiet_NaN();
   for (int y = 0; y < labels.rows; ++y) {
     for (std::size_t k = 0; k < kDecisionInputCount; ++k) out[k] = planes[k].ptr<float>(y);
-    for (std::size_t c = 0; c < n; ++c) p_row[c] = probs[c].ptr<float>(y);
-    for (std::size_t c = 0; c < nv; ++c) v_row[c] = votes[c].ptr<float>(y);
+    for (std::size_t c = 0; c < probs.size(); ++c) p_row[c] = probs[c].ptr<float>(y);
+    for (std::size_t c = 0; c < votes.size(); ++c) v_row[c] = votes[c].ptr<float>(y);
     const auto* l_row = labels.ptr<unsigned char>(y);
-    for (int x = 0; x < labels.cols; ++x) {
-      if (l_row[x] == ignore_label) continue;
-      for (std::size_t c = 0; c < n; ++c) p[c] = p_row[c][x];
-      for (std::size_t c = 0; c < nv; ++c) vote[c] = v_row[c][x];
-      const auto v = pixel_input_values(l_row[x], p, in_l, vote);
-      for (std::size_t k = 0; k < kDecisionInputCount; ++k) out[k][x] = v[k];
-    }
+    pixel_input_rows(static_cast<std::size_t>(labels.cols), l_row, p_row, v_row, in_l, detail::kEveryDecisionInput, out);
+    for (int x = 0; x < labels.cols; ++x)
+      if (l_row[x] == ignore_label)
+        for (std::size_t k = 0; k < kDecisionInputCount; ++k) out[k][x] = nan;
   }
   return planes;
 }
@@ -109,6 +105,23 @@ namespace adaptseg {
   return out;
 }
 
+namespace detail {
+/// A cell's CellInputs from its sums and counts per input (NaN for inputs not `wanted` or
+/// without a known pixel), `boundary` as σ(1 − σ) of its mean.
+[[nodiscard]] inline CellInputs cell_means(const std::array<ExactSum, kDecisionInputCount>& sum,
+                                           const std::array<std::int64_t, kDecisionInputCount>& count,
+                                           std::int64_t field_px, const std::array<bool, kDecisionInputCount>& wanted) {
+  CellInputs out;
+  out.field_px = static_cast<double>(field_px);
+  for (std::size_t k = 0; k < kDecisionInputCount; ++k) {
+    const double mean = wanted[k] && count[k] > 0 ? sum[k].value() / static_cast<double>(count[k])
+                                                  : std::numeric_limits<double>::quiet_NaN();
+    out.values[k] = cell_value(kDecisionInputs[k].input, mean);
+  }
+  return out;
+}
+}  // namespace detail
+
 /// The decision inputs of the cell `cell` (map pixels, in the frame of `grid_planes`, e.g.
 /// planes_on_grid() of a region) over the pixels where `field` (CV_8UC1 of the planes' size,
 /// non-zero = field) is set and the image saw something: means of the planes, `boundary` as
@@ -122,27 +135,26 @@ namespace adaptseg {
     detail::require(p.type() == CV_32FC1 && p.size() == field.size() && field.type() == CV_8UC1,
                     "cell_inputs: planes (CV_32FC1) and field mask (CV_8UC1) must have one size", p.cols);
   const cv::Rect r = cell & cv::Rect(0, 0, field.cols, field.rows);
-  CellInputs out;
-  std::array<double, kDecisionInputCount> sum{};
-  std::array<double, kDecisionInputCount> count{};
+  std::array<detail::ExactSum, kDecisionInputCount> sum{};
+  std::array<std::int64_t, kDecisionInputCount> count{};
+  std::int64_t field_px = 0;
+  std::array<const float*, kDecisionInputCount> row{};
   for (int y = r.y; y < r.y + r.height; ++y) {
     const auto* f = field.ptr<unsigned char>(y);
-    const float* seen = grid_planes[index_of(DecisionInput::sigma)].ptr<float>(y);
+    for (std::size_t k = 0; k < kDecisionInputCount; ++k) row[k] = grid_planes[k].ptr<float>(y);
+    const float* seen = row[index_of(DecisionInput::sigma)];
     for (int x = r.x; x < r.x + r.width; ++x) {
       if (f[x] == 0 || std::isnan(seen[x])) continue;
-      out.field_px += 1.0;
+      ++field_px;
       for (std::size_t k = 0; k < kDecisionInputCount; ++k) {
-        const float v = grid_planes[k].ptr<float>(y)[x];
+        const float v = row[k][x];
         if (std::isnan(v)) continue;
-        sum[k] += v;
-        count[k] += 1.0;
+        sum[k].add(detail::exact_units(v));
+        ++count[k];
       }
     }
   }
-  for (std::size_t k = 0; k < kDecisionInputCount; ++k)
-    out.values[k] = count[k] > 0.0 ? sum[k] / count[k] : std::numeric_limits<double>::quiet_NaN();
-  for (const auto& row : kDecisionInputs) out.values[index_of(row.input)] = cell_value(row.input, out.values[index_of(row.input)]);
-  return out;
+  return detail::cell_means(sum, count, field_px, detail::kEveryDecisionInput);
 }
 
 }  // namespace adaptseg

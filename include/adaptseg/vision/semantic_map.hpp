@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace adaptseg {
 
@@ -46,13 +47,40 @@ class SemanticMap {
     const cv::Rect fp = image.footprint_px;
     const cv::Rect inside = fp & cv::Rect(0, 0, labels_.cols, labels_.rows);
     if (inside.area() == 0) return;
-    cv::Mat up;
-    cv::resize(labels, up, fp.size(), 0, 0, cv::INTER_NEAREST_EXACT);
-    const cv::Mat up_in = up(inside - fp.tl());
+    // Which camera row / column each footprint row / column reads: INTER_NEAREST_EXACT's
+    // resampling applied to the indices (as GridInputs does), kept from image to image.
+    if (index_size_ != cv::Size(labels.cols, labels.rows) || index_fp_ != fp.size()) {
+      cv::Mat cols(1, labels.cols, CV_32SC1), rows(labels.rows, 1, CV_32SC1);
+      for (int x = 0; x < labels.cols; ++x) cols.at<int>(0, x) = x;
+      for (int y = 0; y < labels.rows; ++y) rows.at<int>(y, 0) = y;
+      cv::resize(cols, col_of_, cv::Size(fp.width, 1), 0, 0, cv::INTER_NEAREST_EXACT);
+      cv::resize(rows, row_of_, cv::Size(1, fp.height), 0, 0, cv::INTER_NEAREST_EXACT);
+      index_size_ = cv::Size(labels.cols, labels.rows);
+      index_fp_ = fp.size();
+    }
     const auto gsd = static_cast<float>(image.gsd_cm);
-    cv::Mat write = (gsd_(inside) >= gsd) & (up_in != image.ignore_label);
-    up_in.copyTo(labels_(inside), write);
-    gsd_(inside).setTo(gsd, write);
+    const auto ignore = static_cast<unsigned char>(image.ignore_label);
+    const int* col_of = col_of_.ptr<int>(0) + (inside.x - fp.x);
+    row_.resize(static_cast<std::size_t>(inside.width));
+    int last_row = -1;
+    for (int y = inside.y; y < inside.y + inside.height; ++y) {
+      const int camera_row = row_of_.at<int>(y - fp.y, 0);
+      if (camera_row != last_row) {  // the footprint row's labels, read once per camera row
+        const auto* src = labels.ptr<unsigned char>(camera_row);
+        for (int x = 0; x < inside.width; ++x) row_[static_cast<std::size_t>(x)] = src[col_of[x]];
+        last_row = camera_row;
+      }
+      // Written where the image is at least as fine as what the pixel holds and not ignored
+      // (as blends, which the compiler vectorises).
+      auto* out = labels_.ptr<unsigned char>(y) + inside.x;
+      auto* held = gsd_.ptr<float>(y) + inside.x;
+      const unsigned char* in = row_.data();
+      for (int x = 0; x < inside.width; ++x) {
+        const bool write = held[x] >= gsd && in[x] != ignore;
+        out[x] = write ? in[x] : out[x];
+        held[x] = write ? gsd : held[x];
+      }
+    }
   }
 
   /// Fused labels, CV_8UC1 of the orthomosaic's size.
@@ -87,6 +115,11 @@ class SemanticMap {
   cv::Mat labels_;
   cv::Mat gsd_;
   int unknown_;
+  // fuse()'s scratch: the camera column / row of each footprint column / row for the last
+  // (camera, footprint) sizes, and one footprint row of labels.
+  cv::Mat col_of_, row_of_;
+  cv::Size index_size_, index_fp_;
+  std::vector<unsigned char> row_;
 };
 
 }  // namespace adaptseg
