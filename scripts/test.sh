@@ -8,8 +8,8 @@ cd "$(dirname "$0")/.."
 bash scripts/deps.sh test
 jobs=$(nproc 2>/dev/null || echo 2)
 # node-mavlink, pinned in tests/mavlink/package-lock.json: the peer that mavlink:node_peer checks
-# adaptseg::mavlink against (a test peer, never a library dependency). Without npm the test is
-# skipped, and says so.
+# adaptseg::mavlink against, and the emulated autopilot of mavlink:emulator (a test peer, never a
+# library dependency). Without npm the tests are skipped, and say so.
 if command -v npm >/dev/null; then
   (cd tests/mavlink && npm ci --no-audit --no-fund --loglevel=error)
 fi
