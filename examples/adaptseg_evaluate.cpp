@@ -79,6 +79,9 @@ void write_decisions(std::ostream& os, const std::string& field, const std::stri
     os << ',';
     if (d.outcome) os << csv_finite(d.outcome->top_input) << ',' << csv_finite(d.outcome->fine_input);
     else os << ',';
+    os << ',';
+    if (r) os << r->delta_tp << ',' << r->delta_fp << ',' << r->delta_fn;
+    else os << ",,";
     os << '\n';
   }
 }
@@ -212,7 +215,8 @@ int main(int argc, char** argv) {
     decisions_csv << "field,strategy,decision,image,sigma,action,gsd_cm,images,extra_time_s,forecast_delta_sigma,"
                      "forecast_delta_miou,forecast_delta_miou_std,forecast_relabelled_interest,forecast_field_gain,forecast_front_margin,"
                      "observed_sigma_sub,observed_relabelled,observed_relabelled_interest,realised_region_delta_miou,"
-                     "realised_field_gain,flown,observed_top_input,observed_fine_input\n";
+                     "realised_field_gain,flown,observed_top_input,observed_fine_input,realised_delta_tp,"
+                     "realised_delta_fp,realised_delta_fn\n";
     // The strategies that fly the model, after the lawnmowers, in the table's order on every
     // test field; the table beside the results for the figures.
     const std::vector<std::string> model_strategies = adaptseg::examples::strategy_names(true);
