@@ -19,6 +19,22 @@
 #   bash scripts/loto.sh eval DIR
 #       here: exports every DIR/loto-<k>.pt (PyTorch 1.13 and OpenCV 4.6 check it loads and
 #       matches) to out/loto/model-<k>/ and prints its field mIoU on tile k.
+#   bash scripts/loto.sh recipe-cpu TILES
+#       here, no accelerator: the deployment recipe itself (1784 steps of 32 crops, seed 0; the
+#       GPU run's schedule without --minutes) on the CPU, one held-out tile after another (TILES
+#       comma-separated, default 1,2,3,4,5,6), checkpoints every 100 steps into
+#       out/loto/work-<k> (an interrupted call resumes where it stopped), exported to
+#       out/loto/model-<k> and scored on tile k as `eval` does. About 100 minutes a tile on the
+#       2-core VM with nothing else running. What rebuilds the bundled leave-one-tile-out
+#       networks (examples/models/mobilenetv2-dubai-loto) when their checkpoints are gone.
+#   bash scripts/loto.sh bundle
+#       here, once out/loto/model-<k> exist for k = 1..6 (recipe-cpu, or eval after a device
+#       call): each network's temperature fitted on the tile it never saw (adaptseg_fit_temperature,
+#       out/loto/temperature-<k>.log), then each bundled with the median of the other five's
+#       (never a temperature fitted on the tile it is tested on) into
+#       examples/models/mobilenetv2-dubai-loto/tile-<k> (model.onnx, model.yaml, its logs and
+#       held-out scores), the six fits in its temperatures.csv, and the deployment network
+#       (mobilenetv2-dubai-all) given the median of all six.
 #   bash scripts/loto.sh cpu TILE [--resume]
 #       here, no accelerator: one training of examples/models/mobilenetv2-dubai's CPU recipe
 #       (2000 steps of 8 crops) on the five tiles but TILE, exported to out/loto-cpu/model-TILE
@@ -117,6 +133,59 @@ for c, cls in enumerate(classes):
     print(f"  {cls:<11}" + "  ".join(f"{g:g} cm/px {sum(v) / len(v):.3f} (n={len(v)})" for g, v in vals.items() if v))
 PY
   ;;
+recipe-cpu)
+  IFS=, read -r -a tiles <<<"${2:-1,2,3,4,5,6}"
+  [ -s .device/mnv2_enc.pt ] || { echo "no .device/mnv2_enc.pt: run 'bash $0 weights' here first" >&2; exit 2; }
+  mkdir -p out/loto
+  for k in "${tiles[@]}"; do
+    work=out/loto/work-$k
+    if [ ! -s "$work/done" ]; then
+      resume=()
+      [ -s "$work/checkpoint.pt" ] && resume=(--resume)
+      "$py" examples/tools/train_segnet.py --arch mobilenetv2 --encoder-weights .device/mnv2_enc.pt \
+        --frozen-blocks 4 --no-image-pooling --lr 1e-3 --weight-decay 0.01 --ema 0.998 --augment altitude --seed 0 \
+        --sampler cpu --device cpu --workers 1 --threads "${LOTO_THREADS:-2}" --train-fields "$(train_fields "$k")" \
+        --val-field "dubai-tile-$k" --test-field none --val-every 0 --ckpt-every 100 --log-every 50 --no-export \
+        --steps 1784 --batch 32 --crop 300 --warmup 100 --work-dir "$work" --model-dir "out/loto/unused-$k" \
+        "${resume[@]}" >>"out/loto/train-$k.log" 2>&1 || { echo "training $k failed: out/loto/train-$k.log" >&2; exit 1; }
+      date -u +%FT%TZ >"$work/done"
+    fi
+    "$py" examples/tools/train_segnet.py --arch mobilenetv2 --work-dir "$work" --model-dir "out/loto/model-$k" \
+      --export-only --train-fields "$(train_fields "$k")" --val-field "dubai-tile-$k" --test-field none \
+      >"out/loto/export-$k.log" 2>&1 || { echo "export of tile $k failed: out/loto/export-$k.log" >&2; exit 1; }
+    "$py" examples/tools/eval_ensemble.py --members "loto$k=out/loto/model-$k" \
+      --fields "examples/data/dubai-tile-$k" --bands 1,2,3 --json "out/loto/eval-$k.json"
+  done
+  ;;
+bundle)
+  source scripts/configure.sh
+  configure_for results build/release >/dev/null
+  cmake --build build/release -j2 --target adaptseg_fit_temperature >/dev/null
+  fit=build/release/examples/adaptseg_fit_temperature
+  dest=examples/models/mobilenetv2-dubai-loto
+  declare -A fitted
+  for k in "${tiles_all[@]}"; do
+    [ -s "out/loto/model-$k/model.onnx" ] || { echo "no out/loto/model-$k: bash $0 recipe-cpu $k (or eval)" >&2; exit 1; }
+    "$fit" --model-file "out/loto/model-$k" --field "examples/data/dubai-tile-$k" --threads 2 >"out/loto/temperature-$k.log"
+    fitted[$k]=$(sed -n 's/^temperature: \([0-9.]*\).*/\1/p' "out/loto/temperature-$k.log")
+    [ -n "${fitted[$k]}" ] || { echo "no temperature in out/loto/temperature-$k.log" >&2; exit 1; }
+  done
+  median() { printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { print (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2) }'; }
+  mkdir -p "$dest"
+  echo "held_out_tile,fitted_on_held_out_tile,bundled_median_of_the_other_five" >"$dest/temperatures.csv"
+  for k in "${tiles_all[@]}"; do
+    others=()
+    for j in "${tiles_all[@]}"; do [ "$j" = "$k" ] || others+=("${fitted[$j]}"); done
+    t=$(median "${others[@]}")
+    mkdir -p "$dest/tile-$k"
+    for f in model.onnx model.yaml train_log.csv val_log.csv val_ema_log.csv; do cp "out/loto/model-$k/$f" "$dest/tile-$k/"; done
+    cp "out/loto/eval-$k.json" "$dest/tile-$k/held_out_eval.json"
+    "$fit" --model-file "$dest/tile-$k" --set "$t" >/dev/null
+    echo "dubai-tile-$k,${fitted[$k]},$t" >>"$dest/temperatures.csv"
+  done
+  "$fit" --model-file examples/models/mobilenetv2-dubai-all --set "$(median "${fitted[@]}")"
+  cat "$dest/temperatures.csv"
+  ;;
 cpu)
   k=${2:?held-out tile}
   shift 2
@@ -134,7 +203,7 @@ cpu)
     --field "examples/data/dubai-tile-$k" --threads 2 --write
   ;;
 *)
-  sed -n '2,27p' "$0" >&2
+  sed -n '2,45p' "$0" >&2
   exit 2
   ;;
 esac

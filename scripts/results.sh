@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reproduces docs/results.md.
-#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed|all-tiles] [JOBS]
+#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|loto|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed|all-tiles] [JOBS]
 #   (default: all, one job per core)
 #
 # oracle: the paper's experiment with the ground-truth oracle, deterministic (fixed 0.1 s per
@@ -25,6 +25,14 @@
 #   keeps the other networks' runs.
 #   Calibration keeps each network's segmentations in out/results/segmentation-cache (one folder
 #   per network and weights), so a rerun segments only what the missions need.
+# loto: the yardstick of decisions on ground nobody tuned for (every decision default is judged
+#   here): for each Dubai tile k and each class, the MobileNetV2 of the deployment recipe that
+#   never saw tile k (examples/models/mobilenetv2-dubai-loto/tile-k; scripts/loto.sh) flies tile
+#   k, its decision function calibrated on the other five tiles, each segmented by the network
+#   of the same recipe that never saw it (--calibration-model-file), as the deployment network's
+#   decision model is calibrated for a new site; 24 runs, measured segmentation times. Printed
+#   beside the oracle's runs of the same folds (part oracle-default's Dubai runs, when there).
+#   Every network segments its own tile once into the segmentation cache.
 # ensemble: field mIoU of the bundled networks and of their ensemble (examples/models/ensemble-dubai)
 #   on the same whole-field lawnmowers of tiles 4 and 6 at 5, 10 and 15 cm/px
 #   (examples/tools/eval_ensemble.py, PyTorch on the exported weights), each network also with
@@ -108,9 +116,9 @@
 set -euo pipefail
 part=${1:-all}
 jobs=${2:-$(nproc 2>/dev/null || echo 2)}
-case "$part" in all | oracle | oracle-default | paper | network | ensemble | ensemble-split | cells | curve-check | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | z-choice-network | \
+case "$part" in all | oracle | oracle-default | paper | network | loto | ensemble | ensemble-split | cells | curve-check | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | z-choice-network | \
   cross-fit | network-variants | proxy-check | vertical-speed | all-tiles) ;;
-  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed|all-tiles] [JOBS]" >&2
+  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|loto|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed|all-tiles] [JOBS]" >&2
     exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
@@ -389,6 +397,29 @@ if [ "$part" = ensemble-split ]; then
   check
   /usr/bin/python3 examples/tools/sweep_table.py \
     "ensemble-dubai=$(dir_list "$root/network/ensemble-dubai"-*/)" "with-split=$(dir_list "$root/$config"/*/)"
+  exit 0
+fi
+
+if [ "$part" = loto ]; then
+  loto=examples/models/mobilenetv2-dubai-loto
+  crossed=()
+  for k in 1 2 3 4 5 6; do
+    [ -s "$loto/tile-$k/model.onnx" ] || { echo "no $loto/tile-$k: bash scripts/loto.sh recipe-cpu, then bundle" >&2; exit 1; }
+    crossed+=(--calibration-model-file "$loto/tile-$k")
+  done
+  rm -rf "${root:?}/loto"
+  for cls in $classes; do
+    for t in 1 2 3 4 5 6; do
+      train_except "$t"
+      run loto "mobilenetv2-loto-$cls-tile-$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
+        --model-file "$loto/tile-$t" "${network[@]}" "${crossed[@]}"
+    done
+  done
+  wait
+  check
+  labels=("loto=$(dir_list "$root/loto"/*/)")
+  [ -d "$root/oracle-default" ] && labels+=("oracle=$(dir_list "$root/oracle-default"/dubai-*/)")
+  /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
   exit 0
 fi
 

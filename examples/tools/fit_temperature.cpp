@@ -10,10 +10,13 @@
 // and the ECE bins pixels by their largest probability (15 equal bins) and compares each bin's
 // mean largest probability with the mean share of the predicted class: the accuracy at the
 // orthomosaic's resolution. With --write the temperature is written into the model's model.yaml
-// (key `temperature`, read by ErfnetSegmenter).
+// (key `temperature`, read by ErfnetSegmenter); --set T writes a given one, nothing fitted (a
+// temperature chosen elsewhere, e.g. the median of what networks of the same recipe fit on the
+// tiles they never saw: scripts/loto.sh bundle).
 //
 //   adaptseg_fit_temperature --model-file examples/models/mobilenetv2-dubai
 //       --field examples/data/dubai-tile-4 [--bands 1,1.5,2,2.5,3] [--threads 2] [--write]
+//   adaptseg_fit_temperature --model-file DIR --set 1.25
 
 #include "common/segmenters.hpp"
 #include "common/strategies.hpp"
@@ -88,6 +91,29 @@ double ece(const Pixels& px, double t) {
   return e;
 }
 
+/// Writes `t` as the `temperature` of the network `model_file`'s model.yaml (replacing the key,
+/// or appending it), the rest of the file as it was.
+void write_temperature(const std::filesystem::path& model_file, double t) {
+  if (!std::filesystem::exists(model_file))
+    throw std::invalid_argument("--model-file " + model_file.string() + ": no such directory or file");
+  const std::filesystem::path dir = std::filesystem::is_directory(model_file) ? model_file : model_file.parent_path();
+  const std::filesystem::path yaml = dir / "model.yaml";
+  std::ifstream in(yaml);
+  if (!in) throw std::invalid_argument("cannot read " + yaml.string());
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string s = text.str();
+  char line[64];
+  std::snprintf(line, sizeof line, "temperature: %.4f", t);
+  const std::regex key("(^|\n)temperature:[^\n]*");
+  if (std::regex_search(s, key))
+    s = std::regex_replace(s, key, std::string("$1") + line);
+  else
+    s += (s.empty() || s.back() == '\n' ? "" : "\n") + std::string(line) + "\n";
+  adaptseg::examples::write_text(yaml, s);
+  std::printf("wrote %s to %s\n", line, yaml.string().c_str());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -100,7 +126,10 @@ int main(int argc, char** argv) {
   adaptseg::examples::CommonOptions common;
   adaptseg::examples::SegmenterOptions segmenter;
   segmenter.name = "erfnet";
-  app.add_option("--field", field_spec, "validation field DIR[:x0,y0,x1,y1]")->required();
+  std::optional<double> set;
+  app.add_option("--field", field_spec, "validation field DIR[:x0,y0,x1,y1] (not with --set)");
+  app.add_option("--set", set, "no fit: write this temperature into the model's model.yaml")
+      ->check(CLI::Range(0.01, 100.0));
   app.add_option("--bands", bands, "GSD bands as multiples of the field's GSD, comma-separated")
       ->delimiter(',')
       ->capture_default_str();
@@ -116,6 +145,14 @@ int main(int argc, char** argv) {
   if (const auto code = adaptseg::examples::parse_command_line(app, argc, argv)) return *code;
   try {
     if (segmenter.name != "erfnet") throw std::invalid_argument("--segmenter must be erfnet: the oracle needs no temperature");
+    if (set) {
+      if (!field_spec.empty() || write || at)
+        throw std::invalid_argument("--set writes a given temperature: no --field, --write or --at with it");
+      segmenter.validate();
+      write_temperature(segmenter.model_file, *set);
+      return 0;
+    }
+    if (field_spec.empty()) throw std::invalid_argument("--field is required (the validation field to fit on)");
     const Field field = adaptseg::examples::load_field_spec(field_spec);
     adaptseg::examples::check_gsd_factors(bands, "--bands");
     const MissionOptions mo = common.resolve(field);
@@ -177,25 +214,7 @@ int main(int argc, char** argv) {
     for (std::size_t b = 0; b < per_band.size(); ++b)
       std::printf("| %.1f | %zu | %.4f | %.4f |\n", bands[b] * field.gsd_cm(), per_band[b].size(), ece(per_band[b], 1.0),
                   ece(per_band[b], t));
-    if (write) {
-      const std::filesystem::path dir = std::filesystem::is_directory(segmenter.model_file)
-                                            ? segmenter.model_file
-                                            : segmenter.model_file.parent_path();
-      const std::filesystem::path yaml = dir / "model.yaml";
-      std::ifstream in(yaml);
-      std::stringstream text;
-      text << in.rdbuf();
-      std::string s = text.str();
-      char line[64];
-      std::snprintf(line, sizeof line, "temperature: %.4f", t);
-      const std::regex key("(^|\n)temperature:[^\n]*");
-      if (std::regex_search(s, key))
-        s = std::regex_replace(s, key, std::string("$1") + line);
-      else
-        s += (s.empty() || s.back() == '\n' ? "" : "\n") + std::string(line) + "\n";
-      adaptseg::examples::write_text(yaml, s);
-      std::printf("wrote %s to %s\n", line, yaml.string().c_str());
-    }
+    if (write) write_temperature(segmenter.model_file, t);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "adaptseg_fit_temperature: error: %s\n", e.what());
