@@ -182,6 +182,41 @@ cross_fit)
   # The same network for the missions and the field: other segmentations, another model.
   ! cmp -s "$work/cross.yaml" "$work/plain.yaml" || fail "cross-fitting changed nothing"
   echo "ok: cross-fitted calibration"
+  # The model knows its network by the bytes of its weights and metadata, not by the folder's
+  # name: in the same folder, changed weights or a changed temperature are another network, and
+  # the mission refuses the model.
+  mkdir -p "$work/net"
+  cp "$examples/models/mobilenetv2-dubai-all/model.onnx" "$examples/models/mobilenetv2-dubai-all/model.yaml" "$work/net/"
+  net_common=("${common[@]}")
+  for i in "${!net_common[@]}"; do
+    [ "${net_common[i]}" = "$examples/models/mobilenetv2-dubai-all" ] && net_common[i]="$work/net"
+  done
+  "$calibrate" "${net_common[@]}" --out "$work/net.yaml" 2>"$work/net.log" || fail "calibration with the copy failed"
+  fly() {
+    "$mission" --field "$examples/data/dubai-tile-4:0,0,0.5,0.5" --strategy adaptive --model "$work/net.yaml" \
+      --segmenter erfnet --model-file "$work/net" --threads 1 --seg-time-s 0.1 --plan-time-s 0 --out "$work/fly" \
+      >"$work/fly.log" 2>&1
+  }
+  fly || fail "the model refused its own network: $(tail -2 "$work/fly.log")"
+  cp "$work/net/model.yaml" "$work/model.yaml.orig"
+  sed -i 's/^temperature: .*/temperature: 1.5/' "$work/net/model.yaml"
+  grep -q '^temperature: 1.5$' "$work/net/model.yaml" || echo "temperature: 1.5" >>"$work/net/model.yaml"
+  fly && fail "a changed temperature in the same folder was flown with the old model"
+  grep -q "calibrated with segmenter" "$work/fly.log" || fail "no message naming the segmenters: $(tail -2 "$work/fly.log")"
+  cp "$work/model.yaml.orig" "$work/net/model.yaml"
+  fly || fail "the folder restored was refused: $(tail -2 "$work/fly.log")"
+  # One weight changed: a byte in the middle of the file (inside the weights' raw data).
+  size=$(stat -c %s "$work/net/model.onnx")
+  "$python" - "$work/net/model.onnx" "$((size / 2))" <<'PY' || fail "cannot change a byte"
+import sys
+path, at = sys.argv[1], int(sys.argv[2])
+data = bytearray(open(path, "rb").read())
+data[at] ^= 0x01
+open(path, "wb").write(data)
+PY
+  fly && fail "changed weights in the same folder were flown with the old model"
+  grep -q "calibrated with segmenter" "$work/fly.log" || fail "no message naming the segmenters: $(tail -2 "$work/fly.log")"
+  echo "ok: a model refuses its network's folder with other weights or another temperature"
   ;;
 determinism)
   # Issue 6 item 5: the same inputs and seed give byte-identical outputs (times fixed by
