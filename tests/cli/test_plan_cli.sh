@@ -52,6 +52,28 @@ for nav, w in zip(navs, wps):
 print(f"ok: {len(wps)} waypoints, site {site['width_m']:.1f} x {site['height_m']:.1f} m at {site['heading_deg']:.2f} deg")
 PY
 
+# The same site as KML (Google Earth's format; OGR's KML driver): the same plan.
+"$python" - "$work/site.geojson" "$work/site.kml" <<'PY' || fail "writing the KML site"
+import json, sys
+ring = json.load(open(sys.argv[1]))["features"][0]["geometry"]["coordinates"][0]
+coords = " ".join(f"{lon:.12f},{lat:.12f},0" for lon, lat in ring)
+open(sys.argv[2], "w").write(f"""<?xml version="1.0" encoding="UTF-8"?>
+<kml xmlns="http://www.opengis.net/kml/2.2"><Document><Placemark><name>site</name>
+<Polygon><outerBoundaryIs><LinearRing><coordinates>{coords}</coordinates></LinearRing></outerBoundaryIs></Polygon>
+</Placemark></Document></kml>
+""")
+PY
+"$mission" --area "$work/site.kml" --gsd 10 --altitude-m 5 --out "$work/k" >"$work/out" 2>"$work/err" ||
+  fail "adaptseg_plan --area KML: $(cat "$work/err")"
+"$python" - "$work/p/plan.json" "$work/k/plan.json" <<'PY' || fail "the KML site planned otherwise than the GeoJSON one"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:])
+assert len(a["waypoints"]) == len(b["waypoints"]) == 14, (len(a["waypoints"]), len(b["waypoints"]))
+for u, v in zip(a["waypoints"], b["waypoints"]):
+    assert abs(u["latitude_deg"] - v["latitude_deg"]) < 1e-9 and abs(u["longitude_deg"] - v["longitude_deg"]) < 1e-9, (u, v)
+print("ok: the KML site, the same 14 waypoints")
+PY
+
 expect_error "--area is required" --gsd 10 --out "$work/q"
 expect_error "file not found" --area "$work/none.geojson" --gsd 10 --out "$work/q"
 echo "a line of text" >"$work/text.geojson"
