@@ -81,6 +81,7 @@ expect_error "neither a vector file nor a raster" --area "$work/text.geojson" --
 expect_error "--gsd must be a finite positive GSD in cm/px, got 0.000" --area "$work/site.geojson" --gsd 0 --out "$work/q"
 expect_error "--map-gsd-cm must be" --area "$work/site.geojson" --gsd 10 --map-gsd-cm nan --out "$work/q"
 # 30 cm/px flies at 165 m: above the 120 m ceiling, refused before any file is written.
-expect_error "120" --area "$work/site.geojson" --gsd 30 --out "$work/q"
+expect_error "the mission would fly 165.0 m above home at 30.00 cm/px, above --max-altitude-m 120.0: with this camera fly at most 21.82 cm/px" \
+  --area "$work/site.geojson" --gsd 30 --out "$work/q"
 [ ! -e "$work/q" ] || fail "a refused plan wrote $work/q"
 echo "ok: adaptseg_plan"
