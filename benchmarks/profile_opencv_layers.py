@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Where OpenCV DNN spends an ONNX network's forward pass, and how its convolutions compare with
-PyTorch's on the shapes that dominate (issue 31, item 5).
+PyTorch's on the shapes that dominate.
 
 1. The model's forward through OpenCV DNN (DNN_BACKEND_OPENCV, CPU), per layer type and for the
    slowest convolution layers, from cv::dnn::Net::getPerfProfile (mean over --iters passes).

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Leave-one-tile-out estimate of the deployment MobileNetV2's accuracy on new ground (issue 31,
-# item 3): six trainings of examples/models/mobilenetv2-dubai-all's recipe, each on five of the
+# Leave-one-tile-out estimate of the deployment MobileNetV2's accuracy on new ground: six
+# trainings of examples/models/mobilenetv2-dubai-all's recipe, each on five of the
 # six bundled Dubai tiles, each scored on the tile it never saw (field mIoU of whole-field
 # lawnmowers at 5, 10 and 15 cm/px, examples/tools/eval_ensemble.py).
 #

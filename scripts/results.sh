@@ -104,7 +104,7 @@
 # vertical-speed: the defaults' sweep (calibration included) with climbs and descents limited to
 #   1 m/s against 2 m/s level (--vertical-speed 1; the paper's model climbs at the level speed):
 #   what the immediate descent, the survey-first tour and staying low along a row are worth
-#   when altitude is expensive, as on real multicopters (issue 17). About 8 minutes on 2 cores.
+#   when altitude is expensive, as on real multicopters. About 8 minutes on 2 cores.
 # all-tiles: calibrated on all six Dubai tiles, as a user with every bundled tile calibrates
 #   for new ground (and as acceptance does), per class, with the oracle and the networks NETS
 #   (default mobilenetv2-dubai): the training folds of the z choice (each tile flown with the

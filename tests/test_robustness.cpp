@@ -1,4 +1,4 @@
-// Hardened input (issue 6 item 4): every row of docs/robustness.md is proved by the test case
+// Hardened input: every row of docs/robustness.md is proved by the test case
 // of the same name here. Each bad input is built in a temporary directory from the bundled
 // data (a crop of examples/data/weedmap-000, examples/models/erfnet-dubai) with one thing
 // broken, and must give the documented exception type and message fragment: no crash, no
@@ -957,7 +957,7 @@ TEST_CASE("robustness: erfnet: field without RGB") {
   CHECK_THROWS_WITH_AS((void)erfnet.segment(img), Contains("the image has no RGB"), std::invalid_argument);
 }
 
-// ---- determinism (issue 6 item 5) --------------------------------------------------------------
+// ---- determinism --------------------------------------------------------------
 
 TEST_CASE("determinism: the same samples and seed give the same decision function") {
   const t::TempDir dir;

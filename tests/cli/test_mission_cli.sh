@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Black-box tests of adaptseg_mission: bad input gives one clear error line and exit code 2
 # (never a crash); good input writes result.json with the documented keys and the figures;
-# on the bundled WeedMap field the GSD sweep behaves as the issue demands; adaptseg_calibrate
+# on the bundled WeedMap field the GSD sweep behaves as docs/results.md describes; adaptseg_calibrate
 # (5th argument) is deterministic and cross-fits its calibration fields.
 #   test_mission_cli.sh MISSION_BINARY EXAMPLES_DIR PYTHON CASE [CALIBRATE_BINARY]
 set -uo pipefail
@@ -219,7 +219,7 @@ PY
   echo "ok: a model refuses its network's folder with other weights or another temperature"
   ;;
 determinism)
-  # Issue 6 item 5: the same inputs and seed give byte-identical outputs (times fixed by
+  # The same inputs and seed give byte-identical outputs (times fixed by
   # --seg-time-s and --plan-time-s): the calibrated model, result.json and the figures, for a
   # lawnmower, an adaptive and a linear mission, each flown twice into its own directory.
   [ -x "$calibrate" ] || fail "determinism needs the adaptseg_calibrate binary as 5th argument"

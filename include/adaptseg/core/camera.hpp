@@ -22,7 +22,8 @@ struct CameraParams {
   double focal_length_mm = 5.5;   ///< f [mm]
 };
 
-/// A camera looking straight down (method.md §1; paper §3.2, the GSD definition after
+/// A camera looking straight down (docs/method.md, "Decisions where the paper is silent, and
+/// departures"; paper §3.2, the GSD definition after
 /// Eq. `eq:gp`): `GSD(h) = 100 * h * S_w / (f * I_w)` [cm/px] with h in m, S_w and f in mm.
 /// Pixels are square, so the footprint is `I_w * GSD / 100` by `I_h * GSD / 100` metres.
 ///

@@ -1,6 +1,7 @@
 #pragma once
 /// @file
-/// The calibrated decision function (paper §3.2.2-3.2.3; method.md §4): the gain model with the
+/// The calibrated decision function (paper §3.2.2-3.2.3; docs/method.md, "The decision function"):
+/// the gain model with the
 /// decision rule chosen at calibration, as a decision-model file holds it.
 
 #include <adaptseg/core/decision.hpp>

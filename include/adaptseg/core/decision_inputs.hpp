@@ -35,7 +35,7 @@ enum class DecisionInput : int {
   second_choice,   ///< Σ_{C ∈ L} 1[C is the second most likely class and p_C > 0.2]
   low_confidence,  ///< 1[max_C p_C < 0.6]: generic hesitation, blind to L
   entropy,         ///< −Σ_C p_C ln p_C / ln(classes): generic, blind to L
-  split,           ///< Σ_{C ∈ L} 1[0 < v_C < 1], v_C the members' vote share for C: an ensemble's members split on a class of L (beyond the paper; issue 31)
+  split,           ///< Σ_{C ∈ L} 1[0 < v_C < 1], v_C the members' vote share for C: an ensemble's members split on a class of L (beyond the paper)
 };
 
 /// One row of the table of inputs.

@@ -1,6 +1,7 @@
 #pragma once
 /// @file
-/// The gain model of the decision function (paper §3.2.2-3.2.3, Eq. `eq:veg2h`; method.md §4):
+/// The gain model of the decision function (paper §3.2.2-3.2.3, Eq. `eq:veg2h`; docs/method.md,
+/// "The decision function"):
 /// Gaussian-process regressions that forecast what re-mapping a region from a lower altitude
 /// changes, fitted to initialisation samples. The decision rules that weigh these forecasts
 /// against time are separate types (UtilityPolicy, FrontAwarePolicy).
@@ -58,7 +59,8 @@ struct GainForecast {
 /// The O, I and C regressions.
 ///
 /// - O (paper Eq. `eq:veg2h`, left): Δσ on (Δh [m], σ_{h_max}); the current image's σ is the
-///   only thing the UAV knows when it decides, so it is an input (method.md §4).
+///   only thing the UAV knows when it decides, so it is an input (docs/method.md, "The
+///   decision function").
 /// - I (Eq. `eq:veg2h`, right): ΔmIoU on Δσ (GainInputs::delta_sigma, the paper's), or on
 ///   (Δσ, Δh) (GainInputs::delta_sigma_and_height, beyond the paper: where the backend keeps σ
 ///   nearly unchanged across altitudes, e.g. a ground-truth oracle, Δσ alone predicts the same

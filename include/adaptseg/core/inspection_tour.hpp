@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Ordering inspections into one tour (beyond the paper; docs/method.md §"When descents are
+/// Ordering inspections into one tour (beyond the paper; docs/method.md, "When descents are
 /// flown"): once the top-level lawnmower (or one of its rows) is flown, the sub-lawnmowers it
 /// chose are flown back to back at low altitude, in the order that takes least flight time. Each
 /// inspection is flown as planned (its own waypoint order), so it enters at its first

@@ -2,7 +2,8 @@
 /// @file
 /// The fixed-altitude lawnmower curve, the yardstick of the paper's §5 (Fig. results): field
 /// mIoU against execution time of lawnmowers flown at several GSDs, and the front margin of a
-/// strategy over it (method.md §5). Eigen- and OpenCV-free: the decision function uses it too.
+/// strategy over it (docs/method.md, "Decisions where the paper is silent, and departures"). Eigen-
+/// and OpenCV-free: the decision function uses it too.
 
 #include <adaptseg/core/detail/interpolate.hpp>
 #include <adaptseg/core/error.hpp>
@@ -23,7 +24,7 @@ struct CurvePoint {
 /// The curve's upper envelope: its running maximum over time, as points (sorted by time) whose
 /// linear interpolation, flat beyond the ends, is `max over t' <= t of curve(t')`. A lawnmower
 /// that is slower *and* maps worse than a faster one is not an alternative anybody would fly:
-/// beyond it the best map so far stays on offer (issue 30, "an honest margin"). Where the
+/// beyond it the best map so far stays on offer. Where the
 /// curve rises with time the envelope is the curve.
 /// @throws std::invalid_argument for an empty curve or non-finite values.
 [[nodiscard]] inline std::vector<CurvePoint> upper_envelope(std::vector<CurvePoint> curve) {
@@ -48,7 +49,8 @@ struct CurvePoint {
   return env;
 }
 
-/// Front margin (paper §5, method.md §5): `miou` minus the lawnmower curve's **upper envelope**
+/// Front margin (paper §5, docs/method.md, "Decisions where the paper is silent, and departures"):
+/// `miou` minus the lawnmower curve's **upper envelope**
 /// (upper_envelope(): the best lawnmower at `time_s` or sooner) linearly interpolated at
 /// `time_s`, flat beyond its ends. Positive: the strategy lies above every lawnmower that is
 /// not slower (more accuracy for its time than flying one altitude everywhere). Where the

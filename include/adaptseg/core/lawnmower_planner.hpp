@@ -1,7 +1,8 @@
 #pragma once
 /// @file
 /// Zig-zag (boustrophedon) coverage with non-overlapping camera footprints (paper §3.2.1;
-/// method.md §2): the top-level plan `W^{h_max}` and the sub-lawnmower `W^{h'}` that re-maps
+/// docs/method.md, "Decisions where the paper is silent, and departures"): the top-level plan
+/// `W^{h_max}` and the sub-lawnmower `W^{h'}` that re-maps
 /// one top-level footprint at a lower altitude.
 
 #include <adaptseg/core/area.hpp>

@@ -1,6 +1,7 @@
 #pragma once
 /// @file
-/// Velocity-ramp flight-time model (method.md §2).
+/// Velocity-ramp flight-time model (docs/method.md, "Decisions where the paper is silent, and
+/// departures").
 
 #include <adaptseg/core/error.hpp>
 

@@ -1,6 +1,7 @@
 #pragma once
 /// @file
-/// The paper's decision rule (§3.2.2; method.md §4): descend where the forecast accuracy gain
+/// The paper's decision rule (§3.2.2; docs/method.md, "The decision function"): descend where the
+/// forecast accuracy gain
 /// per second of extra flight beats a threshold chosen on the training field.
 
 #include <adaptseg/core/decision.hpp>

@@ -1,6 +1,7 @@
 #pragma once
 /// @file
-/// Offline initialisation on training fields (paper §3.2.2; method.md §4): collect the O, I and
+/// Offline initialisation on training fields (paper §3.2.2; docs/method.md, "The decision
+/// function"): collect the O, I and
 /// C samples, fit the gain model, and choose the decision rule's settings on the training
 /// fields only, by the front margin over each field's own lawnmower curve.
 

@@ -97,7 +97,8 @@ struct FieldRegion {
   double x0 = 0.0, y0 = 0.0, x1 = 1.0, y1 = 1.0;
 };
 
-/// An orthomosaic with class labels (method.md §1). The field frame has its origin at the
+/// An orthomosaic with class labels (docs/method.md, "Decisions where the paper is silent, and
+/// departures"). The field frame has its origin at the
 /// orthomosaic's bottom-left corner, x along the columns, y up the rows, in metres; pixel
 /// (row r, col c) covers x in [c, c+1) * g0/100 and y in [H-r-1, H-r) * g0/100.
 ///

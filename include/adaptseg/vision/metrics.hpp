@@ -1,6 +1,7 @@
 #pragma once
 /// @file
-/// Segmentation metrics (method.md §3): semantic ratio (paper Eq. `eq:vr`), per-class IoU and
+/// Segmentation metrics (docs/method.md, "Decisions where the paper is silent, and departures"):
+/// semantic ratio (paper Eq. `eq:vr`), per-class IoU and
 /// mIoU (paper Eq. `eq:iou`) over a class set, per image and over the fused field.
 
 #include <adaptseg/core/decision.hpp>

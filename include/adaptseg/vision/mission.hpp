@@ -1,7 +1,8 @@
 #pragma once
 /// @file
 /// Mission execution shared by every strategy: fly to a waypoint, take the image, segment,
-/// fuse, score, and account for time (method.md §2-3); and the fixed-altitude lawnmower.
+/// fuse, score, and account for time (docs/method.md, "Decisions where the paper is silent, and
+/// departures"); and the fixed-altitude lawnmower.
 
 #include <adaptseg/core/camera.hpp>
 #include <adaptseg/core/lawnmower_planner.hpp>

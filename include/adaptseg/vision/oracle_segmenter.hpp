@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// The ground-truth oracle: the segmentation a perfect classifier would give at the image's
-/// resolution (method.md §1).
+/// resolution (docs/method.md, "Decisions where the paper is silent, and departures").
 
 #include <adaptseg/vision/segmentation_backend.hpp>
 

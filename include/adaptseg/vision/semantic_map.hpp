@@ -1,6 +1,7 @@
 #pragma once
 /// @file
-/// The field map built from segmented images: finest GSD wins (paper §3.1, method.md §3).
+/// The field map built from segmented images: finest GSD wins (paper §3.1, docs/method.md,
+/// "Decisions where the paper is silent, and departures").
 
 #include <adaptseg/vision/image.hpp>
 

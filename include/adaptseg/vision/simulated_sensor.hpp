@@ -1,6 +1,7 @@
 #pragma once
 /// @file
-/// The simulated nadir camera over a Field (method.md §1): crop the footprint from the
+/// The simulated nadir camera over a Field (docs/method.md, "Decisions where the paper is silent,
+/// and departures"): crop the footprint from the
 /// orthomosaic and resample it to the camera's pixel grid.
 
 #include <adaptseg/core/camera.hpp>
