@@ -2,6 +2,7 @@
 // Shared command-line plumbing of the example programs: camera/timing options, error
 // reporting, and the result.json writer. Not part of the library.
 
+#include <adaptseg/core/camera_presets.hpp>
 #include <adaptseg/planner.hpp>
 #include <adaptseg/vision/calibration.hpp>
 #include <adaptseg/vision/decision_model.hpp>
@@ -99,12 +100,30 @@ inline void check_gsd_factors(const std::vector<double>& factors, const std::str
 /// Camera, speed and timing options shared by every program.
 struct CommonOptions {
   MissionOptions mission;
+  std::string camera_preset_name;  ///< `--camera`: empty, or a name of kCameraPresets
   std::vector<std::string> interest_names;
   std::optional<double> seg_time_s;
   std::optional<double> plan_time_s;
 
   void add_to(CLI::App& app) {
     auto& cam = mission.camera;
+    std::string presets;
+    for (const auto& p : kCameraPresets) presets += (presets.empty() ? "" : ", ") + std::string(p.name);
+    app.add_option("--camera", camera_preset_name,
+                   "a camera preset (" + presets +
+                       "; include/adaptseg/core/camera_presets.hpp names each one's source): its sensor width, focal "
+                       "length and image size; --image-width alone then scales the image, keeping its aspect ratio, "
+                       "and other camera options override the preset's")
+        ->check([](const std::string& name) {
+          try {
+            (void)camera_preset(name);
+            return std::string();
+          } catch (const std::invalid_argument& e) {
+            return std::string(e.what());
+          }
+        });
+    // After parsing: the preset, then the camera options given explicitly.
+    app.parse_complete_callback([this, &app] { apply_camera_preset(app); });
     app.add_option("--image-width", cam.image_width_px, "camera image width [px]")->capture_default_str();
     app.add_option("--image-height", cam.image_height_px, "camera image height [px]")->capture_default_str();
     app.add_option("--sensor-width-mm", cam.sensor_width_mm, "sensor width [mm]")->capture_default_str();
@@ -123,6 +142,20 @@ struct CommonOptions {
         ->delimiter(',');
   }
 
+  /// `--camera NAME`: the preset's camera, then the camera options given explicitly on top of it
+  /// (`--image-width` alone scales the preset's image, its aspect ratio kept).
+  void apply_camera_preset(const CLI::App& app) {
+    if (camera_preset_name.empty()) return;
+    const CameraParams given = mission.camera;
+    CameraParams cam = camera_preset(camera_preset_name).params;
+    if (app.count("--image-width") > 0 && app.count("--image-height") == 0) cam = at_width(cam, given.image_width_px);
+    if (app.count("--image-width") > 0) cam.image_width_px = given.image_width_px;
+    if (app.count("--image-height") > 0) cam.image_height_px = given.image_height_px;
+    if (app.count("--sensor-width-mm") > 0) cam.sensor_width_mm = given.sensor_width_mm;
+    if (app.count("--focal-mm") > 0) cam.focal_length_mm = given.focal_length_mm;
+    mission.camera = cam;
+  }
+
   /// Model-based strategies fly the model's camera and timing; explicit options must agree.
   /// @throws std::invalid_argument naming the option that differs.
   void check_camera_matches(const CLI::App& app, const DecisionModel& model) const {
@@ -133,6 +166,14 @@ struct CommonOptions {
         throw std::invalid_argument(std::string(opt) + " " + fmt(mine, 4) + " differs from the decision model's " +
                                     fmt(theirs, 4) + " (the model was calibrated for its camera and speed)");
     };
+    if (app.count("--camera") > 0 && (c.image_width_px != m.image_width_px || c.image_height_px != m.image_height_px ||
+                                      c.sensor_width_mm != m.sensor_width_mm || c.focal_length_mm != m.focal_length_mm))
+      throw std::invalid_argument("--camera " + camera_preset_name + " (" + std::to_string(c.image_width_px) + "x" +
+                                  std::to_string(c.image_height_px) + " px, " + fmt(c.sensor_width_mm, 2) + " mm sensor, " +
+                                  fmt(c.focal_length_mm, 2) + " mm focal) differs from the decision model's camera (" +
+                                  std::to_string(m.image_width_px) + "x" + std::to_string(m.image_height_px) + " px, " +
+                                  fmt(m.sensor_width_mm, 2) + " mm sensor, " + fmt(m.focal_length_mm, 2) +
+                                  " mm focal): the model was calibrated for its camera");
     differs("--image-width", c.image_width_px, m.image_width_px);
     differs("--image-height", c.image_height_px, m.image_height_px);
     differs("--sensor-width-mm", c.sensor_width_mm, m.sensor_width_mm);

@@ -6,6 +6,7 @@
 
 #include <adaptseg/core/area.hpp>
 #include <adaptseg/core/camera.hpp>
+#include <adaptseg/core/camera_presets.hpp>
 #include <adaptseg/core/cell_gain_model.hpp>
 #include <adaptseg/core/decision.hpp>
 #include <adaptseg/core/decision_function.hpp>

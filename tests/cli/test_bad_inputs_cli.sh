@@ -75,6 +75,8 @@ adaptseg_evaluate)
     --model "$weedmap_model" --out "$work/o" --no-plots --vertical-speed 1
   expect_error "--speed 3.0000 differs from the decision model's 2.0000" --test "$weedmap" --model "$weedmap_model" \
     --out "$work/o" --no-plots --speed 3
+  expect_error "--camera dji-phantom4-rtk (5472x3648 px, 13.20 mm sensor, 8.80 mm focal) differs from the decision model's camera (480x360 px, 4.80 mm sensor, 5.50 mm focal)" \
+    --test "$weedmap" --model "$weedmap_model" --out "$work/o" --no-plots --camera dji-phantom4-rtk
   ;;
 adaptseg_live)
   common_parse_errors --images "$work/images" --model "$weedmap_model" --record-from "$weedmap"
