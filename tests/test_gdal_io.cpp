@@ -1,19 +1,24 @@
 // GeoTIFF fields and georeferenced maps (adaptseg::gdal): a bundled tile written to GeoTIFF by
 // gdal_translate's own code (GDALTranslate) under a UTM georeference, loaded back, its frame
 // checked against GDAL's transformation of the CRS, its map written and read back by GDAL.
+#include <adaptseg/gdal/elevation_model.hpp>
+#include <adaptseg/gdal/exif_position.hpp>
 #include <adaptseg/gdal/gdal_io.hpp>
+#include <adaptseg/gdal/site_plan.hpp>
 #include <adaptseg/gdal/survey_site.hpp>
 
 #include "test_support.hpp"
 
 #include <doctest/doctest.h>
 #include <gdal_utils.h>
+#include <ogr_geometry.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <sstream>
 #include <string>
@@ -520,26 +525,25 @@ TEST_CASE("a site from a GeoJSON polygon: its frame along the longer side, a pla
   // The mask is the L: 240 x 100 - 80 x 80 m^2 at 10 cm/px, to a pixel along the outline.
   CHECK(cv::countNonZero(site.area.valid_mask) * 0.01 == doctest::Approx(240.0 * 100.0 - 80.0 * 80.0).epsilon(0.01));
 
-  // At 15 cm/px (72 m x 54 m footprints), the grid centred: every waypoint over the site's
-  // rectangle, the overhang even on both sides, the bitten-out corner's cells skipped, and every
-  // pixel of the site under a footprint.
+  // At 15 cm/px (72 m x 54 m footprints), the grid centred: every waypoint inside the L by the
+  // default margin (2 m; the cells whose centre lies outside moved in), the bitten-out corner's
+  // cells skipped, and every pixel of the site under a footprint.
   const CameraModel camera;
   const std::vector<Waypoint> plan = plan_site_survey(site, camera, 15.0);
   REQUIRE(!plan.empty());
-  double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
+  double x0 = 1e9, y0 = 1e9;
   cv::Mat seen(site.area.valid_mask.size(), CV_8UC1, cv::Scalar(0));
   for (const auto& w : plan) {
     CHECK(w.position.z() == doctest::Approx(camera.altitude_m(15.0)));
-    x0 = std::min(x0, w.footprint.x_min_m), x1 = std::max(x1, w.footprint.x_max_m);
-    y0 = std::min(y0, w.footprint.y_min_m), y1 = std::max(y1, w.footprint.y_max_m);
+    x0 = std::min(x0, w.footprint.x_min_m);
+    y0 = std::min(y0, w.footprint.y_min_m);
     CHECK(w.position.x() > 0.0);
     CHECK(w.position.x() < site.area.area.width_m());
     CHECK(w.position.y() > 0.0);
     CHECK(w.position.y() < site.area.area.height_m());
+    CHECK(site.contains(Eigen::Vector2d(w.position.x(), w.position.y()), 2.0));
     seen(raster_rect(w.footprint, 10.0, seen.rows) & cv::Rect(0, 0, seen.cols, seen.rows)).setTo(255);
   }
-  CHECK(-x0 == doctest::Approx(x1 - site.area.area.width_m()).epsilon(1e-9));
-  CHECK(-y0 == doctest::Approx(y1 - site.area.area.height_m()).epsilon(1e-9));
   const LawnmowerPlanner planner(camera);
   const std::size_t full = planner.plan(planner.centred_grid(site.area.area, 15.0), 15.0, Eigen::Vector2d(x0, y0)).size();
   CHECK(plan.size() < full);
@@ -599,4 +603,436 @@ TEST_CASE("bad survey areas: one clear error each, naming the file") {
   write_file(scratch() / "metres.geojson",
              geojson_polygon({{{2787000, 329000, 0}, {2787000, 329100, 0}, {2787100, 329100, 0}}}));
   CHECK(error_of(scratch() / "metres.geojson").find("out of range") != std::string::npos);
+}
+
+namespace {
+
+/// `local` east, north [m] about (lat0, lon0), turned by `angle_deg` counter-clockwise, in WGS84.
+std::vector<GeoPoint> wgs84_ring(double lat0, double lon0, const std::vector<Eigen::Vector2d>& local, double angle_deg = 0.0) {
+  const GeographicLib::LocalCartesian plane(lat0, lon0, 0.0);
+  const double a = angle_deg * std::numbers::pi / 180.0;
+  std::vector<GeoPoint> ring;
+  for (const auto& q : local) {
+    double lat = 0, lon = 0, h = 0;
+    plane.Reverse(std::cos(a) * q.x() - std::sin(a) * q.y(), std::sin(a) * q.x() + std::cos(a) * q.y(), 0.0, lat, lon, h);
+    ring.push_back({lat, lon, 0.0});
+  }
+  return ring;
+}
+
+/// The site's polygon in its own frame, as GDAL's geometry: an independent judge of "inside".
+std::unique_ptr<OGRPolygon> frame_polygon(const SurveySite& site) {
+  auto poly = std::make_unique<OGRPolygon>();
+  for (const auto& r : site.rings) {
+    OGRLinearRing ring;
+    for (const auto& v : r) ring.addPoint(v.x(), v.y());
+    ring.closeRings();
+    poly->addRing(&ring);
+  }
+  return poly;
+}
+
+/// The L-shaped site of the GeoJSON test near Dubai (240 m by 100 m, long side at bearing 60).
+const std::vector<Eigen::Vector2d> kL{{0, 0}, {240, 0}, {240, 20}, {160, 20}, {160, 100}, {0, 100}};
+
+/// An irregular 5 ha site near Zurich with a 50 m square hole.
+const std::vector<Eigen::Vector2d> kOuter{{0, 0}, {250, -30}, {290, 110}, {170, 200}, {30, 170}, {-30, 80}};
+const std::vector<Eigen::Vector2d> kHole{{100, 60}, {150, 60}, {150, 110}, {100, 110}};
+
+SurveySite hole_site() {
+  const fs::path file = scratch() / "hole_site.geojson";
+  write_file(file, geojson_polygon({wgs84_ring(47.4, 8.5, kOuter), wgs84_ring(47.4, 8.5, kHole)}));
+  return load_survey_site(file, 10.0);
+}
+
+/// Easting, northing [m] of a WGS84 point in `srs` (through GDAL).
+std::pair<double, double> projected(const std::string& srs_text, const GeoPoint& g) {
+  OGRSpatialReference src, dst;
+  src.SetWellKnownGeogCS("WGS84");
+  src.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  dst.SetFromUserInput(srs_text.c_str());
+  dst.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  OGRCoordinateTransformation* ct = OGRCreateCoordinateTransformation(&src, &dst);
+  REQUIRE(ct != nullptr);
+  double x = g.longitude_deg, y = g.latitude_deg;
+  REQUIRE(ct->Transform(1, &x, &y));
+  OGRCoordinateTransformation::DestroyCT(ct);
+  return {x, y};
+}
+
+/// A Float32 DEM GeoTIFF in `srs` with its top-left at (e0, n1), `w` x `h` pixels of `px` m, z(e, n).
+template <typename Z>
+void write_dem(const fs::path& file, const std::string& srs_text, double e0, double n1, int w, int h, double px, Z z) {
+  gdal::detail::register_drivers();
+  GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
+  REQUIRE(gtiff != nullptr);
+  gdal::detail::Dataset d(gtiff->Create(file.c_str(), w, h, 1, GDT_Float32, nullptr));
+  REQUIRE(d);
+  double gt[6] = {e0, px, 0.0, n1, 0.0, -px};
+  d->SetGeoTransform(gt);
+  OGRSpatialReference srs;
+  srs.SetFromUserInput(srs_text.c_str());
+  d->SetSpatialRef(&srs);
+  std::vector<float> values(static_cast<std::size_t>(w) * h);
+  for (int r = 0; r < h; ++r)
+    for (int c = 0; c < w; ++c) values[static_cast<std::size_t>(r) * w + c] = static_cast<float>(z(e0 + (c + 0.5) * px, n1 - (r + 0.5) * px));
+  REQUIRE(d->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, w, h, values.data(), w, h, GDT_Float32, 0, 0) == CE_None);
+}
+
+}  // namespace
+
+TEST_CASE("a site with a hole: every waypoint inside its polygon and out of its hole by the margin") {
+  const SurveySite site = hole_site();
+  REQUIRE(site.rings.size() == 2);
+  CHECK(site.holes == std::vector<bool>{false, true});
+  CHECK(site.area_m2() == doctest::Approx(50450.0).epsilon(0.002));  // 52,950 less the hole's 2,500
+  const auto poly = frame_polygon(site);
+  const std::unique_ptr<OGRGeometry> edges(poly->Boundary());
+  const CameraModel camera;
+  // The grid alone, as adaptseg_plan laid it before: centres in the hole and beyond the edges.
+  const LawnmowerPlanner planner(camera);
+  std::size_t outside_before = 0;
+  for (const auto& w : planner.plan(planner.centred_grid(site.area.area, 15.0), 15.0)) {
+    const OGRPoint p(w.position.x(), w.position.y());
+    outside_before += poly->Contains(&p) ? 0 : 1;
+  }
+  CHECK(outside_before > 4);
+  const SiteSurvey survey = survey_site(site, camera, 15.0);
+  REQUIRE(survey.waypoints.size() > 15);
+  CHECK(survey.moved > 0);
+  for (const auto& w : survey.waypoints) {
+    CAPTURE(w.position.transpose());
+    const OGRPoint p(w.position.x(), w.position.y());
+    CHECK(poly->Contains(&p));
+    CHECK(edges->Distance(&p) >= 2.0 - 1e-9);  // the default inside margin
+    CHECK(site.contains(w.position.head<2>(), 2.0));
+    // A moved footprint moved with its waypoint: still centred on it.
+    CHECK(w.footprint.centre().x() == doctest::Approx(w.position.x()));
+    CHECK(w.footprint.centre().y() == doctest::Approx(w.position.y()));
+  }
+  // What moving them cost: under 2 % of the site left under no footprint, reported.
+  CHECK(survey.site_m2 == doctest::Approx(site.area_m2()).epsilon(0.01));
+  CHECK(survey.uncovered_m2 < 0.02 * survey.site_m2);
+  CHECK(survey.coverage() > 0.98);
+  // A wider margin keeps them farther in.
+  SiteSurveyOptions wide;
+  wide.inside_margin_m = 6.0;
+  for (const auto& w : survey_site(site, camera, 15.0, wide).waypoints) {
+    const OGRPoint p(w.position.x(), w.position.y());
+    CHECK(edges->Distance(&p) >= 6.0 - 1e-9);
+  }
+}
+
+TEST_CASE("plan_site: the take-off point on the site, the polygon as the geofence, every leg inside it") {
+  const SurveySite site = hole_site();
+  const GeoPoint home = wgs84_ring(47.4, 8.5, {{20, 80}})[0];
+  SitePlanOptions options;
+  options.gsd_cm = 15.0;
+  options.home = home;
+  const SitePlan plan = plan_site(site, options);
+  CHECK(plan.home_given);
+  CHECK(metres_apart(plan.home, home) < 0.01);
+  // The fence: the outline included, the hole excluded, both as the file gave them.
+  REQUIRE(plan.geofence.size() == 2);
+  CHECK(plan.geofence[0].inclusion);
+  CHECK_FALSE(plan.geofence[1].inclusion);
+  CHECK(plan.geofence[0].vertices.size() == kOuter.size());
+  CHECK(plan.geofence[1].vertices.size() == kHole.size());
+  const auto outer = wgs84_ring(47.4, 8.5, kOuter);
+  for (std::size_t i = 0; i < outer.size(); ++i) CHECK(metres_apart(plan.geofence[0].vertices[i], outer[i]) < 0.01);
+  // Every leg flown, the take-off's and the return's included, inside the polygon and out of the
+  // hole (GDAL's judgement), half the margin from its edges; some bend around the hole.
+  const auto poly = frame_polygon(site);
+  const std::unique_ptr<OGRGeometry> edges(poly->Boundary());
+  REQUIRE(plan.routes.size() == 1);
+  std::vector<Eigen::Vector2d> flown{plan.home_xy};
+  std::size_t images = 0;
+  for (const RoutePoint& r : plan.routes[0]) {
+    flown.push_back(r.position.head<2>());
+    if (r.image) CHECK(*r.image == images++);
+  }
+  flown.push_back(plan.home_xy);
+  CHECK(images == plan.survey.waypoints.size());
+  CHECK(plan.via_points > 0);
+  CHECK(plan.routes[0].size() == images + plan.via_points);
+  for (std::size_t k = 1; k < flown.size(); ++k) {
+    CAPTURE(k);
+    OGRLineString leg;
+    leg.addPoint(flown[k - 1].x(), flown[k - 1].y());
+    leg.addPoint(flown[k].x(), flown[k].y());
+    CHECK(poly->Contains(&leg));
+    CHECK(edges->Distance(&leg) >= 1.0 - 1e-6);
+  }
+  // The lawnmower starts at the end of the site nearer home.
+  CHECK((plan.survey.waypoints.front().position.head<2>() - plan.home_xy).norm() <
+        (plan.survey.waypoints.back().position.head<2>() - plan.home_xy).norm());
+  // The mission file: take-off at home, the via points without an image, the fence.
+  const ExportPath path = plan.sortie_path(0, site);
+  CHECK(path.home == plan.home);
+  CHECK(path.geofence.size() == 2);
+  const auto items = mission_items(path);
+  CHECK(items.front().params[4] == home.latitude_deg);
+  CHECK(items.size() == 3 + 2 * images + plan.via_points);
+  // A take-off point in the hole, or beyond the outline, is refused.
+  options.home = wgs84_ring(47.4, 8.5, {{125, 85}})[0];
+  CHECK_THROWS_WITH_AS((void)plan_site(site, options), doctest::Contains("m off the site (outside its outline or in a hole)"),
+                       std::invalid_argument);
+  options.home = wgs84_ring(47.4, 8.5, {{300, 0}})[0];
+  CHECK_THROWS_WITH_AS((void)plan_site(site, options), doctest::Contains("m off the site"), std::invalid_argument);
+}
+
+TEST_CASE("plan_site: a DEM with a 20 m slope keeps the GSD within 5 %, altitudes relative to home") {
+  const fs::path file = scratch() / "l_dem_site.geojson";
+  write_file(file, geojson_polygon({wgs84_ring(25.2, 55.3, kL, 30.0)}));
+  const SurveySite site = load_survey_site(file, 10.0, 10.0);
+  // The site's extent in UTM 40N; the ground rises 20 m from its west end to its east end.
+  double e_min = 1e12, e_max = -1e12, n_min = 1e12, n_max = -1e12;
+  for (const auto& g : wgs84_ring(25.2, 55.3, kL, 30.0)) {
+    const auto [e, n] = projected("EPSG:32640", g);
+    e_min = std::min(e_min, e), e_max = std::max(e_max, e), n_min = std::min(n_min, n), n_max = std::max(n_max, n);
+  }
+  const auto slope = [&](double rise_m) { return [=](double e, double) { return 100.0 + rise_m * (e - e_min) / (e_max - e_min); }; };
+  const auto ground = slope(20.0);
+  const fs::path dem_file = scratch() / "slope_dem.tif";
+  const double px = 5.0;
+  const int w = static_cast<int>((e_max - e_min + 400.0) / px), h = static_cast<int>((n_max - n_min + 400.0) / px);
+  write_dem(dem_file, "EPSG:32640", e_min - 200.0, n_max + 200.0, w, h, px, ground);
+  const ElevationModel dem(dem_file);
+  const GeoPoint probe = wgs84_ring(25.2, 55.3, {{100, 50}}, 30.0)[0];
+  const auto [pe, pn] = projected("EPSG:32640", probe);
+  REQUIRE(dem.elevation_m(probe.latitude_deg, probe.longitude_deg));
+  CHECK(*dem.elevation_m(probe.latitude_deg, probe.longitude_deg) == doctest::Approx(ground(pe, pn)).epsilon(1e-6));
+  CHECK_FALSE(dem.elevation_m(26.0, 55.3));
+
+  SitePlanOptions options;
+  options.gsd_cm = 10.0;  // 55 m above the ground
+  const SitePlan plan = plan_site(site, options, &dem);
+  REQUIRE(plan.terrain);
+  const CameraModel camera;
+  const GeoReference frame(site.geo);
+  const auto ground_at = [&](double x, double y) {
+    const auto [e, n] = projected("EPSG:32640", frame.to_wgs84({x, y, 0.0}));
+    return ground(e, n);
+  };
+  const double home_ground = ground_at(plan.home_xy.x(), plan.home_xy.y());
+  CHECK(plan.terrain->home_ground_m == doctest::Approx(home_ground).epsilon(1e-6));
+  double low = 1e9, high = -1e9;
+  for (const auto& wp : plan.survey.waypoints) {
+    CAPTURE(wp.position.transpose());
+    // Above its own ground, at the centre and at the footprint's corners: the GSD within 5 %.
+    const double above = wp.position.z() + home_ground - ground_at(wp.position.x(), wp.position.y());
+    CHECK(std::abs(camera.gsd_cm(above) / 10.0 - 1.0) < 0.01);
+    for (const auto& c : {Eigen::Vector2d(wp.footprint.x_min_m, wp.footprint.y_min_m), Eigen::Vector2d(wp.footprint.x_max_m, wp.footprint.y_max_m),
+                          Eigen::Vector2d(wp.footprint.x_min_m, wp.footprint.y_max_m), Eigen::Vector2d(wp.footprint.x_max_m, wp.footprint.y_min_m)})
+      CHECK(std::abs(camera.gsd_cm(wp.position.z() + home_ground - ground_at(c.x(), c.y())) / 10.0 - 1.0) < 0.05);
+    low = std::min(low, wp.position.z()), high = std::max(high, wp.position.z());
+  }
+  CHECK(high - low > 12.0);  // the altitudes above home follow the slope
+  // The same waypoints flown flat at 55 m above home would miss the GSD by more than 5 % somewhere.
+  double worst_flat = 0.0;
+  for (const auto& wp : plan.survey.waypoints)
+    worst_flat = std::max(worst_flat, std::abs(camera.gsd_cm(55.0 + home_ground - ground_at(wp.position.x(), wp.position.y())) / 10.0 - 1.0));
+  CHECK(worst_flat > 0.05);
+  // The ground rises above home: the return altitude must clear it.
+  bool rises = false;
+  for (const auto& warning : plan.warnings) rises = rises || warning.find("rises") != std::string::npos;
+  CHECK(rises);
+  // A slope steep enough that a footprint's highest ground comes within the minimum altitude: refused.
+  const fs::path steep_file = scratch() / "steep_dem.tif";
+  write_dem(steep_file, "EPSG:32640", e_min - 200.0, n_max + 200.0, w, h, px, slope(200.0));
+  const ElevationModel steep(steep_file);
+  options.min_altitude_m = 45.0;
+  CHECK_THROWS_WITH_AS((void)plan_site(site, options, &steep), doctest::Contains("m above the highest ground under its footprint (DEM), below the minimum altitude 45.0 m"),
+                       std::invalid_argument);
+  // A DEM elsewhere: no elevation, named.
+  const fs::path far_file = scratch() / "far_dem.tif";
+  write_dem(far_file, "EPSG:32640", e_min + 50'000.0, n_max + 200.0, 20, 20, px, ground);
+  const ElevationModel far(far_file);
+  options.min_altitude_m = 10.0;
+  CHECK_THROWS_WITH_AS((void)plan_site(site, options, &far), doctest::Contains("has no elevation at the take-off point"),
+                       std::invalid_argument);
+}
+
+TEST_CASE("plan_site: swapped latitude and longitude are named, never planned silently") {
+  const auto ring = wgs84_ring(25.2, 55.3, kL, 30.0);
+  std::vector<GeoPoint> swapped;
+  for (const auto& g : ring) swapped.push_back({g.longitude_deg, g.latitude_deg, 0.0});  // written [lat, lon]
+  const fs::path file = scratch() / "swapped.geojson";
+  write_file(file, geojson_polygon({swapped}));
+  const SurveySite site = load_survey_site(file, 10.0);  // a valid place: near 55.3 N, 25.2 E
+  CHECK(site.centre().latitude_deg == doctest::Approx(55.3).epsilon(0.001));
+  SitePlanOptions options;
+  options.gsd_cm = 10.0;
+  options.home = wgs84_ring(25.2, 55.3, {{40, 50}}, 30.0)[0];  // where the site really is
+  CHECK_THROWS_WITH_AS((void)plan_site(site, options), doctest::Contains("swapped, it would lie on the site"),
+                       std::invalid_argument);
+  // Against a DEM of the real place, too.
+  const auto [e, n] = projected("EPSG:32640", GeoPoint{25.2, 55.3, 0.0});
+  const fs::path dem_file = scratch() / "dubai_dem.tif";
+  write_dem(dem_file, "EPSG:32640", e - 500.0, n + 500.0, 100, 100, 10.0, [](double, double) { return 5.0; });
+  const ElevationModel dem(dem_file);
+  options.home.reset();
+  CHECK_THROWS_WITH_AS((void)plan_site(site, options, &dem), doctest::Contains("swapped, the site would lie on it"),
+                       std::invalid_argument);
+  // A latitude beyond 90 that would be a longitude: Sydney written [lat, lon].
+  write_file(scratch() / "sydney.geojson", R"({"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {}, )"
+                                           R"("geometry": {"type": "Polygon", "coordinates": [[[-33.90, 151.20], [-33.90, 151.21], )"
+                                           R"([-33.91, 151.21], [-33.90, 151.20]]]}}]})");
+  CHECK_THROWS_WITH_AS((void)load_survey_site(scratch() / "sydney.geojson"),
+                       doctest::Contains("are latitude and longitude swapped? GeoJSON and KML list longitude first"),
+                       std::invalid_argument);
+}
+
+TEST_CASE("plan_site: sorties from the take-off point fit the flight-time limit and resume where the last stopped") {
+  const fs::path file = scratch() / "l_sortie_site.geojson";
+  write_file(file, geojson_polygon({wgs84_ring(25.2, 55.3, kL, 30.0)}));
+  const SurveySite site = load_survey_site(file, 10.0);
+  SitePlanOptions options;
+  options.gsd_cm = 5.0;  // 27.5 m, 24 x 18 m footprints
+  options.home = wgs84_ring(25.2, 55.3, {{5, 50}}, 30.0)[0];
+  options.max_flight_s = 300.0;  // the L's far end alone: 4 min from home and back
+  const SitePlan plan = plan_site(site, options);
+  REQUIRE(plan.sorties.size() >= 3);
+  const TimingModel timing;
+  std::size_t next = 0;
+  for (std::size_t k = 0; k < plan.sorties.size(); ++k) {
+    CAPTURE(k);
+    const Sortie& s = plan.sorties[k];
+    CHECK(s.first == next);
+    next = s.end;
+    // The route flown, timed apart: up at home, through every point (holds at the images), back and down.
+    const auto& route = plan.routes[k];
+    const Eigen::Vector3d home(plan.home_xy.x(), plan.home_xy.y(), 0.0);
+    Eigen::Vector3d at(home.x(), home.y(), route.front().position.z());
+    double t = timing.segment_time_s(home, at);
+    std::size_t images = 0;
+    for (const RoutePoint& r : route) {
+      t += timing.segment_time_s(at, r.position) + (r.image ? 1.0 : 0.0);
+      at = r.position;
+      if (r.image) CHECK(*r.image == s.first + images++);
+    }
+    const Eigen::Vector3d above(home.x(), home.y(), at.z());
+    t += timing.segment_time_s(at, above) + timing.segment_time_s(above, home);
+    CHECK(images == s.size());
+    CHECK(t == doctest::Approx(s.flight_s));
+    CHECK(t <= 300.0);
+    CHECK(mission_items(plan.sortie_path(k, site)).size() <= 500);
+  }
+  CHECK(next == plan.survey.waypoints.size());
+  options.max_flight_s = 20.0;
+  CHECK_THROWS_WITH_AS((void)plan_site(site, options), doctest::Contains("alone takes"), std::invalid_argument);
+}
+
+TEST_CASE("plan_site: refusals and warnings, each one line with its numbers") {
+  const fs::path file = scratch() / "l_sanity_site.geojson";
+  write_file(file, geojson_polygon({wgs84_ring(25.2, 55.3, kL, 30.0)}));
+  const SurveySite site = load_survey_site(file, 10.0);
+  SitePlanOptions options;
+  options.gsd_cm = 0.5;
+  CHECK_THROWS_WITH_AS((void)plan_site(site, options),
+                       doctest::Contains("the survey would fly 2.75 m above the ground at 0.50 cm/px, below the minimum "
+                                         "altitude 10.0 m: with this camera fly at least 1.82 cm/px"),
+                       std::invalid_argument);
+  options.gsd_cm = 10.0;
+  CHECK(plan_site(site, options).warnings.empty());
+  // 12 km^2 at 20 cm/px: the area, the waypoints and the hours are each named; the one file
+  // would hold more items than PX4 stores.
+  const fs::path big = scratch() / "big_site.geojson";
+  write_file(big, geojson_polygon({wgs84_ring(25.2, 55.3, {{0, 0}, {4000, 0}, {4000, 3000}, {0, 3000}})}));
+  const SurveySite wide = load_survey_site(big, 100.0);
+  options.gsd_cm = 20.0;
+  const SitePlan plan = plan_site(wide, options);
+  const auto has = [&](const std::string& text) {
+    for (const auto& w : plan.warnings)
+      if (w.find(text) != std::string::npos) return true;
+    return false;
+  };
+  CHECK(has("ha), outside 100 m^2 .. 10 km^2: is it the polygon you meant"));
+  CHECK(has("waypoints, more than 1000: check the GSD (20.00 cm/px) against the site's 1200.0 ha"));
+  CHECK(has("h in 1 sortie(s), more than 2.0 h"));
+  CHECK(has("split it into sorties that fit a battery"));
+  CHECK_THROWS_WITH_AS((void)mission_items(plan.sortie_path(0, wide)), doctest::Contains("more than the PX4 limit of 500"),
+                       std::invalid_argument);
+  // The mask too large for memory: one readable line, the sizes as integers, the GSD that fits.
+  try {
+    (void)load_survey_site(big, 1.0);
+    FAIL("no error");
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    CHECK(what.find("the site's mask at 1 cm/px would be 400") != std::string::npos);
+    CHECK(what.find(" pixels, more than the 400000000 allowed: a map GSD of at least 17.4 cm/px fits (--map-gsd-cm)") !=
+          std::string::npos);
+    CHECK(what.find("e+") == std::string::npos);
+  }
+}
+
+namespace {
+
+/// A 16 x 12 JPEG written by GDAL's JPEG driver with `tags` as its EXIF (EXIF_* metadata items).
+fs::path exif_jpeg(const std::string& name, const std::vector<std::pair<const char*, const char*>>& tags) {
+  GDALAllRegister();
+  GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+  GDALDriver* jpeg = GetGDALDriverManager()->GetDriverByName("JPEG");
+  REQUIRE(mem != nullptr);
+  REQUIRE(jpeg != nullptr);
+  std::unique_ptr<GDALDataset> src(mem->Create("", 16, 12, 3, GDT_Byte, nullptr));
+  for (const auto& [k, v] : tags) src->SetMetadataItem(k, v);
+  const fs::path file = scratch() / name;
+  std::unique_ptr<GDALDataset>(jpeg->CreateCopy(file.c_str(), src.get(), FALSE, nullptr, nullptr, nullptr));
+  return file;
+}
+
+}  // namespace
+
+TEST_CASE("read_exif_position: a picture's EXIF GPS tags, hemispheres and altitude below sea level, none without") {
+  const fs::path dubai = exif_jpeg("exif_dubai.jpg", {{"EXIF_GPSLatitude", "(25) (12) (3.6)"},
+                                                      {"EXIF_GPSLatitudeRef", "N"},
+                                                      {"EXIF_GPSLongitude", "(55) (18) (12.3456)"},
+                                                      {"EXIF_GPSLongitudeRef", "E"},
+                                                      {"EXIF_GPSAltitude", "(51.23)"},
+                                                      {"EXIF_GPSAltitudeRef", "0x00"}});
+  const auto p = read_exif_position(dubai);
+  REQUIRE(p.has_value());
+  CHECK(p->latitude_deg == doctest::Approx(25.0 + 12.0 / 60.0 + 3.6 / 3600.0).epsilon(1e-12));
+  CHECK(p->longitude_deg == doctest::Approx(55.0 + 18.0 / 60.0 + 12.3456 / 3600.0).epsilon(1e-12));
+  REQUIRE(p->altitude_msl_m.has_value());
+  CHECK(*p->altitude_msl_m == doctest::Approx(51.23));
+
+  const fs::path south = exif_jpeg("exif_dead_sea.jpg", {{"EXIF_GPSLatitude", "(31.5) (0) (0)"},
+                                                         {"EXIF_GPSLatitudeRef", "S"},
+                                                         {"EXIF_GPSLongitude", "(35.5) (0) (0)"},
+                                                         {"EXIF_GPSLongitudeRef", "W"},
+                                                         {"EXIF_GPSAltitude", "(430)"},
+                                                         {"EXIF_GPSAltitudeRef", "0x01"}});
+  const auto q = read_exif_position(south);
+  REQUIRE(q.has_value());
+  CHECK(q->latitude_deg == doctest::Approx(-31.5));
+  CHECK(q->longitude_deg == doctest::Approx(-35.5));
+  CHECK(*q->altitude_msl_m == doctest::Approx(-430.0));
+
+  // No GPS tags, or no altitude.
+  CHECK_FALSE(read_exif_position(exif_jpeg("exif_none.jpg", {{"EXIF_Make", "none"}})).has_value());
+  const auto flat = read_exif_position(exif_jpeg("exif_no_alt.jpg", {{"EXIF_GPSLatitude", "(1) (2) (3)"},
+                                                                      {"EXIF_GPSLatitudeRef", "N"},
+                                                                      {"EXIF_GPSLongitude", "(4) (5) (6)"},
+                                                                      {"EXIF_GPSLongitudeRef", "E"}}));
+  REQUIRE(flat.has_value());
+  CHECK_FALSE(flat->altitude_msl_m.has_value());
+
+  // Malformed: refused, naming the file and the tag.
+  const fs::path bad_ref = exif_jpeg("exif_bad_ref.jpg", {{"EXIF_GPSLatitude", "(25) (12) (3.6)"},
+                                                          {"EXIF_GPSLatitudeRef", "E"},
+                                                          {"EXIF_GPSLongitude", "(55) (18) (12)"},
+                                                          {"EXIF_GPSLongitudeRef", "E"}});
+  CHECK_THROWS_WITH_AS((void)read_exif_position(bad_ref),
+                       (bad_ref.string() + ": EXIF EXIF_GPSLatitudeRef 'E' is neither N nor S").c_str(),
+                       std::invalid_argument);
+  const fs::path bad_minutes = exif_jpeg("exif_bad_minutes.jpg", {{"EXIF_GPSLatitude", "(25) (75) (0)"},
+                                                                  {"EXIF_GPSLatitudeRef", "N"},
+                                                                  {"EXIF_GPSLongitude", "(55) (18) (12)"},
+                                                                  {"EXIF_GPSLongitudeRef", "E"}});
+  CHECK_THROWS_WITH_AS((void)read_exif_position(bad_minutes), doctest::Contains("is not degrees, minutes and seconds"),
+                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)read_exif_position(scratch() / "exif_missing.jpg"), doctest::Contains("file not found"),
+                       std::invalid_argument);
 }

@@ -1,14 +1,18 @@
 #include "test_support.hpp"
 
+#include <adaptseg/geo/fence_route.hpp>
 #include <adaptseg/geo/georeference.hpp>
 #include <adaptseg/geo/mission_export.hpp>
+#include <adaptseg/geo/sorties.hpp>
 
 #include <GeographicLib/Geodesic.hpp>
 #include <doctest/doctest.h>
 
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <random>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -536,4 +540,183 @@ TEST_CASE("export: malformed plan and GeoJSON files are rejected, naming the mem
   g = geo;
   g["features"][1]["geometry"]["type"] = "Polygon";
   expect_geo_error(g, "geometry type 'Polygon'");
+}
+
+TEST_CASE("export: each firmware's own camera item, unless one is asked for") {
+  const ExportPath p = sample_path();
+  const auto cameras = [&](const adaptseg::ExportOptions& opt) {
+    std::vector<int> out;
+    for (const MissionItem& item : adaptseg::mission_items(p, opt))
+      if (item.command == 2000 || item.command == 203) out.push_back(item.command);
+    return out;
+  };
+  adaptseg::ExportOptions opt;
+  CHECK(cameras(opt) == std::vector<int>(p.waypoints.size(), 2000));  // PX4: IMAGE_START_CAPTURE
+  opt.firmware_type = adaptseg::mavlink::kAutopilotArduPilot;
+  CHECK(cameras(opt) == std::vector<int>(p.waypoints.size(), 203));  // ArduPilot: DO_DIGICAM_CONTROL
+  opt.camera_trigger = adaptseg::CameraTrigger::image_start_capture;
+  CHECK(cameras(opt) == std::vector<int>(p.waypoints.size(), 2000));
+  opt.firmware_type = adaptseg::mavlink::kAutopilotPx4;
+  opt.camera_trigger = adaptseg::CameraTrigger::digicam_control;
+  CHECK(cameras(opt) == std::vector<int>(p.waypoints.size(), 203));
+  // In the files too: the .plan of an ArduPilot mission triggers with 203.
+  adaptseg::ExportOptions ardupilot;
+  ardupilot.firmware_type = adaptseg::mavlink::kAutopilotArduPilot;
+  const auto plan = adaptseg::read_qgc_plan(adaptseg::write_qgc_plan(p, ardupilot));
+  CHECK(plan.items[3].command == 203);
+  CHECK(adaptseg::read_wpl(adaptseg::write_wpl(p, ardupilot)).items[3].command == 203);
+}
+
+TEST_CASE("export: a mission longer than the firmware stores is refused, naming the count and the limit") {
+  // 250 waypoints: take-off, speed, 250 x (waypoint, camera), RTL = 503 items.
+  const adaptseg::LawnmowerPlanner planner(adaptseg::CameraModel{});
+  const auto path = planner.plan({0.0, 0.0, 250 * 14.4, 10.0}, 3.0);
+  REQUIRE(path.size() == 250);
+  const ExportPath p = adaptseg::make_export_path(path, GeoReference(kGeo), "long");
+  adaptseg::ExportOptions opt;  // PX4: 500
+  CHECK_THROWS_WITH_AS((void)adaptseg::mission_items(p, opt),
+                       doctest::Contains("the mission has 503 mission items (250 waypoints), more than the PX4 limit of 500"),
+                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)adaptseg::write_qgc_plan(p, opt), doctest::Contains("more than the PX4 limit of 500"),
+                       std::invalid_argument);
+  opt.firmware_type = adaptseg::mavlink::kAutopilotArduPilot;  // 717
+  CHECK(adaptseg::mission_items(p, opt).size() == 503);
+  opt.max_mission_items = 400;
+  CHECK_THROWS_WITH_AS((void)adaptseg::write_wpl(p, opt), doctest::Contains("more than max_mission_items 400"),
+                       std::invalid_argument);
+  opt.firmware_type = adaptseg::mavlink::kAutopilotPx4;
+  opt.max_mission_items = 2000;  // a board built with more
+  CHECK(adaptseg::mission_items(p, opt).size() == 503);
+  CHECK(adaptseg::firmware_mission_item_limit(0) == std::nullopt);
+  opt.max_mission_items = 0;
+  CHECK_THROWS_WITH_AS((void)adaptseg::mission_items(p, opt), doctest::Contains("max_mission_items must be > 0"),
+                       std::invalid_argument);
+}
+
+TEST_CASE("export: a geofence goes into the .plan as QGroundControl writes it, and reads back") {
+  ExportPath p = sample_path();
+  const GeoReference geo(kGeo);
+  const auto at = [&](double x, double y) { return geo.to_wgs84({x, y, 0.0}); };
+  adaptseg::GeoFencePolygon outer{true, {at(-5, -5), at(45, -5), at(45, 35), at(-5, 35)}};
+  adaptseg::GeoFencePolygon hole{false, {at(10, 10), at(20, 10), at(15, 20)}};
+  for (auto* f : {&outer, &hole})
+    for (auto& v : f->vertices) v.altitude_m = 0.0;
+  p.geofence = {outer, hole};
+  const std::string text = adaptseg::write_qgc_plan(p);
+  const auto j = nlohmann::json::parse(text);
+  const auto& polygons = j["geoFence"]["polygons"];
+  REQUIRE(polygons.size() == 2);
+  CHECK(j["geoFence"]["version"] == 2);
+  CHECK(j["geoFence"]["circles"].empty());
+  CHECK(polygons[0]["inclusion"] == true);
+  CHECK(polygons[1]["inclusion"] == false);
+  CHECK(polygons[0]["version"] == 1);
+  REQUIRE(polygons[0]["polygon"].size() == 4);  // not closed
+  CHECK(polygons[0]["polygon"][1][0] == outer.vertices[1].latitude_deg);
+  CHECK(polygons[0]["polygon"][1][1] == outer.vertices[1].longitude_deg);
+  const adaptseg::MissionFile back = adaptseg::read_qgc_plan(text);
+  REQUIRE(back.geofence.size() == 2);
+  CHECK(back.geofence[0] == outer);
+  CHECK(back.geofence[1] == hole);
+  // WPL has no place for a fence; the mission is the same.
+  CHECK(adaptseg::read_wpl(adaptseg::write_wpl(p)).items.size() == adaptseg::mission_items(p).size());
+  // Broken fences are refused, both ways.
+  p.geofence = {adaptseg::GeoFencePolygon{true, {at(0, 0), at(1, 0)}}};
+  CHECK_THROWS_WITH_AS((void)adaptseg::write_qgc_plan(p), doctest::Contains("needs at least 3 vertices"),
+                       std::invalid_argument);
+  auto bad = j;
+  bad["geoFence"]["polygons"][0].erase("inclusion");
+  CHECK_THROWS_WITH_AS((void)adaptseg::read_qgc_plan(bad.dump()),
+                       doctest::Contains("geoFence.polygons[0]: missing key 'inclusion'"), std::invalid_argument);
+  // More vertices than the firmware keeps: 64 for PX4 and ArduPilot (63 kept).
+  adaptseg::GeoFencePolygon many{true, {}};
+  for (int k = 0; k < 64; ++k)
+    many.vertices.push_back(at(20 + 30 * std::cos(k * 2 * std::numbers::pi / 64), 15 + 30 * std::sin(k * 2 * std::numbers::pi / 64)));
+  p.geofence = {many};
+  CHECK_THROWS_WITH_AS((void)adaptseg::write_qgc_plan(p), doctest::Contains("the geofence has 64 vertices, more than the PX4 limit of 63"),
+                       std::invalid_argument);
+}
+
+TEST_CASE("export: a via point is flown through, no hold and no image") {
+  ExportPath p = sample_path();
+  p.waypoints[1].via = true;
+  const auto items = adaptseg::mission_items(p);
+  REQUIRE(items.size() == 2 * p.waypoints.size() + 2);
+  CHECK(items[4].command == 16);
+  CHECK(items[4].params[0] == 0.0);  // no hold
+  CHECK(items[5].command == 16);     // the next waypoint: no camera item between
+  CHECK(items[6].command == 2000);
+  CHECK(items[6].params[3] == 2.0);  // the second image
+  const ExportPath back = adaptseg::read_geojson(adaptseg::write_geojson(p));
+  CHECK(back.waypoints[1].via);
+  CHECK_FALSE(back.waypoints[0].via);
+  CHECK(nlohmann::json::parse(adaptseg::write_geojson(p))["features"][2]["properties"]["role"] == "via");
+}
+
+TEST_CASE("sorties: each fits the flight-time limit, in order, and none could take the next waypoint") {
+  const adaptseg::LawnmowerPlanner planner(adaptseg::CameraModel{});
+  const std::vector<adaptseg::Waypoint> path = planner.plan({0.0, 0.0, 80.0, 60.0}, 2.0);  // 9.6 m x 7.2 m footprints
+  REQUIRE(path.size() == 81);
+  const adaptseg::TimingModel timing;
+  const Eigen::Vector3d home(-20.0, -10.0, 0.0);
+  const double limit = 200.0;
+  const auto sorties = adaptseg::split_into_sorties(path, home, timing, 1.0, limit);
+  REQUIRE(sorties.size() > 1);
+  std::size_t next = 0;
+  for (std::size_t k = 0; k < sorties.size(); ++k) {
+    CAPTURE(k);
+    const adaptseg::Sortie& s = sorties[k];
+    CHECK(s.first == next);
+    CHECK(s.end > s.first);
+    const std::span<const adaptseg::Waypoint> part(path.data() + s.first, s.size());
+    CHECK(s.flight_s == doctest::Approx(adaptseg::sortie_flight_s(part, home, timing, 1.0)));
+    CHECK(s.flight_s <= limit);
+    if (s.end < path.size())  // one waypoint more would not fit
+      CHECK(adaptseg::sortie_flight_s(std::span<const adaptseg::Waypoint>(path.data() + s.first, s.size() + 1), home,
+                                      timing, 1.0) > limit);
+    next = s.end;
+  }
+  CHECK(next == path.size());
+  // Take-off straight up, legs, holds, back level and down: one waypoint 30 m above (0, 0).
+  adaptseg::Waypoint w;
+  w.position = {30.0, 40.0, 30.0};
+  const std::vector<adaptseg::Waypoint> one{w};
+  const double up = timing.segment_time_s(Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 30));
+  const double across = timing.segment_time_s(Eigen::Vector3d(0, 0, 30), Eigen::Vector3d(30, 40, 30));
+  CHECK(adaptseg::sortie_flight_s(one, Eigen::Vector3d::Zero(), timing, 2.0) == doctest::Approx(2 * up + 2 * across + 2.0));
+  // Without a limit, one sortie; a waypoint that alone does not fit is named.
+  CHECK(adaptseg::split_into_sorties(path, home, timing, 1.0).size() == 1);
+  CHECK_THROWS_WITH_AS((void)adaptseg::split_into_sorties(one, Eigen::Vector3d::Zero(), timing, 1.0, 30.0),
+                       doctest::Contains("waypoint 0 alone takes 85 s from home and back, more than max_flight_s 30 s"),
+                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)adaptseg::split_into_sorties(path, home, timing, 1.0, 0.0), doctest::Contains("max_flight_s"),
+                       std::invalid_argument);
+}
+
+TEST_CASE("fence route: legs that would leave an L-shaped fence or cross its hole bend at its corners") {
+  // An L (an 80 x 60 m square less its 40 x 30 m upper-right quarter) with a 10 m square hole.
+  const std::vector<Eigen::Vector2d> l{{0, 0}, {80, 0}, {80, 30}, {40, 30}, {40, 60}, {0, 60}};
+  const std::vector<Eigen::Vector2d> hole{{15, 10}, {25, 10}, {25, 20}, {15, 20}};
+  const adaptseg::FenceRouter router({l, hole}, {true, false}, 1.0);
+  CHECK(router.inside({5, 5}));
+  CHECK_FALSE(router.inside({60, 45}));  // the missing quarter
+  CHECK_FALSE(router.inside({20, 15}));  // the hole
+  CHECK(router.route({5, 5}, {75, 5}).empty());  // straight and clear
+  // Across the missing quarter: one bend at its corner (40, 30), on the inside.
+  const auto vias = router.route({70, 25}, {35, 55});
+  REQUIRE(vias.size() == 1);
+  CHECK((vias[0] - Eigen::Vector2d(40, 30)).norm() < 10.0);
+  CHECK(vias[0].x() < 40.0);
+  CHECK(vias[0].y() < 30.0);
+  // Through the hole: around it, every leg clear.
+  const std::vector<Eigen::Vector2d> ends{{5, 15}, {35, 15}};
+  const auto around = router.route(ends[0], ends[1]);
+  REQUIRE(!around.empty());
+  std::vector<Eigen::Vector2d> all{ends[0]};
+  all.insert(all.end(), around.begin(), around.end());
+  all.push_back(ends[1]);
+  for (std::size_t k = 1; k < all.size(); ++k) CHECK(router.clear(all[k - 1], all[k]));
+  CHECK_THROWS_WITH_AS((void)router.route({60, 45}, {5, 5}), doctest::Contains("outside the geofence"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(adaptseg::FenceRouter({{{0, 0}, {1, 0}}}, {true}, 1.0), doctest::Contains("at least 3 vertices"),
+                       std::invalid_argument);
 }

@@ -15,6 +15,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace adaptseg::examples {
@@ -55,13 +56,19 @@ struct ExportCli {
         ->transform(CLI::CheckedTransformer(std::map<std::string, MissionEnd>{{"rtl", MissionEnd::return_to_launch},
                                                                              {"land", MissionEnd::land},
                                                                              {"none", MissionEnd::none}}));
-    app.add_option("--camera-trigger", file_options.camera_trigger,
-                   "the item after every exported waypoint that takes its image: capture "
-                   "(IMAGE_START_CAPTURE, as QGroundControl writes it; default) or digicam "
-                   "(DO_DIGICAM_CONTROL, as Mission Planner writes it)")
+    app.add_option_function<CameraTrigger>(
+           "--camera-trigger", [this](const CameraTrigger& t) { file_options.camera_trigger = t; },
+           "the item after every exported waypoint that takes its image: capture (IMAGE_START_CAPTURE, as "
+           "QGroundControl writes it) or digicam (DO_DIGICAM_CONTROL, as Mission Planner writes it); default: "
+           "the firmware's own, capture for px4 and digicam for ardupilot")
         ->transform(CLI::CheckedTransformer(
             std::map<std::string, CameraTrigger>{{"capture", CameraTrigger::image_start_capture},
                                                  {"digicam", CameraTrigger::digicam_control}}));
+    app.add_option_function<std::size_t>(
+           "--max-mission-items", [this](const std::size_t& n) { file_options.max_mission_items = n; },
+           "the most mission items an exported file may hold (default: the firmware's, px4 500, ardupilot 717; "
+           "raise it for an autopilot configured for more)")
+        ->check(CLI::PositiveNumber);
   }
 
   /// --geo-origin as a FieldGeo, if given.
@@ -86,12 +93,13 @@ struct ExportCli {
     return field;
   }
 
-  /// Throws, before a mission flies, if exporting it would fly above --max-altitude-m: the
-  /// highest waypoint of a mission is its top level's (or a lawnmower's) at `gsd_cm` with
-  /// `camera`; the message names the coarsest GSD that stays below the ceiling.
+  /// Throws, before a mission flies, if exporting it (or, `always`, flying it: adaptseg_live
+  /// --mavlink) would fly above --max-altitude-m: the highest waypoint of a mission is its top
+  /// level's (or a lawnmower's) at `gsd_cm` with `camera`; the message names the coarsest GSD
+  /// that stays below the ceiling.
   /// @throws std::invalid_argument naming the altitude, the ceiling and that GSD.
-  void check_altitude(double gsd_cm, const CameraParams& camera) const {
-    if (formats.empty()) return;
+  void check_altitude(double gsd_cm, const CameraParams& camera, bool always = false) const {
+    if (formats.empty() && !always) return;
     const CameraModel model(camera);
     const double altitude = model.altitude_m(gsd_cm);
     if (altitude <= file_options.max_altitude_m) return;
@@ -111,13 +119,22 @@ struct ExportCli {
 
   /// Writes `path` in every requested format into `out_dir`, flown at `speed_mps`.
   void write(const ExportPath& path, double speed_mps, const std::filesystem::path& out_dir) const {
-    if (formats.empty()) return;
+    for (const auto& [name, text] : files(path, speed_mps, "mission")) write_text(out_dir / name, text);
+  }
+
+  /// The files of `path` in every requested format, `stem` with each format's extension, flown at
+  /// `speed_mps`: (file name, text), made before any is written so that a refused mission
+  /// (too many items, a fence too large) writes nothing.
+  [[nodiscard]] std::vector<std::pair<std::string, std::string>> files(const ExportPath& path, double speed_mps,
+                                                                       const std::string& stem) const {
+    std::vector<std::pair<std::string, std::string>> out;
     ExportOptions opt = file_options;
     opt.hover_speed_mps = speed_mps;
     for (const std::string& name : std::set<std::string>(formats.begin(), formats.end())) {
       const ExportFormat format = parse_export_format(name);
-      write_text(out_dir / export_file_name(format), write_mission(format, path, opt));
+      out.emplace_back(export_file_name(format, stem), write_mission(format, path, opt));
     }
+    return out;
   }
 };
 

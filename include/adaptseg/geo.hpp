@@ -1,7 +1,8 @@
 #pragma once
 /// @file
 /// Umbrella header of the geo component (CMake target adaptseg::geo; GeographicLib, nlohmann_json):
-/// a field's geo-reference and the export of a mission as a flyable plan.
+/// a field's geo-reference, the export of a mission as a flyable plan, and its split into sorties.
 
 #include <adaptseg/geo/georeference.hpp>
 #include <adaptseg/geo/mission_export.hpp>
+#include <adaptseg/geo/sorties.hpp>

@@ -7,11 +7,14 @@
 /// A mission file is one an autopilot flies from the ground and back: a MAV_CMD_NAV_TAKEOFF
 /// above home to the first waypoint's altitude; every waypoint a MAV_CMD_NAV_WAYPOINT that
 /// holds there (the UAV stops at each waypoint, paper §3.2.1) followed by one camera trigger
-/// (QGroundControl's MAV_CMD_IMAGE_START_CAPTURE of one image, or Mission Planner's
-/// MAV_CMD_DO_DIGICAM_CONTROL); then MAV_CMD_NAV_RETURN_TO_LAUNCH (or a landing at home, or
-/// nothing: ExportOptions). Altitudes are relative (MAV_FRAME_GLOBAL_RELATIVE_ALT): the
-/// waypoint's z, its height above the field plane, on which the UAV takes off (the home
-/// position). Formats and conventions: docs/data_format.md, "Mission export".
+/// (the firmware's own: MAV_CMD_IMAGE_START_CAPTURE of one image for PX4, as QGroundControl
+/// writes "Take photo"; MAV_CMD_DO_DIGICAM_CONTROL for ArduPilot, as Mission Planner writes it);
+/// then MAV_CMD_NAV_RETURN_TO_LAUNCH (or a landing at home, or nothing: ExportOptions).
+/// Altitudes are relative (MAV_FRAME_GLOBAL_RELATIVE_ALT): the waypoint's z, its height above
+/// the field plane, on which the UAV takes off (the home position). A path may carry a geofence
+/// (the .plan's `geoFence`; WPL and GeoJSON have no place for one), and a mission longer than
+/// the firmware stores is refused. Formats and conventions: docs/data_format.md, "Mission
+/// export".
 ///
 /// @code
 /// const adaptseg::GeoReference geo(field);
@@ -66,15 +69,30 @@ struct ExportWaypoint {
   double relative_altitude_m = 0.0;  ///< height above the field plane (= home) [m]: the waypoint's z
   double gsd_cm = 0.0;               ///< GSD of the image taken here [cm/px]
   int level = 0;                     ///< 0: top-level plan; 1 (or more): a descent (sub-lawnmower)
+  /// A via point: flown through without a hold or an image (a leg routed inside the geofence).
+  bool via = false;
 
   friend bool operator==(const ExportWaypoint&, const ExportWaypoint&) = default;
+};
+
+/// One polygon of a geofence: the vehicle must stay inside an inclusion polygon and outside an
+/// exclusion one (QGroundControl's `geoFence.polygons[]`, MAVLink's
+/// MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION / _EXCLUSION, 5001 / 5002).
+struct GeoFencePolygon {
+  bool inclusion = true;          ///< true: stay inside; false: stay outside (a hole of the site)
+  std::vector<GeoPoint> vertices; ///< at least 3, not closed (the first is not repeated); altitudes unused
+
+  friend bool operator==(const GeoFencePolygon&, const GeoFencePolygon&) = default;
 };
 
 /// A path in WGS84, ready to export: built from field-frame waypoints by make_export_path().
 struct ExportPath {
   std::string name;                        ///< the GeoJSON's name (the .plan and WPL formats have no place for it)
-  GeoPoint home;                           ///< take-off: the field frame's origin on the field plane
+  GeoPoint home;                           ///< take-off: the field frame's origin on the field plane (or the caller's)
   std::vector<ExportWaypoint> waypoints;   ///< in visiting order
+  /// The geofence the .plan carries (empty: none). adaptseg_plan gives the site's polygon, its
+  /// holes as exclusion polygons.
+  std::vector<GeoFencePolygon> geofence;
 };
 
 /// What a mission file does after its last waypoint.
@@ -86,15 +104,61 @@ enum class MissionEnd {
 
 /// The mission item that takes each image.
 enum class CameraTrigger {
-  image_start_capture,  ///< MAV_CMD_IMAGE_START_CAPTURE of one image, as QGroundControl writes "Take photo"
-  digicam_control,      ///< MAV_CMD_DO_DIGICAM_CONTROL with shoot = 1, as Mission Planner writes it
+  image_start_capture,  ///< MAV_CMD_IMAGE_START_CAPTURE of one image, as QGroundControl writes "Take photo" (PX4's)
+  digicam_control,      ///< MAV_CMD_DO_DIGICAM_CONTROL with shoot = 1, as Mission Planner writes it (ArduPilot's)
 };
+
+/// The camera item a firmware's own ground station writes into a mission: DO_DIGICAM_CONTROL
+/// for ArduPilot (Mission Planner's "DO_DIGICAM_CONTROL", the item ArduPilot's camera library
+/// has triggered since its first missions; ArduPilot also reads IMAGE_START_CAPTURE since 4.x,
+/// but its users and their cameras expect the digicam item), IMAGE_START_CAPTURE for anything
+/// else (QGroundControl's "Take photo", which PX4 executes through its camera trigger). Not
+/// DO_SET_CAM_TRIGG_DIST: that triggers by distance flown through, while the UAV here stops at
+/// every waypoint and takes exactly one image there (paper §3.2.1).
+[[nodiscard]] constexpr CameraTrigger firmware_camera_trigger(int firmware_type) noexcept {
+  return firmware_type == mavlink::kAutopilotArduPilot ? CameraTrigger::digicam_control
+                                                       : CameraTrigger::image_start_capture;
+}
+
+/// How many mission items a firmware stores, in its default configuration (the home position
+/// not counted); nullopt for a firmware adaptseg knows no limit of.
+/// - PX4: 500, `CONFIG_NUM_MISSION_ITMES_SUPPORTED` (dataman's mission storage; 2000 before
+///   PX4 v1.13, PX4-Autopilot pull request 18827, "reduce NUM_MISSIONS_SUPPORTED from 2000->500";
+///   a board may be built with more).
+/// - ArduPilot: 717, Copter on a board with 16 KB of storage (libraries/StorageManager/
+///   StorageManager.cpp: "On Pixhawk this gives 718 waypoints", 15 bytes per command,
+///   AP_Mission.h `AP_MISSION_EEPROM_COMMAND_SIZE`, command 0 being home); more with
+///   BRD_SD_MISSION (mission storage on the SD card).
+/// An autopilot configured for more: ExportOptions::max_mission_items.
+[[nodiscard]] constexpr std::optional<std::size_t> firmware_mission_item_limit(int firmware_type) noexcept {
+  if (firmware_type == mavlink::kAutopilotPx4) return 500;
+  if (firmware_type == mavlink::kAutopilotArduPilot) return 717;
+  return std::nullopt;
+}
+
+/// How many geofence vertices a .plan for `firmware_type` may carry (all polygons together):
+/// 63 for PX4 (dataman's `DM_KEY_FENCE_POINTS_MAX` 64, one slot of which holds the fence's
+/// statistics in the PX4 releases that keep it there) and, as the same conservative bound, for
+/// ArduPilot (about 70 fence points on a Copter with 16 KB of storage, StorageManager.cpp, less
+/// the polygon loader's headers); nullopt for a firmware adaptseg knows no limit of.
+[[nodiscard]] constexpr std::optional<std::size_t> firmware_fence_vertex_limit(int firmware_type) noexcept {
+  if (firmware_type == mavlink::kAutopilotPx4 || firmware_type == mavlink::kAutopilotArduPilot) return 63;
+  return std::nullopt;
+}
+
+/// A firmware's name for messages: "PX4", "ArduPilot", or "firmware N".
+inline std::string firmware_name(int firmware_type) {
+  if (firmware_type == mavlink::kAutopilotPx4) return "PX4";
+  if (firmware_type == mavlink::kAutopilotArduPilot) return "ArduPilot";
+  return "firmware " + std::to_string(firmware_type);
+}
 
 /// Settings of the mission files.
 struct ExportOptions {
   double hold_s = 1.0;              ///< hold time at every waypoint before the image [s] (NAV_WAYPOINT param1)
   bool capture_images = true;       ///< a camera trigger after every waypoint
-  CameraTrigger camera_trigger = CameraTrigger::image_start_capture;  ///< which item triggers the camera
+  /// Which item triggers the camera; empty: the firmware's own (firmware_camera_trigger()).
+  std::optional<CameraTrigger> camera_trigger;
   bool takeoff = true;              ///< a NAV_TAKEOFF at home to the first waypoint's altitude, first
   MissionEnd end = MissionEnd::return_to_launch;  ///< the item after the last waypoint
   /// Multicopter speed [m/s]: .plan `hoverSpeed`, and the DO_CHANGE_SPEED item (`set_speed`);
@@ -109,6 +173,13 @@ struct ExportOptions {
   double cruise_speed_mps = 15.0;   ///< fixed-wing speed [m/s] (.plan `cruiseSpeed`, required by QGC)
   int firmware_type = mavlink::kAutopilotPx4;  ///< MAV_AUTOPILOT of the .plan (mavlink::kAutopilotArduPilot: 3)
   int vehicle_type = mavlink::kTypeQuadrotor;  ///< MAV_TYPE of the .plan
+  /// The most mission items a file may hold; empty: the firmware's (firmware_mission_item_limit()).
+  std::optional<std::size_t> max_mission_items;
+
+  /// The camera item: `camera_trigger`, or the firmware's own.
+  [[nodiscard]] CameraTrigger trigger() const noexcept {
+    return camera_trigger.value_or(firmware_camera_trigger(firmware_type));
+  }
 
   /// @throws std::invalid_argument naming the first invalid member.
   void validate() const {
@@ -122,9 +193,10 @@ struct ExportOptions {
                     vehicle_type);
     detail::require(end == MissionEnd::return_to_launch || end == MissionEnd::land || end == MissionEnd::none,
                     "ExportOptions: end must be a MissionEnd", static_cast<int>(end));
-    detail::require(camera_trigger == CameraTrigger::image_start_capture ||
-                        camera_trigger == CameraTrigger::digicam_control,
-                    "ExportOptions: camera_trigger must be a CameraTrigger", static_cast<int>(camera_trigger));
+    detail::require(trigger() == CameraTrigger::image_start_capture || trigger() == CameraTrigger::digicam_control,
+                    "ExportOptions: camera_trigger must be a CameraTrigger", static_cast<int>(trigger()));
+    detail::require(!max_mission_items || *max_mission_items > 0, "ExportOptions: max_mission_items must be > 0",
+                    max_mission_items.value_or(0));
   }
 };
 
@@ -140,6 +212,7 @@ struct MissionItem {
 struct MissionFile {
   GeoPoint home;  ///< .plan `plannedHomePosition`; WPL line 0
   std::vector<MissionItem> items;
+  std::vector<GeoFencePolygon> geofence;  ///< .plan `geoFence.polygons` (a WPL file has none)
 };
 
 /// The file formats.
@@ -168,6 +241,13 @@ inline std::string export_file_name(ExportFormat format) {
   throw std::invalid_argument("export_file_name: invalid ExportFormat");
 }
 
+/// `stem` with a format's extension: mission-2.plan, mission-2.waypoints, mission-2.geojson (one
+/// file per sortie of a split survey).
+inline std::string export_file_name(ExportFormat format, const std::string& stem) {
+  const std::string name = export_file_name(format);
+  return stem + name.substr(name.find('.'));
+}
+
 /// A field-frame path in WGS84: each waypoint's (x, y) through `geo`, its z as the relative
 /// altitude; `levels[i]` is waypoint i's level (0 top-level, 1 descent). Home is the field
 /// frame's origin at the field plane's height (`FieldGeo::altitude_m`).
@@ -192,7 +272,7 @@ inline ExportPath make_export_path(const std::vector<Waypoint>& path, const std:
     const GeoPoint g = geo.to_wgs84(p);
     // Altitudes to the centimetre: 165.00000000001054 m is what a GSD's arithmetic gives, not
     // what an autopilot should be told.
-    out.waypoints.push_back({g.latitude_deg, g.longitude_deg, std::round(p.z() * 100.0) / 100.0, path[i].gsd_cm, levels[i]});
+    out.waypoints.push_back({g.latitude_deg, g.longitude_deg, std::round(p.z() * 100.0) / 100.0, path[i].gsd_cm, levels[i], false});
   }
   return out;
 }
@@ -217,12 +297,15 @@ inline ExportPath make_export_path(const MissionResult& result, const GeoReferen
 /// have a position (yaw NaN: the autopilot's yaw mode):
 /// - if `takeoff`, a NAV_TAKEOFF at home (pitch 0) to the first waypoint's altitude;
 /// - if `set_speed`, a DO_CHANGE_SPEED to `hover_speed_mps` (ground speed, throttle unchanged);
-/// - per waypoint a NAV_WAYPOINT holding `hold_s`, then, if `capture_images`, one camera
-///   trigger: an IMAGE_START_CAPTURE of one image (all cameras, sequence 1, 2, ...) or a
-///   DO_DIGICAM_CONTROL with shoot = 1;
+/// - per waypoint a NAV_WAYPOINT holding `hold_s` (a via point: 0 s, and no image), then, if
+///   `capture_images`, one camera trigger: an IMAGE_START_CAPTURE of one image (all cameras,
+///   sequence 1, 2, ...) or a
+///   DO_DIGICAM_CONTROL with shoot = 1 (ExportOptions::trigger(): the firmware's own unless set);
 /// - `end`: a RETURN_TO_LAUNCH, a NAV_LAND at home, or nothing.
 /// @throws std::invalid_argument for invalid options, a take-off with the first waypoint not
-///         above home, or a waypoint above `max_altitude_m`.
+///         above home, a waypoint above `max_altitude_m`, or more items than the firmware
+///         stores (ExportOptions::max_mission_items, firmware_mission_item_limit()), naming the
+///         count and the limit.
 inline std::vector<MissionItem> mission_items(const ExportPath& path, const ExportOptions& options = {}) {
   options.validate();
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -247,10 +330,10 @@ inline std::vector<MissionItem> mission_items(const ExportPath& path, const Expo
   int sequence = 0;
   for (const auto& w : path.waypoints) {
     items.push_back({mavlink::kCmdNavWaypoint, mavlink::kFrameGlobalRelativeAlt,
-                     {options.hold_s, 0.0, 0.0, kNaN, w.latitude_deg, w.longitude_deg, w.relative_altitude_m},
+                     {w.via ? 0.0 : options.hold_s, 0.0, 0.0, kNaN, w.latitude_deg, w.longitude_deg, w.relative_altitude_m},
                      true});
-    if (!options.capture_images) continue;
-    if (options.camera_trigger == CameraTrigger::image_start_capture)
+    if (!options.capture_images || w.via) continue;
+    if (options.trigger() == CameraTrigger::image_start_capture)
       items.push_back({mavlink::kCmdImageStartCapture, mavlink::kFrameMission,
                        {0.0, 0.0, 1.0, static_cast<double>(++sequence), kNaN, kNaN, kNaN},
                        true});
@@ -264,6 +347,14 @@ inline std::vector<MissionItem> mission_items(const ExportPath& path, const Expo
     items.push_back({mavlink::kCmdNavLand, mavlink::kFrameGlobalRelativeAlt,
                      {0.0, 0.0, 0.0, kNaN, path.home.latitude_deg, path.home.longitude_deg, 0.0},
                      true});
+  if (const auto limit = options.max_mission_items ? options.max_mission_items
+                                                   : firmware_mission_item_limit(options.firmware_type);
+      limit && items.size() > *limit)
+    throw std::invalid_argument("mission_items: the mission has " + std::to_string(items.size()) +
+                                " mission items (" + std::to_string(path.waypoints.size()) + " waypoints), more than " +
+                                (options.max_mission_items ? std::string("max_mission_items ")
+                                                           : "the " + firmware_name(options.firmware_type) + " limit of ") +
+                                std::to_string(*limit) + ": split it into sorties, or fly fewer waypoints");
   return items;
 }
 
@@ -304,12 +395,45 @@ inline void check_item_position(const MissionItem& item, const char* format, con
 
 /// The QGroundControl plan file of `path` (QGC developer guide, "Plan File Format":
 /// `fileType` "Plan", `version` 1, `mission` version 2 with `plannedHomePosition`
-/// [lat, lon, alt] and `SimpleItem`s; empty `geoFence` and `rallyPoints`). Waypoint items carry
-/// QGC's altitude keys (`Altitude`, `AltitudeMode` 1 = relative, `AMSLAltAboveTerrain` null);
-/// NaN parameters are written as null, as QGC does.
-/// @throws std::invalid_argument for an empty path or invalid options.
+/// [lat, lon, alt] and `SimpleItem`s; `geoFence` version 2 with the path's geofence, empty
+/// `rallyPoints`). Waypoint items carry QGC's altitude keys (`Altitude`, `AltitudeMode` 1 =
+/// relative, `AMSLAltAboveTerrain` null); NaN parameters are written as null, as QGC does. Each
+/// fence polygon is `{"inclusion": bool, "polygon": [[lat, lon], ...], "version": 1}`, as QGC's
+/// QGCFencePolygon::saveToJson writes it (src/MissionManager/QGCFencePolygon.cc: the version key,
+/// `inclusion`, then QGCMapPolygon's `polygon` of [latitude, longitude] pairs, not closed).
+/// @throws std::invalid_argument for an empty path, invalid options, a fence polygon of fewer
+///         than 3 vertices or outside the coordinate ranges, more fence vertices than the
+///         firmware keeps (firmware_fence_vertex_limit()), or as mission_items().
 inline std::string write_qgc_plan(const ExportPath& path, const ExportOptions& options = {}) {
   detail::require_exportable(path, "write_qgc_plan");
+  using fence_json = nlohmann::ordered_json;
+  fence_json polygons = fence_json::array();
+  std::size_t fence_vertices = 0;
+  for (std::size_t k = 0; k < path.geofence.size(); ++k) {
+    const GeoFencePolygon& f = path.geofence[k];
+    detail::require(f.vertices.size() >= 3,
+                    "write_qgc_plan: geofence polygon " + std::to_string(k) + " needs at least 3 vertices; vertices",
+                    f.vertices.size());
+    fence_json ring = fence_json::array();
+    for (const GeoPoint& v : f.vertices) {
+      detail::require(std::isfinite(v.latitude_deg) && std::abs(v.latitude_deg) <= 90.0 &&
+                          std::isfinite(v.longitude_deg) && std::abs(v.longitude_deg) <= 180.0,
+                      "write_qgc_plan: geofence polygon " + std::to_string(k) +
+                          " has a vertex outside latitude [-90, 90], longitude [-180, 180]; latitude",
+                      v.latitude_deg);
+      ring.push_back(fence_json::array({v.latitude_deg, v.longitude_deg}));
+    }
+    fence_vertices += f.vertices.size();
+    fence_json poly = fence_json::object();
+    poly["inclusion"] = f.inclusion;
+    poly["polygon"] = std::move(ring);
+    poly["version"] = 1;
+    polygons.push_back(std::move(poly));
+  }
+  if (const auto limit = firmware_fence_vertex_limit(options.firmware_type); limit && fence_vertices > *limit)
+    throw std::invalid_argument("write_qgc_plan: the geofence has " + std::to_string(fence_vertices) +
+                                " vertices, more than the " + firmware_name(options.firmware_type) + " limit of " +
+                                std::to_string(*limit) + ": simplify its polygons");
   using nlohmann::ordered_json;
   ordered_json items = ordered_json::array();
   int jump_id = 0;
@@ -341,7 +465,7 @@ inline std::string write_qgc_plan(const ExportPath& path, const ExportOptions& o
   mission["version"] = 2;
   ordered_json plan = ordered_json::object();
   plan["fileType"] = "Plan";
-  plan["geoFence"] = {{"circles", ordered_json::array()}, {"polygons", ordered_json::array()}, {"version", 2}};
+  plan["geoFence"] = {{"circles", ordered_json::array()}, {"polygons", std::move(polygons)}, {"version", 2}};
   plan["groundStation"] = "adaptseg";
   plan["mission"] = std::move(mission);
   plan["rallyPoints"] = {{"points", ordered_json::array()}, {"version", 2}};
@@ -349,10 +473,12 @@ inline std::string write_qgc_plan(const ExportPath& path, const ExportOptions& o
   return plan.dump(2) + "\n";
 }
 
-/// Reads a QGroundControl plan file: its home position and mission items (`SimpleItem`s;
-/// null parameters read as NaN).
+/// Reads a QGroundControl plan file: its home position, mission items (`SimpleItem`s; null
+/// parameters read as NaN) and geofence polygons (`geoFence` is optional; its circles are not
+/// read).
 /// @throws std::invalid_argument naming the offending member: not JSON, not a plan, a
-///         missing or mistyped key, a complex item, a position out of range.
+///         missing or mistyped key, a complex item, a position out of range, a fence polygon
+///         of fewer than 3 vertices.
 inline MissionFile read_qgc_plan(std::string_view text) {
   constexpr const char* kFmt = "QGC plan";
   const nlohmann::json plan = detail::json_parse(text, kFmt);
@@ -392,6 +518,31 @@ inline MissionFile read_qgc_plan(std::string_view text) {
                                                                  where + ".params[" + std::to_string(k) + "]");
     detail::check_item_position(item, kFmt, where);
     out.items.push_back(item);
+  }
+  if (plan.contains("geoFence")) {
+    const nlohmann::json& fence = plan["geoFence"];
+    if (!fence.is_object()) detail::export_parse_error(kFmt, "geoFence must be an object");
+    if (fence.contains("polygons")) {
+      const nlohmann::json& polygons = fence["polygons"];
+      if (!polygons.is_array()) detail::export_parse_error(kFmt, "geoFence.polygons must be an array");
+      for (std::size_t k = 0; k < polygons.size(); ++k) {
+        const std::string where = "geoFence.polygons[" + std::to_string(k) + "]";
+        const nlohmann::json& inclusion = detail::json_member(polygons[k], "inclusion", kFmt, where);
+        if (!inclusion.is_boolean()) detail::export_parse_error(kFmt, where + ".inclusion must be true or false");
+        const nlohmann::json& ring = detail::json_member(polygons[k], "polygon", kFmt, where);
+        if (!ring.is_array() || ring.size() < 3)
+          detail::export_parse_error(kFmt, where + ".polygon must be an array of at least 3 [latitude, longitude]");
+        GeoFencePolygon f;
+        f.inclusion = inclusion.get<bool>();
+        for (std::size_t i = 0; i < ring.size(); ++i) {
+          const std::string vwhere = where + ".polygon[" + std::to_string(i) + "]";
+          if (!ring[i].is_array() || ring[i].size() != 2)
+            detail::export_parse_error(kFmt, vwhere + " must be [latitude, longitude]");
+          f.vertices.push_back(detail::json_position(nlohmann::json::array({ring[i][1], ring[i][0], 0.0}), kFmt, vwhere));
+        }
+        out.geofence.push_back(std::move(f));
+      }
+    }
   }
   return out;
 }
@@ -499,7 +650,7 @@ inline MissionFile read_wpl(std::string_view text) {
 
 /// The GeoJSON (RFC 7946) of `path`: a FeatureCollection with the path as a LineString
 /// (properties `kind` "path", `waypoints`), then one Point per waypoint (properties `kind`
-/// "waypoint", `index`, `level`, `role` "top-level" or "descent", `gsd_cm`,
+/// "waypoint", `index`, `level`, `role` "top-level", "descent" or "via" (no image), `gsd_cm`,
 /// `relative_altitude_m`). Positions are [longitude, latitude, height] with the height, as
 /// RFC 7946 requires, above the WGS84 ellipsoid: home altitude + relative altitude. A path of
 /// one waypoint gives a LineString of that position twice (a LineString needs two). Foreign
@@ -525,7 +676,7 @@ inline std::string write_geojson(const ExportPath& path) {
                          {{"kind", "waypoint"},
                           {"index", i},
                           {"level", w.level},
-                          {"role", w.level == 0 ? "top-level" : "descent"},
+                          {"role", w.via ? "via" : w.level == 0 ? "top-level" : "descent"},
                           {"gsd_cm", w.gsd_cm},
                           {"relative_altitude_m", w.relative_altitude_m}}},
                         {"geometry", {{"type", "Point"}, {"coordinates", position(w)}}}});
@@ -585,6 +736,7 @@ inline ExportPath read_geojson(std::string_view text) {
       w.gsd_cm = detail::json_number(detail::json_member(props, "gsd_cm", kFmt, pwhere), kFmt, pwhere + ".gsd_cm");
       w.relative_altitude_m = detail::json_number(detail::json_member(props, "relative_altitude_m", kFmt, pwhere),
                                                   kFmt, pwhere + ".relative_altitude_m");
+      w.via = props.contains("role") && props["role"] == "via";
       if (!points.emplace(index, std::make_pair(w, g)).second)
         detail::export_parse_error(kFmt, pwhere + ".index " + std::to_string(index) + " appears twice");
     } else {
