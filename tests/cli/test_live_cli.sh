@@ -3,7 +3,7 @@
 # images from a small region of the bundled WeedMap field, fly the planner over it step by
 # step, and check that it visits exactly the waypoints adaptseg_mission visits in simulation
 # with the same model on the same region; a folder lacking a requested image is an error.
-# Then the georeferenced loop (issue 33): GNSS poses on a geo-referenced area, the same area
+# Then the georeferenced loop: GNSS poses on a geo-referenced area, the same area
 # given as a GeoJSON polygon (--area), and a loop that stops on a missing image leaving what it
 # flew in --out.
 #   test_live_cli.sh LIVE_BINARY MISSION_BINARY CALIBRATE_BINARY EXAMPLES_DIR PYTHON gdal|nogdal
@@ -103,23 +103,7 @@ wide="$field:0,0.5,1,0.75"
   --geo-origin 47.4,8.5,500,30 >/dev/null || fail "recording GNSS poses"
 head -1 "$work/gnss/poses.csv" | grep -qx "file,latitude_deg,longitude_deg,relative_altitude_m,heading_deg" ||
   fail "GNSS poses.csv header: $(head -1 "$work/gnss/poses.csv")"
-"$python" - "$work" <<'PY' || fail "writing the area polygon"
-import json, math, sys, yaml
-work = sys.argv[1]
-info = yaml.safe_load(open(f"{work}/gnss/area.yaml"))
-g, a = info["geo"], info["area_m"]
-def wgs84(x, y):  # first-order WGS84 tangent plane: ~1e-9 deg over this area
-    lat0, lon0, h = g["latitude_deg"], g["longitude_deg"], math.radians(g["heading_deg"])
-    x, y = x - g["anchor_x_m"], y - g["anchor_y_m"]
-    east, north = x * math.sin(h) - y * math.cos(h), x * math.cos(h) + y * math.sin(h)
-    A, e2 = 6378137.0, 6.69437999014e-3
-    s = math.sin(math.radians(lat0))
-    m, n = A * (1 - e2) / (1 - e2 * s * s) ** 1.5, A / math.sqrt(1 - e2 * s * s)
-    return [lon0 + math.degrees(east / (n * math.cos(math.radians(lat0)))), lat0 + math.degrees(north / m)]
-ring = [wgs84(a[0], a[1]), wgs84(a[2], a[1]), wgs84(a[2], a[3]), wgs84(a[0], a[3]), wgs84(a[0], a[1])]
-json.dump({"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {},
-           "geometry": {"type": "Polygon", "coordinates": [ring]}}]}, open(f"{work}/wide.geojson", "w"))
-PY
+"$python" "$(dirname "$0")/area_polygon.py" "$work/gnss" "$work/wide.geojson" || fail "writing the area polygon"
 "$live" --images "$work/frame" --model "$work/model.yaml" "${times[@]}" --out "$work/live-frame" >/dev/null ||
   fail "live, frame poses"
 "$live" --images "$work/gnss" --model "$work/model.yaml" "${times[@]}" --out "$work/live-gnss" >/dev/null ||

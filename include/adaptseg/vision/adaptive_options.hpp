@@ -21,14 +21,18 @@
 
 namespace adaptseg {
 
-/// Where the top-level lawnmower's grid is laid on the area.
+/// Where the top-level lawnmower's grid is laid on the area, and each descent's sub-lawnmower on
+/// its region.
 enum class GridAnchor {
   /// From the area's corner (x_min, y_min), the whole overhang of the last column and row on the
-  /// far sides (the paper's grid, LawnmowerPlanner::plan).
+  /// far sides (the paper's grid, LawnmowerPlanner::plan); a sub-lawnmower from its region's
+  /// corner nearest the UAV.
   corner,
   /// Centred on the area, the overhang split evenly between opposite sides, so that every
   /// waypoint lies inside the area (LawnmowerPlanner::centred_grid; the grid adaptseg_plan lays
-  /// on a new site, plan_site_survey).
+  /// on a new site, plan_site_survey); a sub-lawnmower centred on the part of its region inside
+  /// the area, so that its waypoints lie inside the area too and the same site in another frame
+  /// (its axes turned half a turn, or the origin moved) asks for the same waypoints on the ground.
   centred,
 };
 
@@ -51,7 +55,8 @@ struct AdaptiveOptions {
   /// of interest (DescentCoverage). A decision model must be calibrated with the same.
   DescentCoverage coverage = DescentCoverage::region;
   /// Where the top-level grid (and the lawnmowers the front-aware rule compares with) is laid on
-  /// the area: a mission time choice, not part of a decision model.
+  /// the area, and each sub-lawnmower on its region: a mission time choice, not part of a
+  /// decision model.
   GridAnchor grid_anchor = GridAnchor::corner;
   /// DescentCoverage::ranked: the decision input whose mass over a cell ranks the cells
   /// (decision_inputs.hpp); a decision model sets the one it was calibrated with.

@@ -289,12 +289,14 @@ class AdaptivePlanner {
   }
 
   /// The sub-lawnmower that re-maps the region of top-level waypoint `top_index` at `gsd_cm`
-  /// (paper §3.2.1 W^{h'}): from the corner nearest that waypoint, cells without field skipped.
+  /// (paper §3.2.1 W^{h'}): its grid laid as AdaptiveOptions::grid_anchor says (from the region's
+  /// corner nearest that waypoint, or centred on the region), visited from the corner nearest
+  /// the waypoint, cells without field skipped.
   /// @throws std::invalid_argument for an index out of range or a GSD that is not positive.
   [[nodiscard]] std::vector<Waypoint> sub_plan(std::size_t top_index, double gsd_cm) const {
     detail::require(top_index < top_.size(), "AdaptivePlanner::sub_plan: top_index out of range", top_index);
     const Waypoint& t = top_[top_index];
-    return LawnmowerPlanner(camera_).plan(t.footprint, gsd_cm, Eigen::Vector2d(t.position.x(), t.position.y()),
+    return LawnmowerPlanner(camera_).plan(sub_grid(t, gsd_cm), gsd_cm, Eigen::Vector2d(t.position.x(), t.position.y()),
                                           keep());
   }
 
@@ -314,7 +316,7 @@ class AdaptivePlanner {
       return valid_pixels(a) > 0 &&
              coverage_.flies(labels, pixel_rect(a) - region.tl(), top_gsd_cm_, area_.map_gsd_cm, options_.mission.interest);
     };
-    return LawnmowerPlanner(camera_).plan(t.footprint, gsd_cm, Eigen::Vector2d(t.position.x(), t.position.y()),
+    return LawnmowerPlanner(camera_).plan(sub_grid(t, gsd_cm), gsd_cm, Eigen::Vector2d(t.position.x(), t.position.y()),
                                           keep_cell);
   }
 
@@ -510,6 +512,22 @@ class AdaptivePlanner {
     const LawnmowerPlanner planner(camera_);
     const Area laid = options_.grid_anchor == GridAnchor::centred ? planner.centred_grid(area_.area, gsd_cm) : area_.area;
     return planner.plan(laid, gsd_cm, Eigen::Vector2d(laid.x_min_m, laid.y_min_m), keep());
+  }
+
+  /// The rectangle a descent's sub-lawnmower at `gsd_cm` is laid on over top-level waypoint
+  /// `t`'s region: the region itself (GridAnchor::corner: the grid grows from the corner nearest
+  /// the waypoint, the region's centre, so which side overhangs is a tie that the frame's axes
+  /// and round-off break), or the grid centred on the part of the region inside the area
+  /// (GridAnchor::centred: every waypoint inside the area, as the top level's, and the same
+  /// waypoints on the ground in any frame of the same site).
+  [[nodiscard]] Area sub_grid(const Waypoint& t, double gsd_cm) const {
+    if (options_.grid_anchor != GridAnchor::centred) return t.footprint;
+    const Area& a = area_.area;
+    const Area inside{std::max(t.footprint.x_min_m, a.x_min_m), std::max(t.footprint.y_min_m, a.y_min_m),
+                      std::min(t.footprint.x_max_m, a.x_max_m), std::min(t.footprint.y_max_m, a.y_max_m)};
+    // A region that does not reach into the area (no cell of it is kept anyway): the region.
+    const bool empty = !(inside.x_max_m > inside.x_min_m && inside.y_max_m > inside.y_min_m);
+    return LawnmowerPlanner(camera_).centred_grid(empty ? t.footprint : inside, gsd_cm);
   }
 
   [[nodiscard]] double segmentation_estimate() const {
