@@ -65,6 +65,7 @@ struct FakeAutopilot {
   double lat = kHomeLat;
   double lon = kHomeLon;
   double rel_alt = 20.0;
+  std::uint16_t heading_cdeg = std::numeric_limits<std::uint16_t>::max();  // GLOBAL_POSITION_INT hdg: unknown
   double speed_mps = 5.0;
   double stop_short_m = 0.0;
   std::optional<mv::LatLonAlt> target;
@@ -210,6 +211,7 @@ struct FakeAutopilot {
       p.lon = static_cast<std::int32_t>(std::lround(lon * 1e7));
       p.relative_alt = static_cast<std::int32_t>(std::lround(rel_alt * 1e3));
       p.alt = static_cast<std::int32_t>(std::lround((rel_alt + kHomeAmsl) * 1e3));
+      p.hdg = heading_cdeg;
       emit(p);
       next_position_s += position_period_s;
     }
@@ -335,6 +337,10 @@ TEST_CASE("link: connect learns the autopilot and asks for its position and GPS 
   CHECK(p.lat_deg == doctest::Approx(kHomeLat));
   CHECK(p.rel_alt_m == doctest::Approx(20.0));
   CHECK(p.home_alt_msl_m() == doctest::Approx(kHomeAmsl));
+  CHECK(std::isnan(p.heading_deg));  // hdg UINT16_MAX: unknown
+  rig.ap->heading_cdeg = 12345;
+  rig.link.poll(rig.link.now() + 0.5);
+  CHECK(rig.link.position().heading_deg == doctest::Approx(123.45));
   // Our heartbeat: a ground station's, system 255, component 190.
   const auto hbs = rig.ap->sent_of<mv::Heartbeat>();
   REQUIRE(!hbs.empty());

@@ -49,6 +49,19 @@ struct ImageSetInfo {
   std::string crs;              ///< `crs:` of area.yaml: the projected CRS of easting/northing poses
 };
 
+/// What area.yaml would say of `field` flown with `model`: its area, classes and geo-reference,
+/// the model's labels of interest and camera (--simulate-camera's area).
+inline ImageSetInfo image_set_info_of(const Field& field, const DecisionModel& model) {
+  ImageSetInfo info;
+  info.name = field.name();
+  info.area = SurveyArea::of(field);
+  info.classes = field.classes();
+  info.interest = model.interest;
+  info.camera = model.camera;
+  info.geo = field.geo();
+  return info;
+}
+
 /// The three forms of poses.csv's header (the optional last column in brackets).
 inline constexpr const char* kPoseHeaders =
     "file,x,y,z[,yaw_deg] (the area's frame [m]), file,latitude_deg,longitude_deg,relative_altitude_m"

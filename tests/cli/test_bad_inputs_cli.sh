@@ -88,7 +88,7 @@ adaptseg_live)
   expect_error "--record-yaw requires --record-from" --images "$work/images" --model "$weedmap_model" --record-yaw 30
   expect_error "--record-yaw: Value 400 not in range" --images "$work/images" --model "$weedmap_model" \
     --record-from "$weedmap" --record-yaw 400
-  # GNSS poses (issue 33): they need a geo-reference, to record and to fly.
+  # GNSS poses: they need a geo-reference, to record and to fly.
   expect_error "--record-gnss requires --record-from" --images "$work/images" --model "$weedmap_model" --record-gnss
   expect_error "--record-gnss needs the field's geo-reference" --images "$work/images" --model "$weedmap_model" \
     --record-from "$weedmap:0.5,0,1,0.5" --record-gnss
@@ -108,6 +108,25 @@ adaptseg_live)
   sed 's/color: \[0, 255, 0\]/color: [0, 256, 0]/' "$work/area.yaml.orig" >"$work/images/area.yaml"
   expect_error "'classes[1].color[1]' must be an integer in [0, 255] (got '256')" --images "$work/images" \
     --model "$weedmap_model"
+  # Flying a vehicle: the camera sources need it, it needs a georeferenced area, the
+  # connection string is checked, and a fence that leaves out waypoints is refused before
+  # anything is sent.
+  quarter="$weedmap:0.5,0,1,0.5"
+  expect_error "give the area to map: --images DIR" --model "$weedmap_model"
+  expect_error "--simulate-camera requires --mavlink" --model "$weedmap_model" --simulate-camera "$quarter"
+  expect_error "--mavlink needs a georeferenced area" --model "$weedmap_model" --mavlink udpin:0 \
+    --simulate-camera "$quarter"
+  expect_error "--camera-folder gives camera images without labels" --model "$weedmap_model" --mavlink udpin:0 \
+    --camera-folder "$work" --images "$work/images"
+  expect_error "--camera-folder requires --mavlink" --model "$weedmap_model" --camera-folder "$work" \
+    --images "$work/images"
+  expect_error "connection 'tcp:5760': unknown scheme 'tcp'; use udpin:[HOST:]PORT" --model "$weedmap_model" \
+    --mavlink tcp:5760 --simulate-camera "$quarter" --geo-origin 47.4,8.5,500,30 --fence-margin-m 10
+  expect_error "waypoints the planner may fly are outside the site's fence" --model "$weedmap_model" \
+    --mavlink udpin:0 --simulate-camera "$quarter" --geo-origin 47.4,8.5,500,30
+  expect_error "the mission would fly 16.5 m above home at 3.00 cm/px, above --max-altitude-m 10.0" \
+    --model "$weedmap_model" --mavlink udpin:0 --simulate-camera "$quarter" --geo-origin 47.4,8.5,500,30 \
+    --max-altitude-m 10
   ;;
 *)
   fail "unknown program $program"

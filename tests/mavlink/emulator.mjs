@@ -18,6 +18,8 @@
 //   --home LAT,LON          home, where the vehicle hovers at the start (default 25.2,55.3)
 //   --home-amsl M           home's altitude above mean sea level    (default 10)
 //   --alt M                 the hover altitude above home at the start (default 20)
+//   --heading DEG           the nose's compass heading GLOBAL_POSITION_INT reports (default: unknown,
+//                           hdg UINT16_MAX)
 //   --speed MPS             horizontal and vertical speed (the timing model's 2 m/s by default)
 //   --accel MPS2            acceleration (default 2)
 //   --land-speed MPS        descent speed when landing (default 1)
@@ -27,6 +29,12 @@
 //   --stop-short M          stop M metres before every reposition target
 //   --no-fix                GPS_RAW_INT fix_type 1 (no fix), no GLOBAL_POSITION_INT
 //   --gcs-timeout S         the GCS failsafe: no GCS HEARTBEAT this long, in flight: RTL (default 5)
+//   --camera-card DIR       a camera's memory card: DIR/card.csv lists its pictures (file,lat,lon,
+//                           each where the camera took it); at every capture the picture nearest the
+//                           vehicle is written into --camera-dir as IMG_NNNN and its extension, as a
+//                           camera (or its download script) writes its pictures where the live loop
+//                           watches (adaptseg_live --camera-folder)
+//   --camera-dir DIR        where --camera-card's pictures are written
 //   --report FILE           on exit (SIGTERM, SIGINT, --max-time), the counts as JSON
 //   --max-time S            exit after S seconds (default 120)
 //
@@ -34,7 +42,8 @@
 // 1 Hz until SET_MESSAGE_INTERVAL asks otherwise; the physics runs at 50 Hz.
 
 import dgram from 'node:dgram';
-import { writeFileSync } from 'node:fs';
+import { copyFileSync, readFileSync, renameSync, writeFileSync } from 'node:fs';
+import { extname, join } from 'node:path';
 import { minimal, common, MavLinkProtocolV2, MavLinkPacketSplitter, MavLinkPacketParser } from 'node-mavlink';
 
 const REGISTRY = { ...minimal.REGISTRY, ...common.REGISTRY };
@@ -42,9 +51,9 @@ const REGISTRY = { ...minimal.REGISTRY, ...common.REGISTRY };
 // ---------------------------------------------------------------- arguments
 function parseArgs(argv) {
   const o = {
-    port: 0, firmware: 'px4', home: [25.2, 55.3], homeAmsl: 10, alt: 20, speed: 2, accel: 2, landSpeed: 1,
+    port: 0, firmware: 'px4', home: [25.2, 55.3], homeAmsl: 10, alt: 20, heading: null, speed: 2, accel: 2, landSpeed: 1,
     drop: 0, seed: 1, loseLinkAfter: Infinity, refuse: [], stopShort: 0, noFix: false, gcsTimeout: 5,
-    report: null, maxTime: 120,
+    report: null, maxTime: 120, cameraCard: null, cameraDir: null,
   };
   for (let i = 2; i < argv.length; i++) {
     const a = argv[i];
@@ -63,6 +72,7 @@ function parseArgs(argv) {
       case '--home': o.home = next().split(',').map(Number); break;
       case '--home-amsl': o.homeAmsl = num(); break;
       case '--alt': o.alt = num(); break;
+      case '--heading': o.heading = num(); break;
       case '--speed': o.speed = num(); break;
       case '--accel': o.accel = num(); break;
       case '--land-speed': o.landSpeed = num(); break;
@@ -74,6 +84,8 @@ function parseArgs(argv) {
       case '--no-fix': o.noFix = true; break;
       case '--gcs-timeout': o.gcsTimeout = num(); break;
       case '--report': o.report = next(); break;
+      case '--camera-card': o.cameraCard = next(); break;
+      case '--camera-dir': o.cameraDir = next(); break;
       case '--max-time': o.maxTime = num(); break;
       default: throw new Error(`unknown option ${a}`);
     }
@@ -81,6 +93,8 @@ function parseArgs(argv) {
   if (!(o.port > 0 && o.port < 65536)) throw new Error('--port PORT is required');
   if (o.firmware !== 'px4' && o.firmware !== 'ardupilot') throw new Error('--firmware must be px4 or ardupilot');
   if (o.home.length !== 2 || !o.home.every(Number.isFinite)) throw new Error('--home must be LAT,LON');
+  if (o.heading !== null && !(o.heading >= 0 && o.heading < 360)) throw new Error('--heading must be in [0, 360)');
+  if ((o.cameraCard === null) !== (o.cameraDir === null)) throw new Error('--camera-card and --camera-dir go together');
   return o;
 }
 
@@ -143,7 +157,7 @@ const v = {
 };
 const counts = {
   firmware: opt.firmware, frames_received: 0, bad_crc: 0, unknown_ids: 0, frames_sent: 0, dropped_in: 0,
-  dropped_out: 0, ignored_after_link_loss: 0, wrong_target: 0, commands: {}, acks: {}, captures: 0,
+  dropped_out: 0, ignored_after_link_loss: 0, wrong_target: 0, commands: {}, acks: {}, captures: 0, pictures: [],
   capture_duplicates: 0, repositions: [], modes: [], failsafe: null, lost_link: false,
   gcs: { sysid: null, compid: null, heartbeats: 0, sequence_gaps: 0 },
 };
@@ -218,7 +232,7 @@ function globalPosition() {
   p.vx = Math.round(v.vn * 100);
   p.vy = Math.round(v.ve * 100);
   p.vz = Math.round(v.vd * 100);
-  p.hdg = 65535;
+  p.hdg = opt.heading === null ? 65535 : Math.round(opt.heading * 100) % 36000;
   send(p);
 }
 
@@ -256,6 +270,27 @@ function statusText(severity, text) {
   s.id = 0;
   s.chunkSeq = 0;
   send(s);
+}
+
+// The memory card of --camera-card: each picture and where it was taken.
+const card = opt.cameraCard === null ? [] : readFileSync(join(opt.cameraCard, 'card.csv'), 'utf8').trim().split('\n')
+  .slice(1).map((line) => {
+    const [file, lat, lon] = line.split(',');
+    return { file, lat: Number(lat), lon: Number(lon) };
+  });
+let pictures = 0;
+
+// A picture taken: the card's nearest the vehicle written into --camera-dir (whole, then renamed,
+// as a camera's download lands).
+function pictureTaken() {
+  if (card.length === 0) return;
+  const k = Math.cos((v.lat * Math.PI) / 180);
+  const d = (p) => (p.lat - v.lat) ** 2 + ((p.lon - v.lon) * k) ** 2;
+  const best = card.reduce((a, b) => (d(b) < d(a) ? b : a));
+  const name = `IMG_${String(pictures++).padStart(4, '0')}${extname(best.file)}`;
+  copyFileSync(join(opt.cameraCard, best.file), join(opt.cameraDir, `.${name}.part`));
+  renameSync(join(opt.cameraDir, `.${name}.part`), join(opt.cameraDir, name));
+  counts.pictures.push(best.file);
 }
 
 function imageCaptured() {
@@ -371,6 +406,7 @@ function onCommand(c, isInt, packet) {
       }
       lastCaptureSequence = sequence;
       counts.captures += 1;
+      pictureTaken();
       imageCaptured();
       return undefined;
     }
@@ -378,6 +414,7 @@ function onCommand(c, isInt, packet) {
       if (PX4) return ack(command, RESULT.UNSUPPORTED, packet);
       if (Math.round(c._param5) !== 1) return ack(command, RESULT.DENIED, packet);
       counts.captures += 1;
+      pictureTaken();
       return ack(command, RESULT.ACCEPTED, packet);
     }
     case CMD.RTL: {

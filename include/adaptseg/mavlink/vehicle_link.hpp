@@ -479,6 +479,7 @@ class VehicleLink {
       p.vn_mps = gp->vx * 1e-2;
       p.ve_mps = gp->vy * 1e-2;
       p.vd_mps = gp->vz * 1e-2;
+      if (gp->hdg != std::numeric_limits<std::uint16_t>::max()) p.heading_deg = gp->hdg * 1e-2;
       p.time_boot_ms = gp->time_boot_ms;
       p.received_s = t;
       position_ = p;

@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -44,6 +45,9 @@ struct VehiclePosition {
   double vn_mps = 0.0;        ///< ground speed north [m/s]
   double ve_mps = 0.0;        ///< ground speed east [m/s]
   double vd_mps = 0.0;        ///< speed down [m/s]
+  /// Heading of the vehicle's nose [deg clockwise from north, 0..360); NaN where the autopilot
+  /// says it is unknown (GLOBAL_POSITION_INT hdg UINT16_MAX).
+  double heading_deg = std::numeric_limits<double>::quiet_NaN();
   std::uint32_t time_boot_ms = 0;  ///< the autopilot's time [ms since boot]
   double received_s = 0.0;    ///< when it arrived [link clock s]
 
