@@ -928,6 +928,58 @@ TEST_CASE("AdaptivePlanner: the budget holds on a slow computer, images and deci
   CHECK(descended >= 40);  // every budget beyond the tightest buys descents
 }
 
+TEST_CASE("AdaptivePlanner: the budget holds on a vehicle's clock, whatever times are fixed") {
+  // A vehicle's mission (adaptseg_live --mavlink) with the segmentation and planning times fixed
+  // as a simulation's: each step costs, beyond the flight model's leg and the fixed 0.1 s, a
+  // random 0-2 s of settling, acknowledgements and wind that no fixed time knows. The clock the
+  // caller reports is the one that counts: every decision and every step of a descent is checked
+  // against it (a descent is cut short where the rest no longer fits), and no mission ends over
+  // its budget.
+  const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
+  OracleSegmenter oracle(f.num_classes());
+  AdaptiveOptions o = options();
+  o.top_gsd_cm = 6.0;
+  o.mission.fixed_segmentation_time_s = 0.1;
+  o.mission.fixed_planning_time_s = 0.0;
+  o.mission.interest = f.interest();
+  const SimulatedSensor sensor(f, CameraModel(o.mission.camera));
+  double coverage_worst = 0.0, everything = 0.0;
+  {
+    Scripted never{.gsd = 0.5}, all{.gsd = 1.0};
+    AdaptiveOptions worst = o;
+    worst.mission.fixed_segmentation_time_s = 2.1;
+    coverage_worst = run_adaptive_mission(f, oracle, never, worst, "never").mission.total_s();
+    everything = run_adaptive_mission(f, oracle, all, o, "all").mission.total_s();
+  }
+  REQUIRE(everything > coverage_worst + 60.0);
+  int over = 0, descended = 0;
+  for (unsigned seed = 0; seed < 20; ++seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> settle(0.0, 2.0);
+    const double budget = coverage_worst + (0.05 + 0.9 * (seed % 10) / 10.0) * (everything - coverage_worst);
+    o.budget_s = budget;
+    Scripted greedy{.gsd = 1.0};
+    AdaptivePlanner<OracleSegmenter, Scripted> planner(SurveyArea::of(f), oracle, greedy, o);
+    double clock = 0.0;
+    std::optional<Eigen::Vector3d> at;
+    while (const auto w = planner.next()) {
+      if (at) clock += planner.timing().segment_time_s(*at, w->waypoint.position);
+      at = w->waypoint.position;
+      clock += settle(rng) + 0.1;
+      const Image image = sensor.capture(w->waypoint);
+      (void)planner.report(image, oracle.segment(image), 0.1, clock);
+    }
+    CAPTURE(seed);
+    CAPTURE(budget);
+    CHECK(clock <= budget);
+    over += clock > budget ? 1 : 0;
+    descended += std::any_of(planner.decisions().begin(), planner.decisions().end(),
+                             [](const DecisionRecord& d) { return d.decision.descend; });
+  }
+  CHECK(over == 0);
+  CHECK(descended >= 12);  // the tightest budgets leave none
+}
+
 TEST_CASE("run_adaptive_mission: a backend and a policy that sleep keep the budget, measured time") {
   // The simulation measures the segmentation and the planner's time with the clock, as a mission
   // flown without fixed times does: both slowed by real sleeps, up to 40 ms each.

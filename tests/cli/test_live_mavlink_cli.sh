@@ -11,6 +11,9 @@
 #   lost       the link lost mid-mission: exit 2, one line, result.json's "stopped" and the map of
 #              what was flown written, no RTL sent (the vehicle is left to its failsafe)
 #   refused    the reposition denied: exit 2 at once, nothing flown, one reposition sent
+#   budget     --budget-s 40 (the mission takes 58.6 s unbounded), the emulator at the timing
+#              model's 2 m/s: the planner, checking each decision and each step of a descent
+#              against the vehicle's clock, descends where it still fits and ends within 40 s
 #   exif       a real camera's way (a quarter of Dubai tile 4, MobileNetV2): the emulator writes,
 #              at each capture, the picture of its memory card nearest the vehicle into the folder
 #              the loop watches (--camera-folder), JPEGs whose EXIF GPS tags lie 0.3 m east of the
@@ -137,12 +140,13 @@ camera=(--mavlink udpin:127.0.0.1:0 --images "$work/dubai" --image-pose exif --s
 fly complete "--home 47.4,8.5" "${weedmap[@]}" --trigger autopilot
 fly lost "--home 47.4,8.5 --lose-link-after 12" "${weedmap[@]}"
 fly refused "--home 47.4,8.5 --refuse 192" "${weedmap[@]}"
+fly budget "--home 47.4,8.5 --speed 2 --accel 2" "${weedmap[@]}" --budget-s 40
 fly exif "--home 25.2,55.3 --camera-card $work/card --camera-dir $work/camera" "${camera[@]}" --camera-folder "$work/camera"
 fly untagged "--home 25.2,55.3 --camera-card $work/plain --camera-dir $work/camera-plain" "${camera[@]}" \
   --camera-folder "$work/camera-plain"
 wait "${pids[@]}"
 pids=()
-for name in complete lost refused exif untagged; do
+for name in complete lost refused budget exif untagged; do
   echo "--- $name: exit code $(cat "$work/$name.rc" 2>/dev/null), $(tail -n 1 "$work/$name.out")"
   cat "$work/$name.err"
 done
@@ -208,6 +212,14 @@ assert refused["images"] == 0 and "refused DO_REPOSITION" in refused["stopped"],
 assert c(refused_report, 192) == 1 and c(refused_report, 20) == 0, refused_report
 PY
 
+[ "$(cat "$work/budget.rc")" = 0 ] || fail "budget: exit code $(cat "$work/budget.rc"), $(cat "$work/budget.err")"
+"$python" - "$work" <<'PY' || fail "the budget flight"
+import json, sys
+r = json.load(open(f"{sys.argv[1]}/budget/result.json"))
+assert r["budget_s"] == 40.0 and r["time_s"]["total"] <= 40.0, r["time_s"]
+assert r["decisions"]["descend"] > 0 and r["decisions"]["budget_limited"] > 0, r["decisions"]
+print(f"budget: {r['images']} images, decisions {r['decisions']}, {r['time_s']['total']:.1f} s of 40 on the vehicle's clock")
+PY
 [ "$(cat "$work/exif.rc")" = 0 ] || fail "camera folder: exit code $(cat "$work/exif.rc"), $(cat "$work/exif.err")"
 [ "$(cat "$work/untagged.rc")" = 2 ] && [ "$(wc -l <"$work/untagged.err")" -eq 1 ] &&
   grep -qE "^adaptseg_live: error: .*/camera-plain/IMG_0000\.jpg: no EXIF GPS position \(--image-pose exif\); fly with --image-pose vehicle" "$work/untagged.err" ||
