@@ -865,6 +865,21 @@ TEST_CASE("AdaptivePlanner: a survey area without a mask covers the rectangle") 
                        std::invalid_argument);
 }
 
+/// A mission on the caller's clock (as a UAV's companion computer keeps it): each leg at the
+/// timing model's time, then `step(waypoint, clock)` takes the image, reports it and advances the
+/// clock by what the step cost. Returns the clock at the end.
+template <typename Planner, typename Step>
+double fly_on_callers_clock(Planner& planner, Step&& step) {
+  double clock = 0.0;
+  std::optional<Eigen::Vector3d> at;
+  while (const auto w = planner.next()) {
+    if (at) clock += planner.timing().segment_time_s(*at, w->waypoint.position);
+    at = w->waypoint.position;
+    step(*w, clock);
+  }
+  return clock;
+}
+
 TEST_CASE("AdaptivePlanner: the budget holds on a slow computer, images and decisions slowed at random") {
   // A caller that keeps the mission clock itself (as a UAV's companion computer does): the flight
   // model's legs, then per image a segmentation of a random 0-300 ms and the planner slowed by
@@ -901,17 +916,13 @@ TEST_CASE("AdaptivePlanner: the budget holds on a slow computer, images and deci
     o.budget_s = budget;
     Scripted greedy{.gsd = 1.0};
     AdaptivePlanner<OracleSegmenter, Scripted> planner(SurveyArea::of(f), oracle, greedy, o);
-    double clock = 0.0;
-    std::optional<Eigen::Vector3d> at;
-    while (const auto w = planner.next()) {
-      if (at) clock += planner.timing().segment_time_s(*at, w->waypoint.position);
-      at = w->waypoint.position;
-      const Image image = sensor.capture(w->waypoint);
+    const double clock = fly_on_callers_clock(planner, [&](const PlannedWaypoint& w, double& now) {
+      const Image image = sensor.capture(w.waypoint);
       const double segmentation_s = slow(rng);
-      clock += segmentation_s;
-      (void)planner.report(image, oracle.segment(image), segmentation_s, clock);
-      clock += slow(rng) + planner.take_planning_s();
-    }
+      now += segmentation_s;
+      (void)planner.report(image, oracle.segment(image), segmentation_s, now);
+      now += slow(rng) + planner.take_planning_s();
+    });
     CAPTURE(seed);
     CAPTURE(budget);
     CHECK(clock <= budget);
@@ -960,15 +971,11 @@ TEST_CASE("AdaptivePlanner: the budget holds on a vehicle's clock, whatever time
     o.budget_s = budget;
     Scripted greedy{.gsd = 1.0};
     AdaptivePlanner<OracleSegmenter, Scripted> planner(SurveyArea::of(f), oracle, greedy, o);
-    double clock = 0.0;
-    std::optional<Eigen::Vector3d> at;
-    while (const auto w = planner.next()) {
-      if (at) clock += planner.timing().segment_time_s(*at, w->waypoint.position);
-      at = w->waypoint.position;
-      clock += settle(rng) + 0.1;
-      const Image image = sensor.capture(w->waypoint);
-      (void)planner.report(image, oracle.segment(image), 0.1, clock);
-    }
+    const double clock = fly_on_callers_clock(planner, [&](const PlannedWaypoint& w, double& now) {
+      now += settle(rng) + 0.1;
+      const Image image = sensor.capture(w.waypoint);
+      (void)planner.report(image, oracle.segment(image), 0.1, now);
+    });
     CAPTURE(seed);
     CAPTURE(budget);
     CHECK(clock <= budget);
