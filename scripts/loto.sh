@@ -29,7 +29,8 @@
 #       networks (examples/models/mobilenetv2-dubai-loto) when their checkpoints are gone.
 #   bash scripts/loto.sh bundle
 #       here, once out/loto/model-<k> exist for k = 1..6 (recipe-cpu, or eval after a device
-#       call): each network's temperature fitted on the tile it never saw (adaptseg_fit_temperature,
+#       call; a tile bundled already, examples/models/mobilenetv2-dubai-loto/tile-<k>, is taken
+#       from there): each network's temperature fitted on the tile it never saw (adaptseg_fit_temperature,
 #       out/loto/temperature-<k>.log), then each bundled with the median of the other five's
 #       (never a temperature fitted on the tile it is tested on) into
 #       examples/models/mobilenetv2-dubai-loto/tile-<k> (model.onnx, model.yaml, its logs and
@@ -163,10 +164,14 @@ bundle)
   cmake --build build/release -j2 --target adaptseg_fit_temperature >/dev/null
   fit=build/release/examples/adaptseg_fit_temperature
   dest=examples/models/mobilenetv2-dubai-loto
-  declare -A fitted
+  declare -A fitted src
+  mkdir -p out/loto
   for k in "${tiles_all[@]}"; do
-    [ -s "out/loto/model-$k/model.onnx" ] || { echo "no out/loto/model-$k: bash $0 recipe-cpu $k (or eval)" >&2; exit 1; }
-    "$fit" --model-file "out/loto/model-$k" --field "examples/data/dubai-tile-$k" --threads 2 >"out/loto/temperature-$k.log"
+    # The network trained here (out/loto/model-k), else the one bundled already (committed).
+    src[$k]=out/loto/model-$k
+    [ -s "${src[$k]}/model.onnx" ] || src[$k]=$dest/tile-$k
+    [ -s "${src[$k]}/model.onnx" ] || { echo "no out/loto/model-$k nor $dest/tile-$k: bash $0 recipe-cpu $k (or eval)" >&2; exit 1; }
+    "$fit" --model-file "${src[$k]}" --field "examples/data/dubai-tile-$k" --threads 2 >"out/loto/temperature-$k.log"
     fitted[$k]=$(sed -n 's/^temperature: \([0-9.]*\).*/\1/p' "out/loto/temperature-$k.log")
     [ -n "${fitted[$k]}" ] || { echo "no temperature in out/loto/temperature-$k.log" >&2; exit 1; }
   done
@@ -178,8 +183,11 @@ bundle)
     for j in "${tiles_all[@]}"; do [ "$j" = "$k" ] || others+=("${fitted[$j]}"); done
     t=$(median "${others[@]}")
     mkdir -p "$dest/tile-$k"
-    for f in model.onnx model.yaml train_log.csv val_log.csv val_ema_log.csv; do cp "out/loto/model-$k/$f" "$dest/tile-$k/"; done
-    cp "out/loto/eval-$k.json" "$dest/tile-$k/held_out_eval.json"
+    if [ "${src[$k]}" != "$dest/tile-$k" ]; then
+      for f in model.onnx model.yaml train_log.csv val_log.csv val_ema_log.csv; do cp "out/loto/model-$k/$f" "$dest/tile-$k/"; done
+      cp "out/loto/eval-$k.json" "$dest/tile-$k/held_out_eval.json"
+      [ ! -f "out/loto/train-$k.log" ] || cp "out/loto/train-$k.log" "$dest/tile-$k/train.log"
+    fi
     "$fit" --model-file "$dest/tile-$k" --set "$t" >/dev/null
     echo "dubai-tile-$k,${fitted[$k]},$t" >>"$dest/temperatures.csv"
   done
