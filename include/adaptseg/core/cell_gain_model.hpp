@@ -27,9 +27,8 @@ namespace adaptseg {
 
 /// How the cell gain model's slopes β and α pool the training fields (CellGainModel::fit):
 /// - `cells`: one weighted least-squares fit over every field's cells together. A field weighs
-///   by its cells' Σ w·x², so the field where the input is largest sets the slope (MobileNetV2's
-///   vegetation on the bundled Dubai tiles: tile 6, 86 % of that weight, whose cells lose when
-///   re-mapped, made β(15, 10) negative while the best cells of every training field gained).
+///   by its cells' Σ w·x², so the field where the input is largest sets the slope, whether or not
+///   the other fields agree (docs/method.md, "Cells that pay", has a bundled case).
 /// - `fields`: each field's own slope, pooled as random effects (DerSimonian and Laird 1986):
 ///   by the fields' precision where they agree within their cells' scatter, alike where they
 ///   disagree beyond it. A new field is one more field, not more cells of the training fields'.

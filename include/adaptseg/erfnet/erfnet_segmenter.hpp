@@ -88,9 +88,9 @@ struct ErfnetParams {
   /// Test-time mirror: true runs the network on the image and on its left-right mirror and takes
   /// the mean of the two probability maps (the mirror's flipped back), labels being the mean's
   /// argmax; two forward passes per image. A network trained with mirrored images (as
-  /// train_segnet.py's augmentations do) answers both, and their mean is the better map: the
-  /// bundled MobileNetV2's field mIoU rose by 0.007-0.016 on tiles 4 and 6
-  /// (examples/models/ensemble-dubai/README.md). logits() stays one pass.
+  /// train_segnet.py's augmentations do) answers both, and their mean is usually the better map
+  /// (measured: examples/models/ensemble-dubai/README.md, "Test-time mirror"). logits() stays one
+  /// pass.
   bool test_time_mirror = false;
   /// 1..256: `cv::setNumThreads(num_threads)` at construction. NOTE: this is OpenCV's
   /// process-wide thread count and affects all OpenCV calls. 0: leave it unchanged.

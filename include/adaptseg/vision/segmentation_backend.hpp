@@ -45,8 +45,8 @@ concept SegmentationBackend = SegmentsImages<B> && NamedBackend<B>;
 /// Optionally, a backend says how sure it is: `segment_with_probabilities(image)` returns the
 /// labels `segment(image)` would give together with per-pixel class probabilities (Segmentation).
 /// Rationale: where a network hesitates is where flying lower can change its map (docs/method.md,
-/// "Decision inputs"); a labels-only backend still flies, with the decision inputs that need no
-/// probabilities.
+/// "Cells that pay", its decision inputs); a labels-only backend still flies, with the decision
+/// inputs that need no probabilities.
 ///
 /// Contract, beyond SegmentationBackend's: the labels equal `segment(image)`'s; `probabilities`
 /// holds one CV_32FC1 plane per class of the image's size, in [0, 1], summing to 1 on every

@@ -377,10 +377,8 @@ ADAPTSEG_GP_DISPATCHED(void, gp_gram, (const double* xt, double* a, Eigen::Index
 
 /// Largest n for which a likelihood evaluation uses the kernels above. They are not blocked
 /// for the cache: each 4-column step streams the triangle once, so beyond a few hundred rows
-/// Eigen's blocked LLT and the recursive triangular inverse/Gram product are faster. The
-/// crossovers, measured on one AVX-512 machine (per evaluation, old = Eigen path):
-/// AVX-512 n = 500: 10 ms vs 22 ms, n = 1000: 172 ms vs 143 ms; baseline n = 300: 8 ms vs
-/// 12 ms, n = 500: 30 ms vs 22 ms. AVX2 was not measured (half the AVX-512 width: in between).
+/// Eigen's blocked LLT and the recursive triangular inverse/Gram product are faster. The limits
+/// are measured crossovers (docs/benchmarks.md, "Design notes that matter for speed").
 [[nodiscard]] inline Eigen::Index gp_dense_kernel_limit() {
   switch (gp_simd_level()) {
     case 2: return 768;
