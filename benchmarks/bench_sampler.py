@@ -84,7 +84,7 @@ def main(argv=None):
     dev_name = torch.cuda.get_device_name(device) if device.type == "cuda" else "cpu"
     print(f"device {dev_name}, PyTorch {torch.__version__}, batch {args.batch}, {args.rounds} rounds of "
           f"{args.batches} batches, {args.threads} thread(s)")
-    print(f"| recipe | sampler | ms per batch | crops/s |\n| --- | --- | ---: | ---: |")
+    print("| recipe | sampler | ms per batch | crops/s |\n| --- | --- | ---: | ---: |")
     for r in rows:
         print(f"| {r['recipe']} | {r['sampler']} | {r['ms_per_batch']} | {r['crops_per_s']} |")
     if args.json:

@@ -20,7 +20,7 @@ build=(cmake g++ make pkg-config libeigen3-dev libopencv-dev doctest-dev liblbfg
 python=(python3 python3-numpy python3-opencv python3-yaml python3-pil)
 case "${1:-build}" in
   build) want=("${build[@]}") ;;
-  test) want=("${build[@]}" "${python[@]}" gdal-bin doxygen) ;;
+  test) want=("${build[@]}" "${python[@]}" gdal-bin doxygen pyflakes3) ;;
   docs) want=(doxygen) ;;
   bench) want=("${build[@]}" "${python[@]}" gdal-bin doxygen python3-sklearn python3-torch libopenblas0-pthread) ;;
   plots) want=("${build[@]}" "${python[@]}" python3-matplotlib) ;;

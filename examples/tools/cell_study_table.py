@@ -22,7 +22,6 @@ def cells(line):
 
 def main():
     inputs, groups = [], []
-    planner = None
     for line in sys.stdin:
         if line.startswith("| field |"):
             inputs = [c.split(":")[0] for c in cells(line)[7:]]

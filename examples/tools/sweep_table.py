@@ -76,7 +76,7 @@ def main(args):
     keys = sorted({k for _, runs, _ in configs for k in runs})
     first_label, first, _ = configs[0]
 
-    print(f"| run | field | adaptive | non-adaptive | tour | row | linear |" +
+    print("| run | field | adaptive | non-adaptive | tour | row | linear |" +
           "".join(f" adaptive, {c[0]} |" for c in configs[1:]))
     print("| --- | --- | ---: | ---: | ---: | ---: | ---: |" + " ---: |" * (len(configs) - 1))
     for run, field in keys:
