@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds, and runs the whole test suite twice: a Release build with
 # warnings as errors, and a Debug build under AddressSanitizer + UndefinedBehaviorSanitizer
-# (every test compiled with them; the package, doxygen, snippet, header-alone and Python tests,
-# which build or run nothing sanitized, run in the Release build only).
+# (every test and every example program compiled with them, so the programs' CLI tests run
+# sanitized too; the package, doxygen, snippet, header-alone and Python tests, which build or
+# run nothing sanitized, run in the Release build only).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh test
@@ -24,7 +25,7 @@ ctest --test-dir build/release --output-on-failure --no-tests=error -j"$jobs"
 # sanitized build ~12 % more compile time (test_decision_function: 100 s against 88 s).
 cmake -S . -B build/asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS="-O1" -DCMAKE_CXX_FLAGS_DEBUG="-g1" \
       -DADAPTSEG_WARNINGS_AS_ERRORS=ON -DADAPTSEG_SANITIZE=ON -DADAPTSEG_BUILD_TESTS=ON -DADAPTSEG_BUILD_BENCHMARKS=OFF \
-      -DADAPTSEG_BUILD_EXAMPLES=OFF
+      -DADAPTSEG_BUILD_EXAMPLES=ON
 cmake --build build/asan -j"$jobs"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build/asan --output-on-failure --no-tests=error -j"$jobs"
