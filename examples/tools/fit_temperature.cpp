@@ -21,12 +21,14 @@
 #include "common/segmenters.hpp"
 #include "common/strategies.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <fstream>
 #include <optional>
-#include <regex>
 #include <sstream>
+#include <string>
+#include <string_view>
 
 namespace {
 
@@ -105,11 +107,23 @@ void write_temperature(const std::filesystem::path& model_file, double t) {
   std::string s = text.str();
   char line[64];
   std::snprintf(line, sizeof line, "temperature: %.4f", t);
-  const std::regex key("(^|\n)temperature:[^\n]*");
-  if (std::regex_search(s, key))
-    s = std::regex_replace(s, key, std::string("$1") + line);
-  else
-    s += (s.empty() || s.back() == '\n' ? "" : "\n") + std::string(line) + "\n";
+  // Every line that starts with the key is replaced (a file has one); none: the key appended.
+  std::string out;
+  bool found = false;
+  for (std::size_t at = 0; at < s.size();) {
+    const std::size_t end = std::min(s.find('\n', at), s.size());
+    const std::string_view row(s.data() + at, end - at);
+    if (row.rfind("temperature:", 0) == 0) {
+      out += line;
+      found = true;
+    } else {
+      out += row;
+    }
+    if (end < s.size()) out += '\n';
+    at = end + 1;
+  }
+  if (!found) out += (out.empty() || out.back() == '\n' ? "" : "\n") + std::string(line) + "\n";
+  s = std::move(out);
   adaptseg::examples::write_text(yaml, s);
   std::printf("wrote %s to %s\n", line, yaml.string().c_str());
 }
