@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Reproduces docs/results.md.
+# Reproduces docs/results.md and the measurements of the journal it links to (docs/journal/).
 #   bash scripts/results.sh [all|oracle|oracle-default|paper|network|loto|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed|all-tiles] [JOBS]
 #   (default: all, one job per core)
 #
@@ -55,18 +55,18 @@
 # network-held-out: ERFNet on tiles 4 and 6 again, each initialised on the other of the two
 #   alone (the one scene the network never trained on either) instead of the five other tiles:
 #   whether calibrating only where the network is as new to the ground as on the test field makes
-#   better decisions (docs/results.md: none below -0.002, but fewer gains and a lower mean). About
-#   9 minutes on 2 cores. NETS (environment; default erfnet-dubai) flies other networks: each
-#   network's runs go to network-held-out-<network> (ERFNet's to network-held-out), about 6
-#   minutes for MobileNetV2.
+#   better decisions (docs/journal/2026-11-networks.md, "Networks": none below -0.002, but fewer
+#   gains and a lower mean). About 9 minutes on 2 cores. NETS (environment; default
+#   erfnet-dubai) flies other networks: each network's runs go to network-held-out-<network>
+#   (ERFNet's to network-held-out), about 6 minutes for MobileNetV2.
 # network-variants: part network's runs of NETS (default mobilenetv2-dubai) flown twice more,
 #   each with one change a reader might expect to make MobileNetV2's descents pay: the top level at
 #   10 cm/px (--lawnmower-factors 1,1.5,2: the descents start where the network's lawnmower
 #   curve flattens), and the cells ranked by the expected error about L alone (--cell-input
 #   expected_error, the input of the cell study's best mean capture) instead of the input chosen
-#   on the training fields; side by side with part network's runs (docs/results.md, "Three
-#   more changes that do not make MobileNetV2's descents pay"). Needs network; about 20
-#   minutes on 2 cores.
+#   on the training fields; side by side with part network's runs
+#   (docs/journal/2026-11-defaults.md, "Three more changes that do not make MobileNetV2's
+#   descents pay"). Needs network; about 20 minutes on 2 cores.
 # proxy-check: whether what the scene check measures after a descent (each decision input's drop
 #   from the top-level image to the finer one over the re-mapped cells) tracks what re-mapping
 #   them gained, on the tiles each network (NETS, default erfnet-dubai mobilenetv2-dubai) was
@@ -79,16 +79,16 @@
 # sigma-prior: the previous defaults' runs (part previous) flown again with the models
 #   `oracle-previous` saved, only the front-aware rule's sigma_prior_weight changed (0.01 and 1;
 #   the calibrated models have 0.25): how much the prior on the field's share of L holds the
-#   forecasts of C and eta back (docs/results.md, "σ̂, the field's share of L"). Needs
-#   out/results/oracle-previous; about 8 minutes on 2 cores.
+#   forecasts of C and eta back (docs/journal/2026-11-oracle.md, "σ̂, the field's share of L").
+#   Needs out/results/oracle-previous; about 8 minutes on 2 cores.
 # sigma-prior-fit: the previous defaults' Dubai runs calibrated again with sigma-hat's prior taken
 #   from the training fields (--sigma-prior spread and estimated). Needs out/results/oracle-previous
 #   for the comparison; about 13 minutes on 2 cores. (With the defaults' field curve sigma-hat
 #   scales a descent's gain and the curve's rise alike: neither part applies to them.)
 # z-choice: for each of the defaults' runs, the training folds' margins per confidence level z
 #   (adaptseg_calibrate) and the test field flown with the run's model at every z: how much any
-#   choice of z could buy (docs/results.md). Needs out/results/oracle-default; about 8 minutes
-#   on 2 cores.
+#   choice of z could buy (docs/results.md, "What any choice of z can buy"). Needs
+#   out/results/oracle-default; about 8 minutes on 2 cores.
 # z-choice-network: the same for the runs of part network (NETS as there; default the two single
 #   networks), their calibrations rerun with the runs' flags (segmentations from the cache),
 #   missions with measured segmentation times. Needs network; MobileNetV2's 8 runs took about

@@ -11,7 +11,8 @@ fitting beta on the training fields, leave one field out: on the cells of every 
   random effects  the fields' slopes pooled as random effects (DerSimonian-Laird: weights
                   1 / (v_f + tau^2), v_f the variance of a field's slope from its cells' scatter,
                   tau^2 the spread between fields); flown on 2026-11-27 and not adopted
-                  (docs/results.md, "Slopes pooled over the training fields as random effects");
+                  (docs/journal/2026-11-defaults.md, "Slopes pooled over the training fields
+                  as random effects");
 
 then forecasts the field gain of the held-out field's best 20 % of cells (ranked by the input's
 mass, as the planner ranks them) and compares it with what re-mapping those cells alone gained.

@@ -149,7 +149,8 @@ for net in ("erfnet-dubai", "mobilenetv2-dubai", "ensemble-dubai"):
     assert fine["miou_all"] > coarse["miou_all"] + 0.02, f"{net}: finer GSD must segment better"
     assert 0.3 < fine["miou_all"] < 1.0, f"{net} is not the oracle, and not useless"
     # Every image has its per-image mIoU and the truth's share of L. (Their mean per GSD is not
-    # asserted: on this tile it does not rise as GSD falls; docs/results.md, networks.)
+    # asserted: on this tile it does not rise as GSD falls; docs/journal/2026-11-networks.md,
+    # "Networks".)
     for name, r in (("fine", fine), ("coarse", coarse)):
         assert all(w["image_miou_all"] is not None for w in r["waypoints"]), name
         assert all(w["truth_ratio"] is not None and 0.0 <= w["truth_ratio"] <= 1.0 for w in r["waypoints"]), name
