@@ -31,14 +31,7 @@
 set -uo pipefail
 live=$1 mission=$2 calibrate=$3 examples=$4 python=$5
 emulator="$(cd "$(dirname "$0")/../mavlink" && pwd)/emulator.mjs"
-if ! command -v node >/dev/null; then
-  echo "SKIP: node not installed (needed for the emulated autopilot)"
-  exit 77
-fi
-if [ ! -f "$(dirname "$emulator")/node_modules/node-mavlink/package.json" ]; then
-  echo "SKIP: node-mavlink not installed in tests/mavlink/node_modules; run: (cd tests/mavlink && npm ci)"
-  exit 77
-fi
+source "$(dirname "$emulator")/require_node_mavlink.sh" "the emulated autopilot"
 work=$(mktemp -d)
 pids=()
 trap 'for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; rm -rf "$work"' EXIT

@@ -18,14 +18,7 @@
 set -uo pipefail
 flight=$1 work=$2
 here=$(cd "$(dirname "$0")" && pwd)
-if ! command -v node >/dev/null; then
-  echo "SKIP: node not installed (needed for the emulated autopilot)"
-  exit 77
-fi
-if [ ! -f "$here/node_modules/node-mavlink/package.json" ]; then
-  echo "SKIP: node-mavlink not installed in tests/mavlink/node_modules; run: (cd tests/mavlink && npm ci)"
-  exit 77
-fi
+source "$here/require_node_mavlink.sh" "the emulated autopilot"
 mkdir -p "$work"
 
 # The emulator's flight: 5 m/s, 3 m/s^2, landing at 4 m/s, so that 5 legs of ~11 m and the

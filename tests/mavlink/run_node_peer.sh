@@ -11,14 +11,7 @@
 set -euo pipefail
 peer=$1 work=$2
 here=$(cd "$(dirname "$0")" && pwd)
-if ! command -v node >/dev/null; then
-  echo "SKIP: node not installed (needed for the node-mavlink cross-check)"
-  exit 77
-fi
-if [ ! -f "$here/node_modules/node-mavlink/package.json" ]; then
-  echo "SKIP: node-mavlink not installed in tests/mavlink/node_modules; run: (cd tests/mavlink && npm ci)"
-  exit 77
-fi
+source "$here/require_node_mavlink.sh" "the node-mavlink cross-check"
 mkdir -p "$work"
 "$peer" write "$work/adaptseg_frames.txt" 200
 node "$here/node_peer.mjs" check "$work/adaptseg_frames.txt"
