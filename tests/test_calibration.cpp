@@ -462,6 +462,21 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
   corrected.save(tmp.path() / "corrected.yaml");
   CHECK(rule_of(DecisionModel::load(tmp.path() / "corrected.yaml")).field_curve);
   CHECK(rule_of(DecisionModel::load(tmp.path() / "corrected.yaml")).curve_ratio);
+  // So is the top-level rule (files without the key: undominated); a name it does not know is refused.
+  CHECK(rule_of(back).top_level == TopLevelChoice::undominated);
+  p.top_level = TopLevelChoice::hull;
+  policy.set_params(p);
+  corrected.save(tmp.path() / "hull.yaml");
+  CHECK(rule_of(DecisionModel::load(tmp.path() / "hull.yaml")).top_level == TopLevelChoice::hull);
+  std::stringstream hull_text;
+  hull_text << std::ifstream(tmp.path() / "hull.yaml").rdbuf();
+  std::string bad = hull_text.str();
+  const auto hull_at = bad.find("top_level: hull");
+  REQUIRE(hull_at != std::string::npos);
+  bad.replace(hull_at, 15, "top_level: hul");
+  std::ofstream(tmp.path() / "bad.yaml") << bad;
+  CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "bad.yaml"),
+                       doctest::Contains("'rule.top_level' must be undominated or hull (got 'hul')"), std::invalid_argument);
   // Fields of another class set are refused.
   const Field other("o", 1.0, a.labels(), {{"a", {0, 0, 0}}, {"b", {1, 1, 1}}, {"c", {2, 2, 2}}}, {1});
   const std::vector<Field> mixed{a, other};

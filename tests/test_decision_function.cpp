@@ -603,6 +603,22 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     FrontAwarePolicy nominal(fitted(), {{"a", {{1.0, 0.95}, {2.0, 0.85}, {3.0, 0.75}}, 0.2}}, {});
     CHECK(nominal.top_gsd(fits, 3.0) == 3.0);
   }
+  SUBCASE("the top level at the predicted curve's first corner: hull") {
+    // 3 -> 2 cm/px rises 0.10 in 20 s, 2 -> 1 as much in 125 s: the curve bends at 2.
+    const std::vector<LawnmowerForecast> usual{{1.0, 185.0}, {2.0, 60.0}, {3.0, 40.0}};
+    const ReferenceCurve bends{"a", {{1.0, 0.95}, {2.0, 0.85}, {3.0, 0.75}}, 0.2, 0.05};
+    CHECK(FrontAwarePolicy(with_cells(1.0), {bends}, {}).top_gsd(usual, 3.0) == 3.0);
+    const FrontAwarePolicy hull(with_cells(1.0), {bends}, {.top_level = TopLevelChoice::hull});
+    CHECK(hull.top_gsd(usual, 3.0) == 2.0);
+    // Where 2 cm/px gains little and 1 cm/px much, the curve is steeper beyond: the nominal top.
+    const ReferenceCurve late{"a", {{1.0, 0.99}, {2.0, 0.76}, {3.0, 0.75}}, 0.2, 0.05};
+    CHECK(FrontAwarePolicy(with_cells(1.0), {late}, {.top_level = TopLevelChoice::hull}).top_gsd(usual, 3.0) == 3.0);
+    // The rates are the field's: the same curves over an area where 2 cm/px takes 100 s more stay at 3.
+    const std::vector<LawnmowerForecast> slow{{1.0, 185.0}, {2.0, 140.0}, {3.0, 40.0}};
+    CHECK(hull.top_gsd(slow, 3.0) == 3.0);
+    CHECK(parse_top_level_choice(to_string(TopLevelChoice::hull)) == TopLevelChoice::hull);
+    CHECK_THROWS_AS((void)parse_top_level_choice("convex"), std::invalid_argument);
+  }
 }
 
 TEST_CASE("front-aware policy: pessimistic when unsure, from the field factor and the spread of the training curves") {

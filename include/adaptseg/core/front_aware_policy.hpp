@@ -16,11 +16,36 @@
 #include <functional>
 #include <limits>
 #include <optional>
+#include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
 namespace adaptseg {
+
+/// How the front-aware rule chooses the GSD of its top level among those it was calibrated for
+/// (FrontAwarePolicy::top_gsd; the lawnmower times are this field's, the accuracies the mean of
+/// the training fields' lawnmower curves at the same GSD, so no label of this field is read):
+/// - `undominated`: the coarsest whose lawnmower no faster lawnmower is predicted to beat;
+/// - `hull`: from there, a finer one while the predicted curve rises faster per second up to it
+///   than from it to any finer lawnmower: the top level at the first corner of the predicted
+///   curve's upper concave hull. A descent is judged against the curve's upper envelope, whose
+///   segments are the lawnmowers' rates; where the curve rises steeply to a GSD for little time
+///   (a finer lawnmower whose grid fits the field better) and flattens after it, descents from
+///   the coarser level must beat the steep segment, those from the corner only the flatter one.
+enum class TopLevelChoice { undominated, hull };
+
+/// The name of a top-level choice (`top_level` in the model file, `--top-level` of the programs).
+[[nodiscard]] inline std::string to_string(TopLevelChoice r) { return r == TopLevelChoice::hull ? "hull" : "undominated"; }
+
+/// Parses a top-level choice's name.
+/// @throws std::invalid_argument for anything but `undominated` or `hull`.
+[[nodiscard]] inline TopLevelChoice parse_top_level_choice(std::string_view name) {
+  if (name == "undominated") return TopLevelChoice::undominated;
+  if (name == "hull") return TopLevelChoice::hull;
+  throw std::invalid_argument("top-level choice must be one of undominated, hull, not '" + std::string(name) + "'");
+}
 
 /// A training field's fixed-altitude lawnmower curve by GSD: the front-aware rule's yardstick.
 struct ReferenceCurve {
@@ -119,6 +144,8 @@ class FrontAwarePolicy {
     /// is fitted on, predict a network's lawnmower poorly: it re-maps every cell with its
     /// neighbours (docs/results.md, "The field curve against the real ones").
     bool curve_ratio = false;
+    /// How top_gsd() chooses the top level (TopLevelChoice).
+    TopLevelChoice top_level = TopLevelChoice::undominated;
 
     /// @throws std::invalid_argument naming the field.
     void validate() const {
@@ -309,8 +336,10 @@ class FrontAwarePolicy {
   /// decide from (its cell gain model's top-level GSDs, else the nominal one) whose lawnmower over
   /// the area is not dominated on the predicted curve: no lawnmower of `lawnmowers` is as fast
   /// or faster and predicted better (mIoU by GSD: the mean of the training fields' curves).
-  /// Where each is dominated, the one predicted to fall least short. Both the adaptive and the
-  /// non-adaptive rule choose so (nothing is learnt here).
+  /// Where each is dominated, the one predicted to fall least short. With TopLevelChoice::hull,
+  /// then a finer one of them while the predicted curve rises faster per second up to it than
+  /// from it to any finer lawnmower of `lawnmowers`. Both the adaptive and the non-adaptive rule
+  /// choose so (nothing is learnt here).
   [[nodiscard]] double top_gsd(std::span<const LawnmowerForecast> lawnmowers, double nominal) const {
     std::vector<double> allowed;
     if (model_.cells())
@@ -335,6 +364,19 @@ class FrontAwarePolicy {
       for (const auto& l : lawnmowers)
         if (l.time_s <= time_of(g)) deficit = std::max(deficit, predicted(l.gsd_cm) - predicted(g));
       if (deficit < best_deficit - 1e-12) best = g, best_deficit = deficit;
+    }
+    if (params_.top_level != TopLevelChoice::hull) return best;
+    for (double g : allowed) {  // coarse to fine
+      const double t0 = time_of(best), t1 = time_of(g);
+      if (!(g < best) || !std::isfinite(t1) || !std::isfinite(t0)) continue;
+      // The rise per second up to g, and the steepest from g to a finer, slower lawnmower.
+      const double rise = predicted(g) - predicted(best);
+      const double rate_to = t1 > t0 ? rise / (t1 - t0) : (rise > 0.0 ? std::numeric_limits<double>::infinity() : rise);
+      double rate_on = 0.0;
+      for (const auto& l : lawnmowers)
+        if (l.gsd_cm < g && l.time_s > t1) rate_on = std::max(rate_on, (predicted(l.gsd_cm) - predicted(g)) / (l.time_s - t1));
+      if (!(rate_to > rate_on)) break;
+      best = g;
     }
     return best;
   }

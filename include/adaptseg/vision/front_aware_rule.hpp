@@ -143,6 +143,7 @@ struct FrontAwareRule {
     e << YAML::Key << "sigma_prior_sd" << YAML::Value << num(p.sigma_prior_sd);
     if (p.field_curve) e << YAML::Key << "field_curve" << YAML::Value << detail::flag_text(true);
     if (p.curve_ratio) e << YAML::Key << "curve_ratio" << YAML::Value << detail::flag_text(true);
+    if (p.top_level != TopLevelChoice::undominated) e << YAML::Key << "top_level" << YAML::Value << to_string(p.top_level);
     e << YAML::Key << "reference" << YAML::Value << YAML::BeginSeq;
     for (const auto& r : rule.reference()) {
       std::vector<double> g, m;
@@ -202,7 +203,18 @@ struct FrontAwareRule {
                              .sigma_prior_weight = rule.number("sigma_prior_weight"),
                              .sigma_prior_sd = rule.has("sigma_prior_sd") ? rule.number("sigma_prior_sd") : 0.0,
                              .field_curve = rule.has("field_curve") && rule.flag("field_curve"),
-                             .curve_ratio = rule.has("curve_ratio") && rule.flag("curve_ratio")});
+                             .curve_ratio = rule.has("curve_ratio") && rule.flag("curve_ratio"),
+                             .top_level = rule.has("top_level") ? read_top_level(rule) : TopLevelChoice::undominated});
+  }
+
+  /// `rule.top_level`, naming the file where it is not a TopLevelChoice.
+  [[nodiscard]] static TopLevelChoice read_top_level(const detail::YamlReader& rule) {
+    const std::string name = rule.text("top_level");
+    try {
+      return parse_top_level_choice(name);
+    } catch (const std::invalid_argument&) {
+      detail::yaml_error(rule.where(), "'rule.top_level' must be undominated or hull (got '" + name + "')");
+    }
   }
 
   /// Refuses options its search cannot use (before calibrate() samples anything).
