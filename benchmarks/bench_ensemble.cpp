@@ -1,5 +1,5 @@
 // Times the ensemble backend against its members, side by side in one run: per round, K
-// segment() calls of each member (ErfnetSegmenter, as the ensemble runs it: with test-time
+// segment() calls of each member (OnnxSegmenter, as the ensemble runs it: with test-time
 // mirror where its `mirror` says so, and then also without), then K of the ensemble (EnsembleSegmenter:
 // every member, the weighted mean, its argmax) and K of segment_with_disagreement() (the same
 // plus disagreement and class splits), on one 480x360 camera image of held-out Dubai tile 6
@@ -42,13 +42,13 @@ int main(int argc, char** argv) {
   try {
     const auto field = adaptseg::Field::load(argv[2]);
     const adaptseg::CameraModel camera;
-    adaptseg::ErfnetParams p{.resize_to_network = true, .num_threads = threads};
+    adaptseg::OnnxParams p{.resize_to_network = true, .num_threads = threads};
     adaptseg::EnsembleSegmenter ensemble(argv[1], field, camera, p);
-    std::vector<adaptseg::ErfnetSegmenter> members;
+    std::vector<adaptseg::OnnxSegmenter> members;
     std::vector<std::string> names;
     for (const auto& m : ensemble.member_list()) {
       const std::string name = m.model_dir.filename().string();
-      adaptseg::ErfnetParams pm = p;
+      adaptseg::OnnxParams pm = p;
       pm.test_time_mirror = m.mirror;
       members.emplace_back(m.model_dir, field, camera, pm);
       names.push_back(name + (m.mirror ? " (member, with mirror)" : " (member)"));

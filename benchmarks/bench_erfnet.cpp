@@ -1,5 +1,5 @@
 // Times the ONNX backend (OpenCV DNN) on one camera image: the network's forward pass alone
-// (at its input size) and the whole ErfnetSegmenter::segment (resampling to the input size if
+// (at its input size) and the whole OnnxSegmenter::segment (resampling to the input size if
 // the camera's differs, normalisation, forward, logits resampled to the camera size, argmax).
 // Driven by benchmarks/bench_erfnet.py, which runs PyTorch on the same weights side by side.
 //
@@ -12,7 +12,7 @@
 
 #include "bench_timing.hpp"
 
-#include <adaptseg/erfnet/erfnet_segmenter.hpp>
+#include <adaptseg/erfnet/onnx_segmenter.hpp>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -76,10 +76,10 @@ int main(int argc, char** argv) {
   }
   if (threads < 1 || iters < 1 || warmup < 0) return usage();
   try {
-    adaptseg::ErfnetParams params;
+    adaptseg::OnnxParams params;
     params.num_threads = threads;
     params.resize_to_network = true;
-    adaptseg::ErfnetSegmenter erfnet(model_dir, params);
+    adaptseg::OnnxSegmenter erfnet(model_dir, params);
     const cv::Size in = erfnet.input_size();
     if (camera.width <= 0 || camera.height <= 0) camera = in;
 

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Network inference: PyTorch vs OpenCV DNN (adaptseg::ErfnetSegmenter, the ONNX backend) side
+"""Network inference: PyTorch vs OpenCV DNN (adaptseg::OnnxSegmenter, the ONNX backend) side
 by side, for any bundled model (ERFNet, MobileNetV2).
 
 Runs PyTorch on the checkpoint the ONNX model was exported from (model.pt next to

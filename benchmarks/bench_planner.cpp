@@ -4,7 +4,7 @@
 // starts (by the oracle or a network), so the network's time is not in it; the simulated camera
 // and the scoring are outside it too.
 //
-//   bench_planner --model MODEL.yaml --field DIR [--field DIR ...] [--segmenter erfnet --model-file NET]
+//   bench_planner --decision-model MODEL.yaml --field DIR [--field DIR ...] [--segmenter erfnet --network NET]
 //                 [--planner-threads N] [--repeat R] [--strategy adaptive|nonadaptive|tour|row]
 //
 // Prints one Markdown row per field: waypoints, descents / decisions, median / 95th percentile /
@@ -90,7 +90,7 @@ int main(int argc, char** argv) {
   int threads = 1, repeat = 3;
   std::string strategy = "adaptive", label;
   adaptseg::examples::SegmenterOptions segmenter;
-  app.add_option("--model", model_path, "decision model (adaptseg_calibrate)")->required();
+  app.add_option("--decision-model", model_path, "decision model (adaptseg_calibrate)")->required();
   app.add_option("--field", fields, "field to fly (repeatable)")->required();
   app.add_option("--planner-threads", threads, "OpenCV threads of the planner (cv::setNumThreads; --threads: the network's)")->capture_default_str();
   app.add_option("--repeat", repeat, "missions per field (the steps of all are pooled)")->capture_default_str();

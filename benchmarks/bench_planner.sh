@@ -51,7 +51,7 @@ if [ -n "${MODELS_ONLY:-}" ]; then
     "$calibrate" --field "$w" --region 0,0,0.5,1 --out "$out/oracle-weedmap.yaml" --seg-time-s 0.1 >"$out/oracle-weedmap.log" 2>&1
   for backend in oracle mobilenetv2-dubai erfnet-dubai; do
     args=()
-    [ "$backend" = oracle ] || args=(--segmenter erfnet --model-file "examples/models/$backend" --threads 2
+    [ "$backend" = oracle ] || args=(--segmenter erfnet --network "examples/models/$backend" --threads 2
                                      --segmentation-cache "$out/cache")
     for cls in vegetation building; do model "$backend" "$cls" "${args[@]}"; done
   done
@@ -63,17 +63,17 @@ w=examples/data/weedmap-000
 [ -s "$out/oracle-weedmap.yaml" ] ||
   "$calibrate" --field "$w" --region 0,0,0.5,1 --out "$out/oracle-weedmap.yaml" --seg-time-s 0.1 >"$out/oracle-weedmap.log" 2>&1
 for threads in 1 2; do
-  bench_row --model "$out/oracle-weedmap.yaml" --field "$w:0.5,0,1,1" --planner-threads "$threads" --repeat 3
+  bench_row --decision-model "$out/oracle-weedmap.yaml" --field "$w:0.5,0,1,1" --planner-threads "$threads" --repeat 3
 done
 for backend in oracle mobilenetv2-dubai erfnet-dubai; do
   args=()
-  [ "$backend" = oracle ] || args=(--segmenter erfnet --model-file "examples/models/$backend" --threads 2)
+  [ "$backend" = oracle ] || args=(--segmenter erfnet --network "examples/models/$backend" --threads 2)
   for cls in vegetation building; do
     cache=()
     [ "$backend" = oracle ] || cache=(--segmentation-cache "$out/cache")
     model "$backend" "$cls" "${args[@]}" "${cache[@]}"
     for threads in 1 2; do
-      bench_row --model "$out/$backend-$cls.yaml" --field examples/data/dubai-tile-4 --field examples/data/dubai-tile-6 \
+      bench_row --decision-model "$out/$backend-$cls.yaml" --field examples/data/dubai-tile-4 --field examples/data/dubai-tile-6 \
         --planner-threads "$threads" --repeat 3 --label "$backend ($cls)" "${args[@]}"
     done
   done

@@ -7,7 +7,7 @@
 //   adaptseg_calibrate --train examples/data/dubai-tile-1 --train examples/data/dubai-tile-2:0,0,1,0.5
 //                      --interest road --out roads.yaml
 //   adaptseg_calibrate --field examples/data/dubai-tile-4 --segmenter erfnet
-//                      --model-file examples/models/ensemble-dubai --out ensemble-model.yaml
+//                      --network examples/models/ensemble-dubai --out ensemble-model.yaml
 
 #include "common/cell_csv.hpp"
 #include "common/segmenters.hpp"
@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
     for (const auto& spec : train_specs) fields.push_back(adaptseg::examples::load_field_spec(spec));
     if (fields.empty()) throw std::invalid_argument("give a training field: --field DIR or --train DIR (repeatable)");
     segmenter.validate();
-    const auto networks = segmenter.calibration_networks(fields);  // its mistakes before any work
+    const auto networks = segmenter.network_per_field(fields);  // its mistakes before any work
     const adaptseg::Field& field = fields.front();
     const adaptseg::MissionOptions mission = common.resolve(field);
     const double g0 = field.gsd_cm();

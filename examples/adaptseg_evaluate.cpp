@@ -5,7 +5,7 @@
 //   adaptseg_evaluate --train examples/data/weedmap-000:0,0,0.5,1
 //                     --test examples/data/weedmap-000:0.5,0,1,1 --segmenter oracle --out out/eval
 //   adaptseg_evaluate --train examples/data/dubai-tile-4 --test examples/data/dubai-tile-6
-//                     --segmenter erfnet --model-file examples/models/ensemble-dubai --out out/eval-ensemble
+//                     --segmenter erfnet --network examples/models/ensemble-dubai --out out/eval-ensemble
 
 #include "common/cell_csv.hpp"
 #include "common/segmenters.hpp"
@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Run every strategy on test fields and write the paper's tables and figures.", "adaptseg_evaluate"};
   std::vector<std::string> train_specs;
   std::vector<std::string> test_specs;
-  fs::path out_dir, model_file;
+  fs::path out_dir, decision_model;
   std::vector<double> lawnmower_factors{1.0, 1.5, 2.0, 2.5, 3.0};
   std::optional<double> budget_s;
   bool no_plots = false;
@@ -125,8 +125,9 @@ int main(int argc, char** argv) {
   adaptseg::examples::SegmenterOptions segmenter;
   app.add_option("--train", train_specs,
                  "training field DIR[:x0,y0,x1,y1] (decision-function initialisation); repeatable");
-  CLI::Option* model_opt =
-      app.add_option("--model", model_file, "use this decision model instead of calibrating on --train");
+  CLI::Option* model_opt = app.add_option("--decision-model", decision_model,
+                                          "use this decision model instead of calibrating on --train");
+  CLI::Option* old_model_opt = adaptseg::examples::accept_old_spelling(app, model_opt, "--model", decision_model);
   app.add_option("--test", test_specs, "test field DIR[:x0,y0,x1,y1]; repeatable")->required();
   app.add_option("--out", out_dir, "output directory")->required();
   app.add_option("--lawnmower-factors", lawnmower_factors, "lawnmower GSDs as multiples of each field's GSD")
@@ -135,16 +136,17 @@ int main(int argc, char** argv) {
   app.add_option("--budget-s", budget_s, "mission-time budget [s] for the adaptive strategies");
   calibration.add_to(app);
   calibration.exclude(model_opt);  // the model file fixes them
+  calibration.exclude(old_model_opt);
   app.add_flag("--no-plots", no_plots, "do not run the plotting script");
   common.add_to(app);
   segmenter.add_to(app);
-  segmenter.add_calibration_networks_to(app)->excludes(model_opt);
+  segmenter.add_calibration_networks_to(app, {model_opt, old_model_opt});
   if (const auto code = adaptseg::examples::parse_command_line(app, argc, argv)) return *code;
 
   bool progress_open = false;  // a progress line on stderr waits for its end
   try {
-    if (train_specs.empty() == model_file.empty())
-      throw std::invalid_argument("give exactly one of --train (calibrate) and --model (load)");
+    if (train_specs.empty() == decision_model.empty())
+      throw std::invalid_argument("give exactly one of --train (calibrate) and --decision-model (load)");
     adaptseg::examples::check_gsd_factors(lawnmower_factors, "--lawnmower-factors");
     if (lawnmower_factors.size() < 2 || !std::is_sorted(lawnmower_factors.begin(), lawnmower_factors.end()) ||
         std::adjacent_find(lawnmower_factors.begin(), lawnmower_factors.end()) != lawnmower_factors.end())
@@ -166,15 +168,15 @@ int main(int argc, char** argv) {
       return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     };
     std::optional<adaptseg::DecisionModel> loaded;
-    if (!model_file.empty()) {
-      loaded = adaptseg::DecisionModel::load(model_file);
+    if (!decision_model.empty()) {
+      loaded = adaptseg::DecisionModel::load(decision_model);
       for (const auto& t : tests) loaded->check_classes(t);
       common.check_camera_matches(app, *loaded);
     } else {
       std::vector<adaptseg::Field> trains;
       for (const auto& spec : train_specs) trains.push_back(adaptseg::examples::load_field_spec(spec));
       segmenter.validate();
-      const auto networks = segmenter.calibration_networks(trains);  // its mistakes before any work
+      const auto networks = segmenter.network_per_field(trains);  // its mistakes before any work
       const adaptseg::Field& train = trains.front();
       adaptseg::CalibrationOptions co;
       co.adaptive.mission = common.resolve(train);

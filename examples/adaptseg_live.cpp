@@ -7,8 +7,8 @@
 // what a real UAV would report as "no image": an error). Make such a folder from a bundled
 // field with --record-from, which captures in simulation every waypoint the planner may ask for:
 //
-//   adaptseg_live --record-from examples/data/weedmap-000:0.5,0,1,0.5 --model model.yaml --images DIR
-//   adaptseg_live --images DIR --model model.yaml [--budget-s 300] [--out OUT]
+//   adaptseg_live --record-from examples/data/weedmap-000:0.5,0,1,0.5 --decision-model model.yaml --images DIR
+//   adaptseg_live --images DIR --decision-model model.yaml [--budget-s 300] [--out OUT]
 //
 // (--record-yaw DEG records every image with the camera turned by DEG, as a UAV that does not
 // hold the plan's heading would take them; the planner fuses each at its recorded yaw.)
@@ -21,7 +21,7 @@
 // with the measured pose and the mission's real clock; at the end the vehicle returns to launch.
 //
 //   adaptseg_live --mavlink udpin:14550 --simulate-camera FIELD --geo-origin LAT,LON,ALT,HEADING
-//       --model model.yaml --out OUT
+//       --decision-model model.yaml --out OUT
 //
 // The folder (docs/data_format.md, "The live image folder"): DIR/area.yaml (area, map GSD,
 // classes, labels of interest, camera, and optionally its geo-reference), DIR/valid_mask.png
@@ -47,7 +47,7 @@
 #include "common/strategies.hpp"
 #include "common/vehicle.hpp"
 
-#include <adaptseg/erfnet/erfnet_segmenter.hpp>
+#include <adaptseg/erfnet/onnx_segmenter.hpp>
 #include <adaptseg/planner.hpp>
 #include <adaptseg/vision/adaptive_planner.hpp>
 #ifdef ADAPTSEG_HAVE_GDAL
@@ -408,13 +408,14 @@ int main(int argc, char** argv) {
                "images, or flying a vehicle over MAVLink.",
                "adaptseg_live"};
   LiveSettings s;
-  fs::path images_dir, model_file, erfnet_dir, camera_folder;
+  fs::path images_dir, decision_model, network, camera_folder;
   std::string record_from, strategy = "adaptive", segmenter = "oracle", simulate_field, trigger, image_pose = "vehicle";
   std::optional<double> budget_s, seg_time_s, plan_time_s, pose_tolerance_m;
   double record_yaw_deg = 0.0, camera_timeout_s = 10.0;
   CLI::Option* images_opt =
       app.add_option("--images", images_dir, "folder of posed images (area.yaml, poses.csv, rgb/, labels/)");
-  app.add_option("--model", model_file, "decision model from adaptseg_calibrate")->required();
+  CLI::Option* model_opt = app.add_option("--decision-model", decision_model, "decision model from adaptseg_calibrate");
+  adaptseg::examples::accept_old_spelling(app, model_opt, "--model", decision_model);
   CLI::Option* record =
       app.add_option("--record-from", record_from,
                      "instead of flying: capture, in simulation, every waypoint the planner may ask for over this "
@@ -434,7 +435,8 @@ int main(int argc, char** argv) {
                  "images")
       ->check(CLI::IsMember({"oracle", "erfnet"}))
       ->capture_default_str();
-  app.add_option("--model-file", erfnet_dir, "network of --segmenter erfnet: a model directory (model.onnx, model.yaml) or an ensemble directory (ensemble.yaml)");
+  CLI::Option* network_opt = app.add_option("--network", network, "network of --segmenter erfnet: a model directory (model.onnx, model.yaml) or an ensemble directory (ensemble.yaml)");
+  adaptseg::examples::accept_old_spelling(app, network_opt, "--model-file", network);
   app.add_option("--budget-s", budget_s, "mission-time budget [s]: a descent is flown only where it and the rest fit, each image at a bound of its processing learned in flight, and cut short where they no longer do");
   app.add_option("--pose-tolerance-m", pose_tolerance_m,
                  "how far [m] a recorded pose may be from the waypoint (or, flying, from the measured pose) "
@@ -538,6 +540,7 @@ int main(int argc, char** argv) {
                  "record and fly with the same")
       ->check(CLI::IsMember({"corner", "centred"}));
   if (const auto code = adaptseg::examples::parse_command_line(app, argc, argv)) return *code;
+  if (decision_model.empty()) return adaptseg::examples::command_line_error(app, "--decision-model is required");
   s.segmenter = segmenter;
   s.flight.trigger = trigger.empty() ? simulate_field.empty() : trigger == "autopilot";
   s.flight.pose_from_exif = image_pose == "exif";
@@ -546,7 +549,7 @@ int main(int argc, char** argv) {
                                         : adaptseg::GridAnchor::corner;
 
   try {
-    const adaptseg::DecisionModel model = adaptseg::DecisionModel::load(model_file);
+    const adaptseg::DecisionModel model = adaptseg::DecisionModel::load(decision_model);
     if (!record_from.empty()) {
       const adaptseg::Field field = ex::load_field_spec(record_from, s.exports.geo_override());
       model.check_classes(field);
@@ -566,7 +569,7 @@ int main(int argc, char** argv) {
 
     if (!camera_folder.empty() && segmenter == "oracle")
       throw std::invalid_argument("--camera-folder gives camera images without labels: segment them with "
-                                  "--segmenter erfnet --model-file DIR (the oracle needs ground truth)");
+                                  "--segmenter erfnet --network DIR (the oracle needs ground truth)");
     if (!s.exports.geo_origin.empty() && simulate_field.empty())
       throw std::invalid_argument(
           "--geo-origin is for --record-from and --simulate-camera; the folder's frame is area.yaml's geo: (or --area)");
@@ -660,14 +663,14 @@ int main(int argc, char** argv) {
       adaptseg::OracleSegmenter oracle(static_cast<int>(info.classes.size()));
       fly_strategy(strategy, model, info, oracle, options, s);
     } else {
-      if (erfnet_dir.empty()) throw std::invalid_argument("--segmenter erfnet needs --model-file");
-      adaptseg::ErfnetParams params;
+      if (network.empty()) throw std::invalid_argument("--segmenter erfnet needs --network");
+      adaptseg::OnnxParams params;
       params.expected_classes = names;
       params.camera_width_px = m.image_width_px;
       params.camera_height_px = m.image_height_px;
       params.resize_to_network = true;
-      adaptseg::examples::with_network(erfnet_dir, std::move(params), [&](auto& network) {
-        fly_strategy(strategy, model, info, network, options, s);
+      adaptseg::examples::with_network(network, std::move(params), [&](auto& backend) {
+        fly_strategy(strategy, model, info, backend, options, s);
       });
     }
     return 0;

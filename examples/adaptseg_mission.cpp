@@ -3,8 +3,8 @@
 //   adaptseg_mission --field examples/data/weedmap-000 --strategy lawnmower --gsd 3.0
 //                    --segmenter oracle --out out/lawnmower-3.0
 //   adaptseg_mission --field examples/data/dubai-tile-6 --strategy lawnmower --gsd 15
-//                    --segmenter erfnet --model-file examples/models/ensemble-dubai --out out/ensemble-15
-//   adaptseg_mission --field DIR --strategy adaptive --model model.yaml --out OUT [--budget-s 900]
+//                    --segmenter erfnet --network examples/models/ensemble-dubai --out out/ensemble-15
+//   adaptseg_mission --field DIR --strategy adaptive --decision-model model.yaml --out OUT [--budget-s 900]
 //
 // Writes OUT/result.json (scores, time, waypoints, decisions), OUT/path.png and OUT/map.png
 // (and OUT/map.tif + OUT/map_gsd.tif in the field's CRS for a georeferenced field, built with GDAL);
@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
   namespace fs = std::filesystem;
   CLI::App app{"Fly one UAV mapping mission over a field (simulated) and score it.", "adaptseg_mission"};
   std::string field_spec;
-  fs::path out_dir, model_file;
+  fs::path out_dir, decision_model;
   std::string strategy = "lawnmower";
   double gsd_cm = 0.0;
   std::optional<double> budget_s;
@@ -36,7 +36,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember(adaptseg::examples::strategy_names()))
       ->capture_default_str();
   app.add_option("--gsd", gsd_cm, "lawnmower GSD [cm/px] (>= the field's GSD)");
-  app.add_option("--model", model_file, "decision model from adaptseg_calibrate (adaptive, nonadaptive, linear)");
+  CLI::Option* model_opt = app.add_option("--decision-model", decision_model,
+                                          "decision model from adaptseg_calibrate (adaptive, nonadaptive, linear)");
+  adaptseg::examples::accept_old_spelling(app, model_opt, "--model", decision_model);
   app.add_option("--budget-s", budget_s, "mission-time budget [s] for adaptive strategies: a descent is flown only where it and the rest fit, each image at a bound of its processing learned in flight, and cut short where they no longer do");
   std::string overlap_text;
   app.add_option("--overlap", overlap_text,
@@ -53,7 +55,7 @@ int main(int argc, char** argv) {
     const adaptseg::Field field = exports.load_field(field_spec);
     adaptseg::MissionOptions options = common.resolve(field);
     std::optional<adaptseg::DecisionModel> model;
-    if (!model_file.empty()) model = adaptseg::DecisionModel::load(model_file);
+    if (!decision_model.empty()) model = adaptseg::DecisionModel::load(decision_model);
     if (strategy != "lawnmower" && model) common.check_camera_matches(app, *model);
     if (budget_s && strategy == "lawnmower")
       throw std::invalid_argument("--budget-s applies to adaptive strategies only");

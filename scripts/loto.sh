@@ -171,7 +171,7 @@ bundle)
     src[$k]=out/loto/model-$k
     [ -s "${src[$k]}/model.onnx" ] || src[$k]=$dest/tile-$k
     [ -s "${src[$k]}/model.onnx" ] || { echo "no out/loto/model-$k nor $dest/tile-$k: bash $0 recipe-cpu $k (or eval)" >&2; exit 1; }
-    "$fit" --model-file "${src[$k]}" --field "examples/data/dubai-tile-$k" --threads 2 >"out/loto/temperature-$k.log"
+    "$fit" --network "${src[$k]}" --field "examples/data/dubai-tile-$k" --threads 2 >"out/loto/temperature-$k.log"
     fitted[$k]=$(sed -n 's/^temperature: \([0-9.]*\).*/\1/p' "out/loto/temperature-$k.log")
     [ -n "${fitted[$k]}" ] || { echo "no temperature in out/loto/temperature-$k.log" >&2; exit 1; }
   done
@@ -188,10 +188,10 @@ bundle)
       cp "out/loto/eval-$k.json" "$dest/tile-$k/held_out_eval.json"
       [ ! -f "out/loto/train-$k.log" ] || cp "out/loto/train-$k.log" "$dest/tile-$k/train.log"
     fi
-    "$fit" --model-file "$dest/tile-$k" --set "$t" >/dev/null
+    "$fit" --network "$dest/tile-$k" --set "$t" >/dev/null
     echo "dubai-tile-$k,${fitted[$k]},$t" >>"$dest/temperatures.csv"
   done
-  "$fit" --model-file examples/models/mobilenetv2-dubai-all --set "$(median "${fitted[@]}")"
+  "$fit" --network examples/models/mobilenetv2-dubai-all --set "$(median "${fitted[@]}")"
   cat "$dest/temperatures.csv"
   ;;
 cpu)
@@ -207,7 +207,7 @@ cpu)
   source scripts/configure.sh
   configure_for results build/release >/dev/null
   cmake --build build/release -j2 --target adaptseg_fit_temperature >/dev/null
-  build/release/examples/adaptseg_fit_temperature --model-file "out/loto-cpu/model-$k" \
+  build/release/examples/adaptseg_fit_temperature --network "out/loto-cpu/model-$k" \
     --field "examples/data/dubai-tile-$k" --threads 2 --write
   ;;
 *)

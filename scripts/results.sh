@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reproduces docs/results.md and the measurements of the journal it links to (docs/journal/).
-#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|loto|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed|all-tiles] [JOBS]
+#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|loto|loto-proxy|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed|all-tiles] [JOBS]
 #   (default: all, one job per core)
 #
 # oracle: the paper's experiment with the ground-truth oracle, deterministic (fixed 0.1 s per
@@ -29,10 +29,19 @@
 #   here): for each Dubai tile k and each class, the MobileNetV2 of the deployment recipe that
 #   never saw tile k (examples/models/mobilenetv2-dubai-loto/tile-k; scripts/loto.sh) flies tile
 #   k, its decision function calibrated on the other five tiles, each segmented by the network
-#   of the same recipe that never saw it (--calibration-model-file), as the deployment network's
+#   of the same recipe that never saw it (--calibration-network), as the deployment network's
 #   decision model is calibrated for a new site; 24 runs, measured segmentation times. Printed
 #   beside the oracle's runs of the same folds (part oracle-default's Dubai runs, when there).
 #   Every network segments its own tile once into the segmentation cache.
+# loto-proxy: until the six leave-one-tile-out networks are trained, a stand-in for loto on the
+#   three tiles that have a network that never saw them: tile 1 flown by
+#   mobilenetv2-dubai-loto/tile-1, calibrated on tiles 4 and 6 segmented by mobilenetv2-dubai
+#   (which never saw them); tiles 4 and 6 flown by mobilenetv2-dubai, calibrated on tile 1
+#   (segmented by tile 1's network) and the other of the two. 12 runs, every field of each run,
+#   calibration and mission, new ground to the network that segments it; but two calibration
+#   fields only, two recipes, and mobilenetv2-dubai's temperature was fitted on tile 4.
+#   CONFIG (environment; default loto-proxy) names the configuration and EXTRA adds flags, e.g.
+#   CONFIG=loto-proxy-hull EXTRA="--top-level hull". About 25 minutes on 2 cores.
 # ensemble: field mIoU of the bundled networks and of their ensemble (examples/models/ensemble-dubai)
 #   on the same whole-field lawnmowers of tiles 4 and 6 at 5, 10 and 15 cm/px
 #   (examples/tools/eval_ensemble.py, PyTorch on the exported weights), each network also with
@@ -96,7 +105,7 @@
 # cross-fit: MobileNetV2's runs of part network (tiles 4 and 6, four classes) calibrated on the
 #   tiles CROSS_TILES (environment; default "1 2 3") and the other unseen tile, twice: every field
 #   segmented by the evaluation network (which trained on tiles 1, 2, 3 and 5), and each of
-#   CROSS_TILES by a network of the same recipe that never saw it (--calibration-model-file
+#   CROSS_TILES by a network of the same recipe that never saw it (--calibration-network
 #   out/loto-cpu/model-K, `bash scripts/loto.sh cpu K`, its temperature fitted on tile K as the
 #   evaluation network's was on its validation tile): whether calibrating on ground the network
 #   knows is what keeps its decision from descending. Needs network; about 20 minutes on 2 cores. With
@@ -116,9 +125,9 @@
 set -euo pipefail
 part=${1:-all}
 jobs=${2:-$(nproc 2>/dev/null || echo 2)}
-case "$part" in all | oracle | oracle-default | paper | network | loto | ensemble | ensemble-split | cells | curve-check | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | z-choice-network | \
+case "$part" in all | oracle | oracle-default | paper | network | loto | loto-proxy | ensemble | ensemble-split | cells | curve-check | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | z-choice-network | \
   cross-fit | network-variants | proxy-check | vertical-speed | all-tiles) ;;
-  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|loto|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed|all-tiles] [JOBS]" >&2
+  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|loto|loto-proxy|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed|all-tiles] [JOBS]" >&2
     exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
@@ -132,7 +141,7 @@ root=out/results
 classes="building road vegetation water"
 fixed=(--seg-time-s 0.1 --plan-time-s 0)
 paper=(--rule utility --gain-inputs delta-sigma --coverage region --no-plots)
-# A bundled network (--model-file examples/models/NET), one thread per run; calibration keeps the
+# A bundled network (--network examples/models/NET), one thread per run; calibration keeps the
 # network's segmentations on disk, so that the runs over the same tiles segment each image once.
 network=(--segmenter erfnet --threads 1 --segmentation-cache "out/results/segmentation-cache")
 # The networks of part network (environment NETS: a subset, e.g. NETS=ensemble-dubai reruns
@@ -214,7 +223,7 @@ if [ "$part" = sigma-prior ]; then
         weedmap-train-right) test=(--test "$w:0,0,0.5,1") ;;
         *) cls=${name#dubai-}; cls=${cls%%-*}; test=(--test "$(dubai "${name##*-}")" --interest "$cls") ;;
       esac
-      run "$config" "$name" --model "$model" "${test[@]}" "${fixed[@]}" --no-plots
+      run "$config" "$name" --decision-model "$model" "${test[@]}" "${fixed[@]}" --no-plots
     done
   done
   wait
@@ -232,7 +241,7 @@ if [ "$part" = z-choice ] || [ "$part" = z-choice-network ]; then
     "$calibrate_bin" "${train[@]}" "${interest[@]}" "${flags[@]}" --out "$out/$name.model.yaml" >"$out/$name.trials.txt" 2>&1
     for z in 0 0.5 1 1.5 2; do
       sed "s/^\(  *confidence:\) .*/\1 $z/" "$d/model.yaml" >"$out/$name.z$z.yaml"
-      "$eval_bin" --model "$out/$name.z$z.yaml" "${test[@]}" "${interest[@]}" "${flags[@]}" --no-plots \
+      "$eval_bin" --decision-model "$out/$name.z$z.yaml" "${test[@]}" "${interest[@]}" "${flags[@]}" --no-plots \
         --out "$out/$name.z$z" >"$out/$name.z$z.log" 2>&1
     done
   }
@@ -270,7 +279,7 @@ if [ "$part" = z-choice ] || [ "$part" = z-choice-network ]; then
     done
   else
     for net in ${NETS:-erfnet-dubai mobilenetv2-dubai}; do
-      flags=(--model-file "examples/models/$net" "${network[@]}")
+      flags=(--network "examples/models/$net" "${network[@]}")
       for cls in $classes; do
         for t in 4 6; do
           [ -d "$root/network/$net-$cls-fly$t" ] || continue
@@ -325,7 +334,7 @@ if [ "$part" = previous ]; then
       for t in 4 6; do
         train_except "$t"
         run network-previous "$net-$cls-fly$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
-          --model-file "examples/models/$net" "${network[@]}" "${previous[@]}"
+          --network "examples/models/$net" "${network[@]}" "${previous[@]}"
       done
     done
   done
@@ -361,8 +370,8 @@ if [ "$part" = cells ]; then
     for t in 4 6; do
       for cls in $classes; do
         build/release/examples/adaptseg_cell_study --field "$(dubai "$t")" --classes "$cls" --gsd 5 \
-          --segmenter erfnet --model-file "examples/models/$net" --threads "$jobs" \
-          --model "$root/network/$net-$cls-fly$t/model.yaml" --csv "$out/$net-$cls-$t.csv" >"$out/$net-$cls-$t.md" 2>/dev/null
+          --segmenter erfnet --network "examples/models/$net" --threads "$jobs" \
+          --decision-model "$root/network/$net-$cls-fly$t/model.yaml" --csv "$out/$net-$cls-$t.csv" >"$out/$net-$cls-$t.md" 2>/dev/null
       done
     done
     echo
@@ -389,7 +398,7 @@ if [ "$part" = ensemble-split ]; then
     for t in 4 6; do
       train_except "$t"
       run "$config" "ensemble-dubai-$cls-fly$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
-        --model-file examples/models/ensemble-dubai "${network[@]}" \
+        --network examples/models/ensemble-dubai "${network[@]}" \
         --cell-input sigma,boundary,ambiguity,expected_error,second_choice,split
     done
   done
@@ -405,14 +414,14 @@ if [ "$part" = loto ]; then
   crossed=()
   for k in 1 2 3 4 5 6; do
     [ -s "$loto/tile-$k/model.onnx" ] || { echo "no $loto/tile-$k: bash scripts/loto.sh recipe-cpu, then bundle" >&2; exit 1; }
-    crossed+=(--calibration-model-file "$loto/tile-$k")
+    crossed+=(--calibration-network "$loto/tile-$k")
   done
   rm -rf "${root:?}/loto"
   for cls in $classes; do
     for t in 1 2 3 4 5 6; do
       train_except "$t"
       run loto "mobilenetv2-loto-$cls-tile-$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
-        --model-file "$loto/tile-$t" "${network[@]}" "${crossed[@]}"
+        --network "$loto/tile-$t" "${network[@]}" "${crossed[@]}"
     done
   done
   wait
@@ -423,13 +432,33 @@ if [ "$part" = loto ]; then
   exit 0
 fi
 
+if [ "$part" = loto-proxy ]; then
+  loto1=examples/models/mobilenetv2-dubai-loto/tile-1 evaluation=examples/models/mobilenetv2-dubai
+  config=${CONFIG:-loto-proxy}
+  read -r -a extra <<<"${EXTRA:-}"
+  rm -rf "${root:?}/$config"
+  for cls in $classes; do
+    run "$config" "$cls-tile-1" --train "$(dubai 4)" --train "$(dubai 6)" --test "$(dubai 1)" --interest "$cls" \
+      --network "$loto1" --calibration-network "$evaluation" "${network[@]}" --no-plots "${extra[@]}"
+    for t in 4 6; do
+      run "$config" "$cls-tile-$t" --train "$(dubai 1)" --train "$(dubai $((10 - t)))" --test "$(dubai "$t")" \
+        --interest "$cls" --network "$evaluation" --calibration-network "$loto1" "${network[@]}" --no-plots "${extra[@]}"
+    done
+  done
+  wait
+  check
+  /usr/bin/python3 examples/tools/sweep_table.py "$config=$(dir_list "$root/$config"/*/)"
+  /usr/bin/python3 examples/tools/descent_table.py "$root/$config"/*/
+  exit 0
+fi
+
 if [ "$part" = cross-fit ]; then
   [ -d "$root/network" ] || { echo "run 'bash $0 network' first" >&2; exit 1; }
   cross_tiles=${CROSS_TILES:-1 2 3}
   crossed=()
   for k in $cross_tiles; do
     [ -s "out/loto-cpu/model-$k/model.onnx" ] || { echo "no out/loto-cpu/model-$k: bash scripts/loto.sh cpu $k" >&2; exit 1; }
-    crossed+=(--calibration-model-file "out/loto-cpu/model-$k")
+    crossed+=(--calibration-network "out/loto-cpu/model-$k")
   done
   # One pair of configurations per set of tiles (network-fields-123, network-cross-fit-123). With
   # all four tiles the network trained on, the evaluation network's runs are part network's.
@@ -446,7 +475,7 @@ if [ "$part" = cross-fit ]; then
         extra=()
         [ "$config" = "$crossfit" ] && extra=("${crossed[@]}")
         run "$config" "mobilenetv2-dubai-$cls-fly$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
-          --model-file examples/models/mobilenetv2-dubai "${network[@]}" --no-plots "${extra[@]}"
+          --network examples/models/mobilenetv2-dubai "${network[@]}" --no-plots "${extra[@]}"
       done
     done
   done
@@ -467,7 +496,7 @@ if [ "$part" = network-held-out ]; then
     for cls in $classes; do
       for t in 4 6; do
         run "$config" "$net-$cls-fly$t" --train "$(dubai $((10 - t)))" --test "$(dubai "$t")" \
-          --interest "$cls" --model-file "examples/models/$net" "${network[@]}" --no-plots
+          --interest "$cls" --network "examples/models/$net" "${network[@]}" --no-plots
       done
     done
   done
@@ -487,7 +516,7 @@ if [ "$part" = all-tiles ]; then
   for k in 1 2 3 4 5 6; do train+=(--train "$(dubai "$k")"); done
   for net in oracle ${NETS:-mobilenetv2-dubai}; do
     flags=("${fixed[@]}")
-    [ "$net" = oracle ] || flags=(--model-file "examples/models/$net" "${network[@]}")
+    [ "$net" = oracle ] || flags=(--network "examples/models/$net" "${network[@]}")
     for cls in $classes; do
       for pooling in cells fields; do
         "$calibrate_bin" "${train[@]}" --interest "$cls" "${flags[@]}" --slope-pooling "$pooling" \
@@ -515,7 +544,7 @@ if [ "$part" = proxy-check ]; then
       fields=()
       for t in $tiles; do fields+=(--field "$(dubai "$t")"); done
       build/release/examples/adaptseg_cell_study "${fields[@]}" --classes "${classes// /,}" --gsd 12.5,10,5 --segmenter erfnet \
-        --model-file "examples/models/$net" --threads 1 --seg-time-s 0.1 --plan-time-s 0 \
+        --network "examples/models/$net" --threads 1 --seg-time-s 0.1 --plan-time-s 0 \
         --csv "$out/$net-$set.csv" >"$out/$net-$set.md" 2>"$out/$net-$set.log" &
       throttle
     done
@@ -552,7 +581,7 @@ if [ "$part" = network-variants ]; then
         for t in 4 6; do
           train_except "$t"
           run "$config" "$net-$cls-fly$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
-            --model-file "examples/models/$net" "${network[@]}" --no-plots "${extra[@]}"
+            --network "examples/models/$net" "${network[@]}" --no-plots "${extra[@]}"
         done
       done
     done
@@ -604,7 +633,7 @@ if [ "$part" = all ] || [ "$part" = network ]; then
       for t in 4 6; do
         train_except "$t"
         run network "$net-$cls-fly$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
-          --model-file "examples/models/$net" "${network[@]}"
+          --network "examples/models/$net" "${network[@]}"
       done
     done
   done

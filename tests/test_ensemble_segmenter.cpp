@@ -47,7 +47,7 @@ Image tile6_image() {
   return img;
 }
 
-const ErfnetParams kParams{.camera_width_px = 480, .camera_height_px = 360, .resize_to_network = true, .num_threads = 2};
+const OnnxParams kParams{.camera_width_px = 480, .camera_height_px = 360, .resize_to_network = true, .num_threads = 2};
 
 }  // namespace
 
@@ -58,7 +58,7 @@ TEST_CASE("ensemble: the mean, its labels, disagreement and class splits follow 
   CHECK(ens.name() == "ensemble");
   CHECK(ens.weight(0) == doctest::Approx(0.75));
   CHECK(ens.weight(1) == doctest::Approx(0.25));
-  ErfnetSegmenter a(mnv2(), kParams), b(erfnet(), kParams);
+  OnnxSegmenter a(mnv2(), kParams), b(erfnet(), kParams);
   const Segmentation sa = a.segment_with_probabilities(img), sb = b.segment_with_probabilities(img);
   const EnsembleSegmentation e = ens.segment_with_disagreement(img);
   const int nc = ens.num_classes();
@@ -133,17 +133,17 @@ TEST_CASE("ensemble: the mean, its labels, disagreement and class splits follow 
 }
 
 TEST_CASE("test-time mirror: a network's probabilities are the mean over the image and its mirror") {
-  // ErfnetParams::test_time_mirror, on MobileNetV2: the mean of the plain probabilities of the
+  // OnnxParams::test_time_mirror, on MobileNetV2: the mean of the plain probabilities of the
   // image and of its left-right mirror (flipped back), labels its argmax, no-data kept; and an
   // ensemble member with `mirror` contributes exactly that.
   const Image img = tile6_image();
   Image mirrored = img;
   mirrored.rgb = cv::Mat();
   cv::flip(img.rgb, mirrored.rgb, 1);
-  ErfnetSegmenter plain(mnv2(), kParams);
-  ErfnetParams pm = kParams;
+  OnnxSegmenter plain(mnv2(), kParams);
+  OnnxParams pm = kParams;
   pm.test_time_mirror = true;
-  ErfnetSegmenter both(mnv2(), pm);
+  OnnxSegmenter both(mnv2(), pm);
   const Segmentation s = plain.segment_with_probabilities(img), f = plain.segment_with_probabilities(mirrored);
   const Segmentation m = both.segment_with_probabilities(img);
   CHECK(cv::countNonZero(m.labels != both.segment(img)) == 0);
@@ -185,7 +185,7 @@ TEST_CASE("test-time mirror: a network's probabilities are the mean over the ima
   CHECK((bundled[0].mirror && fs::equivalent(bundled[0].model_dir, mnv2())));
   CHECK((!bundled[1].mirror && fs::equivalent(bundled[1].model_dir, erfnet())));
   EnsembleSegmenter ens(tmp.path(), kParams);
-  ErfnetSegmenter erf(erfnet(), kParams);
+  OnnxSegmenter erf(erfnet(), kParams);
   const Segmentation e = ens.segment_with_probabilities(img), b = erf.segment_with_probabilities(img);
   double worst = 0.0;
   for (std::size_t k = 0; k < static_cast<std::size_t>(nc); ++k) {
@@ -199,7 +199,7 @@ TEST_CASE("test-time mirror: a network's probabilities are the mean over the ima
 TEST_CASE("ensemble: the bundled ensemble passes the backend conformance suite on held-out tile 6") {
   const Field f = Field::load(t::example_field("dubai-tile-6"));
   const CameraModel camera;
-  EnsembleSegmenter ens(models() / "ensemble-dubai", f, camera, ErfnetParams{.resize_to_network = true, .num_threads = 2});
+  EnsembleSegmenter ens(models() / "ensemble-dubai", f, camera, OnnxParams{.resize_to_network = true, .num_threads = 2});
   REQUIRE(ens.size() == 2);
   CHECK(ens.member(0).model_info().output_stride == 4);  // MobileNetV2 at 512 x 384
   CHECK(ens.member(1).model_info().output_stride == 1);  // ERFNet at 480 x 360
@@ -214,9 +214,9 @@ TEST_CASE("ensemble: the bundled ensemble maps held-out tile 6 at 15 cm/px bette
   const CameraModel camera;
   const SimulatedSensor sensor(f, camera);
   const auto plan = LawnmowerPlanner(camera).plan(f.area(), 3.0 * f.gsd_cm());
-  const ErfnetParams p{.resize_to_network = true, .num_threads = 2};
+  const OnnxParams p{.resize_to_network = true, .num_threads = 2};
   EnsembleSegmenter ens(models() / "ensemble-dubai", f, camera, p);
-  ErfnetSegmenter a(mnv2(), f, camera, p), b(erfnet(), f, camera, p);
+  OnnxSegmenter a(mnv2(), f, camera, p), b(erfnet(), f, camera, p);
   ConfusionMatrix ce(f.num_classes()), ca(f.num_classes()), cb(f.num_classes());
   for (const auto& w : plan) {
     const Image img = sensor.capture(w);
@@ -245,7 +245,7 @@ TEST_CASE("ensemble: bad member lists are refused with one line naming the probl
   refused([] { return EnsembleSegmenter({{mnv2(), 1.0}, {models() / "none", 1.0}}); }, "member 2 (");
   refused([] { return EnsembleSegmenter({{mnv2(), 1.0}, {models() / "none", 1.0}}); }, "model directory not found");
   // Members of another class set than the field's, or than each other.
-  refused([] { return EnsembleSegmenter(std::vector<EnsembleMember>{{mnv2(), 1.0}}, ErfnetParams{.expected_classes = {"soil", "crop", "weed"}}); },
+  refused([] { return EnsembleSegmenter(std::vector<EnsembleMember>{{mnv2(), 1.0}}, OnnxParams{.expected_classes = {"soil", "crop", "weed"}}); },
           "differ from the 3 expected classes");
   t::TempDir tmp;
   const fs::path other = tmp.path() / "renamed";

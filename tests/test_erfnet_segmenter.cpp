@@ -1,4 +1,4 @@
-// Tests of the ONNX backend (include/adaptseg/erfnet/erfnet_segmenter.hpp) with every bundled model:
+// Tests of the ONNX backend (include/adaptseg/erfnet/onnx_segmenter.hpp) with every bundled model:
 // examples/models/erfnet-dubai (ERFNet, input = camera size, stride 1) and
 // examples/models/mobilenetv2-dubai (MobileNetV2 + decoder, input 512x384 for the 480x360
 // camera, logits at stride 4), each with its fixture in tests/data/<fixture> (written by
@@ -10,7 +10,8 @@
 #include "test_support.hpp"
 
 #include <adaptseg/core/lawnmower_planner.hpp>
-#include <adaptseg/erfnet/erfnet_segmenter.hpp>
+#include <adaptseg/erfnet/erfnet_segmenter.hpp>  // the old name: it must still bring OnnxSegmenter in
+#include <adaptseg/erfnet/onnx_segmenter.hpp>
 #include <adaptseg/vision/metrics.hpp>
 #include <adaptseg/vision/oracle_segmenter.hpp>
 
@@ -26,15 +27,16 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 using namespace adaptseg;
 namespace t = adaptseg::test;
 namespace fs = std::filesystem;
 
-static_assert(SegmentationBackend<ErfnetSegmenter>);
-static_assert(!std::is_copy_constructible_v<ErfnetSegmenter>);
-static_assert(std::is_move_constructible_v<ErfnetSegmenter>);
+static_assert(SegmentationBackend<OnnxSegmenter>);
+static_assert(!std::is_copy_constructible_v<OnnxSegmenter>);
+static_assert(std::is_move_constructible_v<OnnxSegmenter>);
 
 namespace {
 
@@ -69,6 +71,14 @@ Image fixture_image(const BundledModel& m = kModels[0]) {
 
 }  // namespace
 
+// The names before adaptseg 0.3 name the same types until 0.4 (with a deprecation warning).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+static_assert(std::is_same_v<adaptseg::ErfnetSegmenter, adaptseg::OnnxSegmenter>);
+static_assert(std::is_same_v<adaptseg::ErfnetParams, adaptseg::OnnxParams>);
+static_assert(std::is_same_v<adaptseg::ErfnetModelInfo, adaptseg::OnnxModelInfo>);
+#pragma GCC diagnostic pop
+
 TEST_CASE("erfnet: each bundled model reproduces PyTorch's logits and labels on its fixture") {
   for (const BundledModel& m : kModels) {
     CAPTURE(m.dir);
@@ -82,7 +92,7 @@ TEST_CASE("erfnet: each bundled model reproduces PyTorch's logits and labels on 
     cv::inRange(img.rgb, cv::Scalar(0, 0, 0), cv::Scalar(0, 0, 0), black);
     REQUIRE(cv::countNonZero(black) == 0);
 
-    ErfnetSegmenter erfnet(m.model_dir(), ErfnetParams{.camera_width_px = img.width_px, .camera_height_px = img.height_px,
+    OnnxSegmenter erfnet(m.model_dir(), OnnxParams{.camera_width_px = img.width_px, .camera_height_px = img.height_px,
                                                      .resize_to_network = true, .num_threads = 2});
     REQUIRE(erfnet.num_classes() == shape[0]);
 
@@ -122,7 +132,7 @@ TEST_CASE("erfnet: each bundled model passes the backend conformance suite on th
   const CameraModel camera;
   for (const BundledModel& m : kModels) {
     CAPTURE(m.dir);
-    ErfnetSegmenter erfnet(m.model_dir(), f, camera, ErfnetParams{.resize_to_network = true, .num_threads = 2});
+    OnnxSegmenter erfnet(m.model_dir(), f, camera, OnnxParams{.resize_to_network = true, .num_threads = 2});
     CHECK(erfnet.name() == "erfnet");
     t::check_backend_conformance(erfnet, SimulatedSensor(f, camera), f.num_classes());
   }
@@ -142,7 +152,7 @@ TEST_CASE("erfnet: mIoU of each bundled model on held-out tile 6 at the finest G
   CHECK(plan.size() == 8);
   for (const BundledModel& m : kModels) {
     CAPTURE(m.dir);
-    ErfnetSegmenter erfnet(m.model_dir(), f, camera, ErfnetParams{.resize_to_network = true, .num_threads = 2});
+    OnnxSegmenter erfnet(m.model_dir(), f, camera, OnnxParams{.resize_to_network = true, .num_threads = 2});
     ConfusionMatrix erf(f.num_classes()), oracle_cm(f.num_classes());
     OracleSegmenter oracle(f.num_classes());
     for (const auto& w : plan) {
@@ -166,7 +176,7 @@ TEST_CASE("erfnet: probabilities are the softmax of the logits and black pixels 
   Image img = fixture_image();
   img.ignore_label = 255;
   img.rgb(cv::Rect(0, 0, 40, 30)).setTo(cv::Scalar(0, 0, 0));  // as outside the orthomosaic
-  ErfnetSegmenter erfnet(model_dir(), ErfnetParams{.num_threads = 2});
+  OnnxSegmenter erfnet(model_dir(), OnnxParams{.num_threads = 2});
   const cv::Mat labels = erfnet.segment(img);
   const std::vector<cv::Mat> probs = erfnet.probabilities(img);
   REQUIRE(probs.size() == static_cast<std::size_t>(erfnet.num_classes()));
@@ -195,7 +205,7 @@ TEST_CASE("erfnet: probabilities are the softmax of the logits and black pixels 
   CHECK(disagree <= 10);    // argmax of the softmax = argmax of the logits, but for exp rounding
 
   // With the no-data mask off, the network labels the black pixels too.
-  ErfnetSegmenter unmasked(model_dir(), ErfnetParams{.black_is_no_data = false});
+  OnnxSegmenter unmasked(model_dir(), OnnxParams{.black_is_no_data = false});
   const cv::Mat all = unmasked.segment(img);
   CHECK(cv::countNonZero(all == 255) == 0);
   CHECK(cv::countNonZero(all != labels) == 30 * 40);
@@ -203,7 +213,7 @@ TEST_CASE("erfnet: probabilities are the softmax of the logits and black pixels 
 
 TEST_CASE("erfnet: labels and tempered probabilities from one pass") {
   const Image img = fixture_image();
-  ErfnetSegmenter erfnet(model_dir(), ErfnetParams{.num_threads = 2});
+  OnnxSegmenter erfnet(model_dir(), OnnxParams{.num_threads = 2});
   const Segmentation s = erfnet.segment_with_probabilities(img);
   CHECK(cv::countNonZero(s.labels != erfnet.segment(img)) == 0);
   const auto probs = erfnet.probabilities(img);
@@ -216,7 +226,7 @@ TEST_CASE("erfnet: labels and tempered probabilities from one pass") {
   std::string yaml = t::read_file(model_dir() / "model.yaml");
   if (const auto at = yaml.find("\ntemperature:"); at != std::string::npos) yaml.erase(at + 1, yaml.find('\n', at + 1) - at);
   t::write_file(tmp.path() / "model.yaml", yaml + "temperature: 2\n");
-  ErfnetSegmenter warm(tmp.path(), ErfnetParams{.num_threads = 2});
+  OnnxSegmenter warm(tmp.path(), OnnxParams{.num_threads = 2});
   CHECK(warm.model_info().temperature == 2.0);
   const Segmentation w = warm.segment_with_probabilities(img);
   CHECK(cv::countNonZero(w.labels != s.labels) == 0);
@@ -232,7 +242,7 @@ TEST_CASE("erfnet: labels and tempered probabilities from one pass") {
   CHECK(bad == 0);
   // A temperature outside [0.01, 100] is refused, naming the file.
   t::write_file(tmp.path() / "model.yaml", yaml + "temperature: 0\n");
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(tmp.path()), doctest::Contains("temperature must be a number in [0.01, 100]"),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path()), doctest::Contains("temperature must be a number in [0.01, 100]"),
                        std::invalid_argument);
 }
 
@@ -242,9 +252,9 @@ TEST_CASE("erfnet: resize_to_network takes other camera sizes of the same aspect
   cv::resize(native.rgb, big.rgb, cv::Size(960, 720), 0, 0, cv::INTER_LINEAR);
   big.width_px = 960;
   big.height_px = 720;
-  ErfnetSegmenter strict(model_dir());
+  OnnxSegmenter strict(model_dir());
   CHECK_THROWS_WITH_AS((void)strict.segment(big), doctest::Contains("resize_to_network"), std::invalid_argument);
-  ErfnetSegmenter erfnet(model_dir(), ErfnetParams{.camera_width_px = 960, .camera_height_px = 720,
+  OnnxSegmenter erfnet(model_dir(), OnnxParams{.camera_width_px = 960, .camera_height_px = 720,
                                                    .resize_to_network = true});
   const cv::Mat labels = erfnet.segment(big);
   REQUIRE(labels.type() == CV_8UC1);
@@ -253,7 +263,7 @@ TEST_CASE("erfnet: resize_to_network takes other camera sizes of the same aspect
   // logits come back bilinearly enlarged to the camera size.
   Image small = native;
   cv::resize(big.rgb, small.rgb, cv::Size(480, 360), 0, 0, cv::INTER_AREA);
-  ErfnetSegmenter native_net(model_dir());
+  OnnxSegmenter native_net(model_dir());
   const std::vector<cv::Mat> want = native_net.logits(small);
   const std::vector<cv::Mat> got = erfnet.logits(big);
   REQUIRE(got.size() == want.size());
@@ -276,16 +286,16 @@ TEST_CASE("erfnet: resize_to_network takes other camera sizes of the same aspect
 TEST_CASE("erfnet: clear errors for bad models, bad parameters and images without RGB") {
   t::TempDir tmp;
   // Missing files.
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(tmp.path() / "nope"), doctest::Contains("model directory not found"),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path() / "nope"), doctest::Contains("model directory not found"),
                        std::invalid_argument);
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(tmp.path()), doctest::Contains("metadata file not found"),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path()), doctest::Contains("metadata file not found"),
                        std::invalid_argument);
   fs::copy_file(model_dir() / "model.yaml", tmp.path() / "model.yaml");
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(tmp.path()), doctest::Contains("ONNX file not found"),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path()), doctest::Contains("ONNX file not found"),
                        std::invalid_argument);
   // A corrupt ONNX file.
   t::write_file(tmp.path() / "model.onnx", "this is not a protobuf \x01\x02\x03 garbage garbage");
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(tmp.path()), doctest::Contains("cannot load ONNX model"),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path()), doctest::Contains("cannot load ONNX model"),
                        std::invalid_argument);
   // A truncated ONNX file.
   {
@@ -294,7 +304,7 @@ TEST_CASE("erfnet: clear errors for bad models, bad parameters and images withou
     bytes.resize(bytes.size() / 2);
     std::ofstream(tmp.path() / "model.onnx", std::ios::binary) << bytes;
   }
-  CHECK_THROWS_AS(ErfnetSegmenter(tmp.path()), std::invalid_argument);
+  CHECK_THROWS_AS(OnnxSegmenter(tmp.path()), std::invalid_argument);
   // Metadata whose class list does not match the network's output channels.
   fs::copy_file(model_dir() / "model.onnx", tmp.path() / "model.onnx", fs::copy_options::overwrite_existing);
   {
@@ -302,46 +312,46 @@ TEST_CASE("erfnet: clear errors for bad models, bad parameters and images withou
     meta["classes"].push_back("extra");
     std::ofstream(tmp.path() / "model.yaml") << meta;
   }
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(tmp.path()), doctest::Contains("outputs 1x5x"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path()), doctest::Contains("outputs 1x5x"), std::invalid_argument);
   // Malformed metadata.
   t::write_file(tmp.path() / "model.yaml", "classes: [a, b]\ninput: {width: 481, height: 360, channel_order: RGB, mean: [0,0,0], std: [1,1,1]}\n");
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(tmp.path()), doctest::Contains("multiples of 8"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path()), doctest::Contains("multiples of 8"), std::invalid_argument);
   t::write_file(tmp.path() / "model.yaml", "classes: [a, b]\ninput: {width: 480, height: 360, channel_order: RGB, mean: [0,0,0], std: [1,0,1]}\n");
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(tmp.path()), doctest::Contains("input.std"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path()), doctest::Contains("input.std"), std::invalid_argument);
   t::write_file(tmp.path() / "model.yaml", "classes: [a, b\n");
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(tmp.path()), doctest::Contains("YAML error"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path()), doctest::Contains("YAML error"), std::invalid_argument);
 
   // Wrong class count vs a field (WeedMap: soil, crop, weed).
   const Field weedmap = Field::load(t::example_field("weedmap-000"));
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(model_dir(), weedmap, CameraModel{}),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(model_dir(), weedmap, CameraModel{}),
                        doctest::Contains("the model's 5 classes [building, land, road, vegetation, water] "
                                          "differ from the 3 expected classes [soil, crop, weed]"),
                        std::invalid_argument);
   // Same count, other names or order.
-  CHECK_THROWS_AS(ErfnetSegmenter(model_dir(), ErfnetParams{.expected_classes = {"land", "building", "road", "vegetation", "water"}}),
+  CHECK_THROWS_AS(OnnxSegmenter(model_dir(), OnnxParams{.expected_classes = {"land", "building", "road", "vegetation", "water"}}),
                   std::invalid_argument);
   // A camera the network cannot take.
   const Field dubai = Field::load(t::example_field(kTestField));
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(model_dir(), dubai, CameraModel({.image_width_px = 640, .image_height_px = 480})),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(model_dir(), dubai, CameraModel({.image_width_px = 640, .image_height_px = 480})),
                        doctest::Contains("640x480 vs network input 480x360"), std::invalid_argument);
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(model_dir(), dubai, CameraModel({.image_width_px = 640, .image_height_px = 360}),
-                                       ErfnetParams{.resize_to_network = true}),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(model_dir(), dubai, CameraModel({.image_width_px = 640, .image_height_px = 360}),
+                                       OnnxParams{.resize_to_network = true}),
                        doctest::Contains("aspect ratio"), std::invalid_argument);
   // Bad parameters.
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(model_dir(), ErfnetParams{.camera_width_px = 480}),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(model_dir(), OnnxParams{.camera_width_px = 480}),
                        doctest::Contains("camera_width_px"), std::invalid_argument);
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(model_dir(), ErfnetParams{.num_threads = -1}),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(model_dir(), OnnxParams{.num_threads = -1}),
                        doctest::Contains("num_threads"), std::invalid_argument);
   // 100000 threads crashed OpenCV's pool at exit: refused before any is started.
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(model_dir(), ErfnetParams{.num_threads = 100000}),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(model_dir(), OnnxParams{.num_threads = 100000}),
                        doctest::Contains("num_threads must be in 0..256"), std::invalid_argument);
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(model_dir(), ErfnetParams{.name = ""}), doctest::Contains("name"),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(model_dir(), OnnxParams{.name = ""}), doctest::Contains("name"),
                        std::invalid_argument);
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(model_dir(), ErfnetParams{.dnn_target = 12345}),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(model_dir(), OnnxParams{.dnn_target = 12345}),
                        doctest::Contains("dnn_target"), std::invalid_argument);
 
   // Images without RGB (a labels-only field such as WeedMap) and mistyped images.
-  ErfnetSegmenter erfnet(model_dir(), dubai, CameraModel{});
+  OnnxSegmenter erfnet(model_dir(), dubai, CameraModel{});
   const SimulatedSensor no_rgb(weedmap, CameraModel{});
   const Image labels_only = no_rgb.capture(LawnmowerPlanner(CameraModel{}).plan(weedmap.area(), 2.0).front());
   REQUIRE(labels_only.rgb.empty());
@@ -367,11 +377,11 @@ TEST_CASE("erfnet: the deployment model (all six tiles) keeps the backend contra
   CHECK(meta["training"]["held_out_test_field"].as<std::string>() == "none");
   const Field f = Field::load(t::example_field(kTestField));
   const CameraModel camera;
-  const ErfnetParams p{.resize_to_network = true, .num_threads = 2};
-  ErfnetSegmenter all(dir, f, camera, p);
+  const OnnxParams p{.resize_to_network = true, .num_threads = 2};
+  OnnxSegmenter all(dir, f, camera, p);
   CHECK(all.model_info().output_stride == 4);
   t::check_backend_conformance(all, SimulatedSensor(f, camera), f.num_classes());
-  ErfnetSegmenter eval(kModels[1].model_dir(), f, camera, p);
+  OnnxSegmenter eval(kModels[1].model_dir(), f, camera, p);
   const SimulatedSensor sensor(f, camera);
   ConfusionMatrix ca(f.num_classes()), ce(f.num_classes());
   for (const auto& w : LawnmowerPlanner(camera).plan(f.area(), 3.0 * f.gsd_cm())) {

@@ -8,7 +8,7 @@
 
 #include <adaptseg/core/decision_function.hpp>
 #include <adaptseg/core/gaussian_process.hpp>
-#include <adaptseg/erfnet/erfnet_segmenter.hpp>
+#include <adaptseg/erfnet/onnx_segmenter.hpp>
 #include <adaptseg/vision/adaptive_mission.hpp>
 #include <adaptseg/vision/decision_model.hpp>
 #include <adaptseg/vision/gp_io.hpp>
@@ -909,7 +909,7 @@ TEST_CASE("robustness: decision model: I with three inputs") {
 // ---- ERFNet model files ----------------------------------------------------------------------
 
 TEST_CASE("robustness: erfnet: ONNX file missing") {
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(erfnet_dir() / "none.onnx", erfnet_dir() / "model.yaml"),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(erfnet_dir() / "none.onnx", erfnet_dir() / "model.yaml"),
                        Contains("ONNX file not found"), std::invalid_argument);
 }
 
@@ -918,7 +918,7 @@ TEST_CASE("robustness: erfnet: ONNX file corrupt") {
   std::string bytes = read_text(erfnet_dir() / "model.onnx");
   for (std::size_t k = 0; k < bytes.size(); k += 97) bytes[k] = static_cast<char>(bytes[k] ^ 0x5a);
   t::write_file(dir.path() / "model.onnx", bytes);
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(dir.path() / "model.onnx", erfnet_dir() / "model.yaml"),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(dir.path() / "model.onnx", erfnet_dir() / "model.yaml"),
                        Contains("cannot load ONNX model"), std::invalid_argument);
 }
 
@@ -926,19 +926,19 @@ TEST_CASE("robustness: erfnet: ONNX file truncated") {
   const t::TempDir dir;
   const std::string bytes = read_text(erfnet_dir() / "model.onnx");
   t::write_file(dir.path() / "model.onnx", bytes.substr(0, bytes.size() / 3));
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(dir.path() / "model.onnx", erfnet_dir() / "model.yaml"),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(dir.path() / "model.onnx", erfnet_dir() / "model.yaml"),
                        Contains("cannot load ONNX model"), std::invalid_argument);
 }
 
 TEST_CASE("robustness: erfnet: ONNX file empty") {
   const t::TempDir dir;
   t::write_file(dir.path() / "model.onnx", "");
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(dir.path() / "model.onnx", erfnet_dir() / "model.yaml"),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(dir.path() / "model.onnx", erfnet_dir() / "model.yaml"),
                        Contains("ONNX model"), std::invalid_argument);
 }
 
 TEST_CASE("robustness: erfnet: model for another class set") {
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(erfnet_dir(), weedmap_field(), CameraModel{}),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(erfnet_dir(), weedmap_field(), CameraModel{}),
                        Contains("differ from the 3 expected classes [soil, crop, weed]"), std::invalid_argument);
 }
 
@@ -946,13 +946,13 @@ TEST_CASE("robustness: erfnet: metadata input size not a multiple of 8") {
   const t::TempDir dir;
   t::write_file(dir.path() / "model.yaml",
                 replaced(read_text(erfnet_dir() / "model.yaml"), "width: 480", "width: 481"));
-  CHECK_THROWS_WITH_AS(ErfnetSegmenter(erfnet_dir() / "model.onnx", dir.path() / "model.yaml"),
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(erfnet_dir() / "model.onnx", dir.path() / "model.yaml"),
                        Contains("positive multiples of 8 (got 481x360)"), std::invalid_argument);
 }
 
 TEST_CASE("robustness: erfnet: field without RGB") {
   const Field f = weedmap_field();
-  ErfnetSegmenter erfnet(erfnet_dir());
+  OnnxSegmenter erfnet(erfnet_dir());
   const Image img = SimulatedSensor(f, CameraModel{}).capture(LawnmowerPlanner(CameraModel{}).plan(f.area(), 3.0)[0]);
   CHECK_THROWS_WITH_AS((void)erfnet.segment(img), Contains("the image has no RGB"), std::invalid_argument);
 }

@@ -7,6 +7,8 @@
 #include <adaptseg/vision/calibration.hpp>
 #include <adaptseg/vision/decision_model.hpp>
 
+#include "old_spelling.hpp"
+
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
@@ -47,10 +49,19 @@ inline std::string nearest_flag(const CLI::App& app, const std::string& word) {
   };
   std::string best;
   std::size_t best_distance = 3;
-  for (const CLI::Option* o : app.get_options())
+  for (const CLI::Option* o : app.get_options()) {
+    if (o->get_group() == kOldSpellings) continue;  // not to be suggested (old_spelling.hpp)
     for (const std::string& name : o->get_lnames())
       if (const std::size_t d = distance(word, "--" + name); d < best_distance) best = "--" + name, best_distance = d;
+  }
   return best;
+}
+
+/// Prints a command-line mistake of program `app` as one line on stderr; returns the exit code 2.
+inline int command_line_error(const CLI::App& app, const std::string& what) {
+  std::fprintf(stderr, "%s: error: %s (run %s --help for the options)\n", app.get_name().c_str(), what.c_str(),
+               app.get_name().c_str());
+  return 2;
 }
 
 /// Parses the command line into `app`. Returns nullopt to go on, else the exit code: 0 after
@@ -59,6 +70,7 @@ inline std::string nearest_flag(const CLI::App& app, const std::string& word) {
 inline std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
   try {
     app.parse(argc, argv);
+    tell_old_spellings(app);
     return std::nullopt;
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
@@ -81,9 +93,7 @@ inline std::optional<int> parse_command_line(CLI::App& app, int argc, char** arg
       what = "unknown option " + word + (near.empty() ? "" : "; did you mean " + near + "?");
       break;
     }
-    std::fprintf(stderr, "%s: error: %s (run %s --help for the options)\n", app.get_name().c_str(), what.c_str(),
-                 app.get_name().c_str());
-    return 2;
+    return command_line_error(app, what);
   }
 }
 
@@ -223,6 +233,7 @@ struct CalibrationCli {
   std::vector<std::string> cell_inputs;
   std::vector<std::string> slope_poolings{"cells", "fields"};
   std::string curve = "corrected";
+  std::string top_level = "undominated";
 
   void add_to(CLI::App& app) {
     std::vector<std::string> coverages;
@@ -263,6 +274,13 @@ struct CalibrationCli {
                        "lawnmowers' rise against the predicted one (corrected)")
             ->check(CLI::IsMember({"training", "field", "corrected"}))
             ->capture_default_str(),
+        app.add_option("--top-level", top_level,
+                       "front-aware rule with --coverage ranked: the top-level GSD among those calibrated, the "
+                       "coarsest whose lawnmower no faster one is predicted to beat (undominated), or from there a "
+                       "finer one while the predicted curve rises faster per second up to it than beyond it "
+                       "(hull); saved in the model")
+            ->check(CLI::IsMember({"undominated", "hull"}))
+            ->capture_default_str(),
         app.add_option("--gain-inputs", gain_inputs,
                        "what the GP I predicts the accuracy gain from: delta-sigma (the paper's) or "
                        "delta-sigma-height (the change of semantic ratio and of altitude)")
@@ -287,7 +305,7 @@ struct CalibrationCli {
     };
   }
 
-  /// Makes giving any calibration flag together with `other` (e.g. `--model`, which loads a
+  /// Makes giving any calibration flag together with `other` (e.g. `--decision-model`, which loads a
   /// calibrated model) a command-line error instead of a silently ignored flag.
   void exclude(CLI::Option* other) {
     for (CLI::Option* o : options_) o->excludes(other);
@@ -305,6 +323,7 @@ struct CalibrationCli {
     options.adaptive.coverage = parse_descent_coverage(coverage);
     options.front_aware.field_curve = curve == "field" || curve == "corrected";
     options.front_aware.curve_ratio = curve == "corrected";
+    options.front_aware.top_level = parse_top_level_choice(top_level);
     options.cell_inputs.clear();
     for (const auto& name : cell_inputs) options.cell_inputs.push_back(parse_decision_input(name));
     options.slope_poolings.clear();

@@ -1,16 +1,18 @@
 #pragma once
-// Choosing the segmentation backend by name (--segmenter oracle|erfnet --model-file PATH) for
+// Choosing the segmentation backend by name (--segmenter oracle|erfnet --network PATH) for
 // the example programs. Not part of the library.
 
 #include <adaptseg/core/camera.hpp>
 #include <adaptseg/core/lawnmower_planner.hpp>
 #include <adaptseg/erfnet/ensemble_segmenter.hpp>
-#include <adaptseg/erfnet/erfnet_segmenter.hpp>
+#include <adaptseg/erfnet/onnx_segmenter.hpp>
 #include <adaptseg/vision/calibration.hpp>
 #include <adaptseg/vision/field.hpp>
 #include <adaptseg/vision/oracle_segmenter.hpp>
 #include <adaptseg/vision/segmentation_backend.hpp>
 #include <adaptseg/vision/simulated_sensor.hpp>
+
+#include "old_spelling.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -22,6 +24,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <initializer_list>
 #include <iterator>
 #include <map>
 #include <memory>
@@ -75,7 +78,7 @@ inline std::string ensemble_digest(const std::filesystem::path& dir) {
   return name.string() + "-" + files_hash(files);
 }
 
-/// --model-file's ONNX file and metadata: a directory with model.onnx + model.yaml, or an .onnx
+/// --network's ONNX file and metadata: a directory with model.onnx + model.yaml, or an .onnx
 /// file with its .yaml next to it.
 inline std::pair<std::filesystem::path, std::filesystem::path> model_paths(const std::filesystem::path& model_file) {
   const bool dir = std::filesystem::is_directory(model_file);
@@ -85,7 +88,7 @@ inline std::pair<std::filesystem::path, std::filesystem::path> model_paths(const
   return {onnx, metadata};
 }
 
-/// --model-file's identity (a network's model_digest(), an ensemble directory's ensemble_digest()).
+/// --network's identity (a network's model_digest(), an ensemble directory's ensemble_digest()).
 inline std::string model_file_digest(const std::filesystem::path& model_file) {
   if (EnsembleSegmenter::is_ensemble_dir(model_file)) return ensemble_digest(model_file);
   const auto [onnx, metadata] = model_paths(model_file);
@@ -102,17 +105,17 @@ inline std::string network_name(const std::filesystem::path& model_file) {
 }
 
 /// Calls `f(backend)` with the network backend of `model_file`: an EnsembleSegmenter for an
-/// ensemble directory (ensemble.yaml), else an ErfnetSegmenter (model_paths()); named by
+/// ensemble directory (ensemble.yaml), else an OnnxSegmenter (model_paths()); named by
 /// network_name() and built with `params` otherwise.
 template <class F>
-decltype(auto) with_network(const std::filesystem::path& model_file, ErfnetParams params, F&& f) {
+decltype(auto) with_network(const std::filesystem::path& model_file, OnnxParams params, F&& f) {
   params.name = network_name(model_file);
   if (EnsembleSegmenter::is_ensemble_dir(model_file)) {
     EnsembleSegmenter ensemble(model_file, std::move(params));
     return std::forward<F>(f)(ensemble);
   }
   const auto [onnx, metadata] = model_paths(model_file);
-  ErfnetSegmenter erfnet(onnx, metadata, std::move(params));
+  OnnxSegmenter erfnet(onnx, metadata, std::move(params));
   return std::forward<F>(f)(erfnet);
 }
 
@@ -294,7 +297,7 @@ inline std::vector<std::string> network_training_fields(const std::filesystem::p
   }
   std::vector<std::string> out;
   for (const auto& file : metadata)
-    for (std::string& f : ErfnetSegmenter::read_model_info(file).training_fields)
+    for (std::string& f : OnnxSegmenter::read_model_info(file).training_fields)
       if (std::find(out.begin(), out.end(), f) == out.end()) out.push_back(std::move(f));
   return out;
 }
@@ -302,23 +305,24 @@ inline std::vector<std::string> network_training_fields(const std::filesystem::p
 /// The backend options shared by adaptseg_mission, adaptseg_calibrate and adaptseg_evaluate.
 struct SegmenterOptions {
   std::string name = "oracle";
-  std::filesystem::path model_file;  ///< ERFNet: model directory, or the .onnx (metadata: same stem .yaml)
+  std::filesystem::path network;  ///< ERFNet: model directory, or the .onnx (metadata: same stem .yaml)
   int threads = 0;                   ///< ERFNet: OpenCV threads (0: OpenCV's default)
   std::filesystem::path cache_root;  ///< ERFNet: where calibration keeps segmentations on disk (empty: nowhere)
-  /// ERFNet, calibration: networks for the training fields --model-file was trained on, each such
+  /// ERFNet, calibration: networks for the training fields --network was trained on, each such
   /// field segmented by the first of them that never saw it (cross-fitting, calibrate()).
-  std::vector<std::filesystem::path> calibration_model_files;
+  std::vector<std::filesystem::path> calibration_networks;
 
   void add_to(CLI::App& app) {
     app.add_option("--segmenter", name,
-                   "segmentation backend: oracle (ground truth, simulation only) or erfnet (needs --model-file)")
+                   "segmentation backend: oracle (ground truth, simulation only) or erfnet (needs --network)")
         ->check(CLI::IsMember({"oracle", "erfnet"}))
         ->capture_default_str();
-    app.add_option("--model-file", model_file,
+    CLI::Option* net = app.add_option("--network", network,
                    "network of --segmenter erfnet (the ONNX backend): a directory with model.onnx + model.yaml, "
                    "an .onnx file with its .yaml next to it (examples/models/erfnet-dubai, "
                    "examples/models/mobilenetv2-dubai), or an ensemble directory with ensemble.yaml "
                    "(examples/models/ensemble-dubai: the mean of its members' probabilities)");
+    accept_old_spelling(app, net, "--model-file", network);
     app.add_option("--threads", threads, "ERFNet: OpenCV threads (0: OpenCV's default; at most 256)")
         ->check(CLI::Range(0, 256))
         ->capture_default_str();
@@ -328,45 +332,51 @@ struct SegmenterOptions {
                    "always segment (their time is measured)");
   }
 
-  /// The calibrating programs' --calibration-model-file (cross-fitting).
-  CLI::Option* add_calibration_networks_to(CLI::App& app) {
-    return app.add_option("--calibration-model-file", calibration_model_files,
-                   "ERFNet, calibration (repeatable): networks of --model-file's recipe for the training fields it "
+  /// The calibrating programs' --calibration-network (cross-fitting), refused together with any
+  /// of `excludes`.
+  void add_calibration_networks_to(CLI::App& app, std::initializer_list<CLI::Option*> excludes = {}) {
+    CLI::Option* current = app.add_option("--calibration-network", calibration_networks,
+                   "ERFNet, calibration (repeatable): networks of --network's recipe for the training fields it "
                    "was trained on (training.fields of its model.yaml), each such field segmented by the first of "
                    "them that was not trained on it: a network knows its training fields so well that, calibrated "
                    "there, the decision learns that flying lower gains little (cross-fitting; the missions fly "
-                   "--model-file)");
+                   "--network)");
+    CLI::Option* old = accept_old_spelling(app, current, "--calibration-model-file", calibration_networks);
+    for (CLI::Option* e : excludes) {
+      current->excludes(e);
+      old->excludes(e);
+    }
   }
 
   /// Where calibration keeps the network's segmentations (--segmentation-cache), if anywhere:
   /// a folder named by the network and the hash of its files (model_file_digest()).
   [[nodiscard]] std::optional<std::filesystem::path> calibration_cache() const {
     if (name != "erfnet" || cache_root.empty()) return std::nullopt;
-    return cache_root / model_file_digest(model_file);
+    return cache_root / model_file_digest(network);
   }
 
   /// @throws std::invalid_argument for a model file given to the oracle or missing for ERFNet.
   void validate() const {
-    if (name == "erfnet" && model_file.empty())
-      throw std::invalid_argument("--segmenter erfnet needs --model-file (e.g. examples/models/erfnet-dubai)");
-    if (name == "oracle" && !model_file.empty())
-      throw std::invalid_argument("--model-file applies to --segmenter erfnet only");
-    if (name == "oracle" && !calibration_model_files.empty())
-      throw std::invalid_argument("--calibration-model-file applies to --segmenter erfnet only");
+    if (name == "erfnet" && network.empty())
+      throw std::invalid_argument("--segmenter erfnet needs --network (e.g. examples/models/erfnet-dubai)");
+    if (name == "oracle" && !network.empty())
+      throw std::invalid_argument("--network applies to --segmenter erfnet only");
+    if (name == "oracle" && !calibration_networks.empty())
+      throw std::invalid_argument("--calibration-network applies to --segmenter erfnet only");
   }
 
-  /// Per training field, the network that segments it in calibration: --model-file where it was
-  /// not trained on the field, else the first --calibration-model-file that was not (empty path:
-  /// --model-file). Without --calibration-model-file, --model-file for every field.
+  /// Per training field, the network that segments it in calibration: --network where it was
+  /// not trained on the field, else the first --calibration-network that was not (empty path:
+  /// --network). Without --calibration-network, --network for every field.
   /// @throws std::invalid_argument for a network whose metadata names no training fields (it
   ///         cannot be told whether it saw a field), or a field no given network is new to.
-  [[nodiscard]] std::vector<std::filesystem::path> calibration_networks(std::span<const Field> fields) const {
+  [[nodiscard]] std::vector<std::filesystem::path> network_per_field(std::span<const Field> fields) const {
     std::vector<std::filesystem::path> out(fields.size());
-    if (calibration_model_files.empty()) return out;
+    if (calibration_networks.empty()) return out;
     const auto trained_on = [](const std::filesystem::path& file, const char* flag) {
       std::vector<std::string> t = network_training_fields(file);
       if (t.empty())
-        throw std::invalid_argument(std::string("--calibration-model-file: ") + flag + " " + file.string() +
+        throw std::invalid_argument(std::string("--calibration-network: ") + flag + " " + file.string() +
                                     " names no training fields (training.fields in its model.yaml), so whether it "
                                     "saw a calibration field cannot be told");
       return t;
@@ -374,9 +384,9 @@ struct SegmenterOptions {
     const auto knows = [](const std::vector<std::string>& trained, const std::string& field) {
       return std::find(trained.begin(), trained.end(), field) != trained.end();
     };
-    const std::vector<std::string> mission = trained_on(model_file, "--model-file");
+    const std::vector<std::string> mission = trained_on(network, "--network");
     std::vector<std::vector<std::string>> pool;
-    for (const auto& file : calibration_model_files) pool.push_back(trained_on(file, "network"));
+    for (const auto& file : calibration_networks) pool.push_back(trained_on(file, "network"));
     for (std::size_t k = 0; k < fields.size(); ++k) {
       // A part of a field ("dubai-tile-1[0,0,0.5,1]", Field::sub_field) is that field's ground.
       const std::string& full = fields[k].name();
@@ -385,10 +395,10 @@ struct SegmenterOptions {
       std::size_t j = 0;
       while (j < pool.size() && knows(pool[j], field)) ++j;
       if (j == pool.size())
-        throw std::invalid_argument("--calibration-model-file: every network given was trained on calibration field '" +
-                                    full + "' (as --model-file " + model_file.string() +
+        throw std::invalid_argument("--calibration-network: every network given was trained on calibration field '" +
+                                    full + "' (as --network " + network.string() +
                                     " was): give one that never saw it");
-      out[k] = calibration_model_files[j];
+      out[k] = calibration_networks[j];
     }
     return out;
   }
@@ -404,10 +414,10 @@ struct SegmenterOptions {
       OracleSegmenter oracle(field.num_classes());
       return std::forward<F>(f)(oracle);
     }
-    ErfnetParams p = ErfnetSegmenter::for_field(field, CameraModel(camera));
+    OnnxParams p = OnnxSegmenter::for_field(field, CameraModel(camera));
     p.num_threads = threads;
     p.resize_to_network = true;
-    return with_network(model_file, std::move(p), std::forward<F>(f));
+    return with_network(network, std::move(p), std::forward<F>(f));
   }
 };
 
@@ -439,8 +449,8 @@ class OwnedCalibrationNetwork final : public CalibrationNetwork {
   AnyBackend any_;
 };
 
-/// adaptseg::calibrate for the programs: every field segmented by `backend` (--model-file, cached
-/// as calibrate_cached()) or, where `networks` (SegmenterOptions::calibration_networks(fields),
+/// adaptseg::calibrate for the programs: every field segmented by `backend` (--network, cached
+/// as calibrate_cached()) or, where `networks` (SegmenterOptions::network_per_field(fields),
 /// resolved once by the program before any work) names one, by that network (built for
 /// `fields.front()` seen by the missions' camera, cached in its own folder of
 /// --segmentation-cache).
@@ -465,7 +475,7 @@ CalibrationResult calibrate_fields(const SegmenterOptions& segmenter, std::span<
     }
     auto& net = built[file];
     if (!net) {
-      ErfnetParams p = ErfnetSegmenter::for_field(fields.front(), CameraModel(options.adaptive.mission.camera));
+      OnnxParams p = OnnxSegmenter::for_field(fields.front(), CameraModel(options.adaptive.mission.camera));
       p.num_threads = segmenter.threads;
       p.resize_to_network = true;
       p.name = network_name(file);
@@ -475,7 +485,7 @@ CalibrationResult calibrate_fields(const SegmenterOptions& segmenter, std::span<
         net = std::make_unique<OwnedCalibrationNetwork<EnsembleSegmenter>>(std::move(cache), file, std::move(p));
       } else {
         const auto [onnx, metadata] = model_paths(file);
-        net = std::make_unique<OwnedCalibrationNetwork<ErfnetSegmenter>>(std::move(cache), onnx, metadata, std::move(p));
+        net = std::make_unique<OwnedCalibrationNetwork<OnnxSegmenter>>(std::move(cache), onnx, metadata, std::move(p));
       }
     }
     backends.push_back(&net->backend());

@@ -187,7 +187,7 @@ inline void check_segmenter(const DecisionModel& model, const std::string& segme
     throw std::invalid_argument("the decision model was calibrated with segmenter '" + model.segmenter +
                                 "' but the mission uses '" + segmenter +
                                 "': calibrate with the backend the mission flies (adaptseg_calibrate --segmenter, "
-                                "--model-file)");
+                                "--network)");
 }
 
 /// One flown strategy: the mission, and the decisions for the model-based ones.
@@ -217,7 +217,7 @@ StrategyRun run_strategy(const Field& field, Backend& backend, const std::string
   if (overlap != LawnmowerOverlap{})
     throw std::invalid_argument("--overlap applies to --strategy lawnmower only (the decision function's regions "
                                 "are the paper's non-overlapping top-level footprints)");
-  if (model == nullptr) throw std::invalid_argument("--strategy " + strategy + " needs --model (from adaptseg_calibrate)");
+  if (model == nullptr) throw std::invalid_argument("--strategy " + strategy + " needs --decision-model (from adaptseg_calibrate)");
   check_segmenter(*model, backend.name());
   // Without --interest, the model's labels of interest (its GPs were fitted for them).
   model->check_classes(field);

@@ -8,12 +8,12 @@
 // for every input of the table in include/adaptseg/core/decision_inputs.hpp, the rank correlation of
 // the cells' input mass (value x field pixels) with their gain and the share of the achievable
 // positive gain that re-mapping the top 10 % / 20 % of cells by that mass captures, beside a
-// random choice and the best possible (hindsight), and their means over the groups; with --model,
+// random choice and the best possible (hindsight), and their means over the groups; with --decision-model,
 // the mean capture of the input that model's planner ranks cells by. --csv writes every cell.
 //
 //   adaptseg_cell_study --field examples/data/dubai-tile-4 --field examples/data/dubai-tile-6
 //       --classes building,road,vegetation,water --segmenter erfnet
-//       --model-file examples/models/mobilenetv2-dubai --csv out/cells.csv
+//       --network examples/models/mobilenetv2-dubai --csv out/cells.csv
 
 #include "common/cell_csv.hpp"
 #include "common/segmenters.hpp"
@@ -179,19 +179,20 @@ int main(int argc, char** argv) {
   app.add_option("--top-gsd", top_gsd, "top-level GSD [cm/px]")->capture_default_str();
   app.add_option("--gsd", gsds, "candidate GSDs of the cells [cm/px], comma-separated")->delimiter(',')->capture_default_str();
   app.add_option("--csv", csv_path, "write every cell to this CSV file");
-  std::filesystem::path model_file;
-  app.add_option("--model", model_file,
+  std::filesystem::path decision_model;
+  CLI::Option* model_opt = app.add_option("--decision-model", decision_model,
                  "a decision model calibrated with --coverage ranked: its input is the planner's ranking, summarised "
                  "on its own line");
+  adaptseg::examples::accept_old_spelling(app, model_opt, "--model", decision_model);
   common.add_to(app);
   segmenter.add_to(app);
   if (const auto code = adaptseg::examples::parse_command_line(app, argc, argv)) return *code;
   try {
     std::optional<DecisionInput> planner_input;
-    if (!model_file.empty()) {
-      const DecisionModel model = DecisionModel::load(model_file);
+    if (!decision_model.empty()) {
+      const DecisionModel model = DecisionModel::load(decision_model);
       if (!model.decision_function.model().cells())
-        throw std::invalid_argument("--model " + model_file.string() + " has no cell gain model (calibrate with --coverage ranked)");
+        throw std::invalid_argument("--decision-model " + decision_model.string() + " has no cell gain model (calibrate with --coverage ranked)");
       planner_input = model.decision_function.model().cells()->input();
     }
     std::vector<Cell> cells;
@@ -273,7 +274,7 @@ int main(int argc, char** argv) {
       const std::size_t k = index_of(*planner_input);
       std::printf("\nthe planner's ranking (%s, from %s): mean capture of the achievable positive gain %.2f at 10 %% "
                   "and %.2f at 20 %% of the cells (best possible at 20 %%: %.2f; random: %.2f)\n",
-                  to_string(*planner_input).c_str(), model_file.string().c_str(),
+                  to_string(*planner_input).c_str(), decision_model.string().c_str(),
                   counted[k] ? c10_sum[k] / counted[k] : NAN, counted[k] ? c20_sum[k] / counted[k] : NAN,
                   n > 0 ? best_sum / n : NAN, n > 0 ? random_sum / n : NAN);
     }

@@ -3,7 +3,7 @@
 
 Usage: cat STUDY.md ... | /usr/bin/python3 examples/tools/cell_study_table.py
 
-Reads the Markdown that adaptseg_cell_study prints (one or more runs, each with --model), and
+Reads the Markdown that adaptseg_cell_study prints (one or more runs, each with --decision-model), and
 prints, as Markdown:
   1. per (field, class, GSD) group: the planner's input and its capture of the achievable positive
      gain at 20 % of the cells, against the best possible and a random choice;

@@ -10,13 +10,13 @@
 // and the ECE bins pixels by their largest probability (15 equal bins) and compares each bin's
 // mean largest probability with the mean share of the predicted class: the accuracy at the
 // orthomosaic's resolution. With --write the temperature is written into the model's model.yaml
-// (key `temperature`, read by ErfnetSegmenter); --set T writes a given one, nothing fitted (a
+// (key `temperature`, read by OnnxSegmenter); --set T writes a given one, nothing fitted (a
 // temperature chosen elsewhere, e.g. the median of what networks of the same recipe fit on the
 // tiles they never saw: scripts/loto.sh bundle).
 //
-//   adaptseg_fit_temperature --model-file examples/models/mobilenetv2-dubai
+//   adaptseg_fit_temperature --network examples/models/mobilenetv2-dubai
 //       --field examples/data/dubai-tile-4 [--bands 1,1.5,2,2.5,3] [--threads 2] [--write]
-//   adaptseg_fit_temperature --model-file DIR --set 1.25
+//   adaptseg_fit_temperature --network DIR --set 1.25
 
 #include "common/segmenters.hpp"
 #include "common/strategies.hpp"
@@ -97,7 +97,7 @@ double ece(const Pixels& px, double t) {
 /// or appending it), the rest of the file as it was.
 void write_temperature(const std::filesystem::path& model_file, double t) {
   if (!std::filesystem::exists(model_file))
-    throw std::invalid_argument("--model-file " + model_file.string() + ": no such directory or file");
+    throw std::invalid_argument("--network " + model_file.string() + ": no such directory or file");
   const std::filesystem::path dir = std::filesystem::is_directory(model_file) ? model_file : model_file.parent_path();
   const std::filesystem::path yaml = dir / "model.yaml";
   std::ifstream in(yaml);
@@ -163,7 +163,7 @@ int main(int argc, char** argv) {
       if (!field_spec.empty() || write || at)
         throw std::invalid_argument("--set writes a given temperature: no --field, --write or --at with it");
       segmenter.validate();
-      write_temperature(segmenter.model_file, *set);
+      write_temperature(segmenter.network, *set);
       return 0;
     }
     if (field_spec.empty()) throw std::invalid_argument("--field is required (the validation field to fit on)");
@@ -228,7 +228,7 @@ int main(int argc, char** argv) {
     for (std::size_t b = 0; b < per_band.size(); ++b)
       std::printf("| %.1f | %zu | %.4f | %.4f |\n", bands[b] * field.gsd_cm(), per_band[b].size(), ece(per_band[b], 1.0),
                   ece(per_band[b], t));
-    if (write) write_temperature(segmenter.model_file, t);
+    if (write) write_temperature(segmenter.network, t);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "adaptseg_fit_temperature: error: %s\n", e.what());

@@ -38,94 +38,94 @@ adaptseg_calibrate)
   expect_error "max_vertical_speed_mps must be finite and >= 0" --field "$weedmap" --out "$work/m.yaml" \
     --vertical-speed -1
   # Cross-fitting: a field every network given was trained on, a flag the oracle has no use for.
-  expect_error "every network given was trained on calibration field 'dubai-tile-1' (as --model-file" \
-    --train "$dubai" --out "$work/m.yaml" --segmenter erfnet --model-file "$examples/models/mobilenetv2-dubai" \
-    --calibration-model-file "$examples/models/erfnet-dubai"
-  expect_error "--calibration-model-file applies to --segmenter erfnet only" --field "$weedmap" --out "$work/m.yaml" \
-    --calibration-model-file "$examples/models/erfnet-dubai"
+  expect_error "every network given was trained on calibration field 'dubai-tile-1' (as --network" \
+    --train "$dubai" --out "$work/m.yaml" --segmenter erfnet --network "$examples/models/mobilenetv2-dubai" \
+    --calibration-network "$examples/models/erfnet-dubai"
+  expect_error "--calibration-network applies to --segmenter erfnet only" --field "$weedmap" --out "$work/m.yaml" \
+    --calibration-network "$examples/models/erfnet-dubai"
   # A network whose model.yaml names no training fields: whether it saw a field cannot be told.
   mkdir -p "$work/unnamed"
   cp "$examples/models/mobilenetv2-dubai/model.onnx" "$work/unnamed/"
   awk '/^training:/ { skip = 1; next } skip && /^[^ ]/ { skip = 0 } !skip' \
     "$examples/models/mobilenetv2-dubai/model.yaml" >"$work/unnamed/model.yaml"
-  expect_error "--calibration-model-file: --model-file $work/unnamed names no training fields" --train "$dubai" \
-    --out "$work/m.yaml" --segmenter erfnet --model-file "$work/unnamed" \
-    --calibration-model-file "$examples/models/erfnet-dubai"
+  expect_error "--calibration-network: --network $work/unnamed names no training fields" --train "$dubai" \
+    --out "$work/m.yaml" --segmenter erfnet --network "$work/unnamed" \
+    --calibration-network "$examples/models/erfnet-dubai"
   # None of them wrote a model.
   [ ! -e "$work/m.yaml" ] || fail "a refused calibration wrote $work/m.yaml"
   ;;
 adaptseg_evaluate)
-  common_parse_errors --test "$dubai" --model "$weedmap_model" --out "$work/o" --no-plots
-  expect_error "did you mean --no-plots?" --test "$dubai" --model "$weedmap_model" --out "$work/o" --no-plot
+  common_parse_errors --test "$dubai" --decision-model "$weedmap_model" --out "$work/o" --no-plots
+  expect_error "did you mean --no-plots?" --test "$dubai" --decision-model "$weedmap_model" --out "$work/o" --no-plot
   expect_error "decision model was calibrated for classes [soil, crop, weed] but field 'dubai-tile-1' has" \
-    --test "$dubai" --model "$weedmap_model" --out "$work/o" --no-plots
+    --test "$dubai" --decision-model "$weedmap_model" --out "$work/o" --no-plots
   expect_error "--lawnmower-factors needs at least two factors in increasing order" --test "$weedmap" \
-    --model "$weedmap_model" --out "$work/o" --no-plots --lawnmower-factors 3,1
-  expect_error "--lawnmower-factors 0.500 is finer than the field" --test "$weedmap" --model "$weedmap_model" \
+    --decision-model "$weedmap_model" --out "$work/o" --no-plots --lawnmower-factors 3,1
+  expect_error "--lawnmower-factors 0.500 is finer than the field" --test "$weedmap" --decision-model "$weedmap_model" \
     --out "$work/o" --no-plots --lawnmower-factors 0.5,1
-  expect_error "write DIR:x0,y0,x1,y1" --test "$weedmap:0,0,1" --model "$weedmap_model" --out "$work/o" --no-plots
-  expect_error "give exactly one of --train (calibrate) and --model (load)" --test "$weedmap" --out "$work/o"
-  expect_error "--model excludes --calibration-model-file" --test "$dubai" --model "$weedmap_model" --out "$work/o" \
-    --calibration-model-file "$examples/models/erfnet-dubai"
+  expect_error "write DIR:x0,y0,x1,y1" --test "$weedmap:0,0,1" --decision-model "$weedmap_model" --out "$work/o" --no-plots
+  expect_error "give exactly one of --train (calibrate) and --decision-model (load)" --test "$weedmap" --out "$work/o"
+  expect_error "--decision-model excludes --calibration-network" --test "$dubai" --decision-model "$weedmap_model" --out "$work/o" \
+    --calibration-network "$examples/models/erfnet-dubai"
   expect_error "every network given was trained on calibration field 'dubai-tile-1[0,0,0.5,1]'" \
     --train "$dubai:0,0,0.5,1" --test "$dubai" --out "$work/o" --no-plots --segmenter erfnet \
-    --model-file "$examples/models/mobilenetv2-dubai" --calibration-model-file "$examples/models/erfnet-dubai"
+    --network "$examples/models/mobilenetv2-dubai" --calibration-network "$examples/models/erfnet-dubai"
   # The lawnmowers fly the model's camera and speed limits too: explicit ones must agree.
   expect_error "--vertical-speed 1.0000 differs from the decision model's 0.0000" --test "$weedmap" \
-    --model "$weedmap_model" --out "$work/o" --no-plots --vertical-speed 1
-  expect_error "--speed 3.0000 differs from the decision model's 2.0000" --test "$weedmap" --model "$weedmap_model" \
+    --decision-model "$weedmap_model" --out "$work/o" --no-plots --vertical-speed 1
+  expect_error "--speed 3.0000 differs from the decision model's 2.0000" --test "$weedmap" --decision-model "$weedmap_model" \
     --out "$work/o" --no-plots --speed 3
   expect_error "--camera dji-phantom4-rtk (5472x3648 px, 13.20 mm sensor, 8.80 mm focal) differs from the decision model's camera (480x360 px, 4.80 mm sensor, 5.50 mm focal)" \
-    --test "$weedmap" --model "$weedmap_model" --out "$work/o" --no-plots --camera dji-phantom4-rtk
+    --test "$weedmap" --decision-model "$weedmap_model" --out "$work/o" --no-plots --camera dji-phantom4-rtk
   ;;
 adaptseg_live)
-  common_parse_errors --images "$work/images" --model "$weedmap_model" --record-from "$weedmap"
-  expect_error "did you mean --record-from?" --images "$work/images" --model "$weedmap_model" --record-for "$weedmap"
-  expect_error "--model is required" --images "$work/images"
+  common_parse_errors --images "$work/images" --decision-model "$weedmap_model" --record-from "$weedmap"
+  expect_error "did you mean --record-from?" --images "$work/images" --decision-model "$weedmap_model" --record-for "$weedmap"
+  expect_error "--decision-model is required" --images "$work/images"
   expect_error "decision model was calibrated for classes [soil, crop, weed] but field 'dubai-tile-1' has" \
-    --images "$work/images" --model "$weedmap_model" --record-from "$dubai"
-  expect_error "area.yaml" --images "$work/none" --model "$weedmap_model"
-  expect_error "--record-yaw requires --record-from" --images "$work/images" --model "$weedmap_model" --record-yaw 30
-  expect_error "--record-yaw: Value 400 not in range" --images "$work/images" --model "$weedmap_model" \
+    --images "$work/images" --decision-model "$weedmap_model" --record-from "$dubai"
+  expect_error "area.yaml" --images "$work/none" --decision-model "$weedmap_model"
+  expect_error "--record-yaw requires --record-from" --images "$work/images" --decision-model "$weedmap_model" --record-yaw 30
+  expect_error "--record-yaw: Value 400 not in range" --images "$work/images" --decision-model "$weedmap_model" \
     --record-from "$weedmap" --record-yaw 400
   # GNSS poses: they need a geo-reference, to record and to fly.
-  expect_error "--record-gnss requires --record-from" --images "$work/images" --model "$weedmap_model" --record-gnss
-  expect_error "--record-gnss needs the field's geo-reference" --images "$work/images" --model "$weedmap_model" \
+  expect_error "--record-gnss requires --record-from" --images "$work/images" --decision-model "$weedmap_model" --record-gnss
+  expect_error "--record-gnss needs the field's geo-reference" --images "$work/images" --decision-model "$weedmap_model" \
     --record-from "$weedmap:0.5,0,1,0.5" --record-gnss
-  "$mission" --images "$work/images" --model "$weedmap_model" --record-from "$weedmap:0.5,0,1,0.5" >/dev/null ||
+  "$mission" --images "$work/images" --decision-model "$weedmap_model" --record-from "$weedmap:0.5,0,1,0.5" >/dev/null ||
     fail "recording"
-  expect_error "--geo-origin is for --record-from" --images "$work/images" --model "$weedmap_model" \
+  expect_error "--geo-origin is for --record-from" --images "$work/images" --decision-model "$weedmap_model" \
     --geo-origin 47.4,8.5,500,30
   printf 'file,latitude_deg,longitude_deg,relative_altitude_m\n00000.png,47.4,8.5,16.5\n' >"$work/images/poses.csv"
-  expect_error "GNSS poses need the area's geo-reference" --images "$work/images" --model "$weedmap_model"
+  expect_error "GNSS poses need the area's geo-reference" --images "$work/images" --decision-model "$weedmap_model"
   printf 'file,lat,lon\n' >"$work/images/poses.csv"
-  expect_error "the header must be one of file,x,y,z[,yaw_deg]" --images "$work/images" --model "$weedmap_model"
+  expect_error "the header must be one of file,x,y,z[,yaw_deg]" --images "$work/images" --decision-model "$weedmap_model"
   # area.yaml is read as field.yaml is: a misspelt key or a bad class colour is named.
   cp "$work/images/area.yaml" "$work/area.yaml.orig"
   echo "colour_map: x" >>"$work/images/area.yaml"
   expect_error "area.yaml: unknown key 'colour_map' (known: format, name," --images "$work/images" \
-    --model "$weedmap_model"
+    --decision-model "$weedmap_model"
   sed 's/color: \[0, 255, 0\]/color: [0, 256, 0]/' "$work/area.yaml.orig" >"$work/images/area.yaml"
   expect_error "'classes[1].color[1]' must be an integer in [0, 255] (got '256')" --images "$work/images" \
-    --model "$weedmap_model"
+    --decision-model "$weedmap_model"
   # Flying a vehicle: the camera sources need it, it needs a georeferenced area, the
   # connection string is checked, and a fence that leaves out waypoints is refused before
   # anything is sent.
   quarter="$weedmap:0.5,0,1,0.5"
-  expect_error "give the area to map: --images DIR" --model "$weedmap_model"
-  expect_error "--simulate-camera requires --mavlink" --model "$weedmap_model" --simulate-camera "$quarter"
-  expect_error "--mavlink needs a georeferenced area" --model "$weedmap_model" --mavlink udpin:0 \
+  expect_error "give the area to map: --images DIR" --decision-model "$weedmap_model"
+  expect_error "--simulate-camera requires --mavlink" --decision-model "$weedmap_model" --simulate-camera "$quarter"
+  expect_error "--mavlink needs a georeferenced area" --decision-model "$weedmap_model" --mavlink udpin:0 \
     --simulate-camera "$quarter"
-  expect_error "--camera-folder gives camera images without labels" --model "$weedmap_model" --mavlink udpin:0 \
+  expect_error "--camera-folder gives camera images without labels" --decision-model "$weedmap_model" --mavlink udpin:0 \
     --camera-folder "$work" --images "$work/images"
-  expect_error "--camera-folder requires --mavlink" --model "$weedmap_model" --camera-folder "$work" \
+  expect_error "--camera-folder requires --mavlink" --decision-model "$weedmap_model" --camera-folder "$work" \
     --images "$work/images"
-  expect_error "connection 'tcp:5760': unknown scheme 'tcp'; use udpin:[HOST:]PORT" --model "$weedmap_model" \
+  expect_error "connection 'tcp:5760': unknown scheme 'tcp'; use udpin:[HOST:]PORT" --decision-model "$weedmap_model" \
     --mavlink tcp:5760 --simulate-camera "$quarter" --geo-origin 47.4,8.5,500,30 --fence-margin-m 10
-  expect_error "waypoints the planner may fly are outside the site's fence" --model "$weedmap_model" \
+  expect_error "waypoints the planner may fly are outside the site's fence" --decision-model "$weedmap_model" \
     --mavlink udpin:0 --simulate-camera "$quarter" --geo-origin 47.4,8.5,500,30
   expect_error "the mission would fly 16.5 m above home at 3.00 cm/px, above --max-altitude-m 10.0" \
-    --model "$weedmap_model" --mavlink udpin:0 --simulate-camera "$quarter" --geo-origin 47.4,8.5,500,30 \
+    --decision-model "$weedmap_model" --mavlink udpin:0 --simulate-camera "$quarter" --geo-origin 47.4,8.5,500,30 \
     --max-altitude-m 10
   ;;
 *)

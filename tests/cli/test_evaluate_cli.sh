@@ -76,16 +76,16 @@ total=$(awk -F, '$2 == "adaptive" {print $6}' "$work/e/results.csv")
 budget=$(awk -F, '$2 == "lawnmower" && $3 == "15.000" {print $6}' "$work/e/results.csv")
 [ -n "$total" ] && [ -n "$budget" ] || fail "missing adaptive or 15 cm/px lawnmower row"
 budget=$(awk -v a="$total" -v b="$budget" 'BEGIN {printf "%.1f", (a + b) / 2}')
-"$evaluate" --model "$work/e/model.yaml" --test "$examples/data/dubai-tile-6" --interest road "${fixed[@]}" \
+"$evaluate" --decision-model "$work/e/model.yaml" --test "$examples/data/dubai-tile-6" --interest road "${fixed[@]}" \
   --budget-s "$budget" --no-plots --out "$work/b" >"$work/log" 2>&1 || fail "evaluate with budget failed"
 awk -F, -v b="$budget" 'NR > 1 && $2 != "lawnmower" && $6 > b + 1e-6 {bad = 1; print "over budget: " $0}
   END {exit bad}' "$work/b/results.csv" || fail "a mission exceeded the budget $budget s"
 echo "ok: budget $budget s kept"
 
-# A calibration flag next to --model (which fixes the calibration) is refused, not ignored.
-if "$evaluate" --model "$work/e/model.yaml" --test "$examples/data/dubai-tile-6" --coverage region \
+# A calibration flag next to --decision-model (which fixes the calibration) is refused, not ignored.
+if "$evaluate" --decision-model "$work/e/model.yaml" --test "$examples/data/dubai-tile-6" --coverage region \
   --out "$work/x" >"$work/log" 2>&1; then
-  fail "--coverage with --model was accepted"
+  fail "--coverage with --decision-model was accepted"
 fi
 grep -q "excludes" "$work/log" || fail "no clear error for --coverage with --model: $(tail -3 "$work/log")"
-echo "ok: calibration flags with --model refused"
+echo "ok: calibration flags with --decision-model refused"

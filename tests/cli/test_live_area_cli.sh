@@ -23,10 +23,10 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 for case in "4 30" "6 0"; do
   read -r tile heading <<<"$case"
   dir="$work/tile$tile"
-  "$live" --record-from "$examples/data/dubai-tile-$tile" --model "$work/model.yaml" --images "$dir" --record-gnss \
+  "$live" --record-from "$examples/data/dubai-tile-$tile" --decision-model "$work/model.yaml" --images "$dir" --record-gnss \
     --geo-origin "25.2,55.3,10,$heading" --grid centred >/dev/null || fail "recording tile $tile"
   "$python" "$(dirname "$0")/area_polygon.py" "$dir" "$dir.geojson" || fail "writing the area polygon"
-  "$live" --images "$dir" --model "$work/model.yaml" "${times[@]}" --area "$dir.geojson" --pose-tolerance-m 0.05 \
+  "$live" --images "$dir" --decision-model "$work/model.yaml" "${times[@]}" --area "$dir.geojson" --pose-tolerance-m 0.05 \
     --out "$dir-live" >"$dir.out" 2>"$work/err" || fail "tile $tile, heading $heading, --area: $(cat "$work/err")"
   "$python" - "$dir" <<'PY' || fail "tile $tile: a waypoint the folder did not record"
 import json, math, sys

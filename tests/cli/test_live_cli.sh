@@ -18,15 +18,15 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 
 "$calibrate" --field "$field" --region 0,0,0.5,0.5 --segmenter oracle "${times[@]}" --out "$work/model.yaml" \
   >/dev/null 2>"$work/calibrate.log" || fail "calibration: $(cat "$work/calibrate.log")"
-"$live" --record-from "$region" --model "$work/model.yaml" --images "$work/images" || fail "recording"
+"$live" --record-from "$region" --decision-model "$work/model.yaml" --images "$work/images" || fail "recording"
 for f in area.yaml poses.csv valid_mask.png; do [ -s "$work/images/$f" ] || fail "recording wrote no $f"; done
 
 # run NAME ARGS...: the live loop and the simulated mission with the same arguments.
 run() {
   local name=$1; shift
-  "$live" --images "$work/images" --model "$work/model.yaml" "$@" "${times[@]}" --out "$work/live-$name" ||
+  "$live" --images "$work/images" --decision-model "$work/model.yaml" "$@" "${times[@]}" --out "$work/live-$name" ||
     fail "live $name"
-  "$mission" --field "$region" --model "$work/model.yaml" "$@" "${times[@]}" --out "$work/mission-$name" \
+  "$mission" --field "$region" --decision-model "$work/model.yaml" "$@" "${times[@]}" --out "$work/mission-$name" \
     >/dev/null || fail "mission $name"
 }
 run adaptive --strategy adaptive
@@ -60,10 +60,10 @@ PY
 # turned half a turn (every image and its labels upside down) fly the same mission to the same
 # map; turned 30 deg, the images are fused turned (the map differs at the footprints' edges).
 for yaw in 180 30; do
-  "$live" --record-from "$region" --model "$work/model.yaml" --images "$work/images-$yaw" --record-yaw $yaw \
+  "$live" --record-from "$region" --decision-model "$work/model.yaml" --images "$work/images-$yaw" --record-yaw $yaw \
     >/dev/null || fail "recording at yaw $yaw"
   grep -q ",$yaw\$" "$work/images-$yaw/poses.csv" || fail "yaw $yaw not in poses.csv: $(sed -n 2p "$work/images-$yaw/poses.csv")"
-  "$live" --images "$work/images-$yaw" --model "$work/model.yaml" --strategy adaptive "${times[@]}" \
+  "$live" --images "$work/images-$yaw" --decision-model "$work/model.yaml" --strategy adaptive "${times[@]}" \
     --out "$work/live-yaw$yaw" >/dev/null || fail "live at yaw $yaw"
 done
 "$python" - "$work" <<'PY' || fail "turned cameras"
@@ -88,7 +88,7 @@ for yaw in ["180", "30"]:
 PY
 # A yaw that is no number: one error line naming the line, exit code 2.
 sed -i '3s/,30$/,nan/' "$work/images-30/poses.csv"
-"$live" --images "$work/images-30" --model "$work/model.yaml" "${times[@]}" >/dev/null 2>"$work/err"
+"$live" --images "$work/images-30" --decision-model "$work/model.yaml" "${times[@]}" >/dev/null 2>"$work/err"
 rc=$?
 [ "$rc" -eq 2 ] && [ "$(wc -l <"$work/err")" -eq 1 ] && grep -qF "line 3 is not file,x,y,z[,yaw_deg]" "$work/err" ||
   fail "yaw nan: exit code $rc, $(cat "$work/err")"
@@ -98,28 +98,28 @@ rc=$?
 # area.yaml's geo:, and from the area as a GeoJSON polygon (--area, the file adaptseg_plan
 # takes): the same waypoints in WGS84, images and decisions as the frame-metre folder's.
 wide="$field:0,0.5,1,0.75"
-"$live" --record-from "$wide" --model "$work/model.yaml" --images "$work/frame" >/dev/null || fail "recording wide"
-"$live" --record-from "$wide" --model "$work/model.yaml" --images "$work/gnss" --record-gnss \
+"$live" --record-from "$wide" --decision-model "$work/model.yaml" --images "$work/frame" >/dev/null || fail "recording wide"
+"$live" --record-from "$wide" --decision-model "$work/model.yaml" --images "$work/gnss" --record-gnss \
   --geo-origin 47.4,8.5,500,30 >/dev/null || fail "recording GNSS poses"
 head -1 "$work/gnss/poses.csv" | grep -qx "file,latitude_deg,longitude_deg,relative_altitude_m,heading_deg" ||
   fail "GNSS poses.csv header: $(head -1 "$work/gnss/poses.csv")"
 "$python" "$(dirname "$0")/area_polygon.py" "$work/gnss" "$work/wide.geojson" || fail "writing the area polygon"
-"$live" --images "$work/frame" --model "$work/model.yaml" "${times[@]}" --out "$work/live-frame" >/dev/null ||
+"$live" --images "$work/frame" --decision-model "$work/model.yaml" "${times[@]}" --out "$work/live-frame" >/dev/null ||
   fail "live, frame poses"
-"$live" --images "$work/gnss" --model "$work/model.yaml" "${times[@]}" --out "$work/live-gnss" >/dev/null ||
+"$live" --images "$work/gnss" --decision-model "$work/model.yaml" "${times[@]}" --out "$work/live-gnss" >/dev/null ||
   fail "live, GNSS poses"
 if [ "$gdal" = gdal ]; then
-  "$live" --images "$work/gnss" --model "$work/model.yaml" "${times[@]}" --area "$work/wide.geojson" \
+  "$live" --images "$work/gnss" --decision-model "$work/model.yaml" "${times[@]}" --area "$work/wide.geojson" \
     --grid corner --out "$work/live-area" >/dev/null || fail "live, --area"
   # --area alone lays the grid centred on the site, as adaptseg_plan does: recorded with the same
   # grid, the folder's own area.yaml flies the same top-level waypoints, each inside the site.
   # (The site's frame, rebuilt from the polygon, is the area's to about a centimetre, which can
   # move a σ in the fourth digit and with it a marginal decision: the descents are not compared.)
-  "$live" --record-from "$wide" --model "$work/model.yaml" --images "$work/gnss-centred" --record-gnss \
+  "$live" --record-from "$wide" --decision-model "$work/model.yaml" --images "$work/gnss-centred" --record-gnss \
     --geo-origin 47.4,8.5,500,30 --grid centred >/dev/null || fail "recording GNSS poses, centred grid"
-  "$live" --images "$work/gnss-centred" --model "$work/model.yaml" "${times[@]}" --grid centred \
+  "$live" --images "$work/gnss-centred" --decision-model "$work/model.yaml" "${times[@]}" --grid centred \
     --out "$work/live-centred" >/dev/null || fail "live, centred grid"
-  "$live" --images "$work/gnss-centred" --model "$work/model.yaml" "${times[@]}" --area "$work/wide.geojson" \
+  "$live" --images "$work/gnss-centred" --decision-model "$work/model.yaml" "${times[@]}" --area "$work/wide.geojson" \
     --out "$work/live-area-centred" >/dev/null || fail "live, --area, centred grid"
   "$python" - "$work" <<'PY' || fail "--area's centred grid"
 import json, sys
@@ -190,7 +190,7 @@ if [ "$gdal" = gdal ] && command -v gdaltransform >/dev/null; then
     tail -n +2 "$work/gnss/poses.csv" | paste -d' ' - "$work/utm.xy" |
       awk '{split($1, c, ","); printf "%s,%.4f,%.4f,%s,%s\n", c[1], $2, $3, c[4], c[5]}'
   } >"$work/utm/poses.csv"
-  "$live" --images "$work/utm" --model "$work/model.yaml" "${times[@]}" --out "$work/live-utm" >/dev/null ||
+  "$live" --images "$work/utm" --decision-model "$work/model.yaml" "${times[@]}" --out "$work/live-utm" >/dev/null ||
     fail "live, UTM poses"
   "$python" - "$work" <<'PY' || fail "UTM poses"
 import json, sys
@@ -222,7 +222,7 @@ for line in lines[1:]:
     out.append(f"{f},{lat:.10f},{lon:.10f},{alt + up:.4f},{hdg}")
 open(f"{work}/gnss-noisy/poses.csv", "w").write("\n".join(out) + "\n")
 PY
-"$live" --images "$work/gnss-noisy" --model "$work/model.yaml" "${times[@]}" --out "$work/live-noisy" \
+"$live" --images "$work/gnss-noisy" --decision-model "$work/model.yaml" "${times[@]}" --out "$work/live-noisy" \
   >"$work/noisy.out" 2>"$work/err" || fail "GNSS poses with a metre of error: $(cat "$work/err")"
 grep -qF "poses: an image within 1.440 m of its waypoint (0.4 x the finest footprint's smaller side" \
   "$work/noisy.out" || fail "the pose tolerance is not printed: $(head -2 "$work/noisy.out")"
@@ -245,7 +245,7 @@ PY
 # with the error and the waypoint it stopped at, and the flown path (that waypoint included).
 cp -r "$work/gnss" "$work/gnss-broken"
 rm "$work/gnss-broken/labels/00002.png"
-"$live" --images "$work/gnss-broken" --model "$work/model.yaml" "${times[@]}" --out "$work/live-broken" \
+"$live" --images "$work/gnss-broken" --decision-model "$work/model.yaml" "${times[@]}" --out "$work/live-broken" \
   >/dev/null 2>"$work/err"
 rc=$?
 [ "$rc" -eq 2 ] && [ "$(wc -l <"$work/err")" -eq 1 ] && grep -qF "gnss-broken/labels/00002.png: no labels" "$work/err" ||
@@ -272,11 +272,11 @@ PY
 # and cropped to 16:9, which is refused saying what to do.
 dubai="$examples/data/dubai-tile-4:0,0,0.5,0.5"
 net="$examples/models/mobilenetv2-dubai"
-"$calibrate" --field "$dubai" --segmenter erfnet --model-file "$net" "${times[@]}" --out "$work/dubai.yaml" \
+"$calibrate" --field "$dubai" --segmenter erfnet --network "$net" "${times[@]}" --out "$work/dubai.yaml" \
   >/dev/null 2>"$work/err" || fail "calibrating with the network: $(cat "$work/err")"
-"$live" --record-from "$dubai" --model "$work/dubai.yaml" --images "$work/dubai" >/dev/null || fail "recording Dubai"
-network=(--segmenter erfnet --model-file "$net" "${times[@]}")
-"$live" --images "$work/dubai" --model "$work/dubai.yaml" "${network[@]}" --out "$work/live-dubai" \
+"$live" --record-from "$dubai" --decision-model "$work/dubai.yaml" --images "$work/dubai" >/dev/null || fail "recording Dubai"
+network=(--segmenter erfnet --network "$net" "${times[@]}")
+"$live" --images "$work/dubai" --decision-model "$work/dubai.yaml" "${network[@]}" --out "$work/live-dubai" \
   >"$work/dubai.out" 2>"$work/err" || fail "live, network: $(cat "$work/err")"
 cp -r "$work/dubai" "$work/dubai-large"
 "$python" - "$work/dubai-large/rgb" <<'PY' || fail "doubling the images"
@@ -285,7 +285,7 @@ for f in glob.glob(f"{sys.argv[1]}/*.png"):  # each pixel repeated 2x2: area res
     m = cv2.imread(f)
     cv2.imwrite(f, cv2.resize(m, (2 * m.shape[1], 2 * m.shape[0]), interpolation=cv2.INTER_NEAREST))
 PY
-"$live" --images "$work/dubai-large" --model "$work/dubai.yaml" "${network[@]}" --out "$work/live-dubai-large" \
+"$live" --images "$work/dubai-large" --decision-model "$work/dubai.yaml" "${network[@]}" --out "$work/live-dubai-large" \
   >/dev/null 2>"$work/err" || fail "live, 960x720 camera images: $(cat "$work/err")"
 "$python" - "$work" <<'PY' || fail "the GSD flown, images of another size"
 import json, re, sys
@@ -307,7 +307,7 @@ import cv2, glob, sys
 for f in glob.glob(f"{sys.argv[1]}/*.png"):
     cv2.imwrite(f, cv2.imread(f)[:540])
 PY
-"$live" --images "$work/dubai-large" --model "$work/dubai.yaml" "${network[@]}" >/dev/null 2>"$work/err"
+"$live" --images "$work/dubai-large" --decision-model "$work/dubai.yaml" "${network[@]}" >/dev/null 2>"$work/err"
 rc=$?
 [ "$rc" -eq 2 ] && [ "$(wc -l <"$work/err")" -eq 1 ] &&
   grep -qF "rgb/00000.png: the image is 960x540 (aspect 1.778), the decision model's camera 480x360 (aspect 1.333): crop the images to the camera's aspect ratio, or calibrate a model for this camera" "$work/err" ||
@@ -316,7 +316,7 @@ echo "ok: $(cat "$work/err")"
 
 # A folder without the image of a requested waypoint: one error line, exit code 2.
 sed -i '2d' "$work/images/poses.csv"  # the first top-level waypoint's image
-"$live" --images "$work/images" --model "$work/model.yaml" "${times[@]}" >/dev/null 2>"$work/err"
+"$live" --images "$work/images" --decision-model "$work/model.yaml" "${times[@]}" >/dev/null 2>"$work/err"
 rc=$?
 [ "$rc" -eq 2 ] || fail "missing image: exit code $rc (want 2)"
 [ "$(wc -l <"$work/err")" -eq 1 ] || fail "missing image: want one error line, got: $(cat "$work/err")"

@@ -42,9 +42,9 @@ times=(--seg-time-s 0.1 --plan-time-s 0)
 
 "$calibrate" --field "$examples/data/weedmap-000" --region 0,0,0.5,0.5 --segmenter oracle --rule utility \
   "${times[@]}" --out "$work/model.yaml" >/dev/null 2>"$work/err" || fail "calibration: $(cat "$work/err")"
-"$mission" --field "$region" --geo-origin "$geo" --strategy adaptive --model "$work/model.yaml" "${times[@]}" \
+"$mission" --field "$region" --geo-origin "$geo" --strategy adaptive --decision-model "$work/model.yaml" "${times[@]}" \
   --out "$work/sim" >/dev/null || fail "the simulated mission"
-flight=(--mavlink udpin:127.0.0.1:0 --simulate-camera "$region" --geo-origin "$geo" --model "$work/model.yaml"
+flight=(--mavlink udpin:127.0.0.1:0 --simulate-camera "$region" --geo-origin "$geo" --decision-model "$work/model.yaml"
         "${times[@]}" --arrival-max-speed-mps 0.1 --link-timeout-s 2)
 
 # The corner grid's far row sticks out of the area: refused before a socket is opened.
@@ -97,9 +97,9 @@ fly() {
 # refused at the first picture (exit 2, one line, nothing lost).
 dubai="$examples/data/dubai-tile-4:0,0,0.5,0.5"
 net="$examples/models/mobilenetv2-dubai"
-"$calibrate" --field "$dubai" --segmenter erfnet --model-file "$net" "${times[@]}" --out "$work/dubai.yaml" \
+"$calibrate" --field "$dubai" --segmenter erfnet --network "$net" "${times[@]}" --out "$work/dubai.yaml" \
   >/dev/null 2>"$work/err" || fail "calibrating with the network: $(cat "$work/err")"
-"$live" --record-from "$dubai" --model "$work/dubai.yaml" --images "$work/dubai" --record-gnss --geo-origin 25.2,55.3,10,30 --grid centred \
+"$live" --record-from "$dubai" --decision-model "$work/dubai.yaml" --images "$work/dubai" --record-gnss --geo-origin 25.2,55.3,10,30 --grid centred \
   >/dev/null || fail "recording Dubai"
 mkdir -p "$work/card" "$work/plain" "$work/camera" "$work/camera-plain"
 "$python" - "$work" <<'PY' || fail "writing the camera's cards"
@@ -127,8 +127,8 @@ PY
 # The WeedMap flights (home at the field's frame origin) and the camera folder's (home at the
 # Dubai quarter's), side by side.
 weedmap=("${flight[@]}" --fence-margin-m "$margin")
-camera=(--mavlink udpin:127.0.0.1:0 --images "$work/dubai" --image-pose exif --segmenter erfnet --model-file "$net"
-        --model "$work/dubai.yaml" "${times[@]}" --arrival-max-speed-mps 0.1 --link-timeout-s 2 --camera-timeout-s 5
+camera=(--mavlink udpin:127.0.0.1:0 --images "$work/dubai" --image-pose exif --segmenter erfnet --network "$net"
+        --decision-model "$work/dubai.yaml" "${times[@]}" --arrival-max-speed-mps 0.1 --link-timeout-s 2 --camera-timeout-s 5
         --grid centred)
 fly complete "--home 47.4,8.5" "${weedmap[@]}" --trigger autopilot
 fly lost "--home 47.4,8.5 --lose-link-after 12" "${weedmap[@]}"

@@ -28,27 +28,27 @@ bad_inputs)
   expect_error "max_vertical_speed_mps must be finite and >= 0" --field "$field" --gsd 3 --vertical-speed -0.5 \
     --out "$work/o"
   expect_error "fixed_segmentation_time_s" --field "$field" --gsd 3 --seg-time-s -1 --out "$work/o"
-  expect_error "needs --model-file" --field "$field" --gsd 3 --segmenter erfnet --out "$work/o"
-  expect_error "applies to --segmenter erfnet only" --field "$field" --gsd 3 --model-file "$work" --out "$work/o"
-  expect_error "not found" --field "$field" --gsd 3 --segmenter erfnet --model-file "$work/none" --out "$work/o"
+  expect_error "needs --network" --field "$field" --gsd 3 --segmenter erfnet --out "$work/o"
+  expect_error "applies to --segmenter erfnet only" --field "$field" --gsd 3 --network "$work" --out "$work/o"
+  expect_error "not found" --field "$field" --gsd 3 --segmenter erfnet --network "$work/none" --out "$work/o"
   # The bundled ERFNet knows the Dubai classes, not WeedMap's.
-  expect_error "classes" --field "$field" --gsd 3 --segmenter erfnet --model-file "$examples/models/erfnet-dubai" \
+  expect_error "classes" --field "$field" --gsd 3 --segmenter erfnet --network "$examples/models/erfnet-dubai" \
     --out "$work/o"
   # A decision model of another class set (WeedMap's, flown on Dubai).
   expect_error "decision model was calibrated for classes [soil, crop, weed] but field 'dubai-tile-1' has" \
     --field "$examples/data/dubai-tile-1" --strategy adaptive \
-    --model "$examples/../tests/data/decision_model/weedmap_utility.yaml" --out "$work/o"
+    --decision-model "$examples/../tests/data/decision_model/weedmap_utility.yaml" --out "$work/o"
   # A model calibrated with one backend flown with another: refused, naming both (a network by its
   # folder and the hash of its weights and metadata).
   expect_error "decision model was calibrated with segmenter 'oracle' but the mission uses 'erfnet:erfnet-dubai-" \
     --field "$examples/data/dubai-tile-1" --strategy adaptive --segmenter erfnet \
-    --model-file "$examples/models/erfnet-dubai" \
-    --model "$examples/../tests/data/decision_model/dubai_road_front_aware.yaml" --out "$work/o"
+    --network "$examples/models/erfnet-dubai" \
+    --decision-model "$examples/../tests/data/decision_model/dubai_road_front_aware.yaml" --out "$work/o"
   sed 's/^  segmenter: oracle/  segmenter: "erfnet:mobilenetv2-dubai-0123456789abcdef"/' \
     "$examples/../tests/data/decision_model/dubai_road_front_aware.yaml" >"$work/mobilenet-model.yaml"
   expect_error "calibrated with segmenter 'erfnet:mobilenetv2-dubai-0123456789abcdef' but the mission uses 'erfnet:erfnet-dubai-" \
     --field "$examples/data/dubai-tile-1" --strategy adaptive --segmenter erfnet \
-    --model-file "$examples/models/erfnet-dubai" --model "$work/mobilenet-model.yaml" --out "$work/o"
+    --network "$examples/models/erfnet-dubai" --decision-model "$work/mobilenet-model.yaml" --out "$work/o"
   expect_error "'0.5,0,1' is not a region x0,y0,x1,y1 (fractions 0..1); write DIR:x0,y0,x1,y1" \
     --field "$field:0.5,0,1" --gsd 3 --out "$work/o"
   # Command-line syntax errors (CLI11's): the same one line and exit code 2.
@@ -66,7 +66,24 @@ bad_inputs)
   expect_error "is not OVERLAP or ALONG,ACROSS" --field "$field" --gsd 3 --overlap 0.2,x --out "$work/o"
   expect_error "--overlap applies to --strategy lawnmower only" --field "$field" --strategy adaptive --overlap 0.2 \
     --out "$work/o"
+  # The old spellings (--model, --model-file) and the new given together: refused.
+  expect_error "excludes" --field "$examples/data/dubai-tile-1" --strategy adaptive \
+    --model "$work/mobilenet-model.yaml" --decision-model "$work/mobilenet-model.yaml" --out "$work/o"
+  expect_error "excludes" --field "$field" --gsd 3 --segmenter erfnet --network "$work" --model-file "$work" \
+    --out "$work/o"
   [ ! -e "$work/o" ] || fail "an error must be reported before the mission writes anything"
+  # The old spellings still fly, until adaptseg 0.4, with one line each on stderr naming the new.
+  "$mission" --field "$examples/data/dubai-tile-1:0,0,0.5,0.5" --strategy adaptive --segmenter erfnet \
+    --model-file "$examples/models/erfnet-dubai" --model "$work/mobilenet-model.yaml" --threads 1 \
+    --out "$work/old" >"$work/old.out" 2>"$work/old.err"
+  grep -q "calibrated with segmenter 'erfnet:mobilenetv2-dubai-0123456789abcdef'" "$work/old.err" ||
+    fail "the old spellings did not reach the mission: $(cat "$work/old.err")"
+  [ "$(grep -c -- "--model is deprecated and goes in adaptseg 0.4: use --decision-model" "$work/old.err")" = 1 ] ||
+    fail "want one notice for --model: $(cat "$work/old.err")"
+  [ "$(grep -c -- "--model-file is deprecated and goes in adaptseg 0.4: use --network" "$work/old.err")" = 1 ] ||
+    fail "want one notice for --model-file: $(cat "$work/old.err")"
+  echo "ok: the old spellings --model and --model-file, each with one notice"
+  rm -rf "$work/old"
   # With overlap the lawnmower takes more images over the same field and says so in result.json.
   for o in 0 0.5,0.25; do
     "$mission" --field "$field" --gsd 3 --seg-time-s 0.1 --plan-time-s 0 --overlap "$o" \
@@ -127,7 +144,7 @@ erfnet_sweep)
   for net in erfnet-dubai mobilenetv2-dubai ensemble-dubai; do
     for gsd in 5 15; do
       "$mission" --field "$tile" --strategy lawnmower --gsd "$gsd" --segmenter erfnet \
-        --model-file "$examples/models/$net" --seg-time-s 0.1 --plan-time-s 0 \
+        --network "$examples/models/$net" --seg-time-s 0.1 --plan-time-s 0 \
         --out "$work/$net-$gsd" >/dev/null || fail "$net mission at $gsd failed"
     done
   done
@@ -163,15 +180,15 @@ PY
   ;;
 cross_fit)
   # A calibration field the missions' network was trained on (the deployment MobileNetV2 saw every
-  # tile) is segmented by the first --calibration-model-file that never saw it: not the deployment
+  # tile) is segmented by the first --calibration-network that never saw it: not the deployment
   # network given again, the evaluation MobileNetV2 (tiles 1, 2, 3, 5). The model names the
   # missions' network and, per field, the one that segmented it; without the flag no field_segmenters.
   [ -x "$calibrate" ] || fail "cross_fit needs the adaptseg_calibrate binary as 5th argument"
   common=(--field "$examples/data/dubai-tile-4" --region 0,0,0.5,0.5 --segmenter erfnet --threads 1
-          --model-file "$examples/models/mobilenetv2-dubai-all" --seg-time-s 0.1 --plan-time-s 0 --confidence 1
+          --network "$examples/models/mobilenetv2-dubai-all" --seg-time-s 0.1 --plan-time-s 0 --confidence 1
           --interest water --top-factor 3 --candidate-factors 1 --lawnmower-factors 1,3)
-  "$calibrate" "${common[@]}" --calibration-model-file "$examples/models/mobilenetv2-dubai-all" \
-    --calibration-model-file "$examples/models/mobilenetv2-dubai" --out "$work/cross.yaml" 2>"$work/cross.log" ||
+  "$calibrate" "${common[@]}" --calibration-network "$examples/models/mobilenetv2-dubai-all" \
+    --calibration-network "$examples/models/mobilenetv2-dubai" --out "$work/cross.yaml" 2>"$work/cross.log" ||
     fail "cross-fitted calibration failed: $(tail -3 "$work/cross.log")"
   grep -q '^  segmenter: erfnet:mobilenetv2-dubai-all-' "$work/cross.yaml" || fail "the model names another segmenter"
   grep -q '^  field_segmenters: \[erfnet:mobilenetv2-dubai-[0-9a-f]*\]$' "$work/cross.yaml" ||
@@ -194,8 +211,8 @@ cross_fit)
   done
   "$calibrate" "${net_common[@]}" --out "$work/net.yaml" 2>"$work/net.log" || fail "calibration with the copy failed"
   fly() {
-    "$mission" --field "$examples/data/dubai-tile-4:0,0,0.5,0.5" --strategy adaptive --model "$work/net.yaml" \
-      --segmenter erfnet --model-file "$work/net" --threads 1 --seg-time-s 0.1 --plan-time-s 0 --out "$work/fly" \
+    "$mission" --field "$examples/data/dubai-tile-4:0,0,0.5,0.5" --strategy adaptive --decision-model "$work/net.yaml" \
+      --segmenter erfnet --network "$work/net" --threads 1 --seg-time-s 0.1 --plan-time-s 0 --out "$work/fly" \
       >"$work/fly.log" 2>&1
   }
   fly || fail "the model refused its own network: $(tail -2 "$work/fly.log")"
@@ -234,7 +251,7 @@ determinism)
     "$mission" --field "$test" --strategy lawnmower --gsd 2 --segmenter oracle "${fixed[@]}" \
       --out "$work/$run/lawnmower" >/dev/null || fail "lawnmower $run failed"
     for s in adaptive linear; do
-      "$mission" --field "$test" --strategy "$s" --model "$work/$run/model.yaml" --segmenter oracle "${fixed[@]}" \
+      "$mission" --field "$test" --strategy "$s" --decision-model "$work/$run/model.yaml" --segmenter oracle "${fixed[@]}" \
         --out "$work/$run/$s" >/dev/null || fail "$s $run failed"
     done
   done

@@ -12,7 +12,7 @@ camera size), and PyTorch's output on it, computed from examples/models/erfnet-d
   labels_torch.png     PyTorch's argmax at full resolution (8-bit PNG)
   fixture.yaml         what the files are, where the image comes from, measured numbers
 
-tests/test_erfnet_segmenter.cpp compares ErfnetSegmenter's output with these.
+tests/test_erfnet_segmenter.cpp compares OnnxSegmenter's output with these.
 
 Usage: /usr/bin/python3 tests/tools/make_erfnet_fixture.py [--model-dir DIR] [--field DIR]
 """

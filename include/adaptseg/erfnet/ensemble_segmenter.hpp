@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// An ensemble of ONNX networks of one class set (ErfnetSegmenter members, of one architecture or
+/// An ensemble of ONNX networks of one class set (OnnxSegmenter members, of one architecture or
 /// of several) run in one process through OpenCV DNN: the weighted mean of the members' class
 /// probabilities, its labels, and where the members disagree. Link `adaptseg::erfnet`.
 ///
@@ -17,7 +17,7 @@
 /// members:
 ///   - model: ../mobilenetv2-dubai
 ///     weight: 1        # optional, default 1; > 0; weights are normalised
-///     mirror: true     # optional, default false: ErfnetParams::test_time_mirror for this member
+///     mirror: true     # optional, default false: OnnxParams::test_time_mirror for this member
 ///   - model: ../erfnet-dubai
 /// description: free text  # optional
 /// @endcode
@@ -25,7 +25,7 @@
 #include <adaptseg/core/camera.hpp>
 #include <adaptseg/core/decision_inputs.hpp>
 #include <adaptseg/core/error.hpp>
-#include <adaptseg/erfnet/erfnet_segmenter.hpp>
+#include <adaptseg/erfnet/onnx_segmenter.hpp>
 #include <adaptseg/vision/detail/yaml_io.hpp>
 #include <adaptseg/vision/field.hpp>
 #include <adaptseg/vision/segmentation_backend.hpp>
@@ -43,12 +43,12 @@
 
 namespace adaptseg {
 
-/// One member of an ensemble: a model directory (model.onnx + model.yaml, as ErfnetSegmenter
+/// One member of an ensemble: a model directory (model.onnx + model.yaml, as OnnxSegmenter
 /// loads it), its weight in the mean, and whether it also segments the mirrored image.
 struct EnsembleMember {
   std::filesystem::path model_dir;
   double weight = 1.0;  ///< > 0, finite; the weights are normalised to sum to 1
-  /// ErfnetParams::test_time_mirror for this member (its probabilities: the mean over the image
+  /// OnnxParams::test_time_mirror for this member (its probabilities: the mean over the image
   /// and its mirror; it still counts once in the votes and the disagreement).
   bool mirror = false;
 };
@@ -101,10 +101,10 @@ struct EnsembleSegmentation {
   return members;
 }
 
-/// Semantic segmentation by an ensemble of ONNX networks (ErfnetSegmenter members); a
+/// Semantic segmentation by an ensemble of ONNX networks (OnnxSegmenter members); a
 /// `SegmentationBackend` with probabilities.
 ///
-/// Per image every member segments it as ErfnetSegmenter does (its own input size, channel
+/// Per image every member segments it as OnnxSegmenter does (its own input size, channel
 /// order, normalisation and temperature) and gives class probabilities at the image's size;
 /// the ensemble's probabilities are their weighted mean, its labels the mean's argmax (ties to
 /// the lower class). segment_with_disagreement() adds where the members disagree.
@@ -124,19 +124,19 @@ class EnsembleSegmenter {
  public:
   /// Applied to every member (classes, camera size, resampling, no-data, threads, DNN backend,
   /// test-time mirror, which a member's own `mirror` adds to); `name` is the ensemble's
-  /// (ErfnetParams' default, "erfnet", becomes "ensemble"; member k is named
+  /// (OnnxParams' default, "erfnet", becomes "ensemble"; member k is named
   /// `name/<its folder>`).
-  using Params = ErfnetParams;
+  using Params = OnnxParams;
 
   /// Loads every member.
   /// @throws std::invalid_argument with one line naming the problem: no members, a weight that
   ///         is not finite and > 0, a member listed twice, members whose classes differ (naming
-  ///         both), and whatever ErfnetSegmenter throws for a member (prefixed with its number
+  ///         both), and whatever OnnxSegmenter throws for a member (prefixed with its number
   ///         and directory).
   explicit EnsembleSegmenter(std::vector<EnsembleMember> members, Params params = {})
       : params_(std::move(params)), specs_(std::move(members)) {
     if (specs_.empty()) throw std::invalid_argument("EnsembleSegmenter: no members (an ensemble needs at least one network)");
-    if (params_.name == ErfnetParams{}.name) params_.name = "ensemble";
+    if (params_.name == OnnxParams{}.name) params_.name = "ensemble";
     double total = 0.0;
     for (std::size_t k = 0; k < specs_.size(); ++k) {
       const EnsembleMember& m = specs_[k];
@@ -172,9 +172,9 @@ class EnsembleSegmenter {
   explicit EnsembleSegmenter(const std::filesystem::path& dir, Params params = {})
       : EnsembleSegmenter(read_ensemble_file(dir), std::move(params)) {}
 
-  /// Loads `dir` for images of `camera` over `field` (ErfnetSegmenter::for_field()).
+  /// Loads `dir` for images of `camera` over `field` (OnnxSegmenter::for_field()).
   EnsembleSegmenter(const std::filesystem::path& dir, const Field& field, const CameraModel& camera, Params params = {})
-      : EnsembleSegmenter(dir, ErfnetSegmenter::for_field(field, camera, std::move(params))) {}
+      : EnsembleSegmenter(dir, OnnxSegmenter::for_field(field, camera, std::move(params))) {}
 
   EnsembleSegmenter(const EnsembleSegmenter&) = delete;
   EnsembleSegmenter& operator=(const EnsembleSegmenter&) = delete;
@@ -192,25 +192,25 @@ class EnsembleSegmenter {
   [[nodiscard]] const std::vector<std::string>& classes() const noexcept { return members_.front().classes(); }
   [[nodiscard]] std::size_t size() const noexcept { return members_.size(); }
   /// Member k (0-based), as loaded.
-  [[nodiscard]] const ErfnetSegmenter& member(std::size_t k) const { return members_.at(k); }
+  [[nodiscard]] const OnnxSegmenter& member(std::size_t k) const { return members_.at(k); }
   /// Member k's normalised weight.
   [[nodiscard]] double weight(std::size_t k) const { return weights_.at(k); }
   /// The members as given (directories and weights before normalisation).
   [[nodiscard]] const std::vector<EnsembleMember>& member_list() const noexcept { return specs_; }
 
   /// Labels of the mean probabilities (see EnsembleSegmentation::mean).
-  /// @throws std::invalid_argument as ErfnetSegmenter::segment().
+  /// @throws std::invalid_argument as OnnxSegmenter::segment().
   [[nodiscard]] cv::Mat segment(const Image& image) { return segment_with_probabilities(image).labels; }
 
   /// Labels, the mean probabilities and the member votes (SegmentsWithProbabilities; the votes
   /// feed decision input `split`).
-  /// @throws std::invalid_argument as ErfnetSegmenter::segment().
+  /// @throws std::invalid_argument as OnnxSegmenter::segment().
   [[nodiscard]] Segmentation segment_with_probabilities(const Image& image) {
     return run(image, false).mean;
   }
 
   /// The mean, its labels, and where the members disagree.
-  /// @throws std::invalid_argument as ErfnetSegmenter::segment().
+  /// @throws std::invalid_argument as OnnxSegmenter::segment().
   [[nodiscard]] EnsembleSegmentation segment_with_disagreement(const Image& image) { return run(image, true); }
 
  private:
@@ -286,7 +286,7 @@ class EnsembleSegmenter {
   Params params_;
   std::vector<EnsembleMember> specs_;
   std::vector<float> weights_;
-  std::vector<ErfnetSegmenter> members_;
+  std::vector<OnnxSegmenter> members_;
 };
 
 static_assert(SegmentationBackend<EnsembleSegmenter>);
