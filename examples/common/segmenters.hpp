@@ -305,7 +305,7 @@ inline std::vector<std::string> network_training_fields(const std::filesystem::p
 /// The backend options shared by adaptseg_mission, adaptseg_calibrate and adaptseg_evaluate.
 struct SegmenterOptions {
   std::string name = "oracle";
-  std::filesystem::path network;  ///< ERFNet: model directory, or the .onnx (metadata: same stem .yaml)
+  std::filesystem::path network;     ///< ERFNet: model directory, or the .onnx (metadata: same stem .yaml)
   int threads = 0;                   ///< ERFNet: OpenCV threads (0: OpenCV's default)
   std::filesystem::path cache_root;  ///< ERFNet: where calibration keeps segmentations on disk (empty: nowhere)
   /// ERFNet, calibration: networks for the training fields --network was trained on, each such
