@@ -37,7 +37,9 @@ namespace adaptseg {
 enum class TopLevelChoice { undominated, hull };
 
 /// The name of a top-level choice (`top_level` in the model file, `--top-level` of the programs).
-[[nodiscard]] inline std::string to_string(TopLevelChoice r) { return r == TopLevelChoice::hull ? "hull" : "undominated"; }
+[[nodiscard]] inline std::string to_string(TopLevelChoice r) {
+  return r == TopLevelChoice::hull ? "hull" : "undominated";
+}
 
 /// Parses a top-level choice's name.
 /// @throws std::invalid_argument for anything but `undominated` or `hull`.

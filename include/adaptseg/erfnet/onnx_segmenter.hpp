@@ -2,8 +2,9 @@
 /// @file
 /// The network backend: any segmentation network exported to ONNX, run through OpenCV DNN (the
 /// paper's is ERFNet, §3.1, §5: Romera et al. 2017, trained on RGB images taken at several
-/// altitudes; OnnxSegmenter, called ErfnetSegmenter before adaptseg 0.3). Link `adaptseg::erfnet`; this header is kept
-/// out of the umbrella `planner.hpp` so that users without OpenCV DNN pay nothing for it.
+/// altitudes; OnnxSegmenter, called ErfnetSegmenter before adaptseg 0.3). Link
+/// `adaptseg::erfnet`; this header is kept out of the umbrella `planner.hpp` so that users
+/// without OpenCV DNN pay nothing for it.
 ///
 /// A model is an ONNX file (fp32, input `1x3xHxW`, output `1xCx(H/s)x(W/s)` logits at output
 /// stride s) plus a metadata YAML written by `examples/tools/train_segnet.py`: class names in
