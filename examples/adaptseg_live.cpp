@@ -661,7 +661,8 @@ int main(int argc, char** argv) {
     if (info.geo && s.flight.connection.empty()) s.exports.check_altitude(options.top_gsd_cm, model.camera);
     if (segmenter == "oracle") {
       adaptseg::OracleSegmenter oracle(static_cast<int>(info.classes.size()));
-      fly_strategy(strategy, model, info, oracle, options, s);
+      adaptseg::examples::AnyBackend any(oracle);  // as with_network's: one backend type to compile for
+      fly_strategy(strategy, model, info, any, options, s);
     } else {
       if (network.empty()) throw std::invalid_argument("--segmenter erfnet needs --network");
       adaptseg::OnnxParams params;

@@ -104,19 +104,42 @@ inline std::string network_name(const std::filesystem::path& model_file) {
   return (EnsembleSegmenter::is_ensemble_dir(model_file) ? "ensemble:" : "erfnet:") + model_file_digest(model_file);
 }
 
-/// Calls `f(backend)` with the network backend of `model_file`: an EnsembleSegmenter for an
-/// ensemble directory (ensemble.yaml), else an OnnxSegmenter (model_paths()); named by
-/// network_name() and built with `params` otherwise.
+/// A backend with probabilities behind one type (it borrows `backend`): calibrate() takes one
+/// backend type for all training fields, and cross-fitting segments them with several networks.
+class AnyBackend {
+ public:
+  template <SegmentationBackend B>
+    requires SegmentsWithProbabilities<B>
+  explicit AnyBackend(B& backend)
+      : name_(backend.name()),
+        segment_([&backend](const Image& image) { return backend.segment(image); }),
+        probabilities_([&backend](const Image& image) { return backend.segment_with_probabilities(image); }) {}
+  [[nodiscard]] std::string name() const { return name_; }
+  [[nodiscard]] cv::Mat segment(const Image& image) { return segment_(image); }
+  [[nodiscard]] Segmentation segment_with_probabilities(const Image& image) { return probabilities_(image); }
+
+ private:
+  std::string name_;
+  std::function<cv::Mat(const Image&)> segment_;
+  std::function<Segmentation(const Image&)> probabilities_;
+};
+
+/// Calls `f(backend)` with the network backend of `model_file` behind AnyBackend: an
+/// EnsembleSegmenter for an ensemble directory (ensemble.yaml), else an OnnxSegmenter
+/// (model_paths()); named by network_name() and built with `params` otherwise. One backend type
+/// for every network, so that a program instantiates the planner and calibration once.
 template <class F>
 decltype(auto) with_network(const std::filesystem::path& model_file, OnnxParams params, F&& f) {
   params.name = network_name(model_file);
   if (EnsembleSegmenter::is_ensemble_dir(model_file)) {
     EnsembleSegmenter ensemble(model_file, std::move(params));
-    return std::forward<F>(f)(ensemble);
+    AnyBackend any(ensemble);
+    return std::forward<F>(f)(any);
   }
   const auto [onnx, metadata] = model_paths(model_file);
-  OnnxSegmenter erfnet(onnx, metadata, std::move(params));
-  return std::forward<F>(f)(erfnet);
+  OnnxSegmenter network(onnx, metadata, std::move(params));
+  AnyBackend any(network);
+  return std::forward<F>(f)(any);
 }
 
 /// Memoises a deterministic backend: a simulated image is identified by its footprint, its
@@ -256,36 +279,6 @@ class CachedBackend {
   std::map<Key, Entry> cache_;
 };
 
-/// adaptseg::calibrate with `backend` cached (in memory, and in `dir` if given; CachedBackend):
-/// calibration flies the same waypoints many times (at its declared per-image time, so a cache
-/// hit changes no number), and a network backend is the slow part.
-template <SegmentationBackend Backend>
-CalibrationResult calibrate_cached(std::span<const Field> fields, Backend& backend, const CalibrationOptions& options,
-                                   std::optional<std::filesystem::path> dir = std::nullopt) {
-  CachedBackend<Backend> cached(backend, std::move(dir));
-  return calibrate(fields, cached, options);
-}
-
-/// A backend with probabilities behind one type (it borrows `backend`): calibrate() takes one
-/// backend type for all training fields, and cross-fitting segments them with several networks.
-class AnyBackend {
- public:
-  template <SegmentationBackend B>
-    requires SegmentsWithProbabilities<B>
-  explicit AnyBackend(B& backend)
-      : name_(backend.name()),
-        segment_([&backend](const Image& image) { return backend.segment(image); }),
-        probabilities_([&backend](const Image& image) { return backend.segment_with_probabilities(image); }) {}
-  [[nodiscard]] std::string name() const { return name_; }
-  [[nodiscard]] cv::Mat segment(const Image& image) { return segment_(image); }
-  [[nodiscard]] Segmentation segment_with_probabilities(const Image& image) { return probabilities_(image); }
-
- private:
-  std::string name_;
-  std::function<cv::Mat(const Image&)> segment_;
-  std::function<Segmentation(const Image&)> probabilities_;
-};
-
 /// The fields the network of `model_file` was trained on (its metadata's training.fields; an
 /// ensemble's: every member's), empty where the metadata names none.
 inline std::vector<std::string> network_training_fields(const std::filesystem::path& model_file) {
@@ -403,16 +396,19 @@ struct SegmenterOptions {
     return out;
   }
 
-  /// Calls `f(backend)` with the chosen backend built for `field` seen by `camera` (the
-  /// network's classes must be the field's; a camera image of another size than the network's
-  /// input, with the same aspect ratio, is resampled to it, as the MobileNetV2 model's 512x384
-  /// input needs for the 480x360 camera).
+  /// Calls `f(backend)` with the chosen backend built for `field` seen by `camera`, behind
+  /// AnyBackend (one type for every backend: the planner and calibration are compiled once; a
+  /// virtual call per image costs nothing next to a segmentation). The network's classes must be
+  /// the field's; a camera image of another size than the network's input, with the same aspect
+  /// ratio, is resampled to it, as the MobileNetV2 model's 512x384 input needs for the 480x360
+  /// camera.
   template <class F>
   decltype(auto) with_backend(const Field& field, const CameraModel::Params& camera, F&& f) const {
     validate();
     if (name == "oracle") {
       OracleSegmenter oracle(field.num_classes());
-      return std::forward<F>(f)(oracle);
+      AnyBackend any(oracle);
+      return std::forward<F>(f)(any);
     }
     OnnxParams p = OnnxSegmenter::for_field(field, CameraModel(camera));
     p.num_threads = threads;
@@ -428,69 +424,16 @@ inline void print_field_segmenters(const DecisionModel& model) {
                  model.field_segmenters[k].c_str());
 }
 
-/// A network of a cross-fitted calibration with its segmentation cache, behind AnyBackend.
-class CalibrationNetwork {
- public:
-  virtual ~CalibrationNetwork() = default;
-  [[nodiscard]] virtual AnyBackend& backend() = 0;
-};
-
-template <class Net>
-class OwnedCalibrationNetwork final : public CalibrationNetwork {
- public:
-  template <class... Args>
-  explicit OwnedCalibrationNetwork(std::optional<std::filesystem::path> cache, Args&&... args)
-      : net_(std::forward<Args>(args)...), cached_(net_, std::move(cache)), any_(cached_) {}
-  [[nodiscard]] AnyBackend& backend() override { return any_; }
-
- private:
-  Net net_;
-  CachedBackend<Net> cached_;
-  AnyBackend any_;
-};
-
-/// adaptseg::calibrate for the programs: every field segmented by `backend` (--network, cached
-/// as calibrate_cached()) or, where `networks` (SegmenterOptions::network_per_field(fields),
-/// resolved once by the program before any work) names one, by that network (built for
-/// `fields.front()` seen by the missions' camera, cached in its own folder of
-/// --segmentation-cache).
+/// adaptseg::calibrate for the programs: every field segmented by `backend` (--network, cached in
+/// memory and in --segmentation-cache if given: calibration flies the same waypoints many times,
+/// at its declared per-image time, so a cache hit changes no number, and a network backend is
+/// the slow part) or, where `networks` (SegmenterOptions::network_per_field(fields), resolved
+/// once by the program before any work) names one, by that network (built for `fields.front()`
+/// seen by the missions' camera, cached in its own folder of --segmentation-cache).
+/// Compiled once, in segmenters.cpp (the adaptseg_examples_common library).
 /// @throws std::invalid_argument if `networks` does not hold one entry per field.
-template <SegmentationBackend Backend>
 CalibrationResult calibrate_fields(const SegmenterOptions& segmenter, std::span<const Field> fields,
-                                   std::span<const std::filesystem::path> networks, Backend& backend,
-                                   const CalibrationOptions& options) {
-  if (networks.size() != fields.size())
-    throw std::invalid_argument("calibrate_fields: one calibration network entry per field is needed (" +
-                                std::to_string(networks.size()) + " for " + std::to_string(fields.size()) + " fields)");
-  if (std::all_of(networks.begin(), networks.end(), [](const auto& n) { return n.empty(); }))
-    return calibrate_cached(fields, backend, options, segmenter.calibration_cache());
-  CachedBackend<Backend> cached(backend, segmenter.calibration_cache());
-  AnyBackend mission(cached);
-  std::map<std::filesystem::path, std::unique_ptr<CalibrationNetwork>> built;
-  std::vector<AnyBackend*> backends;
-  for (const auto& file : networks) {
-    if (file.empty()) {
-      backends.push_back(&mission);
-      continue;
-    }
-    auto& net = built[file];
-    if (!net) {
-      OnnxParams p = OnnxSegmenter::for_field(fields.front(), CameraModel(options.adaptive.mission.camera));
-      p.num_threads = segmenter.threads;
-      p.resize_to_network = true;
-      p.name = network_name(file);
-      std::optional<std::filesystem::path> cache;
-      if (!segmenter.cache_root.empty()) cache = segmenter.cache_root / model_file_digest(file);
-      if (EnsembleSegmenter::is_ensemble_dir(file)) {
-        net = std::make_unique<OwnedCalibrationNetwork<EnsembleSegmenter>>(std::move(cache), file, std::move(p));
-      } else {
-        const auto [onnx, metadata] = model_paths(file);
-        net = std::make_unique<OwnedCalibrationNetwork<OnnxSegmenter>>(std::move(cache), onnx, metadata, std::move(p));
-      }
-    }
-    backends.push_back(&net->backend());
-  }
-  return calibrate(fields, std::span<AnyBackend* const>(backends), options);
-}
+                                   std::span<const std::filesystem::path> networks, AnyBackend& backend,
+                                   const CalibrationOptions& options);
 
 }  // namespace adaptseg::examples

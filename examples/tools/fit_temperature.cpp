@@ -174,37 +174,38 @@ int main(int argc, char** argv) {
     const SimulatedSensor sensor(field, camera);
     OracleSegmenter oracle(field.num_classes());
     std::vector<Pixels> per_band;
-    double temperature_was = 1.0;
-    segmenter.with_backend(field, mo.camera, [&](auto& net) {
-      if constexpr (!requires { net.model_info(); }) {
-        throw std::invalid_argument("--segmenter must be erfnet");  // the oracle has no logits
-      } else {
-      temperature_was = net.model_info().temperature;
-      for (double f : bands) {
-        Pixels px;
-        px.classes = field.num_classes();
-        const auto plan = LawnmowerPlanner(camera).plan(field.area(), f * field.gsd_cm(), {0.0, 0.0},
-                                                         [&](const Area& a) { return field.has_valid(a); });
-        for (const Waypoint& w : plan) {
-          const Image img = sensor.capture(w);
-          const std::vector<cv::Mat> logits = net.logits(img);
-          const Segmentation truth = oracle.segment_with_probabilities(img);
-          for (int y = 0; y < img.height_px; y += stride)
-            for (int x = 0; x < img.width_px; x += stride) {
-              if (truth.labels.at<unsigned char>(y, x) == img.ignore_label) continue;
-              if (img.rgb.at<cv::Vec3b>(y, x) == cv::Vec3b(0, 0, 0)) continue;  // no data: not segmented
-              for (int c = 0; c < px.classes; ++c) {
-                px.logits.push_back(logits[static_cast<std::size_t>(c)].at<float>(y, x));
-                px.target.push_back(truth.probabilities[static_cast<std::size_t>(c)].at<float>(y, x));
-              }
+    segmenter.validate();
+    if (adaptseg::EnsembleSegmenter::is_ensemble_dir(segmenter.network))
+      throw std::invalid_argument("--network " + segmenter.network.string() +
+                                  " is an ensemble: fit each member's temperature on its own folder");
+    adaptseg::OnnxParams params = adaptseg::OnnxSegmenter::for_field(field, camera);
+    params.num_threads = segmenter.threads;
+    params.resize_to_network = true;
+    const auto [onnx, metadata] = adaptseg::examples::model_paths(segmenter.network);
+    adaptseg::OnnxSegmenter net(onnx, metadata, std::move(params));  // its logits, not AnyBackend's labels
+    const double temperature_was = net.model_info().temperature;
+    for (double f : bands) {
+      Pixels px;
+      px.classes = field.num_classes();
+      const auto plan = LawnmowerPlanner(camera).plan(field.area(), f * field.gsd_cm(), {0.0, 0.0},
+                                                       [&](const Area& a) { return field.has_valid(a); });
+      for (const Waypoint& w : plan) {
+        const Image img = sensor.capture(w);
+        const std::vector<cv::Mat> logits = net.logits(img);
+        const Segmentation truth = oracle.segment_with_probabilities(img);
+        for (int y = 0; y < img.height_px; y += stride)
+          for (int x = 0; x < img.width_px; x += stride) {
+            if (truth.labels.at<unsigned char>(y, x) == img.ignore_label) continue;
+            if (img.rgb.at<cv::Vec3b>(y, x) == cv::Vec3b(0, 0, 0)) continue;  // no data: not segmented
+            for (int c = 0; c < px.classes; ++c) {
+              px.logits.push_back(logits[static_cast<std::size_t>(c)].at<float>(y, x));
+              px.target.push_back(truth.probabilities[static_cast<std::size_t>(c)].at<float>(y, x));
             }
-        }
-        std::fprintf(stderr, "band %.2f cm/px: %zu images, %zu pixels\n", f * field.gsd_cm(), plan.size(), px.size());
-        per_band.push_back(std::move(px));
+          }
       }
-      }
-      return 0;
-    });
+      std::fprintf(stderr, "band %.2f cm/px: %zu images, %zu pixels\n", f * field.gsd_cm(), plan.size(), px.size());
+      per_band.push_back(std::move(px));
+    }
     if (at && write) throw std::invalid_argument("--at evaluates a given temperature; it cannot be combined with --write");
     // T: the best of a logarithmic grid over [0.25, 8], refined by golden section.
     double best = 1.0, best_nll = nll(per_band, 1.0);
