@@ -127,7 +127,7 @@ int main(int argc, char** argv) {
                  "training field DIR[:x0,y0,x1,y1] (decision-function initialisation); repeatable");
   CLI::Option* model_opt = app.add_option("--decision-model", decision_model,
                                           "use this decision model instead of calibrating on --train");
-  CLI::Option* old_model_opt = adaptseg::examples::accept_old_spelling(app, model_opt, "--model", decision_model);
+  adaptseg::examples::accept_old_spelling(app, model_opt, "--model", decision_model);
   app.add_option("--test", test_specs, "test field DIR[:x0,y0,x1,y1]; repeatable")->required();
   app.add_option("--out", out_dir, "output directory")->required();
   app.add_option("--lawnmower-factors", lawnmower_factors, "lawnmower GSDs as multiples of each field's GSD")
@@ -135,12 +135,11 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--budget-s", budget_s, "mission-time budget [s] for the adaptive strategies");
   calibration.add_to(app);
-  calibration.exclude(model_opt);  // the model file fixes them
-  calibration.exclude(old_model_opt);
+  calibration.exclude(model_opt);  // the model file fixes them (and --model, its old spelling, alike)
   app.add_flag("--no-plots", no_plots, "do not run the plotting script");
   common.add_to(app);
   segmenter.add_to(app);
-  segmenter.add_calibration_networks_to(app, {model_opt, old_model_opt});
+  segmenter.add_calibration_networks_to(app, {model_opt});
   if (const auto code = adaptseg::examples::parse_command_line(app, argc, argv)) return *code;
 
   bool progress_open = false;  // a progress line on stderr waits for its end

@@ -69,6 +69,7 @@ inline int command_line_error(const CLI::App& app, const std::string& what) {
 /// value), with one error line on stderr naming the flag, as for every other bad input.
 inline std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
   try {
+    inherit_old_spellings(app);
     app.parse(argc, argv);
     tell_old_spellings(app);
     return std::nullopt;

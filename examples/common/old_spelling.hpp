@@ -12,16 +12,39 @@ namespace adaptseg::examples {
 /// The --help group of the old spellings.
 inline constexpr const char* kOldSpellings = "Old spellings (they go in adaptseg 0.4)";
 
+/// The description of an old spelling: this prefix and the current spelling's name.
+inline constexpr const char* kUseInstead = "use ";
+
 /// Accepts `old_name` as another spelling of `current`, an option of `app` that stores into
 /// `value`: the same value (--help lists it in its own group); once the command line has
 /// parsed, tell_old_spellings() names the new spelling on standard error. Giving both is a
-/// command-line error. Returns the old spelling's option (for the program's own excludes).
+/// command-line error, and the old spelling excludes and needs whatever the current one does,
+/// set before or after this call (inherit_old_spellings(), which parse_command_line() calls).
+/// Returns the old spelling's option.
 template <class T>
 CLI::Option* accept_old_spelling(CLI::App& app, CLI::Option* current, const std::string& old_name, T& value) {
   // In its own --help group, its description the new spelling.
-  CLI::Option* old = app.add_option(old_name, value, "use " + current->get_name())->group(kOldSpellings);
+  CLI::Option* old = app.add_option(old_name, value, kUseInstead + current->get_name())->group(kOldSpellings);
   old->excludes(current);
   return old;
+}
+
+/// Before parsing: each old spelling of `app` excludes every option its current spelling
+/// excludes (or is excluded by) and needs what it needs, so that a program states its rules
+/// once, for the current names.
+inline void inherit_old_spellings(CLI::App& app) {
+  const std::string prefix = kUseInstead;
+  for (CLI::Option* old : app.get_options([](const CLI::Option* o) { return o->get_group() == kOldSpellings; })) {
+    const std::string& description = old->get_description();
+    if (description.rfind(prefix, 0) != 0) continue;
+    CLI::Option* current = app.get_option_no_throw(description.substr(prefix.size()));
+    if (current == nullptr) continue;
+    // CLI11's exclusions are symmetric: the current spelling's set holds every option that
+    // excludes it, whichever side stated it.
+    for (CLI::Option* other : current->get_excludes())
+      if (other != old) old->excludes(other);
+    for (CLI::Option* other : current->get_needs()) old->needs(other);
+  }
 }
 
 /// After a successful parse: one line on stderr per old spelling given (accept_old_spelling()).

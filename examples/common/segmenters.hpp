@@ -334,11 +334,8 @@ struct SegmenterOptions {
                    "them that was not trained on it: a network knows its training fields so well that, calibrated "
                    "there, the decision learns that flying lower gains little (cross-fitting; the missions fly "
                    "--network)");
-    CLI::Option* old = accept_old_spelling(app, current, "--calibration-model-file", calibration_networks);
-    for (CLI::Option* e : excludes) {
-      current->excludes(e);
-      old->excludes(e);
-    }
+    accept_old_spelling(app, current, "--calibration-model-file", calibration_networks);
+    for (CLI::Option* e : excludes) current->excludes(e);
   }
 
   /// Where calibration keeps the network's segmentations (--segmentation-cache), if anywhere:

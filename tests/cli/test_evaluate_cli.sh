@@ -88,4 +88,15 @@ if "$evaluate" --decision-model "$work/e/model.yaml" --test "$examples/data/duba
   fail "--coverage with --decision-model was accepted"
 fi
 grep -q "excludes" "$work/log" || fail "no clear error for --coverage with --model: $(tail -3 "$work/log")"
-echo "ok: calibration flags with --decision-model refused"
+# The old spellings (--model, --calibration-model-file) inherit the exclusions stated for the new.
+for flags in "--model $work/e/model.yaml --coverage region" \
+  "--model $work/e/model.yaml --segmenter erfnet --network $examples/models/mobilenetv2-dubai --calibration-network $examples/models/mobilenetv2-dubai-loto/tile-1" \
+  "--decision-model $work/e/model.yaml --segmenter erfnet --network $examples/models/mobilenetv2-dubai --calibration-model-file $examples/models/mobilenetv2-dubai-loto/tile-1"; do
+  # shellcheck disable=SC2086  # the flags split at spaces
+  if "$evaluate" $flags --test "$examples/data/dubai-tile-6" --out "$work/x" >"$work/log" 2>&1; then
+    fail "accepted: $flags"
+  fi
+  grep -q "excludes" "$work/log" || fail "no clear error for $flags: $(tail -3 "$work/log")"
+done
+[ ! -e "$work/x" ] || fail "a refused command line wrote $work/x"
+echo "ok: calibration flags with --decision-model refused, in the old spellings too"
