@@ -36,6 +36,15 @@
 #       examples/models/mobilenetv2-dubai-loto/tile-<k> (model.onnx, model.yaml, its logs and
 #       held-out scores), the six fits in its temperatures.csv, and the deployment network
 #       (mobilenetv2-dubai-all) given the median of all six.
+#   bash scripts/loto.sh decision [CLASSES]
+#       here, after bundle: the deployment network's decision model per class of interest
+#       (CLASSES space-separated, default "building road vegetation water"), calibrated on the six
+#       tiles with each tile segmented by the network that never saw it (adaptseg_calibrate
+#       --network examples/models/mobilenetv2-dubai-all --calibration-network
+#       examples/models/mobilenetv2-dubai-loto/tile-k, k = 1..6; the model file names each
+#       field's network) into examples/models/mobilenetv2-dubai-all/decision-<class>.yaml, logs in
+#       out/loto/decision-<class>.log. What a user flies a new site with (docs/programs.md,
+#       "A new site"). Segmentations are cached in out/results/segmentation-cache.
 #   bash scripts/loto.sh cpu TILE [--resume]
 #       here, no accelerator: one training of examples/models/mobilenetv2-dubai's CPU recipe
 #       (2000 steps of 8 crops) on the five tiles but TILE, exported to out/loto-cpu/model-TILE
@@ -194,6 +203,30 @@ bundle)
   "$fit" --network examples/models/mobilenetv2-dubai-all --set "$(median "${fitted[@]}")"
   cat "$dest/temperatures.csv"
   ;;
+decision)
+  read -r -a classes <<<"${2:-building road vegetation water}"
+  deploy=examples/models/mobilenetv2-dubai-all
+  dest=examples/models/mobilenetv2-dubai-loto
+  trains=() crossed=()
+  for k in "${tiles_all[@]}"; do
+    grep -q '^temperature:' "$dest/tile-$k/model.yaml" 2>/dev/null ||
+      { echo "$dest/tile-$k has no network with its temperature yet: bash $0 recipe-cpu $k, then bundle" >&2; exit 1; }
+    trains+=(--train "examples/data/dubai-tile-$k")
+    crossed+=(--calibration-network "$dest/tile-$k")
+  done
+  grep -q '^temperature:' "$deploy/model.yaml" || { echo "$deploy has no temperature yet: bash $0 bundle" >&2; exit 1; }
+  source scripts/configure.sh
+  configure_for results build/release >/dev/null
+  cmake --build build/release -j2 --target adaptseg_calibrate >/dev/null
+  mkdir -p out/loto
+  for cls in "${classes[@]}"; do
+    build/release/examples/adaptseg_calibrate "${trains[@]}" --interest "$cls" --segmenter erfnet --network "$deploy" \
+      "${crossed[@]}" --threads "${LOTO_THREADS:-2}" --segmentation-cache out/results/segmentation-cache \
+      --out "$deploy/decision-$cls.yaml" >"out/loto/decision-$cls.log" 2>&1 ||
+      { echo "calibration for $cls failed: out/loto/decision-$cls.log" >&2; exit 1; }
+    echo "$deploy/decision-$cls.yaml"
+  done
+  ;;
 cpu)
   k=${2:?held-out tile}
   shift 2
@@ -211,7 +244,7 @@ cpu)
     --field "examples/data/dubai-tile-$k" --threads 2 --write
   ;;
 *)
-  sed -n '2,45p' "$0" >&2
+  sed -n '2,54p' "$0" >&2
   exit 2
   ;;
 esac
