@@ -34,14 +34,17 @@
 #   beside the oracle's runs of the same folds (part oracle-default's Dubai runs, when there).
 #   Every network segments its own tile once into the segmentation cache.
 # loto-proxy: until the six leave-one-tile-out networks are trained, a stand-in for loto on the
-#   three tiles that have a network that never saw them: tile 1 flown by
-#   mobilenetv2-dubai-loto/tile-1, calibrated on tiles 4 and 6 segmented by mobilenetv2-dubai
-#   (which never saw them); tiles 4 and 6 flown by mobilenetv2-dubai, calibrated on tile 1
-#   (segmented by tile 1's network) and the other of the two. 12 runs, every field of each run,
-#   calibration and mission, new ground to the network that segments it; but two calibration
-#   fields only, two recipes, and mobilenetv2-dubai's temperature was fitted on tile 4.
+#   tiles that have a network of MobileNetV2 that never saw them: tiles 1 and 2 flown by
+#   mobilenetv2-dubai-loto/tile-1 and tile-2, tiles 4 and 6 by mobilenetv2-dubai (trained on 1, 2,
+#   3, 5); each calibrated on the other three of the four, each calibration field segmented by a
+#   network of these three that never saw it (--calibration-network, the first that fits). 16
+#   runs, every field of each run, calibration and mission, new ground to the network that
+#   segments it; but three calibration fields only, two recipes, the leave-one-tile-out networks
+#   untempered, and mobilenetv2-dubai's temperature fitted on tile 4. (Before 2026-11-29's
+#   second session: tiles 1, 4 and 6 only, two calibration fields each, 12 runs.)
 #   CONFIG (environment; default loto-proxy) names the configuration and EXTRA adds flags, e.g.
-#   CONFIG=loto-proxy-hull EXTRA="--top-level hull". About 25 minutes on 2 cores.
+#   CONFIG=loto-proxy-hull EXTRA="--top-level hull". About 10 minutes on 2 cores with 2 jobs
+#   (segmentations cached in out/results/segmentation-cache).
 # ensemble: field mIoU of the bundled networks and of their ensemble (examples/models/ensemble-dubai)
 #   on the same whole-field lawnmowers of tiles 4 and 6 at 5, 10 and 15 cm/px
 #   (examples/tools/eval_ensemble.py, PyTorch on the exported weights), each network also with
@@ -433,16 +436,20 @@ if [ "$part" = loto ]; then
 fi
 
 if [ "$part" = loto-proxy ]; then
-  loto1=examples/models/mobilenetv2-dubai-loto/tile-1 evaluation=examples/models/mobilenetv2-dubai
+  loto=examples/models/mobilenetv2-dubai-loto evaluation=examples/models/mobilenetv2-dubai
   config=${CONFIG:-loto-proxy}
   read -r -a extra <<<"${EXTRA:-}"
+  tiles=(1 2 4 6)
+  crossed=(--calibration-network "$loto/tile-1" --calibration-network "$loto/tile-2" --calibration-network "$evaluation")
   rm -rf "${root:?}/$config"
   for cls in $classes; do
-    run "$config" "$cls-tile-1" --train "$(dubai 4)" --train "$(dubai 6)" --test "$(dubai 1)" --interest "$cls" \
-      --network "$loto1" --calibration-network "$evaluation" "${network[@]}" --no-plots "${extra[@]}"
-    for t in 4 6; do
-      run "$config" "$cls-tile-$t" --train "$(dubai 1)" --train "$(dubai $((10 - t)))" --test "$(dubai "$t")" \
-        --interest "$cls" --network "$evaluation" --calibration-network "$loto1" "${network[@]}" --no-plots "${extra[@]}"
+    for t in "${tiles[@]}"; do
+      net=$evaluation
+      [ "$t" -le 2 ] && net=$loto/tile-$t
+      train=()
+      for k in "${tiles[@]}"; do [ "$k" != "$t" ] && train+=(--train "$(dubai "$k")"); done
+      run "$config" "$cls-tile-$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
+        --network "$net" "${crossed[@]}" "${network[@]}" --no-plots "${extra[@]}"
     done
   done
   wait

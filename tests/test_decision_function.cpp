@@ -602,6 +602,15 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     // A model calibrated for its nominal top level alone keeps it.
     FrontAwarePolicy nominal(fitted(), {{"a", {{1.0, 0.95}, {2.0, 0.85}, {3.0, 0.75}}, 0.2}}, {});
     CHECK(nominal.top_gsd(fits, 3.0) == 3.0);
+    // Curves that cross: on field a 2 cm/px maps worse than 3, on b better. Their mean says 3 by
+    // 0.01, but where 2 cm/px is also faster, flying 3 falls short on b (by 0.03, 0.015 on
+    // average) and 2 on neither: the finer, faster top level.
+    const std::vector<ReferenceCurve> crossing{{"a", {{1.0, 0.95}, {2.0, 0.70}, {3.0, 0.75}}, 0.2, 0.05},
+                                               {"b", {{1.0, 0.95}, {2.0, 0.78}, {3.0, 0.75}}, 0.2, 0.05}};
+    const FrontAwarePolicy crossed(with_cells(1.0), crossing, {});
+    CHECK(crossed.top_gsd(fits, 3.0) == 2.0);
+    // Where 3 cm/px is the faster one, nothing faster beats it on either field: the nominal.
+    CHECK(crossed.top_gsd(usual, 3.0) == 3.0);
   }
   SUBCASE("the top level at the predicted curve's first corner: hull") {
     // 3 -> 2 cm/px rises 0.10 in 20 s, 2 -> 1 as much in 125 s: the curve bends at 2.

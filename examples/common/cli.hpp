@@ -276,10 +276,10 @@ struct CalibrationCli {
             ->check(CLI::IsMember({"training", "field", "corrected"}))
             ->capture_default_str(),
         app.add_option("--top-level", top_level,
-                       "front-aware rule with --coverage ranked: the top-level GSD among those calibrated, the "
-                       "coarsest whose lawnmower no faster one is predicted to beat (undominated), or from there a "
-                       "finer one while the predicted curve rises faster per second up to it than beyond it "
-                       "(hull); saved in the model")
+                       "front-aware rule with --coverage ranked: the top-level GSD among those calibrated, the one "
+                       "whose lawnmower falls least short of the faster ones on the training fields' curves, field by "
+                       "field (undominated), or from there a finer one while the predicted curve rises faster per "
+                       "second up to it than beyond it (hull); saved in the model")
             ->check(CLI::IsMember({"undominated", "hull"}))
             ->capture_default_str(),
         app.add_option("--gain-inputs", gain_inputs,

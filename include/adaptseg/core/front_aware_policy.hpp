@@ -25,9 +25,11 @@
 namespace adaptseg {
 
 /// How the front-aware rule chooses the GSD of its top level among those it was calibrated for
-/// (FrontAwarePolicy::top_gsd; the lawnmower times are this field's, the accuracies the mean of
-/// the training fields' lawnmower curves at the same GSD, so no label of this field is read):
-/// - `undominated`: the coarsest whose lawnmower no faster lawnmower is predicted to beat;
+/// (FrontAwarePolicy::top_gsd; the lawnmower times are this field's, the accuracies the training
+/// fields' lawnmower curves at the same GSD, so no label of this field is read):
+/// - `undominated`: the one whose lawnmower falls least short of the faster lawnmowers, the
+///   shortfall taken on each training field's curve and averaged (the coarsest where they tie:
+///   where no lawnmower is faster, the nominal one);
 /// - `hull`: from there, a finer one while the predicted curve rises faster per second up to it
 ///   than from it to any finer lawnmower: the top level at the first corner of the predicted
 ///   curve's upper concave hull. A descent is judged against the curve's upper envelope, whose
@@ -334,11 +336,15 @@ class FrontAwarePolicy {
     return d;
   }
 
-  /// The GSD to fly the top level at (ChoosesTopLevel): the coarsest of those the model can
-  /// decide from (its cell gain model's top-level GSDs, else the nominal one) whose lawnmower over
-  /// the area is not dominated on the predicted curve: no lawnmower of `lawnmowers` is as fast
-  /// or faster and predicted better (mIoU by GSD: the mean of the training fields' curves).
-  /// Where each is dominated, the one predicted to fall least short. With TopLevelChoice::hull,
+  /// The GSD to fly the top level at (ChoosesTopLevel): of those the model can decide from (its
+  /// cell gain model's top-level GSDs, else the nominal one), the one whose lawnmower over the
+  /// area falls least short of the lawnmowers of `lawnmowers` as fast or faster: on each training
+  /// field's curve, the most any of them maps better (0 if none), averaged over the fields; the
+  /// coarsest where they tie. The margin a mission is judged by is exactly such a shortfall
+  /// against the curve's upper envelope, and it is taken field by field because the fields'
+  /// curves cross: a network on ground it never saw maps one field better at 12.5 cm/px than at
+  /// 15 and the next worse, so the shortfall of their mean curve can be 0 where flying the
+  /// coarser, slower lawnmower loses on some of them. With TopLevelChoice::hull,
   /// then a finer one of them while the predicted curve rises faster per second up to it than
   /// from it to any finer lawnmower of `lawnmowers`. Both the adaptive and the non-adaptive rule
   /// choose so (nothing is learnt here).
@@ -360,12 +366,21 @@ class FrontAwarePolicy {
         if (l.gsd_cm == g) return l.time_s;
       return std::numeric_limits<double>::infinity();  // the nominal top without a forecast: never dominated
     };
-    double best = nominal, best_deficit = std::numeric_limits<double>::infinity();
+    // The mean over the training fields of how far a faster lawnmower beats g on each.
+    const auto shortfall = [&](double g) {
+      double sum = 0.0;
+      for (const auto& r : reference_) {
+        double worst = 0.0;
+        for (const auto& l : lawnmowers)
+          if (l.time_s <= time_of(g)) worst = std::max(worst, miou_at_gsd(r.points, l.gsd_cm) - miou_at_gsd(r.points, g));
+        sum += worst;
+      }
+      return sum / static_cast<double>(reference_.size());
+    };
+    double best = nominal, best_shortfall = std::numeric_limits<double>::infinity();
     for (double g : allowed) {
-      double deficit = 0.0;
-      for (const auto& l : lawnmowers)
-        if (l.time_s <= time_of(g)) deficit = std::max(deficit, predicted(l.gsd_cm) - predicted(g));
-      if (deficit < best_deficit - 1e-12) best = g, best_deficit = deficit;
+      const double v = shortfall(g);
+      if (v < best_shortfall - 1e-12) best = g, best_shortfall = v;
     }
     if (params_.top_level != TopLevelChoice::hull) return best;
     for (double g : allowed) {  // coarse to fine
