@@ -55,9 +55,7 @@ CalibrationResult calibrate_fields(const SegmenterOptions& segmenter, std::span<
     }
     auto& net = built[file];
     if (!net) {
-      OnnxParams p = OnnxSegmenter::for_field(fields.front(), CameraModel(options.adaptive.mission.camera));
-      p.num_threads = segmenter.threads;
-      p.resize_to_network = true;
+      OnnxParams p = segmenter.network_params(fields.front(), options.adaptive.mission.camera);
       p.name = network_name(file);
       std::optional<std::filesystem::path> cache;
       if (!segmenter.cache_root.empty()) cache = segmenter.cache_root / model_file_digest(file);

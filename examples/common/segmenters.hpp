@@ -407,10 +407,16 @@ struct SegmenterOptions {
       AnyBackend any(oracle);
       return std::forward<F>(f)(any);
     }
+    return with_network(network, network_params(field, camera), std::forward<F>(f));
+  }
+
+  /// The ONNX backend's parameters for `field` seen by `camera`: --threads, and the camera image
+  /// resampled to the network's input (see with_backend()).
+  [[nodiscard]] OnnxParams network_params(const Field& field, const CameraModel::Params& camera) const {
     OnnxParams p = OnnxSegmenter::for_field(field, CameraModel(camera));
     p.num_threads = threads;
     p.resize_to_network = true;
-    return with_network(network, std::move(p), std::forward<F>(f));
+    return p;
   }
 };
 

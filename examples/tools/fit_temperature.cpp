@@ -178,11 +178,9 @@ int main(int argc, char** argv) {
     if (adaptseg::EnsembleSegmenter::is_ensemble_dir(segmenter.network))
       throw std::invalid_argument("--network " + segmenter.network.string() +
                                   " is an ensemble: fit each member's temperature on its own folder");
-    adaptseg::OnnxParams params = adaptseg::OnnxSegmenter::for_field(field, camera);
-    params.num_threads = segmenter.threads;
-    params.resize_to_network = true;
     const auto [onnx, metadata] = adaptseg::examples::model_paths(segmenter.network);
-    adaptseg::OnnxSegmenter net(onnx, metadata, std::move(params));  // its logits, not AnyBackend's labels
+    // Its logits, not AnyBackend's labels: the network itself, built as with_backend builds it.
+    adaptseg::OnnxSegmenter net(onnx, metadata, segmenter.network_params(field, mo.camera));
     const double temperature_was = net.model_info().temperature;
     for (double f : bands) {
       Pixels px;
