@@ -16,8 +16,8 @@ int main() {
   using namespace adaptseg;
   std::mt19937 rng(1);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  const std::vector<Candidate> candidates{{1.0, 5.5, 9, 36.0}, {1.5, 8.25, 4, 20.0}, {2.0, 11.0, 4, 19.0},
-                                          {2.5, 13.75, 4, 19.0}};
+  const std::vector<Candidate> candidates{
+      {1.0, 5.5, 9, 36.0}, {1.5, 8.25, 4, 20.0}, {2.0, 11.0, 4, 19.0}, {2.5, 13.75, 4, 19.0}};
   const std::vector<LawnmowerForecast> lawnmowers{{1.0, 185.0}, {1.5, 107.0}, {2.0, 101.0}, {2.5, 96.0}, {3.0, 39.0}};
   const std::vector<ReferenceCurve> reference{
       {"a", {{1.0, 1.0}, {1.5, 0.85}, {2.0, 0.82}, {2.5, 0.77}, {3.0, 0.75}}, 0.1},
@@ -52,9 +52,15 @@ int main() {
             policy.observe({16.5, 5.5 + 2.75 * (k % 4), 0.3 * u(rng), 0.3 * u(rng), {0.02 * u(rng), 0.01 * u(rng)}});
           std::vector<double> us;
           for (int rep = 0; rep < 2000; ++rep) {
-            DecisionContext c{.sigma = 0.3 * u(rng), .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5,
-                              .candidates = candidates, .elapsed_s = 40.0 * u(rng), .rest_s = 20.0,
-                              .region_share = 1.0 / 7.0, .lawnmowers = lawnmowers};
+            DecisionContext c{.sigma = 0.3 * u(rng),
+                              .valid_fraction = 1.0,
+                              .top_gsd_cm = 3.0,
+                              .top_altitude_m = 16.5,
+                              .candidates = candidates,
+                              .elapsed_s = 40.0 * u(rng),
+                              .rest_s = 20.0,
+                              .region_share = 1.0 / 7.0,
+                              .lawnmowers = lawnmowers};
             const auto t0 = std::chrono::steady_clock::now();
             const Decision d = policy.decide(c);
             const auto t1 = std::chrono::steady_clock::now();

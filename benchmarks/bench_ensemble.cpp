@@ -21,7 +21,6 @@
 #include <string>
 #include <vector>
 
-
 int main(int argc, char** argv) {
   if (argc < 3) {
     std::cerr << "usage: bench_ensemble ENSEMBLE_DIR FIELD_DIR [--threads N] [--rounds R] [--iters K]\n";
@@ -31,9 +30,12 @@ int main(int argc, char** argv) {
   for (int i = 3; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     const int v = std::stoi(argv[i + 1]);
-    if (a == "--threads") threads = v;
-    else if (a == "--rounds") rounds = v;
-    else if (a == "--iters") iters = v;
+    if (a == "--threads")
+      threads = v;
+    else if (a == "--rounds")
+      rounds = v;
+    else if (a == "--iters")
+      iters = v;
     else {
       std::cerr << "bench_ensemble: unknown option " << a << '\n';
       return 2;
@@ -69,7 +71,8 @@ int main(int argc, char** argv) {
       sample.insert(sample.end(), t.begin(), t.end());
     };
     for (int r = 0; r < rounds; ++r) {
-      for (std::size_t k = 0; k < members.size(); ++k) time_into(member_ms[k], [&] { (void)members[k].segment(image); });
+      for (std::size_t k = 0; k < members.size(); ++k)
+        time_into(member_ms[k], [&] { (void)members[k].segment(image); });
       time_into(ens_ms, [&] { (void)ensemble.segment(image); });
       time_into(dis_ms, [&] { (void)ensemble.segment_with_disagreement(image); });
     }

@@ -58,17 +58,23 @@ int main(int argc, char** argv) {
       return argv[++i];
     };
     try {
-      if (a == "--threads") threads = std::stoi(next());
-      else if (a == "--iters") iters = std::stoi(next());
-      else if (a == "--warmup") warmup = std::stoi(next());
-      else if (a == "--image") image_file = next();
+      if (a == "--threads")
+        threads = std::stoi(next());
+      else if (a == "--iters")
+        iters = std::stoi(next());
+      else if (a == "--warmup")
+        warmup = std::stoi(next());
+      else if (a == "--image")
+        image_file = next();
       else if (a == "--camera") {
         const std::string v = next();
         const auto x = v.find('x');
         if (x == std::string::npos) throw std::invalid_argument("--camera expects WxH, got " + v);
         camera = {std::stoi(v.substr(0, x)), std::stoi(v.substr(x + 1))};
-      } else if (a == "--no-fusion") fusion = false;
-      else return usage();
+      } else if (a == "--no-fusion")
+        fusion = false;
+      else
+        return usage();
     } catch (const std::exception& e) {
       std::cerr << "bench_erfnet: " << e.what() << '\n';
       return usage();
@@ -112,10 +118,11 @@ int main(int argc, char** argv) {
         warmup, iters));
     const Stats seg = stats(time_ms([&] { (void)erfnet.segment(image); }, warmup, iters));
 
-    std::printf("{\"threads\": %d, \"cv_threads\": %d, \"iters\": %d, \"fusion\": %s, \"input\": [%d, %d], "
-                "\"camera\": [%d, %d], ",
-                threads, cv::getNumThreads(), iters, fusion ? "true" : "false", in.height, in.width,
-                image.rgb.rows, image.rgb.cols);
+    std::printf(
+        "{\"threads\": %d, \"cv_threads\": %d, \"iters\": %d, \"fusion\": %s, \"input\": [%d, %d], "
+        "\"camera\": [%d, %d], ",
+        threads, cv::getNumThreads(), iters, fusion ? "true" : "false", in.height, in.width, image.rgb.rows,
+        image.rgb.cols);
     print_stats("forward_ms", fwd);
     std::printf(", ");
     print_stats("segment_ms", seg);

@@ -132,8 +132,8 @@ int main(int argc, char** argv) {
     b.signal_variance = {data.bounds[0], data.bounds[1]};
     b.length_scale = {data.bounds[2], data.bounds[3]};
     b.noise_variance = {data.bounds[4], data.bounds[5]};
-    return run(data, adaptseg::ArdSquaredExponentialKernel(Eigen::VectorXd::Constant(data.d, data.ls), data.sf2,
-                                                           data.sn2, b));
+    return run(
+        data, adaptseg::ArdSquaredExponentialKernel(Eigen::VectorXd::Constant(data.d, data.ls), data.sf2, data.sn2, b));
   } catch (const std::exception& e) {
     std::cerr << "bench_gaussian_process: " << e.what() << "\n";
     return 1;

@@ -44,9 +44,10 @@ int main(int argc, char** argv) {
     const double write_s = seconds_since(t1);
     std::printf("field %d x %d px (%.1f x %.1f m at %.1f cm/px)\n", field.width_px(), field.height_px(),
                 field.area().width_m(), field.area().height_m(), field.gsd_cm());
-    std::printf("load (gdal::load_field): %.2f s, peak RSS %.0f MiB; held: image %.0f MiB + labels %.0f MiB + "
-                "valid mask %.0f MiB = %.0f MiB\n",
-                load_s, load_rss, image_mib, labels_mib, labels_mib, image_mib + 2 * labels_mib);
+    std::printf(
+        "load (gdal::load_field): %.2f s, peak RSS %.0f MiB; held: image %.0f MiB + labels %.0f MiB + "
+        "valid mask %.0f MiB = %.0f MiB\n",
+        load_s, load_rss, image_mib, labels_mib, labels_mib, image_mib + 2 * labels_mib);
     std::printf("write map.tif (DEFLATE): %.2f s, peak RSS %.0f MiB\n", write_s, peak_rss_mib());
     return 0;
   } catch (const std::exception& e) {

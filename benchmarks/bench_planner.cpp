@@ -92,7 +92,9 @@ int main(int argc, char** argv) {
   adaptseg::examples::SegmenterOptions segmenter;
   app.add_option("--decision-model", model_path, "decision model (adaptseg_calibrate)")->required();
   app.add_option("--field", fields, "field to fly (repeatable)")->required();
-  app.add_option("--planner-threads", threads, "OpenCV threads of the planner (cv::setNumThreads; --threads: the network's)")->capture_default_str();
+  app.add_option("--planner-threads", threads,
+                 "OpenCV threads of the planner (cv::setNumThreads; --threads: the network's)")
+      ->capture_default_str();
   app.add_option("--repeat", repeat, "missions per field (the steps of all are pooled)")->capture_default_str();
   app.add_option("--strategy", strategy, "decision strategy")
       ->check(CLI::IsMember(adaptseg::examples::strategy_names(true)))

@@ -60,8 +60,8 @@ int main(int argc, char** argv) {
     if (!field_dir.empty()) {
       // As --train loads it: GeoTIFF fields too (built with GDAL), an empty region refused.
       if (!region_text.empty()) (void)adaptseg::examples::parse_region(region_text);  // its own message
-      fields.push_back(adaptseg::examples::load_field_spec(region_text.empty() ? field_dir.string()
-                                                                                : field_dir.string() + ":" + region_text));
+      fields.push_back(adaptseg::examples::load_field_spec(
+          region_text.empty() ? field_dir.string() : field_dir.string() + ":" + region_text));
     }
     for (const auto& spec : train_specs) fields.push_back(adaptseg::examples::load_field_spec(spec));
     if (fields.empty()) throw std::invalid_argument("give a training field: --field DIR or --train DIR (repeatable)");
@@ -107,10 +107,10 @@ int main(int argc, char** argv) {
       os << "field,top_gsd_cm,sub_gsd_cm,delta_h_m,sigma_top,sigma_sub,miou_top,miou_sub,relabelled,"
             "relabelled_interest,region_share,field_sigma,field_gain\n";
       for (const auto& s : cal.samples)
-        os << adaptseg::examples::csv_field(fields[s.field].name()) << ',' << s.top_gsd_cm << ',' << s.sub_gsd_cm
-           << ',' << s.delta_h_m << ',' << s.sigma_top << ',' << s.sigma_sub << ',' << s.miou_top << ','
-           << s.miou_sub << ',' << s.relabelled.share << ',' << s.relabelled.interest_share << ','
-           << s.region_share << ',' << s.field_sigma << ',' << s.field_gain << '\n';
+        os << adaptseg::examples::csv_field(fields[s.field].name()) << ',' << s.top_gsd_cm << ',' << s.sub_gsd_cm << ','
+           << s.delta_h_m << ',' << s.sigma_top << ',' << s.sigma_sub << ',' << s.miou_top << ',' << s.miou_sub << ','
+           << s.relabelled.share << ',' << s.relabelled.interest_share << ',' << s.region_share << ',' << s.field_sigma
+           << ',' << s.field_gain << '\n';
       adaptseg::examples::write_text(samples_csv, os.str());
     }
     if (!cell_samples_csv.empty()) {
@@ -133,9 +133,10 @@ int main(int argc, char** argv) {
       for (const auto& p : cal.lawnmower_curves[k]) std::printf(" (%.1f, %.4f)", p.time_s, p.miou);
       std::printf("\n");
     }
-    std::printf("settings tried on the training fields, the chosen one first (time, mIoU and front margin: "
-                "means over the fields flown; descents: all of them; then each field's front margin, in the "
-                "order flown):\n");
+    std::printf(
+        "settings tried on the training fields, the chosen one first (time, mIoU and front margin: "
+        "means over the fields flown; descents: all of them; then each field's front margin, in the "
+        "order flown):\n");
     std::printf("  %-52s %9s %8s %13s %13s %8s  %s\n", "setting", "time [s]", "mIoU", "front margin", "worst margin",
                 "descents", "per field");
     for (const auto& t : cal.trials) {
@@ -145,15 +146,17 @@ int main(int argc, char** argv) {
       std::printf("\n");
     }
     if (!cal.cell_input_scores.empty()) {
-      std::printf("decision inputs tried for ranking the cells (share of the achievable gain the best 20 %% of the "
-                  "training fields' cells capture), the chosen one first:\n");
+      std::printf(
+          "decision inputs tried for ranking the cells (share of the achievable gain the best 20 %% of the "
+          "training fields' cells capture), the chosen one first:\n");
       for (const auto& [input, score] : cal.cell_input_scores)
         std::printf("  %-16s %+.3f\n", adaptseg::to_string(input).c_str(), score);
       std::printf("%zu cell samples\n", cal.cell_samples.size());
       if (const auto& cells = cal.decision_function.model().cells()) {
-        std::printf("cell gain model of %s per pair of GSDs (gain slope beta; the scene check's proxy slope gamma "
-                    "and its spread between the training fields tau):\n",
-                    adaptseg::to_string(cells->input()).c_str());
+        std::printf(
+            "cell gain model of %s per pair of GSDs (gain slope beta; the scene check's proxy slope gamma "
+            "and its spread between the training fields tau):\n",
+            adaptseg::to_string(cells->input()).c_str());
         for (const auto& p : cells->points())
           std::printf("  %5.2f -> %5.2f cm/px  beta %+.3f  gamma %+.3f  tau %.3f\n", p.top_gsd_cm, p.sub_gsd_cm,
                       p.gain_slope, p.proxy_slope, p.proxy_slope_sd);

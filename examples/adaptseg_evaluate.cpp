@@ -77,11 +77,15 @@ void write_decisions(std::ostream& os, const std::string& field, const std::stri
       os << ",,";
     if (c) os << (d.candidates[*c].deferred ? "tour" : "now");
     os << ',';
-    if (d.outcome) os << csv_finite(d.outcome->top_input) << ',' << csv_finite(d.outcome->fine_input);
-    else os << ',';
+    if (d.outcome)
+      os << csv_finite(d.outcome->top_input) << ',' << csv_finite(d.outcome->fine_input);
+    else
+      os << ',';
     os << ',';
-    if (r) os << r->delta_tp << ',' << r->delta_fp << ',' << r->delta_fn;
-    else os << ",,";
+    if (r)
+      os << r->delta_tp << ',' << r->delta_fp << ',' << r->delta_fn;
+    else
+      os << ",,";
     os << '\n';
   }
 }
@@ -125,8 +129,8 @@ int main(int argc, char** argv) {
   adaptseg::examples::SegmenterOptions segmenter;
   app.add_option("--train", train_specs,
                  "training field DIR[:x0,y0,x1,y1] (decision-function initialisation); repeatable");
-  CLI::Option* model_opt = app.add_option("--decision-model", decision_model,
-                                          "use this decision model instead of calibrating on --train");
+  CLI::Option* model_opt =
+      app.add_option("--decision-model", decision_model, "use this decision model instead of calibrating on --train");
   adaptseg::examples::accept_old_spelling(app, model_opt, "--model", decision_model);
   app.add_option("--test", test_specs, "test field DIR[:x0,y0,x1,y1]; repeatable")->required();
   app.add_option("--out", out_dir, "output directory")->required();
@@ -157,7 +161,8 @@ int main(int argc, char** argv) {
     // Labels of interest: --interest, else the first test field's default.
     std::vector<std::string> interest_names = common.interest_names;
     if (interest_names.empty())
-      for (int i : tests.front().interest()) interest_names.push_back(tests.front().classes()[static_cast<std::size_t>(i)].name);
+      for (int i : tests.front().interest())
+        interest_names.push_back(tests.front().classes()[static_cast<std::size_t>(i)].name);
     if (interest_names.empty()) throw std::invalid_argument("no labels of interest: pass --interest");
     common.interest_names = interest_names;
     fs::create_directories(out_dir);
@@ -181,20 +186,20 @@ int main(int argc, char** argv) {
       co.adaptive.mission = common.resolve(train);
       const double g0 = train.gsd_cm();
       co.adaptive.top_gsd_cm = lawnmower_factors.back() * g0;
-      for (std::size_t k = 0; k + 1 < lawnmower_factors.size(); ++k) co.adaptive.candidate_gsd_cm.push_back(lawnmower_factors[k] * g0);
+      for (std::size_t k = 0; k + 1 < lawnmower_factors.size(); ++k)
+        co.adaptive.candidate_gsd_cm.push_back(lawnmower_factors[k] * g0);
       for (double f : lawnmower_factors) co.lawnmower_gsd_cm.push_back(f * g0);
       calibration.apply(co, common);
       std::string names;
       for (const auto& f : trains) names += (names.empty() ? "" : ", ") + f.name();
       std::fprintf(stderr, "[%6.1f s] calibrating on %s ...\n", elapsed(), names.c_str());
       const auto cal = segmenter.with_backend(train, co.adaptive.mission.camera, [&](auto& backend) {
-        adaptseg::CalibrationResult c =
-            adaptseg::examples::calibrate_fields(segmenter, trains, networks, backend, co);
+        adaptseg::CalibrationResult c = adaptseg::examples::calibrate_fields(segmenter, trains, networks, backend, co);
         loaded = adaptseg::make_decision_model(trains, backend.name(), co, c);
         return c;
       });
-      std::fprintf(stderr, "[%6.1f s] calibrated: %zu samples, %s, train front margin %+.4f, %d descents\n",
-                   elapsed(), cal.samples.size(), cal.trials.front().description.c_str(), loaded->train_front_margin,
+      std::fprintf(stderr, "[%6.1f s] calibrated: %zu samples, %s, train front margin %+.4f, %d descents\n", elapsed(),
+                   cal.samples.size(), cal.trials.front().description.c_str(), loaded->train_front_margin,
                    cal.trials.front().descents);
       // Every setting the calibration tried, with each training field's margin: why this one.
       for (const auto& t : cal.trials) {
@@ -212,9 +217,11 @@ int main(int argc, char** argv) {
         decisions_csv(out_dir / "decisions.csv");
     results << "field,strategy,gsd_cm,miou_interest,miou_all,time_total,time_flight,time_segmentation,"
                "time_planning,images,front_margin,descents,altitude_changes,curve_front_margin\n";
-    per_image << "field,strategy,gsd_cm,image,level,image_gsd_cm,sigma,image_miou_interest,image_miou_all,truth_sigma\n";
+    per_image
+        << "field,strategy,gsd_cm,image,level,image_gsd_cm,sigma,image_miou_interest,image_miou_all,truth_sigma\n";
     decisions_csv << "field,strategy,decision,image,sigma,action,gsd_cm,images,extra_time_s,forecast_delta_sigma,"
-                     "forecast_delta_miou,forecast_delta_miou_std,forecast_relabelled_interest,forecast_field_gain,forecast_front_margin,"
+                     "forecast_delta_miou,forecast_delta_miou_std,forecast_relabelled_interest,forecast_field_gain,"
+                     "forecast_front_margin,"
                      "observed_sigma_sub,observed_relabelled,observed_relabelled_interest,realised_region_delta_miou,"
                      "realised_field_gain,flown,observed_top_input,observed_fine_input,realised_delta_tp,"
                      "realised_delta_fp,realised_delta_fn\n";
@@ -242,12 +249,10 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "[%6.1f s] (%zu/%zu) %s: %s%s ...", elapsed(), run_index, total_runs, field.name().c_str(),
                      strategy.c_str(), strategy == "lawnmower" ? (" " + fmt(gsd, 2) + " cm/px").c_str() : "");
         progress_open = true;
-        auto run = segmenter.with_backend(field, mo.camera,
-                                          [&](auto& backend) {
-                                            return adaptseg::examples::run_strategy(
-                                                field, backend, strategy, gsd, &model, mo,
-                                                strategy == "lawnmower" ? std::nullopt : budget_s);
-                                          });
+        auto run = segmenter.with_backend(field, mo.camera, [&](auto& backend) {
+          return adaptseg::examples::run_strategy(field, backend, strategy, gsd, &model, mo,
+                                                  strategy == "lawnmower" ? std::nullopt : budget_s);
+        });
         std::fprintf(stderr, " %zu images, %.1f s, mIoU %.4f\n", run.mission.waypoints.size(), run.mission.total_s(),
                      run.mission.miou_interest().value_or(NAN));
         progress_open = false;
@@ -281,13 +286,13 @@ int main(int argc, char** argv) {
         results << csv(field.name()) << ',' << row.strategy << ',' << fmt(row.gsd, 3) << ',' << csv(m.miou_interest())
                 << ',' << csv(m.miou_all()) << ',' << fmt(m.total_s(), 3) << ',' << fmt(m.flight_s, 3) << ','
                 << fmt(m.segmentation_s, 4) << ',' << fmt(m.planning_s, 4) << ',' << m.waypoints.size() << ','
-                << fmt(margin, 6) << ',' << descents << ',' << altitude_changes(m) << ',' << fmt(curve_margin, 6) << '\n';
+                << fmt(margin, 6) << ',' << descents << ',' << altitude_changes(m) << ',' << fmt(curve_margin, 6)
+                << '\n';
         for (std::size_t k = 0; k < m.waypoints.size(); ++k) {
           const auto& w = m.waypoints[k];
           per_image << csv(field.name()) << ',' << row.strategy << ',' << fmt(row.gsd, 3) << ',' << k << ',' << w.level
                     << ',' << fmt(w.waypoint.gsd_cm, 3) << ',' << fmt(w.semantic_ratio, 6) << ','
-                    << csv(w.image_miou_interest) << ',' << csv(w.image_miou_all) << ','
-                    << csv(w.truth_ratio) << '\n';
+                    << csv(w.image_miou_interest) << ',' << csv(w.image_miou_all) << ',' << csv(w.truth_ratio) << '\n';
         }
         if (row.run.decisions)
           write_decisions(decisions_csv, field.name(), row.strategy, *row.run.decisions, row.run.realised);
@@ -303,13 +308,14 @@ int main(int argc, char** argv) {
         for (const auto& w : m.waypoints) path.push_back(w.waypoint);
         const std::string label = field.name() + ": " + name;
         adaptseg::examples::write_png(
-            dir / "path.png", adaptseg::render_path(field, path, label + ", " + std::to_string(path.size()) + " images, " +
-                                                                     fmt(m.total_s(), 0) + " s"));
+            dir / "path.png",
+            adaptseg::render_path(
+                field, path, label + ", " + std::to_string(path.size()) + " images, " + fmt(m.total_s(), 0) + " s"));
         adaptseg::examples::write_png(
-            dir / "map.png", adaptseg::render_map_comparison(field, m.fused_labels,
-                                                             label + " | mIoU interest " +
-                                                                 fmt(m.miou_interest().value_or(NAN), 3) +
-                                                                 ", front margin " + fmt(margin, 3)));
+            dir / "map.png",
+            adaptseg::render_map_comparison(field, m.fused_labels,
+                                            label + " | mIoU interest " + fmt(m.miou_interest().value_or(NAN), 3) +
+                                                ", front margin " + fmt(margin, 3)));
         adaptseg::examples::write_geo_maps(field, m.fused_labels, m.fused_gsd_cm, dir);
       }
       results.flush();
@@ -322,8 +328,7 @@ int main(int argc, char** argv) {
     per_image.close();
     decisions_csv.close();
     std::fprintf(stderr, "[%6.1f s] wrote %s/results.csv, per_image.csv, decisions.csv and per-mission results\n",
-                 elapsed(),
-                 out_dir.string().c_str());
+                 elapsed(), out_dir.string().c_str());
     if (!no_plots) {
       const std::string cmd = "/usr/bin/python3 '" + std::string(ADAPTSEG_PLOT_SCRIPT) + "' '" + out_dir.string() + "'";
       if (std::system(cmd.c_str()) != 0)

@@ -92,22 +92,22 @@ adaptseg::AdaptiveOptions model_options(const adaptseg::DecisionModel& model, st
 
 /// The vehicle's settings (with --mavlink).
 struct FlightSettings {
-  std::string connection;                ///< --mavlink; empty: no vehicle (a recorded folder replayed)
-  std::optional<double> tolerance_m;     ///< --arrival-tolerance-m (default: from the footprint)
-  double max_speed_mps = 0.5;            ///< --arrival-max-speed-mps
-  double stall_s = 10.0;                 ///< --arrival-stall-s
-  bool trigger = true;                   ///< --trigger autopilot
-  bool pose_from_exif = false;           ///< --image-pose exif: each picture at its EXIF GPS position
-  double fence_margin_m = 0.0;           ///< --fence-margin-m
-  double link_timeout_s = 3.0;           ///< --link-timeout-s
-  cv::Mat site_mask;                     ///< the --area site's mask (the fence's outline), if any
+  std::string connection;             ///< --mavlink; empty: no vehicle (a recorded folder replayed)
+  std::optional<double> tolerance_m;  ///< --arrival-tolerance-m (default: from the footprint)
+  double max_speed_mps = 0.5;         ///< --arrival-max-speed-mps
+  double stall_s = 10.0;              ///< --arrival-stall-s
+  bool trigger = true;                ///< --trigger autopilot
+  bool pose_from_exif = false;        ///< --image-pose exif: each picture at its EXIF GPS position
+  double fence_margin_m = 0.0;        ///< --fence-margin-m
+  double link_timeout_s = 3.0;        ///< --link-timeout-s
+  cv::Mat site_mask;                  ///< the --area site's mask (the fence's outline), if any
 };
 
 /// The live loop's settings.
 struct LiveSettings {
   fs::path out;
-  std::string segmenter;   ///< oracle: labels from the camera source; erfnet: its RGB images
-  ex::ExportCli exports;   ///< the flown path's mission files, where the area is georeferenced
+  std::string segmenter;  ///< oracle: labels from the camera source; erfnet: its RGB images
+  ex::ExportCli exports;  ///< the flown path's mission files, where the area is georeferenced
   ex::CameraSource* camera = nullptr;
   FlightSettings flight;
 };
@@ -125,18 +125,20 @@ struct LiveSettings {
   if (shot.file.empty()) throw std::invalid_argument(shot.name + ": --image-pose exif needs a picture file");
   const std::optional<adaptseg::ExifPosition> e = adaptseg::read_exif_position(shot.file);
   if (!e)
-    throw std::invalid_argument(shot.file.string() +
-                                ": no EXIF GPS position (--image-pose exif); fly with --image-pose vehicle to fuse each "
-                                "picture where the vehicle was at the trigger");
+    throw std::invalid_argument(
+        shot.file.string() +
+        ": no EXIF GPS position (--image-pose exif); fly with --image-pose vehicle to fuse each "
+        "picture where the vehicle was at the trigger");
   const adaptseg::GeoReference geo(frame);
   ex::CameraPose pose = shot.pose;
   Eigen::Vector3d x = geo.to_field({e->latitude_deg, e->longitude_deg, frame.altitude_m});
   x.z() = e->altitude_msl_m ? *e->altitude_msl_m - at_trigger.home_alt_msl_m() : shot.pose.position.z();
   const double off = (x.head<2>() - shot.pose.position.head<2>()).norm();
   if (!(off <= max_offset_m) || !(x.z() > 0.0))
-    throw std::invalid_argument(shot.file.string() + ": its EXIF GPS position lies " + ex::fmt(off, 1) + " m from the " +
-                                "vehicle's at the trigger, " + ex::fmt(x.z(), 1) + " m above home (allowed: " +
-                                ex::fmt(max_offset_m, 1) + " m, above home): another picture's, or the camera's "
+    throw std::invalid_argument(shot.file.string() + ": its EXIF GPS position lies " + ex::fmt(off, 1) +
+                                " m from the " + "vehicle's at the trigger, " + ex::fmt(x.z(), 1) +
+                                " m above home (allowed: " + ex::fmt(max_offset_m, 1) +
+                                " m, above home): another picture's, or the camera's "
                                 "receiver or clock is wrong; fly with --image-pose vehicle");
   pose.position = x;
   return pose;
@@ -150,9 +152,8 @@ struct LiveSettings {
 
 template <typename Planner>
 void write_outputs(const Planner& planner, const ImageSetInfo& info, const std::string& policy_name,
-                   const std::string& backend_name, const adaptseg::AdaptiveOptions& options,
-                   const nlohmann::json& wps, const nlohmann::json& vehicle,
-                   const std::optional<std::string>& stopped, const LiveSettings& s) {
+                   const std::string& backend_name, const adaptseg::AdaptiveOptions& options, const nlohmann::json& wps,
+                   const nlohmann::json& vehicle, const std::optional<std::string>& stopped, const LiveSettings& s) {
   if (s.out.empty()) return;
   fs::create_directories(s.out);
   int descents = 0, limited = 0;
@@ -179,8 +180,11 @@ void write_outputs(const Planner& planner, const ImageSetInfo& info, const std::
     // What stopped the mission, and the waypoint the UAV had flown to without an image from it.
     j["stopped"] = *stopped;
     if (const auto w = planner.pending())
-      j["stopped_at"] = {{"x", w->waypoint.position.x()}, {"y", w->waypoint.position.y()},
-                         {"z", w->waypoint.position.z()}, {"level", w->level}, {"index", w->index}};
+      j["stopped_at"] = {{"x", w->waypoint.position.x()},
+                         {"y", w->waypoint.position.y()},
+                         {"z", w->waypoint.position.z()},
+                         {"level", w->level},
+                         {"index", w->index}};
   }
   std::vector<std::string> written{"result.json", "map.png"};
   if (info.geo) {
@@ -197,8 +201,8 @@ void write_outputs(const Planner& planner, const ImageSetInfo& info, const std::
     }
 #ifdef ADAPTSEG_HAVE_GDAL
     const adaptseg::SemanticMap& map = planner.map();
-    const adaptseg::gdal::MapGrid grid{info.name, map.labels().cols, map.labels().rows, info.area.map_gsd_cm,
-                                       std::nullopt, info.geo, info.classes, info.area.ignore_label};
+    const adaptseg::gdal::MapGrid grid{info.name,    map.labels().cols, map.labels().rows, info.area.map_gsd_cm,
+                                       std::nullopt, info.geo,          info.classes,      info.area.ignore_label};
     adaptseg::gdal::write_map_geotiff(s.out / "map.tif", grid, map.labels());
     adaptseg::gdal::write_gsd_geotiff(s.out / "map_gsd.tif", grid, map.gsd_cm());
     written.insert(written.end(), {"map.tif", "map_gsd.tif"});
@@ -224,7 +228,8 @@ std::unique_ptr<ex::MavlinkVehicle> connect_vehicle(const Planner& planner, cons
   const adaptseg::GeoReference frame(*info.geo);
   const double ceiling = s.exports.file_options.max_altitude_m;
   s.exports.check_altitude(planner.top_gsd_cm(), planner.camera().params(), /*always=*/true);
-  const ex::Fence fence = ex::make_fence(info.area.area, f.site_mask, info.area.map_gsd_cm, f.fence_margin_m, frame, ceiling);
+  const ex::Fence fence =
+      ex::make_fence(info.area.area, f.site_mask, info.area.map_gsd_cm, f.fence_margin_m, frame, ceiling);
   const std::vector<adaptseg::Waypoint> reachable = planner.reachable_waypoints();
   ex::check_fence(fence, reachable, frame);
 
@@ -240,15 +245,15 @@ std::unique_ptr<ex::MavlinkVehicle> connect_vehicle(const Planner& planner, cons
   v.arrival.check();
   v.link.link_timeout_s = f.link_timeout_s;
   v.link.capture_wait_s = 0.5;
-  std::printf("fence: %zu vertices (%s, grown %.1f m), ceiling %.1f m above home; every one of the %zu waypoints the "
-              "planner may fly is inside\n",
-              fence.ring.size(), f.site_mask.empty() ? "the area's rectangle" : "the site's outline", f.fence_margin_m,
-              ceiling, reachable.size());
-  std::printf("arrival: within %.2f m (%s), slower than %.2f m/s; camera: %s%s\n", v.arrival.horizontal_m,
-              f.tolerance_m ? "--arrival-tolerance-m"
-                            : "a tenth of the finest footprint's smaller side; --arrival-tolerance-m",
-              v.arrival.max_speed_mps, s.camera->description().c_str(),
-              v.trigger ? ", triggered through the autopilot" : "");
+  std::printf(
+      "fence: %zu vertices (%s, grown %.1f m), ceiling %.1f m above home; every one of the %zu waypoints the "
+      "planner may fly is inside\n",
+      fence.ring.size(), f.site_mask.empty() ? "the area's rectangle" : "the site's outline", f.fence_margin_m, ceiling,
+      reachable.size());
+  std::printf(
+      "arrival: within %.2f m (%s), slower than %.2f m/s; camera: %s%s\n", v.arrival.horizontal_m,
+      f.tolerance_m ? "--arrival-tolerance-m" : "a tenth of the finest footprint's smaller side; --arrival-tolerance-m",
+      v.arrival.max_speed_mps, s.camera->description().c_str(), v.trigger ? ", triggered through the autopilot" : "");
   vehicle_json = {{"connection", f.connection},
                   {"arrival_tolerance_m", v.arrival.horizontal_m},
                   {"arrival_max_speed_mps", v.arrival.max_speed_mps},
@@ -273,12 +278,12 @@ void fly(const ImageSetInfo& info, Backend& backend, Policy& policy, const adapt
   // The GSD the top level is flown at: the model's, or the one its policy chose for this area.
   std::printf("%s: %zu top-level waypoints at %.2f cm/px", info.name.c_str(), planner.top_level().size(),
               planner.top_gsd_cm());
-  if (planner.top_gsd_cm() != options.top_gsd_cm) std::printf(" (the policy's choice; the model's %.2f)", options.top_gsd_cm);
+  if (planner.top_gsd_cm() != options.top_gsd_cm)
+    std::printf(" (the policy's choice; the model's %.2f)", options.top_gsd_cm);
   std::printf(", candidates");
   for (double g : planner.candidate_gsd_cm()) std::printf(" %.2f", g);
   std::printf(" cm/px, policy %s, descents %s, segmenter %s\n", std::string(policy.name()).c_str(),
-              adaptseg::descent_schedule_rule(options.schedule).description,
-              std::string(backend.name()).c_str());
+              adaptseg::descent_schedule_rule(options.schedule).description, std::string(backend.name()).c_str());
 
   nlohmann::json wps = nlohmann::json::array();
   nlohmann::json vehicle_json;
@@ -290,12 +295,15 @@ void fly(const ImageSetInfo& info, Backend& backend, Policy& policy, const adapt
   try {
     if (!s.flight.connection.empty()) vehicle = connect_vehicle(planner, info, s, vehicle_json);
     const ex::Idle idle = [&](double seconds) {
-      if (vehicle) vehicle->idle(seconds);
-      else std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+      if (vehicle)
+        vehicle->idle(seconds);
+      else
+        std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
     };
     while (const auto w = planner.next()) {
       // The UAV's part: fly to w, hover, take the image (replayed: the folder's image there).
-      const ex::CameraPose at = vehicle ? vehicle->fly_to(w->waypoint, *s.camera) : ex::CameraPose{w->waypoint.position, 0.0};
+      const ex::CameraPose at =
+          vehicle ? vehicle->fly_to(w->waypoint, *s.camera) : ex::CameraPose{w->waypoint.position, 0.0};
       ex::Shot shot = s.camera->take(at, idle);
       if (vehicle && s.flight.pose_from_exif)
         shot.pose = exif_pose(shot, *info.geo, vehicle->last_position(), 0.5 * w->waypoint.footprint.height_m());
@@ -310,10 +318,14 @@ void fly(const ImageSetInfo& info, Backend& backend, Policy& policy, const adapt
           vehicle ? vehicle->while_busy([&] { return planner.report(image, elapsed); }) : planner.report(image);
 
       const auto& p = w->waypoint.position;
-      std::printf("[%3zu] %s x=%7.2f y=%7.2f z=%6.2f m  %s  sigma=%.4f", w->index, w->level == 0 ? "top" : "sub",
-                  p.x(), p.y(), p.z(), shot.name.c_str(), step.sigma);
-      nlohmann::json wj{{"x", p.x()},       {"y", p.y()},          {"z", p.z()},
-                        {"gsd_cm", w->waypoint.gsd_cm}, {"level", w->level}, {"image", shot.name},
+      std::printf("[%3zu] %s x=%7.2f y=%7.2f z=%6.2f m  %s  sigma=%.4f", w->index, w->level == 0 ? "top" : "sub", p.x(),
+                  p.y(), p.z(), shot.name.c_str(), step.sigma);
+      nlohmann::json wj{{"x", p.x()},
+                        {"y", p.y()},
+                        {"z", p.z()},
+                        {"gsd_cm", w->waypoint.gsd_cm},
+                        {"level", w->level},
+                        {"image", shot.name},
                         {"yaw_deg", shot.pose.yaw_deg},
                         {"semantic_ratio", step.sigma}};
       if (info.geo) {
@@ -324,8 +336,12 @@ void fly(const ImageSetInfo& info, Backend& backend, Policy& policy, const adapt
       if (vehicle) {
         const auto& m = vehicle->last_position();
         const Eigen::Vector3d& q = shot.pose.position;
-        wj["measured"] = {{"x", q.x()}, {"y", q.y()}, {"z", q.z()}, {"yaw_deg", shot.pose.yaw_deg},
-                          {"latitude_deg", m.lat_deg}, {"longitude_deg", m.lon_deg},
+        wj["measured"] = {{"x", q.x()},
+                          {"y", q.y()},
+                          {"z", q.z()},
+                          {"yaw_deg", shot.pose.yaw_deg},
+                          {"latitude_deg", m.lat_deg},
+                          {"longitude_deg", m.lon_deg},
                           {"relative_altitude_m", m.rel_alt_m}};
         wj["elapsed_s"] = *elapsed;
         std::printf("  %.2f m off, t=%.1f s", (q - p).norm(), *elapsed);
@@ -394,19 +410,27 @@ void fly_strategy(const std::string& strategy, const adaptseg::DecisionModel& mo
 
 /// The classes of a site without labels (--area alone): the model's, in a fixed palette.
 std::vector<adaptseg::ClassInfo> model_classes(const adaptseg::DecisionModel& model) {
-  static constexpr std::array<std::array<std::uint8_t, 3>, 8> kPalette{
-      {{128, 64, 0}, {0, 160, 0}, {220, 30, 30}, {30, 90, 220}, {240, 200, 40}, {150, 40, 190}, {0, 190, 190}, {128, 128, 128}}};
+  static constexpr std::array<std::array<std::uint8_t, 3>, 8> kPalette{{{128, 64, 0},
+                                                                        {0, 160, 0},
+                                                                        {220, 30, 30},
+                                                                        {30, 90, 220},
+                                                                        {240, 200, 40},
+                                                                        {150, 40, 190},
+                                                                        {0, 190, 190},
+                                                                        {128, 128, 128}}};
   std::vector<adaptseg::ClassInfo> out;
-  for (std::size_t k = 0; k < model.classes.size(); ++k) out.push_back({model.classes[k], kPalette[k % kPalette.size()]});
+  for (std::size_t k = 0; k < model.classes.size(); ++k)
+    out.push_back({model.classes[k], kPalette[k % kPalette.size()]});
   return out;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Run the adaptive planner step by step, as a UAV's companion computer does: over a folder of posed "
-               "images, or flying a vehicle over MAVLink.",
-               "adaptseg_live"};
+  CLI::App app{
+      "Run the adaptive planner step by step, as a UAV's companion computer does: over a folder of posed "
+      "images, or flying a vehicle over MAVLink.",
+      "adaptseg_live"};
   LiveSettings s;
   fs::path images_dir, decision_model, network, camera_folder;
   std::string record_from, strategy = "adaptive", segmenter = "oracle", simulate_field, trigger, image_pose = "vehicle";
@@ -435,9 +459,13 @@ int main(int argc, char** argv) {
                  "images")
       ->check(CLI::IsMember({"oracle", "erfnet"}))
       ->capture_default_str();
-  CLI::Option* network_opt = app.add_option("--network", network, "network of --segmenter erfnet: a model directory (model.onnx, model.yaml) or an ensemble directory (ensemble.yaml)");
+  CLI::Option* network_opt = app.add_option("--network", network,
+                                            "network of --segmenter erfnet: a model directory (model.onnx, model.yaml) "
+                                            "or an ensemble directory (ensemble.yaml)");
   adaptseg::examples::accept_old_spelling(app, network_opt, "--model-file", network);
-  app.add_option("--budget-s", budget_s, "mission-time budget [s]: a descent is flown only where it and the rest fit, each image at a bound of its processing learned in flight, and cut short where they no longer do");
+  app.add_option("--budget-s", budget_s,
+                 "mission-time budget [s]: a descent is flown only where it and the rest fit, each image at a bound of "
+                 "its processing learned in flight, and cut short where they no longer do");
   app.add_option("--pose-tolerance-m", pose_tolerance_m,
                  "how far [m] a recorded pose may be from the waypoint (or, flying, from the measured pose) "
                  "(default: 0.4 x the finest footprint's smaller side, printed)");
@@ -464,15 +492,17 @@ int main(int argc, char** argv) {
                      "with --mavlink: render each image over this field (DIR or DIR:x0,y0,x1,y1) at the vehicle's "
                      "measured pose; the field is also the area to map unless --images or --area gives it")
           ->needs(mavlink_opt);
-  CLI::Option* camera_folder_opt = app.add_option("--camera-folder", camera_folder,
-                 "with --mavlink: after each trigger, the next new image file in this folder (a real camera's "
-                 "download), taken at the pose measured at the trigger; any size of the camera's aspect ratio")
-      ->needs(mavlink_opt)
-      ->excludes(sim_opt);
-  app.add_option("--image-pose", image_pose,
-                 "with --camera-folder: where each picture is fused: vehicle (the vehicle's position at the trigger) or "
-                 "exif (the picture's EXIF GPS position, e.g. a camera with its own RTK receiver; its altitude above "
-                 "home from the vehicle's home; refused beyond half a footprint from the vehicle's)")
+  CLI::Option* camera_folder_opt =
+      app.add_option("--camera-folder", camera_folder,
+                     "with --mavlink: after each trigger, the next new image file in this folder (a real camera's "
+                     "download), taken at the pose measured at the trigger; any size of the camera's aspect ratio")
+          ->needs(mavlink_opt)
+          ->excludes(sim_opt);
+  app.add_option(
+         "--image-pose", image_pose,
+         "with --camera-folder: where each picture is fused: vehicle (the vehicle's position at the trigger) or "
+         "exif (the picture's EXIF GPS position, e.g. a camera with its own RTK receiver; its altitude above "
+         "home from the vehicle's home; refused beyond half a footprint from the vehicle's)")
       ->check(CLI::IsMember({"vehicle", "exif"}))
       ->needs(camera_folder_opt)
       ->capture_default_str();
@@ -524,15 +554,19 @@ int main(int argc, char** argv) {
 #endif
   s.exports.formats = {"plan", "wpl", "geojson"};
   s.exports.add_to(app);
-  app.get_option("--export")->description(
-      "the flown path's mission files where the area is georeferenced: plan (QGroundControl), wpl (QGC WPL 110), "
-      "geojson; repeat or comma-separate (default: all three)");
-  app.get_option("--geo-origin")->description(
-      "with --record-from or --simulate-camera: LAT,LON,ALT,HEADING of the field directory's frame origin, replacing "
-      "field.yaml's geo section (recorded into area.yaml)");
-  app.get_option("--max-altitude-m")->description(
-      "the highest a waypoint may fly above home [m] (the usual legal ceiling): the exported files', and with "
-      "--mavlink the fence's ceiling; a mission that would fly higher is refused before it flies");
+  app.get_option("--export")
+      ->description(
+          "the flown path's mission files where the area is georeferenced: plan (QGroundControl), wpl (QGC WPL 110), "
+          "geojson; repeat or comma-separate (default: all three)");
+  app.get_option("--geo-origin")
+      ->description(
+          "with --record-from or --simulate-camera: LAT,LON,ALT,HEADING of the field directory's frame origin, "
+          "replacing "
+          "field.yaml's geo section (recorded into area.yaml)");
+  app.get_option("--max-altitude-m")
+      ->description(
+          "the highest a waypoint may fly above home [m] (the usual legal ceiling): the exported files', and with "
+          "--mavlink the fence's ceiling; a mission that would fly higher is refused before it flies");
   std::string grid_name;
   app.add_option("--grid", grid_name,
                  "where the top-level grid is laid: corner (from the area's corner, the paper's grid) or centred "
@@ -568,11 +602,13 @@ int main(int argc, char** argv) {
     }
 
     if (!camera_folder.empty() && segmenter == "oracle")
-      throw std::invalid_argument("--camera-folder gives camera images without labels: segment them with "
-                                  "--segmenter erfnet --network DIR (the oracle needs ground truth)");
+      throw std::invalid_argument(
+          "--camera-folder gives camera images without labels: segment them with "
+          "--segmenter erfnet --network DIR (the oracle needs ground truth)");
     if (!s.exports.geo_origin.empty() && simulate_field.empty())
       throw std::invalid_argument(
-          "--geo-origin is for --record-from and --simulate-camera; the folder's frame is area.yaml's geo: (or --area)");
+          "--geo-origin is for --record-from and --simulate-camera; the folder's frame is area.yaml's geo: (or "
+          "--area)");
     s.exports.file_options.validate();
     // The area to map: the folder's area.yaml, the simulated field, or the site alone.
     ImageSetInfo info;
@@ -590,15 +626,17 @@ int main(int argc, char** argv) {
       info.interest = model.interest;
       info.camera = model.camera;
     } else {
-      throw std::invalid_argument("give the area to map: --images DIR (a recorded folder), --simulate-camera FIELD "
-                                  "(with --mavlink) or --area SITE");
+      throw std::invalid_argument(
+          "give the area to map: --images DIR (a recorded folder), --simulate-camera FIELD "
+          "(with --mavlink) or --area SITE");
     }
 #ifdef ADAPTSEG_HAVE_GDAL
     if (!area_file.empty()) {
       // The site's frame and mask replace area.yaml's (or the field's): poses are placed in it.
       const double gsd = map_gsd_cm > 0.0 ? map_gsd_cm : info.area.map_gsd_cm > 0.0 ? info.area.map_gsd_cm : 10.0;
       if (!(std::isfinite(gsd) && gsd > 0.0)) throw std::invalid_argument("--map-gsd-cm must be finite and positive");
-      const adaptseg::SurveySite site = adaptseg::load_survey_site(area_file, gsd, info.geo ? info.geo->altitude_m : 0.0);
+      const adaptseg::SurveySite site =
+          adaptseg::load_survey_site(area_file, gsd, info.geo ? info.geo->altitude_m : 0.0);
       info.area.area = site.area.area;
       info.area.map_gsd_cm = site.area.map_gsd_cm;
       info.area.valid_mask = site.area.valid_mask;
@@ -618,9 +656,10 @@ int main(int argc, char** argv) {
         c.sensor_width_mm != m.sensor_width_mm || c.focal_length_mm != m.focal_length_mm)
       throw std::invalid_argument("the images were taken with another camera than the decision model's");
     if (!s.flight.connection.empty() && !info.geo)
-      throw std::invalid_argument("--mavlink needs a georeferenced area, to turn waypoints into latitudes and "
-                                  "longitudes: a geo: section in area.yaml (or the simulated field's field.yaml, or "
-                                  "--geo-origin LAT,LON,ALT,HEADING), or the site as --area SITE");
+      throw std::invalid_argument(
+          "--mavlink needs a georeferenced area, to turn waypoints into latitudes and "
+          "longitudes: a geo: section in area.yaml (or the simulated field's field.yaml, or "
+          "--geo-origin LAT,LON,ALT,HEADING), or the site as --area SITE");
     std::vector<int> interest;
     for (const auto& n : model.interest)
       interest.push_back(static_cast<int>(std::find(names.begin(), names.end(), n) - names.begin()));
@@ -636,15 +675,15 @@ int main(int argc, char** argv) {
         throw std::invalid_argument("--simulate-camera: field '" + sim_field->name() +
                                     "' has no image for --segmenter erfnet (its labels serve --segmenter oracle)");
       const bool other_frame = !area_file.empty() || !images_dir.empty();
-      camera = std::make_unique<ex::SimulatedCamera>(*sim_field, model.camera,
-                                                     other_frame ? info.geo : std::optional<adaptseg::FieldGeo>{},
-                                                     info.area.map_gsd_cm);
+      camera = std::make_unique<ex::SimulatedCamera>(
+          *sim_field, model.camera, other_frame ? info.geo : std::optional<adaptseg::FieldGeo>{}, info.area.map_gsd_cm);
     } else if (!camera_folder.empty()) {
       camera = std::make_unique<ex::FolderCamera>(camera_folder, camera_timeout_s, model.camera);
     } else {
       if (images_dir.empty())
-        throw std::invalid_argument("no camera: give --images DIR (a recorded folder), or with --mavlink "
-                                    "--simulate-camera FIELD or --camera-folder DIR");
+        throw std::invalid_argument(
+            "no camera: give --images DIR (a recorded folder), or with --mavlink "
+            "--simulate-camera FIELD or --camera-folder DIR");
       // A pose within this of its waypoint is nearer it than any other waypoint's image.
       const double tolerance = pose_tolerance_m.value_or(ex::footprint_tolerance_m(
           adaptseg::CameraModel(model.camera), options.candidate_gsd_cm, options.top_gsd_cm, 0.4));
@@ -653,9 +692,9 @@ int main(int argc, char** argv) {
       std::printf("poses: an image within %.3f m of its waypoint%s\n", tolerance,
                   pose_tolerance_m ? " (--pose-tolerance-m)"
                                    : " (0.4 x the finest footprint's smaller side; --pose-tolerance-m)");
-      camera = std::make_unique<ex::RecordedCamera>(images_dir, ex::read_poses(images_dir, info, area_file.empty()),
-                                                    tolerance, segmenter == "erfnet", segmenter == "oracle",
-                                                    model.camera);
+      camera =
+          std::make_unique<ex::RecordedCamera>(images_dir, ex::read_poses(images_dir, info, area_file.empty()),
+                                               tolerance, segmenter == "erfnet", segmenter == "oracle", model.camera);
     }
     s.camera = camera.get();
     if (info.geo && s.flight.connection.empty()) s.exports.check_altitude(options.top_gsd_cm, model.camera);
@@ -670,9 +709,8 @@ int main(int argc, char** argv) {
       params.camera_width_px = m.image_width_px;
       params.camera_height_px = m.image_height_px;
       params.resize_to_network = true;
-      adaptseg::examples::with_network(network, std::move(params), [&](auto& backend) {
-        fly_strategy(strategy, model, info, backend, options, s);
-      });
+      adaptseg::examples::with_network(
+          network, std::move(params), [&](auto& backend) { fly_strategy(strategy, model, info, backend, options, s); });
     }
     return 0;
   } catch (const std::exception& e) {

@@ -39,7 +39,9 @@ int main(int argc, char** argv) {
   CLI::Option* model_opt = app.add_option("--decision-model", decision_model,
                                           "decision model from adaptseg_calibrate (adaptive, nonadaptive, linear)");
   adaptseg::examples::accept_old_spelling(app, model_opt, "--model", decision_model);
-  app.add_option("--budget-s", budget_s, "mission-time budget [s] for adaptive strategies: a descent is flown only where it and the rest fit, each image at a bound of its processing learned in flight, and cut short where they no longer do");
+  app.add_option("--budget-s", budget_s,
+                 "mission-time budget [s] for adaptive strategies: a descent is flown only where it and the rest fit, "
+                 "each image at a bound of its processing learned in flight, and cut short where they no longer do");
   std::string overlap_text;
   app.add_option("--overlap", overlap_text,
                  "OVERLAP or ALONG,ACROSS: image overlap of the lawnmower strategy, fractions of a footprint in "
@@ -86,8 +88,8 @@ int main(int argc, char** argv) {
     exports.write(field, result, options, out_dir);
     std::vector<adaptseg::Waypoint> path;
     for (const auto& w : result.waypoints) path.push_back(w.waypoint);
-    const std::string what = strategy == "lawnmower" ? strategy + " at " + adaptseg::examples::fmt(gsd_cm, 2) + " cm/px"
-                                                     : strategy;
+    const std::string what =
+        strategy == "lawnmower" ? strategy + " at " + adaptseg::examples::fmt(gsd_cm, 2) + " cm/px" : strategy;
     const auto mi = result.miou_interest();
     const auto ma = result.miou_all();
     adaptseg::examples::write_png(
@@ -95,17 +97,17 @@ int main(int argc, char** argv) {
         adaptseg::render_path(field, path,
                               field.name() + ": " + what + ", " + std::to_string(path.size()) + " images, " +
                                   adaptseg::examples::fmt(result.total_s(), 0) + " s"));
-    adaptseg::examples::write_png(
-        out_dir / "map.png",
-        adaptseg::render_map_comparison(field, result.fused_labels,
-                                        field.name() + ": " + what + " | mIoU interest " +
-                                            adaptseg::examples::fmt(mi.value_or(NAN), 3) + ", all " +
-                                            adaptseg::examples::fmt(ma.value_or(NAN), 3)));
+    adaptseg::examples::write_png(out_dir / "map.png", adaptseg::render_map_comparison(
+                                                           field, result.fused_labels,
+                                                           field.name() + ": " + what + " | mIoU interest " +
+                                                               adaptseg::examples::fmt(mi.value_or(NAN), 3) + ", all " +
+                                                               adaptseg::examples::fmt(ma.value_or(NAN), 3)));
     adaptseg::examples::write_geo_maps(field, result.fused_labels, result.fused_gsd_cm, out_dir);
-    std::printf("%s: %s images=%zu time=%.1f s (flight %.1f, segmentation %.2f, planning %.4f) "
-                "mIoU interest=%.4f all=%.4f -> %s\n",
-                field.name().c_str(), what.c_str(), result.waypoints.size(), result.total_s(), result.flight_s,
-                result.segmentation_s, result.planning_s, mi.value_or(NAN), ma.value_or(NAN), out_dir.string().c_str());
+    std::printf(
+        "%s: %s images=%zu time=%.1f s (flight %.1f, segmentation %.2f, planning %.4f) "
+        "mIoU interest=%.4f all=%.4f -> %s\n",
+        field.name().c_str(), what.c_str(), result.waypoints.size(), result.total_s(), result.flight_s,
+        result.segmentation_s, result.planning_s, mi.value_or(NAN), ma.value_or(NAN), out_dir.string().c_str());
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "adaptseg_mission: error: %s\n", e.what());

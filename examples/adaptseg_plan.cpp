@@ -34,9 +34,11 @@ adaptseg::GeoPoint parse_home(const std::string& text) {
   is.imbue(std::locale::classic());
   adaptseg::GeoPoint g;
   char comma = 0;
-  const bool ok = (is >> g.latitude_deg) && (is >> comma) && comma == ',' && (is >> g.longitude_deg) && (is >> std::ws).eof();
+  const bool ok =
+      (is >> g.latitude_deg) && (is >> comma) && comma == ',' && (is >> g.longitude_deg) && (is >> std::ws).eof();
   if (!ok || !(std::abs(g.latitude_deg) <= 90.0) || !(std::abs(g.longitude_deg) <= 180.0))
-    throw std::invalid_argument("--home '" + text + "' is not LAT,LON with a latitude in [-90, 90] and a longitude in "
+    throw std::invalid_argument("--home '" + text +
+                                "' is not LAT,LON with a latitude in [-90, 90] and a longitude in "
                                 "[-180, 180] (degrees, latitude first)");
   return g;
 }
@@ -66,19 +68,22 @@ int main(int argc, char** argv) {
                  "orthomosaic without labels (its pixels with data)")
       ->required();
   app.add_option("--gsd", plan_options.gsd_cm, "GSD of the survey [cm/px]")->required();
-  app.add_option("--home", home_text,
-                 "LAT,LON: the take-off and home point [deg], on the site (default: the ground under the first waypoint)");
-  app.add_option("--dem", dem_file,
-                 "a DEM (GeoTIFF, any raster GDAL reads with a CRS): follow its terrain, each waypoint the GSD's height "
-                 "above the mean ground under its footprint, altitudes relative to home's ground");
+  app.add_option(
+      "--home", home_text,
+      "LAT,LON: the take-off and home point [deg], on the site (default: the ground under the first waypoint)");
+  app.add_option(
+      "--dem", dem_file,
+      "a DEM (GeoTIFF, any raster GDAL reads with a CRS): follow its terrain, each waypoint the GSD's height "
+      "above the mean ground under its footprint, altitudes relative to home's ground");
   app.add_option("--min-altitude-m", plan_options.min_altitude_m,
                  "the lowest a waypoint may fly above the ground [m] (with --dem: above the highest ground under its "
                  "footprint and along every leg)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  app.add_option("--max-flight-min", max_flight_min,
-                 "the longest sortie [min], from take-off to landing (a battery, less its reserve): the survey is split "
-                 "into sorties, one mission file each (default: one sortie)")
+  app.add_option(
+         "--max-flight-min", max_flight_min,
+         "the longest sortie [min], from take-off to landing (a battery, less its reserve): the survey is split "
+         "into sorties, one mission file each (default: one sortie)")
       ->check(CLI::PositiveNumber);
   app.add_option("--inside-margin-m", plan_options.survey.inside_margin_m,
                  "how far inside the site's outline (and outside its holes) every waypoint lies [m]")
@@ -129,8 +134,11 @@ int main(int argc, char** argv) {
         files.push_back(std::move(f));
       const adaptseg::Sortie& s = plan.sorties[k];
       const adaptseg::GeoPoint at = geo.to_wgs84(wps[s.first].position);
-      sorties.push_back({{"mission", stem}, {"first_waypoint", s.first}, {"end_waypoint", s.end},
-                         {"flight_s", s.flight_s}, {"resume_latitude_deg", at.latitude_deg},
+      sorties.push_back({{"mission", stem},
+                         {"first_waypoint", s.first},
+                         {"end_waypoint", s.end},
+                         {"flight_s", s.flight_s},
+                         {"resume_latitude_deg", at.latitude_deg},
                          {"resume_longitude_deg", at.longitude_deg}});
     }
     fs::create_directories(out_dir);
@@ -143,34 +151,44 @@ int main(int argc, char** argv) {
     j["images"] = wps.size();
     j["flight_s"] = plan.survey_s;
     j["total_flight_s"] = plan.flight_s;
-    j["site"] = {{"centre_latitude_deg", site.centre().latitude_deg}, {"centre_longitude_deg", site.centre().longitude_deg},
+    j["site"] = {{"centre_latitude_deg", site.centre().latitude_deg},
+                 {"centre_longitude_deg", site.centre().longitude_deg},
                  {"area_m2", site.area_m2()}};
-    j["home"] = {{"latitude_deg", plan.home.latitude_deg}, {"longitude_deg", plan.home.longitude_deg},
-                 {"x", plan.home_xy.x()}, {"y", plan.home_xy.y()}, {"given", plan.home_given}};
+    j["home"] = {{"latitude_deg", plan.home.latitude_deg},
+                 {"longitude_deg", plan.home.longitude_deg},
+                 {"x", plan.home_xy.x()},
+                 {"y", plan.home_xy.y()},
+                 {"given", plan.home_given}};
     j["inside_margin_m"] = plan_options.survey.inside_margin_m;
     j["min_altitude_m"] = plan_options.min_altitude_m;
-    j["coverage"] = {{"site_m2", plan.survey.site_m2}, {"uncovered_m2", plan.survey.uncovered_m2},
-                     {"moved", plan.survey.moved}, {"dropped", plan.survey.dropped}};
+    j["coverage"] = {{"site_m2", plan.survey.site_m2},
+                     {"uncovered_m2", plan.survey.uncovered_m2},
+                     {"moved", plan.survey.moved},
+                     {"dropped", plan.survey.dropped}};
     j["sorties"] = sorties;
     j["via_points"] = plan.via_points;
     std::size_t fence_vertices = 0;
     for (const auto& f : plan.geofence) fence_vertices += f.vertices.size();
     j["geofence_vertices"] = fence_vertices;
     if (plan.terrain)
-      j["terrain"] = {{"dem", dem_file.string()}, {"home_ground_m", plan.terrain->home_ground_m},
+      j["terrain"] = {{"dem", dem_file.string()},
+                      {"home_ground_m", plan.terrain->home_ground_m},
                       {"highest_rise_m", plan.terrain->highest_rise_m},
                       {"lowest_clearance_m", plan.terrain->lowest_clearance_m()}};
     j["warnings"] = plan.warnings;
-    j["site_frame"] = {{"latitude_deg", site.geo.latitude_deg},   {"longitude_deg", site.geo.longitude_deg},
-                       {"altitude_m", site.geo.altitude_m},       {"heading_deg", site.geo.heading_deg},
-                       {"anchor_x_m", site.geo.anchor_x_m},       {"anchor_y_m", site.geo.anchor_y_m},
-                       {"width_m", site.area.area.width_m()},     {"height_m", site.area.area.height_m()}};
+    j["site_frame"] = {{"latitude_deg", site.geo.latitude_deg}, {"longitude_deg", site.geo.longitude_deg},
+                       {"altitude_m", site.geo.altitude_m},     {"heading_deg", site.geo.heading_deg},
+                       {"anchor_x_m", site.geo.anchor_x_m},     {"anchor_y_m", site.geo.anchor_y_m},
+                       {"width_m", site.area.area.width_m()},   {"height_m", site.area.area.height_m()}};
     nlohmann::json points = nlohmann::json::array();
     for (std::size_t i = 0; i < wps.size(); ++i) {
       const adaptseg::Waypoint& w = wps[i];
       const adaptseg::GeoPoint g = geo.to_wgs84(w.position);
-      nlohmann::json p = {{"x", w.position.x()}, {"y", w.position.y()}, {"z", w.position.z()},
-                          {"latitude_deg", g.latitude_deg}, {"longitude_deg", g.longitude_deg}};
+      nlohmann::json p = {{"x", w.position.x()},
+                          {"y", w.position.y()},
+                          {"z", w.position.z()},
+                          {"latitude_deg", g.latitude_deg},
+                          {"longitude_deg", g.longitude_deg}};
       if (plan.terrain) p["ground_m"] = plan.terrain->ground_m[i];
       points.push_back(std::move(p));
     }
@@ -188,28 +206,32 @@ int main(int argc, char** argv) {
                                                     std::to_string(plan.sorties.size()) + " sortie(s)"));
 
     for (const auto& w : plan.warnings) std::fprintf(stderr, "adaptseg_plan: warning: %s\n", w.c_str());
-    std::printf("%s: %zu images at %.1f cm/px (%.1f m above %s), flight %.0f s; site %.0f x %.0f m, +x at bearing "
-                "%.1f deg -> %s\n",
-                site.name.c_str(), wps.size(), gsd_cm, plan.height_m, plan.terrain ? "the ground" : "home", plan.survey_s,
-                site.area.area.width_m(), site.area.area.height_m(), site.geo.heading_deg, out_dir.string().c_str());
+    std::printf(
+        "%s: %zu images at %.1f cm/px (%.1f m above %s), flight %.0f s; site %.0f x %.0f m, +x at bearing "
+        "%.1f deg -> %s\n",
+        site.name.c_str(), wps.size(), gsd_cm, plan.height_m, plan.terrain ? "the ground" : "home", plan.survey_s,
+        site.area.area.width_m(), site.area.area.height_m(), site.geo.heading_deg, out_dir.string().c_str());
     std::printf("where: centre %s, area %.2f ha; take-off %s (%s); %zu sortie(s), %.1f min from home and back\n",
                 hemisphere(site.centre().latitude_deg, site.centre().longitude_deg).c_str(), site.area_m2() / 1e4,
                 hemisphere(plan.home.latitude_deg, plan.home.longitude_deg).c_str(),
                 plan.home_given ? "--home" : "under the first waypoint", plan.sorties.size(), plan.flight_s / 60.0);
-    std::printf("coverage: %.1f %% of the site under a footprint; %.0f m^2 left at the edges (waypoints kept %.1f m "
-                "inside the outline: %zu moved inward, %zu dropped)\n",
-                100.0 * plan.survey.coverage(), plan.survey.uncovered_m2, plan_options.survey.inside_margin_m,
-                plan.survey.moved, plan.survey.dropped);
+    std::printf(
+        "coverage: %.1f %% of the site under a footprint; %.0f m^2 left at the edges (waypoints kept %.1f m "
+        "inside the outline: %zu moved inward, %zu dropped)\n",
+        100.0 * plan.survey.coverage(), plan.survey.uncovered_m2, plan_options.survey.inside_margin_m,
+        plan.survey.moved, plan.survey.dropped);
     for (std::size_t k = 0; split && k < plan.sorties.size(); ++k) {
       const adaptseg::Sortie& s = plan.sorties[k];
       const adaptseg::GeoPoint at = geo.to_wgs84(wps[s.first].position);
-      std::printf("sortie %zu: mission-%zu.*, waypoints %zu-%zu, resumes at waypoint %zu (%s), %.1f min\n", k + 1, k + 1,
-                  s.first, s.end - 1, s.first, hemisphere(at.latitude_deg, at.longitude_deg).c_str(), s.flight_s / 60.0);
+      std::printf("sortie %zu: mission-%zu.*, waypoints %zu-%zu, resumes at waypoint %zu (%s), %.1f min\n", k + 1,
+                  k + 1, s.first, s.end - 1, s.first, hemisphere(at.latitude_deg, at.longitude_deg).c_str(),
+                  s.flight_s / 60.0);
     }
     if (plan.terrain)
-      std::printf("terrain: home's ground %.1f m (DEM), highest ground under the survey %.1f m above it, lowest "
-                  "clearance %.1f m\n",
-                  plan.terrain->home_ground_m, plan.terrain->highest_rise_m, plan.terrain->lowest_clearance_m());
+      std::printf(
+          "terrain: home's ground %.1f m (DEM), highest ground under the survey %.1f m above it, lowest "
+          "clearance %.1f m\n",
+          plan.terrain->home_ground_m, plan.terrain->highest_rise_m, plan.terrain->lowest_clearance_m());
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "adaptseg_plan: error: %s\n", e.what());

@@ -19,7 +19,8 @@ const std::filesystem::path& field_dir() {
     std::filesystem::create_directories(d);
     cv::Mat labels(12, 16, CV_8UC1);
     for (int r = 0; r < labels.rows; ++r)
-      for (int c = 0; c < labels.cols; ++c) labels.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(c < 2 ? 255 : (r + c) % 3);
+      for (int c = 0; c < labels.cols; ++c)
+        labels.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(c < 2 ? 255 : (r + c) % 3);
     if (!cv::imwrite((d / "labels.png").string(), labels) ||
         !cv::imwrite((d / "image.png").string(), cv::Mat(12, 16, CV_8UC3, cv::Scalar(0, 120, 0))) ||
         !cv::imwrite((d / "small.png").string(), cv::Mat(6, 8, CV_8UC3, cv::Scalar(0, 0, 90))))

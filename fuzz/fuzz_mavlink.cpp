@@ -35,7 +35,8 @@ std::size_t wire_size(const mv::Frame& f) {
 }
 
 /// Feeds `data` in chunks of the given sizes (cycled; 0: all at once); returns the frames.
-std::vector<mv::Frame> run(std::span<const std::uint8_t> data, std::span<const std::size_t> chunks, mv::Parser& parser) {
+std::vector<mv::Frame> run(std::span<const std::uint8_t> data, std::span<const std::size_t> chunks,
+                           mv::Parser& parser) {
   std::vector<mv::Frame> frames;
   std::size_t k = 0;
   for (std::size_t at = 0; at < data.size();) {

@@ -115,8 +115,8 @@ TEST_CASE("adaptive planner: a candidate's extra time is exactly what the descen
       const AdaptiveResult r = run_adaptive_mission(f, oracle, one, options(), "one");
       REQUIRE(r.descents() == 1);
       const auto& d = r.decisions[static_cast<std::size_t>(region)];
-      const auto it = std::find_if(d.candidates.begin(), d.candidates.end(),
-                                   [&](const Candidate& c) { return c.gsd_cm == g; });
+      const auto it =
+          std::find_if(d.candidates.begin(), d.candidates.end(), [&](const Candidate& c) { return c.gsd_cm == g; });
       REQUIRE(it != d.candidates.end());
       CAPTURE(region);
       CAPTURE(g);
@@ -806,8 +806,10 @@ TEST_CASE("AdaptivePlanner: GridAnchor::centred lays the top-level grid centred 
   for (std::size_t i = 0; i < centred.top_level().size(); ++i) {
     const Eigen::Vector3d& p = centred.top_level()[i].position;
     CHECK((p.x() > a.x_min_m && p.x() < a.x_max_m && p.y() > a.y_min_m && p.y() < a.y_max_m));
-    lo_x = std::min(lo_x, centred.top_level()[i].footprint.x_min_m), hi_x = std::max(hi_x, centred.top_level()[i].footprint.x_max_m);
-    lo_y = std::min(lo_y, centred.top_level()[i].footprint.y_min_m), hi_y = std::max(hi_y, centred.top_level()[i].footprint.y_max_m);
+    lo_x = std::min(lo_x, centred.top_level()[i].footprint.x_min_m),
+    hi_x = std::max(hi_x, centred.top_level()[i].footprint.x_max_m);
+    lo_y = std::min(lo_y, centred.top_level()[i].footprint.y_min_m),
+    hi_y = std::max(hi_y, centred.top_level()[i].footprint.y_max_m);
     moved = moved || (p - corner.top_level()[i].position).norm() > 1e-6;
   }
   CHECK(moved);
@@ -933,8 +935,8 @@ TEST_CASE("AdaptivePlanner: the budget holds on a slow computer, images and deci
     descended += n > 0 ? 1 : 0;
     ++runs;
   }
-  MESSAGE("runs over budget: " << over << " of " << runs << "; runs with descents: " << descended
-                               << "; least slack " << worst_slack << " s");
+  MESSAGE("runs over budget: " << over << " of " << runs << "; runs with descents: " << descended << "; least slack "
+                               << worst_slack << " s");
   CHECK(over == 0);
   CHECK(descended >= 40);  // every budget beyond the tightest buys descents
 }

@@ -80,8 +80,8 @@ TEST_CASE("calibration: with coverage 'interest' a sample re-maps the cells that
 TEST_CASE("calibration: region samples carry what the descent relabelled and what it adds to the field") {
   const Field f = t::blob_field(2000, 1500, 1.0, 9, 30);
   OracleSegmenter oracle(f.num_classes());
-  const auto samples = collect_region_samples(f, oracle, CameraModel{}, 3.0, {1.0, 2.0}, f.interest(),
-                                              DescentCoverage::region, 3);
+  const auto samples =
+      collect_region_samples(f, oracle, CameraModel{}, 3.0, {1.0, 2.0}, f.interest(), DescentCoverage::region, 3);
   REQUIRE(samples.size() == 8);
   double share = 0.0;
   for (const auto& s : samples) {
@@ -165,7 +165,8 @@ TEST_CASE("calibration: by default the front-aware rule, its confidence chosen o
   // One trial per confidence level; the chosen one first, with the best mean margin.
   REQUIRE(cal.trials.size() == options.confidences.size());
   for (const auto& trial : cal.trials) CHECK(trial.front_margin <= cal.trials.front().front_margin);
-  CHECK(cal.trials.front().description == "front-aware z=" + std::string(adaptseg::detail::format_number(rule.params().confidence)));
+  CHECK(cal.trials.front().description ==
+        "front-aware z=" + std::string(adaptseg::detail::format_number(rule.params().confidence)));
   // Its reference: the training lawnmower's mIoU at each lawnmower GSD, and the field's σ.
   REQUIRE(rule.reference().size() == 1);
   const auto& reference = rule.reference().front();
@@ -302,8 +303,8 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
       return tmp.path() / "pooling.yaml";
     };
     CHECK(DecisionModel::load(with("fields")).decision_function.model().cells()->pooling() == SlopePooling::fields);
-    CHECK_THROWS_WITH_AS((void)DecisionModel::load(with("both")), doctest::Contains("slope_pooling' must be cells or fields"),
-                         std::invalid_argument);
+    CHECK_THROWS_WITH_AS((void)DecisionModel::load(with("both")),
+                         doctest::Contains("slope_pooling' must be cells or fields"), std::invalid_argument);
   }
   // Each training field's mean input at both top levels: the nominal one's is field_input, and
   // the finer top level's map has less wrong (the oracle's expected error is its share of
@@ -333,8 +334,8 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
   CHECK(labels_only.trials.front().description.find("slopes") == std::string::npos);
   CHECK(labels_only.decision_function.model().cells()->pooling() == SlopePooling::fields);
   // Poolings the search cannot use are refused before anything is sampled.
-  for (const std::vector<SlopePooling>& bad : {std::vector<SlopePooling>{},
-                                               std::vector<SlopePooling>{SlopePooling::cells, SlopePooling::cells}}) {
+  for (const std::vector<SlopePooling>& bad :
+       {std::vector<SlopePooling>{}, std::vector<SlopePooling>{SlopePooling::cells, SlopePooling::cells}}) {
     options.slope_poolings = bad;
     CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
                          doctest::Contains("slope_poolings"), std::invalid_argument);
@@ -439,7 +440,9 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
   // τ = 0, the rule as it was then.
   t::TempDir tmp;
   model.save(tmp.path() / "model.yaml");
-  const auto rule_of = [](const DecisionModel& m) { return std::get<FrontAwarePolicy>(m.decision_function.rule()).params(); };
+  const auto rule_of = [](const DecisionModel& m) {
+    return std::get<FrontAwarePolicy>(m.decision_function.rule()).params();
+  };
   const DecisionModel back = DecisionModel::load(tmp.path() / "model.yaml");
   CHECK(rule_of(back).sigma_prior_sd == rule.params().sigma_prior_sd);
   CHECK(rule_of(back).sigma_prior_weight == rule.params().sigma_prior_weight);
@@ -476,7 +479,8 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
   bad.replace(hull_at, 15, "top_level: hul");
   std::ofstream(tmp.path() / "bad.yaml") << bad;
   CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "bad.yaml"),
-                       doctest::Contains("'rule.top_level' must be undominated or hull (got 'hul')"), std::invalid_argument);
+                       doctest::Contains("'rule.top_level' must be undominated or hull (got 'hul')"),
+                       std::invalid_argument);
   // Fields of another class set are refused.
   const Field other("o", 1.0, a.labels(), {{"a", {0, 0, 0}}, {"b", {1, 1, 1}}, {"c", {2, 2, 2}}}, {1});
   const std::vector<Field> mixed{a, other};
@@ -488,7 +492,8 @@ namespace {
 /// before it): two backends of one type for a cross-fitted calibration.
 class NamedOracle {
  public:
-  NamedOracle(int num_classes, std::string name, bool blind) : oracle_(num_classes), name_(std::move(name)), blind_(blind) {}
+  NamedOracle(int num_classes, std::string name, bool blind)
+      : oracle_(num_classes), name_(std::move(name)), blind_(blind) {}
   [[nodiscard]] std::string name() const { return name_; }
   [[nodiscard]] cv::Mat segment(const Image& image) {
     ++images;
@@ -512,7 +517,8 @@ TEST_CASE("calibration: each training field segmented by its own backend (cross-
   const CalibrationOptions options = small_options();
   NamedOracle plain(a.num_classes(), "oracle", false), blind(a.num_classes(), "blind oracle", true);
   const std::vector<NamedOracle*> backends{&plain, &blind};
-  const CalibrationResult cal = calibrate(std::span<const Field>(fields), std::span<NamedOracle* const>(backends), options);
+  const CalibrationResult cal =
+      calibrate(std::span<const Field>(fields), std::span<NamedOracle* const>(backends), options);
   CHECK(plain.images > 0);
   CHECK(blind.images > 0);
   CHECK(cal.field_backends == std::vector<std::string>{"oracle", "blind oracle"});
@@ -552,11 +558,13 @@ TEST_CASE("calibration: each training field segmented by its own backend (cross-
   CHECK(text.str().find("field_segmenters") == std::string::npos);
   // A backend per field, no fewer, none null.
   const std::vector<NamedOracle*> short_list{&plain};
-  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), std::span<NamedOracle* const>(short_list), options),
-                       doctest::Contains("one backend per training field"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(
+      (void)calibrate(std::span<const Field>(fields), std::span<NamedOracle* const>(short_list), options),
+      doctest::Contains("one backend per training field"), std::invalid_argument);
   const std::vector<NamedOracle*> with_null{&plain, nullptr};
-  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), std::span<NamedOracle* const>(with_null), options),
-                       doctest::Contains("null"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(
+      (void)calibrate(std::span<const Field>(fields), std::span<NamedOracle* const>(with_null), options),
+      doctest::Contains("null"), std::invalid_argument);
   // A file whose field_segmenters do not name one per field is refused.
   std::string bad = text.str();
   const auto at = bad.find("  segmenter:");
@@ -614,8 +622,8 @@ TEST_CASE("decision model: file round trip and compatibility checks") {
                   .timing = {},
                   .top_gsd_cm = 3.0,
                   .candidate_gsd_cm = {1.0, 2.0},
-                  .decision_function = DecisionFunction(UtilityPolicy(GainModel::fit(samples, {.restarts = 1}),
-                                                                      {.min_utility = 1e-3})),
+                  .decision_function =
+                      DecisionFunction(UtilityPolicy(GainModel::fit(samples, {.restarts = 1}), {.min_utility = 1e-3})),
                   .linear = {0.01, 0.2},
                   .samples = samples.size(),
                   .train_front_margin = 0.01};
@@ -651,11 +659,12 @@ TEST_CASE("decision model: file round trip and compatibility checks") {
     std::string text = t::read_file(tmp.path() / "focused.yaml");
     const auto at = text.find("descent_coverage: interest\n");
     REQUIRE(at != std::string::npos);
-    t::write_file(tmp.path() / "old.yaml", std::string(text).erase(at, std::string("descent_coverage: interest\n").size()));
+    t::write_file(tmp.path() / "old.yaml",
+                  std::string(text).erase(at, std::string("descent_coverage: interest\n").size()));
     CHECK(DecisionModel::load(tmp.path() / "old.yaml").coverage == DescentCoverage::region);
     t::write_file(tmp.path() / "bad.yaml", std::string(text).replace(at, 26, "descent_coverage: everywhere"));
-    CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "bad.yaml"), doctest::Contains("'region', 'interest' or 'ranked'"),
-                         std::invalid_argument);
+    CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "bad.yaml"),
+                         doctest::Contains("'region', 'interest' or 'ranked'"), std::invalid_argument);
   }
   {  // the vertical speed limit: kept when set, absent from the file (0) when not
     CHECK(back.timing.max_vertical_speed_mps == 0.0);
@@ -693,12 +702,14 @@ TEST_CASE("decision model: file round trip and compatibility checks") {
 TEST_CASE("decision model: a file of format 1 (adaptseg 0.1) is refused, saying to calibrate again") {
   // Its keys as adaptseg 0.1 wrote them (a decision function as an embedded text block).
   t::TempDir tmp;
-  t::write_file(tmp.path() / "old.yaml", "format: adaptseg.decision_model/1\ncalibration_field: weedmap-000\n"
-                                         "segmenter: oracle\ndecision_function: |\n  adaptseg.decision_function 1\n");
-  CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "old.yaml"),
-                       doctest::Contains("old.yaml: a decision model of format 1 (adaptseg 0.1) is no longer read since "
-                                         "adaptseg 0.2.0; calibrate the model again (adaptseg_calibrate)"),
-                       std::invalid_argument);
+  t::write_file(tmp.path() / "old.yaml",
+                "format: adaptseg.decision_model/1\ncalibration_field: weedmap-000\n"
+                "segmenter: oracle\ndecision_function: |\n  adaptseg.decision_function 1\n");
+  CHECK_THROWS_WITH_AS(
+      (void)DecisionModel::load(tmp.path() / "old.yaml"),
+      doctest::Contains("old.yaml: a decision model of format 1 (adaptseg 0.1) is no longer read since "
+                        "adaptseg 0.2.0; calibrate the model again (adaptseg_calibrate)"),
+      std::invalid_argument);
 }
 
 TEST_CASE("decision model: a plain YAML file, every fitted number a key, written and read under any locale") {

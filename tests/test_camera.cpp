@@ -18,8 +18,8 @@ TEST_CASE("camera: GSD follows 100 h S_w / (f I_w) for the default camera") {
 }
 
 TEST_CASE("camera: altitude and GSD are inverse, and the footprint scales with altitude") {
-  const CameraModel cam({.image_width_px = 640, .image_height_px = 480, .sensor_width_mm = 6.17,
-                         .focal_length_mm = 4.5});
+  const CameraModel cam(
+      {.image_width_px = 640, .image_height_px = 480, .sensor_width_mm = 6.17, .focal_length_mm = 4.5});
   for (double h : {1.0, 7.3, 30.0, 120.0}) {
     CHECK(cam.altitude_m(cam.gsd_cm(h)) == doctest::Approx(h).epsilon(1e-12));
     const auto fp = cam.footprint(h);
@@ -34,8 +34,7 @@ TEST_CASE("camera: altitude and GSD are inverse, and the footprint scales with a
 
 TEST_CASE("camera: invalid parameters are rejected with the parameter's name") {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  CHECK_THROWS_WITH_AS(CameraModel({.image_width_px = 0}), doctest::Contains("image_width_px"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS(CameraModel({.image_width_px = 0}), doctest::Contains("image_width_px"), std::invalid_argument);
   CHECK_THROWS_WITH_AS(CameraModel({.image_height_px = -3}), doctest::Contains("image_height_px"),
                        std::invalid_argument);
   CHECK_THROWS_WITH_AS(CameraModel({.sensor_width_mm = 0.0}), doctest::Contains("sensor_width_mm"),

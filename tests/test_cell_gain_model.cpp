@@ -81,8 +81,9 @@ TEST_CASE("cell gain model: slopes and noise per pair of GSDs, forecasts of a se
   CHECK_THROWS_AS(CellGainModel(DecisionInput::sigma, {}), std::invalid_argument);
   CHECK_THROWS_AS(CellGainModel(DecisionInput::sigma, {{15.0, 5.0, 1.0, -1.0, 1.0, 0.0}}), std::invalid_argument);
   CHECK_THROWS_AS(CellGainModel(DecisionInput::sigma, {{15.0, 20.0, 1.0, 0.0, 1.0, 0.0}}), std::invalid_argument);
-  CHECK_THROWS_AS(CellGainModel(DecisionInput::sigma, {{15.0, 10.0, 1.0, 0.0, 1.0, 0.0}, {15.0, 5.0, 1.0, 0.0, 1.0, 0.0}}),
-                  std::invalid_argument);
+  CHECK_THROWS_AS(
+      CellGainModel(DecisionInput::sigma, {{15.0, 10.0, 1.0, 0.0, 1.0, 0.0}, {15.0, 5.0, 1.0, 0.0, 1.0, 0.0}}),
+      std::invalid_argument);
 }
 
 TEST_CASE("cell gain model: an input is scored by how much of each field's gain its best cells capture") {
@@ -134,7 +135,8 @@ TEST_CASE("cell gain model: the scene check's proxy slope, and how far it differ
                   std::invalid_argument);
 }
 
-TEST_CASE("cell gain model: slopes pooled over the training fields' cells, or the fields' own slopes as random effects") {
+TEST_CASE(
+    "cell gain model: slopes pooled over the training fields' cells, or the fields' own slopes as random effects") {
   // Field 0 holds much input (x up to 0.9) and loses by re-mapping (-0.4 x, relabelling 0.2 x);
   // field 1 holds little (x <= 0.05) and gains (0.8 x, relabelling 1.0 x).
   std::vector<CellSample> s;
@@ -181,7 +183,8 @@ TEST_CASE("cell gain model: slopes pooled over the training fields' cells, or th
   // of little input and scatter of half their gain, gives about 0.5 (their plain mean: 0.53).
   std::vector<CellSample> agree;
   int k = 0;
-  for (double x : {0.5, 0.7, 0.9, 0.6}) agree.push_back(cell(0, 15.0, 5.0, x, 1000.0, 0.5 * x * (k++ % 2 ? 1.01 : 0.99), 0.0));
+  for (double x : {0.5, 0.7, 0.9, 0.6})
+    agree.push_back(cell(0, 15.0, 5.0, x, 1000.0, 0.5 * x * (k++ % 2 ? 1.01 : 0.99), 0.0));
   for (double x : {0.01, 0.03, 0.05, 0.02})
     agree.push_back(cell(1, 15.0, 5.0, x, 1000.0, 0.56 * x * (k++ % 2 ? 1.5 : 0.5), 0.0));
   CHECK(CellGainModel::fit(agree, DecisionInput::expected_error, SlopePooling::fields).at(15.0, 5.0).gain_slope ==

@@ -94,7 +94,9 @@ TEST_CASE("gain model: initialised GPs reproduce the training trends") {
   CHECK_THROWS_AS((void)GainModel::fit({}), std::invalid_argument);
 }
 
-TEST_CASE("gain model: the paper's I on delta sigma alone cannot tell candidate altitudes apart where (delta sigma, delta h) can") {
+TEST_CASE(
+    "gain model: the paper's I on delta sigma alone cannot tell candidate altitudes apart where (delta sigma, delta h) "
+    "can") {
   // What an oracle backend gives: σ does not change with altitude (Δσ = 0), while the
   // accuracy gain grows with the descent.
   std::vector<RegionSample> flat;
@@ -184,7 +186,8 @@ TEST_CASE("utility policy: relative utility compares with the mission's running 
   CHECK_FALSE(policy.decide(high).descend);  // alone again: ratio 1
 }
 
-TEST_CASE("utility policy: online updates extend O only when adaptive, and a new mission starts from the initial model") {
+TEST_CASE(
+    "utility policy: online updates extend O only when adaptive, and a new mission starts from the initial model") {
   UtilityPolicy adaptive(fitted(), {.online = true});
   UtilityPolicy fixed(fitted(), {.online = false});
   CHECK(adaptive.name() == "adaptive");
@@ -221,7 +224,10 @@ struct Scenario {
   }
   /// The k-th region (k = 0, 1, ...), after k descents.
   DecisionContext region(int k, double sigma = 0.2, bool is_cheap = false) const {
-    DecisionContext c{.sigma = sigma, .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5,
+    DecisionContext c{.sigma = sigma,
+                      .valid_fraction = 1.0,
+                      .top_gsd_cm = 3.0,
+                      .top_altitude_m = 16.5,
                       .candidates = is_cheap ? cheap : one};
     c.elapsed_s = 5.7 * (k + 1) + 40.0 * k;
     c.rest_s = 40.0 - 5.7 * (k + 1);
@@ -231,13 +237,17 @@ struct Scenario {
   }
   /// A descent at region 0 that relabelled `factor` times what C forecast.
   static DescentOutcome outcome(double factor) {
-    return {.top_altitude_m = 16.5, .sub_altitude_m = 5.5, .sigma_top = 0.2, .sigma_sub = 0.2,
+    return {.top_altitude_m = 16.5,
+            .sub_altitude_m = 5.5,
+            .sigma_top = 0.2,
+            .sigma_sub = 0.2,
             .relabelled = {0.024 * factor, 0.02 * factor}};
   }
 };
 }  // namespace
 
-TEST_CASE("front-aware policy: a descent's forecast margin is against the curve at its end, and a new mission forgets") {
+TEST_CASE(
+    "front-aware policy: a descent's forecast margin is against the curve at its end, and a new mission forgets") {
   const Scenario s;
   // The curve rises 0.01 per 40 s from the top level (40 s, 0.75); a descent of 40 s from
   // region 0 (T0 = 40 s) is forecast to gain about 0.0143: it ends above the curve.
@@ -246,8 +256,9 @@ TEST_CASE("front-aware policy: a descent's forecast margin is against the curve 
   const Decision first = policy.decide(s.region(0));
   REQUIRE(first.scores.size() == 1);
   const CandidateScore& sc = first.scores[0];
-  CHECK(sc.predicted_front_margin ==
-        doctest::Approx(front_margin(curve, 40.0 + s.one[0].extra_time_s, 0.75 + sc.predicted_field_gain)).epsilon(1e-9));
+  CHECK(
+      sc.predicted_front_margin ==
+      doctest::Approx(front_margin(curve, 40.0 + s.one[0].extra_time_s, 0.75 + sc.predicted_field_gain)).epsilon(1e-9));
   CHECK(sc.predicted_front_margin > 0.0);
   CHECK(first.descend);
   // A new mission forgets what the last one chose and saw.
@@ -373,9 +384,9 @@ namespace {
 /// finer look's input with γ = beta.
 GainModel with_cells(double beta) {
   GainModel m = fitted();
-  m.set_cells(CellGainModel(DecisionInput::expected_error,
-                            {{2.0, 1.0, beta, 1e-4, 1.0, 1e-4, beta, 4e-3 * beta * beta},
-                             {3.0, 1.0, beta, 1e-4, 1.0, 1e-4, beta, 4e-3 * beta * beta}}));
+  m.set_cells(
+      CellGainModel(DecisionInput::expected_error, {{2.0, 1.0, beta, 1e-4, 1.0, 1e-4, beta, 4e-3 * beta * beta},
+                                                    {3.0, 1.0, beta, 1e-4, 1.0, 1e-4, beta, 4e-3 * beta * beta}}));
   return m;
 }
 
@@ -401,8 +412,8 @@ struct CellScenario {
     }
   }
   DecisionContext region(int k, double x) const {
-    DecisionContext c{.sigma = 0.2, .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5,
-                      .candidates = offers};
+    DecisionContext c{
+        .sigma = 0.2, .valid_fraction = 1.0, .top_gsd_cm = 3.0, .top_altitude_m = 16.5, .candidates = offers};
     c.elapsed_s = 5.7 * (k + 1) + 40.0 * k;
     c.rest_s = 40.0 - 5.7 * (k + 1);
     c.region_share = 1.0 / 7.0;
@@ -504,7 +515,8 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
         .confidence = 1.5, .scale_prior_sd = 0.01, .field_curve = true, .curve_ratio = true};
     FrontAwarePolicy spread(with_cells(1.0), two, p);
     FrontAwarePolicy single(with_cells(1.0), mean, p);
-    FrontAwarePolicy uncorrected(with_cells(1.0), mean, {.confidence = 1.5, .scale_prior_sd = 0.01, .field_curve = true});
+    FrontAwarePolicy uncorrected(with_cells(1.0), mean,
+                                 {.confidence = 1.5, .scale_prior_sd = 0.01, .field_curve = true});
     const Decision a = spread.decide(rich.region(0, 0.1));
     const Decision b = single.decide(rich.region(0, 0.1));
     CHECK(a.scores[1].predicted_front_margin == doctest::Approx(b.scores[1].predicted_front_margin));
@@ -535,9 +547,8 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     // training fields disagree on (τ_γ twice γ): one such look is weak evidence, s stays
     // positive and the next region is still worth a descent.
     GainModel doubted = fitted();
-    doubted.set_cells(CellGainModel(DecisionInput::expected_error,
-                                    {{2.0, 1.0, 1.0, 1e-4, 1.0, 1e-4, 1.0, 4e-3, 2.0},
-                                     {3.0, 1.0, 1.0, 1e-4, 1.0, 1e-4, 1.0, 4e-3, 2.0}}));
+    doubted.set_cells(CellGainModel(DecisionInput::expected_error, {{2.0, 1.0, 1.0, 1e-4, 1.0, 1e-4, 1.0, 4e-3, 2.0},
+                                                                    {3.0, 1.0, 1.0, 1e-4, 1.0, 1e-4, 1.0, 4e-3, 2.0}}));
     FrontAwarePolicy trusting(with_cells(1.0), flat, {.online = true});
     FrontAwarePolicy doubting(doubted, flat, {.online = true});
     for (FrontAwarePolicy* p : {&trusting, &doubting}) {
@@ -703,9 +714,9 @@ TEST_CASE("linear decision: altitude falls linearly with σ to the nearest candi
   CHECK_FALSE(lin.decide(ctx).descend);  // below sigma_low: stay at h_max
   ctx.sigma = 0.3;
   CHECK(lin.decide(ctx).gsd_cm == 1.0);  // at sigma_high: the lowest altitude
-  ctx.sigma = 0.2;                        // halfway: 16.5 - 11/2 = 11.0 m -> 2.0 cm/px
+  ctx.sigma = 0.2;                       // halfway: 16.5 - 11/2 = 11.0 m -> 2.0 cm/px
   CHECK(lin.decide(ctx).gsd_cm == 2.0);
-  ctx.sigma = 0.11;                       // 16.5 - 0.55 m: nearer h_max than any candidate
+  ctx.sigma = 0.11;  // 16.5 - 0.55 m: nearer h_max than any candidate
   CHECK_FALSE(lin.decide(ctx).descend);
   CHECK_THROWS_AS(LinearDecision({.sigma_low = 0.3, .sigma_high = 0.3}), std::invalid_argument);
 }
@@ -727,8 +738,8 @@ TEST_CASE("decision policies: every policy passes the conformance suite") {
                                    outcome);
   }
   SUBCASE("front-aware") {
-    test::check_policy_conformance(FrontAwarePolicy(fitted(), s.reference(0.001, 0.002), {.confidence = 0.5}),
-                                   mission, outcome);
+    test::check_policy_conformance(FrontAwarePolicy(fitted(), s.reference(0.001, 0.002), {.confidence = 0.5}), mission,
+                                   outcome);
   }
   SUBCASE("decision function") {
     test::check_policy_conformance(DecisionFunction(FrontAwarePolicy(fitted(), s.reference(0.0), {})), mission,

@@ -142,7 +142,8 @@ TEST_CASE("GridInputs: every cell to the bit as cell_inputs of the planes on the
     Segmentation s;
     s.labels = cv::Mat(img.height_px, img.width_px, CV_8UC1);
     rng.fill(s.labels, cv::RNG::UNIFORM, 0, 5);
-    for (int k = 0; k < 6; ++k) s.labels.at<unsigned char>(rng.uniform(0, img.height_px), rng.uniform(0, img.width_px)) = 255;
+    for (int k = 0; k < 6; ++k)
+      s.labels.at<unsigned char>(rng.uniform(0, img.height_px), rng.uniform(0, img.width_px)) = 255;
     cv::Mat sum(s.labels.size(), CV_32F, cv::Scalar(0.0f));
     for (int c = 0; c < 5; ++c) {
       cv::Mat p(s.labels.size(), CV_32F);
@@ -155,13 +156,14 @@ TEST_CASE("GridInputs: every cell to the bit as cell_inputs of the planes on the
     const cv::Rect rect(rng.uniform(-5, 15), rng.uniform(-5, 15), rng.uniform(10, 60), rng.uniform(10, 60));
     cv::Mat field(rect.size(), CV_8UC1);
     rng.fill(field, cv::RNG::UNIFORM, 0, 4);  // about a quarter not field
-    if (trial % 2 == 1) field.setTo(255);      // all field: summed by camera pixel, weighted
+    if (trial % 2 == 1) field.setTo(255);     // all field: summed by camera pixel, weighted
     const auto grid = planes_on_grid(img, pixel_inputs(s, interest, 255), rect);
     for (const auto& row : kDecisionInputs) {
       const GridInputs fast(img, s, interest, 255, rect, std::array{row.input},
                             trial % 4 < 2 ? GridInputs::Cells::many : GridInputs::Cells::one);
       for (int c = 0; c < 6; ++c) {
-        const cv::Rect cell(rng.uniform(-3, rect.width), rng.uniform(-3, rect.height), rng.uniform(1, 30), rng.uniform(1, 30));
+        const cv::Rect cell(rng.uniform(-3, rect.width), rng.uniform(-3, rect.height), rng.uniform(1, 30),
+                            rng.uniform(1, 30));
         const CellInputs want = cell_inputs(grid, field, cell);
         const CellInputs got = fast.cell(field, cell);
         CHECK(got.field_px == want.field_px);
@@ -170,7 +172,8 @@ TEST_CASE("GridInputs: every cell to the bit as cell_inputs of the planes on the
           CHECK_MESSAGE(((std::isnan(a) && std::isnan(b)) || a == b), "input ", to_string(i), " trial ", trial);
         }
         if (row.input != DecisionInput::sigma && row.input != DecisionInput::boundary)
-          CHECK(std::isnan(got.value(DecisionInput::entropy == row.input ? DecisionInput::ambiguity : DecisionInput::entropy)));
+          CHECK(std::isnan(
+              got.value(DecisionInput::entropy == row.input ? DecisionInput::ambiguity : DecisionInput::entropy)));
         compared += want.field_px > 0.0 ? 1 : 0;
       }
     }
@@ -193,7 +196,8 @@ std::array<float, kDecisionInputCount> reference_values(int label, std::span<con
   float vote_sum = 0.0f, split = 0.0f;
   for (std::size_t c = 0; c < votes.size() && c < 256; ++c) {
     vote_sum += votes[c];
-    if (in_interest[c]) split += (votes[c] > kVoteShareTolerance && votes[c] < 1.0f - kVoteShareTolerance) ? 1.0f : 0.0f;
+    if (in_interest[c])
+      split += (votes[c] > kVoteShareTolerance && votes[c] < 1.0f - kVoteShareTolerance) ? 1.0f : 0.0f;
   }
   if (vote_sum > 0.0f) v[index_of(DecisionInput::split)] = split;
   const std::size_t n = p.size();
@@ -239,11 +243,13 @@ TEST_CASE("decision inputs: the row kernel equals the per-pixel formulas, every 
     const std::size_t classes = 1 + static_cast<std::size_t>(trial % 6), n = 1 + static_cast<std::size_t>(rng() % 200);
     const bool with_votes = trial % 3 == 0;
     std::vector<unsigned char> labels(n);
-    std::vector<std::vector<float>> p(classes, std::vector<float>(n)), v(with_votes ? classes : 0, std::vector<float>(n));
+    std::vector<std::vector<float>> p(classes, std::vector<float>(n)),
+        v(with_votes ? classes : 0, std::vector<float>(n));
     for (std::size_t x = 0; x < n; ++x) {
       labels[x] = static_cast<unsigned char>(rng() % classes);
       float total = 0.0f;
-      for (std::size_t c = 0; c < classes; ++c) total += (p[c][x] = rng() % 5 == 0 ? 0.0f : (rng() % 7 == 0 ? 0.25f : u(rng)));
+      for (std::size_t c = 0; c < classes; ++c)
+        total += (p[c][x] = rng() % 5 == 0 ? 0.0f : (rng() % 7 == 0 ? 0.25f : u(rng)));
       const bool none = rng() % 10 == 0;  // a pixel without probabilities
       for (std::size_t c = 0; c < classes; ++c) p[c][x] = none || total == 0.0f ? 0.0f : p[c][x] / total;
       for (auto& vote : v) vote[x] = static_cast<float>(rng() % 3) / 2.0f;

@@ -86,7 +86,9 @@ TEST_CASE("ensemble: the mean, its labels, disagreement and class splits follow 
         const auto k = static_cast<std::size_t>(c);
         const float want = 0.75f * sa.probabilities[k].at<float>(r, x) + 0.25f * sb.probabilities[k].at<float>(r, x);
         bad_mean += std::abs(e.mean.probabilities[k].at<float>(r, x) - want) > 1e-6f ? 1 : 0;
-        if (e.mean.probabilities[k].at<float>(r, x) > e.mean.probabilities[static_cast<std::size_t>(best)].at<float>(r, x)) best = c;
+        if (e.mean.probabilities[k].at<float>(r, x) >
+            e.mean.probabilities[static_cast<std::size_t>(best)].at<float>(r, x))
+          best = c;
         const bool split = (la == c) != (lb == c);
         bad_split += (e.class_split[k].at<std::uint8_t>(r, x) == 255) != split ? 1 : 0;
         const float want_vote = (la == c ? 0.75f : 0.0f) + (lb == c ? 0.25f : 0.0f);
@@ -116,10 +118,9 @@ TEST_CASE("ensemble: the mean, its labels, disagreement and class splits follow 
   int bad_split_input = 0;
   for (int r = 30; r < img.height_px; ++r)
     for (int x = 0; x < img.width_px; ++x)
-      bad_split_input += split_plane.at<float>(r, x) != ((sa.labels.at<std::uint8_t>(r, x) == water) !=
-                                                                 (sb.labels.at<std::uint8_t>(r, x) == water)
-                                                             ? 1.0f
-                                                             : 0.0f);
+      bad_split_input +=
+          split_plane.at<float>(r, x) !=
+          ((sa.labels.at<std::uint8_t>(r, x) == water) != (sb.labels.at<std::uint8_t>(r, x) == water) ? 1.0f : 0.0f);
   CHECK(bad_split_input == 0);
   CHECK(cv::countNonZero(pixel_inputs(sa, l, img.ignore_label)[index_of(DecisionInput::split)] ==
                          pixel_inputs(sa, l, img.ignore_label)[index_of(DecisionInput::split)]) == 0);  // all NaN
@@ -128,7 +129,8 @@ TEST_CASE("ensemble: the mean, its labels, disagreement and class splits follow 
   const EnsembleSegmentation o = one.segment_with_disagreement(img);
   CHECK(cv::countNonZero(o.mean.labels != sa.labels) == 0);
   for (int c = 0; c < nc; ++c)
-    CHECK(cv::norm(o.mean.probabilities[static_cast<std::size_t>(c)], sa.probabilities[static_cast<std::size_t>(c)], cv::NORM_INF) < 1e-6);
+    CHECK(cv::norm(o.mean.probabilities[static_cast<std::size_t>(c)], sa.probabilities[static_cast<std::size_t>(c)],
+                   cv::NORM_INF) < 1e-6);
   CHECK(cv::countNonZero(o.disagreement) == 0);
 }
 
@@ -156,10 +158,13 @@ TEST_CASE("test-time mirror: a network's probabilities are the mean over the ima
       int best = 0;
       for (int c = 0; c < nc; ++c) {
         const auto k = static_cast<std::size_t>(c);
-        const float want = no_data ? 0.0f : 0.5f * (s.probabilities[k].at<float>(r, x) +
-                                                    f.probabilities[k].at<float>(r, img.width_px - 1 - x));
+        const float want =
+            no_data
+                ? 0.0f
+                : 0.5f * (s.probabilities[k].at<float>(r, x) + f.probabilities[k].at<float>(r, img.width_px - 1 - x));
         bad_mean += std::abs(m.probabilities[k].at<float>(r, x) - want) > 1e-6f ? 1 : 0;
-        if (m.probabilities[k].at<float>(r, x) > m.probabilities[static_cast<std::size_t>(best)].at<float>(r, x)) best = c;
+        if (m.probabilities[k].at<float>(r, x) > m.probabilities[static_cast<std::size_t>(best)].at<float>(r, x))
+          best = c;
       }
       const int got = m.labels.at<std::uint8_t>(r, x);
       bad_label += got != (no_data ? img.ignore_label : best) ? 1 : 0;
@@ -173,8 +178,9 @@ TEST_CASE("test-time mirror: a network's probabilities are the mean over the ima
   CHECK(changed < img.width_px * img.height_px / 10);
   // An ensemble member with `mirror: true` (the file's key) is that segmenter.
   t::TempDir tmp;
-  t::write_file(tmp.path() / "ensemble.yaml", "members:\n  - model: " + mnv2().string() + "\n    mirror: true\n  - model: " +
-                                                 erfnet().string() + "\n    mirror: false\n");
+  t::write_file(tmp.path() / "ensemble.yaml", "members:\n  - model: " + mnv2().string() +
+                                                  "\n    mirror: true\n  - model: " + erfnet().string() +
+                                                  "\n    mirror: false\n");
   const auto list = read_ensemble_file(tmp.path());
   REQUIRE(list.size() == 2);
   CHECK(list[0].mirror);
@@ -199,7 +205,8 @@ TEST_CASE("test-time mirror: a network's probabilities are the mean over the ima
 TEST_CASE("ensemble: the bundled ensemble passes the backend conformance suite on held-out tile 6") {
   const Field f = Field::load(t::example_field("dubai-tile-6"));
   const CameraModel camera;
-  EnsembleSegmenter ens(models() / "ensemble-dubai", f, camera, OnnxParams{.resize_to_network = true, .num_threads = 2});
+  EnsembleSegmenter ens(models() / "ensemble-dubai", f, camera,
+                        OnnxParams{.resize_to_network = true, .num_threads = 2});
   REQUIRE(ens.size() == 2);
   CHECK(ens.member(0).model_info().output_stride == 4);  // MobileNetV2 at 512 x 384
   CHECK(ens.member(1).model_info().output_stride == 1);  // ERFNet at 480 x 360
@@ -239,14 +246,25 @@ TEST_CASE("ensemble: bad member lists are refused with one line naming the probl
   refused([] { return EnsembleSegmenter(std::vector<EnsembleMember>{}); }, "no members");
   refused([] { return EnsembleSegmenter({{mnv2(), 0.0}, {erfnet(), 1.0}}); }, "member 1 (");
   refused([] { return EnsembleSegmenter({{mnv2(), 1.0}, {erfnet(), -1.0}}); }, "weight must be a finite number > 0");
-  refused([] { return EnsembleSegmenter(std::vector<EnsembleMember>{{mnv2(), std::numeric_limits<double>::quiet_NaN()}}); }, "weight must be");
-  refused([] { return EnsembleSegmenter({{mnv2(), 1.0}, {models() / ".." / "models" / "mobilenetv2-dubai", 1.0}}); },
-          "is listed twice (also member 1)");
+  refused(
+      [] {
+        return EnsembleSegmenter(std::vector<EnsembleMember>{{mnv2(), std::numeric_limits<double>::quiet_NaN()}});
+      },
+      "weight must be");
+  refused(
+      [] {
+        return EnsembleSegmenter({{mnv2(), 1.0}, {models() / ".." / "models" / "mobilenetv2-dubai", 1.0}});
+      },
+      "is listed twice (also member 1)");
   refused([] { return EnsembleSegmenter({{mnv2(), 1.0}, {models() / "none", 1.0}}); }, "member 2 (");
   refused([] { return EnsembleSegmenter({{mnv2(), 1.0}, {models() / "none", 1.0}}); }, "model directory not found");
   // Members of another class set than the field's, or than each other.
-  refused([] { return EnsembleSegmenter(std::vector<EnsembleMember>{{mnv2(), 1.0}}, OnnxParams{.expected_classes = {"soil", "crop", "weed"}}); },
-          "differ from the 3 expected classes");
+  refused(
+      [] {
+        return EnsembleSegmenter(std::vector<EnsembleMember>{{mnv2(), 1.0}},
+                                 OnnxParams{.expected_classes = {"soil", "crop", "weed"}});
+      },
+      "differ from the 3 expected classes");
   t::TempDir tmp;
   const fs::path other = tmp.path() / "renamed";
   fs::create_directories(other);
@@ -254,7 +272,11 @@ TEST_CASE("ensemble: bad member lists are refused with one line naming the probl
   std::string yaml = t::read_file(erfnet() / "model.yaml");
   yaml.replace(yaml.find("[building,"), 10, "[house,");
   t::write_file(other / "model.yaml", yaml);
-  refused([&] { return EnsembleSegmenter({{mnv2(), 1.0}, {other, 1.0}}, kParams); }, "members must share one class set");
+  refused(
+      [&] {
+        return EnsembleSegmenter({{mnv2(), 1.0}, {other, 1.0}}, kParams);
+      },
+      "members must share one class set");
   // Ensemble directories: the file, its keys, its members.
   const fs::path dir = tmp.path() / "ens";
   fs::create_directories(dir);
@@ -269,11 +291,13 @@ TEST_CASE("ensemble: bad member lists are refused with one line naming the probl
   refused(with("models:\n  - model: x\n"), "unknown key 'models' (known: members, description)");
   refused(with("description: x\n"), "missing key 'members'");
   refused(with("members:\n  - path: x\n"), "unknown key 'members[0].path' (known: model, weight, mirror)");
-  refused(with("members:\n  - model: x\n    mirror: yes please\n"), "'members[0].mirror' must be true or false (got 'yes please')");
+  refused(with("members:\n  - model: x\n    mirror: yes please\n"),
+          "'members[0].mirror' must be true or false (got 'yes please')");
   refused(with("members:\n  - weight: 2\n"), "missing key 'members[0].model'");
   refused(with("members:\n  - x\n"), "'members[0]' must be a mapping");
   refused(with("members:\n  - model: x\n    wieght: 2\n"), "unknown key 'members[0].wieght'");
-  refused(with("members:\n  - model: x\n    weight: heavy\n"), "'members[0].weight' must be a finite number (got 'heavy')");
+  refused(with("members:\n  - model: x\n    weight: heavy\n"),
+          "'members[0].weight' must be a finite number (got 'heavy')");
   refused(with("members:\n  - model: " + mnv2().string() + "\n  - model: ../none\n"), "member 2 (");
   // Relative member paths are resolved against the ensemble directory.
   t::write_file(dir / "ensemble.yaml", "members:\n  - model: ../renamed\n    weight: 2\n");

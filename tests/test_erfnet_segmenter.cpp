@@ -92,8 +92,10 @@ TEST_CASE("erfnet: each bundled model reproduces PyTorch's logits and labels on 
     cv::inRange(img.rgb, cv::Scalar(0, 0, 0), cv::Scalar(0, 0, 0), black);
     REQUIRE(cv::countNonZero(black) == 0);
 
-    OnnxSegmenter erfnet(m.model_dir(), OnnxParams{.camera_width_px = img.width_px, .camera_height_px = img.height_px,
-                                                     .resize_to_network = true, .num_threads = 2});
+    OnnxSegmenter erfnet(m.model_dir(), OnnxParams{.camera_width_px = img.width_px,
+                                                   .camera_height_px = img.height_px,
+                                                   .resize_to_network = true,
+                                                   .num_threads = 2});
     REQUIRE(erfnet.num_classes() == shape[0]);
 
     std::vector<float> ref(static_cast<std::size_t>(shape[0]) * static_cast<std::size_t>(shape[1]) *
@@ -111,8 +113,10 @@ TEST_CASE("erfnet: each bundled model reproduces PyTorch's logits and labels on 
     for (int c = 0; c < shape[0]; ++c)
       for (int i = 0; i < shape[1]; ++i)
         for (int j = 0; j < shape[2]; ++j, ++k)
-          max_diff = std::max(max_diff, std::abs(static_cast<double>(logits[static_cast<std::size_t>(c)].at<float>(i * stride, j * stride)) -
-                                                 static_cast<double>(ref[k])));
+          max_diff = std::max(
+              max_diff,
+              std::abs(static_cast<double>(logits[static_cast<std::size_t>(c)].at<float>(i * stride, j * stride)) -
+                       static_cast<double>(ref[k])));
     CAPTURE(max_diff);
     CHECK(max_diff < 1e-3);
 
@@ -161,8 +165,9 @@ TEST_CASE("erfnet: mIoU of each bundled model on held-out tile 6 at the finest G
       oracle_cm += image_confusion(img, oracle.segment(img), f.num_classes());
     }
     const double miou = erf.miou_all().value();
-    const double measured = YAML::LoadFile((m.fixture_dir() / "fixture.yaml").string())["test_field_miou"]
-                                ["test_region"]["miou_ortho"].as<double>();
+    const double measured =
+        YAML::LoadFile((m.fixture_dir() / "fixture.yaml").string())["test_field_miou"]["test_region"]["miou_ortho"]
+            .as<double>();
     CAPTURE(miou);
     CAPTURE(measured);
     CHECK(miou > m.floor);
@@ -197,7 +202,8 @@ TEST_CASE("erfnet: probabilities are the softmax of the logits and black pixels 
       bad_sum += std::abs(sum.at<float>(r, c) - 1.0f) > 1e-4f ? 1 : 0;
       int best = 0;
       for (int k = 1; k < erfnet.num_classes(); ++k)
-        if (probs[static_cast<std::size_t>(k)].at<float>(r, c) > probs[static_cast<std::size_t>(best)].at<float>(r, c)) best = k;
+        if (probs[static_cast<std::size_t>(k)].at<float>(r, c) > probs[static_cast<std::size_t>(best)].at<float>(r, c))
+          best = k;
       disagree += best != labels.at<std::uint8_t>(r, c) ? 1 : 0;
     }
   CHECK(bad_no_data == 0);  // no-data pixels: ignore label, all probabilities 0
@@ -224,7 +230,8 @@ TEST_CASE("erfnet: labels and tempered probabilities from one pass") {
   t::TempDir tmp;
   fs::copy_file(model_dir() / "model.onnx", tmp.path() / "model.onnx");
   std::string yaml = t::read_file(model_dir() / "model.yaml");
-  if (const auto at = yaml.find("\ntemperature:"); at != std::string::npos) yaml.erase(at + 1, yaml.find('\n', at + 1) - at);
+  if (const auto at = yaml.find("\ntemperature:"); at != std::string::npos)
+    yaml.erase(at + 1, yaml.find('\n', at + 1) - at);
   t::write_file(tmp.path() / "model.yaml", yaml + "temperature: 2\n");
   OnnxSegmenter warm(tmp.path(), OnnxParams{.num_threads = 2});
   CHECK(warm.model_info().temperature == 2.0);
@@ -237,7 +244,8 @@ TEST_CASE("erfnet: labels and tempered probabilities from one pass") {
       double z = 0.0;
       for (const auto& l : logits) z += std::exp(l.at<float>(r, x) / 2.0);
       for (std::size_t c = 0; c < logits.size(); ++c)
-        bad += std::abs(w.probabilities[c].at<float>(r, x) - std::exp(logits[c].at<float>(r, x) / 2.0) / z) > 1e-5 ? 1 : 0;
+        bad +=
+            std::abs(w.probabilities[c].at<float>(r, x) - std::exp(logits[c].at<float>(r, x) / 2.0) / z) > 1e-5 ? 1 : 0;
     }
   CHECK(bad == 0);
   // A temperature outside [0.01, 100] is refused, naming the file.
@@ -254,8 +262,8 @@ TEST_CASE("erfnet: resize_to_network takes other camera sizes of the same aspect
   big.height_px = 720;
   OnnxSegmenter strict(model_dir());
   CHECK_THROWS_WITH_AS((void)strict.segment(big), doctest::Contains("resize_to_network"), std::invalid_argument);
-  OnnxSegmenter erfnet(model_dir(), OnnxParams{.camera_width_px = 960, .camera_height_px = 720,
-                                                   .resize_to_network = true});
+  OnnxSegmenter erfnet(model_dir(),
+                       OnnxParams{.camera_width_px = 960, .camera_height_px = 720, .resize_to_network = true});
   const cv::Mat labels = erfnet.segment(big);
   REQUIRE(labels.type() == CV_8UC1);
   REQUIRE(labels.size() == cv::Size(960, 720));
@@ -288,15 +296,12 @@ TEST_CASE("erfnet: clear errors for bad models, bad parameters and images withou
   // Missing files.
   CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path() / "nope"), doctest::Contains("model directory not found"),
                        std::invalid_argument);
-  CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path()), doctest::Contains("metadata file not found"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path()), doctest::Contains("metadata file not found"), std::invalid_argument);
   fs::copy_file(model_dir() / "model.yaml", tmp.path() / "model.yaml");
-  CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path()), doctest::Contains("ONNX file not found"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path()), doctest::Contains("ONNX file not found"), std::invalid_argument);
   // A corrupt ONNX file.
   t::write_file(tmp.path() / "model.onnx", "this is not a protobuf \x01\x02\x03 garbage garbage");
-  CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path()), doctest::Contains("cannot load ONNX model"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path()), doctest::Contains("cannot load ONNX model"), std::invalid_argument);
   // A truncated ONNX file.
   {
     std::ifstream src(model_dir() / "model.onnx", std::ios::binary);
@@ -314,9 +319,11 @@ TEST_CASE("erfnet: clear errors for bad models, bad parameters and images withou
   }
   CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path()), doctest::Contains("outputs 1x5x"), std::invalid_argument);
   // Malformed metadata.
-  t::write_file(tmp.path() / "model.yaml", "classes: [a, b]\ninput: {width: 481, height: 360, channel_order: RGB, mean: [0,0,0], std: [1,1,1]}\n");
+  t::write_file(tmp.path() / "model.yaml",
+                "classes: [a, b]\ninput: {width: 481, height: 360, channel_order: RGB, mean: [0,0,0], std: [1,1,1]}\n");
   CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path()), doctest::Contains("multiples of 8"), std::invalid_argument);
-  t::write_file(tmp.path() / "model.yaml", "classes: [a, b]\ninput: {width: 480, height: 360, channel_order: RGB, mean: [0,0,0], std: [1,0,1]}\n");
+  t::write_file(tmp.path() / "model.yaml",
+                "classes: [a, b]\ninput: {width: 480, height: 360, channel_order: RGB, mean: [0,0,0], std: [1,0,1]}\n");
   CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path()), doctest::Contains("input.std"), std::invalid_argument);
   t::write_file(tmp.path() / "model.yaml", "classes: [a, b\n");
   CHECK_THROWS_WITH_AS(OnnxSegmenter(tmp.path()), doctest::Contains("YAML error"), std::invalid_argument);
@@ -328,27 +335,28 @@ TEST_CASE("erfnet: clear errors for bad models, bad parameters and images withou
                                          "differ from the 3 expected classes [soil, crop, weed]"),
                        std::invalid_argument);
   // Same count, other names or order.
-  CHECK_THROWS_AS(OnnxSegmenter(model_dir(), OnnxParams{.expected_classes = {"land", "building", "road", "vegetation", "water"}}),
-                  std::invalid_argument);
+  CHECK_THROWS_AS(
+      OnnxSegmenter(model_dir(), OnnxParams{.expected_classes = {"land", "building", "road", "vegetation", "water"}}),
+      std::invalid_argument);
   // A camera the network cannot take.
   const Field dubai = Field::load(t::example_field(kTestField));
   CHECK_THROWS_WITH_AS(OnnxSegmenter(model_dir(), dubai, CameraModel({.image_width_px = 640, .image_height_px = 480})),
                        doctest::Contains("640x480 vs network input 480x360"), std::invalid_argument);
   CHECK_THROWS_WITH_AS(OnnxSegmenter(model_dir(), dubai, CameraModel({.image_width_px = 640, .image_height_px = 360}),
-                                       OnnxParams{.resize_to_network = true}),
+                                     OnnxParams{.resize_to_network = true}),
                        doctest::Contains("aspect ratio"), std::invalid_argument);
   // Bad parameters.
   CHECK_THROWS_WITH_AS(OnnxSegmenter(model_dir(), OnnxParams{.camera_width_px = 480}),
                        doctest::Contains("camera_width_px"), std::invalid_argument);
-  CHECK_THROWS_WITH_AS(OnnxSegmenter(model_dir(), OnnxParams{.num_threads = -1}),
-                       doctest::Contains("num_threads"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(model_dir(), OnnxParams{.num_threads = -1}), doctest::Contains("num_threads"),
+                       std::invalid_argument);
   // 100000 threads crashed OpenCV's pool at exit: refused before any is started.
   CHECK_THROWS_WITH_AS(OnnxSegmenter(model_dir(), OnnxParams{.num_threads = 100000}),
                        doctest::Contains("num_threads must be in 0..256"), std::invalid_argument);
   CHECK_THROWS_WITH_AS(OnnxSegmenter(model_dir(), OnnxParams{.name = ""}), doctest::Contains("name"),
                        std::invalid_argument);
-  CHECK_THROWS_WITH_AS(OnnxSegmenter(model_dir(), OnnxParams{.dnn_target = 12345}),
-                       doctest::Contains("dnn_target"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(model_dir(), OnnxParams{.dnn_target = 12345}), doctest::Contains("dnn_target"),
+                       std::invalid_argument);
 
   // Images without RGB (a labels-only field such as WeedMap) and mistyped images.
   OnnxSegmenter erfnet(model_dir(), dubai, CameraModel{});

@@ -86,9 +86,9 @@ TEST_CASE("field: bad field directories give clear errors") {
   expect_error("name: x\ngsd_cm: 1\nlabels: labels.png\nclasses: [{name: a, color: [0,0,300]}]\n",
                "'classes[0].color[2]' must be an integer in [0, 255] (got '300')");
   expect_error("name: x\ngsd_cm: 1\nlabels: labels.png\nclasses: [{name: a}]\n", "missing key 'classes[0].color'");
-  expect_error(std::string(t::kWeedYaml).replace(std::string(t::kWeedYaml).find("ignore_label: 255"), 17,
-                                                 "ignore_label: 1"),
-               "ignore_label must not be a class index");
+  expect_error(
+      std::string(t::kWeedYaml).replace(std::string(t::kWeedYaml).find("ignore_label: 255"), 17, "ignore_label: 1"),
+      "ignore_label must not be a class index");
   expect_error(std::string(t::kWeedYaml).replace(std::string(t::kWeedYaml).find("[crop, weed]"), 12, "[crop, tree]"),
                "unknown class 'tree'");
   expect_error(std::string(t::kWeedYaml).replace(std::string(t::kWeedYaml).find("name: weed"), 10, "name: crop"),

@@ -42,8 +42,7 @@ static_assert(adaptseg::RestorableKernel<SquaredExponentialKernel>);
 // A kernel with everything, to derive the negative cases from by removing one piece.
 struct CompleteKernel {
   static constexpr std::string_view kName = "complete";
-  static CompleteKernel from_log_parameters(const Eigen::VectorXd&, const Eigen::VectorXd&,
-                                            const Eigen::VectorXd&) {
+  static CompleteKernel from_log_parameters(const Eigen::VectorXd&, const Eigen::VectorXd&, const Eigen::VectorXd&) {
     return {};
   }
   Eigen::VectorXd log_parameters() const { return {}; }
@@ -240,10 +239,14 @@ Fixture load_fixture(const std::string& name) {
 }
 
 const std::vector<std::string>& fixture_names() {
-  static const std::vector<std::string> names = {
-      "iso_1d_smooth",       "iso_1d_noisy_normalized",        "iso_1d_low_noise",
-      "iso_2d",              "ard_2d_normalized",              "badly_scaled_1d_normalized",
-      "badly_scaled_ard_2d_normalized", "badly_scaled_1d_raw"};
+  static const std::vector<std::string> names = {"iso_1d_smooth",
+                                                 "iso_1d_noisy_normalized",
+                                                 "iso_1d_low_noise",
+                                                 "iso_2d",
+                                                 "ard_2d_normalized",
+                                                 "badly_scaled_1d_normalized",
+                                                 "badly_scaled_ard_2d_normalized",
+                                                 "badly_scaled_1d_raw"};
   return names;
 }
 
@@ -303,8 +306,8 @@ K conformance_kernel(Eigen::Index dims) {
 }
 }  // namespace
 
-TEST_CASE_TEMPLATE("kernel conformance: covariance, parameters, contracted gradient", K,
-                   SquaredExponentialKernel, ArdSquaredExponentialKernel) {
+TEST_CASE_TEMPLATE("kernel conformance: covariance, parameters, contracted gradient", K, SquaredExponentialKernel,
+                   ArdSquaredExponentialKernel) {
   for (Eigen::Index dims : {1, 2, 3}) {
     CAPTURE(dims);
     const K k = conformance_kernel<K>(dims);
@@ -413,9 +416,9 @@ std::vector<int> runnable_simd_levels() {
 }  // namespace
 
 #if defined(ADAPTSEG_GP_DISPATCH)
-#define GP_AT_LEVEL(level, name, ...)                                                   \
-  ((level) == 2   ? adaptseg::detail::name##_avx512(__VA_ARGS__)                        \
-   : (level) == 1 ? adaptseg::detail::name##_avx2(__VA_ARGS__)                          \
+#define GP_AT_LEVEL(level, name, ...)                            \
+  ((level) == 2   ? adaptseg::detail::name##_avx512(__VA_ARGS__) \
+   : (level) == 1 ? adaptseg::detail::name##_avx2(__VA_ARGS__)   \
                   : adaptseg::detail::name##_body<16>(__VA_ARGS__))
 #else
 #define GP_AT_LEVEL(level, name, ...) adaptseg::detail::name##_body<16>(__VA_ARGS__)
@@ -827,8 +830,8 @@ TEST_CASE("errors: non-finite input, shapes, options, numerical failure") {
                        std::invalid_argument);
   CHECK_THROWS_WITH_AS(gp.fit(x, y, {.max_iterations = 0}), doctest::Contains("FitOptions::max_iterations"),
                        std::invalid_argument);
-  CHECK_THROWS_WITH_AS(gp.fit(x, y, {.gradient_tolerance = -1.0}),
-                       doctest::Contains("FitOptions::gradient_tolerance"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(gp.fit(x, y, {.gradient_tolerance = -1.0}), doctest::Contains("FitOptions::gradient_tolerance"),
+                       std::invalid_argument);
 
   // Exactly repeated inputs, negligible noise and no jitter retries allowed: NumericalError.
   Eigen::MatrixXd xd(3, 1);

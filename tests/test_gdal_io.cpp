@@ -221,8 +221,8 @@ TEST_CASE("labels as class colours with nodata, and field.yaml's gsd_cm and geo:
     a.insert(a.end(), grid.begin(), grid.end());
     return a;
   }());
-  CHECK_THROWS_WITH_AS((void)gdal::load_field(dir), doctest::Contains("colour (0, 0, 0) at row 0, col 0 is no class colour"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)gdal::load_field(dir),
+                       doctest::Contains("colour (0, 0, 0) at row 0, col 0 is no class colour"), std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)gdal::load_field(dir), doctest::Contains("no nodata value"), std::invalid_argument);
   translate(kTile / "labels.png", dir / "labels.tif", [&] {
     std::vector<std::string> a{"-of", "GTiff", "-a_srs", "EPSG:32640"};
@@ -235,9 +235,10 @@ TEST_CASE("labels as class colours with nodata, and field.yaml's gsd_cm and geo:
   CHECK(gdal::load_field(dir).gsd_cm() == doctest::Approx(5.0));
   const GeoPoint origin = GeoReference(ref).to_wgs84({0.0, 0.0, 0.0});
   const auto with_geo = [&](double lat, double heading) {
-    const fs::path d2 = geotiff_field("colours_geo", "EPSG:32640", 0.05, 0.05,
-                                      "geo: {latitude_deg: " + f2s(lat) + ", longitude_deg: " + f2s(origin.longitude_deg) +
-                                          ", altitude_m: 12.5, heading_deg: " + f2s(heading) + "}\n");
+    const fs::path d2 =
+        geotiff_field("colours_geo", "EPSG:32640", 0.05, 0.05,
+                      "geo: {latitude_deg: " + f2s(lat) + ", longitude_deg: " + f2s(origin.longitude_deg) +
+                          ", altitude_m: 12.5, heading_deg: " + f2s(heading) + "}\n");
     return gdal::load_field(d2);
   };
   const Field agreed = with_geo(origin.latitude_deg, ref.geo()->heading_deg);
@@ -245,9 +246,9 @@ TEST_CASE("labels as class colours with nodata, and field.yaml's gsd_cm and geo:
   // A field 3000 m above the ellipsoid: the model's tangent plane lies there, and still agrees
   // with GDAL's transformation of the grid (without the height, 4 cm off at the corners).
   const fs::path high = geotiff_field("colours_high", "EPSG:32640", 0.05, 0.05,
-                                      "geo: {latitude_deg: " + f2s(origin.latitude_deg) + ", longitude_deg: " +
-                                          f2s(origin.longitude_deg) + ", altitude_m: 3000, heading_deg: " +
-                                          f2s(ref.geo()->heading_deg) + "}\n");
+                                      "geo: {latitude_deg: " + f2s(origin.latitude_deg) +
+                                          ", longitude_deg: " + f2s(origin.longitude_deg) +
+                                          ", altitude_m: 3000, heading_deg: " + f2s(ref.geo()->heading_deg) + "}\n");
   const Field up = gdal::load_field(high);
   const GeoReference up_geo(up);
   double worst_high = 0.0;
@@ -259,8 +260,8 @@ TEST_CASE("labels as class colours with nodata, and field.yaml's gsd_cm and geo:
   CHECK(worst_high < 0.0005);
   CHECK_THROWS_WITH_AS((void)with_geo(origin.latitude_deg + 1e-4, ref.geo()->heading_deg),
                        doctest::Contains("geo: disagrees with 'labels.tif'"), std::invalid_argument);
-  CHECK_THROWS_WITH_AS((void)with_geo(origin.latitude_deg, ref.geo()->heading_deg + 1.0),
-                       doctest::Contains("heading"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)with_geo(origin.latitude_deg, ref.geo()->heading_deg + 1.0), doctest::Contains("heading"),
+                       std::invalid_argument);
   const fs::path d3 = geotiff_field("gsd", "EPSG:32640", 0.05, 0.05, "gsd_cm: 4.0\n");
   CHECK_THROWS_WITH_AS((void)gdal::load_field(d3), doctest::Contains("gsd_cm 4 disagrees with 'labels.tif'"),
                        std::invalid_argument);
@@ -271,7 +272,8 @@ TEST_CASE("bad GeoTIFF fields: one clear error each") {
     const fs::path dir = scratch() / "geographic";
     fs::remove_all(dir);
     fs::create_directories(dir);
-    translate(kTile / "labels.png", dir / "labels.tif", {"-of", "GTiff", "-a_srs", "EPSG:4326", "-a_ullr", "55.1", "25.2", "55.101", "25.199"});
+    translate(kTile / "labels.png", dir / "labels.tif",
+              {"-of", "GTiff", "-a_srs", "EPSG:4326", "-a_ullr", "55.1", "25.2", "55.101", "25.199"});
     fs::copy_file(geotiff_field("geographic_yaml") / "field.yaml", dir / "field.yaml");
     std::ofstream(dir / "image.tif") << "";  // never read: the labels fail first
     CHECK_THROWS_WITH_AS((void)gdal::load_field(dir), doctest::Contains("geographic CRS (coordinates in degrees)"),
@@ -284,13 +286,12 @@ TEST_CASE("bad GeoTIFF fields: one clear error each") {
     const fs::path dir = geotiff_field("empty");
     const Field png = Field::load(kTile);
     cv::imwrite((dir / "empty.png").string(), cv::Mat(png.labels().size(), CV_8UC3, cv::Scalar(0, 0, 0)));
-    translate(dir / "empty.png", dir / "labels.tif",
-              [&] {
-                std::vector<std::string> a{"-of", "GTiff", "-a_srs", "EPSG:32640", "-a_nodata", "0"};
-                const auto g = ullr(kE0, kN0, png.width_px(), png.height_px(), 0.05, 0.05);
-                a.insert(a.end(), g.begin(), g.end());
-                return a;
-              }());
+    translate(dir / "empty.png", dir / "labels.tif", [&] {
+      std::vector<std::string> a{"-of", "GTiff", "-a_srs", "EPSG:32640", "-a_nodata", "0"};
+      const auto g = ullr(kE0, kN0, png.width_px(), png.height_px(), 0.05, 0.05);
+      a.insert(a.end(), g.begin(), g.end());
+      return a;
+    }());
     CHECK_THROWS_WITH_AS((void)gdal::load_field(dir), doctest::Contains("the field has no valid pixel"),
                          std::invalid_argument);
   }
@@ -305,7 +306,8 @@ TEST_CASE("bad GeoTIFF fields: one clear error each") {
     std::vector<std::string> args{"-of", "GTiff", "-a_srs", "EPSG:32640"};
     args.insert(args.end(), shifted.begin(), shifted.end());
     translate(kTile / "image.jpg", dir / "image.tif", args);
-    CHECK_THROWS_WITH_AS((void)gdal::load_field(dir), doctest::Contains("are not on the same grid"), std::invalid_argument);
+    CHECK_THROWS_WITH_AS((void)gdal::load_field(dir), doctest::Contains("are not on the same grid"),
+                         std::invalid_argument);
     // ... or in different CRSs.
     const auto grid = ullr(kE0, kN0, png.width_px(), png.height_px(), 0.05, 0.05);
     std::vector<std::string> args2{"-of", "GTiff", "-a_srs", "EPSG:32639"};
@@ -322,10 +324,11 @@ TEST_CASE("bad GeoTIFF fields: one clear error each") {
     std::vector<std::string> args{"-of", "GTiff", "-a_srs", "EPSG:32640"};
     args.insert(args.end(), grid.begin(), grid.end());
     translate(dir / "bad.png", dir / "labels.tif", args);
-    CHECK_THROWS_WITH_AS((void)gdal::load_field(dir),
-                         doctest::Contains("value 7 at row 3, col 4 is no class index (0..4), not the ignore label 255, "
-                                           "and the band has no nodata value"),
-                         std::invalid_argument);
+    CHECK_THROWS_WITH_AS(
+        (void)gdal::load_field(dir),
+        doctest::Contains("value 7 at row 3, col 4 is no class index (0..4), not the ignore label 255, "
+                          "and the band has no nodata value"),
+        std::invalid_argument);
     // Declared as nodata, it is unlabelled.
     args.insert(args.end(), {"-a_nodata", "7"});
     translate(dir / "bad.png", dir / "labels.tif", args);
@@ -426,14 +429,16 @@ TEST_CASE("map.tif and map_gsd.tif: the field's grid and CRS, classes as colours
   const GDALColorEntry* after = band->GetColorTable()->GetColorEntry(field.num_classes());
   CHECK((after == nullptr || (after->c1 == 0 && after->c2 == 0 && after->c3 == 0)));
   cv::Mat back(labels.size(), CV_8UC1);
-  REQUIRE(band->RasterIO(GF_Read, 0, 0, back.cols, back.rows, back.data, back.cols, back.rows, GDT_Byte, 0, 0) == CE_None);
+  REQUIRE(band->RasterIO(GF_Read, 0, 0, back.cols, back.rows, back.data, back.cols, back.rows, GDT_Byte, 0, 0) ==
+          CE_None);
   CHECK(cv::countNonZero(back != labels) == 0);
 
-  gdal::detail::Dataset g(GDALDataset::Open((map.parent_path() / "map_gsd.tif").c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
+  gdal::detail::Dataset g(
+      GDALDataset::Open((map.parent_path() / "map_gsd.tif").c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
   REQUIRE(g);
   cv::Mat gsd_back(gsd.size(), CV_32F);
-  REQUIRE(g->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, gsd.cols, gsd.rows, gsd_back.data, gsd.cols, gsd.rows, GDT_Float32,
-                                        0, 0) == CE_None);
+  REQUIRE(g->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, gsd.cols, gsd.rows, gsd_back.data, gsd.cols, gsd.rows,
+                                        GDT_Float32, 0, 0) == CE_None);
   CHECK(gsd_back.at<float>(0, 0) == 0.0f);
   CHECK(gsd_back.at<float>(100, 100) == 5.0f);
   CHECK(g->GetRasterBand(1)->GetNoDataValue(&has) == 0.0);
@@ -483,9 +488,7 @@ std::string geojson_polygon(const std::vector<std::vector<GeoPoint>>& rings) {
   return s.str();
 }
 
-void write_file(const fs::path& p, const std::string& text) {
-  std::ofstream(p) << text;
-}
+void write_file(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
 
 }  // namespace
 
@@ -498,7 +501,8 @@ TEST_CASE("a site from a GeoJSON polygon: its frame along the longer side, a pla
   std::vector<GeoPoint> ring;
   for (const auto& q : local) {
     double lat = 0, lon = 0, h = 0;
-    plane.Reverse(std::cos(a) * q.x() - std::sin(a) * q.y(), std::sin(a) * q.x() + std::cos(a) * q.y(), 0.0, lat, lon, h);
+    plane.Reverse(std::cos(a) * q.x() - std::sin(a) * q.y(), std::sin(a) * q.x() + std::cos(a) * q.y(), 0.0, lat, lon,
+                  h);
     ring.push_back({lat, lon, 10.0});
   }
   const fs::path file = scratch() / "l_site.geojson";
@@ -508,7 +512,8 @@ TEST_CASE("a site from a GeoJSON polygon: its frame along the longer side, a pla
   CHECK(site.area.area.width_m() == doctest::Approx(240.0).epsilon(0.002));
   CHECK(site.area.area.height_m() == doctest::Approx(100.0).epsilon(0.002));
   // +x along the long side: at compass bearing 60 deg (or its opposite).
-  CHECK(std::remainder(site.geo.heading_deg - 60.0, 180.0) == doctest::Approx(0.0).epsilon(0.01));  // the two tangent planes: meridians converge
+  CHECK(std::remainder(site.geo.heading_deg - 60.0, 180.0) ==
+        doctest::Approx(0.0).epsilon(0.01));  // the two tangent planes: meridians converge
   // The frame is a georeference: every corner back where the file put it.
   const GeoReference geo(site.geo);
   REQUIRE(site.rings.size() == 1);
@@ -545,7 +550,8 @@ TEST_CASE("a site from a GeoJSON polygon: its frame along the longer side, a pla
     seen(raster_rect(w.footprint, 10.0, seen.rows) & cv::Rect(0, 0, seen.cols, seen.rows)).setTo(255);
   }
   const LawnmowerPlanner planner(camera);
-  const std::size_t full = planner.plan(planner.centred_grid(site.area.area, 15.0), 15.0, Eigen::Vector2d(x0, y0)).size();
+  const std::size_t full =
+      planner.plan(planner.centred_grid(site.area.area, 15.0), 15.0, Eigen::Vector2d(x0, y0)).size();
   CHECK(plan.size() < full);
   CHECK(cv::countNonZero(site.area.valid_mask & ~seen) == 0);
 }
@@ -608,13 +614,15 @@ TEST_CASE("bad survey areas: one clear error each, naming the file") {
 namespace {
 
 /// `local` east, north [m] about (lat0, lon0), turned by `angle_deg` counter-clockwise, in WGS84.
-std::vector<GeoPoint> wgs84_ring(double lat0, double lon0, const std::vector<Eigen::Vector2d>& local, double angle_deg = 0.0) {
+std::vector<GeoPoint> wgs84_ring(double lat0, double lon0, const std::vector<Eigen::Vector2d>& local,
+                                 double angle_deg = 0.0) {
   const GeographicLib::LocalCartesian plane(lat0, lon0, 0.0);
   const double a = angle_deg * std::numbers::pi / 180.0;
   std::vector<GeoPoint> ring;
   for (const auto& q : local) {
     double lat = 0, lon = 0, h = 0;
-    plane.Reverse(std::cos(a) * q.x() - std::sin(a) * q.y(), std::sin(a) * q.x() + std::cos(a) * q.y(), 0.0, lat, lon, h);
+    plane.Reverse(std::cos(a) * q.x() - std::sin(a) * q.y(), std::sin(a) * q.x() + std::cos(a) * q.y(), 0.0, lat, lon,
+                  h);
     ring.push_back({lat, lon, 0.0});
   }
   return ring;
@@ -675,7 +683,8 @@ void write_dem(const fs::path& file, const std::string& srs_text, double e0, dou
   d->SetSpatialRef(&srs);
   std::vector<float> values(static_cast<std::size_t>(w) * h);
   for (int r = 0; r < h; ++r)
-    for (int c = 0; c < w; ++c) values[static_cast<std::size_t>(r) * w + c] = static_cast<float>(z(e0 + (c + 0.5) * px, n1 - (r + 0.5) * px));
+    for (int c = 0; c < w; ++c)
+      values[static_cast<std::size_t>(r) * w + c] = static_cast<float>(z(e0 + (c + 0.5) * px, n1 - (r + 0.5) * px));
   REQUIRE(d->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, w, h, values.data(), w, h, GDT_Float32, 0, 0) == CE_None);
 }
 
@@ -775,8 +784,8 @@ TEST_CASE("plan_site: the take-off point on the site, the polygon as the geofenc
   CHECK(items.size() == 3 + 2 * images + plan.via_points);
   // A take-off point in the hole, or beyond the outline, is refused.
   options.home = wgs84_ring(47.4, 8.5, {{125, 85}})[0];
-  CHECK_THROWS_WITH_AS((void)plan_site(site, options), doctest::Contains("m off the site (outside its outline or in a hole)"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)plan_site(site, options),
+                       doctest::Contains("m off the site (outside its outline or in a hole)"), std::invalid_argument);
   options.home = wgs84_ring(47.4, 8.5, {{300, 0}})[0];
   CHECK_THROWS_WITH_AS((void)plan_site(site, options), doctest::Contains("m off the site"), std::invalid_argument);
 }
@@ -791,7 +800,9 @@ TEST_CASE("plan_site: a DEM with a 20 m slope keeps the GSD within 5 %, altitude
     const auto [e, n] = projected("EPSG:32640", g);
     e_min = std::min(e_min, e), e_max = std::max(e_max, e), n_min = std::min(n_min, n), n_max = std::max(n_max, n);
   }
-  const auto slope = [&](double rise_m) { return [=](double e, double) { return 100.0 + rise_m * (e - e_min) / (e_max - e_min); }; };
+  const auto slope = [&](double rise_m) {
+    return [=](double e, double) { return 100.0 + rise_m * (e - e_min) / (e_max - e_min); };
+  };
   const auto ground = slope(20.0);
   const fs::path dem_file = scratch() / "slope_dem.tif";
   const double px = 5.0;
@@ -822,8 +833,10 @@ TEST_CASE("plan_site: a DEM with a 20 m slope keeps the GSD within 5 %, altitude
     // Above its own ground, at the centre and at the footprint's corners: the GSD within 5 %.
     const double above = wp.position.z() + home_ground - ground_at(wp.position.x(), wp.position.y());
     CHECK(std::abs(camera.gsd_cm(above) / 10.0 - 1.0) < 0.01);
-    for (const auto& c : {Eigen::Vector2d(wp.footprint.x_min_m, wp.footprint.y_min_m), Eigen::Vector2d(wp.footprint.x_max_m, wp.footprint.y_max_m),
-                          Eigen::Vector2d(wp.footprint.x_min_m, wp.footprint.y_max_m), Eigen::Vector2d(wp.footprint.x_max_m, wp.footprint.y_min_m)})
+    for (const auto& c : {Eigen::Vector2d(wp.footprint.x_min_m, wp.footprint.y_min_m),
+                          Eigen::Vector2d(wp.footprint.x_max_m, wp.footprint.y_max_m),
+                          Eigen::Vector2d(wp.footprint.x_min_m, wp.footprint.y_max_m),
+                          Eigen::Vector2d(wp.footprint.x_max_m, wp.footprint.y_min_m)})
       CHECK(std::abs(camera.gsd_cm(wp.position.z() + home_ground - ground_at(c.x(), c.y())) / 10.0 - 1.0) < 0.05);
     low = std::min(low, wp.position.z()), high = std::max(high, wp.position.z());
   }
@@ -831,7 +844,9 @@ TEST_CASE("plan_site: a DEM with a 20 m slope keeps the GSD within 5 %, altitude
   // The same waypoints flown flat at 55 m above home would miss the GSD by more than 5 % somewhere.
   double worst_flat = 0.0;
   for (const auto& wp : plan.survey.waypoints)
-    worst_flat = std::max(worst_flat, std::abs(camera.gsd_cm(55.0 + home_ground - ground_at(wp.position.x(), wp.position.y())) / 10.0 - 1.0));
+    worst_flat = std::max(
+        worst_flat,
+        std::abs(camera.gsd_cm(55.0 + home_ground - ground_at(wp.position.x(), wp.position.y())) / 10.0 - 1.0));
   CHECK(worst_flat > 0.05);
   // The ground rises above home: the return altitude must clear it.
   bool rises = false;
@@ -842,15 +857,17 @@ TEST_CASE("plan_site: a DEM with a 20 m slope keeps the GSD within 5 %, altitude
   write_dem(steep_file, "EPSG:32640", e_min - 200.0, n_max + 200.0, w, h, px, slope(200.0));
   const ElevationModel steep(steep_file);
   options.min_altitude_m = 45.0;
-  CHECK_THROWS_WITH_AS((void)plan_site(site, options, &steep), doctest::Contains("m above the highest ground under its footprint (DEM), below the minimum altitude 45.0 m"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS(
+      (void)plan_site(site, options, &steep),
+      doctest::Contains("m above the highest ground under its footprint (DEM), below the minimum altitude 45.0 m"),
+      std::invalid_argument);
   // A DEM elsewhere: no elevation, named.
   const fs::path far_file = scratch() / "far_dem.tif";
   write_dem(far_file, "EPSG:32640", e_min + 50'000.0, n_max + 200.0, 20, 20, px, ground);
   const ElevationModel far(far_file);
   options.min_altitude_m = 10.0;
-  CHECK_THROWS_WITH_AS((void)plan_site(site, options, &far), doctest::Contains("has no elevation at the take-off point"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)plan_site(site, options, &far),
+                       doctest::Contains("has no elevation at the take-off point"), std::invalid_argument);
 }
 
 TEST_CASE("plan_site: swapped latitude and longitude are named, never planned silently") {
@@ -875,9 +892,10 @@ TEST_CASE("plan_site: swapped latitude and longitude are named, never planned si
   CHECK_THROWS_WITH_AS((void)plan_site(site, options, &dem), doctest::Contains("swapped, the site would lie on it"),
                        std::invalid_argument);
   // A latitude beyond 90 that would be a longitude: Sydney written [lat, lon].
-  write_file(scratch() / "sydney.geojson", R"({"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {}, )"
-                                           R"("geometry": {"type": "Polygon", "coordinates": [[[-33.90, 151.20], [-33.90, 151.21], )"
-                                           R"([-33.91, 151.21], [-33.90, 151.20]]]}}]})");
+  write_file(scratch() / "sydney.geojson",
+             R"({"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {}, )"
+             R"("geometry": {"type": "Polygon", "coordinates": [[[-33.90, 151.20], [-33.90, 151.21], )"
+             R"([-33.91, 151.21], [-33.90, 151.20]]]}}]})");
   CHECK_THROWS_WITH_AS((void)load_survey_site(scratch() / "sydney.geojson"),
                        doctest::Contains("are latitude and longitude swapped? GeoJSON and KML list longitude first"),
                        std::invalid_argument);
@@ -929,10 +947,11 @@ TEST_CASE("plan_site: refusals and warnings, each one line with its numbers") {
   const SurveySite site = load_survey_site(file, 10.0);
   SitePlanOptions options;
   options.gsd_cm = 0.5;
-  CHECK_THROWS_WITH_AS((void)plan_site(site, options),
-                       doctest::Contains("the survey would fly 2.75 m above the ground at 0.50 cm/px, below the minimum "
-                                         "altitude 10.0 m: with this camera fly at least 1.82 cm/px"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS(
+      (void)plan_site(site, options),
+      doctest::Contains("the survey would fly 2.75 m above the ground at 0.50 cm/px, below the minimum "
+                        "altitude 10.0 m: with this camera fly at least 1.82 cm/px"),
+      std::invalid_argument);
   options.gsd_cm = 10.0;
   CHECK(plan_site(site, options).warnings.empty());
   // 12 km^2 at 20 cm/px: the area, the waypoints and the hours are each named; the one file
@@ -951,8 +970,8 @@ TEST_CASE("plan_site: refusals and warnings, each one line with its numbers") {
   CHECK(has("waypoints, more than 1000: check the GSD (20.00 cm/px) against the site's 1200.0 ha"));
   CHECK(has("h in 1 sortie(s), more than 2.0 h"));
   CHECK(has("split it into sorties that fit a battery"));
-  CHECK_THROWS_WITH_AS((void)mission_items(plan.sortie_path(0, wide)), doctest::Contains("more than the PX4 limit of 500"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)mission_items(plan.sortie_path(0, wide)),
+                       doctest::Contains("more than the PX4 limit of 500"), std::invalid_argument);
   // The mask too large for memory: one readable line, the sizes as integers, the GSD that fits.
   try {
     (void)load_survey_site(big, 1.0);
@@ -1013,9 +1032,9 @@ TEST_CASE("read_exif_position: a picture's EXIF GPS tags, hemispheres and altitu
   // No GPS tags, or no altitude.
   CHECK_FALSE(read_exif_position(exif_jpeg("exif_none.jpg", {{"EXIF_Make", "none"}})).has_value());
   const auto flat = read_exif_position(exif_jpeg("exif_no_alt.jpg", {{"EXIF_GPSLatitude", "(1) (2) (3)"},
-                                                                      {"EXIF_GPSLatitudeRef", "N"},
-                                                                      {"EXIF_GPSLongitude", "(4) (5) (6)"},
-                                                                      {"EXIF_GPSLongitudeRef", "E"}}));
+                                                                     {"EXIF_GPSLatitudeRef", "N"},
+                                                                     {"EXIF_GPSLongitude", "(4) (5) (6)"},
+                                                                     {"EXIF_GPSLongitudeRef", "E"}}));
   REQUIRE(flat.has_value());
   CHECK_FALSE(flat->altitude_msl_m.has_value());
 

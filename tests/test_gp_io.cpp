@@ -7,8 +7,8 @@
 #include <adaptseg/core/gaussian_process.hpp>
 #include <adaptseg/vision/gp_io.hpp>
 
-#include <doctest/doctest.h>
 #include <Eigen/Core>
+#include <doctest/doctest.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>

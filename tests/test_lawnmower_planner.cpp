@@ -37,8 +37,8 @@ TEST_CASE("lawnmower: grid size, non-overlapping footprints, full coverage") {
     for (double y = 0.05; y < 30.0; y += 0.5) {
       bool covered = false;
       for (const auto& w : plan)
-        covered |= x >= w.footprint.x_min_m && x < w.footprint.x_max_m && y >= w.footprint.y_min_m &&
-                   y < w.footprint.y_max_m;
+        covered |=
+            x >= w.footprint.x_min_m && x < w.footprint.x_max_m && y >= w.footprint.y_min_m && y < w.footprint.y_max_m;
       REQUIRE(covered);
     }
 }
@@ -149,8 +149,8 @@ TEST_CASE("lawnmower: overlap along and across the rows") {
 }
 
 TEST_CASE("descent schedules: the windows of a lawnmower, and every name parses back") {
-  using adaptseg::DescentSchedule;
   using adaptseg::descent_schedule_rule;
+  using adaptseg::DescentSchedule;
   const LawnmowerPlanner planner(CameraModel{});
   const auto plan = planner.plan(Area{0, 0, 40.0, 30.0}, 3.0);  // 3 rows of 3
   REQUIRE(plan.size() == 9);

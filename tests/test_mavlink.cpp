@@ -79,10 +79,16 @@ bool same_message(const mv::Message& a, const mv::Message& b) {
 /// for `crc_extra`.
 Bytes raw_frame(std::uint32_t id, const Bytes& payload, std::uint8_t crc_extra, std::uint8_t incompat = 0) {
   Bytes out(mv::kHeaderLengthV2 + payload.size());
-  const std::array<std::uint8_t, mv::kHeaderLengthV2> header = {
-      mv::kStartV2, static_cast<std::uint8_t>(payload.size()), incompat, 0, 9, 1, 1,
-      static_cast<std::uint8_t>(id & 0xFF), static_cast<std::uint8_t>((id >> 8) & 0xFF),
-      static_cast<std::uint8_t>(id >> 16)};
+  const std::array<std::uint8_t, mv::kHeaderLengthV2> header = {mv::kStartV2,
+                                                                static_cast<std::uint8_t>(payload.size()),
+                                                                incompat,
+                                                                0,
+                                                                9,
+                                                                1,
+                                                                1,
+                                                                static_cast<std::uint8_t>(id & 0xFF),
+                                                                static_cast<std::uint8_t>((id >> 8) & 0xFF),
+                                                                static_cast<std::uint8_t>(id >> 16)};
   std::copy(header.begin(), header.end(), out.begin());
   std::copy(payload.begin(), payload.end(), out.begin() + static_cast<std::ptrdiff_t>(mv::kHeaderLengthV2));
   std::uint16_t crc = mv::crc_calculate(std::span<const std::uint8_t>(out.data() + 1, out.size() - 1));
@@ -98,8 +104,11 @@ Bytes concat(std::initializer_list<Bytes> parts) {
   return out;
 }
 
-const mv::Heartbeat kPx4Heartbeat{.type = mv::mav_type::kQuadrotor, .autopilot = mv::mav_autopilot::kPx4,
-                                  .base_mode = 157, .custom_mode = 0x04040000, .system_status = mv::mav_state::kActive};
+const mv::Heartbeat kPx4Heartbeat{.type = mv::mav_type::kQuadrotor,
+                                  .autopilot = mv::mav_autopilot::kPx4,
+                                  .base_mode = 157,
+                                  .custom_mode = 0x04040000,
+                                  .system_status = mv::mav_state::kActive};
 
 }  // namespace
 
@@ -440,8 +449,8 @@ TEST_CASE("mavlink: unknown message ids are skipped whole and counted") {
 TEST_CASE("mavlink: a corrupted frame is never accepted and the frames after it are") {
   // Every bit of a COMMAND_LONG frame flipped in turn, then good frames: no corrupted frame
   // comes out as a message, and the good ones behind it all do.
-  const mv::CommandLong cmd{.target_system = 1, .target_component = 1, .command = mv::mav_cmd::kNavTakeoff,
-                            .param7 = 30.0F};
+  const mv::CommandLong cmd{
+      .target_system = 1, .target_component = 1, .command = mv::mav_cmd::kNavTakeoff, .param7 = 30.0F};
   const Bytes good = mv::encode(cmd, {.sequence = 3});
   const Bytes hb = mv::encode(kPx4Heartbeat, {.sequence = 4});
   Bytes tail;  // enough good frames to complete any length the corruption declares
@@ -470,8 +479,11 @@ TEST_CASE("mavlink: a corrupted frame is never accepted and the frames after it 
 }
 
 TEST_CASE("mavlink: a frame cut short is never accepted and the next frame is") {
-  const Bytes good = mv::encode(mv::HomePosition{.latitude = 507332101, .longitude = 71038874, .altitude = 61230,
-                                                 .q = {1.0F, 0.0F, 0.0F, 0.0F}, .time_usec = 42},
+  const Bytes good = mv::encode(mv::HomePosition{.latitude = 507332101,
+                                                 .longitude = 71038874,
+                                                 .altitude = 61230,
+                                                 .q = {1.0F, 0.0F, 0.0F, 0.0F},
+                                                 .time_usec = 42},
                                 {.sequence = 1});
   const Bytes hb = mv::encode(kPx4Heartbeat, {.sequence = 2});
   Bytes tail;
@@ -526,8 +538,8 @@ TEST_CASE("mavlink: signed frames are accepted with their signature skipped unve
   CHECK(frames[0].signature->link_id == 7);
   // 2025-01-01 00:00 UTC in 10 us since 2015-01-01: 3653 days.
   CHECK(frames[0].signature->timestamp == 3653ULL * 86400ULL * 100000ULL);
-  CHECK(std::equal(frames[0].signature->signature.begin(), frames[0].signature->signature.end(),
-                   line->bytes.end() - 6));
+  CHECK(
+      std::equal(frames[0].signature->signature.begin(), frames[0].signature->signature.end(), line->bytes.end() - 6));
   CHECK(t::compare(mv::decode(frames[0]), *line).empty());
   CHECK(parser.stats().signed_frames == 1);
   check_accounting(parser, frames);

@@ -57,11 +57,13 @@ struct FakeAutopilot {
   std::int32_t captures = 0;
   std::vector<Sent> sent;  // every frame the link sent
 
-  mv::Heartbeat heartbeat{mv::mav_type::kQuadrotor, mv::mav_autopilot::kPx4,
-                          static_cast<std::uint8_t>(mv::mav_mode_flag::kCustomModeEnabled |
-                                                    mv::mav_mode_flag::kSafetyArmed),
-                          mv::px4_mode::custom_mode(mv::px4_mode::kMainPosctl), mv::mav_state::kActive,
-                          mv::kMavlinkVersion};
+  mv::Heartbeat heartbeat{
+      mv::mav_type::kQuadrotor,
+      mv::mav_autopilot::kPx4,
+      static_cast<std::uint8_t>(mv::mav_mode_flag::kCustomModeEnabled | mv::mav_mode_flag::kSafetyArmed),
+      mv::px4_mode::custom_mode(mv::px4_mode::kMainPosctl),
+      mv::mav_state::kActive,
+      mv::kMavlinkVersion};
   double lat = kHomeLat;
   double lon = kHomeLon;
   double rel_alt = 20.0;
@@ -432,10 +434,9 @@ TEST_CASE("link: temporarily rejected is asked again and in progress is waited f
   rig.ap->script[mv::mav_cmd::kDoReposition] = {mv::mav_result::kTemporarilyRejected};
   rig.link.go_to(at(30, 0));
   CHECK(rig.ap->commands(mv::mav_cmd::kDoReposition) == 2);
-  rig.ap->script[mv::mav_cmd::kNavReturnToLaunch] = {mv::mav_result::kTemporarilyRejected,
-                                                     mv::mav_result::kTemporarilyRejected,
-                                                     mv::mav_result::kTemporarilyRejected,
-                                                     mv::mav_result::kTemporarilyRejected};
+  rig.ap->script[mv::mav_cmd::kNavReturnToLaunch] = {
+      mv::mav_result::kTemporarilyRejected, mv::mav_result::kTemporarilyRejected, mv::mav_result::kTemporarilyRejected,
+      mv::mav_result::kTemporarilyRejected};
   const mv::VehicleLinkError e = link_error([&] { rig.link.return_to_launch(); });
   CHECK(e.failure() == mv::LinkFailure::no_ack);
   CHECK(contains(e.what(), "TEMPORARILY_REJECTED, 4 attempts"));
@@ -453,8 +454,7 @@ TEST_CASE("link: a target outside the site or above the ceiling is never sent") 
   CHECK(high.failure() == mv::LinkFailure::outside_site);
   CHECK(contains(high.what(), "altitude 61.0 m above home is above the ceiling 60.0 m"));
   CHECK(link_error([&] { rig.link.go_to(at(10, 10, -1.0)); }).failure() == mv::LinkFailure::outside_site);
-  CHECK(link_error([&] { rig.link.go_to({std::nan(""), kHomeLon, 20.0}); }).failure() ==
-        mv::LinkFailure::outside_site);
+  CHECK(link_error([&] { rig.link.go_to({std::nan(""), kHomeLon, 20.0}); }).failure() == mv::LinkFailure::outside_site);
   CHECK(rig.ap->commands(mv::mav_cmd::kDoReposition) == 0);
   CHECK(static_cast<int>(rig.ap->sent.size()) == before);  // not even a heartbeat was due
 }
@@ -642,13 +642,21 @@ TEST_CASE("link: bad options, criteria and site limits are refused naming the fi
   CHECK(contains(message([&] { make({.system_id = 0}); }), "LinkOptions: system_id must be 1..255"));
   CHECK(contains(message([&] { make({.ground_speed_mps = 0.0}); }), "LinkOptions: ground_speed_mps"));
   CHECK(contains(message([&] { make({.camera_command = 201}); }), "LinkOptions: camera_command must be 0"));
-  CHECK(contains(message([] { (void)mv::SiteLimits({{25.2, 55.3}, {25.3, 55.3}}, 100.0); }),
+  CHECK(contains(message([] {
+                   (void)mv::SiteLimits({{25.2, 55.3}, {25.3, 55.3}}, 100.0);
+                 }),
                  "SiteLimits: polygon needs at least 3 vertices (got 2)"));
-  CHECK(contains(message([] { (void)mv::SiteLimits({{25.2, 55.3}, {25.3, 55.3}, {95.0, 55.4}}, 100.0); }),
+  CHECK(contains(message([] {
+                   (void)mv::SiteLimits({{25.2, 55.3}, {25.3, 55.3}, {95.0, 55.4}}, 100.0);
+                 }),
                  "SiteLimits: polygon vertex 2 must be a latitude in -90..90"));
-  CHECK(contains(message([] { (void)mv::SiteLimits({{25.2, 55.3}, {25.3, 55.3}, {25.4, 55.3}}, 100.0); }),
+  CHECK(contains(message([] {
+                   (void)mv::SiteLimits({{25.2, 55.3}, {25.3, 55.3}, {25.4, 55.3}}, 100.0);
+                 }),
                  "SiteLimits: polygon has no area"));
-  CHECK(contains(message([] { (void)mv::SiteLimits({{25.2, 55.3}, {25.3, 55.3}, {25.3, 55.4}}, 0.0); }),
+  CHECK(contains(message([] {
+                   (void)mv::SiteLimits({{25.2, 55.3}, {25.3, 55.3}, {25.3, 55.4}}, 0.0);
+                 }),
                  "SiteLimits: ceiling_m must be finite and above floor_m"));
   Rig rig;
   rig.link.connect();

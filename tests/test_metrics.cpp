@@ -25,8 +25,8 @@ TEST_CASE("metrics: IoU and mIoU on a hand-computed example") {
   const cv::Mat pred = (cv::Mat_<std::uint8_t>(1, 6) << 0, 1, 1, 1, 255, 2);
   ConfusionMatrix cm(3);
   cm.add(truth, pred, 255);
-  CHECK(cm.total() == 5);                       // the ignore truth pixel is skipped
-  CHECK(cm.count(2, 3) == 1);                   // weed predicted as none
+  CHECK(cm.total() == 5);                                  // the ignore truth pixel is skipped
+  CHECK(cm.count(2, 3) == 1);                              // weed predicted as none
   CHECK(cm.iou(0).value() == doctest::Approx(1.0 / 2.0));  // TP 1, FN 1
   CHECK(cm.iou(1).value() == doctest::Approx(2.0 / 3.0));  // TP 2, FP 1
   CHECK(cm.iou(2).value() == doctest::Approx(0.0));        // FN 1
@@ -95,7 +95,8 @@ TEST_CASE("front margin: measured against the curve's upper envelope, not a curv
   const std::vector<CurvePoint> rising{{10.0, 0.1}, {20.0, 0.3}, {30.0, 0.35}};
   const auto same = upper_envelope(rising);
   REQUIRE(same.size() == rising.size());
-  for (std::size_t k = 0; k < same.size(); ++k) CHECK((same[k].time_s == rising[k].time_s && same[k].miou == rising[k].miou));
+  for (std::size_t k = 0; k < same.size(); ++k)
+    CHECK((same[k].time_s == rising[k].time_s && same[k].miou == rising[k].miou));
   CHECK_THROWS_AS((void)upper_envelope({}), std::invalid_argument);
   CHECK_THROWS_AS((void)front_margin({{1.0, NAN}}, 1.0, 0.5), std::invalid_argument);
 }

@@ -30,17 +30,15 @@ namespace {
 /// Distance [m] and azimuth [deg clockwise from north] from a to b on the WGS84 ellipsoid.
 std::pair<double, double> geodesic(const GeoPoint& a, const GeoPoint& b) {
   double s12 = 0.0, azi1 = 0.0, azi2 = 0.0, m12 = 0.0, M12 = 0.0, M21 = 0.0, S12 = 0.0;
-  GeographicLib::Geodesic::WGS84().Inverse(a.latitude_deg, a.longitude_deg, b.latitude_deg, b.longitude_deg, s12,
-                                           azi1, azi2, m12, M12, M21, S12);
+  GeographicLib::Geodesic::WGS84().Inverse(a.latitude_deg, a.longitude_deg, b.latitude_deg, b.longitude_deg, s12, azi1,
+                                           azi2, m12, M12, M21, S12);
   return {s12, azi1};
 }
 
 /// Angle difference folded into (-180, 180].
 double angle_diff(double a, double b) { return std::remainder(a - b, 360.0); }
 
-bool same_number(double a, double b, double tol) {
-  return (std::isnan(a) && std::isnan(b)) || std::abs(a - b) <= tol;
-}
+bool same_number(double a, double b, double tol) { return (std::isnan(a) && std::isnan(b)) || std::abs(a - b) <= tol; }
 
 void check_same_items(const std::vector<MissionItem>& got, const std::vector<MissionItem>& want) {
   REQUIRE(got.size() == want.size());
@@ -101,8 +99,8 @@ TEST_CASE("geo: the heading is the compass bearing of +x, and +y lies 90 degrees
     double heading, azimuth_x, azimuth_y;
   };
   // heading 90: +x east, +y north; 0: +x north, +y west; 30: +x at 30, +y at -60; 180: +x south, +y east.
-  for (const Case c : {Case{90.0, 90.0, 0.0}, Case{0.0, 0.0, -90.0}, Case{30.0, 30.0, -60.0},
-                       Case{180.0, 180.0, 90.0}, Case{-90.0, -90.0, 180.0}}) {
+  for (const Case c : {Case{90.0, 90.0, 0.0}, Case{0.0, 0.0, -90.0}, Case{30.0, 30.0, -60.0}, Case{180.0, 180.0, 90.0},
+                       Case{-90.0, -90.0, 180.0}}) {
     CAPTURE(c.heading);
     // At the ellipsoid's surface (altitude 0): geodesic distances are measured there.
     const FieldGeo g{kGeo.latitude_deg, kGeo.longitude_deg, 0.0, c.heading};
@@ -146,9 +144,9 @@ TEST_CASE("geo: the heading is the compass bearing of +x, and +y lies 90 degrees
 TEST_CASE("geo: field.yaml's geo section loads, and a sub-field keeps every point's WGS84 position") {
   t::TempDir tmp;
   cv::Mat labels(4, 6, CV_8UC1, cv::Scalar(0));
-  t::write_field(tmp.path(), labels,
-                 std::string(t::kWeedYaml) +
-                     "geo: {latitude_deg: 50.7, longitude_deg: 7.2, altitude_m: 60, heading_deg: 30}\n");
+  t::write_field(
+      tmp.path(), labels,
+      std::string(t::kWeedYaml) + "geo: {latitude_deg: 50.7, longitude_deg: 7.2, altitude_m: 60, heading_deg: 30}\n");
   const Field f = Field::load(tmp.path());
   REQUIRE(f.geo().has_value());
   CHECK(*f.geo() == FieldGeo{50.7, 7.2, 60.0, 30.0, 0.0, 0.0});
@@ -187,8 +185,7 @@ TEST_CASE("geo: bad geo sections and values are rejected, naming the file and ke
     CHECK_THROWS_WITH_AS(Field::load(dir), doctest::Contains(fragment.c_str()), std::invalid_argument);
   };
   expect_error("geo: {latitude_deg: 91, longitude_deg: 7, altitude_m: 0, heading_deg: 0}\n", "geo.latitude_deg");
-  expect_error("geo: {latitude_deg: 50, longitude_deg: -180.5, altitude_m: 0, heading_deg: 0}\n",
-               "geo.longitude_deg");
+  expect_error("geo: {latitude_deg: 50, longitude_deg: -180.5, altitude_m: 0, heading_deg: 0}\n", "geo.longitude_deg");
   expect_error("geo: {latitude_deg: 50, longitude_deg: 7, altitude_m: .inf, heading_deg: 0}\n", "geo.altitude_m");
   expect_error("geo: {latitude_deg: 50, longitude_deg: 7, altitude_m: 0, heading_deg: .nan}\n", "geo.heading_deg");
   expect_error("geo: {latitude_deg: north, longitude_deg: 7, altitude_m: 0, heading_deg: 0}\n",
@@ -286,8 +283,8 @@ TEST_CASE("export: mission items take off, hold at every waypoint, capture one i
     CHECK(nav.params[6] == p.waypoints[i].relative_altitude_m);
     CHECK(cap.command == 2000);
     CHECK(cap.frame == 2);
-    CHECK(cap.params[2] == 1.0);                          // one image
-    CHECK(cap.params[3] == static_cast<double>(i + 1));   // capture sequence number
+    CHECK(cap.params[2] == 1.0);                         // one image
+    CHECK(cap.params[3] == static_cast<double>(i + 1));  // capture sequence number
   }
   const MissionItem& rtl = items.back();
   CHECK(rtl.command == 20);
@@ -317,8 +314,8 @@ TEST_CASE("export: mission items take off, hold at every waypoint, capture one i
   // A take-off needs somewhere to climb to.
   ExportPath low = p;
   low.waypoints.front().relative_altitude_m = 0.0;
-  CHECK_THROWS_WITH_AS((void)adaptseg::mission_items(low), doctest::Contains("take-off needs the first waypoint above home"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)adaptseg::mission_items(low),
+                       doctest::Contains("take-off needs the first waypoint above home"), std::invalid_argument);
   opt.takeoff = false;
   CHECK(adaptseg::mission_items(low, opt).size() == p.waypoints.size());
   // Above the legal ceiling (120 m by default): refused.
@@ -395,8 +392,10 @@ TEST_CASE("export: a QGC WPL 110 file reads back equal") {
   // Spaces, \r\n and blank lines are read as well.
   std::string crlf;
   for (char c : text) {
-    if (c == '\n') crlf += "\r\n";
-    else crlf += c == '\t' ? ' ' : c;
+    if (c == '\n')
+      crlf += "\r\n";
+    else
+      crlf += c == '\t' ? ' ' : c;
   }
   CHECK(adaptseg::read_wpl(crlf + "\r\n\r\n").items.size() == back.items.size());
 }
@@ -465,8 +464,7 @@ TEST_CASE("export: malformed WPL files are rejected with the line number") {
   expect_error("QGC WPL 110\n" + home + "1\t0\t3\t16\tx\t0\t0\t0\t50\t7\t60\t1\n", "line 3: field 5 (param1)");
   expect_error("QGC WPL 110\n" + home + "1\t0\t3\t16\t0\t0\t0\t0\t50\t7\t60\t2\n", "line 3: autocontinue");
   expect_error("QGC WPL 110\n" + home + "1\t2\t3\t16\t0\t0\t0\t0\t50\t7\t60\t1\n", "line 3: current");
-  expect_error("QGC WPL 110\n" + home + "1\t0\t3\t99999999999999999999\t0\t0\t0\t0\t50\t7\t60\t1\n",
-               "line 3: command");
+  expect_error("QGC WPL 110\n" + home + "1\t0\t3\t99999999999999999999\t0\t0\t0\t0\t50\t7\t60\t1\n", "line 3: command");
   expect_error("QGC WPL 110\n" + home + "1\t0\t3\t16\t1e999\t0\t0\t0\t50\t7\t60\t1\n", "line 3: field 5");
   expect_error("QGC WPL 110\n0\t1\t0\t16\t0\t0\t0\t0\tnan\t7.2\t60\t1\n", "line 2: latitude");
   expect_error("QGC WPL 110\n0\t1\t2\t16\t0\t0\t0\t0\tnan\t7.2\t60\t1\n", "line 2: the home position");
@@ -574,9 +572,10 @@ TEST_CASE("export: a mission longer than the firmware stores is refused, naming 
   REQUIRE(path.size() == 250);
   const ExportPath p = adaptseg::make_export_path(path, GeoReference(kGeo), "long");
   adaptseg::ExportOptions opt;  // PX4: 500
-  CHECK_THROWS_WITH_AS((void)adaptseg::mission_items(p, opt),
-                       doctest::Contains("the mission has 503 mission items (250 waypoints), more than the PX4 limit of 500"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS(
+      (void)adaptseg::mission_items(p, opt),
+      doctest::Contains("the mission has 503 mission items (250 waypoints), more than the PX4 limit of 500"),
+      std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)adaptseg::write_qgc_plan(p, opt), doctest::Contains("more than the PX4 limit of 500"),
                        std::invalid_argument);
   opt.firmware_type = adaptseg::mavlink::kAutopilotArduPilot;  // 717
@@ -631,9 +630,11 @@ TEST_CASE("export: a geofence goes into the .plan as QGroundControl writes it, a
   // More vertices than the firmware keeps: 64 for PX4 and ArduPilot (63 kept).
   adaptseg::GeoFencePolygon many{true, {}};
   for (int k = 0; k < 64; ++k)
-    many.vertices.push_back(at(20 + 30 * std::cos(k * 2 * std::numbers::pi / 64), 15 + 30 * std::sin(k * 2 * std::numbers::pi / 64)));
+    many.vertices.push_back(
+        at(20 + 30 * std::cos(k * 2 * std::numbers::pi / 64), 15 + 30 * std::sin(k * 2 * std::numbers::pi / 64)));
   p.geofence = {many};
-  CHECK_THROWS_WITH_AS((void)adaptseg::write_qgc_plan(p), doctest::Contains("the geofence has 64 vertices, more than the PX4 limit of 63"),
+  CHECK_THROWS_WITH_AS((void)adaptseg::write_qgc_plan(p),
+                       doctest::Contains("the geofence has 64 vertices, more than the PX4 limit of 63"),
                        std::invalid_argument);
 }
 
@@ -683,14 +684,15 @@ TEST_CASE("sorties: each fits the flight-time limit, in order, and none could ta
   const std::vector<adaptseg::Waypoint> one{w};
   const double up = timing.segment_time_s(Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 30));
   const double across = timing.segment_time_s(Eigen::Vector3d(0, 0, 30), Eigen::Vector3d(30, 40, 30));
-  CHECK(adaptseg::sortie_flight_s(one, Eigen::Vector3d::Zero(), timing, 2.0) == doctest::Approx(2 * up + 2 * across + 2.0));
+  CHECK(adaptseg::sortie_flight_s(one, Eigen::Vector3d::Zero(), timing, 2.0) ==
+        doctest::Approx(2 * up + 2 * across + 2.0));
   // Without a limit, one sortie; a waypoint that alone does not fit is named.
   CHECK(adaptseg::split_into_sorties(path, home, timing, 1.0).size() == 1);
   CHECK_THROWS_WITH_AS((void)adaptseg::split_into_sorties(one, Eigen::Vector3d::Zero(), timing, 1.0, 30.0),
                        doctest::Contains("waypoint 0 alone takes 85 s from home and back, more than max_flight_s 30 s"),
                        std::invalid_argument);
-  CHECK_THROWS_WITH_AS((void)adaptseg::split_into_sorties(path, home, timing, 1.0, 0.0), doctest::Contains("max_flight_s"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)adaptseg::split_into_sorties(path, home, timing, 1.0, 0.0),
+                       doctest::Contains("max_flight_s"), std::invalid_argument);
 }
 
 TEST_CASE("fence route: legs that would leave an L-shaped fence or cross its hole bend at its corners") {
@@ -699,8 +701,8 @@ TEST_CASE("fence route: legs that would leave an L-shaped fence or cross its hol
   const std::vector<Eigen::Vector2d> hole{{15, 10}, {25, 10}, {25, 20}, {15, 20}};
   const adaptseg::FenceRouter router({l, hole}, {true, false}, 1.0);
   CHECK(router.inside({5, 5}));
-  CHECK_FALSE(router.inside({60, 45}));  // the missing quarter
-  CHECK_FALSE(router.inside({20, 15}));  // the hole
+  CHECK_FALSE(router.inside({60, 45}));          // the missing quarter
+  CHECK_FALSE(router.inside({20, 15}));          // the hole
   CHECK(router.route({5, 5}, {75, 5}).empty());  // straight and clear
   // Across the missing quarter: one bend at its corner (40, 30), on the inside.
   const auto vias = router.route({70, 25}, {35, 55});
@@ -716,7 +718,8 @@ TEST_CASE("fence route: legs that would leave an L-shaped fence or cross its hol
   all.insert(all.end(), around.begin(), around.end());
   all.push_back(ends[1]);
   for (std::size_t k = 1; k < all.size(); ++k) CHECK(router.clear(all[k - 1], all[k]));
-  CHECK_THROWS_WITH_AS((void)router.route({60, 45}, {5, 5}), doctest::Contains("outside the geofence"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)router.route({60, 45}, {5, 5}), doctest::Contains("outside the geofence"),
+                       std::invalid_argument);
   CHECK_THROWS_WITH_AS(adaptseg::FenceRouter({{{0, 0}, {1, 0}}}, {true}, 1.0), doctest::Contains("at least 3 vertices"),
                        std::invalid_argument);
 }

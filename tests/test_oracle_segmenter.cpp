@@ -44,14 +44,14 @@ TEST_CASE("oracle: passes the backend conformance suite on the bundled WeedMap f
 TEST_CASE("oracle: identity at the orthomosaic's GSD, area-weighted majority above it") {
   // 960 x 720 field: a 2x2 block per camera pixel at 2 cm/px.
   cv::Mat labels(720, 960, CV_8UC1, cv::Scalar(0));
-  labels(cv::Rect(0, 0, 2, 2)).setTo(1);        // whole block crop -> crop
+  labels(cv::Rect(0, 0, 2, 2)).setTo(1);  // whole block crop -> crop
   labels(cv::Rect(2, 0, 2, 2)).setTo(2);
-  labels.at<std::uint8_t>(0, 2) = 0;            // 3 weed of 4 -> weed
-  labels.at<std::uint8_t>(0, 4) = 1;            // 1 crop of 4 -> soil
+  labels.at<std::uint8_t>(0, 2) = 0;  // 3 weed of 4 -> weed
+  labels.at<std::uint8_t>(0, 4) = 1;  // 1 crop of 4 -> soil
   labels(cv::Rect(6, 0, 2, 2)).setTo(255);
-  labels.at<std::uint8_t>(1, 7) = 2;            // 3 ignore + 1 weed -> weed (ignore does not vote)
-  labels(cv::Rect(8, 0, 2, 2)).setTo(255);      // only ignore -> ignore
-  labels.at<std::uint8_t>(0, 10) = 1;           // tie crop/weed 2:2 -> crop (lower index)
+  labels.at<std::uint8_t>(1, 7) = 2;        // 3 ignore + 1 weed -> weed (ignore does not vote)
+  labels(cv::Rect(8, 0, 2, 2)).setTo(255);  // only ignore -> ignore
+  labels.at<std::uint8_t>(0, 10) = 1;       // tie crop/weed 2:2 -> crop (lower index)
   labels.at<std::uint8_t>(0, 11) = 1;
   labels.at<std::uint8_t>(1, 10) = 2;
   labels.at<std::uint8_t>(1, 11) = 2;
@@ -77,7 +77,7 @@ TEST_CASE("oracle: its probabilities are the shares of the area vote") {
   // 960 x 720 field, 2x2 blocks per camera pixel at 2 cm/px, as above.
   cv::Mat labels(720, 960, CV_8UC1, cv::Scalar(0));
   labels(cv::Rect(2, 0, 2, 2)).setTo(2);
-  labels.at<std::uint8_t>(0, 2) = 0;        // 3 weed, 1 soil
+  labels.at<std::uint8_t>(0, 2) = 0;  // 3 weed, 1 soil
   labels(cv::Rect(6, 0, 2, 2)).setTo(255);
   labels.at<std::uint8_t>(1, 7) = 1;        // 3 ignore, 1 crop: crop alone votes
   labels(cv::Rect(8, 0, 2, 2)).setTo(255);  // no vote at all
@@ -95,7 +95,7 @@ TEST_CASE("oracle: its probabilities are the shares of the area vote") {
   CHECK(p(0, 1) == doctest::Approx(0.25));
   CHECK(p(2, 1) == doctest::Approx(0.75));
   CHECK(p(1, 1) == 0.0f);
-  CHECK(p(1, 3) == doctest::Approx(1.0));  // the one valid pixel is crop
+  CHECK(p(1, 3) == doctest::Approx(1.0));              // the one valid pixel is crop
   for (int c = 0; c < 3; ++c) CHECK(p(c, 4) == 0.0f);  // nothing votes: no probability, ignore label
   CHECK(s.labels.at<std::uint8_t>(0, 4) == 255);
   CHECK_NOTHROW(check_probabilities(s.probabilities, s.labels, img, 3, "oracle"));

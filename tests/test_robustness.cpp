@@ -152,12 +152,9 @@ struct ContractBreaker {
   [[nodiscard]] std::string name() const { return "breaker"; }
   [[nodiscard]] cv::Mat segment(const Image& image) const {
     switch (fault) {
-      case Fault::size:
-        return cv::Mat(1, 1, CV_8UC1, cv::Scalar(0));
-      case Fault::type:
-        return cv::Mat(image.height_px, image.width_px, CV_16UC1, cv::Scalar(0));
-      case Fault::label:
-        break;
+      case Fault::size: return cv::Mat(1, 1, CV_8UC1, cv::Scalar(0));
+      case Fault::type: return cv::Mat(image.height_px, image.width_px, CV_16UC1, cv::Scalar(0));
+      case Fault::label: break;
     }
     cv::Mat labels(image.height_px, image.width_px, CV_8UC1, cv::Scalar(0));
     labels.at<unsigned char>(5, 7) = 7;  // row 5, column 7: not a class of a 3-class field
@@ -198,8 +195,8 @@ TEST_CASE("robustness: camera: NaN sensor width and infinite focal length") {
 }
 
 TEST_CASE("robustness: camera: image too large to simulate") {
-  CHECK_THROWS_WITH_AS(CameraModel({.image_width_px = 200000, .image_height_px = 150000}),
-                       Contains("too many pixels"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(CameraModel({.image_width_px = 200000, .image_height_px = 150000}), Contains("too many pixels"),
+                       std::invalid_argument);
 }
 
 TEST_CASE("robustness: timing: zero speed and negative acceleration") {
@@ -213,8 +210,7 @@ TEST_CASE("robustness: timing: zero speed and negative acceleration") {
 
 TEST_CASE("robustness: field: directory missing") {
   const t::TempDir dir;
-  CHECK_THROWS_WITH_AS(Field::load(dir.path() / "none"), Contains("field directory not found"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS(Field::load(dir.path() / "none"), Contains("field directory not found"), std::invalid_argument);
 }
 
 TEST_CASE("robustness: field: field.yaml missing") {
@@ -289,19 +285,22 @@ TEST_CASE("robustness: field: empty class list") {
 TEST_CASE("robustness: field: class colour out of range") {
   const t::TempDir dir;
   const auto f = make_field(dir.path(), replaced(weedmap_yaml(), "[0, 255, 0]", "[0, 256, 0]"));
-  CHECK_THROWS_WITH_AS(Field::load(f), Contains("'classes[1].color[1]' must be an integer in [0, 255] (got '256')"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(Field::load(f), Contains("'classes[1].color[1]' must be an integer in [0, 255] (got '256')"),
+                       std::invalid_argument);
 }
 
 TEST_CASE("robustness: field: class colour with two components") {
   const t::TempDir dir;
   const auto f = make_field(dir.path(), replaced(weedmap_yaml(), "[0, 255, 0]", "[0, 255]"));
-  CHECK_THROWS_WITH_AS(Field::load(f), Contains("'classes[1].color' must be a list of 3 integers"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(Field::load(f), Contains("'classes[1].color' must be a list of 3 integers"),
+                       std::invalid_argument);
 }
 
 TEST_CASE("robustness: field: duplicate class name") {
   const t::TempDir dir;
   const auto f = make_field(dir.path(), replaced(weedmap_yaml(), "{name: weed,", "{name: crop,"));
-  CHECK_THROWS_WITH_AS(Field::load(f), Contains("'classes[2].name': class name 'crop' listed twice"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(Field::load(f), Contains("'classes[2].name': class name 'crop' listed twice"),
+                       std::invalid_argument);
 }
 
 TEST_CASE("robustness: field: ignore_label is a class index") {
@@ -313,7 +312,8 @@ TEST_CASE("robustness: field: ignore_label is a class index") {
 TEST_CASE("robustness: field: ignore_label out of 0..255") {
   const t::TempDir dir;
   const auto f = make_field(dir.path(), replaced(weedmap_yaml(), "ignore_label: 255", "ignore_label: 300"));
-  CHECK_THROWS_WITH_AS(Field::load(f), Contains("'ignore_label' must be an integer in [0, 255] (got '300')"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(Field::load(f), Contains("'ignore_label' must be an integer in [0, 255] (got '300')"),
+                       std::invalid_argument);
 }
 
 TEST_CASE("robustness: field: label PNG missing") {
@@ -379,8 +379,7 @@ TEST_CASE("robustness: field: unknown label of interest asked by name") {
 
 TEST_CASE("robustness: field: region outside 0..1 or empty") {
   const Field f = weedmap_field();
-  CHECK_THROWS_WITH_AS((void)f.sub_field({0.5, 0.0, 0.4, 1.0}), Contains("region must satisfy"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)f.sub_field({0.5, 0.0, 0.4, 1.0}), Contains("region must satisfy"), std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)f.sub_field({0.0, 0.0, 1.0, kNaN}), Contains("region must satisfy"),
                        std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)f.sub_field({0.0, 0.0, 1e-4, 1.0}), Contains("region holds no pixel"),
@@ -529,7 +528,8 @@ TEST_CASE("robustness: ranked missions: class probabilities that break the contr
                                 "have one plane per class (3) (got 2)"),
                        std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)run_adaptive_mission(f, nan, never, o, "ranked"),
-                       Contains("probability nan of class 0 at pixel (x 7, y 5) is not in [0, 1]"), std::invalid_argument);
+                       Contains("probability nan of class 0 at pixel (x 7, y 5) is not in [0, 1]"),
+                       std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)run_adaptive_mission(f, sum, never, o, "ranked"),
                        Contains("sum to 1.5, not 1 (tolerance 0.001)"), std::invalid_argument);
   ProbabilityBreaker votes{ProbabilityBreaker::Fault::votes};
@@ -559,8 +559,8 @@ TEST_CASE("robustness: decision model: a broken cell gain model") {
   DecisionModel m = small_model();
   m.coverage = DescentCoverage::ranked;
   GainModel g = m.decision_function.model();
-  g.set_cells(CellGainModel(DecisionInput::expected_error,
-                            {{3.0, 1.0, 0.9, 0.01, 1.0, 0.01, 0.8, 0.02}, {3.0, 2.0, 0.3, 0.01, 0.9, 0.01, 0.2, 0.02}}));
+  g.set_cells(CellGainModel(DecisionInput::expected_error, {{3.0, 1.0, 0.9, 0.01, 1.0, 0.01, 0.8, 0.02},
+                                                            {3.0, 2.0, 0.3, 0.01, 0.9, 0.01, 0.2, 0.02}}));
   m.decision_function = DecisionFunction(UtilityPolicy(g, {}));
   m.save(dir.path() / "ranked.yaml");
   const std::string text = read_text(dir.path() / "ranked.yaml");
@@ -612,8 +612,8 @@ TEST_CASE("robustness: live planner: survey area without its class count") {
                        Contains("SurveyArea: num_classes must be the size of the backend's class set, 1..255"),
                        std::invalid_argument);
   area.num_classes = 1;  // interest is class 1 or 2 of the WeedMap crop: not a class any more
-  CHECK_THROWS_WITH_AS(AdaptivePlanner(area, oracle, never, o), Contains("a label of interest is not a class index 0..0"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS(AdaptivePlanner(area, oracle, never, o),
+                       Contains("a label of interest is not a class index 0..0"), std::invalid_argument);
 }
 
 TEST_CASE("robustness: adaptive: top GSD finer than the field") {
@@ -735,14 +735,15 @@ TEST_CASE("robustness: GP file: huge or false announced dimension") {
   // The rows are the data: a `dimension` key that disagrees with them is refused, whatever its
   // size (nothing is allocated from it), and beyond 1e6 it is out of range.
   CHECK_THROWS_WITH_AS(load_gp(replaced(gp_text(), "dimension: 1", "dimension: 1000000")),
-                       Contains("'dimension' is 1000000 but the rows of 'inputs' have 1 values"), std::invalid_argument);
+                       Contains("'dimension' is 1000000 but the rows of 'inputs' have 1 values"),
+                       std::invalid_argument);
   CHECK_THROWS_WITH_AS(load_gp(replaced(gp_text(), "dimension: 1", "dimension: 100000000")), Contains("dimension"),
                        std::invalid_argument);
   // An ARD kernel has as many length scales as inputs: an empty model of another dimension is
   // refused up front.
   std::ostringstream os;
-  save_gaussian_process(GaussianProcess<ArdSquaredExponentialKernel>(ArdSquaredExponentialKernel(Eigen::VectorXd::Ones(2))),
-                        os);
+  save_gaussian_process(
+      GaussianProcess<ArdSquaredExponentialKernel>(ArdSquaredExponentialKernel(Eigen::VectorXd::Ones(2))), os);
   std::istringstream is(replaced(os.str(), "dimension: 0", "dimension: 1000000"));
   CHECK_THROWS_WITH_AS((void)load_gaussian_process<ArdSquaredExponentialKernel>(is),
                        Contains("does not accept inputs of dimension 1000000"), std::invalid_argument);
@@ -818,8 +819,8 @@ TEST_CASE("robustness: decision model: a number that is none, or a GP whose data
   const auto eol = text.find('\n', y_mean);
   std::string bad = text;
   bad.replace(y_mean, eol - y_mean, "    y_mean: 0,25");
-  CHECK_THROWS_WITH_AS((void)load_model_text(dir, bad), Contains("'gain_model.O.y_mean' must be a finite number (got '0,25')"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, bad),
+                       Contains("'gain_model.O.y_mean' must be a finite number (got '0,25')"), std::invalid_argument);
   const auto targets = text.find("    targets: [");
   REQUIRE(targets != std::string::npos);
   bad = text;
@@ -838,9 +839,10 @@ TEST_CASE("robustness: decision model: from another class set") {
   const t::TempDir dir;
   const DecisionModel m = load_model_text(dir, model_text());
   const Field dubai = Field::load(t::example_field("dubai-tile-1"));
-  CHECK_THROWS_WITH_AS(m.check_compatible(dubai, dubai.interest()),
-                       Contains("decision model was calibrated for classes [soil, crop, weed] but field 'dubai-tile-1'"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS(
+      m.check_compatible(dubai, dubai.interest()),
+      Contains("decision model was calibrated for classes [soil, crop, weed] but field 'dubai-tile-1'"),
+      std::invalid_argument);
 }
 
 TEST_CASE("robustness: decision model: other labels of interest") {
@@ -890,7 +892,8 @@ TEST_CASE("robustness: decision model: refit count out of range") {
 TEST_CASE("robustness: decision model: unknown descent coverage") {
   const t::TempDir dir;
   const std::string text = replaced(model_text(), "descent_coverage: region", "descent_coverage: everywhere");
-  CHECK_THROWS_WITH_AS((void)load_model_text(dir, text), Contains("'region', 'interest' or 'ranked'"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, text), Contains("'region', 'interest' or 'ranked'"),
+                       std::invalid_argument);
 }
 
 TEST_CASE("robustness: decision model: I with three inputs") {
@@ -933,8 +936,8 @@ TEST_CASE("robustness: erfnet: ONNX file truncated") {
 TEST_CASE("robustness: erfnet: ONNX file empty") {
   const t::TempDir dir;
   t::write_file(dir.path() / "model.onnx", "");
-  CHECK_THROWS_WITH_AS(OnnxSegmenter(dir.path() / "model.onnx", erfnet_dir() / "model.yaml"),
-                       Contains("ONNX model"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(dir.path() / "model.onnx", erfnet_dir() / "model.yaml"), Contains("ONNX model"),
+                       std::invalid_argument);
 }
 
 TEST_CASE("robustness: erfnet: model for another class set") {

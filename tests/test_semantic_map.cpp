@@ -42,8 +42,8 @@ TEST_CASE("map: ignore pixels write nothing and parts outside the map are droppe
   labels.at<std::uint8_t>(0, 0) = 255;
   map.fuse(image_at({-2, -1, 4, 3}, 1.0), labels);  // shifted: only the lower-right 2x2 lands
   CHECK(cv::countNonZero(map.labels() == 1) == 4);
-  CHECK(map.labels().at<std::uint8_t>(0, 0) == 1);   // camera (1, 2) lands at map (0, 0)
-  CHECK(map.labels().at<std::uint8_t>(2, 3) == 255); // never observed
+  CHECK(map.labels().at<std::uint8_t>(0, 0) == 1);    // camera (1, 2) lands at map (0, 0)
+  CHECK(map.labels().at<std::uint8_t>(2, 3) == 255);  // never observed
   CHECK(std::isinf(map.gsd_cm().at<float>(2, 3)));
   CHECK_THROWS_AS(map.fuse(image_at({0, 0, 4, 3}, 1.0), cv::Mat(2, 2, CV_8UC1)), std::invalid_argument);
 }
@@ -124,8 +124,8 @@ TEST_CASE("map: a yaw that is not finite is refused") {
   SemanticMap map(cv::Size(8, 6));
   Image img = image_at({0, 0, 4, 3}, 1.0);
   img.yaw_deg = std::numeric_limits<double>::quiet_NaN();
-  CHECK_THROWS_WITH_AS(map.fuse(img, cv::Mat(3, 4, CV_8UC1, cv::Scalar(1))), doctest::Contains("yaw_deg must be finite"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS(map.fuse(img, cv::Mat(3, 4, CV_8UC1, cv::Scalar(1))),
+                       doctest::Contains("yaw_deg must be finite"), std::invalid_argument);
   CHECK(cv::countNonZero(map.labels() != 255) == 0);
 }
 
@@ -145,8 +145,9 @@ TEST_CASE("semantic map: fuse writes what resampling the labels onto the footpri
       img.ignore_label = 255;
       img.gsd_cm = rng.uniform(1, 5);
       const double ratio = rng.uniform(0.5, 3.5);
-      img.footprint_px = cv::Rect(rng.uniform(-20, size.width), rng.uniform(-20, size.height),
-                                  static_cast<int>(img.width_px * ratio) + 1, static_cast<int>(img.height_px * ratio) + 1);
+      img.footprint_px =
+          cv::Rect(rng.uniform(-20, size.width), rng.uniform(-20, size.height),
+                   static_cast<int>(img.width_px * ratio) + 1, static_cast<int>(img.height_px * ratio) + 1);
       cv::Mat labels(img.height_px, img.width_px, CV_8UC1);
       rng.fill(labels, cv::RNG::UNIFORM, 0, 4);
       labels.setTo(255, labels == 3);  // some ignored

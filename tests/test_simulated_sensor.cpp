@@ -91,7 +91,8 @@ TEST_CASE("sensor: outside the orthomosaic is ignore (labels) and black (RGB)") 
 TEST_CASE("sensor: RGB is area-averaged when flying higher") {
   cv::Mat rgb(720, 960, CV_8UC3);
   for (int r = 0; r < rgb.rows; ++r)
-    for (int c = 0; c < rgb.cols; ++c) rgb.at<cv::Vec3b>(r, c) = ((r + c) % 2) ? cv::Vec3b(255, 255, 255) : cv::Vec3b(0, 0, 0);
+    for (int c = 0; c < rgb.cols; ++c)
+      rgb.at<cv::Vec3b>(r, c) = ((r + c) % 2) ? cv::Vec3b(255, 255, 255) : cv::Vec3b(0, 0, 0);
   const Field f("checker", 1.0, cv::Mat(720, 960, CV_8UC1, cv::Scalar(0)), t::soil_crop_weed(), {1}, 255, rgb);
   const SimulatedSensor sensor(f, CameraModel{});
   const Image img = sensor.capture(LawnmowerPlanner(sensor.camera()).plan(f.area(), 2.0).front());

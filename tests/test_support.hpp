@@ -45,9 +45,7 @@ class TempDir {
   std::filesystem::path path_;
 };
 
-inline void write_file(const std::filesystem::path& p, const std::string& text) {
-  std::ofstream(p) << text;
-}
+inline void write_file(const std::filesystem::path& p, const std::string& text) { std::ofstream(p) << text; }
 
 inline std::string read_file(const std::filesystem::path& p) {
   std::ifstream in(p);

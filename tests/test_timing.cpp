@@ -11,7 +11,7 @@ using adaptseg::TimingModel;
 TEST_CASE("timing: velocity ramp below and above the cruise distance v^2/a") {
   const TimingModel t({.max_speed_mps = 2.0, .max_accel_mps2 = 2.0});  // v^2/a = 2 m
   CHECK(t.segment_time_s(0.0) == 0.0);
-  CHECK(t.segment_time_s(1.0) == doctest::Approx(2.0 * std::sqrt(0.5)));  // triangle profile
+  CHECK(t.segment_time_s(1.0) == doctest::Approx(2.0 * std::sqrt(0.5)));     // triangle profile
   CHECK(t.segment_time_s(10.0) == doctest::Approx(10.0 / 2.0 + 2.0 / 2.0));  // trapezoid
   // Continuous at the switch: 2 sqrt(d/a) = d/v + v/a = 2 v / a at d = v^2 / a.
   CHECK(t.segment_time_s(2.0 - 1e-12) == doctest::Approx(t.segment_time_s(2.0)));
@@ -37,8 +37,7 @@ TEST_CASE("timing: 3-D segments include altitude changes, and paths add segments
 }
 
 TEST_CASE("timing: invalid limits and distances are rejected") {
-  CHECK_THROWS_WITH_AS(TimingModel({.max_speed_mps = 0.0}), doctest::Contains("max_speed_mps"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS(TimingModel({.max_speed_mps = 0.0}), doctest::Contains("max_speed_mps"), std::invalid_argument);
   CHECK_THROWS_WITH_AS(TimingModel({.max_accel_mps2 = -1.0}), doctest::Contains("max_accel_mps2"),
                        std::invalid_argument);
   CHECK_THROWS_AS((void)TimingModel{}.segment_time_s(-0.1), std::invalid_argument);

@@ -41,10 +41,10 @@ struct CameraPose {
 
 /// One picture from a camera source.
 struct Shot {
-  std::string name;  ///< its file (or a label) for the console and result.json
-  cv::Mat rgb;       ///< CV_8UC3 of the camera model's size, or empty (no image: the oracle's labels only)
-  cv::Mat labels;    ///< ground-truth labels under the footprint at map resolution (the oracle's), or empty
-  CameraPose pose;   ///< where it was taken: what the planner fuses it at
+  std::string name;            ///< its file (or a label) for the console and result.json
+  cv::Mat rgb;                 ///< CV_8UC3 of the camera model's size, or empty (no image: the oracle's labels only)
+  cv::Mat labels;              ///< ground-truth labels under the footprint at map resolution (the oracle's), or empty
+  CameraPose pose;             ///< where it was taken: what the planner fuses it at
   std::filesystem::path file;  ///< the picture's file, where it is a new file (FolderCamera), else empty
 };
 
@@ -72,9 +72,12 @@ class CameraSource {
 inline cv::Mat fit_to_camera(cv::Mat rgb, const CameraParams& camera, const std::string& what) {
   if (rgb.empty()) return rgb;
   if (rgb.depth() != CV_8U)
-    throw std::invalid_argument(what + ": an 8-bit image is needed (got OpenCV depth " + std::to_string(rgb.depth()) + ")");
-  if (rgb.channels() == 1) cv::cvtColor(rgb, rgb, cv::COLOR_GRAY2BGR);
-  else if (rgb.channels() == 4) cv::cvtColor(rgb, rgb, cv::COLOR_BGRA2BGR);
+    throw std::invalid_argument(what + ": an 8-bit image is needed (got OpenCV depth " + std::to_string(rgb.depth()) +
+                                ")");
+  if (rgb.channels() == 1)
+    cv::cvtColor(rgb, rgb, cv::COLOR_GRAY2BGR);
+  else if (rgb.channels() == 4)
+    cv::cvtColor(rgb, rgb, cv::COLOR_BGRA2BGR);
   else if (rgb.channels() != 3)
     throw std::invalid_argument(what + ": 1, 3 or 4 channels expected (got " + std::to_string(rgb.channels()) + ")");
   const int w = camera.image_width_px, h = camera.image_height_px;
@@ -102,9 +105,10 @@ inline cv::Mat fit_to_camera(cv::Mat rgb, const CameraParams& camera, const std:
 inline void attach_labels(Image& image, cv::Mat labels, const std::string& what) {
   const cv::Size want = image.footprint_px.size(), got = labels.size();
   const bool near = std::abs(got.width - want.width) <= 2 && std::abs(got.height - want.height) <= 2;
-  const bool same_shape = !labels.empty() && want.area() > 0 &&
-                          std::abs(static_cast<double>(got.width) * want.height /
-                                       (static_cast<double>(got.height) * want.width) - 1.0) <= 0.02;
+  const bool same_shape =
+      !labels.empty() && want.area() > 0 &&
+      std::abs(static_cast<double>(got.width) * want.height / (static_cast<double>(got.height) * want.width) - 1.0) <=
+          0.02;
   if (labels.type() == CV_8UC1 && got != want && (near || same_shape))
     cv::resize(cv::Mat(labels), labels, want, 0, 0, cv::INTER_NEAREST);
   if (labels.type() != CV_8UC1 || labels.size() != want)
@@ -122,7 +126,11 @@ class RecordedCamera final : public CameraSource {
   /// `rgb`: read rgb/FILE (a network segments it); `labels`: read labels/FILE (the oracle's).
   RecordedCamera(std::filesystem::path dir, std::vector<PosedImage> images, double tolerance_m, bool rgb, bool labels,
                  CameraParams camera)
-      : dir_(std::move(dir)), images_(std::move(images)), tolerance_m_(tolerance_m), rgb_(rgb), labels_(labels),
+      : dir_(std::move(dir)),
+        images_(std::move(images)),
+        tolerance_m_(tolerance_m),
+        rgb_(rgb),
+        labels_(labels),
         camera_(camera) {}
 
   [[nodiscard]] std::string description() const override {
@@ -132,8 +140,9 @@ class RecordedCamera final : public CameraSource {
   Shot take(const CameraPose& at, const Idle&) override {
     const PosedImage& p = find_image(images_, at.position, tolerance_m_);
     Shot s{p.file, {}, {}, {p.pose, p.yaw_deg}, {}};
-    if (rgb_) s.rgb = fit_to_camera(read(dir_ / "rgb" / p.file, cv::IMREAD_COLOR, "camera image"), camera_,
-                                    (dir_ / "rgb" / p.file).string());
+    if (rgb_)
+      s.rgb = fit_to_camera(read(dir_ / "rgb" / p.file, cv::IMREAD_COLOR, "camera image"), camera_,
+                            (dir_ / "rgb" / p.file).string());
     if (labels_) s.labels = read(dir_ / "labels" / p.file, cv::IMREAD_UNCHANGED, "labels");
     return s;
   }
@@ -196,8 +205,8 @@ class FolderCamera final : public CameraSource {
         sizes[path] = size;
       }
       if (waited() >= timeout_s_)
-        throw std::invalid_argument("--camera-folder " + dir_.string() + ": no new image within " +
-                                    fmt(timeout_s_, 1) + " s of the trigger (--camera-timeout-s)");
+        throw std::invalid_argument("--camera-folder " + dir_.string() + ": no new image within " + fmt(timeout_s_, 1) +
+                                    " s of the trigger (--camera-timeout-s)");
       idle(0.1);
     }
   }
@@ -209,7 +218,8 @@ class FolderCamera final : public CameraSource {
     for (const auto& e : std::filesystem::directory_iterator(dir_, ec)) {
       if (!e.is_regular_file(ec)) continue;
       std::string ext = e.path().extension().string();
-      std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+      std::transform(ext.begin(), ext.end(), ext.begin(),
+                     [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
       if (ext == ".jpg" || ext == ".jpeg" || ext == ".png" || ext == ".tif" || ext == ".tiff")
         out[e.path()] = e.file_size(ec);
     }

@@ -144,10 +144,8 @@ struct CommonOptions {
     app.add_option("--vertical-speed", mission.timing.max_vertical_speed_mps,
                    "maximum climb and sink rate [m/s] (0: none, climbs as fast as level flight, the paper's model)")
         ->capture_default_str();
-    app.add_option("--seg-time-s", seg_time_s,
-                   "fixed segmentation time per image [s] (default: measured)");
-    app.add_option("--plan-time-s", plan_time_s,
-                   "fixed planning time per waypoint [s] (default: measured)");
+    app.add_option("--seg-time-s", seg_time_s, "fixed segmentation time per image [s] (default: measured)");
+    app.add_option("--plan-time-s", plan_time_s, "fixed planning time per waypoint [s] (default: measured)");
     app.add_option("--interest", interest_names,
                    "labels of interest, comma-separated (default: the field's 'interest')")
         ->delimiter(',');
@@ -180,8 +178,9 @@ struct CommonOptions {
     if (app.count("--camera") > 0 && (c.image_width_px != m.image_width_px || c.image_height_px != m.image_height_px ||
                                       c.sensor_width_mm != m.sensor_width_mm || c.focal_length_mm != m.focal_length_mm))
       throw std::invalid_argument("--camera " + camera_preset_name + " (" + std::to_string(c.image_width_px) + "x" +
-                                  std::to_string(c.image_height_px) + " px, " + fmt(c.sensor_width_mm, 2) + " mm sensor, " +
-                                  fmt(c.focal_length_mm, 2) + " mm focal) differs from the decision model's camera (" +
+                                  std::to_string(c.image_height_px) + " px, " + fmt(c.sensor_width_mm, 2) +
+                                  " mm sensor, " + fmt(c.focal_length_mm, 2) +
+                                  " mm focal) differs from the decision model's camera (" +
                                   std::to_string(m.image_width_px) + "x" + std::to_string(m.image_height_px) + " px, " +
                                   fmt(m.sensor_width_mm, 2) + " mm sensor, " + fmt(m.focal_length_mm, 2) +
                                   " mm focal): the model was calibrated for its camera");
@@ -215,8 +214,7 @@ struct CommonOptions {
     out.fixed_planning_time_s = plan_time_s;
     if (!interest_names.empty()) out.interest = field.class_indices(interest_names);
     if (out.interest.empty() && field.interest().empty())
-      throw std::invalid_argument("no labels of interest: field '" + field.name() +
-                                  "' names none; pass --interest");
+      throw std::invalid_argument("no labels of interest: field '" + field.name() + "' names none; pass --interest");
     return out;
   }
 };
@@ -361,8 +359,8 @@ inline nlohmann::json result_json(const Field& field, const MissionResult& r, co
     per_class[field.classes()[static_cast<std::size_t>(c)].name] = opt_json(r.confusion.iou(c));
   j["iou_per_class"] = per_class;
   j["images"] = r.waypoints.size();
-  j["time_s"] = {{"total", r.total_s()}, {"flight", r.flight_s}, {"segmentation", r.segmentation_s},
-                 {"planning", r.planning_s}};
+  j["time_s"] = {
+      {"total", r.total_s()}, {"flight", r.flight_s}, {"segmentation", r.segmentation_s}, {"planning", r.planning_s}};
   // Coverage: share of valid field pixels that received a label.
   const cv::Mat observed = (r.fused_labels != field.ignore_label()) & field.valid_mask();
   const int valid = field.valid_pixels();
@@ -412,9 +410,8 @@ inline nlohmann::json result_json(const Field& field, const MissionResult& r, co
       if (d.outcome) dj["observed_sigma_sub"] = d.outcome->sigma_sub;
       j["waypoints"][d.waypoint_index]["decision"] = dj;
     }
-    j["decisions"] = {{"descend", descend},
-                      {"continue", static_cast<int>(decisions->size()) - descend},
-                      {"budget_limited", limited}};
+    j["decisions"] = {
+        {"descend", descend}, {"continue", static_cast<int>(decisions->size()) - descend}, {"budget_limited", limited}};
   }
   const auto& cam = opt.camera;
   j["camera"] = {{"image_width_px", cam.image_width_px},

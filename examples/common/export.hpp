@@ -37,8 +37,7 @@ struct ExportCli {
                    "LAT,LON,ALT,HEADING: WGS84 position [deg] and ellipsoidal height [m] of the field "
                    "directory's frame origin, and the compass bearing [deg] of its +x axis; replaces "
                    "field.yaml's geo section");
-    app.add_option("--hold-s", file_options.hold_s, "hold time at every exported waypoint [s]")
-        ->capture_default_str();
+    app.add_option("--hold-s", file_options.hold_s, "hold time at every exported waypoint [s]")->capture_default_str();
     app.add_option("--max-altitude-m", file_options.max_altitude_m,
                    "the highest an exported waypoint may fly above home [m] (the usual legal ceiling); a mission "
                    "that would fly higher is refused before it flies, with the GSD it may fly at")
@@ -46,24 +45,22 @@ struct ExportCli {
         ->capture_default_str();
     app.add_option("--firmware", file_options.firmware_type,
                    "the autopilot of the exported .plan: px4 (default) or ardupilot")
-        ->transform(CLI::CheckedTransformer(std::map<std::string, int>{{"px4", mavlink::kAutopilotPx4},
-                                                                       {"ardupilot", mavlink::kAutopilotArduPilot}}));
+        ->transform(CLI::CheckedTransformer(
+            std::map<std::string, int>{{"px4", mavlink::kAutopilotPx4}, {"ardupilot", mavlink::kAutopilotArduPilot}}));
     app.add_flag("!--no-takeoff", file_options.takeoff,
                  "begin the exported mission without a take-off, for a UAV already airborne (default: a "
                  "take-off at home to the first waypoint's altitude)");
     app.add_option("--mission-end", file_options.end,
                    "after the last exported waypoint: rtl (return to launch, default), land (at home) or none")
-        ->transform(CLI::CheckedTransformer(std::map<std::string, MissionEnd>{{"rtl", MissionEnd::return_to_launch},
-                                                                             {"land", MissionEnd::land},
-                                                                             {"none", MissionEnd::none}}));
+        ->transform(CLI::CheckedTransformer(std::map<std::string, MissionEnd>{
+            {"rtl", MissionEnd::return_to_launch}, {"land", MissionEnd::land}, {"none", MissionEnd::none}}));
     app.add_option_function<CameraTrigger>(
            "--camera-trigger", [this](const CameraTrigger& t) { file_options.camera_trigger = t; },
            "the item after every exported waypoint that takes its image: capture (IMAGE_START_CAPTURE, as "
            "QGroundControl writes it) or digicam (DO_DIGICAM_CONTROL, as Mission Planner writes it); default: "
            "the firmware's own, capture for px4 and digicam for ardupilot")
-        ->transform(CLI::CheckedTransformer(
-            std::map<std::string, CameraTrigger>{{"capture", CameraTrigger::image_start_capture},
-                                                 {"digicam", CameraTrigger::digicam_control}}));
+        ->transform(CLI::CheckedTransformer(std::map<std::string, CameraTrigger>{
+            {"capture", CameraTrigger::image_start_capture}, {"digicam", CameraTrigger::digicam_control}}));
     app.add_option_function<std::size_t>(
            "--max-mission-items", [this](const std::size_t& n) { file_options.max_mission_items = n; },
            "the most mission items an exported file may hold (default: the firmware's, px4 500, ardupilot 717; "

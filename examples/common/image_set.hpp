@@ -88,8 +88,9 @@ inline double wrap_deg(double a) {
 inline void write_image_set(const std::filesystem::path& dir, const Field& field, const DecisionModel& model,
                             const std::vector<Waypoint>& waypoints, double yaw_deg, bool gnss) {
   if (gnss && !field.geo())
-    throw std::invalid_argument("--record-gnss needs the field's geo-reference (a geo: section, --geo-origin or a "
-                                "GeoTIFF field)");
+    throw std::invalid_argument(
+        "--record-gnss needs the field's geo-reference (a geo: section, --geo-origin or a "
+        "GeoTIFF field)");
   std::filesystem::create_directories(dir / "labels");
   if (field.has_image()) std::filesystem::create_directories(dir / "rgb");
   write_png(dir / "valid_mask.png", field.valid_mask());
@@ -98,15 +99,15 @@ inline void write_image_set(const std::filesystem::path& dir, const Field& field
   e << YAML::BeginMap << YAML::Key << "format" << YAML::Value << "adaptseg.image_set/1";
   e << YAML::Key << "name" << YAML::Value << field.name();
   const Area a = field.area();
-  e << YAML::Key << "area_m" << YAML::Value << YAML::Flow << std::vector<double>{a.x_min_m, a.y_min_m, a.x_max_m, a.y_max_m};
+  e << YAML::Key << "area_m" << YAML::Value << YAML::Flow
+    << std::vector<double>{a.x_min_m, a.y_min_m, a.x_max_m, a.y_max_m};
   e << YAML::Key << "map_gsd_cm" << YAML::Value << field.gsd_cm();
   e << YAML::Key << "valid_mask" << YAML::Value << "valid_mask.png";
   e << YAML::Key << "ignore_label" << YAML::Value << field.ignore_label();
   e << YAML::Key << "classes" << YAML::Value << YAML::BeginSeq;
   for (const auto& c : field.classes())
     e << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << c.name << YAML::Key << "color"
-      << YAML::Value << YAML::Flow << std::vector<int>{c.color_rgb[0], c.color_rgb[1], c.color_rgb[2]}
-      << YAML::EndMap;
+      << YAML::Value << YAML::Flow << std::vector<int>{c.color_rgb[0], c.color_rgb[1], c.color_rgb[2]} << YAML::EndMap;
   e << YAML::EndSeq;
   e << YAML::Key << "interest" << YAML::Value << YAML::Flow << model.interest;
   e << YAML::Key << "camera" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "image_width_px"
@@ -157,8 +158,9 @@ inline void write_image_set(const std::filesystem::path& dir, const Field& field
 inline ImageSetInfo read_image_set_info(const std::filesystem::path& dir, bool area_from_elsewhere = false) {
   const std::filesystem::path file = dir / "area.yaml";
   if (!std::filesystem::is_regular_file(file))
-    detail_image_set::fail(file, "not found (is --images a folder written by --record-from? docs/data_format.md, "
-                                 "\"The live image folder\")");
+    detail_image_set::fail(file,
+                           "not found (is --images a folder written by --record-from? docs/data_format.md, "
+                           "\"The live image folder\")");
   namespace d = adaptseg::detail;
   const d::YamlReader r(
       d::yaml_mapping(file.string(), "an image set description", [&] { return YAML::LoadFile(file.string()); }),
@@ -176,8 +178,10 @@ inline ImageSetInfo read_image_set_info(const std::filesystem::path& dir, bool a
   } else if (!area_from_elsewhere) {
     detail_image_set::fail(file, "missing key 'area_m' (or give the area as --area FILE)");
   }
-  if (r.has("map_gsd_cm")) info.area.map_gsd_cm = r.number("map_gsd_cm");
-  else if (!area_from_elsewhere) detail_image_set::fail(file, "missing key 'map_gsd_cm'");
+  if (r.has("map_gsd_cm"))
+    info.area.map_gsd_cm = r.number("map_gsd_cm");
+  else if (!area_from_elsewhere)
+    detail_image_set::fail(file, "missing key 'map_gsd_cm'");
   info.area.ignore_label = r.has("ignore_label") ? static_cast<int>(r.integer("ignore_label", 0, 255)) : 255;
   if (r.has("valid_mask") && !area_from_elsewhere) {
     const std::filesystem::path mask = dir / r.text("valid_mask");
@@ -213,14 +217,19 @@ inline std::vector<PosedImage> read_poses(const std::filesystem::path& dir, cons
   std::getline(is, line);
   if (!line.empty() && line.back() == '\r') line.pop_back();
   enum class Form { frame, wgs84, projected } form{};
-  if (line.rfind("file,x,y,z", 0) == 0) form = Form::frame;
-  else if (line.rfind("file,latitude_deg,longitude_deg,relative_altitude_m", 0) == 0) form = Form::wgs84;
-  else if (line.rfind("file,easting_m,northing_m,relative_altitude_m", 0) == 0) form = Form::projected;
-  else detail_image_set::fail(file, std::string("the header must be one of ") + kPoseHeaders);
+  if (line.rfind("file,x,y,z", 0) == 0)
+    form = Form::frame;
+  else if (line.rfind("file,latitude_deg,longitude_deg,relative_altitude_m", 0) == 0)
+    form = Form::wgs84;
+  else if (line.rfind("file,easting_m,northing_m,relative_altitude_m", 0) == 0)
+    form = Form::projected;
+  else
+    detail_image_set::fail(file, std::string("the header must be one of ") + kPoseHeaders);
   if (form == Form::frame && !frame_allowed)
-    detail_image_set::fail(file, "with --area the poses must be GNSS poses (file,latitude_deg,longitude_deg,"
-                                 "relative_altitude_m[,heading_deg] or easting/northing): frame metres belong to "
-                                 "area.yaml's frame, not the site's");
+    detail_image_set::fail(file,
+                           "with --area the poses must be GNSS poses (file,latitude_deg,longitude_deg,"
+                           "relative_altitude_m[,heading_deg] or easting/northing): frame metres belong to "
+                           "area.yaml's frame, not the site's");
   std::optional<GeoReference> geo;
   if (form != Form::frame) {
     if (!info.geo)
@@ -232,7 +241,8 @@ inline std::vector<PosedImage> read_poses(const std::filesystem::path& dir, cons
 #endif
   if (form == Form::projected) {
 #ifdef ADAPTSEG_HAVE_GDAL
-    if (info.crs.empty()) detail_image_set::fail(file, "easting/northing poses need crs: in area.yaml (e.g. EPSG:32640)");
+    if (info.crs.empty())
+      detail_image_set::fail(file, "easting/northing poses need crs: in area.yaml (e.g. EPSG:32640)");
     gdal::detail::register_drivers();
     OGRSpatialReference srs;
     if (srs.SetFromUserInput(info.crs.c_str()) != OGRERR_NONE)
@@ -276,11 +286,12 @@ inline std::vector<PosedImage> read_poses(const std::filesystem::path& dir, cons
         p.yaw_deg = cells == 5 ? detail_image_set::wrap_deg(info.geo->heading_deg - 90.0 - angle) : 0.0;
       }
     } catch (const std::exception&) {
-      detail_image_set::fail(file, "line " + std::to_string(n) + " is not " +
-                                       (form == Form::frame   ? "file,x,y,z[,yaw_deg]"
-                                        : form == Form::wgs84 ? "file,latitude_deg,longitude_deg,relative_altitude_m[,heading_deg]"
-                                                              : "file,easting_m,northing_m,relative_altitude_m[,heading_deg]") +
-                                       " (finite numbers): '" + line + "'");
+      detail_image_set::fail(
+          file, "line " + std::to_string(n) + " is not " +
+                    (form == Form::frame   ? "file,x,y,z[,yaw_deg]"
+                     : form == Form::wgs84 ? "file,latitude_deg,longitude_deg,relative_altitude_m[,heading_deg]"
+                                           : "file,easting_m,northing_m,relative_altitude_m[,heading_deg]") +
+                    " (finite numbers): '" + line + "'");
     }
     out.push_back(p);
   }

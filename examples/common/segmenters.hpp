@@ -30,9 +30,9 @@
 #include <memory>
 #include <optional>
 #include <span>
-#include <tuple>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -109,7 +109,7 @@ inline std::string network_name(const std::filesystem::path& model_file) {
 class AnyBackend {
  public:
   template <SegmentationBackend B>
-    requires SegmentsWithProbabilities<B>
+  requires SegmentsWithProbabilities<B>
   explicit AnyBackend(B& backend)
       : name_(backend.name()),
         segment_([&backend](const Image& image) { return backend.segment(image); }),
@@ -161,9 +161,8 @@ class CachedBackend {
   }
   [[nodiscard]] std::string name() const { return inner_.name(); }
   [[nodiscard]] cv::Mat segment(const Image& image) { return lookup(image, false).labels; }
-  [[nodiscard]] Segmentation segment_with_probabilities(const Image& image)
-    requires SegmentsWithProbabilities<Backend>
-  {
+  [[nodiscard]] Segmentation segment_with_probabilities(const Image& image) requires
+      SegmentsWithProbabilities<Backend> {
     return lookup(image, true);
   }
 
@@ -175,8 +174,16 @@ class CachedBackend {
   };
   static Key key_of(const Image& image) {
     const cv::Scalar sum = image.rgb.empty() ? cv::Scalar() : cv::sum(image.rgb);
-    return {image.footprint_px.x, image.footprint_px.y, image.footprint_px.width, image.footprint_px.height,
-            image.yaw_deg, image.width_px, image.height_px, sum[0], sum[1], sum[2]};
+    return {image.footprint_px.x,
+            image.footprint_px.y,
+            image.footprint_px.width,
+            image.footprint_px.height,
+            image.yaw_deg,
+            image.width_px,
+            image.height_px,
+            sum[0],
+            sum[1],
+            sum[2]};
   }
 
   static Segmentation copy(const Segmentation& s) {
@@ -257,7 +264,8 @@ class CachedBackend {
     tmp += ".tmp" + std::to_string(reinterpret_cast<std::uintptr_t>(this));
     {
       std::ofstream out(tmp, std::ios::binary);
-      const std::int32_t head[5] = {kMagic, s.labels.rows, s.labels.cols, static_cast<std::int32_t>(s.probabilities.size()),
+      const std::int32_t head[5] = {kMagic, s.labels.rows, s.labels.cols,
+                                    static_cast<std::int32_t>(s.probabilities.size()),
                                     static_cast<std::int32_t>(s.member_votes.size())};
       out.write(reinterpret_cast<const char*>(head), sizeof head);
       const cv::Mat labels = s.labels.isContinuous() ? s.labels : s.labels.clone();
@@ -310,11 +318,12 @@ struct SegmenterOptions {
                    "segmentation backend: oracle (ground truth, simulation only) or erfnet (needs --network)")
         ->check(CLI::IsMember({"oracle", "erfnet"}))
         ->capture_default_str();
-    CLI::Option* net = app.add_option("--network", network,
-                   "network of --segmenter erfnet (the ONNX backend): a directory with model.onnx + model.yaml, "
-                   "an .onnx file with its .yaml next to it (examples/models/erfnet-dubai, "
-                   "examples/models/mobilenetv2-dubai), or an ensemble directory with ensemble.yaml "
-                   "(examples/models/ensemble-dubai: the mean of its members' probabilities)");
+    CLI::Option* net =
+        app.add_option("--network", network,
+                       "network of --segmenter erfnet (the ONNX backend): a directory with model.onnx + model.yaml, "
+                       "an .onnx file with its .yaml next to it (examples/models/erfnet-dubai, "
+                       "examples/models/mobilenetv2-dubai), or an ensemble directory with ensemble.yaml "
+                       "(examples/models/ensemble-dubai: the mean of its members' probabilities)");
     accept_old_spelling(app, net, "--model-file", network);
     app.add_option("--threads", threads, "ERFNet: OpenCV threads (0: OpenCV's default; at most 256)")
         ->check(CLI::Range(0, 256))
@@ -328,12 +337,13 @@ struct SegmenterOptions {
   /// The calibrating programs' --calibration-network (cross-fitting), refused together with any
   /// of `excludes`.
   void add_calibration_networks_to(CLI::App& app, std::initializer_list<CLI::Option*> excludes = {}) {
-    CLI::Option* current = app.add_option("--calibration-network", calibration_networks,
-                   "ERFNet, calibration (repeatable): networks of --network's recipe for the training fields it "
-                   "was trained on (training.fields of its model.yaml), each such field segmented by the first of "
-                   "them that was not trained on it: a network knows its training fields so well that, calibrated "
-                   "there, the decision learns that flying lower gains little (cross-fitting; the missions fly "
-                   "--network)");
+    CLI::Option* current =
+        app.add_option("--calibration-network", calibration_networks,
+                       "ERFNet, calibration (repeatable): networks of --network's recipe for the training fields it "
+                       "was trained on (training.fields of its model.yaml), each such field segmented by the first of "
+                       "them that was not trained on it: a network knows its training fields so well that, calibrated "
+                       "there, the decision learns that flying lower gains little (cross-fitting; the missions fly "
+                       "--network)");
     accept_old_spelling(app, current, "--calibration-model-file", calibration_networks);
     for (CLI::Option* e : excludes) current->excludes(e);
   }
@@ -386,8 +396,7 @@ struct SegmenterOptions {
       while (j < pool.size() && knows(pool[j], field)) ++j;
       if (j == pool.size())
         throw std::invalid_argument("--calibration-network: every network given was trained on calibration field '" +
-                                    full + "' (as --network " + network.string() +
-                                    " was): give one that never saw it");
+                                    full + "' (as --network " + network.string() + " was): give one that never saw it");
       out[k] = calibration_networks[j];
     }
     return out;

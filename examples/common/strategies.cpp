@@ -22,13 +22,14 @@ StrategyRun run_strategy(const Field& field, AnyBackend& backend, const std::str
     if (!(gsd_cm > 0.0) || !std::isfinite(gsd_cm))
       throw std::invalid_argument("--gsd must be a finite positive GSD in cm/px (got " + fmt(gsd_cm, 3) + ")");
     if (gsd_cm < field.gsd_cm() * (1.0 - 1e-9))
-      throw std::invalid_argument("--gsd " + std::to_string(gsd_cm) + " cm/px is finer than field '" +
-                                  field.name() + "' (" + std::to_string(field.gsd_cm()) + " cm/px)");
+      throw std::invalid_argument("--gsd " + std::to_string(gsd_cm) + " cm/px is finer than field '" + field.name() +
+                                  "' (" + std::to_string(field.gsd_cm()) + " cm/px)");
     return {run_lawnmower_mission(field, gsd_cm, backend, options, overlap), std::nullopt};
   }
   if (overlap != LawnmowerOverlap{})
-    throw std::invalid_argument("--overlap applies to --strategy lawnmower only (the decision function's regions "
-                                "are the paper's non-overlapping top-level footprints)");
+    throw std::invalid_argument(
+        "--overlap applies to --strategy lawnmower only (the decision function's regions "
+        "are the paper's non-overlapping top-level footprints)");
   if (model == nullptr)
     throw std::invalid_argument("--strategy " + strategy + " needs --decision-model (from adaptseg_calibrate)");
   check_segmenter(*model, backend.name());
@@ -48,6 +49,5 @@ StrategyRun run_strategy(const Field& field, AnyBackend& backend, const std::str
   auto r = run_adaptive_mission(field, backend, df, ao, strategy);
   return {std::move(r.mission), std::move(r.decisions), std::move(r.realised)};
 }
-
 
 }  // namespace adaptseg::examples

@@ -15,8 +15,8 @@
 #include <filesystem>
 #include <locale>
 #include <optional>
-#include <stdexcept>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -37,7 +37,7 @@ enum class StrategyPolicy {
 /// and examples/tools/plot_evaluation.py (through the `strategies.csv` adaptseg_evaluate writes)
 /// read it.
 struct StrategyInfo {
-  std::string_view name;     ///< on the command line and in results.csv
+  std::string_view name;  ///< on the command line and in results.csv
   StrategyPolicy policy;
   DescentSchedule schedule;  ///< when the chosen descents are flown (not lawnmower)
   bool online;               ///< decision_function: learns in flight (DecisionFunction::set_online)
@@ -139,7 +139,8 @@ inline Field load_field_spec(const std::string& spec, const std::optional<FieldG
     const Field f = Field::load(dir);
 #endif
     if (geo && f.crs())
-      throw std::invalid_argument("field '" + f.name() + "' is georeferenced by its rasters; --geo-origin cannot replace that");
+      throw std::invalid_argument("field '" + f.name() +
+                                  "' is georeferenced by its rasters; --geo-origin cannot replace that");
     return geo ? f.with_geo(geo) : f;
   };
   // "DIR:tail" where the tail looks like numbers is a region (a malformed one is an error that
@@ -158,7 +159,8 @@ inline Field load_field_spec(const std::string& spec, const std::optional<FieldG
       }
       Field part = load(spec.substr(0, colon)).sub_field(region);
       if (part.valid_pixels() == 0)
-        throw std::invalid_argument("field '" + spec + "': the region has no valid pixel (all of it is the ignore label)");
+        throw std::invalid_argument("field '" + spec +
+                                    "': the region has no valid pixel (all of it is the ignore label)");
       return part;
     }
   }

@@ -66,8 +66,10 @@ inline std::vector<Eigen::Vector2d> grown_outline(const cv::Mat& mask, double gs
   cv::Mat m = mask > 0;
   const double scale = std::max(1.0, std::sqrt(static_cast<double>(mask.total()) / 4e6));
   if (scale > 1.0) {
-    cv::resize(m, m, cv::Size(std::max(1, static_cast<int>(mask.cols / scale)), std::max(1, static_cast<int>(mask.rows / scale))),
-               0, 0, cv::INTER_AREA);
+    cv::resize(
+        m, m,
+        cv::Size(std::max(1, static_cast<int>(mask.cols / scale)), std::max(1, static_cast<int>(mask.rows / scale))), 0,
+        0, cv::INTER_AREA);
     m = m > 0;  // any site in a cell: the cell is site
   }
   const double cell_x = width_m / m.cols, cell_y = height_m / m.rows;
@@ -81,14 +83,14 @@ inline std::vector<Eigen::Vector2d> grown_outline(const cv::Mat& mask, double gs
   std::vector<std::vector<cv::Point>> contours;
   cv::findContours(grown, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
   if (contours.size() != 1)
-    throw std::invalid_argument("the site is " + std::to_string(contours.size()) + " separate parts at --fence-margin-m " +
-                                fmt(margin_m, 1) + ": fly each as its own site, or grow the fence until they join");
+    throw std::invalid_argument("the site is " + std::to_string(contours.size()) +
+                                " separate parts at --fence-margin-m " + fmt(margin_m, 1) +
+                                ": fly each as its own site, or grow the fence until they join");
   std::vector<cv::Point> poly;
   cv::approxPolyDP(contours.front(), poly, 1.0, true);  // within the extra cell
   if (poly.size() < 3) poly = contours.front();
   std::vector<Eigen::Vector2d> ring;
-  for (const cv::Point& p : poly)
-    ring.emplace_back((p.x - pad + 0.5) * cell_x, height_m - (p.y - pad + 0.5) * cell_y);
+  for (const cv::Point& p : poly) ring.emplace_back((p.x - pad + 0.5) * cell_x, height_m - (p.y - pad + 0.5) * cell_y);
   return ring;
 }
 
@@ -118,8 +120,10 @@ inline Fence make_fence(const Area& area, const cv::Mat& site_mask, double map_g
     ring = detail_vehicle::grown_outline(site_mask, map_gsd_cm, margin_m);
   } else {
     const double m = margin_m;
-    ring = {{area.x_min_m - m, area.y_min_m - m}, {area.x_max_m + m, area.y_min_m - m},
-            {area.x_max_m + m, area.y_max_m + m}, {area.x_min_m - m, area.y_max_m + m}};
+    ring = {{area.x_min_m - m, area.y_min_m - m},
+            {area.x_max_m + m, area.y_min_m - m},
+            {area.x_max_m + m, area.y_max_m + m},
+            {area.x_min_m - m, area.y_max_m + m}};
   }
   std::vector<mavlink::LatLon> polygon;
   for (const Eigen::Vector2d& p : ring) {
@@ -166,10 +170,10 @@ inline void check_fence(const Fence& fence, const std::vector<Waypoint>& waypoin
 
 /// What the vehicle loop needs to be told.
 struct VehicleSettings {
-  std::string connection;           ///< --mavlink
+  std::string connection;            ///< --mavlink
   mavlink::ArrivalCriteria arrival;  ///< the tolerance and the settled speed
-  bool trigger = true;              ///< command the autopilot's camera at each waypoint
-  mavlink::LinkOptions link;        ///< timeouts
+  bool trigger = true;               ///< command the autopilot's camera at each waypoint
+  mavlink::LinkOptions link;         ///< timeouts
 };
 
 /// The vehicle flown over MAVLink: connect, fly to each waypoint, trigger, measure, and at the

@@ -40,12 +40,12 @@ struct Cell {
   std::string cls;
   std::size_t region = 0;
   double gsd_cm = 0.0;
-  CellInputs top;           ///< decision inputs of the top-level image over the cell
-  CellInputs fine;          ///< the same quantities from the finer image over the cell
+  CellInputs top;            ///< decision inputs of the top-level image over the cell
+  CellInputs fine;           ///< the same quantities from the finer image over the cell
   double field_share = 0.0;  ///< the cell's field pixels / the field's
   double field_sigma = 0.0;  ///< σ of the class over the field's top-level map
-  double relabelled = 0.0;  ///< share of the cell's field pixels relabelled with the class involved
-  double gain = 0.0;        ///< field IoU of the class with this cell re-mapped, minus without
+  double relabelled = 0.0;   ///< share of the cell's field pixels relabelled with the class involved
+  double gain = 0.0;         ///< field IoU of the class with this cell re-mapped, minus without
 };
 
 /// Ranks of `v` (average ranks for ties), 1-based.
@@ -113,9 +113,11 @@ std::vector<Cell> study_field(const Field& field, Backend& backend, const Camera
     const cv::Mat field_px = field.valid_mask()(region);
     std::vector<std::vector<cv::Mat>> top_planes;  // per class
     for (int c : classes)
-      top_planes.push_back(planes_on_grid(images[t], pixel_inputs(segs[t], std::vector<int>{c}, field.ignore_label()), region));
+      top_planes.push_back(
+          planes_on_grid(images[t], pixel_inputs(segs[t], std::vector<int>{c}, field.ignore_label()), region));
     for (double g : gsds) {
-      const auto sub = planner.plan(tops[t].footprint, g, Eigen::Vector2d(tops[t].position.x(), tops[t].position.y()), keep);
+      const auto sub =
+          planner.plan(tops[t].footprint, g, Eigen::Vector2d(tops[t].position.x(), tops[t].position.y()), keep);
       for (const auto& w : sub) {
         const Image img = sensor.capture(w);
         const Segmentation fine = segment_with_probabilities_checked(backend, img, n);
@@ -174,15 +176,19 @@ int main(int argc, char** argv) {
   adaptseg::examples::CommonOptions common;
   adaptseg::examples::SegmenterOptions segmenter;
   app.add_option("--field", field_specs, "field DIR[:x0,y0,x1,y1]; repeatable")->required();
-  app.add_option("--classes", class_names, "classes to study, each alone as L, comma-separated (default: the field's interest)")
+  app.add_option("--classes", class_names,
+                 "classes to study, each alone as L, comma-separated (default: the field's interest)")
       ->delimiter(',');
   app.add_option("--top-gsd", top_gsd, "top-level GSD [cm/px]")->capture_default_str();
-  app.add_option("--gsd", gsds, "candidate GSDs of the cells [cm/px], comma-separated")->delimiter(',')->capture_default_str();
+  app.add_option("--gsd", gsds, "candidate GSDs of the cells [cm/px], comma-separated")
+      ->delimiter(',')
+      ->capture_default_str();
   app.add_option("--csv", csv_path, "write every cell to this CSV file");
   std::filesystem::path decision_model;
-  CLI::Option* model_opt = app.add_option("--decision-model", decision_model,
-                 "a decision model calibrated with --coverage ranked: its input is the planner's ranking, summarised "
-                 "on its own line");
+  CLI::Option* model_opt = app.add_option(
+      "--decision-model", decision_model,
+      "a decision model calibrated with --coverage ranked: its input is the planner's ranking, summarised "
+      "on its own line");
   adaptseg::examples::accept_old_spelling(app, model_opt, "--model", decision_model);
   common.add_to(app);
   segmenter.add_to(app);
@@ -192,20 +198,21 @@ int main(int argc, char** argv) {
     if (!decision_model.empty()) {
       const DecisionModel model = DecisionModel::load(decision_model);
       if (!model.decision_function.model().cells())
-        throw std::invalid_argument("--decision-model " + decision_model.string() + " has no cell gain model (calibrate with --coverage ranked)");
+        throw std::invalid_argument("--decision-model " + decision_model.string() +
+                                    " has no cell gain model (calibrate with --coverage ranked)");
       planner_input = model.decision_function.model().cells()->input();
     }
     std::vector<Cell> cells;
     for (const auto& spec : field_specs) {
       const Field field = adaptseg::examples::load_field_spec(spec);
       std::vector<int> classes = class_names.empty() ? field.interest() : field.class_indices(class_names);
-      if (classes.empty()) throw std::invalid_argument("field '" + field.name() + "' names no class of interest: pass --classes");
+      if (classes.empty())
+        throw std::invalid_argument("field '" + field.name() + "' names no class of interest: pass --classes");
       const MissionOptions mo = common.resolve(field);
       const CameraModel camera(mo.camera);
       std::fprintf(stderr, "adaptseg_cell_study: %s ...\n", field.name().c_str());
-      auto part = segmenter.with_backend(field, mo.camera, [&](auto& backend) {
-        return study_field(field, backend, camera, top_gsd, gsds, classes);
-      });
+      auto part = segmenter.with_backend(
+          field, mo.camera, [&](auto& backend) { return study_field(field, backend, camera, top_gsd, gsds, classes); });
       cells.insert(cells.end(), part.begin(), part.end());
     }
     if (!csv_path.empty()) {
@@ -214,8 +221,8 @@ int main(int argc, char** argv) {
       adaptseg::examples::write_input_columns_header(os);
       os << '\n';
       for (const Cell& c : cells) {
-        os << adaptseg::examples::csv_field(c.field) << ',' << c.cls << ',' << c.region << ',' << c.gsd_cm << ',' << c.top.field_px << ','
-           << c.field_share << ',' << c.field_sigma << ',' << c.relabelled << ',' << c.gain;
+        os << adaptseg::examples::csv_field(c.field) << ',' << c.cls << ',' << c.region << ',' << c.gsd_cm << ','
+           << c.top.field_px << ',' << c.field_share << ',' << c.field_sigma << ',' << c.relabelled << ',' << c.gain;
         adaptseg::examples::write_input_columns(os, c.top, c.fine);
         os << '\n';
       }
@@ -250,7 +257,8 @@ int main(int argc, char** argv) {
       double positive = 0.0, total = 0.0;
       for (double x : gain) positive += std::max(0.0, x), total += x;
       std::printf("| %s | %s | %.1f | %zu | %.4f | %.2f | %.2f |", f.c_str(), cls.c_str(), g, gain.size(), positive,
-                  positive > 0.0 ? top_gain(gain, gain, 0.2) / positive : NAN, positive > 0.0 ? 0.2 * total / positive : NAN);
+                  positive > 0.0 ? top_gain(gain, gain, 0.2) / positive : NAN,
+                  positive > 0.0 ? 0.2 * total / positive : NAN);
       for (std::size_t k = 0; k < kDecisionInputCount; ++k) {
         // An input the backend cannot give (e.g. the members' split of a single network) ranks
         // nothing: unknown, not the order the cells happen to come in.
@@ -258,7 +266,8 @@ int main(int argc, char** argv) {
         const double c10 = known[k] && positive > 0.0 ? top_gain(mass[k], gain, 0.1) / positive : NAN;
         const double c20 = known[k] && positive > 0.0 ? top_gain(mass[k], gain, 0.2) / positive : NAN;
         std::printf(" %+.2f / %.2f / %.2f |", rho, c10, c20);
-        if (std::isfinite(rho) && std::isfinite(c20)) rho_sum[k] += rho, c10_sum[k] += c10, c20_sum[k] += c20, ++counted[k];
+        if (std::isfinite(rho) && std::isfinite(c20))
+          rho_sum[k] += rho, c10_sum[k] += c10, c20_sum[k] += c20, ++counted[k];
       }
       if (positive > 0.0) best_sum += top_gain(gain, gain, 0.2) / positive, random_sum += 0.2 * total / positive;
       std::printf("\n");
@@ -272,11 +281,12 @@ int main(int argc, char** argv) {
     std::printf("\n");
     if (planner_input) {
       const std::size_t k = index_of(*planner_input);
-      std::printf("\nthe planner's ranking (%s, from %s): mean capture of the achievable positive gain %.2f at 10 %% "
-                  "and %.2f at 20 %% of the cells (best possible at 20 %%: %.2f; random: %.2f)\n",
-                  to_string(*planner_input).c_str(), decision_model.string().c_str(),
-                  counted[k] ? c10_sum[k] / counted[k] : NAN, counted[k] ? c20_sum[k] / counted[k] : NAN,
-                  n > 0 ? best_sum / n : NAN, n > 0 ? random_sum / n : NAN);
+      std::printf(
+          "\nthe planner's ranking (%s, from %s): mean capture of the achievable positive gain %.2f at 10 %% "
+          "and %.2f at 20 %% of the cells (best possible at 20 %%: %.2f; random: %.2f)\n",
+          to_string(*planner_input).c_str(), decision_model.string().c_str(),
+          counted[k] ? c10_sum[k] / counted[k] : NAN, counted[k] ? c20_sum[k] / counted[k] : NAN,
+          n > 0 ? best_sum / n : NAN, n > 0 ? random_sum / n : NAN);
     }
     return 0;
   } catch (const std::exception& e) {

@@ -158,7 +158,8 @@ int main(int argc, char** argv) {
   segmenter.add_to(app);
   if (const auto code = adaptseg::examples::parse_command_line(app, argc, argv)) return *code;
   try {
-    if (segmenter.name != "erfnet") throw std::invalid_argument("--segmenter must be erfnet: the oracle needs no temperature");
+    if (segmenter.name != "erfnet")
+      throw std::invalid_argument("--segmenter must be erfnet: the oracle needs no temperature");
     if (set) {
       if (!field_spec.empty() || write || at)
         throw std::invalid_argument("--set writes a given temperature: no --field, --write or --at with it");
@@ -186,7 +187,7 @@ int main(int argc, char** argv) {
       Pixels px;
       px.classes = field.num_classes();
       const auto plan = LawnmowerPlanner(camera).plan(field.area(), f * field.gsd_cm(), {0.0, 0.0},
-                                                       [&](const Area& a) { return field.has_valid(a); });
+                                                      [&](const Area& a) { return field.has_valid(a); });
       for (const Waypoint& w : plan) {
         const Image img = sensor.capture(w);
         const std::vector<cv::Mat> logits = net.logits(img);
@@ -204,7 +205,8 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "band %.2f cm/px: %zu images, %zu pixels\n", f * field.gsd_cm(), plan.size(), px.size());
       per_band.push_back(std::move(px));
     }
-    if (at && write) throw std::invalid_argument("--at evaluates a given temperature; it cannot be combined with --write");
+    if (at && write)
+      throw std::invalid_argument("--at evaluates a given temperature; it cannot be combined with --write");
     // T: the best of a logarithmic grid over [0.25, 8], refined by golden section.
     double best = 1.0, best_nll = nll(per_band, 1.0);
     for (double t = 0.25; !at && t <= 8.0001; t *= 1.1) {
@@ -225,8 +227,8 @@ int main(int argc, char** argv) {
                 at ? "evaluated at" : "temperature", t, nll(per_band, 1.0), nll(per_band, t), t, temperature_was);
     std::printf("| GSD [cm/px] | pixels | ECE at T = 1 | ECE at T = %.2f |\n| ---: | ---: | ---: | ---: |\n", t);
     for (std::size_t b = 0; b < per_band.size(); ++b)
-      std::printf("| %.1f | %zu | %.4f | %.4f |\n", bands[b] * field.gsd_cm(), per_band[b].size(), ece(per_band[b], 1.0),
-                  ece(per_band[b], t));
+      std::printf("| %.1f | %zu | %.4f | %.4f |\n", bands[b] * field.gsd_cm(), per_band[b].size(),
+                  ece(per_band[b], 1.0), ece(per_band[b], t));
     if (write) write_temperature(segmenter.network, t);
     return 0;
   } catch (const std::exception& e) {

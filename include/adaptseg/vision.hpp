@@ -18,8 +18,8 @@
 #include <adaptseg/vision/field.hpp>
 #include <adaptseg/vision/front_aware_rule.hpp>
 #include <adaptseg/vision/gp_io.hpp>
-#include <adaptseg/vision/image.hpp>
 #include <adaptseg/vision/grid_inputs.hpp>
+#include <adaptseg/vision/image.hpp>
 #include <adaptseg/vision/image_summary.hpp>
 #include <adaptseg/vision/metrics.hpp>
 #include <adaptseg/vision/mission.hpp>

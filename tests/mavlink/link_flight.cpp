@@ -71,29 +71,46 @@ Args parse(int argc, char** argv) {
     const std::string flag = argv[i];
     if (i + 1 >= argc) throw std::invalid_argument(flag + " needs a value");
     const char* value = argv[++i];
-    if (flag == "--connect") a.connect = value;
-    else if (flag == "--port-file") a.port_file = value;
+    if (flag == "--connect")
+      a.connect = value;
+    else if (flag == "--port-file")
+      a.port_file = value;
     else if (flag == "--home") {
       const std::string s = value;
       const auto comma = s.find(',');
       if (comma == std::string::npos) throw std::invalid_argument("--home needs LAT,LON");
       a.home_lat = number(flag, s.substr(0, comma).c_str());
       a.home_lon = number(flag, s.substr(comma + 1).c_str());
-    } else if (flag == "--waypoints") a.waypoints = static_cast<int>(number(flag, value));
-    else if (flag == "--radius-m") a.radius_m = number(flag, value);
-    else if (flag == "--alt-m") a.alt_m = number(flag, value);
-    else if (flag == "--tolerance-m") a.tolerance_m = number(flag, value);
-    else if (flag == "--stall-s") a.stall_s = number(flag, value);
-    else if (flag == "--site-m") a.site_m = number(flag, value);
-    else if (flag == "--ceiling-m") a.ceiling_m = number(flag, value);
-    else if (flag == "--outside-after") a.outside_after = static_cast<int>(number(flag, value));
-    else if (flag == "--land-timeout-s") a.land_timeout_s = number(flag, value);
-    else if (flag == "--link-timeout-s") a.link.link_timeout_s = number(flag, value);
-    else if (flag == "--fix-timeout-s") a.link.fix_timeout_s = number(flag, value);
-    else if (flag == "--ack-timeout-s") a.link.ack_timeout_s = number(flag, value);
-    else if (flag == "--attempts") a.link.command_attempts = static_cast<int>(number(flag, value));
-    else if (flag == "--mode-timeout-s") a.link.mode_timeout_s = number(flag, value);
-    else throw std::invalid_argument("unknown option " + flag);
+    } else if (flag == "--waypoints")
+      a.waypoints = static_cast<int>(number(flag, value));
+    else if (flag == "--radius-m")
+      a.radius_m = number(flag, value);
+    else if (flag == "--alt-m")
+      a.alt_m = number(flag, value);
+    else if (flag == "--tolerance-m")
+      a.tolerance_m = number(flag, value);
+    else if (flag == "--stall-s")
+      a.stall_s = number(flag, value);
+    else if (flag == "--site-m")
+      a.site_m = number(flag, value);
+    else if (flag == "--ceiling-m")
+      a.ceiling_m = number(flag, value);
+    else if (flag == "--outside-after")
+      a.outside_after = static_cast<int>(number(flag, value));
+    else if (flag == "--land-timeout-s")
+      a.land_timeout_s = number(flag, value);
+    else if (flag == "--link-timeout-s")
+      a.link.link_timeout_s = number(flag, value);
+    else if (flag == "--fix-timeout-s")
+      a.link.fix_timeout_s = number(flag, value);
+    else if (flag == "--ack-timeout-s")
+      a.link.ack_timeout_s = number(flag, value);
+    else if (flag == "--attempts")
+      a.link.command_attempts = static_cast<int>(number(flag, value));
+    else if (flag == "--mode-timeout-s")
+      a.link.mode_timeout_s = number(flag, value);
+    else
+      throw std::invalid_argument("unknown option " + flag);
   }
   if (a.connect.empty()) throw std::invalid_argument("--connect SPEC is required");
   return a;
@@ -138,9 +155,9 @@ int main(int argc, char** argv) {
     for (int k = 0; k < args.waypoints; ++k) {
       const double angle = 2.0 * std::numbers::pi * k / args.waypoints;
       const double alt = args.alt_m + (k % 2 == 1 ? 5.0 : 0.0);
-      targets.push_back(k == args.outside_after ? offset(args, 3.0 * s, 0.0, alt)
-                                                : offset(args, args.radius_m * std::cos(angle),
-                                                         args.radius_m * std::sin(angle), alt));
+      targets.push_back(k == args.outside_after
+                            ? offset(args, 3.0 * s, 0.0, alt)
+                            : offset(args, args.radius_m * std::cos(angle), args.radius_m * std::sin(angle), alt));
     }
 
     mv::VehicleLink link(std::move(transport), site, args.link);
@@ -148,10 +165,8 @@ int main(int argc, char** argv) {
     std::cout << "connected: " << mv::to_string(v.firmware()) << " system " << int{v.system_id} << ", "
               << (v.armed() ? "armed" : "disarmed") << ", mode " << v.mode() << ", at "
               << mv::to_string(link.position().lat_lon_alt()) << '\n';
-    const mv::ArrivalCriteria criteria{.horizontal_m = args.tolerance_m,
-                                       .vertical_m = args.tolerance_m,
-                                       .timeout_s = 60.0,
-                                       .stall_s = args.stall_s};
+    const mv::ArrivalCriteria criteria{
+        .horizontal_m = args.tolerance_m, .vertical_m = args.tolerance_m, .timeout_s = 60.0, .stall_s = args.stall_s};
     for (const mv::LatLonAlt& target : targets) {
       link.go_to(target);
       const mv::Arrival arrival = link.wait_arrival(target, criteria);

@@ -77,8 +77,8 @@ int check(const std::string& file) {
   const std::uint64_t rejected = s.crc_errors + s.unknown_ids + s.incompatible_flags + s.dropped_bytes;
   if (frames.size() != lines.size() || rejected != 0) {
     problem(file + ": " + std::to_string(lines.size()) + " frames written, " + std::to_string(frames.size()) +
-            " accepted (checksum errors " + std::to_string(s.crc_errors) + ", unknown ids " + std::to_string(s.unknown_ids) + ", dropped bytes " +
-            std::to_string(s.dropped_bytes) + ")");
+            " accepted (checksum errors " + std::to_string(s.crc_errors) + ", unknown ids " +
+            std::to_string(s.unknown_ids) + ", dropped bytes " + std::to_string(s.dropped_bytes) + ")");
   }
   int identical = 0, zero_payload = 0, signed_frames = 0, v1_frames = 0;
   for (std::size_t i = 0; i < std::min(frames.size(), lines.size()); ++i) {

@@ -16,10 +16,10 @@ struct Extent {
 
 /// Camera parameters; validated by CameraModel's constructor.
 struct CameraParams {
-  int image_width_px = 480;       ///< I_w [px]
-  int image_height_px = 360;      ///< I_h [px]
-  double sensor_width_mm = 4.8;   ///< S_w [mm]
-  double focal_length_mm = 5.5;   ///< f [mm]
+  int image_width_px = 480;      ///< I_w [px]
+  int image_height_px = 360;     ///< I_h [px]
+  double sensor_width_mm = 4.8;  ///< S_w [mm]
+  double focal_length_mm = 5.5;  ///< f [mm]
 };
 
 /// A camera looking straight down (docs/method.md, "Decisions where the paper is silent, and
@@ -43,10 +43,8 @@ class CameraModel {
   /// @throws std::invalid_argument if a value is not finite and positive, or the image has
   ///         more than kMaxImagePixels pixels.
   explicit CameraModel(Params params = {}) : params_(params) {
-    detail::require(params_.image_width_px > 0, "CameraModel: image_width_px must be > 0",
-                    params_.image_width_px);
-    detail::require(params_.image_height_px > 0, "CameraModel: image_height_px must be > 0",
-                    params_.image_height_px);
+    detail::require(params_.image_width_px > 0, "CameraModel: image_width_px must be > 0", params_.image_width_px);
+    detail::require(params_.image_height_px > 0, "CameraModel: image_height_px must be > 0", params_.image_height_px);
     detail::require(static_cast<long long>(params_.image_width_px) * params_.image_height_px <= kMaxImagePixels,
                     "CameraModel: the image has too many pixels (image_width_px x image_height_px must be "
                     "<= 2^28)",
@@ -63,16 +61,14 @@ class CameraModel {
   /// @throws std::invalid_argument if the altitude is not finite and positive.
   [[nodiscard]] double gsd_cm(double altitude_m) const {
     detail::require_positive(altitude_m, "CameraModel::gsd_cm: altitude_m");
-    return 100.0 * altitude_m * params_.sensor_width_mm /
-           (params_.focal_length_mm * params_.image_width_px);
+    return 100.0 * altitude_m * params_.sensor_width_mm / (params_.focal_length_mm * params_.image_width_px);
   }
 
   /// Altitude [m] that gives `gsd_cm` [cm/px]; the inverse of gsd_cm().
   /// @throws std::invalid_argument if the GSD is not finite and positive.
   [[nodiscard]] double altitude_m(double gsd_cm) const {
     detail::require_positive(gsd_cm, "CameraModel::altitude_m: gsd_cm");
-    return gsd_cm * params_.focal_length_mm * params_.image_width_px /
-           (100.0 * params_.sensor_width_mm);
+    return gsd_cm * params_.focal_length_mm * params_.image_width_px / (100.0 * params_.sensor_width_mm);
   }
 
   /// Ground footprint at a GSD [cm/px].
@@ -84,9 +80,7 @@ class CameraModel {
 
   /// Ground footprint at an altitude [m].
   /// @throws std::invalid_argument if the altitude is not finite and positive.
-  [[nodiscard]] Extent footprint(double altitude_m) const {
-    return footprint_at_gsd(gsd_cm(altitude_m));
-  }
+  [[nodiscard]] Extent footprint(double altitude_m) const { return footprint_at_gsd(gsd_cm(altitude_m)); }
 
  private:
   Params params_;

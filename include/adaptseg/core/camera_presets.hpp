@@ -33,7 +33,8 @@ inline constexpr std::array<CameraPreset, 5> kCameraPresets{{
     {"default", "the library's default camera (CameraParams{}), which every bundled model is calibrated for",
      CameraParams{480, 360, 4.8, 5.5}, "CameraParams's defaults; no product of its own"},
     {"micasense-rededge-mx", "MicaSense RedEdge-MX, one band (1280 x 960)", CameraParams{1280, 960, 4.8, 5.4},
-     "MicaSense RedEdge-MX integration guide and specifications: 1280 x 960 px, 4.8 x 3.6 mm imager, 5.4 mm focal length"},
+     "MicaSense RedEdge-MX integration guide and specifications: 1280 x 960 px, 4.8 x 3.6 mm imager, 5.4 mm focal "
+     "length"},
     {"dji-phantom4-rtk", "DJI Phantom 4 RTK (FC6310R, 1-inch sensor, 8.8 mm lens; 3:2 photos)",
      CameraParams{5472, 3648, 13.2, 8.8},
      "dji.com/phantom-4-rtk/info (Camera: 1\" CMOS, lens 8.8 mm / 24 mm equivalent, image size 5472 x 3648 at 3:2); "

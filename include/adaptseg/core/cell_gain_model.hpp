@@ -50,16 +50,16 @@ enum class SlopePooling { cells, fields };
 /// One cell of a top-level region, re-mapped alone from a lower altitude on a training field
 /// (calibration knows the truth): a row of the cell gain model.
 struct CellSample {
-  std::size_t field = 0;      ///< which calibration field it comes from (index)
-  std::size_t region = 0;     ///< its region (top-level waypoint index) on that field
-  double top_gsd_cm = 0.0;    ///< the GSD of the top-level image that saw it [cm/px]
-  double sub_gsd_cm = 0.0;    ///< the GSD it was re-mapped at [cm/px]
-  CellInputs top;             ///< the cell as the top-level image saw it
+  std::size_t field = 0;    ///< which calibration field it comes from (index)
+  std::size_t region = 0;   ///< its region (top-level waypoint index) on that field
+  double top_gsd_cm = 0.0;  ///< the GSD of the top-level image that saw it [cm/px]
+  double sub_gsd_cm = 0.0;  ///< the GSD it was re-mapped at [cm/px]
+  CellInputs top;           ///< the cell as the top-level image saw it
   /// The same quantities from the finer image over the cell (NaN values where unknown): what a
   /// descent shows in flight about how much surer the finer look is.
   CellInputs fine;
-  double field_share = 0.0;   ///< the cell's field pixels / the field's
-  double field_sigma = 0.0;   ///< σ of the field's top-level map (share of L over its field pixels)
+  double field_share = 0.0;  ///< the cell's field pixels / the field's
+  double field_sigma = 0.0;  ///< σ of the field's top-level map (share of L over its field pixels)
   /// Share of the cell's field pixels whose label the re-mapping changed with L involved
   /// (observable in flight: no truth needed).
   double relabelled = 0.0;
@@ -130,12 +130,12 @@ class CellGainModel {
 
   /// A forecast for a set of cells, in shares of the region's field pixels.
   struct Forecast {
-    double gain = 0.0;            ///< normalised gain (× region share / field σ = field gain)
+    double gain = 0.0;  ///< normalised gain (× region share / field σ = field gain)
     double gain_var = 0.0;
-    double relabelled = 0.0;      ///< relabelled share of the region with L involved
+    double relabelled = 0.0;  ///< relabelled share of the region with L involved
     double relabelled_var = 0.0;
-    double input = 0.0;           ///< Σ w_c·x_c: the cells' input, what the finer look is compared with
-    double proxy_var = 0.0;       ///< κ_p·Σ w_c²·x_c: the spread of the scene check's measurement
+    double input = 0.0;      ///< Σ w_c·x_c: the cells' input, what the finer look is compared with
+    double proxy_var = 0.0;  ///< κ_p·Σ w_c²·x_c: the spread of the scene check's measurement
   };
 
   /// @throws std::invalid_argument for no point, GSDs that are not finite and positive with the
@@ -152,7 +152,8 @@ class CellGainModel {
                       p.sub_gsd_cm);
       detail::require(k == 0 || p.top_gsd_cm > points_[k - 1].top_gsd_cm ||
                           (p.top_gsd_cm == points_[k - 1].top_gsd_cm && p.sub_gsd_cm > points_[k - 1].sub_gsd_cm),
-                      "CellGainModel: points must be in increasing (top, descent) GSD order; descent GSD", p.sub_gsd_cm);
+                      "CellGainModel: points must be in increasing (top, descent) GSD order; descent GSD",
+                      p.sub_gsd_cm);
       detail::require(std::isfinite(p.gain_slope) && std::isfinite(p.relabel_slope) && std::isfinite(p.gain_noise) &&
                           std::isfinite(p.relabel_noise) && p.gain_noise >= 0.0 && p.relabel_noise >= 0.0 &&
                           std::isfinite(p.proxy_slope) && std::isfinite(p.proxy_noise) && p.proxy_noise >= 0.0 &&
@@ -178,7 +179,9 @@ class CellGainModel {
                           std::isfinite(s.field_share) && std::isfinite(s.field_sigma),
                       "CellGainModel::fit: samples must be finite; field gain", s.field_gain);
       std::size_t k = 0;
-      while (k < groups.size() && !(detail::same_gsd(groups[k].top, s.top_gsd_cm) && detail::same_gsd(groups[k].sub, s.sub_gsd_cm))) ++k;
+      while (k < groups.size() &&
+             !(detail::same_gsd(groups[k].top, s.top_gsd_cm) && detail::same_gsd(groups[k].sub, s.sub_gsd_cm)))
+        ++k;
       if (k == groups.size()) groups.push_back(Group{s.top_gsd_cm, s.sub_gsd_cm, {}});
       groups[k].cells.push_back(&s);
     }
@@ -246,8 +249,8 @@ class CellGainModel {
       sx += w * x_of(c);
       sxx += w * w * x_of(c);
     }
-    return {p.gain_slope * sx, p.gain_noise * sxx, std::max(0.0, p.relabel_slope * sx), p.relabel_noise * sxx,
-            sx, p.proxy_noise * sxx};
+    return {p.gain_slope * sx,  p.gain_noise * sxx, std::max(0.0, p.relabel_slope * sx), p.relabel_noise * sxx, sx,
+            p.proxy_noise * sxx};
   }
 
   /// The scene check's estimate of a descent's normalised gain (in shares of its region) from

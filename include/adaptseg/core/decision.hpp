@@ -33,11 +33,11 @@ struct Relabelling {
 struct RegionSample {
   double top_gsd_cm = 0.0;
   double sub_gsd_cm = 0.0;
-  double delta_h_m = 0.0;    ///< Δh = h_max − h' [m]
-  double sigma_top = 0.0;    ///< σ_{h_max}
-  double sigma_sub = 0.0;    ///< σ_{h'} (fused sub-lawnmower images over the region)
-  double miou_top = 0.0;     ///< mIoU_{h_max} over L on the region
-  double miou_sub = 0.0;     ///< mIoU_{h'} over L on the region
+  double delta_h_m = 0.0;  ///< Δh = h_max − h' [m]
+  double sigma_top = 0.0;  ///< σ_{h_max}
+  double sigma_sub = 0.0;  ///< σ_{h'} (fused sub-lawnmower images over the region)
+  double miou_top = 0.0;   ///< mIoU_{h_max} over L on the region
+  double miou_sub = 0.0;   ///< mIoU_{h'} over L on the region
   /// What the descent changed in the region's map (a row of C; observable in flight).
   Relabelling relabelled{};
   // The sample in field terms (calibration knows the whole field's top-level map and truth):
@@ -46,7 +46,7 @@ struct RegionSample {
   /// Field mIoU over L of the top-level map with this region re-mapped, minus without: what
   /// this descent alone adds to a top-level lawnmower's result.
   double field_gain = 0.0;
-  std::size_t field = 0;      ///< which calibration field it comes from (index)
+  std::size_t field = 0;  ///< which calibration field it comes from (index)
   /// The field gain per unit of region share and per unit of the field's σ:
   /// field_gain · field_sigma / region_share (≈ the share of the region's pixels corrected).
   [[nodiscard]] double normalized_field_gain() const noexcept {
@@ -79,15 +79,15 @@ struct LawnmowerForecast {
 
 /// The situation at a top-level waypoint, after its image has been segmented.
 struct DecisionContext {
-  double sigma = 0.0;             ///< semantic ratio σ of the current image (paper Eq. `eq:vr`)
-  double valid_fraction = 1.0;    ///< share of the image's ground inside the field (0..1]
-  double top_gsd_cm = 0.0;        ///< GSD at h_max [cm/px]
-  double top_altitude_m = 0.0;    ///< h_max [m]
+  double sigma = 0.0;                     ///< semantic ratio σ of the current image (paper Eq. `eq:vr`)
+  double valid_fraction = 1.0;            ///< share of the image's ground inside the field (0..1]
+  double top_gsd_cm = 0.0;                ///< GSD at h_max [cm/px]
+  double top_altitude_m = 0.0;            ///< h_max [m]
   std::span<const Candidate> candidates;  ///< affordable lower altitudes (may be empty)
   // The mission so far and ahead (used by front-aware policies; the paper's rule ignores it).
-  double elapsed_s = 0.0;         ///< mission time so far, this image included [s]
-  double rest_s = 0.0;            ///< time to finish the top-level coverage from here without descending [s]
-  double region_share = 0.0;      ///< the region's ground inside the field / the field's (0..1]
+  double elapsed_s = 0.0;     ///< mission time so far, this image included [s]
+  double rest_s = 0.0;        ///< time to finish the top-level coverage from here without descending [s]
+  double region_share = 0.0;  ///< the region's ground inside the field / the field's (0..1]
   /// The region's field pixels on the map grid (Candidate::cells' pixels are shares of it).
   double region_px = 0.0;
   /// DescentCoverage::ranked: the ranking decision input's value over the region's field pixels,
@@ -99,10 +99,10 @@ struct DecisionContext {
 /// A policy's assessment of one candidate.
 struct CandidateScore {
   double gsd_cm = 0.0;
-  double predicted_delta_sigma = 0.0;  ///< μ_O: σ_{h_max} − σ_{h'}
-  double predicted_delta_miou = 0.0;   ///< μ_I(μ_O): mIoU_{h_max} − mIoU_{h'} (< 0: lower is better)
+  double predicted_delta_sigma = 0.0;     ///< μ_O: σ_{h_max} − σ_{h'}
+  double predicted_delta_miou = 0.0;      ///< μ_I(μ_O): mIoU_{h_max} − mIoU_{h'} (< 0: lower is better)
   double predicted_delta_miou_std = 0.0;  ///< predictive standard deviation of the latter
-  double utility = 0.0;                ///< gain per second of extra time
+  double utility = 0.0;                   ///< gain per second of extra time
   /// The policy's forecast of the descent's gain in field mIoU over L (NaN where the policy
   /// makes none; see FrontAwarePolicy).
   double predicted_field_gain = std::numeric_limits<double>::quiet_NaN();
@@ -117,7 +117,7 @@ struct CandidateScore {
 /// The outcome of a decision: continue (`descend == false`) or re-map the region from `gsd_cm`.
 struct Decision {
   bool descend = false;
-  double gsd_cm = 0.0;                 ///< chosen GSD when descending
+  double gsd_cm = 0.0;  ///< chosen GSD when descending
   /// The chosen candidate's index in the context's order, where several share a GSD
   /// (DescentCoverage::ranked: one candidate per number of cells). A policy that leaves it at 0
   /// names its candidate by `gsd_cm` alone: the first candidate of that GSD (chosen_candidate()).

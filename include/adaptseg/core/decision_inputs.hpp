@@ -35,7 +35,7 @@ enum class DecisionInput : int {
   second_choice,   ///< Σ_{C ∈ L} 1[C is the second most likely class and p_C > 0.2]
   low_confidence,  ///< 1[max_C p_C < 0.6]: generic hesitation, blind to L
   entropy,         ///< −Σ_C p_C ln p_C / ln(classes): generic, blind to L
-  split,           ///< Σ_{C ∈ L} 1[0 < v_C < 1], v_C the members' vote share for C: an ensemble's members split on a class of L (beyond the paper)
+  split,           ///< Σ_{C ∈ L} 1[0 < v_C < 1], v_C the members' vote share: members split on L (beyond the paper)
 };
 
 /// One row of the table of inputs.
@@ -117,8 +117,8 @@ inline void pixel_input_rows(std::size_t n, const Label* labels, std::span<const
   const std::size_t classes = probabilities.size();
   const bool with_entropy = want(DecisionInput::entropy);
   const bool ranked = want(DecisionInput::second_choice) || want(DecisionInput::low_confidence);
-  const bool from_probabilities = classes > 0 && (want(DecisionInput::ambiguity) || want(DecisionInput::expected_error) ||
-                                                  ranked || with_entropy);
+  const bool from_probabilities =
+      classes > 0 && (want(DecisionInput::ambiguity) || want(DecisionInput::expected_error) || ranked || with_entropy);
   for (std::size_t x0 = 0; x0 < n; x0 += kChunk) {
     const std::size_t m = std::min(kChunk, n - x0);
     const Label* l = labels + x0;

@@ -53,8 +53,8 @@ enum class TopLevelChoice { undominated, hull };
 
 /// A training field's fixed-altitude lawnmower curve by GSD: the front-aware rule's yardstick.
 struct ReferenceCurve {
-  std::string field;              ///< the training field's name
-  std::vector<GsdPoint> points;   ///< field mIoU over L by lawnmower GSD
+  std::string field;             ///< the training field's name
+  std::vector<GsdPoint> points;  ///< field mIoU over L by lawnmower GSD
   /// σ of the field's top-level map (its share of L as the UAV sees it); 0: unknown. The mean
   /// over the reference curves is the prior of a new field's σ.
   double field_sigma = 0.0;
@@ -126,12 +126,12 @@ class FrontAwarePolicy {
  public:
   /// Behaviour; validated by the constructor.
   struct Params {
-    double min_sigma = 0.0;         ///< σ below which the UAV never descends
-    bool online = true;             ///< field correction and O's update (false: non-adaptive)
-    double confidence = 0.0;        ///< z >= 0 of the lower bound (see class comment)
-    double scale_prior_sd = 0.5;    ///< ω > 0, prior spread of the field factor s
+    double min_sigma = 0.0;            ///< σ below which the UAV never descends
+    bool online = true;                ///< field correction and O's update (false: non-adaptive)
+    double confidence = 0.0;           ///< z >= 0 of the lower bound (see class comment)
+    double scale_prior_sd = 0.5;       ///< ω > 0, prior spread of the field factor s
     double sigma_prior_weight = 0.25;  ///< k > 0: weight of the training fields' σ in σ̂ [fields]
-    double sigma_prior_sd = 0.0;    ///< τ >= 0: spread of a field's σ about the training fields' mean
+    double sigma_prior_sd = 0.0;       ///< τ >= 0: spread of a field's σ about the training fields' mean
     /// With a cell gain model: the lawnmower curve a descent is compared with is predicted for
     /// this field by the same model (what re-mapping the whole field at each lawnmower GSD would
     /// gain, from the field's mean input estimated from its top-level images so far) instead of
@@ -186,8 +186,7 @@ class FrontAwarePolicy {
                         "FrontAwarePolicy: reference curve '" + r.field + "' needs GSD > 0 and finite mIoU; GSD",
                         p.gsd_cm);
       detail::require(std::isfinite(r.field_sigma) && r.field_sigma >= 0.0 && r.field_sigma <= 1.0,
-                      "FrontAwarePolicy: reference curve '" + r.field + "' needs field_sigma in [0, 1]",
-                      r.field_sigma);
+                      "FrontAwarePolicy: reference curve '" + r.field + "' needs field_sigma in [0, 1]", r.field_sigma);
       if (r.field_sigma > 0.0) {
         prior_sigma_ += r.field_sigma / static_cast<double>(reference_.size());
         ++with_sigma;
@@ -198,10 +197,9 @@ class FrontAwarePolicy {
       detail::require(std::isfinite(r.field_input) && r.field_input >= 0.0,
                       "FrontAwarePolicy: reference curve '" + r.field + "' needs field_input >= 0", r.field_input);
       for (const auto& [g, x] : r.top_inputs)
-        detail::require(std::isfinite(g) && g > 0.0 && std::isfinite(x) && x >= 0.0,
-                        "FrontAwarePolicy: reference curve '" + r.field +
-                            "' needs top_inputs of GSD > 0 and input >= 0; GSD",
-                        g);
+        detail::require(
+            std::isfinite(g) && g > 0.0 && std::isfinite(x) && x >= 0.0,
+            "FrontAwarePolicy: reference curve '" + r.field + "' needs top_inputs of GSD > 0 and input >= 0; GSD", g);
     }
     begin_mission();
   }
@@ -372,7 +370,8 @@ class FrontAwarePolicy {
       for (const auto& r : reference_) {
         double worst = 0.0;
         for (const auto& l : lawnmowers)
-          if (l.time_s <= time_of(g)) worst = std::max(worst, miou_at_gsd(r.points, l.gsd_cm) - miou_at_gsd(r.points, g));
+          if (l.time_s <= time_of(g))
+            worst = std::max(worst, miou_at_gsd(r.points, l.gsd_cm) - miou_at_gsd(r.points, g));
         sum += worst;
       }
       return sum / static_cast<double>(reference_.size());
@@ -391,7 +390,8 @@ class FrontAwarePolicy {
       const double rate_to = t1 > t0 ? rise / (t1 - t0) : (rise > 0.0 ? std::numeric_limits<double>::infinity() : rise);
       double rate_on = 0.0;
       for (const auto& l : lawnmowers)
-        if (l.gsd_cm < g && l.time_s > t1) rate_on = std::max(rate_on, (predicted(l.gsd_cm) - predicted(g)) / (l.time_s - t1));
+        if (l.gsd_cm < g && l.time_s > t1)
+          rate_on = std::max(rate_on, (predicted(l.gsd_cm) - predicted(g)) / (l.time_s - t1));
       if (!(rate_to > rate_on)) break;
       best = g;
     }
@@ -466,7 +466,7 @@ class FrontAwarePolicy {
     const double unseen = std::max(0.0, 1.0 - seen_input_share_);
     double prior_input = 0.0;  // the training fields' mean input at this top level (0: unknown)
     for (const auto& r : reference_) prior_input += r.input_at(c.top_gsd_cm) / static_cast<double>(reference_.size());
-    const double rest = prior_input > 0.0 ? (seen_input_ + k * prior_input) / (seen_input_share_ + k)
+    const double rest = prior_input > 0.0         ? (seen_input_ + k * prior_input) / (seen_input_share_ + k)
                         : seen_input_share_ > 0.0 ? seen_input_ / seen_input_share_
                                                   : 0.0;
     return seen_input_ + unseen * rest;
@@ -551,9 +551,9 @@ class FrontAwarePolicy {
   GainModel model_;
   std::vector<ReferenceCurve> reference_;
   Params params_;
-  double prior_sigma_ = 0.0;        ///< mean σ of the training fields (0: unknown)
+  double prior_sigma_ = 0.0;  ///< mean σ of the training fields (0: unknown)
   // Per mission (reset by begin_mission):
-  double sigma_sum_ = 0.0;          ///< σ of the top-level images so far
+  double sigma_sum_ = 0.0;  ///< σ of the top-level images so far
   std::size_t sigma_count_ = 0;
   double seen_share_ = 0.0;         ///< field share of the top-level regions seen so far
   double seen_interest_ = 0.0;      ///< ... and Σ share · σ over them

@@ -27,9 +27,9 @@ namespace adaptseg {
 
 /// Forecasts of one descent (one region, one lower altitude).
 struct GainForecast {
-  double delta_sigma = 0.0;      ///< μ_O: σ_{h_max} − σ_{h'}
-  double delta_miou = 0.0;       ///< μ_I: mIoU_{h_max} − mIoU_{h'} over L on the region (< 0: lower is better)
-  double delta_miou_std = 0.0;   ///< I's predictive standard deviation
+  double delta_sigma = 0.0;     ///< μ_O: σ_{h_max} − σ_{h'}
+  double delta_miou = 0.0;      ///< μ_I: mIoU_{h_max} − mIoU_{h'} over L on the region (< 0: lower is better)
+  double delta_miou_std = 0.0;  ///< I's predictive standard deviation
   /// μ_C: share of the region's field pixels whose label will change with L involved
   /// (Relabelling::interest_share); NaN for a model without C.
   double relabelled = std::numeric_limits<double>::quiet_NaN();
@@ -108,8 +108,8 @@ class GainModel {
   /// How `fit` fits the regressions.
   struct FitOptions {
     GainInputs gain_inputs = GainInputs::delta_sigma_and_height;
-    int restarts = 3;         ///< deterministic hyperparameter restarts per GP, >= 0
-    std::uint64_t seed = 0;   ///< of the restarts
+    int restarts = 3;        ///< deterministic hyperparameter restarts per GP, >= 0
+    std::uint64_t seed = 0;  ///< of the restarts
   };
 
   /// η at one descent height.
@@ -123,7 +123,10 @@ class GainModel {
   ///         η >= 0, heights strictly increasing).
   GainModel(Gp o, Gp i, std::optional<Gp> c = std::nullopt, std::vector<EfficiencyPoint> efficiency = {},
             int refit_every = 0)
-      : o_(std::move(o)), i_(std::move(i)), c_(std::move(c)), efficiency_(std::move(efficiency)),
+      : o_(std::move(o)),
+        i_(std::move(i)),
+        c_(std::move(c)),
+        efficiency_(std::move(efficiency)),
         refit_every_(refit_every) {
     detail::require(!c_ || !efficiency_.empty(), "GainModel: C needs efficiency points; count", efficiency_.size());
     for (std::size_t k = 0; k < efficiency_.size(); ++k)
@@ -139,8 +142,7 @@ class GainModel {
                     "GainModel: I must hold data with 1 input (delta_sigma) or 2 (delta_sigma, delta_h); dimension",
                     i_.dimension());
     detail::require(!c_ || (c_->size() > 0 && c_->dimension() == 2),
-                    "GainModel: C must hold data with 2 inputs (delta_h, sigma); dimension",
-                    c_ ? c_->dimension() : 0);
+                    "GainModel: C must hold data with 2 inputs (delta_h, sigma); dimension", c_ ? c_->dimension() : 0);
     detail::require(refit_every_ >= 0, "GainModel: refit_every must be >= 0", refit_every_);
   }
 
@@ -295,8 +297,7 @@ class GainModel {
     b.signal_variance = {1e-4, 1e2};
     b.noise_variance = {1e-8, 1e1};
     const auto start = [&](Eigen::Index d) { return std::max(spread(x.col(d)), min_length_scale); };
-    return Gp(ArdSquaredExponentialKernel(Eigen::Vector2d(start(0), start(1)), 1.0, 0.1, b),
-              {.normalize_y = true});
+    return Gp(ArdSquaredExponentialKernel(Eigen::Vector2d(start(0), start(1)), 1.0, 0.1, b), {.normalize_y = true});
   }
 
   Gp o_;

@@ -99,8 +99,7 @@ class GaussianProcess {
   using CovariancePrediction = GpCovariancePrediction;
 
   /// @throws std::invalid_argument if `options` is invalid (message names the field).
-  explicit GaussianProcess(K kernel, const Options& options = {})
-      : kernel_(std::move(kernel)), options_(options) {
+  explicit GaussianProcess(K kernel, const Options& options = {}) : kernel_(std::move(kernel)), options_(options) {
     options_.validate();
   }
 
@@ -155,9 +154,9 @@ class GaussianProcess {
 
   /// Adds one observation in O(n^2) (one triangular solve) by extending the Cholesky factor;
   /// hyperparameters and normalisation stay as they are. Afterwards `predict_mean` costs an
-  /// extra O(n^2) per call until the next `fit`/`refit`/`condition`/`set_kernel`. If the extended factor is not positive definite
-  /// (a nearly repeated input with tiny noise), falls back to an O(n^3) refactorisation with
-  /// jitter retries.
+  /// extra O(n^2) per call until the next `fit`/`refit`/`condition`/`set_kernel`. If the extended factor is not
+  /// positive definite (a nearly repeated input with tiny noise), falls back to an O(n^3) refactorisation with jitter
+  /// retries.
   /// @param x input of dimension D (the data's, or any the kernel accepts if there is none).
   /// @param y target [output units].
   /// @throws std::invalid_argument on non-finite values or a wrong dimension; NumericalError.
@@ -290,8 +289,8 @@ class GaussianProcess {
   /// Posterior mean and full covariance K(X*,X*) - K(X*,X) K_XX^-1 K(X,X*) (eq:gp), plus
   /// sn2 I for `kNoisy`; original units. O(m^2 n + m n^2) time, m^2 memory.
   /// @throws std::invalid_argument on a wrong dimension or non-finite input.
-  [[nodiscard]] CovariancePrediction predict_covariance(
-      const Eigen::Ref<const Eigen::MatrixXd>& xq, PredictiveVariance kind = PredictiveVariance::kLatent) const {
+  [[nodiscard]] CovariancePrediction predict_covariance(const Eigen::Ref<const Eigen::MatrixXd>& xq,
+                                                        PredictiveVariance kind = PredictiveVariance::kLatent) const {
     check_query(xq);
     const detail::GpScopedFlushSubnormals flush;
     CovariancePrediction out{Eigen::VectorXd::Zero(xq.rows()), kernel_.cross_covariance(xq, xq)};
@@ -322,7 +321,8 @@ class GaussianProcess {
   /// O(n^3); the model is not changed.
   /// @throws std::invalid_argument on a wrong-size or non-finite theta, or no data;
   ///         NumericalError if K_XX cannot be factorised even with jitter.
-  [[nodiscard]] double log_marginal_likelihood(const Eigen::VectorXd& theta, Eigen::VectorXd* gradient = nullptr) const {
+  [[nodiscard]] double log_marginal_likelihood(const Eigen::VectorXd& theta,
+                                               Eigen::VectorXd* gradient = nullptr) const {
     detail::require(n_ > 0, "GaussianProcess::log_marginal_likelihood: number of training samples must be > 0", n_);
     K kernel = kernel_;
     kernel.set_log_parameters(theta);
@@ -353,9 +353,9 @@ class GaussianProcess {
 
   /// Everything that defines a fitted model: what a file format stores to restore it exactly.
   struct State {
-    K kernel;                 ///< hyperparameters and their bounds
+    K kernel;  ///< hyperparameters and their bounds
     Options options;
-    double y_mean = 0.0;      ///< frozen target normalisation (0 and 1 without normalize_y)
+    double y_mean = 0.0;  ///< frozen target normalisation (0 and 1 without normalize_y)
     double y_std = 1.0;
     Eigen::MatrixXd inputs;   ///< n x D training inputs (online additions included)
     Eigen::VectorXd targets;  ///< n training targets [output units]
@@ -371,8 +371,8 @@ class GaussianProcess {
   ///         y_mean that is not finite, inputs and targets of different lengths, non-finite
   ///         data, or a dimension the kernel does not accept; NumericalError.
   [[nodiscard]] static GaussianProcess from_state(State s) {
-    detail::require(std::isfinite(s.y_std) && s.y_std > 0.0, "GaussianProcess::from_state: y_std must be finite and > 0",
-                    s.y_std);
+    detail::require(std::isfinite(s.y_std) && s.y_std > 0.0,
+                    "GaussianProcess::from_state: y_std must be finite and > 0", s.y_std);
     detail::require_finite(s.y_mean, "GaussianProcess::from_state: y_mean");
     GaussianProcess gp(std::move(s.kernel), s.options);
     gp.y_mean_ = s.y_mean;
@@ -388,7 +388,8 @@ class GaussianProcess {
   }
 
  private:
-  void check_training_data(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y) const {
+  void check_training_data(const Eigen::Ref<const Eigen::MatrixXd>& x,
+                           const Eigen::Ref<const Eigen::VectorXd>& y) const {
     detail::require(x.rows() >= 1, "GaussianProcess: number of training samples (rows of x) must be >= 1", x.rows());
     detail::require(kernel_.accepts_dimension(x.cols()),
                     "GaussianProcess: kernel does not accept the input dimension (columns of x)", x.cols());

@@ -87,8 +87,8 @@ concept RestorableKernel = requires(const Eigen::VectorXd& v) {
 /// - `K::from_log_parameters(theta, lower, upper)` rebuilds an equal kernel.
 /// - Const members are safe to call concurrently; kernels own their parameters by value.
 template <typename K>
-concept Kernel = std::copyable<K> && LogParameterized<K> && LatentCovariance<K> &&
-                 ObservationNoise<K> && ContractedGradient<K> && RestorableKernel<K>;
+concept Kernel = std::copyable<K> && LogParameterized<K> && LatentCovariance<K> && ObservationNoise<K> &&
+    ContractedGradient<K> && RestorableKernel<K>;
 
 // ============================================================================================
 // Squared-exponential kernel
@@ -116,9 +116,8 @@ enum class LengthScales { kIsotropic, kPerDimension };
 template <LengthScales Mode>
 class SquaredExponential {
  public:
-  static constexpr std::string_view kName = Mode == LengthScales::kIsotropic
-                                                ? "squared_exponential_isotropic"
-                                                : "squared_exponential_ard";
+  static constexpr std::string_view kName =
+      Mode == LengthScales::kIsotropic ? "squared_exponential_isotropic" : "squared_exponential_ard";
 
   /// Bounds for the optimiser, natural units; the length-scale bounds apply to every l_d.
   struct Bounds {
@@ -133,11 +132,9 @@ class SquaredExponential {
   /// @param noise_variance sn2 [output units^2], finite > 0.
   /// @param bounds optimiser bounds; each `0 < lower < upper < inf`.
   /// @throws std::invalid_argument naming the offending parameter.
-  explicit SquaredExponential(double length_scale = 1.0, double signal_variance = 1.0,
-                              double noise_variance = 1.0, const Bounds& bounds = {})
-    requires(Mode == LengthScales::kIsotropic)
-      : SquaredExponential(Eigen::VectorXd::Constant(1, length_scale), signal_variance,
-                           noise_variance, bounds, 0) {}
+  explicit SquaredExponential(double length_scale = 1.0, double signal_variance = 1.0, double noise_variance = 1.0,
+                              const Bounds& bounds = {}) requires(Mode == LengthScales::kIsotropic)
+      : SquaredExponential(Eigen::VectorXd::Constant(1, length_scale), signal_variance, noise_variance, bounds, 0) {}
 
   /// ARD kernel for inputs of dimension `length_scales.size()`.
   /// @param length_scales l_d [input units], each finite > 0, at least one.
@@ -146,8 +143,8 @@ class SquaredExponential {
   /// @param bounds optimiser bounds; each `0 < lower < upper < inf`.
   /// @throws std::invalid_argument naming the offending parameter.
   explicit SquaredExponential(const Eigen::VectorXd& length_scales, double signal_variance = 1.0,
-                              double noise_variance = 1.0, const Bounds& bounds = {})
-    requires(Mode == LengthScales::kPerDimension)
+                              double noise_variance = 1.0,
+                              const Bounds& bounds = {}) requires(Mode == LengthScales::kPerDimension)
       : SquaredExponential(length_scales, signal_variance, noise_variance, bounds, 0) {}
 
   /// Rebuilds a kernel from `log_parameters()`, `log_lower_bounds()`, `log_upper_bounds()`.
@@ -165,7 +162,9 @@ class SquaredExponential {
       // Built only on failure, and by append: GCC 12 at -O3 reports a false -Warray-bounds on
       // an operator+ chain of std::string temporaries here.
       std::string what(kName);
-      what.append(": log bounds must be finite with lower < upper at index ").append(std::to_string(i)).append(", lower");
+      what.append(": log bounds must be finite with lower < upper at index ")
+          .append(std::to_string(i))
+          .append(", lower");
       detail::require(false, what, lower(i));
     }
     SquaredExponential k(Eigen::VectorXd::Ones(p - 2), 1.0, 1.0, Bounds{}, 0);
@@ -178,9 +177,7 @@ class SquaredExponential {
   /// sf2 [output units^2].
   [[nodiscard]] double signal_variance() const { return std::exp(theta_(0)); }
   /// l_d [input units]: one entry (isotropic) or D entries (ARD).
-  [[nodiscard]] Eigen::VectorXd length_scales() const {
-    return theta_.segment(1, num_length_scales()).array().exp();
-  }
+  [[nodiscard]] Eigen::VectorXd length_scales() const { return theta_.segment(1, num_length_scales()).array().exp(); }
   /// sn2 [output units^2].
   [[nodiscard]] double noise_variance() const { return std::exp(theta_(theta_.size() - 1)); }
 
@@ -190,10 +187,8 @@ class SquaredExponential {
 
   /// @throws std::invalid_argument if `theta` has the wrong size or a non-finite entry.
   void set_log_parameters(const Eigen::VectorXd& theta) {
-    detail::require(theta.size() == theta_.size(), std::string(kName) + ": size of log parameters",
-                    theta.size());
-    detail::require(theta.allFinite(), std::string(kName) + ": log parameters must be finite",
-                    theta.transpose());
+    detail::require(theta.size() == theta_.size(), std::string(kName) + ": size of log parameters", theta.size());
+    detail::require(theta.allFinite(), std::string(kName) + ": log parameters must be finite", theta.transpose());
     theta_ = theta;
   }
 
@@ -208,8 +203,7 @@ class SquaredExponential {
                                                  const Eigen::Ref<const Eigen::MatrixXd>& b) const {
     check_inputs(a, "a");
     check_inputs(b, "b");
-    detail::require(a.cols() == b.cols(), std::string(kName) + ": column counts of a and b differ, b",
-                    b.cols());
+    detail::require(a.cols() == b.cols(), std::string(kName) + ": column counts of a and b differ, b", b.cols());
     const Eigen::ArrayXd inv = inverse_length_scales(a.cols());
     // Scale first, then take differences: scikit-learn's cdist(X / l, Y / l) order, and no
     // cancellation from the |a|^2 + |b|^2 - 2ab expansion.
@@ -284,8 +278,8 @@ class SquaredExponential {
   }
 
  private:
-  SquaredExponential(const Eigen::VectorXd& length_scales, double signal_variance,
-                     double noise_variance, const Bounds& bounds, int /*tag*/) {
+  SquaredExponential(const Eigen::VectorXd& length_scales, double signal_variance, double noise_variance,
+                     const Bounds& bounds, int /*tag*/) {
     const std::string name(kName);
     detail::require(length_scales.size() >= 1, name + ": number of length scales", length_scales.size());
     for (Eigen::Index i = 0; i < length_scales.size(); ++i) {
@@ -343,8 +337,7 @@ class SquaredExponential {
 
   static void check_bounds(const HyperparameterBounds& b, const std::string& name) {
     detail::require_positive(b.lower, name + ".lower");
-    detail::require(std::isfinite(b.upper) && b.upper > b.lower, name + ".upper must be finite and > lower",
-                    b.upper);
+    detail::require(std::isfinite(b.upper) && b.upper > b.lower, name + ".upper must be finite and > lower", b.upper);
   }
 
   void check_inputs(const Eigen::Ref<const Eigen::MatrixXd>& a, const char* what) const {

@@ -60,8 +60,7 @@ struct GpOptions {
   void validate() const {
     detail::require_positive(initial_jitter, "GaussianProcess::Options::initial_jitter");
     detail::require(max_jitter_attempts >= 0 && max_jitter_attempts <= 30,
-                    "GaussianProcess::Options::max_jitter_attempts must be in [0, 30]",
-                    max_jitter_attempts);
+                    "GaussianProcess::Options::max_jitter_attempts must be in [0, 30]", max_jitter_attempts);
   }
 };
 
@@ -86,14 +85,11 @@ struct GpFitOptions {
   /// @throws std::invalid_argument naming the field.
   void validate() const {
     detail::require(restarts >= 0, "GaussianProcess::FitOptions::restarts must be >= 0", restarts);
-    detail::require(max_iterations >= 1, "GaussianProcess::FitOptions::max_iterations must be >= 1",
-                    max_iterations);
+    detail::require(max_iterations >= 1, "GaussianProcess::FitOptions::max_iterations must be >= 1", max_iterations);
     detail::require(std::isfinite(gradient_tolerance) && gradient_tolerance >= 0.0,
-                    "GaussianProcess::FitOptions::gradient_tolerance must be finite and >= 0",
-                    gradient_tolerance);
+                    "GaussianProcess::FitOptions::gradient_tolerance must be finite and >= 0", gradient_tolerance);
     detail::require(std::isfinite(relative_tolerance) && relative_tolerance >= 0.0,
-                    "GaussianProcess::FitOptions::relative_tolerance must be finite and >= 0",
-                    relative_tolerance);
+                    "GaussianProcess::FitOptions::relative_tolerance must be finite and >= 0", relative_tolerance);
     detail::require(history >= 1, "GaussianProcess::FitOptions::history must be >= 1", history);
   }
 };
@@ -111,9 +107,9 @@ struct GpStartSummary {
 /// Result of `fit`/`refit`.
 struct GpFitSummary {
   FitStatus status = FitStatus::kNotOptimized;  ///< status of the chosen start
-  double log_marginal_likelihood = 0.0;          ///< at the chosen hyperparameters
-  Eigen::VectorXd log_parameters;                ///< chosen hyperparameters (log)
-  std::vector<GpStartSummary> starts;              ///< empty if not optimised
+  double log_marginal_likelihood = 0.0;         ///< at the chosen hyperparameters
+  Eigen::VectorXd log_parameters;               ///< chosen hyperparameters (log)
+  std::vector<GpStartSummary> starts;           ///< empty if not optimised
   std::size_t best_start = 0;
   int evaluations = 0;  ///< LML + gradient evaluations over all starts
 };

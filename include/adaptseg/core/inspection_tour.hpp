@@ -98,12 +98,9 @@ struct TourInsertion {
 /// after `max_passes` passes); never longer than `order`. O(n³) per pass; meant for the tens
 /// of inspections of one mission.
 /// @throws std::invalid_argument for an index out of range.
-[[nodiscard]] inline std::vector<std::size_t> improve_tour_order(const TimingModel& timing,
-                                                                 const Eigen::Vector3d& start,
-                                                                 std::span<const TourStop> stops,
-                                                                 std::vector<std::size_t> order,
-                                                                 const TourEnd& end = std::nullopt,
-                                                                 int max_passes = 100) {
+[[nodiscard]] inline std::vector<std::size_t> improve_tour_order(
+    const TimingModel& timing, const Eigen::Vector3d& start, std::span<const TourStop> stops,
+    std::vector<std::size_t> order, const TourEnd& end = std::nullopt, int max_passes = 100) {
   const auto cost = [&](const std::vector<std::size_t>& o) { return tour_flight_s(timing, start, stops, o, end); };
   double best = cost(order);
   const std::size_t n = order.size();
@@ -161,8 +158,7 @@ inline constexpr std::size_t kExactTourStops = 12;
       for (std::size_t next = 0; next < n; ++next) {
         if (set >> next & 1U) continue;
         const std::size_t grown = set | std::size_t{1} << next;
-        const double t =
-            here + timing.segment_time_s(stops[last].exit, stops[next].entry) + stops[next].inner_flight_s;
+        const double t = here + timing.segment_time_s(stops[last].exit, stops[next].entry) + stops[next].inner_flight_s;
         if (t < best[grown * n + next]) best[grown * n + next] = t, previous[grown * n + next] = last;
       }
     }
@@ -187,8 +183,7 @@ inline constexpr std::size_t kExactTourStops = 12;
 /// improved by improve_tour_order (both to `end`, if given). Never longer than `order` (a
 /// permutation of the stops).
 /// @throws std::invalid_argument for an index out of range.
-[[nodiscard]] inline std::vector<std::size_t> plan_tour_order(const TimingModel& timing,
-                                                              const Eigen::Vector3d& start,
+[[nodiscard]] inline std::vector<std::size_t> plan_tour_order(const TimingModel& timing, const Eigen::Vector3d& start,
                                                               std::span<const TourStop> stops,
                                                               std::vector<std::size_t> order,
                                                               const TourEnd& end = std::nullopt) {

@@ -69,11 +69,11 @@ class LawnmowerPlanner {
   /// Covers `area` at `gsd_cm`, starting in the corner of `area` nearest `start_xy` [m].
   /// @throws std::invalid_argument if the GSD is not positive or the area is empty.
   template <typename Keep>
-  [[nodiscard]] std::vector<Waypoint> plan(const Area& area, double gsd_cm,
-                                           const Eigen::Vector2d& start_xy, Keep&& keep) const {
+  [[nodiscard]] std::vector<Waypoint> plan(const Area& area, double gsd_cm, const Eigen::Vector2d& start_xy,
+                                           Keep&& keep) const {
     detail::require_positive(gsd_cm, "LawnmowerPlanner::plan: gsd_cm");
-    detail::require(std::isfinite(area.width_m()) && area.width_m() > 0.0 &&
-                        std::isfinite(area.height_m()) && area.height_m() > 0.0,
+    detail::require(std::isfinite(area.width_m()) && area.width_m() > 0.0 && std::isfinite(area.height_m()) &&
+                        area.height_m() > 0.0,
                     "LawnmowerPlanner::plan: area must have a finite positive size [m]",
                     area.width_m() * area.height_m());
     const Extent fp = camera_.footprint_at_gsd(gsd_cm);
@@ -125,8 +125,7 @@ class LawnmowerPlanner {
   }
 
   /// plan() keeping every cell.
-  [[nodiscard]] std::vector<Waypoint> plan(const Area& area, double gsd_cm,
-                                           const Eigen::Vector2d& start_xy) const {
+  [[nodiscard]] std::vector<Waypoint> plan(const Area& area, double gsd_cm, const Eigen::Vector2d& start_xy) const {
     return plan(area, gsd_cm, start_xy, [](const Area&) { return true; });
   }
 

@@ -29,9 +29,9 @@ class LinearDecision {
   explicit LinearDecision(Params params) : params_(params) {
     detail::require(std::isfinite(params_.sigma_low) && params_.sigma_low >= 0.0,
                     "LinearDecision: sigma_low must be in [0, 1)", params_.sigma_low);
-    detail::require(std::isfinite(params_.sigma_high) && params_.sigma_high > params_.sigma_low &&
-                        params_.sigma_high <= 1.0,
-                    "LinearDecision: sigma_high must be in (sigma_low, 1]", params_.sigma_high);
+    detail::require(
+        std::isfinite(params_.sigma_high) && params_.sigma_high > params_.sigma_low && params_.sigma_high <= 1.0,
+        "LinearDecision: sigma_high must be in (sigma_low, 1]", params_.sigma_high);
   }
 
   [[nodiscard]] const Params& params() const noexcept { return params_; }

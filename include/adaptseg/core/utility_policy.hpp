@@ -37,12 +37,12 @@ class UtilityPolicy {
  public:
   /// Thresholds and behaviour; validated by the constructor.
   struct Params {
-    double min_sigma = 0.0;        ///< σ below which the UAV never descends
-    double min_utility = 0.0;      ///< utility threshold [gain per second]
-    double exploration = 0.0;      ///< κ >= 0, weight of I's predictive standard deviation
-    bool weight_by_sigma = true;   ///< gain weighted by σ (see class comment)
-    bool online = true;            ///< update O after each descent (false: non-adaptive)
-    bool relative_utility = false; ///< threshold on U / mean best U so far (see class comment)
+    double min_sigma = 0.0;         ///< σ below which the UAV never descends
+    double min_utility = 0.0;       ///< utility threshold [gain per second]
+    double exploration = 0.0;       ///< κ >= 0, weight of I's predictive standard deviation
+    bool weight_by_sigma = true;    ///< gain weighted by σ (see class comment)
+    bool online = true;             ///< update O after each descent (false: non-adaptive)
+    bool relative_utility = false;  ///< threshold on U / mean best U so far (see class comment)
 
     /// @throws std::invalid_argument naming the field.
     void validate() const {

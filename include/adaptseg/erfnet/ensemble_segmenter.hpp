@@ -135,7 +135,8 @@ class EnsembleSegmenter {
   ///         and directory).
   explicit EnsembleSegmenter(std::vector<EnsembleMember> members, Params params = {})
       : params_(std::move(params)), specs_(std::move(members)) {
-    if (specs_.empty()) throw std::invalid_argument("EnsembleSegmenter: no members (an ensemble needs at least one network)");
+    if (specs_.empty())
+      throw std::invalid_argument("EnsembleSegmenter: no members (an ensemble needs at least one network)");
     if (params_.name == OnnxParams{}.name) params_.name = "ensemble";
     double total = 0.0;
     for (std::size_t k = 0; k < specs_.size(); ++k) {
@@ -163,7 +164,8 @@ class EnsembleSegmenter {
       if (members_.back().classes() != members_.front().classes())
         throw std::invalid_argument("EnsembleSegmenter: " + member_label(k) + " has classes " +
                                     detail::class_list(members_.back().classes()) + ", " + member_label(0) + " has " +
-                                    detail::class_list(members_.front().classes()) + "; members must share one class set");
+                                    detail::class_list(members_.front().classes()) +
+                                    "; members must share one class set");
     }
   }
 
@@ -205,9 +207,7 @@ class EnsembleSegmenter {
   /// Labels, the mean probabilities and the member votes (SegmentsWithProbabilities; the votes
   /// feed decision input `split`).
   /// @throws std::invalid_argument as OnnxSegmenter::segment().
-  [[nodiscard]] Segmentation segment_with_probabilities(const Image& image) {
-    return run(image, false).mean;
-  }
+  [[nodiscard]] Segmentation segment_with_probabilities(const Image& image) { return run(image, false).mean; }
 
   /// The mean, its labels, and where the members disagree.
   /// @throws std::invalid_argument as OnnxSegmenter::segment().
@@ -227,7 +227,8 @@ class EnsembleSegmenter {
         // Member 0's labels carry the ignore pixels (pixels without RGB content, the same for all).
         out.mean.labels = s.labels.clone();
       } else {
-        for (std::size_t c = 0; c < ncs; ++c) cv::scaleAdd(s.probabilities[c], weights_[k], out.mean.probabilities[c], out.mean.probabilities[c]);
+        for (std::size_t c = 0; c < ncs; ++c)
+          cv::scaleAdd(s.probabilities[c], weights_[k], out.mean.probabilities[c], out.mean.probabilities[c]);
       }
       member_labels.push_back(std::move(s.labels));
     }

@@ -141,8 +141,7 @@ class OnnxSegmenter {
   ///         the network cannot take (see OnnxParams::resize_to_network), or invalid
   ///         params (negative sizes or threads, an empty name, a DNN backend/target pair
   ///         this OpenCV build does not offer).
-  OnnxSegmenter(const std::filesystem::path& onnx_file, const std::filesystem::path& metadata_file,
-                  Params params = {})
+  OnnxSegmenter(const std::filesystem::path& onnx_file, const std::filesystem::path& metadata_file, Params params = {})
       : params_(std::move(params)) {
     validate_params();
     info_ = read_metadata(metadata_file);
@@ -155,15 +154,14 @@ class OnnxSegmenter {
   /// Loads `model_dir/model.onnx` and `model_dir/model.yaml`.
   /// @throws std::invalid_argument as the two-file constructor, and for a missing directory.
   explicit OnnxSegmenter(const std::filesystem::path& model_dir, Params params = {})
-      : OnnxSegmenter(checked_dir(model_dir) / "model.onnx", model_dir / "model.yaml",
-                        std::move(params)) {}
+      : OnnxSegmenter(checked_dir(model_dir) / "model.onnx", model_dir / "model.yaml", std::move(params)) {}
 
   /// Loads `model_dir` for images of `camera` over `field`: the model's classes must be the
   /// field's classes and the camera's image size the network's input size (unless
   /// `params.resize_to_network`). Overrides `params.expected_classes` and the camera size.
   /// @throws std::invalid_argument as the two-file constructor.
-  OnnxSegmenter(const std::filesystem::path& model_dir, const Field& field,
-                  const CameraModel& camera, Params params = {})
+  OnnxSegmenter(const std::filesystem::path& model_dir, const Field& field, const CameraModel& camera,
+                Params params = {})
       : OnnxSegmenter(model_dir, for_field(field, camera, std::move(params))) {}
 
   OnnxSegmenter(const OnnxSegmenter&) = delete;
@@ -192,9 +190,7 @@ class OnnxSegmenter {
   [[nodiscard]] int num_classes() const noexcept { return static_cast<int>(info_.classes.size()); }
   [[nodiscard]] const std::vector<std::string>& classes() const noexcept { return info_.classes; }
   /// The network's input size [px].
-  [[nodiscard]] cv::Size input_size() const noexcept {
-    return {info_.input_width_px, info_.input_height_px};
-  }
+  [[nodiscard]] cv::Size input_size() const noexcept { return {info_.input_width_px, info_.input_height_px}; }
   /// The size of the network's logits [px]: the input size / the output stride.
   [[nodiscard]] cv::Size output_size() const noexcept {
     return {info_.input_width_px / info_.output_stride, info_.input_height_px / info_.output_stride};
@@ -248,7 +244,9 @@ class OnnxSegmenter {
   /// (OnnxModelInfo::temperature); they sum to 1 per pixel, except on pixels without RGB
   /// content (see OnnxParams::black_is_no_data), where all are 0.
   /// @throws std::invalid_argument as segment().
-  [[nodiscard]] std::vector<cv::Mat> probabilities(const Image& image) { return segment_with_probabilities(image).probabilities; }
+  [[nodiscard]] std::vector<cv::Mat> probabilities(const Image& image) {
+    return segment_with_probabilities(image).probabilities;
+  }
 
   /// The raw network output: one CV_32FC1 plane of logits per class at the image's size
   /// (resampled bilinearly where the network's output size differs from it). No masking; one
@@ -345,8 +343,8 @@ class OnnxSegmenter {
     bool target_ok = false;
     for (const auto t : targets) target_ok = target_ok || static_cast<int>(t) == params_.dnn_target;
     detail::require(target_ok,
-                    "OnnxParams: dnn_target is not available for dnn_backend " +
-                        std::to_string(params_.dnn_backend) + " in this OpenCV build",
+                    "OnnxParams: dnn_target is not available for dnn_backend " + std::to_string(params_.dnn_backend) +
+                        " in this OpenCV build",
                     params_.dnn_target);
   }
 
@@ -364,7 +362,8 @@ class OnnxSegmenter {
     OnnxModelInfo info;
     info.classes = r.texts("classes");
     if (info.classes.empty() || info.classes.size() > 255)
-      meta_error(file, "'classes' must be a list of 1 to 255 class names (got " + std::to_string(info.classes.size()) + ")");
+      meta_error(file,
+                 "'classes' must be a list of 1 to 255 class names (got " + std::to_string(info.classes.size()) + ")");
     const detail::YamlReader input = r.map("input");
     info.input_width_px = static_cast<int>(input.integer("width", 8, 1 << 16));
     info.input_height_px = static_cast<int>(input.integer("height", 8, 1 << 16));
@@ -372,7 +371,8 @@ class OnnxSegmenter {
       meta_error(file, "input width and height must be positive multiples of 8 (got " +
                            std::to_string(info.input_width_px) + "x" + std::to_string(info.input_height_px) + ")");
     const std::string order = input.text("channel_order");
-    if (order != "RGB" && order != "BGR") meta_error(file, "input.channel_order must be RGB or BGR (got '" + order + "')");
+    if (order != "RGB" && order != "BGR")
+      meta_error(file, "input.channel_order must be RGB or BGR (got '" + order + "')");
     info.rgb_order = order == "RGB";
     for (const char* key : {"mean", "std"}) {
       const bool std_dev = std::string(key) == "std";
@@ -404,9 +404,8 @@ class OnnxSegmenter {
     if (params_.expected_classes.empty()) return;
     if (params_.expected_classes != info_.classes)
       throw std::invalid_argument(
-          "OnnxSegmenter: " + file.string() + ": the model's " +
-          std::to_string(info_.classes.size()) + " classes " + detail::class_list(info_.classes) +
-          " differ from the " + std::to_string(params_.expected_classes.size()) +
+          "OnnxSegmenter: " + file.string() + ": the model's " + std::to_string(info_.classes.size()) + " classes " +
+          detail::class_list(info_.classes) + " differ from the " + std::to_string(params_.expected_classes.size()) +
           " expected classes " + detail::class_list(params_.expected_classes));
   }
 
@@ -414,18 +413,19 @@ class OnnxSegmenter {
   void check_size(const cv::Size& size, const char* who) const {
     const cv::Size in = input_size();
     if (size == in) return;
-    const std::string desc = std::to_string(size.width) + "x" + std::to_string(size.height) +
-                             " vs network input " + std::to_string(in.width) + "x" +
-                             std::to_string(in.height);
+    const std::string desc = std::to_string(size.width) + "x" + std::to_string(size.height) + " vs network input " +
+                             std::to_string(in.width) + "x" + std::to_string(in.height);
     detail::require(params_.resize_to_network,
-                    std::string(who) + ": image size differs from the network input size "
-                                       "(set OnnxParams::resize_to_network to resample)",
+                    std::string(who) +
+                        ": image size differs from the network input size "
+                        "(set OnnxParams::resize_to_network to resample)",
                     desc);
     const double a = static_cast<double>(size.width) / size.height;
     const double b = static_cast<double>(in.width) / in.height;
     detail::require(std::abs(a / b - 1.0) <= 0.01,
-                    std::string(who) + ": image aspect ratio differs from the network input's by "
-                                       "more than 1 %",
+                    std::string(who) +
+                        ": image aspect ratio differs from the network input's by "
+                        "more than 1 %",
                     desc);
   }
 
@@ -440,11 +440,9 @@ class OnnxSegmenter {
     try {
       net_ = cv::dnn::readNetFromONNX(onnx_file.string());
     } catch (const cv::Exception& e) {
-      throw std::invalid_argument("OnnxSegmenter: cannot load ONNX model " + onnx_file.string() +
-                                  ": " + e.what());
+      throw std::invalid_argument("OnnxSegmenter: cannot load ONNX model " + onnx_file.string() + ": " + e.what());
     }
-    if (net_.empty())
-      throw std::invalid_argument("OnnxSegmenter: ONNX model " + onnx_file.string() + " is empty");
+    if (net_.empty()) throw std::invalid_argument("OnnxSegmenter: ONNX model " + onnx_file.string() + " is empty");
     net_.setPreferableBackend(params_.dnn_backend);
     net_.setPreferableTarget(params_.dnn_target);
     // Shape inference (no forward pass): the output must be 1 x classes x H x W.
@@ -459,9 +457,9 @@ class OnnxSegmenter {
       net_.getLayerShapes(in_shape, outs.front(), in_shapes, out_shapes);
       if (!out_shapes.empty()) out_shape = out_shapes.front();
     } catch (const cv::Exception& e) {
-      throw std::invalid_argument("OnnxSegmenter: ONNX model " + onnx_file.string() +
-                                  " does not take a 1x3x" + std::to_string(info_.input_height_px) +
-                                  "x" + std::to_string(info_.input_width_px) + " input: " + e.what());
+      throw std::invalid_argument("OnnxSegmenter: ONNX model " + onnx_file.string() + " does not take a 1x3x" +
+                                  std::to_string(info_.input_height_px) + "x" + std::to_string(info_.input_width_px) +
+                                  " input: " + e.what());
     }
     const cv::Size net_out = output_size();
     const cv::dnn::MatShape expected{1, num_classes(), net_out.height, net_out.width};
@@ -471,9 +469,9 @@ class OnnxSegmenter {
         if (!got.empty()) got += 'x';
         got += std::to_string(d);
       }
-      throw std::invalid_argument("OnnxSegmenter: ONNX model " + onnx_file.string() +
-                                  " outputs " + got + ", expected 1x" + std::to_string(num_classes()) +
-                                  "x" + std::to_string(net_out.height) + "x" + std::to_string(net_out.width) +
+      throw std::invalid_argument("OnnxSegmenter: ONNX model " + onnx_file.string() + " outputs " + got +
+                                  ", expected 1x" + std::to_string(num_classes()) + "x" +
+                                  std::to_string(net_out.height) + "x" + std::to_string(net_out.width) +
                                   " (classes x input size / output stride from the metadata)");
     }
   }
@@ -483,8 +481,7 @@ class OnnxSegmenter {
                     "OnnxSegmenter: the image has no RGB (Image::rgb is empty, e.g. a "
                     "field without an image); ERFNet segments RGB images only",
                     "empty rgb");
-    detail::require(image.rgb.type() == CV_8UC3,
-                    "OnnxSegmenter: Image::rgb must be 8-bit 3-channel BGR (CV_8UC3)",
+    detail::require(image.rgb.type() == CV_8UC3, "OnnxSegmenter: Image::rgb must be 8-bit 3-channel BGR (CV_8UC3)",
                     "type " + std::to_string(image.rgb.type()));
     detail::require(image.rgb.cols == image.width_px && image.rgb.rows == image.height_px,
                     "OnnxSegmenter: Image::rgb size differs from width_px x height_px",

@@ -89,7 +89,8 @@ class ElevationModel {
       to_wgs84_.reset(OGRCreateCoordinateTransformation(&crs_, &wgs84_));
     }
     if (!to_dem_ || !to_wgs84_)
-      gdal::detail::fail(file, "no transformation between WGS84 and the DEM's CRS (" + gdal::detail::last_error() + ")");
+      gdal::detail::fail(file,
+                         "no transformation between WGS84 and the DEM's CRS (" + gdal::detail::last_error() + ")");
     GDALRasterBand* band = d->GetRasterBand(1);
     z_ = cv::Mat(height_, width_, CV_32FC1);
     {
@@ -104,7 +105,8 @@ class ElevationModel {
     for (int r = 0; r < height_; ++r) {
       float* row = z_.ptr<float>(r);
       for (int c = 0; c < width_; ++c) {
-        if (!std::isfinite(row[c]) || (has_nodata && static_cast<double>(row[c]) == static_cast<double>(static_cast<float>(nodata))))
+        if (!std::isfinite(row[c]) ||
+            (has_nodata && static_cast<double>(row[c]) == static_cast<double>(static_cast<float>(nodata))))
           row[c] = std::numeric_limits<float>::quiet_NaN();
         else
           any = true;
@@ -185,7 +187,7 @@ struct TerrainFollowing {
   double home_ground_m = 0.0;       ///< the DEM's elevation at home [m]
   std::vector<double> ground_m;     ///< per waypoint: the mean elevation under its footprint [m]
   std::vector<double> clearance_m;  ///< per waypoint: its height above the highest ground under its footprint [m]
-  double highest_rise_m = 0.0;      ///< the highest ground under any footprint, above home's [m] (what a return must clear)
+  double highest_rise_m = 0.0;  ///< the highest ground under any footprint, above home's [m] (what a return must clear)
 
   /// The lowest of clearance_m (infinity for no waypoint).
   [[nodiscard]] double lowest_clearance_m() const {
@@ -209,8 +211,9 @@ struct TerrainFollowing {
 /// waypoint's height above the highest ground under its footprint.
 /// @throws std::invalid_argument if the DEM has no elevation at home or under a footprint
 ///         (naming the waypoint and where), `height_m` is not positive, or `samples` < 1.
-inline TerrainFollowing follow_terrain(std::vector<Waypoint>& path, const GeoReference& frame, const Eigen::Vector2d& home_xy,
-                                       const ElevationModel& dem, double height_m, int samples = 9) {
+inline TerrainFollowing follow_terrain(std::vector<Waypoint>& path, const GeoReference& frame,
+                                       const Eigen::Vector2d& home_xy, const ElevationModel& dem, double height_m,
+                                       int samples = 9) {
   detail::require_positive(height_m, "follow_terrain: height_m");
   detail::require(samples >= 1, "follow_terrain: samples must be >= 1", samples);
   const auto at = [&](const Eigen::Vector2d& xy) {
@@ -221,8 +224,8 @@ inline TerrainFollowing follow_terrain(std::vector<Waypoint>& path, const GeoRef
   const auto [home_z, home_g] = at(home_xy);
   if (!home_z)
     throw std::invalid_argument("the DEM '" + dem.file().string() + "' has no elevation at the take-off point (" +
-                                gdal::detail::num(home_g.latitude_deg) + ", " + gdal::detail::num(home_g.longitude_deg) +
-                                ")");
+                                gdal::detail::num(home_g.latitude_deg) + ", " +
+                                gdal::detail::num(home_g.longitude_deg) + ")");
   out.home_ground_m = *home_z;
   out.highest_rise_m = -std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < path.size(); ++i) {
@@ -230,7 +233,8 @@ inline TerrainFollowing follow_terrain(std::vector<Waypoint>& path, const GeoRef
     double sum = 0.0, highest = -std::numeric_limits<double>::infinity();
     for (int a = 0; a < samples; ++a)
       for (int b = 0; b < samples; ++b) {
-        const Eigen::Vector2d xy(f.x_min_m + (a + 0.5) / samples * f.width_m(), f.y_min_m + (b + 0.5) / samples * f.height_m());
+        const Eigen::Vector2d xy(f.x_min_m + (a + 0.5) / samples * f.width_m(),
+                                 f.y_min_m + (b + 0.5) / samples * f.height_m());
         const auto [z, g] = at(xy);
         if (!z)
           throw std::invalid_argument("the DEM '" + dem.file().string() + "' has no elevation under waypoint " +
@@ -252,9 +256,9 @@ inline TerrainFollowing follow_terrain(std::vector<Waypoint>& path, const GeoRef
 /// (site-frame positions, z relative to home, whose ground is `home_ground_m`), sampled every
 /// `step_m` metres and at each point; where the DEM has no elevation the leg is not checked.
 /// `where` gets the index of the leg's start with the lowest height.
-[[nodiscard]] inline double lowest_leg_clearance_m(const std::vector<Eigen::Vector3d>& points, const GeoReference& frame,
-                                                   const ElevationModel& dem, double home_ground_m, double step_m,
-                                                   std::size_t* where = nullptr) {
+[[nodiscard]] inline double lowest_leg_clearance_m(const std::vector<Eigen::Vector3d>& points,
+                                                   const GeoReference& frame, const ElevationModel& dem,
+                                                   double home_ground_m, double step_m, std::size_t* where = nullptr) {
   detail::require_positive(step_m, "lowest_leg_clearance_m: step_m");
   double low = std::numeric_limits<double>::infinity();
   for (std::size_t k = 1; k < points.size(); ++k) {

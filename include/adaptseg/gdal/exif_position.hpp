@@ -74,8 +74,8 @@ inline std::vector<double> exif_rationals(const std::filesystem::path& file, con
     const double deg = dms[0] + (dms.size() > 1 ? dms[1] / 60.0 : 0.0) + (dms.size() > 2 ? dms[2] / 3600.0 : 0.0);
     const std::string ref = item(ref_tag).value_or("");
     if (ref.empty() || (ref[0] != positive && ref[0] != negative))
-      throw std::invalid_argument(file.string() + ": EXIF " + ref_tag + " '" + ref + "' is neither " + positive + " nor " +
-                                  negative);
+      throw std::invalid_argument(file.string() + ": EXIF " + ref_tag + " '" + ref + "' is neither " + positive +
+                                  " nor " + negative);
     if (deg > limit)
       throw std::invalid_argument(file.string() + ": EXIF " + tag + " " + gdal::detail::num(deg) + " deg is beyond " +
                                   gdal::detail::num(limit));
@@ -86,7 +86,8 @@ inline std::vector<double> exif_rationals(const std::filesystem::path& file, con
   p.longitude_deg = angle("EXIF_GPSLongitude", *lon_text, "EXIF_GPSLongitudeRef", 'E', 'W', 180.0);
   if (const auto alt = item("EXIF_GPSAltitude")) {
     const std::vector<double> a = detail::exif_rationals(file, "EXIF_GPSAltitude", *alt);
-    if (a.size() != 1) throw std::invalid_argument(file.string() + ": EXIF GPSAltitude '" + *alt + "' is not one number");
+    if (a.size() != 1)
+      throw std::invalid_argument(file.string() + ": EXIF GPSAltitude '" + *alt + "' is not one number");
     // GPSAltitudeRef: a byte, 0 above sea level, 1 below (GDAL writes it "0x00" or "0x01").
     const std::string ref = item("EXIF_GPSAltitudeRef").value_or("0x00");
     const bool below = ref == "0x01" || ref == "1";

@@ -39,14 +39,14 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <iomanip>
-#include <locale>
-#include <sstream>
 #include <filesystem>
+#include <iomanip>
 #include <limits>
+#include <locale>
 #include <memory>
 #include <numbers>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -134,8 +134,9 @@ inline RasterGrid grid_of(GDALDataset& d, const std::filesystem::path& file) {
   {
     const QuietErrors quiet;
     if (d.GetGeoTransform(g.geotransform.data()) != CE_None)
-      fail(file, "the raster has no geotransform (georeference it, e.g. gdal_translate -a_srs -a_ullr, "
-                 "or give gsd_cm in field.yaml and use a plain image)");
+      fail(file,
+           "the raster has no geotransform (georeference it, e.g. gdal_translate -a_srs -a_ullr, "
+           "or give gsd_cm in field.yaml and use a plain image)");
   }
   const OGRSpatialReference* srs = d.GetSpatialRef();
   if (srs == nullptr || srs->IsEmpty()) fail(file, "the raster has no coordinate reference system");
@@ -145,9 +146,10 @@ inline RasterGrid grid_of(GDALDataset& d, const std::filesystem::path& file) {
     const double lat = g.geotransform[3] + 0.5 * g.height_px * g.geotransform[5];
     const int zone = std::clamp(static_cast<int>(std::floor((lon + 180.0) / 6.0)) + 1, 1, 60);
     const int epsg = (lat >= 0.0 ? 32600 : 32700) + zone;
-    fail(file, "geographic CRS (coordinates in degrees): reproject to a projected CRS in metres, "
-               "e.g. gdalwarp -t_srs EPSG:" + std::to_string(epsg) + " (UTM zone " + std::to_string(zone) +
-                   (lat >= 0.0 ? "N" : "S") + ", the field's)");
+    fail(file,
+         "geographic CRS (coordinates in degrees): reproject to a projected CRS in metres, "
+         "e.g. gdalwarp -t_srs EPSG:" +
+             std::to_string(epsg) + " (UTM zone " + std::to_string(zone) + (lat >= 0.0 ? "N" : "S") + ", the field's)");
   }
   if (!srs->IsProjected()) fail(file, "the CRS is not a projected one (need easting and northing in metres)");
   const char* unit = nullptr;
@@ -162,12 +164,11 @@ inline RasterGrid grid_of(GDALDataset& d, const std::filesystem::path& file) {
     fail(file, "rotated or sheared geotransform (terms " + num(gt[2]) + ", " + num(gt[4]) +
                    "): only north-up rasters are supported (resample with gdalwarp)");
   if (!(gt[1] > 0.0) || !(gt[5] < 0.0))
-    fail(file, "the geotransform must have columns eastwards and rows southwards (pixel size " +
-                   num(gt[1]) + " x " + num(gt[5]) + ")");
+    fail(file, "the geotransform must have columns eastwards and rows southwards (pixel size " + num(gt[1]) + " x " +
+                   num(gt[5]) + ")");
   if (std::abs(gt[1] + gt[5]) > 1e-6 * gt[1])
     fail(file, "non-square pixels (" + num(gt[1]) + " x " + num(-gt[5]) +
-                   " m): resample to square pixels, e.g. gdalwarp -tr " + num(gt[1]) + " " +
-                   num(gt[1]));
+                   " m): resample to square pixels, e.g. gdalwarp -tr " + num(gt[1]) + " " + num(gt[1]));
   char* wkt = nullptr;
   const char* const options[] = {"FORMAT=WKT2_2019", nullptr};
   if (srs->exportToWkt(&wkt, options) != OGRERR_NONE || wkt == nullptr) {
@@ -197,8 +198,8 @@ inline cv::Mat read_interleaved(GDALDataset& d, const std::filesystem::path& fil
   const int n = static_cast<int>(band_map.size());
   for (int b : band_map)
     if (d.GetRasterBand(b)->GetRasterDataType() != GDT_Byte)
-      fail(file, "band " + std::to_string(b) + " is " +
-                     GDALGetDataTypeName(d.GetRasterBand(b)->GetRasterDataType()) + ", need 8-bit (Byte)");
+      fail(file, "band " + std::to_string(b) + " is " + GDALGetDataTypeName(d.GetRasterBand(b)->GetRasterDataType()) +
+                     ", need 8-bit (Byte)");
   cv::Mat m(d.GetRasterYSize(), d.GetRasterXSize(), CV_8UC(n));
   const std::size_t row_bytes = m.step[0];
   const int strip = strip_rows(*d.GetRasterBand(band_map.front()), row_bytes, strip_bytes);
@@ -224,9 +225,7 @@ inline std::optional<int> nodata_byte(GDALDataset& d, int b, const std::filesyst
   return static_cast<int>(v);
 }
 
-inline std::string pixel_at(int r, int c) {
-  return "row " + std::to_string(r) + ", col " + std::to_string(c);
-}
+inline std::string pixel_at(int r, int c) { return "row " + std::to_string(r) + ", col " + std::to_string(c); }
 
 /// Labels as class indices (1 band) or class colours (3 bands, optional alpha) -> CV_8UC1 with
 /// `ignore` where unlabelled.
@@ -246,9 +245,10 @@ inline cv::Mat read_labels(GDALDataset& d, const std::filesystem::path& file, co
         if (nodata && v == *nodata) {
           row[c] = static_cast<std::uint8_t>(ignore);
         } else if (v >= k && v != ignore) {
-          fail(file, "value " + std::to_string(v) + " at " + pixel_at(r, c) + " is no class index (0.." +
-                         std::to_string(k - 1) + "), not the ignore label " + std::to_string(ignore) +
-                         (nodata ? ", not nodata " + std::to_string(*nodata) : ", and the band has no nodata value" + fix));
+          fail(file,
+               "value " + std::to_string(v) + " at " + pixel_at(r, c) + " is no class index (0.." +
+                   std::to_string(k - 1) + "), not the ignore label " + std::to_string(ignore) +
+                   (nodata ? ", not nodata " + std::to_string(*nodata) : ", and the band has no nodata value" + fix));
         }
       }
     }
@@ -262,7 +262,9 @@ inline cv::Mat read_labels(GDALDataset& d, const std::filesystem::path& file, co
   // Colour -> class through a table of all 2^24 colours (32 MB; one lookup per pixel).
   constexpr std::int16_t kNone = -1;
   std::vector<std::int16_t> table(std::size_t{1} << 24, kNone);
-  const auto key = [](int r, int g, int b) { return (static_cast<std::size_t>(r) << 16) | (static_cast<std::size_t>(g) << 8) | static_cast<std::size_t>(b); };
+  const auto key = [](int r, int g, int b) {
+    return (static_cast<std::size_t>(r) << 16) | (static_cast<std::size_t>(g) << 8) | static_cast<std::size_t>(b);
+  };
   for (int i = k - 1; i >= 0; --i) {
     const auto& col = classes[static_cast<std::size_t>(i)].color_rgb;
     table[key(col[0], col[1], col[2])] = static_cast<std::int16_t>(i);
@@ -279,9 +281,10 @@ inline cv::Mat read_labels(GDALDataset& d, const std::filesystem::path& file, co
       }
       const std::int16_t cls = table[key(in[0], in[1], in[2])];
       if (cls == kNone)
-        fail(file, "colour (" + std::to_string(in[0]) + ", " + std::to_string(in[1]) + ", " + std::to_string(in[2]) +
-                       ") at " + pixel_at(r, c) + " is no class colour of field.yaml" +
-                       (has_nodata || n == 4 ? std::string() : std::string(", and the raster has no nodata value") + fix));
+        fail(file,
+             "colour (" + std::to_string(in[0]) + ", " + std::to_string(in[1]) + ", " + std::to_string(in[2]) +
+                 ") at " + pixel_at(r, c) + " is no class colour of field.yaml" +
+                 (has_nodata || n == 4 ? std::string() : std::string(", and the raster has no nodata value") + fix));
       out[c] = static_cast<std::uint8_t>(cls);
     }
   }
@@ -303,7 +306,8 @@ class CrsToWgs84 {
   /// (easting, northing) [m] -> (latitude, longitude) [deg].
   [[nodiscard]] std::pair<double, double> operator()(double e, double n) const {
     double x = e, y = n;
-    if (!ct_->Transform(1, &x, &y)) throw std::invalid_argument("the CRS cannot transform easting " + std::to_string(e));
+    if (!ct_->Transform(1, &x, &y))
+      throw std::invalid_argument("the CRS cannot transform easting " + std::to_string(e));
     return {y, x};
   }
 
@@ -349,8 +353,8 @@ inline FieldGeo field_geo_of(const RasterGrid& g, const std::filesystem::path& f
   // A conformal grid: the same scale both ways and +x at right angles to +y.
   const double skew = std::remainder(az_we - (az_ns + 90.0), 360.0);
   if (std::abs(s_ns - s_we) > 1e-5 * s_ns || std::abs(skew) > 1e-3)
-    fail(file, "the CRS is not conformal here (scale " + num(2 * d / s_ns) + " north-south vs " +
-                   num(2 * d / s_we) + " east-west): use a conformal projection such as UTM");
+    fail(file, "the CRS is not conformal here (scale " + num(2 * d / s_ns) + " north-south vs " + num(2 * d / s_we) +
+                   " east-west): use a conformal projection such as UTM");
   const GeoReference model(geo);
   double worst = 0.0;
   for (const auto& [x, y] : {std::pair{0.0, 0.0}, std::pair{w, 0.0}, std::pair{0.0, h}, std::pair{w, h}}) {
@@ -407,10 +411,10 @@ inline FieldGeo field_geo_of(const RasterGrid& g, const std::filesystem::path& f
     if (!same)
       field_error(y.yaml, "'" + *y.image_file + "' and '" + y.labels_file + "' are not on the same grid (" +
                               std::to_string(ig.width_px) + "x" + std::to_string(ig.height_px) + " px from (" +
-                              detail::num(ig.geotransform[0]) + ", " + detail::num(ig.geotransform[3]) +
-                              ") vs " + std::to_string(grid.width_px) + "x" + std::to_string(grid.height_px) +
-                              " px from (" + detail::num(grid.geotransform[0]) + ", " +
-                              detail::num(grid.geotransform[3]) + "); align them with gdalwarp -te -tr)");
+                              detail::num(ig.geotransform[0]) + ", " + detail::num(ig.geotransform[3]) + ") vs " +
+                              std::to_string(grid.width_px) + "x" + std::to_string(grid.height_px) + " px from (" +
+                              detail::num(grid.geotransform[0]) + ", " + detail::num(grid.geotransform[3]) +
+                              "); align them with gdalwarp -te -tr)");
     if (!a.IsSame(&b)) field_error(y.yaml, "'" + *y.image_file + "' and '" + y.labels_file + "' differ in CRS");
     if (id->GetRasterCount() < 3)
       detail::fail(image_file, std::to_string(id->GetRasterCount()) + " band(s): the image needs red, green, blue");
@@ -454,23 +458,22 @@ inline FieldGeo field_geo_of(const RasterGrid& g, const std::filesystem::path& f
     const double dh = std::remainder(y.geo->heading_deg - geo.heading_deg, 360.0);
     if (s > 1.0 || std::abs(dh) > 0.1)
       field_error(y.yaml, "geo: disagrees with '" + y.labels_file + "' (field origin " + detail::num(s) +
-                              " m apart, heading " + detail::num(dh) +
-                              " degrees apart); omit geo: or correct it");
+                              " m apart, heading " + detail::num(dh) + " degrees apart); omit geo: or correct it");
   }
   adaptseg::detail::FieldYaml with_geo = y;
   with_geo.geo = geo;
   return adaptseg::detail::field_from_yaml(with_geo, gsd_cm, std::move(labels), std::move(image))
-      .with_crs(FieldCrs{grid.crs_wkt, grid.geotransform[0],
-                         grid.geotransform[3] + grid.height_px * grid.geotransform[5]});
+      .with_crs(
+          FieldCrs{grid.crs_wkt, grid.geotransform[0], grid.geotransform[3] + grid.height_px * grid.geotransform[5]});
 }
 
 /// The grid of a map to write as a GeoTIFF: its size, GSD, georeference, classes. A field's
 /// (MapGrid::of), or a live mission's, whose map covers a SurveyArea with a geo-reference.
 struct MapGrid {
-  std::string name;     ///< for messages
+  std::string name;  ///< for messages
   int width_px = 0;
   int height_px = 0;
-  double gsd_cm = 0.0;  ///< square pixels [cm/px]; the raster's bottom-left corner is the frame origin
+  double gsd_cm = 0.0;          ///< square pixels [cm/px]; the raster's bottom-left corner is the frame origin
   std::optional<FieldCrs> crs;  ///< a projected CRS (a GeoTIFF field's), used when present
   std::optional<FieldGeo> geo;  ///< otherwise the frame's WGS84 geo-reference
   std::vector<ClassInfo> classes;
@@ -478,8 +481,8 @@ struct MapGrid {
 
   /// The grid of `field`'s orthomosaic.
   [[nodiscard]] static MapGrid of(const Field& field) {
-    return {field.name(), field.width_px(), field.height_px(), field.gsd_cm(), field.crs(), field.geo(),
-            field.classes(), field.ignore_label()};
+    return {field.name(), field.width_px(), field.height_px(), field.gsd_cm(),
+            field.crs(),  field.geo(),      field.classes(),   field.ignore_label()};
   }
 };
 

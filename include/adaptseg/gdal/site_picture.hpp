@@ -53,11 +53,12 @@ inline double round_scale_length_m(double most_m) {
   cv::Mat base(size, CV_8UC3, cv::Scalar(255, 255, 255));
   // The mask scaled first: a full-resolution colour canvas of a large site would take gigabytes.
   cv::Mat small;
-  cv::resize(mask, small, cv::Size(std::max(1, static_cast<int>(std::lround(mask.cols * s))),
-                                   std::max(1, static_cast<int>(std::lround(mask.rows * s)))),
+  cv::resize(mask, small,
+             cv::Size(std::max(1, static_cast<int>(std::lround(mask.cols * s))),
+                      std::max(1, static_cast<int>(std::lround(mask.rows * s)))),
              0, 0, cv::INTER_NEAREST);
-  const cv::Rect at(static_cast<int>(std::lround(-canvas.x * s)), static_cast<int>(std::lround(-canvas.y * s)), small.cols,
-                    small.rows);
+  const cv::Rect at(static_cast<int>(std::lround(-canvas.x * s)), static_cast<int>(std::lround(-canvas.y * s)),
+                    small.cols, small.rows);
   const cv::Rect fit = at & cv::Rect(0, 0, size.width, size.height);
   if (fit.area() > 0) base(fit).setTo(cv::Scalar(170, 225, 170), small(fit - at.tl()));
   const auto px = [&](double x_m, double y_m) {
@@ -72,7 +73,8 @@ inline double round_scale_length_m(double most_m) {
   for (const auto& w : path)
     cv::rectangle(base, px(w.footprint.x_min_m, w.footprint.y_max_m), px(w.footprint.x_max_m, w.footprint.y_min_m),
                   cv::Scalar(150, 90, 40), 1);
-  static const cv::Scalar kSortie[] = {{60, 60, 60}, {30, 30, 200}, {200, 80, 30}, {30, 150, 200}, {150, 30, 150}, {30, 150, 30}};
+  static const cv::Scalar kSortie[] = {{60, 60, 60},   {30, 30, 200},  {200, 80, 30},
+                                       {30, 150, 200}, {150, 30, 150}, {30, 150, 30}};
   const cv::Point home = px(plan.home_xy.x(), plan.home_xy.y());
   const int radius = std::max(2, static_cast<int>(std::lround(std::min(size.width, size.height) / 150.0)));
   for (std::size_t k = 0; k < plan.sorties.size() && k < plan.routes.size(); ++k) {
@@ -82,18 +84,21 @@ inline double round_scale_length_m(double most_m) {
     for (const RoutePoint& r : plan.routes[k]) {
       const cv::Point p = px(r.position.x(), r.position.y());
       cv::line(base, prev, p, colour, 1, cv::LINE_AA);
-      if (r.image) cv::circle(base, p, radius, colour, cv::FILLED, cv::LINE_AA);
-      else cv::circle(base, p, std::max(2, radius / 2), colour, 1, cv::LINE_AA);  // a via point
+      if (r.image)
+        cv::circle(base, p, radius, colour, cv::FILLED, cv::LINE_AA);
+      else
+        cv::circle(base, p, std::max(2, radius / 2), colour, 1, cv::LINE_AA);  // a via point
       prev = p;
     }
     cv::line(base, prev, home, colour, 1, cv::LINE_4);  // the return
     if (plan.sorties.size() > 1)
-      detail::put_text(base, std::to_string(k + 1), px(path[sortie.first].position.x(), path[sortie.first].position.y()) +
-                                                        cv::Point(5, -5),
-                       0.5, colour, 2);
+      detail::put_text(base, std::to_string(k + 1),
+                       px(path[sortie.first].position.x(), path[sortie.first].position.y()) + cv::Point(5, -5), 0.5,
+                       colour, 2);
   }
   const int tri = radius + 5;
-  const std::vector<cv::Point> triangle{home + cv::Point(0, -tri), home + cv::Point(-tri, tri), home + cv::Point(tri, tri)};
+  const std::vector<cv::Point> triangle{home + cv::Point(0, -tri), home + cv::Point(-tri, tri),
+                                        home + cv::Point(tri, tri)};
   cv::fillConvexPoly(base, triangle, cv::Scalar(0, 0, 0), cv::LINE_AA);
   detail::put_text(base, "home", home + cv::Point(tri + 3, tri), 0.5);
 
@@ -117,8 +122,10 @@ inline double round_scale_length_m(double most_m) {
   const cv::Point2d north(std::cos(h), -std::sin(h));
   const cv::Point c(out.cols - 45, base.rows + 48);
   const int len = 28;
-  const cv::Point tail = c - cv::Point(static_cast<int>(std::lround(north.x * len * 0.7)), static_cast<int>(std::lround(north.y * len * 0.7)));
-  const cv::Point tip = c + cv::Point(static_cast<int>(std::lround(north.x * len * 0.7)), static_cast<int>(std::lround(north.y * len * 0.7)));
+  const cv::Point tail = c - cv::Point(static_cast<int>(std::lround(north.x * len * 0.7)),
+                                       static_cast<int>(std::lround(north.y * len * 0.7)));
+  const cv::Point tip = c + cv::Point(static_cast<int>(std::lround(north.x * len * 0.7)),
+                                      static_cast<int>(std::lround(north.y * len * 0.7)));
   cv::circle(out, c, len, cv::Scalar(160, 160, 160), 1, cv::LINE_AA);
   cv::arrowedLine(out, tail, tip, cv::Scalar(0, 0, 0), 2, cv::LINE_AA, 0, 0.35);
   const cv::Point n_at = c + cv::Point(static_cast<int>(std::lround(north.x * (len + 10))) - 5,

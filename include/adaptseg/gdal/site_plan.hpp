@@ -64,11 +64,11 @@ struct SitePlanOptions {
   /// simplified by at most half the inside margin to fit. Empty: no limit.
   std::optional<std::size_t> fence_max_vertices;
   // Thresholds of the warnings (not errors): a plan beyond them is flown as planned.
-  std::size_t warn_waypoints = 1000;   ///< more waypoints than this
-  double warn_flight_s = 2 * 3600.0;   ///< more flight, all sorties together [s]
-  double warn_sortie_s = 30 * 60.0;    ///< one unsplit sortie longer than this [s]: longer than batteries last
-  double warn_min_area_m2 = 100.0;     ///< a site smaller than this [m^2]: a footprint or two
-  double warn_max_area_m2 = 10e6;      ///< a site larger than this [m^2] (10 km^2)
+  std::size_t warn_waypoints = 1000;  ///< more waypoints than this
+  double warn_flight_s = 2 * 3600.0;  ///< more flight, all sorties together [s]
+  double warn_sortie_s = 30 * 60.0;   ///< one unsplit sortie longer than this [s]: longer than batteries last
+  double warn_min_area_m2 = 100.0;    ///< a site smaller than this [m^2]: a footprint or two
+  double warn_max_area_m2 = 10e6;     ///< a site larger than this [m^2] (10 km^2)
 
   /// @throws std::invalid_argument naming the first invalid member.
   void validate() const {
@@ -96,23 +96,23 @@ struct RoutePoint {
 
 /// A site's plan: what to fly, in how many sorties, and what to read first.
 struct SitePlan {
-  SiteSurvey survey;        ///< the waypoints (z: above home; with a DEM, following the terrain) and the coverage
-  double height_m = 0.0;    ///< the height above the ground the GSD flies at [m]
+  SiteSurvey survey;      ///< the waypoints (z: above home; with a DEM, following the terrain) and the coverage
+  double height_m = 0.0;  ///< the height above the ground the GSD flies at [m]
   Eigen::Vector2d home_xy = Eigen::Vector2d::Zero();  ///< take-off point in the site frame [m]
-  GeoPoint home;            ///< take-off point in WGS84, at the site frame's altitude
-  bool home_given = false;  ///< false: home is the ground under the first waypoint
-  std::optional<TerrainFollowing> terrain;  ///< with a DEM
-  std::vector<Sortie> sorties;              ///< one, or as many as the flight-time limit needs (over survey.waypoints)
+  GeoPoint home;                                      ///< take-off point in WGS84, at the site frame's altitude
+  bool home_given = false;                            ///< false: home is the ground under the first waypoint
+  std::optional<TerrainFollowing> terrain;            ///< with a DEM
+  std::vector<Sortie> sorties;  ///< one, or as many as the flight-time limit needs (over survey.waypoints)
   /// Per sortie, what it flies between the take-off (straight up at home) and the return (the
   /// autopilot's RTL, straight home from the last point): its waypoints and the via points that
   /// keep every leg inside the geofence.
   std::vector<std::vector<RoutePoint>> routes;
   std::size_t via_points = 0;  ///< via points of all routes
-  double survey_s = 0.0;   ///< between the waypoints (straight) and their holds, no take-off or return [s]
-  double flight_s = 0.0;   ///< every sortie from home and back, along its route [s]
-  SiteFence fence;                          ///< the geofence in the site frame
-  std::vector<GeoFencePolygon> geofence;    ///< the same in WGS84: outer rings inclusion, holes exclusion polygons
-  std::vector<std::string> warnings;        ///< one line each, for a person to read before flying
+  double survey_s = 0.0;       ///< between the waypoints (straight) and their holds, no take-off or return [s]
+  double flight_s = 0.0;       ///< every sortie from home and back, along its route [s]
+  SiteFence fence;             ///< the geofence in the site frame
+  std::vector<GeoFencePolygon> geofence;  ///< the same in WGS84: outer rings inclusion, holes exclusion polygons
+  std::vector<std::string> warnings;      ///< one line each, for a person to read before flying
 
   /// Sortie `k`'s route as a path to export: its waypoints and via points, home and the geofence.
   [[nodiscard]] ExportPath sortie_path(std::size_t k, const SurveySite& site) const {
@@ -204,10 +204,11 @@ inline std::string where_text(const GeoPoint& g) {
                                   detail::where_text(site.centre()) + ": take off on the site");
     plan.home_xy = frame.to_field(plan.home).head<2>();
     if (!site.contains(plan.home_xy))
-      throw std::invalid_argument("the take-off point " + detail::where_text(plan.home) + " lies " +
-                                  detail::fixed(site.distance_to_edge_m(plan.home_xy), 1) +
-                                  " m off the site (outside its outline or in a hole): take off on the site, inside the "
-                                  "geofence the plan carries");
+      throw std::invalid_argument(
+          "the take-off point " + detail::where_text(plan.home) + " lies " +
+          detail::fixed(site.distance_to_edge_m(plan.home_xy), 1) +
+          " m off the site (outside its outline or in a hole): take off on the site, inside the "
+          "geofence the plan carries");
     survey.start_xy = plan.home_xy;
   }
   plan.survey = survey_site(site, camera, options.gsd_cm, survey);
@@ -224,8 +225,9 @@ inline std::string where_text(const GeoPoint& g) {
   if (dem != nullptr) {
     if (!dem->elevation_m(plan.home.latitude_deg, plan.home.longitude_deg) &&
         looks_swapped(site, dem->centre(), dem->radius_m()))
-      throw std::invalid_argument("the DEM '" + dem->file().string() + "' covers " + detail::fixed(dem->radius_m() / 1000.0, 1) +
-                                  " km around " + detail::where_text(dem->centre()) + ", " +
+      throw std::invalid_argument("the DEM '" + dem->file().string() + "' covers " +
+                                  detail::fixed(dem->radius_m() / 1000.0, 1) + " km around " +
+                                  detail::where_text(dem->centre()) + ", " +
                                   detail::fixed(geodesic_distance_m(site.centre(), dem->centre()) / 1000.0, 0) +
                                   " km from the site, whose centre is " + detail::where_text(site.centre()) +
                                   "; swapped, the site would lie on it: are the site's latitude and longitude swapped "
@@ -233,19 +235,22 @@ inline std::string where_text(const GeoPoint& g) {
     plan.terrain = follow_terrain(path, frame, plan.home_xy, *dem, plan.height_m);
     for (std::size_t i = 0; i < path.size(); ++i)
       if (plan.terrain->clearance_m[i] < options.min_altitude_m)
-        throw std::invalid_argument("waypoint " + std::to_string(i) + " flies " + detail::fixed(plan.terrain->clearance_m[i], 1) +
-                                    " m above the highest ground under its footprint (DEM), below the minimum altitude " +
-                                    detail::fixed(options.min_altitude_m, 1) + " m: fly a coarser GSD");
+        throw std::invalid_argument(
+            "waypoint " + std::to_string(i) + " flies " + detail::fixed(plan.terrain->clearance_m[i], 1) +
+            " m above the highest ground under its footprint (DEM), below the minimum altitude " +
+            detail::fixed(options.min_altitude_m, 1) + " m: fly a coarser GSD");
   }
 
   // The geofence (simplified by at most a quarter of the margin, so waypoints stay 3/4 of it
   // inside) and the router that keeps legs half the margin inside it.
   const double margin = survey.inside_margin_m;
-  plan.fence = site_fence(site, options.fence_max_vertices.value_or(std::numeric_limits<std::size_t>::max()), 0.25 * margin);
+  plan.fence =
+      site_fence(site, options.fence_max_vertices.value_or(std::numeric_limits<std::size_t>::max()), 0.25 * margin);
   plan.geofence = plan.fence.wgs84(site.geo);
   const FenceRouter router(plan.fence.rings, plan.fence.inclusion, 0.5 * margin);
   if (!router.inside(plan.home_xy))
-    throw std::invalid_argument("the take-off point lies off the simplified geofence: take off farther inside the site");
+    throw std::invalid_argument(
+        "the take-off point lies off the simplified geofence: take off farther inside the site");
   for (std::size_t i = 0; i < path.size(); ++i)
     if (!router.inside(path[i].position.head<2>()))
       throw std::invalid_argument("waypoint " + std::to_string(i) +
@@ -263,7 +268,8 @@ inline std::string where_text(const GeoPoint& g) {
   std::vector<std::vector<Eigen::Vector3d>> legs(path.size());
   for (std::size_t i = 1; i < path.size(); ++i) {
     const Eigen::Vector3d a = path[i - 1].position, b = path[i].position;
-    const auto vias = route2d(a.head<2>(), b.head<2>(), "from waypoint " + std::to_string(i - 1) + " to " + std::to_string(i));
+    const auto vias =
+        route2d(a.head<2>(), b.head<2>(), "from waypoint " + std::to_string(i - 1) + " to " + std::to_string(i));
     double total = 0.0, run = 0.0;
     Eigen::Vector2d prev = a.head<2>();
     for (const auto& v : vias) total += (v - prev).norm(), prev = v;
@@ -276,11 +282,14 @@ inline std::string where_text(const GeoPoint& g) {
   }
   std::vector<std::optional<std::vector<Eigen::Vector2d>>> out_vias(path.size()), back_vias(path.size());
   const auto outbound = [&](std::size_t i) -> const std::vector<Eigen::Vector2d>& {
-    if (!out_vias[i]) out_vias[i] = route2d(plan.home_xy, path[i].position.head<2>(), "from the take-off to waypoint " + std::to_string(i));
+    if (!out_vias[i])
+      out_vias[i] =
+          route2d(plan.home_xy, path[i].position.head<2>(), "from the take-off to waypoint " + std::to_string(i));
     return *out_vias[i];
   };
   const auto back = [&](std::size_t i) -> const std::vector<Eigen::Vector2d>& {
-    if (!back_vias[i]) back_vias[i] = route2d(path[i].position.head<2>(), plan.home_xy, "from waypoint " + std::to_string(i) + " home");
+    if (!back_vias[i])
+      back_vias[i] = route2d(path[i].position.head<2>(), plan.home_xy, "from waypoint " + std::to_string(i) + " home");
     return *back_vias[i];
   };
   // Times along routes: every point a stop (the timing model's), holds at the waypoints only.
@@ -300,8 +309,8 @@ inline std::string where_text(const GeoPoint& g) {
       path.size(), options.max_flight_s,
       [&](std::size_t i) {
         const double z = path[i].position.z();
-        return timing.segment_time_s(home3, above_home(z)) + through(above_home(z), at_z(outbound(i), z), path[i].position) +
-               options.hold_s;
+        return timing.segment_time_s(home3, above_home(z)) +
+               through(above_home(z), at_z(outbound(i), z), path[i].position) + options.hold_s;
       },
       [&](std::size_t i) { return through(path[i - 1].position, legs[i], path[i].position) + options.hold_s; },
       [&](std::size_t i) {
@@ -321,7 +330,8 @@ inline std::string where_text(const GeoPoint& g) {
     for (const auto& p : route) plan.via_points += p.image ? 0 : 1;
   }
   plan.survey_s = options.hold_s * static_cast<double>(path.size());
-  for (std::size_t k = 1; k < path.size(); ++k) plan.survey_s += timing.segment_time_s(path[k - 1].position, path[k].position);
+  for (std::size_t k = 1; k < path.size(); ++k)
+    plan.survey_s += timing.segment_time_s(path[k - 1].position, path[k].position);
 
   if (dem != nullptr) {
     // Every leg a sortie flies over the DEM: up at home, along its route; the return is the
@@ -336,9 +346,10 @@ inline std::string where_text(const GeoPoint& g) {
         const auto name = [&](std::size_t r) {
           return route[r].image ? "waypoint " + std::to_string(*route[r].image) : std::string("a via point");
         };
-        throw std::invalid_argument((at == 0 ? "the leg from the take-off to " + name(0) : "the leg from " + name(at - 1) + " to " + name(at)) +
-                                    " passes " + detail::fixed(low, 1) + " m above the ground (DEM), below the minimum altitude " +
-                                    detail::fixed(options.min_altitude_m, 1) + " m: fly a coarser GSD");
+        throw std::invalid_argument(
+            (at == 0 ? "the leg from the take-off to " + name(0) : "the leg from " + name(at - 1) + " to " + name(at)) +
+            " passes " + detail::fixed(low, 1) + " m above the ground (DEM), below the minimum altitude " +
+            detail::fixed(options.min_altitude_m, 1) + " m: fly a coarser GSD");
       }
     }
   }
@@ -349,7 +360,8 @@ inline std::string where_text(const GeoPoint& g) {
   if (area < options.warn_min_area_m2 || area > options.warn_max_area_m2)
     warn.push_back("the site's area is " + detail::fixed(area, 0) + " m^2 (" + detail::fixed(area / 1e4, 2) +
                    " ha), outside " + detail::fixed(options.warn_min_area_m2, 0) + " m^2 .. " +
-                   detail::fixed(options.warn_max_area_m2 / 1e6, 0) + " km^2: is it the polygon you meant, in the units you meant?");
+                   detail::fixed(options.warn_max_area_m2 / 1e6, 0) +
+                   " km^2: is it the polygon you meant, in the units you meant?");
   if (path.size() > options.warn_waypoints)
     warn.push_back("the plan has " + std::to_string(path.size()) + " waypoints, more than " +
                    std::to_string(options.warn_waypoints) + ": check the GSD (" + detail::fixed(options.gsd_cm, 2) +

@@ -96,7 +96,8 @@ struct SurveySite {
     for (std::size_t k = 0; k < rings.size(); ++k) {
       const auto& r = rings[k];
       double twice = 0.0;
-      for (std::size_t i = 0, j = r.size() - 1; i < r.size(); j = i++) twice += r[j].x() * r[i].y() - r[i].x() * r[j].y();
+      for (std::size_t i = 0, j = r.size() - 1; i < r.size(); j = i++)
+        twice += r[j].x() * r[i].y() - r[i].x() * r[j].y();
       a += (k < holes.size() && holes[k] ? -0.5 : 0.5) * std::abs(twice);
     }
     return std::max(0.0, a);
@@ -119,8 +120,13 @@ struct SurveySite {
     double distance_m = 0.0, azimuth_deg = 0.0, azimuth_there_deg = 0.0;
     GeographicLib::Geodesic::WGS84().Inverse(o.latitude_deg, o.longitude_deg, ahead.latitude_deg, ahead.longitude_deg,
                                              distance_m, azimuth_deg, azimuth_there_deg);
-    return FieldGeo{o.latitude_deg, o.longitude_deg, geo.altitude_m, azimuth_deg < 0.0 ? azimuth_deg + 360.0 : azimuth_deg,
-                    0.0, 0.0, 1.0};
+    return FieldGeo{o.latitude_deg,
+                    o.longitude_deg,
+                    geo.altitude_m,
+                    azimuth_deg < 0.0 ? azimuth_deg + 360.0 : azimuth_deg,
+                    0.0,
+                    0.0,
+                    1.0};
   }
 };
 
@@ -133,7 +139,8 @@ inline double enclosing_rectangle_angle(const std::vector<Eigen::Vector2d>& poin
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
   for (const auto& q : points) mean += q / static_cast<double>(points.size());
   std::vector<cv::Point2f> p;
-  for (const auto& q : points) p.emplace_back(static_cast<float>(q.x() - mean.x()), static_cast<float>(q.y() - mean.y()));
+  for (const auto& q : points)
+    p.emplace_back(static_cast<float>(q.x() - mean.x()), static_cast<float>(q.y() - mean.y()));
   const cv::RotatedRect r = cv::minAreaRect(p);
   cv::Point2f v[4];
   r.points(v);
@@ -146,15 +153,16 @@ inline double enclosing_rectangle_angle(const std::vector<Eigen::Vector2d>& poin
 /// is an inner ring): the frame along the enclosing rectangle's longer side, the mask
 /// rasterised at `map_gsd_cm`.
 inline SurveySite site_from_rings(std::string name, const GeoPoint& origin, double altitude_m,
-                                  const std::vector<std::vector<Eigen::Vector2d>>& rings_enu, const std::vector<bool>& holes,
-                                  double map_gsd_cm) {
+                                  const std::vector<std::vector<Eigen::Vector2d>>& rings_enu,
+                                  const std::vector<bool>& holes, double map_gsd_cm) {
   std::vector<Eigen::Vector2d> all;
   for (const auto& r : rings_enu) all.insert(all.end(), r.begin(), r.end());
-  require(all.size() >= 3, "the area needs a polygon of at least 3 points; points",
-          all.size());
+  require(all.size() >= 3, "the area needs a polygon of at least 3 points; points", all.size());
   const double angle = enclosing_rectangle_angle(all);  // of +x, from east, counter-clockwise
   const double c = std::cos(angle), s = std::sin(angle);
-  const auto rotate = [&](const Eigen::Vector2d& e) { return Eigen::Vector2d(c * e.x() + s * e.y(), -s * e.x() + c * e.y()); };
+  const auto rotate = [&](const Eigen::Vector2d& e) {
+    return Eigen::Vector2d(c * e.x() + s * e.y(), -s * e.x() + c * e.y());
+  };
   double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
   for (const auto& e : all) {
     const Eigen::Vector2d q = rotate(e);
@@ -164,8 +172,13 @@ inline SurveySite site_from_rings(std::string name, const GeoPoint& origin, doub
   SurveySite site;
   site.name = std::move(name);
   // +x at compass bearing 90 - angle [deg]; the tangent point (0, 0 east-north) at -(x0, y0).
-  site.geo = FieldGeo{origin.latitude_deg, origin.longitude_deg, altitude_m,
-                      std::remainder(90.0 - angle * 180.0 / std::numbers::pi, 360.0), -x0, -y0, 1.0};
+  site.geo = FieldGeo{origin.latitude_deg,
+                      origin.longitude_deg,
+                      altitude_m,
+                      std::remainder(90.0 - angle * 180.0 / std::numbers::pi, 360.0),
+                      -x0,
+                      -y0,
+                      1.0};
   if (site.geo.heading_deg < 0.0) site.geo.heading_deg += 360.0;
   site.area.area = {0.0, 0.0, x1 - x0, y1 - y0};
   site.area.map_gsd_cm = map_gsd_cm;
@@ -209,23 +222,25 @@ inline SurveySite site_from_rings(std::string name, const GeoPoint& origin, doub
 /// The site from WGS84 rings (longitude, latitude; `holes` as site_from_rings): the tangent
 /// plane at the centre of their extent, then site_from_rings.
 inline SurveySite site_from_wgs84(const std::string& where, std::string name,
-                                  const std::vector<std::vector<Eigen::Vector2d>>& rings, const std::vector<bool>& holes,
-                                  double map_gsd_cm, double altitude_m) {
+                                  const std::vector<std::vector<Eigen::Vector2d>>& rings,
+                                  const std::vector<bool>& holes, double map_gsd_cm, double altitude_m) {
   for (const auto& r : rings)
     for (const auto& p : r) {
       if (std::isfinite(p.x()) && std::isfinite(p.y()) && std::abs(p.y()) <= 90.0 && std::abs(p.x()) <= 180.0) continue;
       // A latitude beyond 90 whose longitude would be a latitude: most likely swapped.
-      const bool swapped = std::isfinite(p.x()) && std::isfinite(p.y()) && std::abs(p.y()) <= 180.0 &&
-                           std::abs(p.x()) <= 90.0;
+      const bool swapped =
+          std::isfinite(p.x()) && std::isfinite(p.y()) && std::abs(p.y()) <= 180.0 && std::abs(p.x()) <= 90.0;
       throw std::invalid_argument(where + ": longitude, latitude out of range: (" + gdal::detail::num(p.x()) + ", " +
                                   gdal::detail::num(p.y()) + ")" +
-                                  (swapped ? ": are latitude and longitude swapped? GeoJSON and KML list longitude first"
-                                           : ": coordinates in metres need the file's CRS declared"));
+                                  (swapped
+                                       ? ": are latitude and longitude swapped? GeoJSON and KML list longitude first"
+                                       : ": coordinates in metres need the file's CRS declared"));
     }
   double lon0 = rings[0][0].x(), lon1 = lon0, lat0 = rings[0][0].y(), lat1 = lat0;
   for (const auto& r : rings)
     for (const auto& p : r)
-      lon0 = std::min(lon0, p.x()), lon1 = std::max(lon1, p.x()), lat0 = std::min(lat0, p.y()), lat1 = std::max(lat1, p.y());
+      lon0 = std::min(lon0, p.x()), lon1 = std::max(lon1, p.x()), lat0 = std::min(lat0, p.y()),
+      lat1 = std::max(lat1, p.y());
   const GeoPoint centre{0.5 * (lat0 + lat1), 0.5 * (lon0 + lon1), altitude_m};
   const GeographicLib::LocalCartesian plane(centre.latitude_deg, centre.longitude_deg, altitude_m);
   std::vector<std::vector<Eigen::Vector2d>> enu;
@@ -245,7 +260,8 @@ inline SurveySite site_from_wgs84(const std::string& where, std::string name,
 }
 
 /// The outline of an orthomosaic's pixels with data (alpha > 0, not the bands' nodata), in WGS84.
-inline std::vector<std::vector<Eigen::Vector2d>> raster_outline(const std::filesystem::path& file, const std::string& where) {
+inline std::vector<std::vector<Eigen::Vector2d>> raster_outline(const std::filesystem::path& file,
+                                                                const std::string& where) {
   const gdal::detail::Dataset d = gdal::detail::open(file);
   const gdal::RasterGrid grid = gdal::detail::grid_of(*d, file);
   cv::Mat data(grid.height_px, grid.width_px, CV_8UC1, cv::Scalar(255));
@@ -336,7 +352,8 @@ inline std::vector<std::vector<Eigen::Vector2d>> raster_outline(const std::files
       std::vector<Eigen::Vector2d> r;
       for (int i = 0; i < ring->getNumPoints(); ++i) {
         double x = ring->getX(i), y = ring->getY(i);
-        if (to_wgs84 && !to_wgs84->Transform(1, &x, &y)) throw std::invalid_argument(where + ": a point does not transform to WGS84");
+        if (to_wgs84 && !to_wgs84->Transform(1, &x, &y))
+          throw std::invalid_argument(where + ": a point does not transform to WGS84");
         r.emplace_back(x, y);
       }
       rings.push_back(std::move(r));
@@ -352,7 +369,8 @@ inline std::vector<std::vector<Eigen::Vector2d>> raster_outline(const std::files
     if (type == wkbMultiPolygon)
       for (const OGRPolygon* p : *g->toMultiPolygon()) add_polygon(*p);
   }
-  if (rings.empty()) throw std::invalid_argument(where + ": no polygon in its first layer (an area is a Polygon or MultiPolygon)");
+  if (rings.empty())
+    throw std::invalid_argument(where + ": no polygon in its first layer (an area is a Polygon or MultiPolygon)");
   return detail::site_from_wgs84(where, file.stem().string(), rings, holes, map_gsd_cm, altitude_m);
 }
 
@@ -380,8 +398,8 @@ struct SiteSurveyOptions {
 /// A site's lawnmower and what it leaves out.
 struct SiteSurvey {
   std::vector<Waypoint> waypoints;  ///< in visiting order, each at least the margin inside the site
-  std::size_t moved = 0;    ///< cells whose centre lay outside (or too near the edge) and whose waypoint moved inward
-  std::size_t dropped = 0;  ///< cells with some site under them but no point the margin inside: not flown
+  std::size_t moved = 0;      ///< cells whose centre lay outside (or too near the edge) and whose waypoint moved inward
+  std::size_t dropped = 0;    ///< cells with some site under them but no point the margin inside: not flown
   double site_m2 = 0.0;       ///< the site's area on its mask [m^2]
   double uncovered_m2 = 0.0;  ///< the site's area under no footprint [m^2]
 
@@ -394,8 +412,8 @@ namespace detail {
 /// The site-frame point nearest `c` among the mask's pixels in `rect` that lie at least
 /// `margin_m` inside the site (a pixel's distance to the nearest pixel off the site, less the
 /// 1.5 pixel a rasterised edge may be off by); empty if there is none.
-inline std::optional<Eigen::Vector2d> nearest_inside(const SurveySite& site, const cv::Rect& rect, const Eigen::Vector2d& c,
-                                                     double margin_m) {
+inline std::optional<Eigen::Vector2d> nearest_inside(const SurveySite& site, const cv::Rect& rect,
+                                                     const Eigen::Vector2d& c, double margin_m) {
   const cv::Mat& mask = site.area.valid_mask;
   const double px_m = site.area.map_gsd_cm / 100.0;
   const double need_px = margin_m / px_m + 1.5;
@@ -408,7 +426,8 @@ inline std::optional<Eigen::Vector2d> nearest_inside(const SurveySite& site, con
   if (in.area() > 0) mask(in).copyTo(sub(in - window.tl()));
   cv::Mat distance;
   cv::distanceTransform(sub != 0, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  const double cx = c.x() / px_m - window.x - 0.5, cy = mask.rows - c.y() / px_m - window.y - 0.5;  // c in window pixels
+  const double cx = c.x() / px_m - window.x - 0.5,
+               cy = mask.rows - c.y() / px_m - window.y - 0.5;  // c in window pixels
   double best = std::numeric_limits<double>::infinity();
   std::optional<Eigen::Vector2d> out;
   for (int r = pad; r < pad + rect.height; ++r) {
@@ -489,8 +508,8 @@ inline std::optional<Eigen::Vector2d> nearest_inside(const SurveySite& site, con
 /// survey_site()'s waypoints with `overlap` and the default margin (2 m inside), from the
 /// corner (x_min, y_min).
 /// @throws std::invalid_argument as LawnmowerPlanner::plan.
-[[nodiscard]] inline std::vector<Waypoint> plan_site_survey(const SurveySite& site, const CameraModel& camera, double gsd_cm,
-                                                            LawnmowerOverlap overlap = {}) {
+[[nodiscard]] inline std::vector<Waypoint> plan_site_survey(const SurveySite& site, const CameraModel& camera,
+                                                            double gsd_cm, LawnmowerOverlap overlap = {}) {
   SiteSurveyOptions options;
   options.overlap = overlap;
   return survey_site(site, camera, gsd_cm, options).waypoints;
@@ -550,7 +569,8 @@ struct SiteFence {
     for (const auto& r : fence.rings) {
       // Floats about the ring's first vertex: sub-millimetre over kilometres.
       std::vector<cv::Point2f> p, q;
-      for (const auto& v : r) p.emplace_back(static_cast<float>(v.x() - r[0].x()), static_cast<float>(v.y() - r[0].y()));
+      for (const auto& v : r)
+        p.emplace_back(static_cast<float>(v.x() - r[0].x()), static_cast<float>(v.y() - r[0].y()));
       cv::approxPolyDP(p, q, epsilon, true);
       auto& o = out.rings.emplace_back();
       if (q.size() < 3) {  // a ring smaller than the tolerance: keep a triangle of it
@@ -570,17 +590,19 @@ struct SiteFence {
   double lo = 0.0, hi = tolerance_m;  // the smallest tolerance that fits, to 1 % of the largest
   while (hi - lo > 0.01 * tolerance_m) {
     const double mid = 0.5 * (lo + hi);
-    if (simplified(mid).vertices() <= max_vertices) hi = mid;
-    else lo = mid;
+    if (simplified(mid).vertices() <= max_vertices)
+      hi = mid;
+    else
+      lo = mid;
   }
   return simplified(hi);
 }
 
 /// site_fence() in WGS84.
 /// @throws std::invalid_argument as site_fence().
-[[nodiscard]] inline std::vector<GeoFencePolygon> site_geofence(const SurveySite& site,
-                                                                std::size_t max_vertices = std::numeric_limits<std::size_t>::max(),
-                                                                double tolerance_m = 0.0) {
+[[nodiscard]] inline std::vector<GeoFencePolygon> site_geofence(
+    const SurveySite& site, std::size_t max_vertices = std::numeric_limits<std::size_t>::max(),
+    double tolerance_m = 0.0) {
   return site_fence(site, max_vertices, tolerance_m).wgs84(site.geo);
 }
 

@@ -46,9 +46,10 @@ class FenceRouter {
       : rings_(std::move(rings)), inclusion_(std::move(inclusion)), clearance_m_(clearance_m) {
     detail::require(rings_.size() == inclusion_.size(), "FenceRouter: one inclusion flag per ring is needed; flags",
                     inclusion_.size());
-    detail::require(std::isfinite(clearance_m) && clearance_m >= 0.0, "FenceRouter: clearance_m must be finite and >= 0",
-                    clearance_m);
-    for (const auto& r : rings_) detail::require(r.size() >= 3, "FenceRouter: a ring needs at least 3 vertices; vertices", r.size());
+    detail::require(std::isfinite(clearance_m) && clearance_m >= 0.0,
+                    "FenceRouter: clearance_m must be finite and >= 0", clearance_m);
+    for (const auto& r : rings_)
+      detail::require(r.size() >= 3, "FenceRouter: a ring needs at least 3 vertices; vertices", r.size());
   }
 
   [[nodiscard]] double clearance_m() const noexcept { return clearance_m_; }
@@ -68,7 +69,8 @@ class FenceRouter {
   [[nodiscard]] double distance_to_edges(const Eigen::Vector2d& a, const Eigen::Vector2d& b) const {
     double best = std::numeric_limits<double>::infinity();
     for (const auto& r : rings_)
-      for (std::size_t i = 0, j = r.size() - 1; i < r.size(); j = i++) best = std::min(best, segment_distance(a, b, r[j], r[i]));
+      for (std::size_t i = 0, j = r.size() - 1; i < r.size(); j = i++)
+        best = std::min(best, segment_distance(a, b, r[j], r[i]));
     return best;
   }
 
@@ -92,7 +94,9 @@ class FenceRouter {
     // Dijkstra over the vias, a (start) and b (goal).
     std::vector<double> dist(n + 2, std::numeric_limits<double>::infinity());
     std::vector<std::size_t> prev(n + 2, n + 2);
-    const auto point = [&](std::size_t i) -> const Eigen::Vector2d& { return i == start ? a : i == goal ? b : vias_[i]; };
+    const auto point = [&](std::size_t i) -> const Eigen::Vector2d& {
+      return i == start ? a : i == goal ? b : vias_[i];
+    };
     using Item = std::pair<double, std::size_t>;
     std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
     dist[start] = 0.0;
@@ -120,8 +124,8 @@ class FenceRouter {
       }
     }
     if (!std::isfinite(dist[goal]))
-      throw std::invalid_argument("FenceRouter::route: no route inside the geofence keeps " + std::to_string(clearance_m_) +
-                                  " m from its edges between the leg's ends");
+      throw std::invalid_argument("FenceRouter::route: no route inside the geofence keeps " +
+                                  std::to_string(clearance_m_) + " m from its edges between the leg's ends");
     std::vector<Eigen::Vector2d> out;
     for (std::size_t i = prev[goal]; i != start; i = prev[i]) out.push_back(vias_[i]);
     std::reverse(out.begin(), out.end());
@@ -163,7 +167,8 @@ class FenceRouter {
     for (const auto& r : rings_)
       for (std::size_t i = 0; i < r.size(); ++i) {
         const Eigen::Vector2d& v = r[i];
-        const Eigen::Vector2d u = (r[(i + r.size() - 1) % r.size()] - v).normalized(), w = (r[(i + 1) % r.size()] - v).normalized();
+        const Eigen::Vector2d u = (r[(i + r.size() - 1) % r.size()] - v).normalized(),
+                              w = (r[(i + 1) % r.size()] - v).normalized();
         Eigen::Vector2d bisector = u + w;
         if (bisector.norm() < 1e-9) bisector = Eigen::Vector2d(-u.y(), u.x());  // a straight corner: its normal
         bisector.normalize();

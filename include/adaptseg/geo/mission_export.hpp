@@ -47,19 +47,21 @@ namespace adaptseg {
 
 /// The MAVLink enumeration values the exports use (MAVLink common.xml).
 namespace mavlink {
-inline constexpr int kCmdNavWaypoint = 16;          ///< MAV_CMD_NAV_WAYPOINT: p1 hold [s], p4 yaw, p5-7 position
-inline constexpr int kCmdNavReturnToLaunch = 20;    ///< MAV_CMD_NAV_RETURN_TO_LAUNCH: no parameters
-inline constexpr int kCmdNavLand = 21;              ///< MAV_CMD_NAV_LAND: p4 yaw, p5-7 position (altitude ignored)
-inline constexpr int kCmdNavTakeoff = 22;           ///< MAV_CMD_NAV_TAKEOFF: p1 pitch, p4 yaw, p5-6 position, p7 altitude
-inline constexpr int kCmdDoChangeSpeed = 178;       ///< MAV_CMD_DO_CHANGE_SPEED: p1 speed type (1 ground), p2 speed [m/s], p3 throttle (-1: unchanged)
-inline constexpr int kCmdDoDigicamControl = 203;    ///< MAV_CMD_DO_DIGICAM_CONTROL: p5 1 = take one shot
-inline constexpr int kCmdImageStartCapture = 2000;  ///< MAV_CMD_IMAGE_START_CAPTURE: p1 camera, p2 interval, p3 count, p4 sequence
-inline constexpr int kFrameGlobal = 0;              ///< MAV_FRAME_GLOBAL: altitude above mean sea level
-inline constexpr int kFrameMission = 2;             ///< MAV_FRAME_MISSION: the item has no position
-inline constexpr int kFrameGlobalRelativeAlt = 3;   ///< MAV_FRAME_GLOBAL_RELATIVE_ALT: altitude above home
-inline constexpr int kAutopilotArduPilot = 3;       ///< MAV_AUTOPILOT_ARDUPILOTMEGA
-inline constexpr int kAutopilotPx4 = 12;            ///< MAV_AUTOPILOT_PX4
-inline constexpr int kTypeQuadrotor = 2;            ///< MAV_TYPE_QUADROTOR
+inline constexpr int kCmdNavWaypoint = 16;        ///< MAV_CMD_NAV_WAYPOINT: p1 hold [s], p4 yaw, p5-7 position
+inline constexpr int kCmdNavReturnToLaunch = 20;  ///< MAV_CMD_NAV_RETURN_TO_LAUNCH: no parameters
+inline constexpr int kCmdNavLand = 21;            ///< MAV_CMD_NAV_LAND: p4 yaw, p5-7 position (altitude ignored)
+inline constexpr int kCmdNavTakeoff = 22;         ///< MAV_CMD_NAV_TAKEOFF: p1 pitch, p4 yaw, p5-6 position, p7 altitude
+inline constexpr int kCmdDoChangeSpeed =
+    178;  ///< MAV_CMD_DO_CHANGE_SPEED: p1 speed type (1 ground), p2 speed [m/s], p3 throttle (-1: unchanged)
+inline constexpr int kCmdDoDigicamControl = 203;  ///< MAV_CMD_DO_DIGICAM_CONTROL: p5 1 = take one shot
+inline constexpr int kCmdImageStartCapture =
+    2000;                                ///< MAV_CMD_IMAGE_START_CAPTURE: p1 camera, p2 interval, p3 count, p4 sequence
+inline constexpr int kFrameGlobal = 0;   ///< MAV_FRAME_GLOBAL: altitude above mean sea level
+inline constexpr int kFrameMission = 2;  ///< MAV_FRAME_MISSION: the item has no position
+inline constexpr int kFrameGlobalRelativeAlt = 3;  ///< MAV_FRAME_GLOBAL_RELATIVE_ALT: altitude above home
+inline constexpr int kAutopilotArduPilot = 3;      ///< MAV_AUTOPILOT_ARDUPILOTMEGA
+inline constexpr int kAutopilotPx4 = 12;           ///< MAV_AUTOPILOT_PX4
+inline constexpr int kTypeQuadrotor = 2;           ///< MAV_TYPE_QUADROTOR
 }  // namespace mavlink
 
 /// One waypoint of an exported path.
@@ -79,17 +81,17 @@ struct ExportWaypoint {
 /// exclusion one (QGroundControl's `geoFence.polygons[]`, MAVLink's
 /// MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION / _EXCLUSION, 5001 / 5002).
 struct GeoFencePolygon {
-  bool inclusion = true;          ///< true: stay inside; false: stay outside (a hole of the site)
-  std::vector<GeoPoint> vertices; ///< at least 3, not closed (the first is not repeated); altitudes unused
+  bool inclusion = true;           ///< true: stay inside; false: stay outside (a hole of the site)
+  std::vector<GeoPoint> vertices;  ///< at least 3, not closed (the first is not repeated); altitudes unused
 
   friend bool operator==(const GeoFencePolygon&, const GeoFencePolygon&) = default;
 };
 
 /// A path in WGS84, ready to export: built from field-frame waypoints by make_export_path().
 struct ExportPath {
-  std::string name;                        ///< the GeoJSON's name (the .plan and WPL formats have no place for it)
-  GeoPoint home;                           ///< take-off: the field frame's origin on the field plane (or the caller's)
-  std::vector<ExportWaypoint> waypoints;   ///< in visiting order
+  std::string name;                       ///< the GeoJSON's name (the .plan and WPL formats have no place for it)
+  GeoPoint home;                          ///< take-off: the field frame's origin on the field plane (or the caller's)
+  std::vector<ExportWaypoint> waypoints;  ///< in visiting order
   /// The geofence the .plan carries (empty: none). adaptseg_plan gives the site's polygon, its
   /// holes as exclusion polygons.
   std::vector<GeoFencePolygon> geofence;
@@ -155,11 +157,11 @@ inline std::string firmware_name(int firmware_type) {
 
 /// Settings of the mission files.
 struct ExportOptions {
-  double hold_s = 1.0;              ///< hold time at every waypoint before the image [s] (NAV_WAYPOINT param1)
-  bool capture_images = true;       ///< a camera trigger after every waypoint
+  double hold_s = 1.0;         ///< hold time at every waypoint before the image [s] (NAV_WAYPOINT param1)
+  bool capture_images = true;  ///< a camera trigger after every waypoint
   /// Which item triggers the camera; empty: the firmware's own (firmware_camera_trigger()).
   std::optional<CameraTrigger> camera_trigger;
-  bool takeoff = true;              ///< a NAV_TAKEOFF at home to the first waypoint's altitude, first
+  bool takeoff = true;                            ///< a NAV_TAKEOFF at home to the first waypoint's altitude, first
   MissionEnd end = MissionEnd::return_to_launch;  ///< the item after the last waypoint
   /// Multicopter speed [m/s]: .plan `hoverSpeed`, and the DO_CHANGE_SPEED item (`set_speed`);
   /// the programs set the mission's modelled speed.
@@ -170,7 +172,7 @@ struct ExportOptions {
   /// The highest a waypoint may fly above home [m] (120: the usual legal ceiling for small
   /// UAVs); a path above it is refused.
   double max_altitude_m = 120.0;
-  double cruise_speed_mps = 15.0;   ///< fixed-wing speed [m/s] (.plan `cruiseSpeed`, required by QGC)
+  double cruise_speed_mps = 15.0;              ///< fixed-wing speed [m/s] (.plan `cruiseSpeed`, required by QGC)
   int firmware_type = mavlink::kAutopilotPx4;  ///< MAV_AUTOPILOT of the .plan (mavlink::kAutopilotArduPilot: 3)
   int vehicle_type = mavlink::kTypeQuadrotor;  ///< MAV_TYPE of the .plan
   /// The most mission items a file may hold; empty: the firmware's (firmware_mission_item_limit()).
@@ -202,9 +204,9 @@ struct ExportOptions {
 
 /// One MAVLink mission item (the fields of MISSION_ITEM_INT that mission files carry).
 struct MissionItem {
-  int command = 0;                ///< MAV_CMD
-  int frame = 0;                  ///< MAV_FRAME
-  std::array<double, 7> params{}; ///< param1..4, x (latitude), y (longitude), z (altitude); NaN: unset
+  int command = 0;                 ///< MAV_CMD
+  int frame = 0;                   ///< MAV_FRAME
+  std::array<double, 7> params{};  ///< param1..4, x (latitude), y (longitude), z (altitude); NaN: unset
   bool autocontinue = true;
 };
 
@@ -255,9 +257,10 @@ inline std::string export_file_name(ExportFormat format, const std::string& stem
 ///         not finite.
 inline ExportPath make_export_path(const std::vector<Waypoint>& path, const std::vector<int>& levels,
                                    const GeoReference& geo, std::string name) {
-  detail::require(levels.size() == path.size(), "make_export_path: one level per waypoint is needed, waypoints " +
-                                                    std::to_string(path.size()) + ", levels",
-                  levels.size());
+  detail::require(
+      levels.size() == path.size(),
+      "make_export_path: one level per waypoint is needed, waypoints " + std::to_string(path.size()) + ", levels",
+      levels.size());
   ExportPath out;
   out.name = std::move(name);
   out.home = geo.to_wgs84(Eigen::Vector3d::Zero());
@@ -272,7 +275,8 @@ inline ExportPath make_export_path(const std::vector<Waypoint>& path, const std:
     const GeoPoint g = geo.to_wgs84(p);
     // Altitudes to the centimetre: 165.00000000001054 m is what a GSD's arithmetic gives, not
     // what an autopilot should be told.
-    out.waypoints.push_back({g.latitude_deg, g.longitude_deg, std::round(p.z() * 100.0) / 100.0, path[i].gsd_cm, levels[i], false});
+    out.waypoints.push_back(
+        {g.latitude_deg, g.longitude_deg, std::round(p.z() * 100.0) / 100.0, path[i].gsd_cm, levels[i], false});
   }
   return out;
 }
@@ -319,41 +323,48 @@ inline std::vector<MissionItem> mission_items(const ExportPath& path, const Expo
     const double altitude = path.waypoints.front().relative_altitude_m;
     detail::require(altitude > 0.0, "mission_items: a take-off needs the first waypoint above home, relative altitude",
                     altitude);
-    items.push_back({mavlink::kCmdNavTakeoff, mavlink::kFrameGlobalRelativeAlt,
+    items.push_back({mavlink::kCmdNavTakeoff,
+                     mavlink::kFrameGlobalRelativeAlt,
                      {0.0, 0.0, 0.0, kNaN, path.home.latitude_deg, path.home.longitude_deg, altitude},
                      true});
   }
   if (options.set_speed)
-    items.push_back({mavlink::kCmdDoChangeSpeed, mavlink::kFrameMission,
+    items.push_back({mavlink::kCmdDoChangeSpeed,
+                     mavlink::kFrameMission,
                      {1.0, options.hover_speed_mps, -1.0, 0.0, kNaN, kNaN, kNaN},
                      true});
   int sequence = 0;
   for (const auto& w : path.waypoints) {
-    items.push_back({mavlink::kCmdNavWaypoint, mavlink::kFrameGlobalRelativeAlt,
-                     {w.via ? 0.0 : options.hold_s, 0.0, 0.0, kNaN, w.latitude_deg, w.longitude_deg, w.relative_altitude_m},
-                     true});
+    items.push_back(
+        {mavlink::kCmdNavWaypoint,
+         mavlink::kFrameGlobalRelativeAlt,
+         {w.via ? 0.0 : options.hold_s, 0.0, 0.0, kNaN, w.latitude_deg, w.longitude_deg, w.relative_altitude_m},
+         true});
     if (!options.capture_images || w.via) continue;
     if (options.trigger() == CameraTrigger::image_start_capture)
-      items.push_back({mavlink::kCmdImageStartCapture, mavlink::kFrameMission,
+      items.push_back({mavlink::kCmdImageStartCapture,
+                       mavlink::kFrameMission,
                        {0.0, 0.0, 1.0, static_cast<double>(++sequence), kNaN, kNaN, kNaN},
                        true});
     else
-      items.push_back({mavlink::kCmdDoDigicamControl, mavlink::kFrameMission, {0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0},
-                       true});
+      items.push_back(
+          {mavlink::kCmdDoDigicamControl, mavlink::kFrameMission, {0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0}, true});
   }
   if (options.end == MissionEnd::return_to_launch)
     items.push_back({mavlink::kCmdNavReturnToLaunch, mavlink::kFrameMission, {}, true});
   else if (options.end == MissionEnd::land)
-    items.push_back({mavlink::kCmdNavLand, mavlink::kFrameGlobalRelativeAlt,
+    items.push_back({mavlink::kCmdNavLand,
+                     mavlink::kFrameGlobalRelativeAlt,
                      {0.0, 0.0, 0.0, kNaN, path.home.latitude_deg, path.home.longitude_deg, 0.0},
                      true});
-  if (const auto limit = options.max_mission_items ? options.max_mission_items
-                                                   : firmware_mission_item_limit(options.firmware_type);
+  if (const auto limit =
+          options.max_mission_items ? options.max_mission_items : firmware_mission_item_limit(options.firmware_type);
       limit && items.size() > *limit)
-    throw std::invalid_argument("mission_items: the mission has " + std::to_string(items.size()) +
-                                " mission items (" + std::to_string(path.waypoints.size()) + " waypoints), more than " +
-                                (options.max_mission_items ? std::string("max_mission_items ")
-                                                           : "the " + firmware_name(options.firmware_type) + " limit of ") +
+    throw std::invalid_argument("mission_items: the mission has " + std::to_string(items.size()) + " mission items (" +
+                                std::to_string(path.waypoints.size()) + " waypoints), more than " +
+                                (options.max_mission_items
+                                     ? std::string("max_mission_items ")
+                                     : "the " + firmware_name(options.firmware_type) + " limit of ") +
                                 std::to_string(*limit) + ": split it into sorties, or fly fewer waypoints");
   return items;
 }
@@ -491,8 +502,8 @@ inline MissionFile read_qgc_plan(std::string_view text) {
   if (!home.is_array() || home.size() != 3)
     detail::export_parse_error(kFmt, "mission.plannedHomePosition must be [latitude, longitude, altitude]");
   // [lat, lon, alt] is the reverse of GeoJSON's order: swap into it for json_position.
-  out.home = detail::json_position(nlohmann::json::array({home[1], home[0], home[2]}), kFmt,
-                                   "mission.plannedHomePosition");
+  out.home =
+      detail::json_position(nlohmann::json::array({home[1], home[0], home[2]}), kFmt, "mission.plannedHomePosition");
   const nlohmann::json& items = detail::json_member(mission, "items", kFmt, "mission");
   if (!items.is_array()) detail::export_parse_error(kFmt, "mission.items must be an array");
   for (std::size_t i = 0; i < items.size(); ++i) {
@@ -513,9 +524,9 @@ inline MissionFile read_qgc_plan(std::string_view text) {
     if (!params.is_array() || params.size() != 7)
       detail::export_parse_error(kFmt, where + ".params must be an array of 7 numbers or nulls");
     for (std::size_t k = 0; k < 7; ++k)
-      item.params[k] = params[k].is_null() ? std::numeric_limits<double>::quiet_NaN()
-                                           : detail::json_number(params[k], kFmt,
-                                                                 where + ".params[" + std::to_string(k) + "]");
+      item.params[k] = params[k].is_null()
+                           ? std::numeric_limits<double>::quiet_NaN()
+                           : detail::json_number(params[k], kFmt, where + ".params[" + std::to_string(k) + "]");
     detail::check_item_position(item, kFmt, where);
     out.items.push_back(item);
   }
@@ -538,7 +549,8 @@ inline MissionFile read_qgc_plan(std::string_view text) {
           const std::string vwhere = where + ".polygon[" + std::to_string(i) + "]";
           if (!ring[i].is_array() || ring[i].size() != 2)
             detail::export_parse_error(kFmt, vwhere + " must be [latitude, longitude]");
-          f.vertices.push_back(detail::json_position(nlohmann::json::array({ring[i][1], ring[i][0], 0.0}), kFmt, vwhere));
+          f.vertices.push_back(
+              detail::json_position(nlohmann::json::array({ring[i][1], ring[i][0], 0.0}), kFmt, vwhere));
         }
         out.geofence.push_back(std::move(f));
       }
@@ -563,8 +575,10 @@ inline std::string write_wpl(const ExportPath& path, const ExportOptions& option
     out += item.autocontinue ? "\t1\n" : "\t0\n";
   };
   line(0, true,
-       {mavlink::kCmdNavWaypoint, mavlink::kFrameGlobal,
-        {0.0, 0.0, 0.0, 0.0, path.home.latitude_deg, path.home.longitude_deg, path.home.altitude_m}, true});
+       {mavlink::kCmdNavWaypoint,
+        mavlink::kFrameGlobal,
+        {0.0, 0.0, 0.0, 0.0, path.home.latitude_deg, path.home.longitude_deg, path.home.altitude_m},
+        true});
   const std::vector<MissionItem> items = mission_items(path, options);
   for (std::size_t i = 0; i < items.size(); ++i) line(i + 1, false, items[i]);
   return out;
@@ -607,8 +621,10 @@ inline MissionFile read_wpl(std::string_view text) {
     }
     if (fields.empty()) continue;
     if (fields.size() != 12)
-      detail::export_parse_error(kFmt, at + ": want 12 fields (seq current frame command p1..p4 lat lon alt "
-                                            "autocontinue), got " + std::to_string(fields.size()));
+      detail::export_parse_error(kFmt, at +
+                                           ": want 12 fields (seq current frame command p1..p4 lat lon alt "
+                                           "autocontinue), got " +
+                                           std::to_string(fields.size()));
     long long ints[4];
     static constexpr const char* kIntNames[] = {"seq", "current", "frame", "command"};
     static constexpr long long kIntMax[] = {65535, 1, 255, 65535};
@@ -621,8 +637,8 @@ inline MissionFile read_wpl(std::string_view text) {
                                              std::string(fields[static_cast<std::size_t>(k)]) + "')");
     const std::size_t want_seq = home ? out.items.size() + 1 : 0;
     if (static_cast<std::size_t>(ints[0]) != want_seq)
-      detail::export_parse_error(kFmt, at + ": seq " + std::to_string(ints[0]) + " out of order (want " +
-                                           std::to_string(want_seq) + ")");
+      detail::export_parse_error(
+          kFmt, at + ": seq " + std::to_string(ints[0]) + " out of order (want " + std::to_string(want_seq) + ")");
     MissionItem item;
     item.frame = static_cast<int>(ints[2]);
     item.command = static_cast<int>(ints[3]);
@@ -636,7 +652,8 @@ inline MissionFile read_wpl(std::string_view text) {
     detail::check_item_position(item, kFmt, at);
     if (!home) {
       if (!std::isfinite(item.params[4]) || !std::isfinite(item.params[5]) || !std::isfinite(item.params[6]))
-        detail::export_parse_error(kFmt, at + ": the home position must have a finite latitude, longitude and altitude");
+        detail::export_parse_error(kFmt,
+                                   at + ": the home position must have a finite latitude, longitude and altitude");
       out.home = {item.params[4], item.params[5], item.params[6]};
       home = true;
     } else {
@@ -676,7 +693,9 @@ inline std::string write_geojson(const ExportPath& path) {
                          {{"kind", "waypoint"},
                           {"index", i},
                           {"level", w.level},
-                          {"role", w.via ? "via" : w.level == 0 ? "top-level" : "descent"},
+                          {"role", w.via          ? "via"
+                                   : w.level == 0 ? "top-level"
+                                                  : "descent"},
                           {"gsd_cm", w.gsd_cm},
                           {"relative_altitude_m", w.relative_altitude_m}}},
                         {"geometry", {{"type", "Point"}, {"coordinates", position(w)}}}});
@@ -710,9 +729,8 @@ inline ExportPath read_geojson(std::string_view text) {
     if (detail::json_string(detail::json_member(f, "type", kFmt, where), kFmt, where + ".type") != "Feature")
       detail::export_parse_error(kFmt, where + ".type must be \"Feature\"");
     const nlohmann::json& geometry = detail::json_member(f, "geometry", kFmt, where);
-    const std::string& type =
-        detail::json_string(detail::json_member(geometry, "type", kFmt, where + ".geometry"), kFmt,
-                            where + ".geometry.type");
+    const std::string& type = detail::json_string(detail::json_member(geometry, "type", kFmt, where + ".geometry"),
+                                                  kFmt, where + ".geometry.type");
     const nlohmann::json& coords = detail::json_member(geometry, "coordinates", kFmt, where + ".geometry");
     const std::string cwhere = where + ".geometry.coordinates";
     if (type == "LineString") {
@@ -734,8 +752,8 @@ inline ExportPath read_geojson(std::string_view text) {
       w.level = static_cast<int>(detail::json_integer(detail::json_member(props, "level", kFmt, pwhere), 0,
                                                       std::numeric_limits<int>::max(), kFmt, pwhere + ".level"));
       w.gsd_cm = detail::json_number(detail::json_member(props, "gsd_cm", kFmt, pwhere), kFmt, pwhere + ".gsd_cm");
-      w.relative_altitude_m = detail::json_number(detail::json_member(props, "relative_altitude_m", kFmt, pwhere),
-                                                  kFmt, pwhere + ".relative_altitude_m");
+      w.relative_altitude_m = detail::json_number(detail::json_member(props, "relative_altitude_m", kFmt, pwhere), kFmt,
+                                                  pwhere + ".relative_altitude_m");
       w.via = props.contains("role") && props["role"] == "via";
       if (!points.emplace(index, std::make_pair(w, g)).second)
         detail::export_parse_error(kFmt, pwhere + ".index " + std::to_string(index) + " appears twice");
@@ -756,8 +774,8 @@ inline ExportPath read_geojson(std::string_view text) {
     const GeoPoint& g = wg.second;
     if (std::abs(p.latitude_deg - g.latitude_deg) > 1e-9 || std::abs(p.longitude_deg - g.longitude_deg) > 1e-9 ||
         std::abs(p.altitude_m - g.altitude_m) > 1e-6)
-      detail::export_parse_error(kFmt, "LineString position " + std::to_string(index) +
-                                           " differs from the waypoint Point of that index");
+      detail::export_parse_error(
+          kFmt, "LineString position " + std::to_string(index) + " differs from the waypoint Point of that index");
     out.waypoints.push_back(wg.first);
   }
   return out;

@@ -82,8 +82,8 @@ inline double takeoff_time_s(const TimingModel& timing, const Eigen::Vector3d& h
 /// @throws std::invalid_argument for a limit that is not finite and positive, or a waypoint
 ///         that alone, from home and back, takes longer than the limit (naming it and both times).
 template <typename Outbound, typename Leg, typename Return>
-[[nodiscard]] std::vector<Sortie> split_into_sorties(std::size_t n, std::optional<double> max_flight_s, Outbound&& outbound_s,
-                                                     Leg&& leg_s, Return&& return_s) {
+[[nodiscard]] std::vector<Sortie> split_into_sorties(std::size_t n, std::optional<double> max_flight_s,
+                                                     Outbound&& outbound_s, Leg&& leg_s, Return&& return_s) {
   if (n == 0) return {};
   if (!max_flight_s) {
     double t = outbound_s(std::size_t{0});
@@ -121,8 +121,8 @@ template <typename Outbound, typename Leg, typename Return>
 /// `max_flight_s`; the greedy split above.
 /// @throws std::invalid_argument as the split above, or for a negative hold.
 [[nodiscard]] inline std::vector<Sortie> split_into_sorties(std::span<const Waypoint> path, const Eigen::Vector3d& home,
-                                                           const TimingModel& timing, double hold_s,
-                                                           std::optional<double> max_flight_s = std::nullopt) {
+                                                            const TimingModel& timing, double hold_s,
+                                                            std::optional<double> max_flight_s = std::nullopt) {
   detail::require(std::isfinite(hold_s) && hold_s >= 0.0, "split_into_sorties: hold_s must be finite and >= 0", hold_s);
   return split_into_sorties(
       path.size(), max_flight_s,

@@ -18,9 +18,9 @@ inline constexpr std::uint8_t kMavlinkVersion = 3;
 
 /// MAV_CMD: commands of COMMAND_LONG / COMMAND_INT (`command`, uint16).
 namespace mav_cmd {
-inline constexpr std::uint16_t kNavWaypoint = 16;          ///< MAV_CMD_NAV_WAYPOINT
-inline constexpr std::uint16_t kNavReturnToLaunch = 20;    ///< MAV_CMD_NAV_RETURN_TO_LAUNCH: no parameters
-inline constexpr std::uint16_t kNavLand = 21;              ///< MAV_CMD_NAV_LAND
+inline constexpr std::uint16_t kNavWaypoint = 16;        ///< MAV_CMD_NAV_WAYPOINT
+inline constexpr std::uint16_t kNavReturnToLaunch = 20;  ///< MAV_CMD_NAV_RETURN_TO_LAUNCH: no parameters
+inline constexpr std::uint16_t kNavLand = 21;            ///< MAV_CMD_NAV_LAND
 /// MAV_CMD_NAV_TAKEOFF: p1 pitch, p4 yaw [deg], p5-p6 latitude, longitude, p7 altitude [m]
 inline constexpr std::uint16_t kNavTakeoff = 22;
 /// MAV_CMD_DO_SET_MODE: p1 base mode (MAV_MODE_FLAG, with kCustomModeEnabled), p2 custom mode,
@@ -43,22 +43,22 @@ inline constexpr std::uint16_t kImageStartCapture = 2000;
 
 /// MAV_RESULT: COMMAND_ACK's `result` (uint8).
 namespace mav_result {
-inline constexpr std::uint8_t kAccepted = 0;                   ///< MAV_RESULT_ACCEPTED
-inline constexpr std::uint8_t kTemporarilyRejected = 1;        ///< MAV_RESULT_TEMPORARILY_REJECTED
-inline constexpr std::uint8_t kDenied = 2;                     ///< MAV_RESULT_DENIED
-inline constexpr std::uint8_t kUnsupported = 3;                ///< MAV_RESULT_UNSUPPORTED
-inline constexpr std::uint8_t kFailed = 4;                     ///< MAV_RESULT_FAILED
-inline constexpr std::uint8_t kInProgress = 5;                 ///< MAV_RESULT_IN_PROGRESS: another ACK follows
-inline constexpr std::uint8_t kCancelled = 6;                  ///< MAV_RESULT_CANCELLED
-inline constexpr std::uint8_t kCommandLongOnly = 7;            ///< MAV_RESULT_COMMAND_LONG_ONLY
-inline constexpr std::uint8_t kCommandIntOnly = 8;             ///< MAV_RESULT_COMMAND_INT_ONLY
-inline constexpr std::uint8_t kCommandUnsupportedMavFrame = 9; ///< MAV_RESULT_COMMAND_UNSUPPORTED_MAV_FRAME
+inline constexpr std::uint8_t kAccepted = 0;                    ///< MAV_RESULT_ACCEPTED
+inline constexpr std::uint8_t kTemporarilyRejected = 1;         ///< MAV_RESULT_TEMPORARILY_REJECTED
+inline constexpr std::uint8_t kDenied = 2;                      ///< MAV_RESULT_DENIED
+inline constexpr std::uint8_t kUnsupported = 3;                 ///< MAV_RESULT_UNSUPPORTED
+inline constexpr std::uint8_t kFailed = 4;                      ///< MAV_RESULT_FAILED
+inline constexpr std::uint8_t kInProgress = 5;                  ///< MAV_RESULT_IN_PROGRESS: another ACK follows
+inline constexpr std::uint8_t kCancelled = 6;                   ///< MAV_RESULT_CANCELLED
+inline constexpr std::uint8_t kCommandLongOnly = 7;             ///< MAV_RESULT_COMMAND_LONG_ONLY
+inline constexpr std::uint8_t kCommandIntOnly = 8;              ///< MAV_RESULT_COMMAND_INT_ONLY
+inline constexpr std::uint8_t kCommandUnsupportedMavFrame = 9;  ///< MAV_RESULT_COMMAND_UNSUPPORTED_MAV_FRAME
 }  // namespace mav_result
 
 /// MAV_FRAME: `frame` of COMMAND_INT, `coordinate_frame` of the position targets (uint8).
 namespace mav_frame {
-inline constexpr std::uint8_t kGlobal = 0;               ///< MAV_FRAME_GLOBAL: altitude above mean sea level
-inline constexpr std::uint8_t kGlobalRelativeAlt = 3;    ///< MAV_FRAME_GLOBAL_RELATIVE_ALT: altitude above home
+inline constexpr std::uint8_t kGlobal = 0;             ///< MAV_FRAME_GLOBAL: altitude above mean sea level
+inline constexpr std::uint8_t kGlobalRelativeAlt = 3;  ///< MAV_FRAME_GLOBAL_RELATIVE_ALT: altitude above home
 /// MAV_FRAME_GLOBAL_INT: latitude and longitude scaled by 1e7, altitude above mean sea level
 inline constexpr std::uint8_t kGlobalInt = 5;
 /// MAV_FRAME_GLOBAL_RELATIVE_ALT_INT: latitude and longitude scaled by 1e7, altitude above home
@@ -112,7 +112,7 @@ inline constexpr std::uint8_t kGeneric = 0;        ///< MAV_AUTOPILOT_GENERIC
 inline constexpr std::uint8_t kArduPilotMega = 3;  ///< MAV_AUTOPILOT_ARDUPILOTMEGA: ArduPilot
 /// MAV_AUTOPILOT_INVALID: not an autopilot (a GCS, a camera, a companion)
 inline constexpr std::uint8_t kInvalid = 8;
-inline constexpr std::uint8_t kPx4 = 12;           ///< MAV_AUTOPILOT_PX4
+inline constexpr std::uint8_t kPx4 = 12;  ///< MAV_AUTOPILOT_PX4
 }  // namespace mav_autopilot
 
 /// MAV_STATE: HEARTBEAT's `system_status` (uint8).
@@ -160,11 +160,11 @@ inline constexpr std::uint8_t kDebug = 7;      ///< MAV_SEVERITY_DEBUG
 
 /// MAV_COMPONENT: component ids of a frame's sender and of a command's target (uint8).
 namespace mav_component {
-inline constexpr std::uint8_t kAll = 0;               ///< MAV_COMP_ID_ALL: every component (a target)
-inline constexpr std::uint8_t kAutopilot1 = 1;        ///< MAV_COMP_ID_AUTOPILOT1
-inline constexpr std::uint8_t kCamera = 100;          ///< MAV_COMP_ID_CAMERA
-inline constexpr std::uint8_t kMissionPlanner = 190;  ///< MAV_COMP_ID_MISSIONPLANNER: a GCS
-inline constexpr std::uint8_t kOnboardComputer = 191; ///< MAV_COMP_ID_ONBOARD_COMPUTER: a companion computer
+inline constexpr std::uint8_t kAll = 0;                ///< MAV_COMP_ID_ALL: every component (a target)
+inline constexpr std::uint8_t kAutopilot1 = 1;         ///< MAV_COMP_ID_AUTOPILOT1
+inline constexpr std::uint8_t kCamera = 100;           ///< MAV_COMP_ID_CAMERA
+inline constexpr std::uint8_t kMissionPlanner = 190;   ///< MAV_COMP_ID_MISSIONPLANNER: a GCS
+inline constexpr std::uint8_t kOnboardComputer = 191;  ///< MAV_COMP_ID_ONBOARD_COMPUTER: a companion computer
 }  // namespace mav_component
 
 /// POSITION_TARGET_TYPEMASK: bits of the position targets' `type_mask` (uint16); a set bit

@@ -33,12 +33,12 @@
 
 namespace adaptseg::mavlink {
 
-inline constexpr std::uint8_t kStartV2 = 0xFD;          ///< start byte of a MAVLink 2 frame
-inline constexpr std::uint8_t kStartV1 = 0xFE;          ///< start byte of a MAVLink 1 frame
-inline constexpr std::size_t kHeaderLengthV2 = 10;      ///< start byte to message id, MAVLink 2 [bytes]
-inline constexpr std::size_t kHeaderLengthV1 = 6;       ///< start byte to message id, MAVLink 1 [bytes]
-inline constexpr std::size_t kChecksumLength = 2;       ///< [bytes]
-inline constexpr std::size_t kSignatureLength = 13;     ///< link id, 6-byte timestamp, 6-byte signature [bytes]
+inline constexpr std::uint8_t kStartV2 = 0xFD;             ///< start byte of a MAVLink 2 frame
+inline constexpr std::uint8_t kStartV1 = 0xFE;             ///< start byte of a MAVLink 1 frame
+inline constexpr std::size_t kHeaderLengthV2 = 10;         ///< start byte to message id, MAVLink 2 [bytes]
+inline constexpr std::size_t kHeaderLengthV1 = 6;          ///< start byte to message id, MAVLink 1 [bytes]
+inline constexpr std::size_t kChecksumLength = 2;          ///< [bytes]
+inline constexpr std::size_t kSignatureLength = 13;        ///< link id, 6-byte timestamp, 6-byte signature [bytes]
 inline constexpr std::uint8_t kIncompatFlagSigned = 0x01;  ///< MAVLINK_IFLAG_SIGNED: a signature follows
 /// The longest frame: a signed MAVLink 2 frame with a 255-byte payload [bytes].
 inline constexpr std::size_t kMaxFrameLength = kHeaderLengthV2 + kMaxPayloadLength + kChecksumLength + kSignatureLength;
@@ -51,8 +51,8 @@ enum class ProtocolVersion : std::uint8_t {
 
 /// What the sender of a frame chooses: its sequence number and its address.
 struct FrameHeader {
-  std::uint8_t sequence = 0;      ///< per-sender counter, +1 per frame, wraps at 255
-  std::uint8_t system_id = 1;     ///< the sender's system (a companion shares its autopilot's, usually 1)
+  std::uint8_t sequence = 0;   ///< per-sender counter, +1 per frame, wraps at 255
+  std::uint8_t system_id = 1;  ///< the sender's system (a companion shares its autopilot's, usually 1)
   std::uint8_t component_id = mav_component::kOnboardComputer;  ///< the sender's component
   friend bool operator==(const FrameHeader&, const FrameHeader&) = default;
 };
@@ -66,21 +66,21 @@ struct FrameSignature {
 };
 
 /// One frame the Parser accepted: a known message id, checksum verified (its payload may be
-/// longer than our message's: decode() ignores the rest). The payload is zero-extended: bytes past `payload_length` are zero, so
-/// a truncated MAVLink 2 payload (or a MAVLink 1 one, without extensions) reads as the full
-/// message with zeros. decode() (message.hpp) turns it into a Message.
+/// longer than our message's: decode() ignores the rest). The payload is zero-extended: bytes past `payload_length` are
+/// zero, so a truncated MAVLink 2 payload (or a MAVLink 1 one, without extensions) reads as the full message with
+/// zeros. decode() (message.hpp) turns it into a Message.
 struct Frame {
   ProtocolVersion version = ProtocolVersion::v2;  ///< MAVLink 1 or 2
-  std::uint8_t incompat_flags = 0;  ///< MAVLink 2 incompat flags (0, or kIncompatFlagSigned)
-  std::uint8_t compat_flags = 0;    ///< MAVLink 2 compat flags (ignored)
-  std::uint8_t sequence = 0;        ///< the sender's sequence number
-  std::uint8_t system_id = 0;       ///< the sender's system id
-  std::uint8_t component_id = 0;    ///< the sender's component id
-  std::uint32_t message_id = 0;     ///< message id (24 bits)
-  std::uint8_t payload_length = 0;  ///< payload bytes on the wire [bytes]
-  PayloadBuffer payload{};          ///< the payload, zero after `payload_length`
-  std::uint16_t checksum = 0;       ///< the frame's checksum (verified)
-  std::optional<FrameSignature> signature;  ///< present if the frame was signed (not verified)
+  std::uint8_t incompat_flags = 0;                ///< MAVLink 2 incompat flags (0, or kIncompatFlagSigned)
+  std::uint8_t compat_flags = 0;                  ///< MAVLink 2 compat flags (ignored)
+  std::uint8_t sequence = 0;                      ///< the sender's sequence number
+  std::uint8_t system_id = 0;                     ///< the sender's system id
+  std::uint8_t component_id = 0;                  ///< the sender's component id
+  std::uint32_t message_id = 0;                   ///< message id (24 bits)
+  std::uint8_t payload_length = 0;                ///< payload bytes on the wire [bytes]
+  PayloadBuffer payload{};                        ///< the payload, zero after `payload_length`
+  std::uint16_t checksum = 0;                     ///< the frame's checksum (verified)
+  std::optional<FrameSignature> signature;        ///< present if the frame was signed (not verified)
 
   /// The payload bytes as received (`payload_length` of them).
   [[nodiscard]] std::span<const std::uint8_t> wire_payload() const { return {payload.data(), payload_length}; }

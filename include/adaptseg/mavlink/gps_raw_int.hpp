@@ -16,22 +16,22 @@ struct GpsRawInt {
   static constexpr std::string_view kName = "GPS_RAW_INT";  ///< name in the definitions
   static constexpr std::uint8_t kCrcExtra = 24;             ///< published CRC_EXTRA
 
-  std::uint64_t time_usec = 0;         ///< timestamp [us] (since boot or UNIX epoch)
-  std::uint8_t fix_type = 0;           ///< GPS_FIX_TYPE (gps_fix_type::)
-  std::int32_t lat = 0;                ///< latitude, WGS84 [degE7]
-  std::int32_t lon = 0;                ///< longitude, WGS84 [degE7]
-  std::int32_t alt = 0;                ///< altitude above mean sea level [mm]
-  std::uint16_t eph = 0;               ///< horizontal dilution of precision [x100] (UINT16_MAX: unknown)
-  std::uint16_t epv = 0;               ///< vertical dilution of precision [x100] (UINT16_MAX: unknown)
-  std::uint16_t vel = 0;               ///< ground speed [cm/s] (UINT16_MAX: unknown)
-  std::uint16_t cog = 0;               ///< course over ground [cdeg], 0..35999 (UINT16_MAX: unknown)
-  std::uint8_t satellites_visible = 0; ///< satellites visible (UINT8_MAX: unknown)
-  std::int32_t alt_ellipsoid = 0;      ///< extension: altitude above the WGS84 ellipsoid [mm]
-  std::uint32_t h_acc = 0;             ///< extension: position uncertainty [mm]
-  std::uint32_t v_acc = 0;             ///< extension: altitude uncertainty [mm]
-  std::uint32_t vel_acc = 0;           ///< extension: speed uncertainty [mm/s]
-  std::uint32_t hdg_acc = 0;           ///< extension: heading uncertainty [degE5]
-  std::uint16_t yaw = 0;               ///< extension: yaw from north [cdeg] (0: unknown, 36000: north)
+  std::uint64_t time_usec = 0;          ///< timestamp [us] (since boot or UNIX epoch)
+  std::uint8_t fix_type = 0;            ///< GPS_FIX_TYPE (gps_fix_type::)
+  std::int32_t lat = 0;                 ///< latitude, WGS84 [degE7]
+  std::int32_t lon = 0;                 ///< longitude, WGS84 [degE7]
+  std::int32_t alt = 0;                 ///< altitude above mean sea level [mm]
+  std::uint16_t eph = 0;                ///< horizontal dilution of precision [x100] (UINT16_MAX: unknown)
+  std::uint16_t epv = 0;                ///< vertical dilution of precision [x100] (UINT16_MAX: unknown)
+  std::uint16_t vel = 0;                ///< ground speed [cm/s] (UINT16_MAX: unknown)
+  std::uint16_t cog = 0;                ///< course over ground [cdeg], 0..35999 (UINT16_MAX: unknown)
+  std::uint8_t satellites_visible = 0;  ///< satellites visible (UINT8_MAX: unknown)
+  std::int32_t alt_ellipsoid = 0;       ///< extension: altitude above the WGS84 ellipsoid [mm]
+  std::uint32_t h_acc = 0;              ///< extension: position uncertainty [mm]
+  std::uint32_t v_acc = 0;              ///< extension: altitude uncertainty [mm]
+  std::uint32_t vel_acc = 0;            ///< extension: speed uncertainty [mm/s]
+  std::uint32_t hdg_acc = 0;            ///< extension: heading uncertainty [degE5]
+  std::uint16_t yaw = 0;                ///< extension: yaw from north [cdeg] (0: unknown, 36000: north)
 
   friend bool operator==(const GpsRawInt&, const GpsRawInt&) = default;
 

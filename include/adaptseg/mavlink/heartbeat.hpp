@@ -16,15 +16,15 @@ namespace adaptseg::mavlink {
 /// and either from a ground station (`type == mav_type::kGcs`). Members in the order of the
 /// definition; fields() gives the wire order.
 struct Heartbeat {
-  static constexpr std::uint32_t kId = 0;                  ///< message id
-  static constexpr std::string_view kName = "HEARTBEAT";   ///< name in the definitions
-  static constexpr std::uint8_t kCrcExtra = 50;            ///< published CRC_EXTRA
+  static constexpr std::uint32_t kId = 0;                 ///< message id
+  static constexpr std::string_view kName = "HEARTBEAT";  ///< name in the definitions
+  static constexpr std::uint8_t kCrcExtra = 50;           ///< published CRC_EXTRA
 
-  std::uint8_t type = 0;          ///< MAV_TYPE (mav_type::)
-  std::uint8_t autopilot = 0;     ///< MAV_AUTOPILOT (mav_autopilot::)
-  std::uint8_t base_mode = 0;     ///< MAV_MODE_FLAG bits (mav_mode_flag::)
-  std::uint32_t custom_mode = 0;  ///< the autopilot's own flight mode (PX4: main mode << 16 | sub mode << 24)
-  std::uint8_t system_status = 0; ///< MAV_STATE (mav_state::)
+  std::uint8_t type = 0;           ///< MAV_TYPE (mav_type::)
+  std::uint8_t autopilot = 0;      ///< MAV_AUTOPILOT (mav_autopilot::)
+  std::uint8_t base_mode = 0;      ///< MAV_MODE_FLAG bits (mav_mode_flag::)
+  std::uint32_t custom_mode = 0;   ///< the autopilot's own flight mode (PX4: main mode << 16 | sub mode << 24)
+  std::uint8_t system_status = 0;  ///< MAV_STATE (mav_state::)
   std::uint8_t mavlink_version = kMavlinkVersion;  ///< MAVLink version (3)
 
   friend bool operator==(const Heartbeat&, const Heartbeat&) = default;

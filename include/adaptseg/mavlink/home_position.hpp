@@ -19,18 +19,18 @@ struct HomePosition {
   static constexpr std::string_view kName = "HOME_POSITION";  ///< name in the definitions
   static constexpr std::uint8_t kCrcExtra = 104;              ///< published CRC_EXTRA
 
-  std::int32_t latitude = 0;          ///< latitude, WGS84 [degE7]
-  std::int32_t longitude = 0;         ///< longitude, WGS84 [degE7]
-  std::int32_t altitude = 0;          ///< altitude above mean sea level [mm]
-  float x = 0.0F;                     ///< local x [m]
-  float y = 0.0F;                     ///< local y [m]
-  float z = 0.0F;                     ///< local z [m]
+  std::int32_t latitude = 0;   ///< latitude, WGS84 [degE7]
+  std::int32_t longitude = 0;  ///< longitude, WGS84 [degE7]
+  std::int32_t altitude = 0;   ///< altitude above mean sea level [mm]
+  float x = 0.0F;              ///< local x [m]
+  float y = 0.0F;              ///< local y [m]
+  float z = 0.0F;              ///< local z [m]
   /// Heading and slope of the ground at home, quaternion w, x, y, z (all NaN: unknown).
   std::array<float, 4> q{};
-  float approach_x = 0.0F;            ///< local x of the end of the approach [m]
-  float approach_y = 0.0F;            ///< local y of the end of the approach [m]
-  float approach_z = 0.0F;            ///< local z of the end of the approach [m]
-  std::uint64_t time_usec = 0;        ///< extension: timestamp [us] (since boot or UNIX epoch)
+  float approach_x = 0.0F;      ///< local x of the end of the approach [m]
+  float approach_y = 0.0F;      ///< local y of the end of the approach [m]
+  float approach_z = 0.0F;      ///< local z of the end of the approach [m]
+  std::uint64_t time_usec = 0;  ///< extension: timestamp [us] (since boot or UNIX epoch)
 
   friend bool operator==(const HomePosition&, const HomePosition&) = default;
 

@@ -23,20 +23,20 @@ struct LinkOptions {
   std::uint8_t component_id = mav_component::kMissionPlanner;  ///< our component id (190, as QGroundControl)
   /// Our HEARTBEAT's type: a ground station's, whose heartbeat PX4's data-link-loss failsafe watches.
   std::uint8_t heartbeat_type = mav_type::kGcs;
-  std::uint8_t vehicle_system_id = 0;  ///< the autopilot's system id to talk to (0: the first autopilot heard)
-  double heartbeat_period_s = 1.0;     ///< our HEARTBEAT period [s] (MAVLink: 1 Hz)
-  double heartbeat_timeout_s = 10.0;   ///< connect(): longest wait for the autopilot's first HEARTBEAT [s]
-  double fix_timeout_s = 30.0;         ///< connect(): longest wait for a 3-D fix and a position [s]
-  double link_timeout_s = 3.0;         ///< no frame from the vehicle this long: the link is lost [s]
-  double ack_timeout_s = 1.0;          ///< wait for a COMMAND_ACK before sending the command again [s]
-  int command_attempts = 4;            ///< sends of one command at most (the first and the retries), 1..100
-  double in_progress_timeout_s = 10.0; ///< longest wait after MAV_RESULT_IN_PROGRESS for the final answer [s]
-  double position_interval_s = 0.1;    ///< GLOBAL_POSITION_INT period asked for (SET_MESSAGE_INTERVAL) [s]
-  double gps_interval_s = 0.5;         ///< GPS_RAW_INT period asked for [s]
-  double position_timeout_s = 2.0;     ///< no GLOBAL_POSITION_INT this long while frames come: stale [s]
-  double mode_timeout_s = 3.0;         ///< time for a mode change to show in the HEARTBEAT [s]
-  double ground_speed_mps = -1.0;      ///< DO_REPOSITION's ground speed [m/s] (-1: the vehicle's default)
-  double capture_wait_s = 1.0;         ///< trigger_camera(): wait this long for CAMERA_IMAGE_CAPTURED [s] (0: none)
+  std::uint8_t vehicle_system_id = 0;   ///< the autopilot's system id to talk to (0: the first autopilot heard)
+  double heartbeat_period_s = 1.0;      ///< our HEARTBEAT period [s] (MAVLink: 1 Hz)
+  double heartbeat_timeout_s = 10.0;    ///< connect(): longest wait for the autopilot's first HEARTBEAT [s]
+  double fix_timeout_s = 30.0;          ///< connect(): longest wait for a 3-D fix and a position [s]
+  double link_timeout_s = 3.0;          ///< no frame from the vehicle this long: the link is lost [s]
+  double ack_timeout_s = 1.0;           ///< wait for a COMMAND_ACK before sending the command again [s]
+  int command_attempts = 4;             ///< sends of one command at most (the first and the retries), 1..100
+  double in_progress_timeout_s = 10.0;  ///< longest wait after MAV_RESULT_IN_PROGRESS for the final answer [s]
+  double position_interval_s = 0.1;     ///< GLOBAL_POSITION_INT period asked for (SET_MESSAGE_INTERVAL) [s]
+  double gps_interval_s = 0.5;          ///< GPS_RAW_INT period asked for [s]
+  double position_timeout_s = 2.0;      ///< no GLOBAL_POSITION_INT this long while frames come: stale [s]
+  double mode_timeout_s = 3.0;          ///< time for a mode change to show in the HEARTBEAT [s]
+  double ground_speed_mps = -1.0;       ///< DO_REPOSITION's ground speed [m/s] (-1: the vehicle's default)
+  double capture_wait_s = 1.0;          ///< trigger_camera(): wait this long for CAMERA_IMAGE_CAPTURED [s] (0: none)
   /// trigger_camera()'s command: 0 by firmware (PX4: IMAGE_START_CAPTURE, ArduPilot:
   /// DO_DIGICAM_CONTROL), or mav_cmd::kImageStartCapture, mav_cmd::kDoDigicamControl.
   std::uint16_t camera_command = 0;
@@ -68,8 +68,10 @@ struct LinkOptions {
                                   std::to_string(command_attempts) + ")");
     }
     if (!(ground_speed_mps == -1.0 || (std::isfinite(ground_speed_mps) && ground_speed_mps > 0.0))) {
-      throw std::invalid_argument("LinkOptions: ground_speed_mps must be -1 (the vehicle's default) or finite and > 0 "
-                                  "(got " + std::to_string(ground_speed_mps) + ")");
+      throw std::invalid_argument(
+          "LinkOptions: ground_speed_mps must be -1 (the vehicle's default) or finite and > 0 "
+          "(got " +
+          std::to_string(ground_speed_mps) + ")");
     }
     if (!std::isfinite(capture_wait_s) || capture_wait_s < 0.0) {
       throw std::invalid_argument("LinkOptions: capture_wait_s must be finite and >= 0 (got " +
@@ -77,21 +79,23 @@ struct LinkOptions {
     }
     if (camera_command != 0 && camera_command != mav_cmd::kImageStartCapture &&
         camera_command != mav_cmd::kDoDigicamControl) {
-      throw std::invalid_argument("LinkOptions: camera_command must be 0 (by firmware), 2000 (IMAGE_START_CAPTURE) or "
-                                  "203 (DO_DIGICAM_CONTROL) (got " + std::to_string(camera_command) + ")");
+      throw std::invalid_argument(
+          "LinkOptions: camera_command must be 0 (by firmware), 2000 (IMAGE_START_CAPTURE) or "
+          "203 (DO_DIGICAM_CONTROL) (got " +
+          std::to_string(camera_command) + ")");
     }
   }
 };
 
 /// When wait_arrival() counts the vehicle as there, and how long it waits.
 struct ArrivalCriteria {
-  double horizontal_m = 1.0;   ///< horizontal distance to the target at most [m]
-  double vertical_m = 1.0;     ///< vertical distance at most [m]
+  double horizontal_m = 1.0;  ///< horizontal distance to the target at most [m]
+  double vertical_m = 1.0;    ///< vertical distance at most [m]
   /// Horizontal speed at most [m/s] (infinity: not checked): the vehicle has settled.
   double max_speed_mps = std::numeric_limits<double>::infinity();
-  double timeout_s = 300.0;    ///< longest wait [s]
-  double stall_s = 5.0;        ///< no progress this long, outside the tolerance: stopped short [s]
-  double min_progress_m = 0.2; ///< what counts as progress: the distance left shrinks by this much [m]
+  double timeout_s = 300.0;     ///< longest wait [s]
+  double stall_s = 5.0;         ///< no progress this long, outside the tolerance: stopped short [s]
+  double min_progress_m = 0.2;  ///< what counts as progress: the distance left shrinks by this much [m]
 
   /// @throws std::invalid_argument naming the field and its value.
   void check() const {

@@ -56,11 +56,11 @@ using Message = std::variant<Heartbeat, SysStatus, GpsRawInt, GlobalPositionInt,
 
 /// What the Parser needs to know of a message id to check a frame.
 struct MessageInfo {
-  std::uint32_t id = 0;           ///< message id
-  std::string_view name;          ///< name in the definitions
-  std::uint8_t crc_extra = 0;     ///< CRC_EXTRA
-  std::size_t base_length = 0;    ///< payload without extensions [bytes]
-  std::size_t full_length = 0;    ///< payload with extensions: the longest accepted [bytes]
+  std::uint32_t id = 0;         ///< message id
+  std::string_view name;        ///< name in the definitions
+  std::uint8_t crc_extra = 0;   ///< CRC_EXTRA
+  std::size_t base_length = 0;  ///< payload without extensions [bytes]
+  std::size_t full_length = 0;  ///< payload with extensions: the longest accepted [bytes]
 };
 
 }  // namespace adaptseg::mavlink
@@ -69,8 +69,8 @@ namespace adaptseg::detail {
 
 template <typename... Ms>
 constexpr std::array<mavlink::MessageInfo, sizeof...(Ms)> mavlink_message_infos(const std::variant<Ms...>*) {
-  return {mavlink::MessageInfo{Ms::kId, Ms::kName, Ms::kCrcExtra, mavlink::kBaseLength<Ms>,
-                               mavlink::kFullLength<Ms>}...};
+  return {
+      mavlink::MessageInfo{Ms::kId, Ms::kName, Ms::kCrcExtra, mavlink::kBaseLength<Ms>, mavlink::kFullLength<Ms>}...};
 }
 
 inline constexpr auto kMavlinkMessageInfos = mavlink_message_infos(static_cast<const mavlink::Message*>(nullptr));
@@ -89,8 +89,7 @@ template <typename... Ms>
 mavlink::Message mavlink_decode_known(std::uint32_t id, const mavlink::PayloadBuffer& payload,
                                       const std::variant<Ms...>*) {
   std::optional<mavlink::Message> out;
-  (void)((id == Ms::kId ? (out.emplace(std::in_place_type<Ms>, mavlink::decode_payload<Ms>(payload)), true)
-                        : false) ||
+  (void)((id == Ms::kId ? (out.emplace(std::in_place_type<Ms>, mavlink::decode_payload<Ms>(payload)), true) : false) ||
          ...);
   return std::move(*out);  // the caller checked that the id is known
 }

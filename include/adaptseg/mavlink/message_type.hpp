@@ -130,7 +130,7 @@ concept HasFieldList = requires(detail::LayoutVisitor& layout, detail::CrcExtraV
 
 /// The CRC_EXTRA of M computed from its name and field list.
 template <HasFieldList M>
-  requires HasMessageIdentity<M>
+requires HasMessageIdentity<M>
 [[nodiscard]] constexpr std::uint8_t crc_extra_of() {
   detail::CrcExtraVisitor v;
   v.crc = crc_calculate(std::string_view(M::kName));
@@ -145,11 +145,11 @@ template <HasFieldList M>
 /// with `==`. Each message's header checks `static_assert(MessageType<...>)`.
 template <typename M>
 concept MessageType = HasMessageIdentity<M> && HasFieldList<M> && std::regular<M> &&
-                      (M::kId < (1u << 24)) &&                       // 24-bit id
-                      (crc_extra_of<M>() == M::kCrcExtra) &&         // the published field list
-                      detail::layout_of<M>().in_wire_order &&        // sorted by type size
-                      (detail::layout_of<M>().extension_marks <= 1) &&
-                      (detail::layout_of<M>().base_length >= 1) &&
+                      (M::kId < (1u << 24)) &&                // 24-bit id
+                      (crc_extra_of<M>() == M::kCrcExtra) &&  // the published field list
+                      detail::layout_of<M>().in_wire_order
+                      &&  // sorted by type size
+                      (detail::layout_of<M>().extension_marks <= 1) && (detail::layout_of<M>().base_length >= 1) &&
                       (detail::layout_of<M>().total_length <= kMaxPayloadLength);
 
 /// Payload length of M without its extension fields [bytes] (a MAVLink 1 payload).
@@ -192,8 +192,8 @@ struct EncodeVisitor {
     }
     if (value.find('\0') != std::string::npos) {
       throw std::invalid_argument(std::string(Msg::kName) + "." + std::string(name) +
-                                  " must not contain a NUL byte (got one at byte " +
-                                  std::to_string(value.find('\0')) + ")");
+                                  " must not contain a NUL byte (got one at byte " + std::to_string(value.find('\0')) +
+                                  ")");
     }
     std::copy(value.begin(), value.end(), out.begin() + static_cast<std::ptrdiff_t>(offset));
     offset += length;

@@ -24,9 +24,9 @@ namespace adaptseg::mavlink {
 /// What a Parser saw. Every byte fed is in exactly one of: an accepted frame, a skipped
 /// frame (`skipped_bytes`), `dropped_bytes`, or Parser::pending().
 struct ParseStats {
-  std::uint64_t bytes_fed = 0;      ///< bytes given to Parser::feed()
-  std::uint64_t frames_ok = 0;      ///< frames accepted (known id, checksum verified)
-  std::uint64_t signed_frames = 0;  ///< of frames_ok, frames that carried a signature (not verified)
+  std::uint64_t bytes_fed = 0;        ///< bytes given to Parser::feed()
+  std::uint64_t frames_ok = 0;        ///< frames accepted (known id, checksum verified)
+  std::uint64_t signed_frames = 0;    ///< of frames_ok, frames that carried a signature (not verified)
   std::uint64_t mavlink1_frames = 0;  ///< of frames_ok, MAVLink 1 frames
   /// Frames of a known id whose checksum failed (corrupted, cut short by the next frame, or a
   /// start byte inside other data): their start byte is dropped, the rest read again.

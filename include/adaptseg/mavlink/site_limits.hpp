@@ -75,12 +75,13 @@ class SiteLimits {
       lon_max = std::fmax(lon_max, v.lon_deg);
     }
     if (lon_max - lon_min >= 180.0) {
-      throw std::invalid_argument("SiteLimits: polygon spans 180 deg of longitude or more (the antimeridian is not "
-                                  "supported)");
+      throw std::invalid_argument(
+          "SiteLimits: polygon spans 180 deg of longitude or more (the antimeridian is not "
+          "supported)");
     }
     if (std::fabs(twice_area()) < 1e-18) throw std::invalid_argument("SiteLimits: polygon has no area");
-    if (!std::isfinite(floor_m_)) throw std::invalid_argument("SiteLimits: floor_m must be finite (got " +
-                                                             std::to_string(floor_m_) + ")");
+    if (!std::isfinite(floor_m_))
+      throw std::invalid_argument("SiteLimits: floor_m must be finite (got " + std::to_string(floor_m_) + ")");
     if (!std::isfinite(ceiling_m_) || ceiling_m_ <= floor_m_) {
       throw std::invalid_argument("SiteLimits: ceiling_m must be finite and above floor_m " + std::to_string(floor_m_) +
                                   " (got " + std::to_string(ceiling_m_) + ")");
@@ -124,8 +125,8 @@ class SiteLimits {
   }
 
   [[nodiscard]] const std::vector<LatLon>& polygon() const { return polygon_; }  ///< the vertices, as given
-  [[nodiscard]] double ceiling_m() const { return ceiling_m_; }  ///< highest altitude above home [m]
-  [[nodiscard]] double floor_m() const { return floor_m_; }      ///< lowest altitude above home [m]
+  [[nodiscard]] double ceiling_m() const { return ceiling_m_; }                  ///< highest altitude above home [m]
+  [[nodiscard]] double floor_m() const { return floor_m_; }                      ///< lowest altitude above home [m]
 
  private:
   [[nodiscard]] double twice_area() const {

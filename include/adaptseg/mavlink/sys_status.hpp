@@ -20,16 +20,16 @@ struct SysStatus {
   std::uint32_t onboard_control_sensors_present = 0;  ///< MAV_SYS_STATUS_SENSOR bits: present
   std::uint32_t onboard_control_sensors_enabled = 0;  ///< MAV_SYS_STATUS_SENSOR bits: enabled
   std::uint32_t onboard_control_sensors_health = 0;   ///< MAV_SYS_STATUS_SENSOR bits: healthy (1) or not
-  std::uint16_t load = 0;                 ///< main loop load [d%] (1000: 100 %)
-  std::uint16_t voltage_battery = 0;      ///< battery voltage [mV] (UINT16_MAX: unknown)
-  std::int16_t current_battery = 0;       ///< battery current [cA] (-1: unknown)
-  std::int8_t battery_remaining = 0;      ///< remaining battery [%] (-1: unknown)
-  std::uint16_t drop_rate_comm = 0;       ///< communication drop rate [c%]
-  std::uint16_t errors_comm = 0;          ///< communication errors
-  std::uint16_t errors_count1 = 0;        ///< autopilot-specific errors
-  std::uint16_t errors_count2 = 0;        ///< autopilot-specific errors
-  std::uint16_t errors_count3 = 0;        ///< autopilot-specific errors
-  std::uint16_t errors_count4 = 0;        ///< autopilot-specific errors
+  std::uint16_t load = 0;                             ///< main loop load [d%] (1000: 100 %)
+  std::uint16_t voltage_battery = 0;                  ///< battery voltage [mV] (UINT16_MAX: unknown)
+  std::int16_t current_battery = 0;                   ///< battery current [cA] (-1: unknown)
+  std::int8_t battery_remaining = 0;                  ///< remaining battery [%] (-1: unknown)
+  std::uint16_t drop_rate_comm = 0;                   ///< communication drop rate [c%]
+  std::uint16_t errors_comm = 0;                      ///< communication errors
+  std::uint16_t errors_count1 = 0;                    ///< autopilot-specific errors
+  std::uint16_t errors_count2 = 0;                    ///< autopilot-specific errors
+  std::uint16_t errors_count3 = 0;                    ///< autopilot-specific errors
+  std::uint16_t errors_count4 = 0;                    ///< autopilot-specific errors
   /// Extension: MAV_SYS_STATUS_SENSOR_EXTENDED bits, present.
   std::uint32_t onboard_control_sensors_present_extended = 0;
   std::uint32_t onboard_control_sensors_enabled_extended = 0;  ///< extension: enabled

@@ -55,8 +55,8 @@ class AnyTransport {
  public:
   /// Takes `transport` over.
   template <typename T>
-    requires(!std::same_as<std::remove_cvref_t<T>, AnyTransport>) && ByteTransport<T>
-  AnyTransport(T transport)  // NOLINT(google-explicit-constructor): a transport is an AnyTransport
+  requires(!std::same_as<std::remove_cvref_t<T>, AnyTransport>) &&
+      ByteTransport<T> AnyTransport(T transport)  // NOLINT(google-explicit-constructor): a transport is an AnyTransport
       : impl_(std::make_unique<Model<T>>(std::move(transport))) {}
 
   AnyTransport(AnyTransport&&) noexcept = default;
@@ -87,7 +87,9 @@ class AnyTransport {
       return transport.receive(buffer, timeout_s);
     }
     [[nodiscard]] std::string description() const override {
-      if constexpr (requires(const T& t) { { t.description() } -> std::convertible_to<std::string>; }) {
+      if constexpr (requires(const T& t) {
+                      { t.description() } -> std::convertible_to<std::string>;
+                    }) {
         return transport.description();
       } else {
         return "transport";

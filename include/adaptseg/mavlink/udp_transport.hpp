@@ -57,8 +57,7 @@ class UdpTransport {
   /// Sends to `host:port` from `local_port` (0: ephemeral) and reads datagrams from anyone.
   /// @throws std::invalid_argument if `host` does not resolve to an IPv4 address, or `port`
   ///         is 0; std::system_error if the socket cannot be made or bound.
-  [[nodiscard]] static UdpTransport connect(const std::string& host, std::uint16_t port,
-                                            std::uint16_t local_port = 0) {
+  [[nodiscard]] static UdpTransport connect(const std::string& host, std::uint16_t port, std::uint16_t local_port = 0) {
     if (port == 0) throw std::invalid_argument("UDP peer port must be 1..65535 (got 0)");
     UdpTransport t(resolve("0.0.0.0", local_port, "UDP local address"), resolve(host, port, "UDP peer"));
     t.description_ = "udpout:" + host + ":" + std::to_string(port);
@@ -76,8 +75,7 @@ class UdpTransport {
     const ssize_t n = ::sendto(fd_.get(), bytes.data(), bytes.size(), 0, reinterpret_cast<const sockaddr*>(&*peer_),
                                sizeof(sockaddr_in));
     if (n < 0) {
-      if (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS || errno == EINTR ||
-          errno == ECONNREFUSED) {
+      if (errno == EAGAIN || errno == EWOULDBLOCK || errno == ENOBUFS || errno == EINTR || errno == ECONNREFUSED) {
         ++unsent_frames_;
         return;
       }
@@ -92,8 +90,8 @@ class UdpTransport {
     if (!detail::wait_fd(fd_.get(), POLLIN, timeout_s, description_)) return 0;
     sockaddr_in from{};
     socklen_t from_length = sizeof(from);
-    const ssize_t n = ::recvfrom(fd_.get(), buffer.data(), buffer.size(), 0, reinterpret_cast<sockaddr*>(&from),
-                                 &from_length);
+    const ssize_t n =
+        ::recvfrom(fd_.get(), buffer.data(), buffer.size(), 0, reinterpret_cast<sockaddr*>(&from), &from_length);
     if (n < 0) {
       if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR || errno == ECONNREFUSED) return 0;
       detail::throw_errno(errno, description_ + ": receive");

@@ -112,10 +112,11 @@ class VehicleLink {
     const char* step = "connect";
     const double t0 = now();
     next_heartbeat_s_ = t0;  // announce ourselves at once: some links talk only to who talks
-    if (!pump_until(t0 + options_.heartbeat_timeout_s, [&] { return vehicle_.has_value(); }, step)) {
+    if (!pump_until(
+            t0 + options_.heartbeat_timeout_s, [&] { return vehicle_.has_value(); }, step)) {
       throw VehicleLinkError(LinkFailure::no_heartbeat, step,
-                             "no HEARTBEAT from an autopilot within " +
-                                 num(options_.heartbeat_timeout_s) + " s on " + transport_.description());
+                             "no HEARTBEAT from an autopilot within " + num(options_.heartbeat_timeout_s) + " s on " +
+                                 transport_.description());
     }
     request_interval(GlobalPositionInt::kId, options_.position_interval_s, step);
     request_interval(GpsRawInt::kId, options_.gps_interval_s, step);
@@ -134,9 +135,9 @@ class VehicleLink {
       } else {
         why = "a 3-D fix but no valid GLOBAL_POSITION_INT after it";
       }
-      throw VehicleLinkError(LinkFailure::no_gps_fix, step,
-                             "no 3-D GPS fix within " + num(options_.fix_timeout_s) + " s: " + why +
-                                 "; refusing to start without one");
+      throw VehicleLinkError(
+          LinkFailure::no_gps_fix, step,
+          "no 3-D GPS fix within " + num(options_.fix_timeout_s) + " s: " + why + "; refusing to start without one");
     }
     connected_ = true;
     return *vehicle_;
@@ -146,7 +147,8 @@ class VehicleLink {
   /// (on now()'s clock). Call it while doing other work between operations.
   /// @throws LinkLost after connect() if the vehicle is silent for LinkOptions::link_timeout_s.
   void poll(double deadline_s) {
-    pump_until(deadline_s, [] { return false; }, "poll");
+    pump_until(
+        deadline_s, [] { return false; }, "poll");
   }
 
   /// Whether connect() succeeded.
@@ -208,8 +210,8 @@ class VehicleLink {
     const char* step = "go_to";
     require_connected(step);
     if (const auto why = limits_.violation(target)) {
-      throw VehicleLinkError(LinkFailure::outside_site, step, "refused to send the vehicle to " + to_string(target) +
-                                                                  ": " + *why);
+      throw VehicleLinkError(LinkFailure::outside_site, step,
+                             "refused to send the vehicle to " + to_string(target) + ": " + *why);
     }
     refresh(step);
     if (!vehicle_->armed()) {
@@ -254,8 +256,9 @@ class VehicleLink {
     for (;;) {
       check_mode(step);
       const double t = now();
-      const bool fresh = pump_until(std::min(t0 + criteria.timeout_s, t + options_.position_timeout_s),
-                                    [&] { return position_ && position_->received_s > seen_s; }, step);
+      const bool fresh = pump_until(
+          std::min(t0 + criteria.timeout_s, t + options_.position_timeout_s),
+          [&] { return position_ && position_->received_s > seen_s; }, step);
       const double t1 = now();
       if (fresh) {
         const VehiclePosition& p = *position_;
@@ -274,9 +277,9 @@ class VehicleLink {
           throw VehicleLinkError(LinkFailure::stopped_short, step,
                                  "the vehicle stopped " + num(left) + " m short of " + to_string(target) + " (" +
                                      num(h) + " m horizontally, " + num(std::fabs(v)) +
-                                     " m vertically) and made no progress for " + num(t1 - best_s) +
-                                     " s; tolerance " + num(criteria.horizontal_m) + " m horizontal, " +
-                                     num(criteria.vertical_m) + " m vertical");
+                                     " m vertically) and made no progress for " + num(t1 - best_s) + " s; tolerance " +
+                                     num(criteria.horizontal_m) + " m horizontal, " + num(criteria.vertical_m) +
+                                     " m vertical");
         }
       } else if (!position_ || t1 - position_->received_s >= options_.position_timeout_s) {
         throw VehicleLinkError(LinkFailure::stale_position, step,
@@ -284,13 +287,12 @@ class VehicleLink {
                                    " s while the vehicle's other frames still come");
       }
       if (t1 - t0 >= criteria.timeout_s) {
-        const std::string left =
-            position_ ? num(detail::horizontal_distance_m(target.lat_deg, target.lon_deg, position_->lat_deg,
-                                                          position_->lon_deg))
-                      : std::string("?");
+        const std::string left = position_ ? num(detail::horizontal_distance_m(target.lat_deg, target.lon_deg,
+                                                                               position_->lat_deg, position_->lon_deg))
+                                           : std::string("?");
         throw VehicleLinkError(LinkFailure::arrival_timeout, step,
-                               "the vehicle did not reach " + to_string(target) + " within " +
-                                   num(criteria.timeout_s) + " s (" + left + " m left horizontally)");
+                               "the vehicle did not reach " + to_string(target) + " within " + num(criteria.timeout_s) +
+                                   " s (" + left + " m left horizontally)");
       }
     }
   }
@@ -307,7 +309,7 @@ class VehicleLink {
     require_connected(step);
     refresh(step);
     CommandLong cmd = command_long_to_vehicle();
-    cmd.command = options_.camera_command != 0 ? options_.camera_command
+    cmd.command = options_.camera_command != 0                  ? options_.camera_command
                   : vehicle_->firmware() == Firmware::ardupilot ? mav_cmd::kDoDigicamControl
                                                                 : mav_cmd::kImageStartCapture;
     if (cmd.command == mav_cmd::kImageStartCapture) {
@@ -321,7 +323,8 @@ class VehicleLink {
     images_.clear();
     command(cmd, step);
     if (options_.capture_wait_s > 0.0) {
-      pump_until(now() + options_.capture_wait_s, [&] { return !images_.empty(); }, step);
+      pump_until(
+          now() + options_.capture_wait_s, [&] { return !images_.empty(); }, step);
     }
     CameraCapture out;
     out.command = cmd.command;
@@ -348,7 +351,8 @@ class VehicleLink {
   /// @throws LinkLost.
   bool wait_disarmed(double timeout_s) {
     require_connected("wait_disarmed");
-    return pump_until(now() + timeout_s, [&] { return !vehicle_->armed(); }, "wait_disarmed");
+    return pump_until(
+        now() + timeout_s, [&] { return !vehicle_->armed(); }, "wait_disarmed");
   }
 
   /// The latest STATUSTEXT from the vehicle, if any (PreArm and failsafe messages).
@@ -361,8 +365,8 @@ class VehicleLink {
     return s;
   }
 
-  [[nodiscard]] const SiteLimits& limits() const { return limits_; }     ///< the site's limits
-  [[nodiscard]] const LinkOptions& options() const { return options_; }  ///< the settings
+  [[nodiscard]] const SiteLimits& limits() const { return limits_; }                  ///< the site's limits
+  [[nodiscard]] const LinkOptions& options() const { return options_; }               ///< the settings
   [[nodiscard]] std::string description() const { return transport_.description(); }  ///< the transport
 
   /// Bytes read from the transport at a time: a UDP datagram of the largest size.
@@ -536,7 +540,9 @@ class VehicleLink {
       double deadline_s = sent_s + options_.ack_timeout_s;
       for (;;) {
         std::optional<CommandAck> ack;
-        if (!pump_until(deadline_s, [&] { return (ack = take_ack(id)).has_value(); }, step)) break;
+        if (!pump_until(
+                deadline_s, [&] { return (ack = take_ack(id)).has_value(); }, step))
+          break;
         if (ack->result == mav_result::kAccepted) return *ack;
         if (ack->result == mav_result::kInProgress) {  // a final answer follows
           deadline_s = std::min(now() + options_.ack_timeout_s, sent_s + options_.in_progress_timeout_s);
@@ -544,12 +550,13 @@ class VehicleLink {
         }
         if (ack->result == mav_result::kTemporarilyRejected) {  // try again once this attempt's time is up
           temporarily_rejected = true;
-          pump_until(deadline_s, [] { return false; }, step);
+          pump_until(
+              deadline_s, [] { return false; }, step);
           break;
         }
-        throw VehicleLinkError(LinkFailure::refused, step,
-                               "the vehicle refused " + command_name(id) + ": " + result_name(ack->result) +
-                                   vehicle_says(started_s));
+        throw VehicleLinkError(
+            LinkFailure::refused, step,
+            "the vehicle refused " + command_name(id) + ": " + result_name(ack->result) + vehicle_says(started_s));
       }
     }
     if (temporarily_rejected) {
@@ -560,8 +567,8 @@ class VehicleLink {
     }
     throw VehicleLinkError(LinkFailure::no_ack, step,
                            "no COMMAND_ACK for " + command_name(id) + " after " +
-                               std::to_string(options_.command_attempts) + " attempts, " +
-                               num(options_.ack_timeout_s) + " s each");
+                               std::to_string(options_.command_attempts) + " attempts, " + num(options_.ack_timeout_s) +
+                               " s each");
   }
 
   // " (the vehicle says: ...)" for a warning or worse STATUSTEXT since `since_s`.
@@ -596,22 +603,20 @@ class VehicleLink {
       cmd.param2 = static_cast<float>(*mode);
       command(cmd, step);
       const double t = now();
-      if (!pump_until(t + options_.mode_timeout_s,
-                      [&] { return vehicle_->received_s > t && vehicle_->custom_mode == *mode; }, step)) {
-        throw VehicleLinkError(LinkFailure::refused, step,
-                               "the vehicle acknowledged DO_SET_MODE " + mode_name(Firmware::ardupilot, vehicle_->type,
-                                                                                   *mode) +
-                                   " but its HEARTBEAT still says " + vehicle_->mode() + " after " +
-                                   num(options_.mode_timeout_s) + " s");
+      if (!pump_until(
+              t + options_.mode_timeout_s, [&] { return vehicle_->received_s > t && vehicle_->custom_mode == *mode; },
+              step)) {
+        throw VehicleLinkError(
+            LinkFailure::refused, step,
+            "the vehicle acknowledged DO_SET_MODE " + mode_name(Firmware::ardupilot, vehicle_->type, *mode) +
+                " but its HEARTBEAT still says " + vehicle_->mode() + " after " + num(options_.mode_timeout_s) + " s");
       }
     }
     guided_mode_ = *mode;
   }
 
   // The mode a vehicle under our control must be in.
-  std::uint32_t expected_mode() const {
-    return vehicle_->firmware() == Firmware::px4 ? px4_mode::kHold : guided_mode_;
-  }
+  std::uint32_t expected_mode() const { return vehicle_->firmware() == Firmware::px4 ? px4_mode::kHold : guided_mode_; }
 
   // Throws mode_changed if the vehicle is returning or landing, or left the mode we put it in
   // (judged on a HEARTBEAT that came after the mode had time to show).
@@ -673,9 +678,9 @@ class VehicleLink {
   std::optional<StatusText> last_status_text_;
   double last_status_text_s_ = 0.0;
   bool connected_ = false;
-  bool in_control_ = false;       // a go_to was accepted since connect() or the last RTL
+  bool in_control_ = false;        // a go_to was accepted since connect() or the last RTL
   std::uint32_t guided_mode_ = 0;  // ArduPilot's GUIDED number, once set
-  double mode_settled_s_ = 0.0;   // the mode a go_to asked for shows in HEARTBEATs after this
+  double mode_settled_s_ = 0.0;    // the mode a go_to asked for shows in HEARTBEATs after this
   std::uint32_t capture_sequence_ = 0;
   LinkStats stats_;
 };

@@ -27,7 +27,7 @@ namespace adaptseg {
 
 /// What a descent gained, measured against the ground truth (simulation only).
 struct RealisedDescent {
-  std::size_t decision = 0;      ///< index into AdaptiveResult::decisions
+  std::size_t decision = 0;         ///< index into AdaptiveResult::decisions
   double region_miou_before = 0.0;  ///< mIoU over L of the region's map before the descent (paired_miou)
   double region_miou_after = 0.0;   ///< ... after it
   /// Field mIoU over L at the end of the mission minus the same with the pixels this descent
@@ -53,8 +53,8 @@ struct AdaptiveResult {
   std::vector<DecisionRecord> decisions;
   std::vector<RealisedDescent> realised;  ///< one per descent, in decision order (simulation)
   [[nodiscard]] int descents() const {
-    return static_cast<int>(std::count_if(decisions.begin(), decisions.end(),
-                                           [](const DecisionRecord& d) { return d.decision.descend; }));
+    return static_cast<int>(
+        std::count_if(decisions.begin(), decisions.end(), [](const DecisionRecord& d) { return d.decision.descend; }));
   }
 };
 
@@ -98,12 +98,14 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
     // cells: the top-level images' decision inputs, a descent's scene check).
     const bool probabilities = descent_coverage_rule(options.coverage).ranks_cells;
     auto visit = mission.visit_without_fusion(w->waypoint, w->level, probabilities);
-    planner.report(visit.image, Segmentation{visit.labels, std::move(visit.probabilities), std::move(visit.member_votes)},
+    planner.report(visit.image,
+                   Segmentation{visit.labels, std::move(visit.probabilities), std::move(visit.member_votes)},
                    visit.record->segmentation_s, mission.elapsed_s());
     if (w->level == 0) top_only.fuse(visit.image, visit.labels);
   }
   // In decision order (a tour flies them in its own).
-  std::sort(descents.begin(), descents.end(), [](const Pending& a, const Pending& b) { return a.decision < b.decision; });
+  std::sort(descents.begin(), descents.end(),
+            [](const Pending& a, const Pending& b) { return a.decision < b.decision; });
   // The last decision's measured time (a fixed planning time is charged per waypoint only).
   if (!mission.options().fixed_planning_time_s) mission.charge_planning(planner.take_planning_s());
   AdaptiveResult result{std::move(mission).finish(planner.map()), planner.decisions(), {}};

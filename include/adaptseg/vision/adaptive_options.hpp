@@ -41,7 +41,7 @@ struct AdaptiveOptions {
   /// Camera, timing, labels of interest, fixed per-image/waypoint times. AdaptivePlanner needs
   /// `interest` set; run_adaptive_mission fills an empty one from the field.
   MissionOptions mission{};
-  double top_gsd_cm = 3.0;                ///< GSD at h_max [cm/px]
+  double top_gsd_cm = 3.0;  ///< GSD at h_max [cm/px]
   /// Lower GSDs a sub-lawnmower may fly [cm/px]; at least one not finer than the map is
   /// required (AdaptivePlanner rejects an empty list: it could never descend).
   std::vector<double> candidate_gsd_cm{};
@@ -71,9 +71,9 @@ struct DecisionRecord {
   std::size_t waypoint_index = 0;  ///< index into the path (= MissionResult::waypoints in simulation)
   double sigma = 0.0;              ///< σ of the top-level image
   Decision decision;
-  std::vector<Candidate> candidates;  ///< what was affordable, with exact costs
+  std::vector<Candidate> candidates;      ///< what was affordable, with exact costs
   std::optional<DescentOutcome> outcome;  ///< after a descent
-  bool budget_limited = false;     ///< some candidate was dropped because of the budget
+  bool budget_limited = false;            ///< some candidate was dropped because of the budget
 };
 
 /// The ground a mission covers, as a real mission knows it: no labels, only where the field is.
@@ -82,12 +82,12 @@ struct DecisionRecord {
 /// corner, x along its columns, y up its rows, `map_gsd_cm` per pixel; it is what the planner
 /// fuses segmentations into and what `valid_mask` is drawn on.
 struct SurveyArea {
-  Area area{};               ///< the rectangle to cover [m], x_min, y_min >= 0
-  double map_gsd_cm = 1.0;   ///< resolution of the fused map (and of `valid_mask`) [cm/px]
+  Area area{};              ///< the rectangle to cover [m], x_min, y_min >= 0
+  double map_gsd_cm = 1.0;  ///< resolution of the fused map (and of `valid_mask`) [cm/px]
   /// Optional CV_8UC1 over the map grid, non-zero where there is field; its size sets the
   /// grid's. Empty: every pixel under `area` is field, and the grid just covers `area`.
   cv::Mat valid_mask{};
-  int ignore_label = 255;    ///< "no class" in segmentations and in the map (0..255)
+  int ignore_label = 255;  ///< "no class" in segmentations and in the map (0..255)
   /// Size of the class set the backend labels with (1..255; labels 0 .. num_classes - 1).
   /// Required: every segmentation reported to the planner is checked against it
   /// (check_segmentation()); 0, the default, is rejected by the planner with a message.

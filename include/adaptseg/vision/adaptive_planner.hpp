@@ -103,15 +103,14 @@ class AdaptivePlanner {
     const auto& interest = options_.mission.interest;
     detail::require(!interest.empty(), "AdaptivePlanner: no labels of interest (options.mission.interest)", 0);
     for (int c : interest)
-      detail::require(c >= 0 && c < area_.num_classes,
-                      "AdaptivePlanner: a label of interest is not a class index 0.." +
-                          std::to_string(area_.num_classes - 1),
-                      c);
+      detail::require(
+          c >= 0 && c < area_.num_classes,
+          "AdaptivePlanner: a label of interest is not a class index 0.." + std::to_string(area_.num_classes - 1), c);
     const double map_gsd = area_.map_gsd_cm;
-    detail::require(std::isfinite(options_.top_gsd_cm) && options_.top_gsd_cm >= map_gsd * (1.0 - 1e-9),
-                    "AdaptivePlanner: top_gsd_cm must not be finer than the map's " + std::to_string(map_gsd) +
-                        " cm/px",
-                    options_.top_gsd_cm);
+    detail::require(
+        std::isfinite(options_.top_gsd_cm) && options_.top_gsd_cm >= map_gsd * (1.0 - 1e-9),
+        "AdaptivePlanner: top_gsd_cm must not be finer than the map's " + std::to_string(map_gsd) + " cm/px",
+        options_.top_gsd_cm);
     for (double g : options_.candidate_gsd_cm) {
       detail::require(std::isfinite(g) && g > 0.0 && g < options_.top_gsd_cm,
                       "AdaptivePlanner: candidate GSDs must be positive and finer than top_gsd_cm", g);
@@ -142,11 +141,13 @@ class AdaptivePlanner {
     top_gsd_cm_ = options_.top_gsd_cm;
     if constexpr (ChoosesTopLevel<Policy>) {
       const double g = policy_.top_gsd(lawnmower_forecasts(), options_.top_gsd_cm);
-      const bool known = std::any_of(lawnmowers_.begin(), lawnmowers_.end(), [&](const LawnmowerCost& l) { return l.gsd_cm == g; });
+      const bool known =
+          std::any_of(lawnmowers_.begin(), lawnmowers_.end(), [&](const LawnmowerCost& l) { return l.gsd_cm == g; });
       const bool below = std::any_of(candidates_.begin(), candidates_.end(), [&](double c) { return c < g; });
       if (!known || !below)
         throw std::logic_error("decision policy '" + std::string(policy_.name()) + "' chose the top-level GSD " +
-                               std::to_string(g) + " cm/px, which is not one of the lawnmower GSDs with a candidate "
+                               std::to_string(g) +
+                               " cm/px, which is not one of the lawnmower GSDs with a candidate "
                                "below it");
       top_gsd_cm_ = g;
       std::erase_if(candidates_, [&](double c) { return c >= g; });
@@ -217,9 +218,8 @@ class AdaptivePlanner {
     // With the backend's class probabilities where it gives them and the decision reads them
     // (a coverage that ranks cells: the cells' decision inputs at the top level,
     // image_summary.hpp, and in a descent's images the scene check's); otherwise the labels alone.
-    Segmentation s = coverage_.ranks_cells
-                         ? segment_with_probabilities_checked(backend_, image, area_.num_classes)
-                         : Segmentation{segment_checked(backend_, image, area_.num_classes), {}};
+    Segmentation s = coverage_.ranks_cells ? segment_with_probabilities_checked(backend_, image, area_.num_classes)
+                                           : Segmentation{segment_checked(backend_, image, area_.num_classes), {}};
     const auto segmented = std::chrono::steady_clock::now();
     const double segmentation_s = std::chrono::duration<double>(segmented - t0).count();  // as Mission measures it
     return accept(image, s, segmentation_s, elapsed_s, segmented);
@@ -269,11 +269,11 @@ class AdaptivePlanner {
   [[nodiscard]] Image image_at(const Eigen::Vector3d& pose, cv::Mat rgb = {}, double yaw_deg = 0.0) const {
     detail::require(pose.allFinite(), "AdaptivePlanner::image_at: the pose must be finite", pose.transpose());
     detail::require(std::isfinite(yaw_deg), "AdaptivePlanner::image_at: yaw_deg must be finite", yaw_deg);
-    detail::require(rgb.empty() || (rgb.type() == CV_8UC3 && rgb.cols == camera_.width_px() &&
-                                    rgb.rows == camera_.height_px()),
-                    "AdaptivePlanner::image_at: rgb must be CV_8UC3 of the camera's size " +
-                        std::to_string(camera_.width_px()) + "x" + std::to_string(camera_.height_px()),
-                    std::to_string(rgb.cols) + "x" + std::to_string(rgb.rows));
+    detail::require(
+        rgb.empty() || (rgb.type() == CV_8UC3 && rgb.cols == camera_.width_px() && rgb.rows == camera_.height_px()),
+        "AdaptivePlanner::image_at: rgb must be CV_8UC3 of the camera's size " + std::to_string(camera_.width_px()) +
+            "x" + std::to_string(camera_.height_px()),
+        std::to_string(rgb.cols) + "x" + std::to_string(rgb.rows));
     Image img;
     img.rgb = std::move(rgb);
     img.position = pose;
@@ -313,8 +313,8 @@ class AdaptivePlanner {
     const cv::Rect region = region_rect(top_index);
     const cv::Mat labels = map_.labels()(region);
     const auto keep_cell = [&](const Area& a) {
-      return valid_pixels(a) > 0 &&
-             coverage_.flies(labels, pixel_rect(a) - region.tl(), top_gsd_cm_, area_.map_gsd_cm, options_.mission.interest);
+      return valid_pixels(a) > 0 && coverage_.flies(labels, pixel_rect(a) - region.tl(), top_gsd_cm_, area_.map_gsd_cm,
+                                                    options_.mission.interest);
     };
     return LawnmowerPlanner(camera_).plan(sub_grid(t, gsd_cm), gsd_cm, Eigen::Vector2d(t.position.x(), t.position.y()),
                                           keep_cell);
@@ -408,7 +408,7 @@ class AdaptivePlanner {
     double altitude_m = 0.0;    ///< h'
     std::size_t ordinal = 0;    ///< 0, 1, ... in the order chosen (DescentOutcome::descent)
     std::vector<Waypoint> plan;
-    bool deferred = false;      ///< flown in a tour (DescentSchedule::tour, row), not at once
+    bool deferred = false;  ///< flown in a tour (DescentSchedule::tour, row), not at once
   };
 
   /// A reported image and its checked labels: the time account, the fused map, and at a
@@ -420,7 +420,8 @@ class AdaptivePlanner {
     pending_ = false;
     reported_elapsed_s_ = elapsed_s;
     const PlannedWaypoint& p = path_.back();
-    const double leg = p.index > 0 ? timing_.segment_time_s(path_[p.index - 1].waypoint.position, p.waypoint.position) : 0.0;
+    const double leg =
+        p.index > 0 ? timing_.segment_time_s(path_[p.index - 1].waypoint.position, p.waypoint.position) : 0.0;
     flight_s_ += leg;
     const double seg = options_.mission.fixed_segmentation_time_s.value_or(segmentation_s);
     segmentation_s_ += seg;
@@ -477,11 +478,10 @@ class AdaptivePlanner {
   static cv::Size grid_size(const SurveyArea& a) {
     const Area& r = a.area;
     detail::require_positive(a.map_gsd_cm, "SurveyArea: map_gsd_cm");
-    detail::require(std::isfinite(r.x_min_m) && std::isfinite(r.y_min_m) && r.x_min_m >= 0.0 && r.y_min_m >= 0.0 &&
-                        std::isfinite(r.width_m()) && r.width_m() > 0.0 && std::isfinite(r.height_m()) &&
-                        r.height_m() > 0.0,
-                    "SurveyArea: area must be finite with x_min, y_min >= 0 and a positive size [m]",
-                    r.width_m() * r.height_m());
+    detail::require(
+        std::isfinite(r.x_min_m) && std::isfinite(r.y_min_m) && r.x_min_m >= 0.0 && r.y_min_m >= 0.0 &&
+            std::isfinite(r.width_m()) && r.width_m() > 0.0 && std::isfinite(r.height_m()) && r.height_m() > 0.0,
+        "SurveyArea: area must be finite with x_min, y_min >= 0 and a positive size [m]", r.width_m() * r.height_m());
     detail::require(a.num_classes >= 1 && a.num_classes <= 255,
                     "SurveyArea: num_classes must be the size of the backend's class set, 1..255 "
                     "(SurveyArea::of(field) sets it)",
@@ -491,8 +491,7 @@ class AdaptivePlanner {
     const double s = 100.0 / a.map_gsd_cm;
     if (a.valid_mask.empty())
       return {static_cast<int>(std::ceil(r.x_max_m * s - 1e-6)), static_cast<int>(std::ceil(r.y_max_m * s - 1e-6))};
-    detail::require(a.valid_mask.type() == CV_8UC1, "SurveyArea: valid_mask must be CV_8UC1",
-                    a.valid_mask.type());
+    detail::require(a.valid_mask.type() == CV_8UC1, "SurveyArea: valid_mask must be CV_8UC1", a.valid_mask.type());
     detail::require(r.x_max_m * s <= a.valid_mask.cols + 0.5 && r.y_max_m * s <= a.valid_mask.rows + 0.5,
                     "SurveyArea: area must lie inside the valid mask's grid",
                     std::to_string(a.valid_mask.cols) + "x" + std::to_string(a.valid_mask.rows) + " px");
@@ -510,7 +509,8 @@ class AdaptivePlanner {
   /// says, the cells without valid ground left out.
   [[nodiscard]] std::vector<Waypoint> top_level_plan(double gsd_cm) const {
     const LawnmowerPlanner planner(camera_);
-    const Area laid = options_.grid_anchor == GridAnchor::centred ? planner.centred_grid(area_.area, gsd_cm) : area_.area;
+    const Area laid =
+        options_.grid_anchor == GridAnchor::centred ? planner.centred_grid(area_.area, gsd_cm) : area_.area;
     return planner.plan(laid, gsd_cm, Eigen::Vector2d(laid.x_min_m, laid.y_min_m), keep());
   }
 
@@ -569,8 +569,7 @@ class AdaptivePlanner {
                     "AdaptivePlanner::report: the image's rgb must be of its size",
                     std::to_string(image.rgb.cols) + "x" + std::to_string(image.rgb.rows));
     detail::require(image.footprint_px.width > 0 && image.footprint_px.height > 0 && image.gsd_cm > 0.0,
-                    "AdaptivePlanner::report: the image has no footprint (make it with image_at())",
-                    image.gsd_cm);
+                    "AdaptivePlanner::report: the image has no footprint (make it with image_at())", image.gsd_cm);
     detail::require(std::isfinite(image.yaw_deg), "AdaptivePlanner::report: the image's yaw_deg must be finite",
                     image.yaw_deg);
     if (elapsed_s)
@@ -734,8 +733,9 @@ class AdaptivePlanner {
     rec.decision = policy_.decide(ctx);
     if (rec.decision.descend) {
       const std::size_t k = chosen_candidate(rec.decision, rec.candidates, policy_.name());
-      ChosenDescent chosen{decisions_.size(), i, rec.candidates[k].altitude_m, descents_chosen_++, std::move(sub_plans[k]),
-                           rec.candidates[k].deferred};
+      ChosenDescent chosen{
+          decisions_.size(),         i, rec.candidates[k].altitude_m, descents_chosen_++, std::move(sub_plans[k]),
+          rec.candidates[k].deferred};
       if (rec.candidates[k].deferred) {
         tour_stops_.push_back(stops[k].first);
         tour_order_.insert(tour_order_.begin() + static_cast<std::ptrdiff_t>(stops[k].second.position), queued_.size());
@@ -756,7 +756,8 @@ class AdaptivePlanner {
   [[nodiscard]] bool descent_rest_fits() const {
     const double bound = step_bound();
     double inner = 0.0;  // from the image just reported through the descent's remaining waypoints
-    for (std::size_t k = sub_next_; k < sub_.size(); ++k) inner += timing_.segment_time_s(sub_[k - 1].position, sub_[k].position);
+    for (std::size_t k = sub_next_; k < sub_.size(); ++k)
+      inner += timing_.segment_time_s(sub_[k - 1].position, sub_[k].position);
     const double more_images = static_cast<double>(sub_.size() - sub_next_);
     // What follows: the rest of the tour being flown (none for a descent flown at once), its end,
     // and the top level from there on.
@@ -772,7 +773,8 @@ class AdaptivePlanner {
       next_top = window_last + 1;
     } else {
       if (next_top < top_.size()) end = top_[next_top].position;
-      if (schedule_.defers) after_flight += tour_extra_s(current_.top_index), after_images += static_cast<double>(tour_images_);
+      if (schedule_.defers)
+        after_flight += tour_extra_s(current_.top_index), after_images += static_cast<double>(tour_images_);
     }
     if (next_top < top_.size()) after_flight += flight_after_[next_top];
     after_images += static_cast<double>(top_.size() - std::min(next_top, top_.size()));
@@ -835,12 +837,12 @@ class AdaptivePlanner {
     out.descent = current_.ordinal;
     out.sigma_top = rec.sigma;
     const cv::Rect region = region_rect(top_index);
-    out.sigma_sub = region.area() == 0 ? 0.0
-                                       : semantic_ratio(map_.labels()(region), options_.mission.interest,
-                                                        map_.unknown_label());
+    out.sigma_sub = region.area() == 0
+                        ? 0.0
+                        : semantic_ratio(map_.labels()(region), options_.mission.interest, map_.unknown_label());
     if (region.area() > 0)
-      out.relabelled = relabelling(descent_before_, map_.labels()(region), area_.valid_mask(region),
-                                   options_.mission.interest);
+      out.relabelled =
+          relabelling(descent_before_, map_.labels()(region), area_.valid_mask(region), options_.mission.interest);
     if (coverage_.ranks_cells) {
       const Candidate& chosen = rec.candidates[chosen_candidate(rec.decision, rec.candidates, policy_.name())];
       const double region_px = static_cast<double>(valid_pixels(top_[top_index].footprint));
@@ -882,31 +884,31 @@ class AdaptivePlanner {
   std::vector<LawnmowerCost> lawnmowers_;  ///< at the candidate and top GSDs
   double valid_px_ = 0.0;                  ///< field pixels of the whole map grid
 
-  std::size_t top_next_ = 0;          ///< next top-level waypoint to hand out
-  std::vector<Waypoint> sub_;         ///< the descent in progress, if any
-  std::size_t sub_next_ = 0;          ///< next waypoint of sub_ to hand out
-  ChosenDescent current_;             ///< the descent in progress (its plan moved to sub_)
+  std::size_t top_next_ = 0;   ///< next top-level waypoint to hand out
+  std::vector<Waypoint> sub_;  ///< the descent in progress, if any
+  std::size_t sub_next_ = 0;   ///< next waypoint of sub_ to hand out
+  ChosenDescent current_;      ///< the descent in progress (its plan moved to sub_)
   std::size_t descents_chosen_ = 0;
-  cv::Mat descent_before_;            ///< the region's map before the descent in progress
-  double fine_mass_ = 0.0;            ///< ranked: Σ over its images so far of the finer look's input mass
-  bool fine_known_ = true;            ///< ... every image of it gave the input
-  bool cut_short_ = false;            ///< the budget ended the descent in progress early
-  GridInputs region_inputs_;          ///< the last top-level image's inputs (buffers reused)
-  GridInputs scene_inputs_;           ///< the last descent image's inputs over its cell (the scene check)
+  cv::Mat descent_before_;    ///< the region's map before the descent in progress
+  double fine_mass_ = 0.0;    ///< ranked: Σ over its images so far of the finer look's input mass
+  bool fine_known_ = true;    ///< ... every image of it gave the input
+  bool cut_short_ = false;    ///< the budget ended the descent in progress early
+  GridInputs region_inputs_;  ///< the last top-level image's inputs (buffers reused)
+  GridInputs scene_inputs_;   ///< the last descent image's inputs over its cell (the scene check)
   /// Per top-level waypoint, the last top-level waypoint of its window: where the window's tour
   /// starts (DescentScheduleRule::window_last).
   std::vector<std::size_t> window_last_;
   // A schedule that defers descents (DescentSchedule::tour, row): the tour of the window being flown.
-  std::vector<ChosenDescent> queued_;     ///< every descent deferred in the window, in decision order
-  std::vector<TourStop> tour_stops_;      ///< ... as tour stops (same order)
-  std::vector<std::size_t> tour_order_;   ///< indices into queued_, in flight order
-  std::size_t tour_next_ = 0;             ///< next of tour_order_ to fly
-  std::size_t tour_images_ = 0;           ///< images of the queued descents
-  bool pending_ = false;              ///< path_.back() awaits its image
+  std::vector<ChosenDescent> queued_;    ///< every descent deferred in the window, in decision order
+  std::vector<TourStop> tour_stops_;     ///< ... as tour stops (same order)
+  std::vector<std::size_t> tour_order_;  ///< indices into queued_, in flight order
+  std::size_t tour_next_ = 0;            ///< next of tour_order_ to fly
+  std::size_t tour_images_ = 0;          ///< images of the queued descents
+  bool pending_ = false;                 ///< path_.back() awaits its image
   std::vector<PlannedWaypoint> path_;
   std::vector<DecisionRecord> decisions_;
 
-  double flight_s_ = 0.0;             ///< the planner's own time account [s]
+  double flight_s_ = 0.0;  ///< the planner's own time account [s]
   double segmentation_s_ = 0.0;
   double planning_s_ = 0.0;
   double slowest_segmentation_s_ = 0.0;

@@ -180,8 +180,8 @@ template <SegmentationBackend Backend>
   std::vector<CellSample> cell_samples;
   std::vector<std::vector<CellSample>> cells_by_field;
   for (std::size_t k = 0; k < fields.size(); ++k) {
-    CalibrationSamples c = collect_samples(fields[k], *backends[k], camera, adaptive.top_gsd_cm, adaptive.candidate_gsd_cm,
-                                           interest, adaptive.coverage, k);
+    CalibrationSamples c = collect_samples(fields[k], *backends[k], camera, adaptive.top_gsd_cm,
+                                           adaptive.candidate_gsd_cm, interest, adaptive.coverage, k);
     by_field.push_back(std::move(c.regions));
     detail::require(!by_field.back().empty(), "calibrate: the training field gave no region sample", fields[k].name());
     samples.insert(samples.end(), by_field.back().begin(), by_field.back().end());
@@ -191,7 +191,8 @@ template <SegmentationBackend Backend>
       std::vector<double> below;
       for (double g : adaptive.candidate_gsd_cm)
         if (g < top) below.push_back(g);
-      CalibrationSamples alt = collect_samples(fields[k], *backends[k], camera, top, below, interest, adaptive.coverage, k);
+      CalibrationSamples alt =
+          collect_samples(fields[k], *backends[k], camera, top, below, interest, adaptive.coverage, k);
       cells_by_field.back().insert(cells_by_field.back().end(), alt.cells.begin(), alt.cells.end());
     }
     cell_samples.insert(cell_samples.end(), cells_by_field.back().begin(), cells_by_field.back().end());
@@ -206,7 +207,8 @@ template <SegmentationBackend Backend>
   const auto backend_of = [&](const Field& f) -> Backend& {
     for (std::size_t k = 0; k < fields.size(); ++k)
       if (&f == &fields[k]) return *backends[k];
-    detail::require(fields.size() == 1, "calibrate: the rule search flew a field that is not a training field", f.name());
+    detail::require(fields.size() == 1, "calibrate: the rule search flew a field that is not a training field",
+                    f.name());
     return *backends.front();
   };
   const auto curve_of = [&](const Field& f) {
@@ -246,8 +248,8 @@ template <SegmentationBackend Backend>
   }
 
   // The rule's settings, chosen by its own search (decision_rules.hpp).
-  const RuleSearchInputs inputs{options, adaptive, fields, curves, halves, half_curves, by_field, cells_by_field,
-                                model, reference};
+  const RuleSearchInputs inputs{options,     adaptive, fields,         curves, halves,
+                                half_curves, by_field, cells_by_field, model,  reference};
   const auto fly = [&](const Field& f, auto& policy, const std::vector<CurvePoint>& curve, double& margin) {
     return detail::fly_scored(f, backend_of(f), policy, adaptive, curve, margin);
   };
@@ -257,9 +259,9 @@ template <SegmentationBackend Backend>
   });
 
   const LinearDecision::Params linear = detail::linear_sigma_range(samples);
-  CalibrationResult result{std::move(samples),          std::move(cell_samples), std::move(input_scores),
-                           std::move(searched->chosen), linear,                  std::move(curves),
-                           std::move(searched->trials)};
+  CalibrationResult result{
+      std::move(samples), std::move(cell_samples),    std::move(input_scores), std::move(searched->chosen), linear,
+      std::move(curves),  std::move(searched->trials)};
   for (Backend* b : backends) result.field_backends.push_back(b->name());
   return result;
 }
@@ -305,7 +307,8 @@ template <SegmentationBackend Backend>
   if (std::any_of(backends.begin(), backends.end(), [&](const std::string& b) { return b != segmenter; }))
     m.field_segmenters = backends;
   for (const auto& c : first.classes()) m.classes.push_back(c.name);
-  const auto& interest = options.adaptive.mission.interest.empty() ? first.interest() : options.adaptive.mission.interest;
+  const auto& interest =
+      options.adaptive.mission.interest.empty() ? first.interest() : options.adaptive.mission.interest;
   for (int i : interest) m.interest.push_back(first.classes().at(static_cast<std::size_t>(i)).name);
   return m;
 }

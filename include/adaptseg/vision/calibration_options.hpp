@@ -35,7 +35,7 @@ struct CalibrationOptions {
   /// Segmentation time charged per image during calibration [s]: declared, not measured, so
   /// that the same inputs give the same model on any machine (recorded in the model file).
   double segmentation_time_s = 0.1;
-  double planning_time_s = 0.0;            ///< planning time charged per waypoint [s]
+  double planning_time_s = 0.0;  ///< planning time charged per waypoint [s]
 
   /// The lawnmower curve's GSDs: `lawnmower_gsd_cm`, or if it is empty the candidate GSDs
   /// and the top GSD, ascending.
@@ -62,8 +62,8 @@ struct CalibrationOptions {
   /// faster than the top where its grid fits the field better). Each must be a candidate GSD
   /// with a finer candidate below it.
   std::optional<std::vector<double>> alternative_top_gsd_cm{};
-  GainModel::FitOptions fit{};             ///< what I predicts from, hyperparameter restarts
-  int refit_every = 0;                     ///< O's scheduled re-optimisation (GainModel)
+  GainModel::FitOptions fit{};  ///< what I predicts from, hyperparameter restarts
+  int refit_every = 0;          ///< O's scheduled re-optimisation (GainModel)
 
   /// Which rule the model holds, by name (decision_rules.hpp): `front-aware`, the
   /// FrontAwarePolicy (default; its confidence level z is chosen below), or `utility`, the
@@ -101,7 +101,7 @@ struct CalibrationOptions {
   /// flown over every layout (the fields; one field: the field and its halves) and scored by
   /// its worst front margin (ties: larger mean margin, then the relative rule, then shorter time).
   UtilityPolicy::Params utility{};
-  int threshold_steps = 10;                ///< utility thresholds tried per weighting
+  int threshold_steps = 10;  ///< utility thresholds tried per weighting
 };
 
 /// One setting of the rule tried on the training fields.
@@ -117,15 +117,15 @@ struct RuleTrial {
 
 /// Everything calibration produced.
 struct CalibrationResult {
-  std::vector<RegionSample> samples;               ///< pooled over the fields (RegionSample::field)
+  std::vector<RegionSample> samples;  ///< pooled over the fields (RegionSample::field)
   /// DescentCoverage::ranked: the cell samples, pooled (CellSample::field), and every input
   /// tried with its capture on the training fields (the chosen one first).
   std::vector<CellSample> cell_samples{};
   std::vector<std::pair<DecisionInput, double>> cell_input_scores{};
-  DecisionFunction decision_function;              ///< fitted, with the chosen rule and settings
-  LinearDecision::Params linear{};                 ///< σ range of the training fields' top-level images
+  DecisionFunction decision_function;                     ///< fitted, with the chosen rule and settings
+  LinearDecision::Params linear{};                        ///< σ range of the training fields' top-level images
   std::vector<std::vector<CurvePoint>> lawnmower_curves;  ///< per training field, at lawnmower_gsds()
-  std::vector<RuleTrial> trials;                   ///< every setting tried, the chosen one first
+  std::vector<RuleTrial> trials;                          ///< every setting tried, the chosen one first
   /// Per training field, the name of the backend that segmented it (calibrate()'s `backends`).
   std::vector<std::string> field_backends{};
 };
@@ -146,14 +146,14 @@ struct RuleSearchInputs {
   std::span<const std::vector<CurvePoint>> half_curves;
   std::span<const std::vector<RegionSample>> samples;  ///< per field
   std::span<const std::vector<CellSample>> cells;      ///< per field (DescentCoverage::ranked)
-  const GainModel& model;                             ///< fitted on every field
-  std::span<const ReferenceCurve> reference;          ///< per field
+  const GainModel& model;                              ///< fitted on every field
+  std::span<const ReferenceCurve> reference;           ///< per field
 };
 
 /// What a rule's calibration search gives.
 struct RuleSearchResult {
-  DecisionFunction chosen;         ///< the rule with the settings chosen
-  std::vector<RuleTrial> trials;   ///< every setting tried, the chosen one first
+  DecisionFunction chosen;        ///< the rule with the settings chosen
+  std::vector<RuleTrial> trials;  ///< every setting tried, the chosen one first
 };
 
 namespace detail {

@@ -62,12 +62,12 @@ inline constexpr std::array<std::pair<const char*, double CellGainModel::Point::
 /// A calibrated decision model and its provenance.
 struct DecisionModel {
   std::vector<std::string> calibration_fields;  ///< names of the training fields (with regions)
-  std::string segmenter;                  ///< backend used for calibration
+  std::string segmenter;                        ///< backend used for calibration
   /// Segmentation time charged per image during calibration [s]: declared, not measured, so
   /// that the model is a function of its inputs.
   double calibration_segmentation_time_s = 0.0;
-  std::vector<std::string> classes;       ///< class names, index order
-  std::vector<std::string> interest;      ///< labels of interest L
+  std::vector<std::string> classes;   ///< class names, index order
+  std::vector<std::string> interest;  ///< labels of interest L
   CameraParams camera{};
   TimingParams timing{};
   double top_gsd_cm = 0.0;
@@ -77,8 +77,8 @@ struct DecisionModel {
   DescentCoverage coverage = DescentCoverage::region;
   DecisionFunction decision_function;
   LinearDecision::Params linear{};
-  std::size_t samples = 0;                ///< region samples the GPs were fitted to
-  double train_front_margin = 0.0;        ///< of the chosen rule, on the training fields (mean)
+  std::size_t samples = 0;          ///< region samples the GPs were fitted to
+  double train_front_margin = 0.0;  ///< of the chosen rule, on the training fields (mean)
   /// Cross-fitted calibration: per calibration field, the backend that segmented it, where one
   /// differs from `segmenter` (a network that never saw that field; calibrate()); empty when
   /// `segmenter` segmented every field (the file then has no `field_segmenters`).
@@ -114,8 +114,8 @@ struct DecisionModel {
     std::vector<std::string> names;
     for (const auto& c : field.classes()) names.push_back(c.name);
     if (names != classes)
-      throw std::invalid_argument("decision model was calibrated for classes [" + join(classes) +
-                                  "] but field '" + field.name() + "' has [" + join(names) +
+      throw std::invalid_argument("decision model was calibrated for classes [" + join(classes) + "] but field '" +
+                                  field.name() + "' has [" + join(names) +
                                   "]: calibrate a model on a field with the same classes");
   }
 
@@ -153,14 +153,14 @@ struct DecisionModel {
     e << YAML::EndMap;
     e << YAML::Key << "classes" << YAML::Value << YAML::Flow << classes;
     e << YAML::Key << "interest" << YAML::Value << YAML::Flow << interest;
-    e << YAML::Key << "camera" << YAML::Value << YAML::Flow << YAML::BeginMap
-      << YAML::Key << "image_width_px" << YAML::Value << std::to_string(camera.image_width_px)
-      << YAML::Key << "image_height_px" << YAML::Value << std::to_string(camera.image_height_px)
-      << YAML::Key << "sensor_width_mm" << YAML::Value << num(camera.sensor_width_mm)
-      << YAML::Key << "focal_length_mm" << YAML::Value << num(camera.focal_length_mm) << YAML::EndMap;
-    e << YAML::Key << "timing" << YAML::Value << YAML::Flow << YAML::BeginMap
-      << YAML::Key << "max_speed_mps" << YAML::Value << num(timing.max_speed_mps)
-      << YAML::Key << "max_accel_mps2" << YAML::Value << num(timing.max_accel_mps2);
+    e << YAML::Key << "camera" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "image_width_px"
+      << YAML::Value << std::to_string(camera.image_width_px) << YAML::Key << "image_height_px" << YAML::Value
+      << std::to_string(camera.image_height_px) << YAML::Key << "sensor_width_mm" << YAML::Value
+      << num(camera.sensor_width_mm) << YAML::Key << "focal_length_mm" << YAML::Value << num(camera.focal_length_mm)
+      << YAML::EndMap;
+    e << YAML::Key << "timing" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "max_speed_mps"
+      << YAML::Value << num(timing.max_speed_mps) << YAML::Key << "max_accel_mps2" << YAML::Value
+      << num(timing.max_accel_mps2);
     // Written only when set, so that models of the isotropic model keep their bytes.
     if (timing.max_vertical_speed_mps > 0.0)
       e << YAML::Key << "max_vertical_speed_mps" << YAML::Value << num(timing.max_vertical_speed_mps);
@@ -169,9 +169,8 @@ struct DecisionModel {
     e << YAML::Key << "candidate_gsd_cm" << YAML::Value;
     emit_numbers(e, candidate_gsd_cm);
     e << YAML::Key << "descent_coverage" << YAML::Value << to_string(coverage);
-    e << YAML::Key << "linear" << YAML::Value << YAML::Flow << YAML::BeginMap
-      << YAML::Key << "sigma_low" << YAML::Value << num(linear.sigma_low)
-      << YAML::Key << "sigma_high" << YAML::Value << num(linear.sigma_high) << YAML::EndMap;
+    e << YAML::Key << "linear" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "sigma_low" << YAML::Value
+      << num(linear.sigma_low) << YAML::Key << "sigma_high" << YAML::Value << num(linear.sigma_high) << YAML::EndMap;
     const GainModel& gm = decision_function.model();
     e << YAML::Key << "gain_model" << YAML::Value << YAML::BeginMap;
     e << YAML::Key << "gain_inputs" << YAML::Value
@@ -237,10 +236,12 @@ struct DecisionModel {
       const std::string format = root["format"] && root["format"].IsScalar() ? root["format"].Scalar() : "";
       const detail::YamlReader r(root, where);
       if (format == "adaptseg.decision_model/1")
-        throw std::invalid_argument(where + ": a decision model of format 1 (adaptseg 0.1) is no longer read since "
-                                            "adaptseg 0.2.0; calibrate the model again (adaptseg_calibrate)");
+        throw std::invalid_argument(where +
+                                    ": a decision model of format 1 (adaptseg 0.1) is no longer read since "
+                                    "adaptseg 0.2.0; calibrate the model again (adaptseg_calibrate)");
       if (format != "adaptseg.decision_model/2")
-        throw std::invalid_argument(where + ": not an adaptseg decision model (format must be adaptseg.decision_model/2)");
+        throw std::invalid_argument(where +
+                                    ": not an adaptseg decision model (format must be adaptseg.decision_model/2)");
       DecisionModel m = read_v2(r);
       m.check(where);
       return m;
@@ -283,8 +284,8 @@ struct DecisionModel {
     const auto gm = r.map("gain_model");
     const std::string inputs = gm.text("gain_inputs");
     if (inputs != "delta-sigma" && inputs != "delta-sigma-height")
-      detail::yaml_error(r.where(), "'gain_model.gain_inputs' must be delta-sigma or delta-sigma-height (got '" +
-                                         inputs + "')");
+      detail::yaml_error(r.where(),
+                         "'gain_model.gain_inputs' must be delta-sigma or delta-sigma-height (got '" + inputs + "')");
     const bool with_c = gm.has("C");
     std::vector<GainModel::EfficiencyPoint> efficiency;
     if (with_c) {
@@ -298,8 +299,9 @@ struct DecisionModel {
     const auto gp = [&](const char* key, Eigen::Index dimension) {
       return detail::read_gp<detail::ModelGp::KernelType>(gm.map(key), dimension);
     };
-    GainModel model(gp("O", 2), gp("I", inputs == "delta-sigma" ? 1 : 2), with_c ? std::optional(gp("C", 2)) : std::nullopt,
-                    std::move(efficiency), static_cast<int>(gm.integer("refit_every", 0, 1'000'000'000)));
+    GainModel model(gp("O", 2), gp("I", inputs == "delta-sigma" ? 1 : 2),
+                    with_c ? std::optional(gp("C", 2)) : std::nullopt, std::move(efficiency),
+                    static_cast<int>(gm.integer("refit_every", 0, 1'000'000'000)));
     if (gm.has("cells")) {
       const auto c = gm.map("cells");
       const DecisionInput input = parse_decision_input(c.text("input"));
@@ -309,9 +311,10 @@ struct DecisionModel {
         const auto v = c.numbers(key);
         if (points.empty()) points.resize(v.size());
         if (v.empty() || v.size() != points.size())
-          detail::yaml_error(r.where(), "'gain_model.cells' needs one top_gsd_cm, sub_gsd_cm, gain_slope, gain_noise, "
-                                        "relabel_slope, relabel_noise, proxy_slope, proxy_noise and (optional) "
-                                        "proxy_slope_sd value per point (>= 1 point)");
+          detail::yaml_error(r.where(),
+                             "'gain_model.cells' needs one top_gsd_cm, sub_gsd_cm, gain_slope, gain_noise, "
+                             "relabel_slope, relabel_noise, proxy_slope, proxy_noise and (optional) "
+                             "proxy_slope_sd value per point (>= 1 point)");
         for (std::size_t j = 0; j < v.size(); ++j) points[j].*member = v[j];
       }
       // Absent (files of adaptseg before 2026-11-27, or pooled over the cells): cells.
@@ -321,7 +324,8 @@ struct DecisionModel {
         try {
           pooling = parse_slope_pooling(name);
         } catch (const std::invalid_argument&) {
-          detail::yaml_error(r.where(), "'gain_model.cells.slope_pooling' must be cells or fields (got '" + name + "')");
+          detail::yaml_error(r.where(),
+                             "'gain_model.cells.slope_pooling' must be cells or fields (got '" + name + "')");
         }
       }
       model.set_cells(CellGainModel(input, std::move(points), pooling));
@@ -338,8 +342,7 @@ struct DecisionModel {
       if (!function && kind == Rule::kName)
         function.emplace(Rule::read_keys(rule, std::move(model), min_sigma, online));
     });
-    if (!function)
-      detail::yaml_error(r.where(), "'rule.kind' must be " + rule_names_text() + " (got '" + kind + "')");
+    if (!function) detail::yaml_error(r.where(), "'rule.kind' must be " + rule_names_text() + " (got '" + kind + "')");
     const auto samples = static_cast<std::size_t>(cal.integer("samples", 0, 1'000'000'000));
     // The calibration record and the decision function; read_setup fills in the rest.
     DecisionModel m{.calibration_fields = std::move(fields),

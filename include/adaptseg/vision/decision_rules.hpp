@@ -28,7 +28,8 @@ template <class F>
 void for_each_rule(F&& f) {
   [&]<std::size_t... I>(std::index_sequence<I...>) {
     (f.template operator()<std::tuple_element_t<I, DecisionRules>>(), ...);
-  }(std::make_index_sequence<std::tuple_size_v<DecisionRules>>{});
+  }
+  (std::make_index_sequence<std::tuple_size_v<DecisionRules>>{});
 }
 
 /// The rules' names, in order (`--rule`'s choices).
@@ -42,8 +43,7 @@ void for_each_rule(F&& f) {
 [[nodiscard]] inline std::string rule_names_text() {
   const std::vector<std::string> names = rule_names();
   std::string s;
-  for (std::size_t k = 0; k < names.size(); ++k)
-    s += (k == 0 ? "" : k + 1 == names.size() ? " or " : ", ") + names[k];
+  for (std::size_t k = 0; k < names.size(); ++k) s += (k == 0 ? "" : k + 1 == names.size() ? " or " : ", ") + names[k];
   return s;
 }
 

@@ -46,8 +46,8 @@ enum class DescentCoverage { region, interest, ranked };
   detail::require(std::isfinite(top_gsd_cm) && top_gsd_cm > 0.0 && std::isfinite(grid_gsd_cm) && grid_gsd_cm > 0.0,
                   "cell_shows_interest: GSDs must be finite and > 0; top", top_gsd_cm);
   const int m = static_cast<int>(std::ceil(top_gsd_cm / grid_gsd_cm - 1e-9));  // one top-level pixel
-  const cv::Rect rect =
-      cv::Rect(cell.x - m, cell.y - m, cell.width + 2 * m, cell.height + 2 * m) & cv::Rect(0, 0, labels.cols, labels.rows);
+  const cv::Rect rect = cv::Rect(cell.x - m, cell.y - m, cell.width + 2 * m, cell.height + 2 * m) &
+                        cv::Rect(0, 0, labels.cols, labels.rows);
   const auto lut = detail::label_lut(interest);
   for (int r = rect.y; r < rect.y + rect.height; ++r) {
     const auto* row = labels.ptr<std::uint8_t>(r);

@@ -66,9 +66,9 @@ struct FieldGeo {
 /// orthomosaic's bottom-left corner, +x along the easting axis, +y along the northing axis
 /// (north-up grids only). Plain data; written back into the fused map's GeoTIFF.
 struct FieldCrs {
-  std::string wkt;                ///< the CRS as WKT (what GDAL read from the raster)
-  double origin_easting_m = 0.0;  ///< CRS easting of the field frame's origin [m]
-  double origin_northing_m = 0.0; ///< CRS northing of the field frame's origin [m]
+  std::string wkt;                 ///< the CRS as WKT (what GDAL read from the raster)
+  double origin_easting_m = 0.0;   ///< CRS easting of the field frame's origin [m]
+  double origin_northing_m = 0.0;  ///< CRS northing of the field frame's origin [m]
 
   friend bool operator==(const FieldCrs&, const FieldCrs&) = default;
 };
@@ -117,8 +117,8 @@ class Field {
   ///         positive, no classes, duplicate or empty class names, an ignore label that is
   ///         also a class index, labels of interest out of range, an image of another size,
   ///         or a label value that is neither a class index nor the ignore label.
-  Field(std::string name, double gsd_cm, cv::Mat labels, std::vector<ClassInfo> classes,
-        std::vector<int> interest, int ignore_label = 255, cv::Mat image = {})
+  Field(std::string name, double gsd_cm, cv::Mat labels, std::vector<ClassInfo> classes, std::vector<int> interest,
+        int ignore_label = 255, cv::Mat image = {})
       : name_(std::move(name)),
         gsd_cm_(gsd_cm),
         labels_(std::move(labels)),
@@ -219,8 +219,7 @@ class Field {
       if (!i) {
         std::string known;
         for (const auto& c : classes_) known += (known.empty() ? "" : ", ") + c.name;
-        throw std::invalid_argument("unknown class '" + n + "' in field '" + name_ +
-                                    "' (classes: " + known + ")");
+        throw std::invalid_argument("unknown class '" + n + "' in field '" + name_ + "' (classes: " + known + ")");
       }
       out.insert(*i);
     }
@@ -238,10 +237,9 @@ class Field {
     const auto in01 = [](double v) { return std::isfinite(v) && v >= 0.0 && v <= 1.0; };
     std::ostringstream desc;
     desc << region.x0 << ',' << region.y0 << ',' << region.x1 << ',' << region.y1;
-    detail::require(in01(region.x0) && in01(region.x1) && in01(region.y0) && in01(region.y1) &&
-                        region.x0 < region.x1 && region.y0 < region.y1,
-                    "Field::sub_field: region must satisfy 0 <= x0 < x1 <= 1, 0 <= y0 < y1 <= 1",
-                    desc.str());
+    detail::require(in01(region.x0) && in01(region.x1) && in01(region.y0) && in01(region.y1) && region.x0 < region.x1 &&
+                        region.y0 < region.y1,
+                    "Field::sub_field: region must satisfy 0 <= x0 < x1 <= 1, 0 <= y0 < y1 <= 1", desc.str());
     const int c0 = static_cast<int>(std::lround(region.x0 * width_px()));
     const int c1 = static_cast<int>(std::lround(region.x1 * width_px()));
     const int r0 = static_cast<int>(std::lround(region.y0 * height_px()));
@@ -270,11 +268,10 @@ class Field {
     detail::require(!labels_.empty(), "Field '" + name_ + "': the label map is empty", "0x0");
     detail::require(labels_.type() == CV_8UC1,
                     "Field '" + name_ + "': the label map must be 8-bit single channel (CV_8UC1)",
-                    "channels=" + std::to_string(labels_.channels()) +
-                        " depth=" + std::to_string(labels_.depth()));
+                    "channels=" + std::to_string(labels_.channels()) + " depth=" + std::to_string(labels_.depth()));
     detail::require(!classes_.empty(), "Field '" + name_ + "': at least one class is required", 0);
-    detail::require(ignore_label_ >= 0 && ignore_label_ <= 255,
-                    "Field '" + name_ + "': ignore_label must be in 0..255", ignore_label_);
+    detail::require(ignore_label_ >= 0 && ignore_label_ <= 255, "Field '" + name_ + "': ignore_label must be in 0..255",
+                    ignore_label_);
     detail::require(ignore_label_ >= num_classes(),
                     "Field '" + name_ + "': ignore_label must not be a class index (there are " +
                         std::to_string(num_classes()) + " classes)",
@@ -282,18 +279,14 @@ class Field {
     std::set<std::string> names;
     for (const auto& c : classes_) {
       detail::require(!c.name.empty(), "Field '" + name_ + "': a class has an empty name", "''");
-      detail::require(names.insert(c.name).second,
-                      "Field '" + name_ + "': class name listed twice", c.name);
+      detail::require(names.insert(c.name).second, "Field '" + name_ + "': class name listed twice", c.name);
     }
     for (int i : interest_)
-      detail::require(i >= 0 && i < num_classes(),
-                      "Field '" + name_ + "': label of interest out of range", i);
+      detail::require(i >= 0 && i < num_classes(), "Field '" + name_ + "': label of interest out of range", i);
     if (!image_.empty()) {
-      detail::require(image_.type() == CV_8UC3,
-                      "Field '" + name_ + "': the image must be 8-bit 3-channel",
+      detail::require(image_.type() == CV_8UC3, "Field '" + name_ + "': the image must be 8-bit 3-channel",
                       "channels=" + std::to_string(image_.channels()));
-      detail::require(image_.size() == labels_.size(),
-                      "Field '" + name_ + "': image and label map differ in size",
+      detail::require(image_.size() == labels_.size(), "Field '" + name_ + "': image and label map differ in size",
                       std::to_string(image_.cols) + "x" + std::to_string(image_.rows) + " vs " +
                           std::to_string(labels_.cols) + "x" + std::to_string(labels_.rows));
     }
@@ -303,10 +296,9 @@ class Field {
       for (int c = 0; c < labels_.cols; ++c) {
         const int v = row[c];
         if (v >= num_classes() && v != ignore_label_) {
-          throw std::invalid_argument("Field '" + name_ + "': label value " + std::to_string(v) +
-                                      " at row " + std::to_string(r) + ", col " +
-                                      std::to_string(c) + " is neither a class index (0.." +
-                                      std::to_string(num_classes() - 1) +
+          throw std::invalid_argument("Field '" + name_ + "': label value " + std::to_string(v) + " at row " +
+                                      std::to_string(r) + ", col " + std::to_string(c) +
+                                      " is neither a class index (0.." + std::to_string(num_classes() - 1) +
                                       ") nor the ignore label " + std::to_string(ignore_label_));
         }
       }
@@ -375,10 +367,8 @@ inline std::vector<ClassInfo> field_read_classes(const YamlReader& r) {
   return classes;
 }
 
-inline cv::Mat field_read_image(const std::filesystem::path& file, int flags,
-                                const std::filesystem::path& yaml) {
-  if (!std::filesystem::is_regular_file(file))
-    field_error(yaml, "file not found: " + file.string());
+inline cv::Mat field_read_image(const std::filesystem::path& file, int flags, const std::filesystem::path& yaml) {
+  if (!std::filesystem::is_regular_file(file)) field_error(yaml, "file not found: " + file.string());
   cv::Mat m = cv::imread(file.string(), flags);
   if (m.empty()) field_error(yaml, "cannot decode image: " + file.string());
   return m;
@@ -386,11 +376,11 @@ inline cv::Mat field_read_image(const std::filesystem::path& file, int flags,
 
 /// field.yaml read and checked, the rasters not yet loaded (Field::load, gdal::load_field).
 struct FieldYaml {
-  std::filesystem::path yaml;                  ///< the field.yaml file
+  std::filesystem::path yaml;  ///< the field.yaml file
   std::string name;
-  std::optional<double> gsd_cm;                ///< absent: the rasters must carry it
-  std::string labels_file;                     ///< as written, relative to the directory
-  std::optional<std::string> image_file;       ///< as written, relative to the directory
+  std::optional<double> gsd_cm;           ///< absent: the rasters must carry it
+  std::string labels_file;                ///< as written, relative to the directory
+  std::optional<std::string> image_file;  ///< as written, relative to the directory
   int ignore_label = 255;
   std::vector<ClassInfo> classes;
   std::vector<int> interest;
@@ -401,8 +391,7 @@ struct FieldYaml {
 /// @throws std::invalid_argument naming the file and the problem.
 inline FieldYaml read_field_yaml(const std::filesystem::path& dir) {
   namespace fs = std::filesystem;
-  if (!fs::is_directory(dir))
-    throw std::invalid_argument("field directory not found: " + dir.string());
+  if (!fs::is_directory(dir)) throw std::invalid_argument("field directory not found: " + dir.string());
   const fs::path yaml = dir / "field.yaml";
   if (!fs::is_regular_file(yaml)) throw std::invalid_argument("missing " + yaml.string());
   const YamlReader r(yaml_mapping(yaml.string(), "a field description", [&] { return YAML::LoadFile(yaml.string()); }),
@@ -439,8 +428,8 @@ inline FieldYaml read_field_yaml(const std::filesystem::path& dir) {
 inline cv::Mat field_check_labels(cv::Mat labels, const FieldYaml& y) {
   if (labels.type() != CV_8UC1)
     field_error(y.yaml, "'" + y.labels_file + "' must be an 8-bit single-channel PNG (got " +
-                            std::to_string(labels.channels()) + " channels, depth " +
-                            std::to_string(labels.depth()) + ")");
+                            std::to_string(labels.channels()) + " channels, depth " + std::to_string(labels.depth()) +
+                            ")");
   return labels;
 }
 
@@ -464,10 +453,11 @@ inline Field field_from_yaml(const FieldYaml& y, double gsd_cm, cv::Mat labels, 
 inline Field Field::load(const std::filesystem::path& dir) {
   const detail::FieldYaml y = detail::read_field_yaml(dir);
   if (!y.gsd_cm)
-    detail::field_error(y.yaml, "missing key 'gsd_cm' (a field whose rasters carry their georeference, "
-                                "e.g. GeoTIFFs, loads with adaptseg::gdal::load_field, <adaptseg/gdal/gdal_io.hpp>)");
-  cv::Mat labels = detail::field_check_labels(
-      detail::field_read_image(dir / y.labels_file, cv::IMREAD_UNCHANGED, y.yaml), y);
+    detail::field_error(y.yaml,
+                        "missing key 'gsd_cm' (a field whose rasters carry their georeference, "
+                        "e.g. GeoTIFFs, loads with adaptseg::gdal::load_field, <adaptseg/gdal/gdal_io.hpp>)");
+  cv::Mat labels =
+      detail::field_check_labels(detail::field_read_image(dir / y.labels_file, cv::IMREAD_UNCHANGED, y.yaml), y);
   cv::Mat image;
   if (y.image_file) image = detail::field_read_image(dir / *y.image_file, cv::IMREAD_COLOR, y.yaml);
   return detail::field_from_yaml(y, *y.gsd_cm, std::move(labels), std::move(image));

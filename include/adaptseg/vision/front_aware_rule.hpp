@@ -143,13 +143,14 @@ struct FrontAwareRule {
     e << YAML::Key << "sigma_prior_sd" << YAML::Value << num(p.sigma_prior_sd);
     if (p.field_curve) e << YAML::Key << "field_curve" << YAML::Value << detail::flag_text(true);
     if (p.curve_ratio) e << YAML::Key << "curve_ratio" << YAML::Value << detail::flag_text(true);
-    if (p.top_level != TopLevelChoice::undominated) e << YAML::Key << "top_level" << YAML::Value << to_string(p.top_level);
+    if (p.top_level != TopLevelChoice::undominated)
+      e << YAML::Key << "top_level" << YAML::Value << to_string(p.top_level);
     e << YAML::Key << "reference" << YAML::Value << YAML::BeginSeq;
     for (const auto& r : rule.reference()) {
       std::vector<double> g, m;
       for (const auto& pt : r.points) g.push_back(pt.gsd_cm), m.push_back(pt.miou);
-      e << YAML::BeginMap << YAML::Key << "field" << YAML::Value << r.field << YAML::Key << "field_sigma"
-        << YAML::Value << num(r.field_sigma);
+      e << YAML::BeginMap << YAML::Key << "field" << YAML::Value << r.field << YAML::Key << "field_sigma" << YAML::Value
+        << num(r.field_sigma);
       if (r.field_input > 0.0) e << YAML::Key << "field_input" << YAML::Value << num(r.field_input);
       if (!r.top_inputs.empty()) {
         std::vector<double> tg, tx;
@@ -182,7 +183,9 @@ struct FrontAwareRule {
       const auto v = c.numbers("miou");
       if (g.size() != v.size())
         detail::yaml_error(rule.where(), "a 'rule.reference' curve needs as many 'miou' as 'gsd_cm' values");
-      ReferenceCurve curve{c.text("field"), {}, c.has("field_sigma") ? c.number("field_sigma") : 0.0,
+      ReferenceCurve curve{c.text("field"),
+                           {},
+                           c.has("field_sigma") ? c.number("field_sigma") : 0.0,
                            c.has("field_input") ? c.number("field_input") : 0.0};
       for (std::size_t i = 0; i < g.size(); ++i) curve.points.push_back({g[i], v[i]});
       if (c.has("top_input_gsd_cm") || c.has("top_input")) {

@@ -110,8 +110,12 @@ template <Kernel K>
     return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size())));
   };
   typename GaussianProcess<K>::State s{
-      K::from_log_parameters(vec("log_parameters"), vec("log_lower_bounds"), vec("log_upper_bounds")), {}, 0.0, 1.0,
-      {}, {}};
+      K::from_log_parameters(vec("log_parameters"), vec("log_lower_bounds"), vec("log_upper_bounds")),
+      {},
+      0.0,
+      1.0,
+      {},
+      {}};
   s.options.normalize_y = r.flag("normalize_y");
   s.options.initial_jitter = r.number("initial_jitter");
   s.options.max_jitter_attempts = static_cast<int>(r.integer("max_jitter_attempts", 0, 30));
@@ -201,8 +205,9 @@ template <Kernel K>
   const std::string text{std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>()};
   return detail::naming_file(where, [&] {
     if (detail::is_gp_text_v1(text))
-      throw std::invalid_argument(where + ": a Gaussian process in adaptseg 0.1's line format is no longer read "
-                                          "since adaptseg 0.2.0; fit it again and save it with save_gaussian_process");
+      throw std::invalid_argument(where +
+                                  ": a Gaussian process in adaptseg 0.1's line format is no longer read "
+                                  "since adaptseg 0.2.0; fit it again and save it with save_gaussian_process");
     const detail::YamlReader r(detail::yaml_mapping(where, "a Gaussian process", [&] { return YAML::Load(text); }),
                                where);
     const std::string format = r.text("format");

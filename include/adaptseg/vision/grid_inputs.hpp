@@ -68,7 +68,8 @@ class GridInputs {
     for (const auto* planes : {&segmentation.probabilities, &segmentation.member_votes})
       for (const cv::Mat& p : *planes)
         detail::require(p.type() == CV_32FC1 && p.size() == labels.size(),
-                        "GridInputs: probabilities and member votes must be CV_32FC1 planes of the labels' size", p.cols);
+                        "GridInputs: probabilities and member votes must be CV_32FC1 planes of the labels' size",
+                        p.cols);
     wanted_[index_of(DecisionInput::sigma)] = true;
     for (DecisionInput i : inputs) wanted_[index_of(i)] = true;
     camera_units(segmentation, interest, ignore_label);
@@ -224,7 +225,8 @@ class GridInputs {
           column_field.assign(static_cast<std::size_t>(rect_.width), 0);
           for (int y = y0; y < y0 + static_cast<int>(rows); ++y) {
             const auto* f = field.ptr<unsigned char>(y);
-            for (int x = x_first; x < r.x + r.width; ++x) column_field[static_cast<std::size_t>(x)] += f[x] != 0 ? 1 : 0;
+            for (int x = x_first; x < r.x + r.width; ++x)
+              column_field[static_cast<std::size_t>(x)] += f[x] != 0 ? 1 : 0;
           }
         }
         int x0 = x_first;
@@ -267,7 +269,8 @@ class GridInputs {
         std::int64_t s = 0, c = 0;
         for (int cx = 0; cx < camera_.width; ++cx) {
           const std::size_t at = at0 + static_cast<std::size_t>(cx);
-          const std::int64_t w = col_start_[static_cast<std::size_t>(cx) + 1] - col_start_[static_cast<std::size_t>(cx)];
+          const std::int64_t w =
+              col_start_[static_cast<std::size_t>(cx) + 1] - col_start_[static_cast<std::size_t>(cx)];
           if (w > 0 && sigma[at] != kUnknown && units_[k][at] != kUnknown) {
             s += units_[k][at] * w;
             c += w;
@@ -324,8 +327,9 @@ class GridInputs {
     for (int c : interest) classes += c >= 0 && c < 256 ? 1 : 0;
     const auto largest = static_cast<std::int64_t>(std::max<std::size_t>(1, classes)) * (std::int64_t{1} << 32);
     // A strip's sum: at most a whole footprint's pixels (or the rect's) times the largest value.
-    const std::int64_t most_px = std::max<std::int64_t>(
-        1, std::max(static_cast<std::int64_t>(fp_.width) * fp_.height, static_cast<std::int64_t>(rect_.width) * rect_.height));
+    const std::int64_t most_px =
+        std::max<std::int64_t>(1, std::max(static_cast<std::int64_t>(fp_.width) * fp_.height,
+                                           static_cast<std::int64_t>(rect_.width) * rect_.height));
     rows_fit_ = largest <= (std::int64_t{1} << 62) / most_px;
   }
 
@@ -362,7 +366,7 @@ class GridInputs {
   /// Unturned: per camera row (camera width + 1 entries each), prefix sums of a wanted input's
   /// units and of its known pixels, weighted by the footprint columns reading each pixel.
   std::array<std::vector<std::int64_t>, kDecisionInputCount> prefix_sum_{}, prefix_count_{};
-  std::vector<int> index_;            ///< turned: camera pixel of each map pixel of rect (-1: none)
+  std::vector<int> index_;  ///< turned: camera pixel of each map pixel of rect (-1: none)
   /// A row's sum of units fits 64 bits (always, but for inputs of hundreds of classes over
   /// rows of millions of pixels): rows are summed in plain integers, else pixel by pixel.
   bool rows_fit_ = true;

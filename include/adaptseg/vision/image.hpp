@@ -61,10 +61,10 @@ struct Image {
   double yaw_deg = 0.0;
   /// Where the image was taken: x, y [m] field frame, z altitude [m].
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  double gsd_cm = 0.0;    ///< [cm/px]
-  int width_px = 0;       ///< I_w
-  int height_px = 0;      ///< I_h
-  int ignore_label = 255; ///< label for "no class" in ground_truth and in segmentations
+  double gsd_cm = 0.0;     ///< [cm/px]
+  int width_px = 0;        ///< I_w
+  int height_px = 0;       ///< I_h
+  int ignore_label = 255;  ///< label for "no class" in ground_truth and in segmentations
 };
 
 /// Where a camera frame lies on the map grid: footprint coordinates (a, b) [map px] from the
@@ -195,7 +195,9 @@ inline void check_probabilities(const std::vector<cv::Mat>& probabilities, const
                         std::to_string(image.height_px),
                     std::to_string(p.cols) + "x" + std::to_string(p.rows));
   }
-  const auto where = [](int x, int y) { return " at pixel (x " + std::to_string(x) + ", y " + std::to_string(y) + ")"; };
+  const auto where = [](int x, int y) {
+    return " at pixel (x " + std::to_string(x) + ", y " + std::to_string(y) + ")";
+  };
   const auto text = [](double v) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.6g", v);

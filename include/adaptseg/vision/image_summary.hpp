@@ -57,7 +57,8 @@ namespace adaptseg {
     for (std::size_t c = 0; c < probs.size(); ++c) p_row[c] = probs[c].ptr<float>(y);
     for (std::size_t c = 0; c < votes.size(); ++c) v_row[c] = votes[c].ptr<float>(y);
     const auto* l_row = labels.ptr<unsigned char>(y);
-    pixel_input_rows(static_cast<std::size_t>(labels.cols), l_row, p_row, v_row, in_l, detail::kEveryDecisionInput, out);
+    pixel_input_rows(static_cast<std::size_t>(labels.cols), l_row, p_row, v_row, in_l, detail::kEveryDecisionInput,
+                     out);
     for (int x = 0; x < labels.cols; ++x)
       if (l_row[x] == ignore_label)
         for (std::size_t k = 0; k < kDecisionInputCount; ++k) out[k][x] = nan;

@@ -29,8 +29,7 @@ namespace adaptseg {
 /// pixels; pixels outside the field carry no information, so they are left out here. 0 when
 /// the image has no valid pixel.
 /// @throws std::invalid_argument unless `labels` is CV_8UC1.
-[[nodiscard]] inline double semantic_ratio(const cv::Mat& labels, std::span<const int> interest,
-                                           int ignore_label) {
+[[nodiscard]] inline double semantic_ratio(const cv::Mat& labels, std::span<const int> interest, int ignore_label) {
   detail::require(labels.type() == CV_8UC1, "semantic_ratio: labels must be CV_8UC1", labels.type());
   std::int64_t valid = 0, hits = 0;
   const auto lut = detail::label_lut(interest);
@@ -52,8 +51,8 @@ class ConfusionMatrix {
  public:
   /// @throws std::invalid_argument unless 1 <= num_classes <= 255.
   explicit ConfusionMatrix(int num_classes) : n_(num_classes) {
-    detail::require(num_classes >= 1 && num_classes <= 255,
-                    "ConfusionMatrix: num_classes must be in 1..255", num_classes);
+    detail::require(num_classes >= 1 && num_classes <= 255, "ConfusionMatrix: num_classes must be in 1..255",
+                    num_classes);
     counts_.assign(static_cast<std::size_t>(n_ * (n_ + 1)), 0);
   }
 
@@ -62,8 +61,7 @@ class ConfusionMatrix {
   /// Adds every pixel where `truth` is not `ignore_label`.
   /// @throws std::invalid_argument unless both are CV_8UC1 of the same size.
   void add(const cv::Mat& truth, const cv::Mat& predicted, int ignore_label) {
-    detail::require(truth.type() == CV_8UC1 && predicted.type() == CV_8UC1 &&
-                        truth.size() == predicted.size(),
+    detail::require(truth.type() == CV_8UC1 && predicted.type() == CV_8UC1 && truth.size() == predicted.size(),
                     "ConfusionMatrix::add: truth and prediction must be CV_8UC1 of one size",
                     std::to_string(truth.cols) + "x" + std::to_string(truth.rows) + " vs " +
                         std::to_string(predicted.cols) + "x" + std::to_string(predicted.rows));
@@ -209,18 +207,17 @@ class ConfusionMatrix {
     }
   }
   if (n == 0) return {};
-  return {static_cast<double>(changed) / static_cast<double>(n), static_cast<double>(changed_l) / static_cast<double>(n)};
+  return {static_cast<double>(changed) / static_cast<double>(n),
+          static_cast<double>(changed_l) / static_cast<double>(n)};
 }
 
 /// Confusion of one image's segmentation against its ground truth at the orthomosaic's
 /// resolution (each camera pixel spread over the orthomosaic pixels it covers).
 /// @throws std::invalid_argument if the image has no ground truth or `labels` is not
 ///         CV_8UC1 of the image's size.
-[[nodiscard]] inline ConfusionMatrix image_confusion(const Image& image, const cv::Mat& labels,
-                                                     int num_classes) {
+[[nodiscard]] inline ConfusionMatrix image_confusion(const Image& image, const cv::Mat& labels, int num_classes) {
   detail::require(!image.ground_truth.empty(), "image_confusion: the image has no ground truth", 0);
-  detail::require(labels.type() == CV_8UC1 && labels.cols == image.width_px &&
-                      labels.rows == image.height_px,
+  detail::require(labels.type() == CV_8UC1 && labels.cols == image.width_px && labels.rows == image.height_px,
                   "image_confusion: labels must be CV_8UC1 of the image's size", labels.cols);
   cv::Mat up;
   cv::resize(labels, up, image.ground_truth.size(), 0, 0, cv::INTER_NEAREST_EXACT);

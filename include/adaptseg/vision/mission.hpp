@@ -24,8 +24,8 @@ namespace adaptseg {
 /// What happened at one waypoint.
 struct WaypointRecord {
   Waypoint waypoint;
-  int level = 0;                ///< 0: top-level plan; 1: a sub-lawnmower waypoint
-  double semantic_ratio = 0.0;  ///< σ of the segmentation over L (paper Eq. `eq:vr`)
+  int level = 0;                              ///< 0: top-level plan; 1: a sub-lawnmower waypoint
+  double semantic_ratio = 0.0;                ///< σ of the segmentation over L (paper Eq. `eq:vr`)
   std::optional<double> image_miou_interest;  ///< per-image mIoU over L, if defined
   std::optional<double> image_miou_all;       ///< per-image mIoU over all classes, if defined
   /// Share of the footprint's valid ground-truth pixels in L (σ of the truth, not of the
@@ -156,9 +156,7 @@ class Mission {
   }
 
   /// Charges planning time: `measured_s`, or the fixed per-waypoint time if one is set.
-  void charge_planning(double measured_s) {
-    result_.planning_s += options_.fixed_planning_time_s.value_or(measured_s);
-  }
+  void charge_planning(double measured_s) { result_.planning_s += options_.fixed_planning_time_s.value_or(measured_s); }
 
   /// Scores the fused map against the field and returns the result. Call once, at the end.
   MissionResult finish() && { return std::move(*this).finish(map_); }
@@ -205,9 +203,9 @@ template <SegmentationBackend Backend>
   Mission<Backend> mission(field, backend, options, "lawnmower");
   const auto t0 = std::chrono::steady_clock::now();
   const LawnmowerPlanner planner(mission.camera(), overlap);
-  const auto plan = planner.plan(field.area(), gsd_cm, {0.0, 0.0},
-                                 [&](const Area& a) { return field.has_valid(a); });
-  const double per_waypoint = plan.empty() ? 0.0 : Mission<Backend>::seconds_since(t0) / static_cast<double>(plan.size());
+  const auto plan = planner.plan(field.area(), gsd_cm, {0.0, 0.0}, [&](const Area& a) { return field.has_valid(a); });
+  const double per_waypoint =
+      plan.empty() ? 0.0 : Mission<Backend>::seconds_since(t0) / static_cast<double>(plan.size());
   for (const auto& w : plan) {
     mission.charge_planning(per_waypoint);
     mission.visit(w, 0);

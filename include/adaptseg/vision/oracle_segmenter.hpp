@@ -24,8 +24,8 @@ class OracleSegmenter {
   /// @param num_classes size of the field's class set.
   /// @throws std::invalid_argument unless 1 <= num_classes <= 255.
   explicit OracleSegmenter(int num_classes) : num_classes_(num_classes) {
-    detail::require(num_classes >= 1 && num_classes <= 255,
-                    "OracleSegmenter: num_classes must be in 1..255", num_classes);
+    detail::require(num_classes >= 1 && num_classes <= 255, "OracleSegmenter: num_classes must be in 1..255",
+                    num_classes);
   }
 
   [[nodiscard]] std::string name() const { return "oracle"; }
@@ -50,10 +50,9 @@ class OracleSegmenter {
                     "(the oracle works on simulated images only)",
                     image.ground_truth.type());
     detail::require(image.ground_truth.size() == image.footprint_px.size(),
-                    "OracleSegmenter::segment: ground truth size differs from footprint",
-                    image.ground_truth.cols);
-    detail::require(image.width_px > 0 && image.height_px > 0,
-                    "OracleSegmenter::segment: image size must be positive", image.width_px);
+                    "OracleSegmenter::segment: ground truth size differs from footprint", image.ground_truth.cols);
+    detail::require(image.width_px > 0 && image.height_px > 0, "OracleSegmenter::segment: image size must be positive",
+                    image.width_px);
     const cv::Size out_size(image.width_px, image.height_px);
     Segmentation out;
     if (image.ground_truth.size() == out_size) {
@@ -78,7 +77,7 @@ class OracleSegmenter {
       }
       indicator.convertTo(indicator, CV_32F, 1.0 / 255.0);
       cv::resize(indicator, votes, out_size, 0, 0, cv::INTER_AREA);  // area fraction of c
-      const cv::Mat better = votes > best_votes;  // strict: ties keep the lower index
+      const cv::Mat better = votes > best_votes;                     // strict: ties keep the lower index
       votes.copyTo(best_votes, better);
       out.labels.setTo(c, better);
       if (with_probabilities) {

@@ -127,7 +127,8 @@ template <SegmentationBackend Backend>
         img.footprint_px -= region.tl();
         local.fuse(img, seg.labels);
         if (!ranked) continue;
-        const cv::Rect cell = ((field.pixel_rect(w.footprint) & inside) - region.tl()) & cv::Rect(0, 0, region.width, region.height);
+        const cv::Rect cell =
+            ((field.pixel_rect(w.footprint) & inside) - region.tl()) & cv::Rect(0, 0, region.width, region.height);
         if (cell.area() == 0) {
           fine_inputs.emplace_back();
           continue;

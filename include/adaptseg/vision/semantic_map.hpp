@@ -23,10 +23,9 @@ class SemanticMap {
   /// @param unknown_label value of pixels never observed (the field's ignore label).
   /// @throws std::invalid_argument for an empty size or a label outside 0..255.
   explicit SemanticMap(cv::Size size, int unknown_label = 255) : unknown_(unknown_label) {
-    detail::require(size.width > 0 && size.height > 0, "SemanticMap: size must be positive",
-                    size.width * size.height);
-    detail::require(unknown_label >= 0 && unknown_label <= 255,
-                    "SemanticMap: unknown_label must be in 0..255", unknown_label);
+    detail::require(size.width > 0 && size.height > 0, "SemanticMap: size must be positive", size.width * size.height);
+    detail::require(unknown_label >= 0 && unknown_label <= 255, "SemanticMap: unknown_label must be in 0..255",
+                    unknown_label);
     labels_ = cv::Mat(size, CV_8UC1, cv::Scalar(unknown_label));
     gsd_ = cv::Mat(size, CV_32F, cv::Scalar(std::numeric_limits<float>::infinity()));
   }
@@ -39,8 +38,7 @@ class SemanticMap {
   /// @throws std::invalid_argument if `labels` does not match the image's size or type, or the
   ///         image has no footprint or a yaw that is not finite.
   void fuse(const Image& image, const cv::Mat& labels) {
-    detail::require(labels.type() == CV_8UC1 && labels.cols == image.width_px &&
-                        labels.rows == image.height_px,
+    detail::require(labels.type() == CV_8UC1 && labels.cols == image.width_px && labels.rows == image.height_px,
                     "SemanticMap::fuse: labels must be CV_8UC1 of the image's size",
                     std::to_string(labels.cols) + "x" + std::to_string(labels.rows));
     const FootprintFrame frame(image);

@@ -50,8 +50,8 @@ class SimulatedSensor {
                     w.gsd_cm);
     // The footprint is cut out of the orthomosaic at its resolution: bound it before
     // allocating (an absurd altitude must be an error, not a terabyte allocation).
-    const double fp_px = (w.footprint.width_m() * 100.0 / field_.gsd_cm()) *
-                         (w.footprint.height_m() * 100.0 / field_.gsd_cm());
+    const double fp_px =
+        (w.footprint.width_m() * 100.0 / field_.gsd_cm()) * (w.footprint.height_m() * 100.0 / field_.gsd_cm());
     detail::require(std::isfinite(fp_px) && fp_px <= kMaxFootprintPixels,
                     "SimulatedSensor::capture: the footprint is too large to simulate (more than 2^28 "
                     "orthomosaic pixels: lower the altitude), waypoint gsd_cm",

@@ -85,8 +85,8 @@ inline cv::Mat class_legend(const std::vector<ClassInfo>& classes, int width, co
 /// Top view of `path` (in visiting order) over the field: the field's labels faded, the
 /// path as lines, each waypoint as a dot coloured by altitude, with an altitude/GSD colour
 /// bar, a class legend and `title`. Longer side of the map at most `max_side` px.
-[[nodiscard]] inline cv::Mat render_path(const Field& field, std::span<const Waypoint> path,
-                                         const std::string& title, int max_side = 1000) {
+[[nodiscard]] inline cv::Mat render_path(const Field& field, std::span<const Waypoint> path, const std::string& title,
+                                         int max_side = 1000) {
   // Canvas: the orthomosaic and every footprint (the last row/column may stick out).
   cv::Rect canvas(0, 0, field.width_px(), field.height_px());
   for (const auto& w : path) canvas |= field.pixel_rect(w.footprint);
@@ -97,12 +97,12 @@ inline cv::Mat class_legend(const std::vector<ClassInfo>& classes, int width, co
       .copyTo(full(cv::Rect(-canvas.x, -canvas.y, field.width_px(), field.height_px())));
   cv::Mat base;
   cv::resize(full, base, cv::Size(), s, s, cv::INTER_NEAREST);
-  cv::addWeighted(base, 1.0 - kFade, cv::Mat(base.size(), base.type(), cv::Scalar(255, 255, 255)), kFade, 0.0,
-                  base);
+  cv::addWeighted(base, 1.0 - kFade, cv::Mat(base.size(), base.type(), cv::Scalar(255, 255, 255)), kFade, 0.0, base);
   const auto rect_px = [&](const Area& a) {
     const cv::Rect r = field.pixel_rect(a) - canvas.tl();
-    return cv::Rect(cv::Point(static_cast<int>(std::lround(r.x * s)), static_cast<int>(std::lround(r.y * s))),
-                    cv::Point(static_cast<int>(std::lround(r.br().x * s)), static_cast<int>(std::lround(r.br().y * s))));
+    return cv::Rect(
+        cv::Point(static_cast<int>(std::lround(r.x * s)), static_cast<int>(std::lround(r.y * s))),
+        cv::Point(static_cast<int>(std::lround(r.br().x * s)), static_cast<int>(std::lround(r.br().y * s))));
   };
   double z_lo = 0.0, z_hi = 1.0;
   if (!path.empty()) {
@@ -113,8 +113,9 @@ inline cv::Mat class_legend(const std::vector<ClassInfo>& classes, int width, co
     }
   }
   const auto to_px = [&](const Eigen::Vector3d& p) {
-    return cv::Point(static_cast<int>(std::lround((p.x() * 100.0 / field.gsd_cm() - canvas.x) * s)),
-                     static_cast<int>(std::lround((field.height_px() - p.y() * 100.0 / field.gsd_cm() - canvas.y) * s)));
+    return cv::Point(
+        static_cast<int>(std::lround((p.x() * 100.0 / field.gsd_cm() - canvas.x) * s)),
+        static_cast<int>(std::lround((field.height_px() - p.y() * 100.0 / field.gsd_cm() - canvas.y) * s)));
   };
   cv::Mat ramp(1, 256, CV_8UC1);
   for (int i = 0; i < 256; ++i) ramp.at<std::uint8_t>(0, i) = static_cast<std::uint8_t>(i);
@@ -156,8 +157,7 @@ inline cv::Mat class_legend(const std::vector<ClassInfo>& classes, int width, co
   std::snprintf(buf, sizeof buf, "%zu waypoints", path.size());
   detail::put_text(panel, buf, {10, bar_top + bar_h + 28}, 0.5);
   detail::put_text(panel, "boxes: image footprints", {10, bar_top + bar_h + 50}, 0.45);
-  const cv::Mat legend =
-      detail::class_legend(field.classes(), panel_w, "outside field", {255, 255, 255}, kFade);
+  const cv::Mat legend = detail::class_legend(field.classes(), panel_w, "outside field", {255, 255, 255}, kFade);
   if (bar_top + bar_h + 60 + legend.rows <= panel.rows)
     legend.copyTo(panel(cv::Rect(0, bar_top + bar_h + 60, panel_w, legend.rows)));
   cv::Mat out;
@@ -181,8 +181,9 @@ inline cv::Mat class_legend(const std::vector<ClassInfo>& classes, int width, co
   cv::Mat full(canvas.size(), CV_8UC3, cv::Scalar(255, 255, 255));
   full(cv::Rect(-canvas.x, -canvas.y, mask.cols, mask.rows)).setTo(cv::Scalar(170, 225, 170), mask);
   cv::Mat base;
-  cv::resize(full, base, cv::Size(std::max(1, static_cast<int>(std::lround(canvas.width * s))),
-                                  std::max(1, static_cast<int>(std::lround(canvas.height * s)))),
+  cv::resize(full, base,
+             cv::Size(std::max(1, static_cast<int>(std::lround(canvas.width * s))),
+                      std::max(1, static_cast<int>(std::lround(canvas.height * s)))),
              0, 0, cv::INTER_NEAREST);
   const auto px = [&](double x_m, double y_m) {
     return cv::Point(static_cast<int>(std::lround((x_m * 100.0 / map_gsd_cm - canvas.x) * s)),
@@ -192,10 +193,11 @@ inline cv::Mat class_legend(const std::vector<ClassInfo>& classes, int width, co
     cv::rectangle(base, px(w.footprint.x_min_m, w.footprint.y_max_m), px(w.footprint.x_max_m, w.footprint.y_min_m),
                   cv::Scalar(150, 90, 40), 1);
   for (std::size_t i = 1; i < path.size(); ++i)
-    cv::line(base, px(path[i - 1].position.x(), path[i - 1].position.y()), px(path[i].position.x(), path[i].position.y()),
-             cv::Scalar(60, 60, 60), 1, cv::LINE_AA);
+    cv::line(base, px(path[i - 1].position.x(), path[i - 1].position.y()),
+             px(path[i].position.x(), path[i].position.y()), cv::Scalar(60, 60, 60), 1, cv::LINE_AA);
   const int radius = std::max(2, static_cast<int>(std::lround(std::min(base.cols, base.rows) / 150.0)));
-  for (const auto& w : path) cv::circle(base, px(w.position.x(), w.position.y()), radius, cv::Scalar(0, 0, 0), cv::FILLED, cv::LINE_AA);
+  for (const auto& w : path)
+    cv::circle(base, px(w.position.x(), w.position.y()), radius, cv::Scalar(0, 0, 0), cv::FILLED, cv::LINE_AA);
   if (!path.empty())
     detail::put_text(base, "start", px(path.front().position.x(), path.front().position.y()) + cv::Point(6, -6), 0.5);
   return detail::with_title(base, title);
@@ -222,8 +224,8 @@ inline cv::Mat class_legend(const std::vector<ClassInfo>& classes, int width, co
 /// neighbour) so that its longer side is `side` px, with a legend. Never-observed pixels are
 /// grey ("not observed / outside"); in the error panel wrong pixels are red, right ones light
 /// grey, pixels never observed or without truth dark grey.
-[[nodiscard]] inline cv::Mat render_map_comparison(const Field& field, const cv::Mat& fused,
-                                                   const std::string& title, int side = 700) {
+[[nodiscard]] inline cv::Mat render_map_comparison(const Field& field, const cv::Mat& fused, const std::string& title,
+                                                   int side = 700) {
   detail::require(fused.type() == CV_8UC1 && fused.size() == field.labels().size(),
                   "render_map_comparison: the map must be CV_8UC1 of the field's size", fused.cols);
   const double s = static_cast<double>(side) / std::max(field.width_px(), field.height_px());

@@ -37,8 +37,7 @@ int main() {
       s.miou_sub = 0.7 + 0.025 * dh;
       samples.push_back(s);
     }
-  adaptseg::DecisionFunction decision(
-      adaptseg::UtilityPolicy(adaptseg::GainModel::fit(samples), {}));
+  adaptseg::DecisionFunction decision(adaptseg::UtilityPolicy(adaptseg::GainModel::fit(samples), {}));
   const std::vector<adaptseg::Candidate> candidates{{1.0, 5.5, 9, 40.0}, {2.0, 11.0, 4, 20.0}};
   decision.begin_mission();
   const adaptseg::Decision d = decision.decide(

@@ -34,8 +34,7 @@ inline void gp_invert_lower_in_place(Eigen::Ref<Eigen::MatrixXd> a) {
       a(j, j) = 1.0 / a(j, j);
       const Eigen::Index m = n - j - 1;
       if (m > 0) {
-        const Eigen::VectorXd t =
-            a.bottomRightCorner(m, m).template triangularView<Eigen::Lower>() * a.col(j).tail(m);
+        const Eigen::VectorXd t = a.bottomRightCorner(m, m).template triangularView<Eigen::Lower>() * a.col(j).tail(m);
         a.col(j).tail(m) = -a(j, j) * t;
       }
     }
@@ -48,8 +47,7 @@ inline void gp_invert_lower_in_place(Eigen::Ref<Eigen::MatrixXd> a) {
   // [A 0; B C]^{-1} = [A^-1 0; -C^-1 B A^-1, C^-1]
   const Eigen::MatrixXd t =
       a.bottomLeftCorner(n2, n1) * a.topLeftCorner(n1, n1).template triangularView<Eigen::Lower>();
-  a.bottomLeftCorner(n2, n1).noalias() =
-      -(a.bottomRightCorner(n2, n2).template triangularView<Eigen::Lower>() * t);
+  a.bottomLeftCorner(n2, n1).noalias() = -(a.bottomRightCorner(n2, n2).template triangularView<Eigen::Lower>() * t);
 }
 
 /// lower(a) <- lower(L^T L), where L = lower(a) (recursive LAPACK lauum, n^3/3 flops).
@@ -65,11 +63,9 @@ inline void gp_lower_gram_in_place(Eigen::Ref<Eigen::MatrixXd> a) {
   const Eigen::Index n2 = n - n1;
   // [P 0; Q R]^T [P 0; Q R] = [P^T P + Q^T Q, Q^T R; R^T Q, R^T R]
   gp_lower_gram_in_place(a.topLeftCorner(n1, n1));
-  a.topLeftCorner(n1, n1).template selfadjointView<Eigen::Lower>().rankUpdate(
-      a.bottomLeftCorner(n2, n1).transpose());
+  a.topLeftCorner(n1, n1).template selfadjointView<Eigen::Lower>().rankUpdate(a.bottomLeftCorner(n2, n1).transpose());
   const Eigen::MatrixXd t =
-      a.bottomRightCorner(n2, n2).template triangularView<Eigen::Lower>().transpose() *
-      a.bottomLeftCorner(n2, n1);
+      a.bottomRightCorner(n2, n2).template triangularView<Eigen::Lower>().transpose() * a.bottomLeftCorner(n2, n1);
   a.bottomLeftCorner(n2, n1) = t;
   gp_lower_gram_in_place(a.bottomRightCorner(n2, n2));
 }

@@ -51,7 +51,7 @@ namespace detail {
 /// Defines `name(params)`, which runs `name##_body<Bytes>(args)` for the widest instruction
 /// set of `gp_simd_level()`, with `name##_avx512` and `name##_avx2` compiled for those.
 #if defined(ADAPTSEG_GP_DISPATCH)
-#define ADAPTSEG_GP_DISPATCHED(ret, name, params, args)                                          \
+#define ADAPTSEG_GP_DISPATCHED(ret, name, params, args)                                       \
   [[gnu::target("avx512f")]] inline ret name##_avx512 params { return name##_body<64> args; } \
   [[gnu::target("avx2,fma")]] inline ret name##_avx2 params { return name##_body<32> args; }  \
   inline ret name params {                                                                    \
@@ -63,7 +63,7 @@ namespace detail {
   }                                                                                           \
   static_assert(true, "a use ends with a semicolon")
 #else
-#define ADAPTSEG_GP_DISPATCHED(ret, name, params, args)    \
+#define ADAPTSEG_GP_DISPATCHED(ret, name, params, args)   \
   inline ret name params { return name##_body<16> args; } \
   static_assert(true, "a use ends with a semicolon")
 #endif
@@ -363,7 +363,8 @@ template <int Bytes>
   for (Eigen::Index b0 = 0; b0 < n4; b0 += 4) {
     for (Eigen::Index ps = b0 / (2 * kWidth) * (2 * kWidth); ps < n4; ps += 2 * kWidth) {
       Vd s[4][2] = {};
-      for (Eigen::Index i = std::max(b0, ps); i < n4; ++i) gp_rank_one_4x2<Bytes>(s, xt + i * ld + b0, xt + i * ld + ps);
+      for (Eigen::Index i = std::max(b0, ps); i < n4; ++i)
+        gp_rank_one_4x2<Bytes>(s, xt + i * ld + b0, xt + i * ld + ps);
       for (int c = 0; c < 4; ++c) std::memcpy(a + (b0 + c) * ld + ps, &s[c], 2 * Bytes);
     }
   }

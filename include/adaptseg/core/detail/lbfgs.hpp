@@ -123,7 +123,7 @@ struct BoxMinimizerSettings {
   double gradient_tolerance = 1e-5;  ///< stop when the projected gradient's norm is below this
   /// Stop when one step improves the objective by less than this (relative).
   double relative_tolerance = 1e7 * std::numeric_limits<double>::epsilon();
-  int max_iterations = 15000;        ///< iteration budget
+  int max_iterations = 15000;  ///< iteration budget
 };
 
 /// Minimises `f` (`double f(const Eigen::VectorXd& x, Eigen::VectorXd& gradient)`) over the

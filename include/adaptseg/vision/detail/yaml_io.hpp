@@ -105,7 +105,8 @@ class YamlReader {
     const YAML::Node n = node(key);
     if (!n.IsSequence()) yaml_error(where_, "'" + path(key) + "' must be a list of numbers");
     std::vector<double> out;
-    for (std::size_t k = 0; k < n.size(); ++k) out.push_back(number_of(n[k], path(key) + "[" + std::to_string(k) + "]"));
+    for (std::size_t k = 0; k < n.size(); ++k)
+      out.push_back(number_of(n[k], path(key) + "[" + std::to_string(k) + "]"));
     return out;
   }
   /// The list `key` of mappings, a reader for each (`key[i]` in its errors).
@@ -143,14 +144,16 @@ class YamlReader {
   [[nodiscard]] std::string path(const char* key) const { return prefix_.empty() ? key : prefix_ + "." + key; }
   [[nodiscard]] double number_of(const YAML::Node& n, const std::string& what) const {
     const auto v = n.IsScalar() ? parse_number(n.Scalar()) : std::nullopt;
-    if (!v) yaml_error(where_, "'" + what + "' must be a finite number" + (n.IsScalar() ? " (got '" + n.Scalar() + "')" : ""));
+    if (!v)
+      yaml_error(where_,
+                 "'" + what + "' must be a finite number" + (n.IsScalar() ? " (got '" + n.Scalar() + "')" : ""));
     return *v;
   }
   [[nodiscard]] long long integer_of(const YAML::Node& n, const std::string& what, long long lo, long long hi) const {
     const auto v = n.IsScalar() ? parse_integer(n.Scalar(), lo, hi) : std::nullopt;
     if (!v)
       yaml_error(where_, "'" + what + "' must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                              "]" + (n.IsScalar() ? " (got '" + n.Scalar() + "')" : ""));
+                             "]" + (n.IsScalar() ? " (got '" + n.Scalar() + "')" : ""));
     return *v;
   }
 
