@@ -91,14 +91,14 @@ int main(int argc, char** argv) {
 
     adaptseg::Image image;
     if (!image_file.empty()) {
-      image.rgb = cv::imread(image_file, cv::IMREAD_COLOR);
-      if (image.rgb.empty()) throw std::invalid_argument("cannot read image " + image_file);
+      image.bgr = cv::imread(image_file, cv::IMREAD_COLOR);
+      if (image.bgr.empty()) throw std::invalid_argument("cannot read image " + image_file);
     } else {
-      image.rgb.create(camera, CV_8UC3);
-      cv::randu(image.rgb, 0, 256);
+      image.bgr.create(camera, CV_8UC3);
+      cv::randu(image.bgr, 0, 256);
     }
-    image.width_px = image.rgb.cols;
-    image.height_px = image.rgb.rows;
+    image.width_px = image.bgr.cols;
+    image.height_px = image.bgr.rows;
 
     // The raw network, loaded the same way, for the forward pass alone.
     cv::dnn::Net net = cv::dnn::readNetFromONNX(model_dir + "/model.onnx");
@@ -121,8 +121,8 @@ int main(int argc, char** argv) {
     std::printf(
         "{\"threads\": %d, \"cv_threads\": %d, \"iters\": %d, \"fusion\": %s, \"input\": [%d, %d], "
         "\"camera\": [%d, %d], ",
-        threads, cv::getNumThreads(), iters, fusion ? "true" : "false", in.height, in.width, image.rgb.rows,
-        image.rgb.cols);
+        threads, cv::getNumThreads(), iters, fusion ? "true" : "false", in.height, in.width, image.bgr.rows,
+        image.bgr.cols);
     print_stats("forward_ms", fwd);
     std::printf(", ");
     print_stats("segment_ms", seg);

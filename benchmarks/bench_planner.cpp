@@ -56,7 +56,7 @@ Steps fly(const adaptseg::Field& field, Backend& backend, const adaptseg::Decisi
   DecisionFunction policy = model.decision_function;
   policy.set_online(strategy.online);
   Mission<Backend> mission(field, backend, ao.mission, std::string(strategy.name));
-  const bool probabilities = descent_coverage_rule(ao.coverage).ranks_cells;
+  const bool probabilities = descent_coverage_info(ao.coverage).ranks_cells;
   Steps out;
   const auto t_start = std::chrono::steady_clock::now();
   AdaptivePlanner<Backend, DecisionFunction> planner(SurveyArea::of(field), backend, policy, ao);

@@ -283,7 +283,7 @@ void fly(const ImageSetInfo& info, Backend& backend, Policy& policy, const adapt
   std::printf(", candidates");
   for (double g : planner.candidate_gsd_cm()) std::printf(" %.2f", g);
   std::printf(" cm/px, policy %s, descents %s, segmenter %s\n", std::string(policy.name()).c_str(),
-              adaptseg::descent_schedule_rule(options.schedule).description, std::string(backend.name()).c_str());
+              adaptseg::descent_schedule_info(options.schedule).description, std::string(backend.name()).c_str());
 
   nlohmann::json wps = nlohmann::json::array();
   nlohmann::json vehicle_json;
@@ -307,10 +307,10 @@ void fly(const ImageSetInfo& info, Backend& backend, Policy& policy, const adapt
       ex::Shot shot = s.camera->take(at, idle);
       if (vehicle && s.flight.pose_from_exif)
         shot.pose = exif_pose(shot, *info.geo, vehicle->last_position(), 0.5 * w->waypoint.footprint.height_m());
-      if (s.segmenter == "erfnet" && shot.rgb.empty())
+      if (s.segmenter == "erfnet" && shot.bgr.empty())
         throw std::invalid_argument(shot.name + ": no camera image for the network (--segmenter erfnet)");
       // The pose and heading measured, not the ones planned.
-      adaptseg::Image image = planner.image_at(shot.pose.position, shot.rgb, shot.pose.yaw_deg);
+      adaptseg::Image image = planner.image_at(shot.pose.position, shot.bgr, shot.pose.yaw_deg);
       if (s.segmenter == "oracle") ex::attach_labels(image, std::move(shot.labels), shot.name + " (labels)");
       // The mission's real clock, from the first waypoint on: the budget learns each step's cost.
       const std::optional<double> elapsed = vehicle ? std::optional<double>(vehicle->elapsed_s()) : std::nullopt;

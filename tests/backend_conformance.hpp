@@ -27,7 +27,7 @@ void check_backend_conformance(Backend& backend, const SimulatedSensor& sensor, 
     for (std::size_t i = 0; i < plan.size() && i < 3; ++i) {
       const Image image = sensor.capture(plan[i]);
       const cv::Mat gt_before = image.ground_truth.clone();
-      const cv::Mat rgb_before = image.rgb.clone();
+      const cv::Mat rgb_before = image.bgr.clone();
       const cv::Mat labels = backend.segment(image);
       REQUIRE(labels.type() == CV_8UC1);
       REQUIRE(labels.rows == image.height_px);
@@ -38,7 +38,7 @@ void check_backend_conformance(Backend& backend, const SimulatedSensor& sensor, 
           REQUIRE((v < num_classes || v == image.ignore_label));
         }
       CHECK(cv::countNonZero(gt_before != image.ground_truth) == 0);
-      if (!rgb_before.empty()) CHECK(cv::norm(rgb_before, image.rgb, cv::NORM_INF) == 0.0);
+      if (!rgb_before.empty()) CHECK(cv::norm(rgb_before, image.bgr, cv::NORM_INF) == 0.0);
       const cv::Mat again = backend.segment(image);
       CHECK(cv::countNonZero(again != labels) == 0);
       if constexpr (SegmentsWithProbabilities<Backend>) {

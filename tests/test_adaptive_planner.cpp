@@ -159,16 +159,16 @@ TEST_CASE("descent coverages: each rule says which cells it flies and whether it
   cv::Mat crop = labels.clone();
   crop(cv::Rect(12, 12, 2, 2)).setTo(1);
   const std::vector<int> interest{1};
-  const auto& interest_rule = descent_coverage_rule(DescentCoverage::interest);
-  REQUIRE(static_cast<bool>(interest_rule.flies));
+  const auto& interest_row = descent_coverage_info(DescentCoverage::interest);
+  REQUIRE(static_cast<bool>(interest_row.flies));
   // One top-level pixel (3 px of the 1 cm/px grid) around the cell: the patch 2 px off is seen.
-  CHECK(interest_rule.flies(crop, cv::Rect(0, 0, 10, 10), 3.0, 1.0, interest));
-  CHECK_FALSE(interest_rule.flies(crop, cv::Rect(20, 20, 10, 10), 3.0, 1.0, interest));
-  CHECK_FALSE(interest_rule.flies(labels, cv::Rect(0, 0, 10, 10), 3.0, 1.0, interest));
-  CHECK_FALSE(static_cast<bool>(descent_coverage_rule(DescentCoverage::region).flies));  // every cell with field
-  CHECK_FALSE(static_cast<bool>(descent_coverage_rule(DescentCoverage::ranked).flies));
-  CHECK(descent_coverage_rule(DescentCoverage::ranked).ranks_cells);
-  CHECK_FALSE(interest_rule.ranks_cells);
+  CHECK(interest_row.flies(crop, cv::Rect(0, 0, 10, 10), 3.0, 1.0, interest));
+  CHECK_FALSE(interest_row.flies(crop, cv::Rect(20, 20, 10, 10), 3.0, 1.0, interest));
+  CHECK_FALSE(interest_row.flies(labels, cv::Rect(0, 0, 10, 10), 3.0, 1.0, interest));
+  CHECK_FALSE(static_cast<bool>(descent_coverage_info(DescentCoverage::region).flies));  // every cell with field
+  CHECK_FALSE(static_cast<bool>(descent_coverage_info(DescentCoverage::ranked).flies));
+  CHECK(descent_coverage_info(DescentCoverage::ranked).ranks_cells);
+  CHECK_FALSE(interest_row.ranks_cells);
   for (const auto& rule : kDescentCoverages) {
     CHECK(parse_descent_coverage(rule.name) == rule.coverage);
     CHECK(std::string(to_string(rule.coverage)) == rule.name);
@@ -728,7 +728,7 @@ TEST_CASE("AdaptivePlanner: report() refuses a missing, repeated or malformed im
                        doctest::Contains("labels must have the image's size 480x360"), std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)planner.report(first, -1.0), doctest::Contains("elapsed_s"), std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)planner.image_at(w->waypoint.position, cv::Mat(10, 10, CV_8UC3)),
-                       doctest::Contains("rgb must be CV_8UC3 of the camera's size"), std::invalid_argument);
+                       doctest::Contains("bgr must be CV_8UC3 of the camera's size"), std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)planner.image_at(w->waypoint.position, {}, std::numeric_limits<double>::quiet_NaN()),
                        doctest::Contains("yaw_deg must be finite"), std::invalid_argument);
   Image lost = first;
@@ -832,7 +832,7 @@ TEST_CASE("AdaptivePlanner: a camera that does not hold the plan's heading is fu
     const SimulatedSensor sensor(f, planner.camera());
     while (const auto w = planner.next()) {
       const Image sim = sensor.capture(w->waypoint, yaw);
-      Image live = planner.image_at(w->waypoint.position, sim.rgb, yaw);
+      Image live = planner.image_at(w->waypoint.position, sim.bgr, yaw);
       CHECK(live.yaw_deg == yaw);
       CHECK(live.footprint_px == sim.footprint_px);
       live.ground_truth = sim.ground_truth;

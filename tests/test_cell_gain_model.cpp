@@ -192,5 +192,7 @@ TEST_CASE(
 
   CHECK(parse_slope_pooling(to_string(SlopePooling::fields)) == SlopePooling::fields);
   CHECK(parse_slope_pooling(to_string(SlopePooling::cells)) == SlopePooling::cells);
-  CHECK_THROWS_WITH_AS((void)parse_slope_pooling("field"), doctest::Contains("cells, fields"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)parse_slope_pooling("field"),
+                       doctest::Contains("slope pooling must be 'cells' or 'fields', not 'field'"),
+                       std::invalid_argument);
 }

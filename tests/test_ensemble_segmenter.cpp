@@ -43,7 +43,7 @@ Image tile6_image() {
   const auto plan = LawnmowerPlanner(camera).plan(f.area(), 2.0 * f.gsd_cm());
   REQUIRE(plan.size() > 4);
   Image img = SimulatedSensor(f, camera).capture(plan[4]);
-  img.rgb(cv::Rect(0, 0, 40, 30)).setTo(cv::Scalar(0, 0, 0));
+  img.bgr(cv::Rect(0, 0, 40, 30)).setTo(cv::Scalar(0, 0, 0));
   return img;
 }
 
@@ -140,8 +140,8 @@ TEST_CASE("test-time mirror: a network's probabilities are the mean over the ima
   // ensemble member with `mirror` contributes exactly that.
   const Image img = tile6_image();
   Image mirrored = img;
-  mirrored.rgb = cv::Mat();
-  cv::flip(img.rgb, mirrored.rgb, 1);
+  mirrored.bgr = cv::Mat();
+  cv::flip(img.bgr, mirrored.bgr, 1);
   OnnxSegmenter plain(mnv2(), kParams);
   OnnxParams pm = kParams;
   pm.test_time_mirror = true;

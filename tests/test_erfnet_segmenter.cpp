@@ -62,10 +62,10 @@ const char* kTestField = "dubai-tile-6";  // held out of training and validation
 /// The fixture's camera image as the sensor would hand it over.
 Image fixture_image(const BundledModel& m = kModels[0]) {
   Image img;
-  img.rgb = cv::imread((m.fixture_dir() / "camera.png").string(), cv::IMREAD_COLOR);
-  REQUIRE_FALSE(img.rgb.empty());
-  img.width_px = img.rgb.cols;
-  img.height_px = img.rgb.rows;
+  img.bgr = cv::imread((m.fixture_dir() / "camera.png").string(), cv::IMREAD_COLOR);
+  REQUIRE_FALSE(img.bgr.empty());
+  img.width_px = img.bgr.cols;
+  img.height_px = img.bgr.rows;
   return img;
 }
 
@@ -89,7 +89,7 @@ TEST_CASE("erfnet: each bundled model reproduces PyTorch's logits and labels on 
     const Image img = fixture_image(m);
     // The fixture image has RGB content everywhere, so no pixel is masked as no-data.
     cv::Mat black;
-    cv::inRange(img.rgb, cv::Scalar(0, 0, 0), cv::Scalar(0, 0, 0), black);
+    cv::inRange(img.bgr, cv::Scalar(0, 0, 0), cv::Scalar(0, 0, 0), black);
     REQUIRE(cv::countNonZero(black) == 0);
 
     OnnxSegmenter erfnet(m.model_dir(), OnnxParams{.camera_width_px = img.width_px,
@@ -180,7 +180,7 @@ TEST_CASE("erfnet: mIoU of each bundled model on held-out tile 6 at the finest G
 TEST_CASE("erfnet: probabilities are the softmax of the logits and black pixels are no-data") {
   Image img = fixture_image();
   img.ignore_label = 255;
-  img.rgb(cv::Rect(0, 0, 40, 30)).setTo(cv::Scalar(0, 0, 0));  // as outside the orthomosaic
+  img.bgr(cv::Rect(0, 0, 40, 30)).setTo(cv::Scalar(0, 0, 0));  // as outside the orthomosaic
   OnnxSegmenter erfnet(model_dir(), OnnxParams{.num_threads = 2});
   const cv::Mat labels = erfnet.segment(img);
   const std::vector<cv::Mat> probs = erfnet.probabilities(img);
@@ -257,7 +257,7 @@ TEST_CASE("erfnet: labels and tempered probabilities from one pass") {
 TEST_CASE("erfnet: resize_to_network takes other camera sizes of the same aspect ratio") {
   const Image native = fixture_image();
   Image big = native;
-  cv::resize(native.rgb, big.rgb, cv::Size(960, 720), 0, 0, cv::INTER_LINEAR);
+  cv::resize(native.bgr, big.bgr, cv::Size(960, 720), 0, 0, cv::INTER_LINEAR);
   big.width_px = 960;
   big.height_px = 720;
   OnnxSegmenter strict(model_dir());
@@ -270,7 +270,7 @@ TEST_CASE("erfnet: resize_to_network takes other camera sizes of the same aspect
   // The contract: the network sees the image shrunk with INTER_AREA to its input size, and its
   // logits come back bilinearly enlarged to the camera size.
   Image small = native;
-  cv::resize(big.rgb, small.rgb, cv::Size(480, 360), 0, 0, cv::INTER_AREA);
+  cv::resize(big.bgr, small.bgr, cv::Size(480, 360), 0, 0, cv::INTER_AREA);
   OnnxSegmenter native_net(model_dir());
   const std::vector<cv::Mat> want = native_net.logits(small);
   const std::vector<cv::Mat> got = erfnet.logits(big);
@@ -362,11 +362,11 @@ TEST_CASE("erfnet: clear errors for bad models, bad parameters and images withou
   OnnxSegmenter erfnet(model_dir(), dubai, CameraModel{});
   const SimulatedSensor no_rgb(weedmap, CameraModel{});
   const Image labels_only = no_rgb.capture(LawnmowerPlanner(CameraModel{}).plan(weedmap.area(), 2.0).front());
-  REQUIRE(labels_only.rgb.empty());
+  REQUIRE(labels_only.bgr.empty());
   CHECK_THROWS_WITH_AS((void)erfnet.segment(labels_only), doctest::Contains("no RGB"), std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)erfnet.probabilities(labels_only), doctest::Contains("no RGB"), std::invalid_argument);
   Image gray = fixture_image();
-  cv::cvtColor(gray.rgb, gray.rgb, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(gray.bgr, gray.bgr, cv::COLOR_BGR2GRAY);
   CHECK_THROWS_WITH_AS((void)erfnet.segment(gray), doctest::Contains("CV_8UC3"), std::invalid_argument);
   Image mismatch = fixture_image();
   mismatch.width_px = 481;

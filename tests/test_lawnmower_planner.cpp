@@ -149,18 +149,18 @@ TEST_CASE("lawnmower: overlap along and across the rows") {
 }
 
 TEST_CASE("descent schedules: the windows of a lawnmower, and every name parses back") {
-  using adaptseg::descent_schedule_rule;
+  using adaptseg::descent_schedule_info;
   using adaptseg::DescentSchedule;
   const LawnmowerPlanner planner(CameraModel{});
   const auto plan = planner.plan(Area{0, 0, 40.0, 30.0}, 3.0);  // 3 rows of 3
   REQUIRE(plan.size() == 9);
   using Last = std::vector<std::size_t>;
-  CHECK(descent_schedule_rule(DescentSchedule::immediate).window_last(plan) == Last{0, 1, 2, 3, 4, 5, 6, 7, 8});
-  CHECK(descent_schedule_rule(DescentSchedule::tour).window_last(plan) == Last(9, 8));
-  CHECK(descent_schedule_rule(DescentSchedule::row).window_last(plan) == Last{2, 2, 2, 5, 5, 5, 8, 8, 8});
-  CHECK(descent_schedule_rule(DescentSchedule::row).window_last({}).empty());
-  CHECK_FALSE(descent_schedule_rule(DescentSchedule::immediate).defers);
-  CHECK(descent_schedule_rule(DescentSchedule::tour).defers);
+  CHECK(descent_schedule_info(DescentSchedule::immediate).window_last(plan) == Last{0, 1, 2, 3, 4, 5, 6, 7, 8});
+  CHECK(descent_schedule_info(DescentSchedule::tour).window_last(plan) == Last(9, 8));
+  CHECK(descent_schedule_info(DescentSchedule::row).window_last(plan) == Last{2, 2, 2, 5, 5, 5, 8, 8, 8});
+  CHECK(descent_schedule_info(DescentSchedule::row).window_last({}).empty());
+  CHECK_FALSE(descent_schedule_info(DescentSchedule::immediate).defers);
+  CHECK(descent_schedule_info(DescentSchedule::tour).defers);
   for (const auto& rule : adaptseg::kDescentSchedules) {
     CHECK(adaptseg::parse_descent_schedule(rule.name) == rule.schedule);
     CHECK(std::string(to_string(rule.schedule)) == rule.name);

@@ -437,7 +437,8 @@ TEST_CASE("export: formats by name, and empty paths are refused") {
   CHECK(adaptseg::parse_export_format("plan") == ExportFormat::qgc_plan);
   CHECK(adaptseg::parse_export_format("wpl") == ExportFormat::wpl);
   CHECK(adaptseg::parse_export_format("geojson") == ExportFormat::geojson);
-  CHECK_THROWS_WITH_AS((void)adaptseg::parse_export_format("kml"), doctest::Contains("plan, wpl, geojson"),
+  CHECK_THROWS_WITH_AS((void)adaptseg::parse_export_format("kml"),
+                       doctest::Contains("export format must be 'plan', 'wpl' or 'geojson', not 'kml'"),
                        std::invalid_argument);
   CHECK(adaptseg::export_file_name(ExportFormat::wpl) == "mission.waypoints");
   ExportPath empty;

@@ -567,7 +567,7 @@ TEST_CASE("robustness: decision model: a broken cell gain model") {
   REQUIRE(text.find("    input: expected_error") != std::string::npos);
   CHECK(DecisionModel::load(dir.path() / "ranked.yaml").decision_function.model().cells().has_value());
   CHECK_THROWS_WITH_AS((void)load_model_text(dir, replaced(text, "input: expected_error", "input: confusion")),
-                       Contains("decision input must be one of sigma, boundary"), std::invalid_argument);
+                       Contains("decision input must be 'sigma', 'boundary'"), std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)load_model_text(dir, replaced(text, "gain_slope: [0.9, 0.3]", "gain_slope: [0.9]")),
                        Contains("'gain_model.cells' needs one top_gsd_cm, sub_gsd_cm, gain_slope"),
                        std::invalid_argument);

@@ -18,7 +18,7 @@ TEST_CASE("sensor: at the orthomosaic's GSD the image is the orthomosaic crop") 
   CHECK(img.width_px == 480);
   CHECK(img.height_px == 360);
   CHECK(cv::countNonZero(img.ground_truth != f.labels()(img.footprint_px)) == 0);
-  CHECK(img.rgb.empty());  // the field has no RGB
+  CHECK(img.bgr.empty());  // the field has no RGB
 }
 
 TEST_CASE("sensor: a turned camera cuts its footprint out in its own orientation") {
@@ -38,8 +38,8 @@ TEST_CASE("sensor: a turned camera cuts its footprint out in its own orientation
   cv::Mat flipped;
   cv::flip(upright.ground_truth, flipped, -1);
   CHECK(cv::countNonZero(half.ground_truth != flipped) == 0);
-  cv::flip(upright.rgb, flipped, -1);
-  CHECK(cv::norm(half.rgb, flipped, cv::NORM_INF) == 0.0);
+  cv::flip(upright.bgr, flipped, -1);
+  CHECK(cv::norm(half.bgr, flipped, cv::NORM_INF) == 0.0);
   // A quarter turn counter-clockwise: the image's x axis runs up the map, its rows to the
   // right; camera pixel (c, r) sees map pixel (column 460 + r, row 619 - c).
   const Image quarter = sensor.capture(w, 90.0);
@@ -48,7 +48,7 @@ TEST_CASE("sensor: a turned camera cuts its footprint out in its own orientation
   for (int r = 0; r < 360; ++r)
     for (int c = 0; c < 480; ++c) {
       differ += quarter.ground_truth.at<std::uint8_t>(r, c) != f.labels().at<std::uint8_t>(619 - c, 460 + r);
-      differ += quarter.rgb.at<cv::Vec3b>(r, c) != f.image().at<cv::Vec3b>(619 - c, 460 + r);
+      differ += quarter.bgr.at<cv::Vec3b>(r, c) != f.image().at<cv::Vec3b>(619 - c, 460 + r);
     }
   CHECK(differ == 0);
   CHECK_THROWS_WITH_AS((void)sensor.capture(w, std::numeric_limits<double>::infinity()),
@@ -83,9 +83,9 @@ TEST_CASE("sensor: outside the orthomosaic is ignore (labels) and black (RGB)") 
   const Image img = sensor.capture(plan.front());
   CHECK(cv::countNonZero(img.ground_truth == 1) == 100 * 100);
   CHECK(cv::countNonZero(img.ground_truth == 255) == 480 * 360 - 100 * 100);
-  REQUIRE(img.rgb.size() == cv::Size(480, 360));
-  CHECK(img.rgb.at<cv::Vec3b>(359, 0) == cv::Vec3b(200, 100, 50));  // bottom-left is the field
-  CHECK(img.rgb.at<cv::Vec3b>(0, 479) == cv::Vec3b(0, 0, 0));
+  REQUIRE(img.bgr.size() == cv::Size(480, 360));
+  CHECK(img.bgr.at<cv::Vec3b>(359, 0) == cv::Vec3b(200, 100, 50));  // bottom-left is the field
+  CHECK(img.bgr.at<cv::Vec3b>(0, 479) == cv::Vec3b(0, 0, 0));
 }
 
 TEST_CASE("sensor: RGB is area-averaged when flying higher") {
@@ -96,9 +96,9 @@ TEST_CASE("sensor: RGB is area-averaged when flying higher") {
   const Field f("checker", 1.0, cv::Mat(720, 960, CV_8UC1, cv::Scalar(0)), t::soil_crop_weed(), {1}, 255, rgb);
   const SimulatedSensor sensor(f, CameraModel{});
   const Image img = sensor.capture(LawnmowerPlanner(sensor.camera()).plan(f.area(), 2.0).front());
-  REQUIRE(img.rgb.size() == cv::Size(480, 360));
+  REQUIRE(img.bgr.size() == cv::Size(480, 360));
   double lo = 0, hi = 0;
-  cv::minMaxLoc(img.rgb.reshape(1), &lo, &hi);
+  cv::minMaxLoc(img.bgr.reshape(1), &lo, &hi);
   CHECK(lo >= 126);  // every 2x2 block averages to mid grey
   CHECK(hi <= 129);
 }

@@ -41,10 +41,10 @@ struct CameraPose {
 
 /// One picture from a camera source.
 struct Shot {
-  std::string name;            ///< its file (or a label) for the console and result.json
-  cv::Mat rgb;                 ///< CV_8UC3 of the camera model's size, or empty (no image: the oracle's labels only)
-  cv::Mat labels;              ///< ground-truth labels under the footprint at map resolution (the oracle's), or empty
-  CameraPose pose;             ///< where it was taken: what the planner fuses it at
+  std::string name;  ///< its file (or a label) for the console and result.json
+  cv::Mat bgr;       ///< CV_8UC3 (B, G, R) of the camera model's size, or empty (no image: the oracle's labels only)
+  cv::Mat labels;    ///< ground-truth labels under the footprint at map resolution (the oracle's), or empty
+  CameraPose pose;   ///< where it was taken: what the planner fuses it at
   std::filesystem::path file;  ///< the picture's file, where it is a new file (FolderCamera), else empty
 };
 
@@ -65,34 +65,36 @@ class CameraSource {
   virtual Shot take(const CameraPose& at, const Idle& idle) = 0;
 };
 
-/// `rgb` as the planner takes it: 8-bit BGR (grey and BGRA converted) of the camera model's
+/// `picture` as the planner takes it: 8-bit BGR (grey and BGRA converted) of the camera model's
 /// size, resampled with area interpolation where it has another size of the same aspect ratio
 /// (within 1 %; a camera that crops or pads is not resampled into shape).
 /// @throws std::invalid_argument naming `what`, both sizes and what to do.
-inline cv::Mat fit_to_camera(cv::Mat rgb, const CameraParams& camera, const std::string& what) {
-  if (rgb.empty()) return rgb;
-  if (rgb.depth() != CV_8U)
-    throw std::invalid_argument(what + ": an 8-bit image is needed (got OpenCV depth " + std::to_string(rgb.depth()) +
+inline cv::Mat fit_to_camera(cv::Mat picture, const CameraParams& camera, const std::string& what) {
+  if (picture.empty()) return picture;
+  if (picture.depth() != CV_8U)
+    throw std::invalid_argument(what + ": an 8-bit image is needed (got OpenCV depth " +
+                                std::to_string(picture.depth()) + ")");
+  if (picture.channels() == 1)
+    cv::cvtColor(picture, picture, cv::COLOR_GRAY2BGR);
+  else if (picture.channels() == 4)
+    cv::cvtColor(picture, picture, cv::COLOR_BGRA2BGR);
+  else if (picture.channels() != 3)
+    throw std::invalid_argument(what + ": 1, 3 or 4 channels expected (got " + std::to_string(picture.channels()) +
                                 ")");
-  if (rgb.channels() == 1)
-    cv::cvtColor(rgb, rgb, cv::COLOR_GRAY2BGR);
-  else if (rgb.channels() == 4)
-    cv::cvtColor(rgb, rgb, cv::COLOR_BGRA2BGR);
-  else if (rgb.channels() != 3)
-    throw std::invalid_argument(what + ": 1, 3 or 4 channels expected (got " + std::to_string(rgb.channels()) + ")");
   const int w = camera.image_width_px, h = camera.image_height_px;
-  if (rgb.cols == w && rgb.rows == h) return rgb;
-  const double want = static_cast<double>(w) / h, got = static_cast<double>(rgb.cols) / rgb.rows;
+  if (picture.cols == w && picture.rows == h) return picture;
+  const double want = static_cast<double>(w) / h, got = static_cast<double>(picture.cols) / picture.rows;
   if (std::abs(got / want - 1.0) > 0.01)
-    throw std::invalid_argument(what + ": the image is " + std::to_string(rgb.cols) + "x" + std::to_string(rgb.rows) +
-                                " (aspect " + fmt(got, 3) + "), the decision model's camera " + std::to_string(w) +
-                                "x" + std::to_string(h) + " (aspect " + fmt(want, 3) +
+    throw std::invalid_argument(what + ": the image is " + std::to_string(picture.cols) + "x" +
+                                std::to_string(picture.rows) + " (aspect " + fmt(got, 3) +
+                                "), the decision model's camera " + std::to_string(w) + "x" + std::to_string(h) +
+                                " (aspect " + fmt(want, 3) +
                                 "): crop the images to the camera's aspect ratio, or calibrate a model for this "
                                 "camera (adaptseg_calibrate --image-width " +
-                                std::to_string(rgb.cols) + " --image-height " + std::to_string(rgb.rows) +
+                                std::to_string(picture.cols) + " --image-height " + std::to_string(picture.rows) +
                                 " --sensor-width-mm ... --focal-mm ...)");
   cv::Mat out;
-  cv::resize(rgb, out, cv::Size(w, h), 0, 0, cv::INTER_AREA);
+  cv::resize(picture, out, cv::Size(w, h), 0, 0, cv::INTER_AREA);
   return out;
 }
 
@@ -141,7 +143,7 @@ class RecordedCamera final : public CameraSource {
     const PosedImage& p = find_image(images_, at.position, tolerance_m_);
     Shot s{p.file, {}, {}, {p.pose, p.yaw_deg}, {}};
     if (rgb_)
-      s.rgb = fit_to_camera(read(dir_ / "rgb" / p.file, cv::IMREAD_COLOR, "camera image"), camera_,
+      s.bgr = fit_to_camera(read(dir_ / "rgb" / p.file, cv::IMREAD_COLOR, "camera image"), camera_,
                             (dir_ / "rgb" / p.file).string());
     if (labels_) s.labels = read(dir_ / "labels" / p.file, cv::IMREAD_UNCHANGED, "labels");
     return s;
@@ -286,7 +288,7 @@ class SimulatedCamera final : public CameraSource {
     }
     char name[96];
     std::snprintf(name, sizeof name, "sim-%05zu", shots_++);
-    return {name, std::move(img.rgb), std::move(img.ground_truth), at, {}};
+    return {name, std::move(img.bgr), std::move(img.ground_truth), at, {}};
   }
 
  private:

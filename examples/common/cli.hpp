@@ -236,7 +236,7 @@ struct CalibrationCli {
 
   void add_to(CLI::App& app) {
     std::vector<std::string> coverages;
-    for (const DescentCoverageRule& c : kDescentCoverages) coverages.emplace_back(c.name);
+    for (const DescentCoverageInfo& c : kDescentCoverages) coverages.emplace_back(c.name);
     options_ = {
         app.add_option("--rule", rule,
                        "decision rule: front-aware (descend while descents beat the lawnmower curve; no threshold) "

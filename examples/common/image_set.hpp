@@ -136,7 +136,7 @@ inline void write_image_set(const std::filesystem::path& dir, const Field& field
     std::snprintf(buf, sizeof buf, "%05zu.png", k);
     const std::string file = buf;
     write_png(dir / "labels" / file, img.ground_truth);
-    if (!img.rgb.empty()) write_png(dir / "rgb" / file, img.rgb);
+    if (!img.bgr.empty()) write_png(dir / "rgb" / file, img.bgr);
     const Eigen::Vector3d& p = waypoints[k].position;
     if (gnss) {
       // The GNSS fix of the camera and the compass bearing of the image's top (the frame's

@@ -173,7 +173,7 @@ class CachedBackend {
     int probability_asks = 0;
   };
   static Key key_of(const Image& image) {
-    const cv::Scalar sum = image.rgb.empty() ? cv::Scalar() : cv::sum(image.rgb);
+    const cv::Scalar sum = image.bgr.empty() ? cv::Scalar() : cv::sum(image.bgr);
     return {image.footprint_px.x,
             image.footprint_px.y,
             image.footprint_px.width,

@@ -195,7 +195,7 @@ int main(int argc, char** argv) {
         for (int y = 0; y < img.height_px; y += stride)
           for (int x = 0; x < img.width_px; x += stride) {
             if (truth.labels.at<unsigned char>(y, x) == img.ignore_label) continue;
-            if (img.rgb.at<cv::Vec3b>(y, x) == cv::Vec3b(0, 0, 0)) continue;  // no data: not segmented
+            if (img.bgr.at<cv::Vec3b>(y, x) == cv::Vec3b(0, 0, 0)) continue;  // no data: not segmented
             for (int c = 0; c < px.classes; ++c) {
               px.logits.push_back(logits[static_cast<std::size_t>(c)].at<float>(y, x));
               px.target.push_back(truth.probabilities[static_cast<std::size_t>(c)].at<float>(y, x));

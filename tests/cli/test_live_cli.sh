@@ -268,7 +268,7 @@ PY
 # Camera images segmented by a network: a quarter of Dubai tile 4, whose model's
 # policy flies the top level at 12.5 cm/px rather than the model's 15 (bug ii: the console said
 # 15.00 while flying 12.5); its RGB images recorded at 480x360, then at twice that size (bug iv:
-# refused as "rgb must be CV_8UC3 of the camera's size 480x360"), which fly the same mission,
+# refused as "bgr must be CV_8UC3 of the camera's size 480x360"), which fly the same mission,
 # and cropped to 16:9, which is refused saying what to do.
 dubai="$examples/data/dubai-tile-4:0,0,0.5,0.5"
 net="$examples/models/mobilenetv2-dubai"

@@ -8,9 +8,11 @@
 #include <adaptseg/core/decision_inputs.hpp>
 #include <adaptseg/core/detail/gsd.hpp>
 #include <adaptseg/core/detail/interpolate.hpp>
+#include <adaptseg/core/detail/named_rows.hpp>
 #include <adaptseg/core/error.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -36,15 +38,21 @@ namespace adaptseg {
 /// with the confidence level z by leave-one-field-out); docs/method.md, "Cells that pay".
 enum class SlopePooling { cells, fields };
 
-/// The name of a pooling (`slope_pooling` in the model file, `--slope-pooling` of the programs).
-[[nodiscard]] inline std::string to_string(SlopePooling p) { return p == SlopePooling::fields ? "fields" : "cells"; }
+/// Every pooling by name (`slope_pooling` in the model file, `--slope-pooling` of the programs).
+inline constexpr std::array<detail::NamedValue<SlopePooling>, 2> kSlopePoolings{{
+    {SlopePooling::cells, "cells"},
+    {SlopePooling::fields, "fields"},
+}};
+
+/// The name of a pooling.
+[[nodiscard]] inline std::string to_string(SlopePooling p) {
+  return detail::name_of(kSlopePoolings, p, "slope pooling");
+}
 
 /// Parses a pooling's name.
 /// @throws std::invalid_argument for anything but `cells` or `fields`.
 [[nodiscard]] inline SlopePooling parse_slope_pooling(std::string_view name) {
-  if (name == "cells") return SlopePooling::cells;
-  if (name == "fields") return SlopePooling::fields;
-  throw std::invalid_argument("slope pooling must be one of cells, fields, not '" + std::string(name) + "'");
+  return detail::value_named(kSlopePoolings, name, "slope pooling");
 }
 
 /// One cell of a top-level region, re-mapped alone from a lower altitude on a training field

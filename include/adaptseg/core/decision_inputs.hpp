@@ -12,6 +12,8 @@
 /// (cell_gain_model.hpp, calibration.hpp), the model file, the command line and the study tool
 /// (examples/tools/cell_study.cpp). No OpenCV here: the decision side compiles without it.
 
+#include <adaptseg/core/detail/named_rows.hpp>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -83,12 +85,7 @@ using DecisionInputValues = std::array<double, kDecisionInputCount>;
 /// Parses an input's name.
 /// @throws std::invalid_argument naming every input for anything else.
 [[nodiscard]] inline DecisionInput parse_decision_input(std::string_view name) {
-  std::string all;
-  for (const auto& row : kDecisionInputs) {
-    if (row.name == name) return row.input;
-    all += (all.empty() ? "" : ", ") + std::string(row.name);
-  }
-  throw std::invalid_argument("decision input must be one of " + all + ", not '" + std::string(name) + "'");
+  return detail::row_named(kDecisionInputs, name, "decision input").input;
 }
 
 /// Member vote shares within this of 0 or 1 count as none or all of the members (weight shares

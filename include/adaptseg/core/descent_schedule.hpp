@@ -2,7 +2,7 @@
 /// @file
 /// When the chosen descents are flown (DescentSchedule, an AdaptiveOptions setting), one place
 /// per schedule: its name and the windows it cuts the top-level lawnmower into
-/// (DescentScheduleRule). The adaptive planner asks a schedule's rule, never the schedule's name;
+/// (DescentScheduleInfo). The adaptive planner asks a schedule's row, never the schedule's name;
 /// a new schedule is a new row of kDescentSchedules.
 
 #include <adaptseg/core/detail/named_rows.hpp>
@@ -46,7 +46,7 @@ enum class DescentSchedule {
 /// windows of consecutive waypoints; a descent chosen in a window is flown at once, or (where
 /// the schedule `defers`) deferred to the window's tour, flown after the window's last
 /// top-level waypoint and ending at the next window's first, whichever adds less time.
-struct DescentScheduleRule {
+struct DescentScheduleInfo {
   DescentSchedule schedule;
   const char* name;         ///< in results, model files and on the command line
   const char* description;  ///< when its descents are flown, in words (a program's banner)
@@ -57,7 +57,7 @@ struct DescentScheduleRule {
 };
 
 /// Every schedule, one row each.
-inline constexpr std::array<DescentScheduleRule, 3> kDescentSchedules{{
+inline constexpr std::array<DescentScheduleInfo, 3> kDescentSchedules{{
     {DescentSchedule::immediate, "immediate", "at once", false,
      [](std::span<const Waypoint> top) {
        std::vector<std::size_t> last(top.size());
@@ -78,13 +78,20 @@ inline constexpr std::array<DescentScheduleRule, 3> kDescentSchedules{{
      }},
 }};
 
-/// The rule of schedule `s`.
-[[nodiscard]] inline const DescentScheduleRule& descent_schedule_rule(DescentSchedule s) {
-  return detail::row_of(kDescentSchedules, &DescentScheduleRule::schedule, s, "descent schedule");
+/// The row of schedule `s`.
+[[nodiscard]] inline const DescentScheduleInfo& descent_schedule_info(DescentSchedule s) {
+  return detail::row_of(kDescentSchedules, &DescentScheduleInfo::schedule, s, "descent schedule");
+}
+
+/// The names before adaptseg 0.3 ("rule" now means a decision rule only); kept until 0.4.
+using DescentScheduleRule [[deprecated("renamed adaptseg::DescentScheduleInfo in adaptseg 0.3")]] = DescentScheduleInfo;
+[[deprecated("renamed adaptseg::descent_schedule_info in adaptseg 0.3")]] inline const DescentScheduleInfo&
+descent_schedule_rule(DescentSchedule s) {
+  return descent_schedule_info(s);
 }
 
 /// The name used in results and on the command line: "immediate", "tour" or "row".
-[[nodiscard]] inline const char* to_string(DescentSchedule s) { return descent_schedule_rule(s).name; }
+[[nodiscard]] inline const char* to_string(DescentSchedule s) { return descent_schedule_info(s).name; }
 
 /// Parses a schedule's name.
 /// @throws std::invalid_argument for anything else.

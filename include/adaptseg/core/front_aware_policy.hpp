@@ -7,11 +7,13 @@
 #include <adaptseg/core/decision.hpp>
 #include <adaptseg/core/detail/gsd.hpp>
 #include <adaptseg/core/detail/interpolate.hpp>
+#include <adaptseg/core/detail/named_rows.hpp>
 #include <adaptseg/core/error.hpp>
 #include <adaptseg/core/gain_model.hpp>
 #include <adaptseg/core/lawnmower_curve.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -38,17 +40,21 @@ namespace adaptseg {
 ///   the coarser level must beat the steep segment, those from the corner only the flatter one.
 enum class TopLevelChoice { undominated, hull };
 
-/// The name of a top-level choice (`top_level` in the model file, `--top-level` of the programs).
+/// Every top-level choice by name (`top_level` in the model file, `--top-level` of the programs).
+inline constexpr std::array<detail::NamedValue<TopLevelChoice>, 2> kTopLevelChoices{{
+    {TopLevelChoice::undominated, "undominated"},
+    {TopLevelChoice::hull, "hull"},
+}};
+
+/// The name of a top-level choice.
 [[nodiscard]] inline std::string to_string(TopLevelChoice r) {
-  return r == TopLevelChoice::hull ? "hull" : "undominated";
+  return detail::name_of(kTopLevelChoices, r, "top-level choice");
 }
 
 /// Parses a top-level choice's name.
 /// @throws std::invalid_argument for anything but `undominated` or `hull`.
 [[nodiscard]] inline TopLevelChoice parse_top_level_choice(std::string_view name) {
-  if (name == "undominated") return TopLevelChoice::undominated;
-  if (name == "hull") return TopLevelChoice::hull;
-  throw std::invalid_argument("top-level choice must be one of undominated, hull, not '" + std::string(name) + "'");
+  return detail::value_named(kTopLevelChoices, name, "top-level choice");
 }
 
 /// A training field's fixed-altitude lawnmower curve by GSD: the front-aware rule's yardstick.

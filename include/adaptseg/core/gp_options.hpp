@@ -5,10 +5,12 @@
 /// hyperparameter-search options with their validation, what a search did, what a prediction
 /// gives. Independent of the kernel.
 
+#include <adaptseg/core/detail/named_rows.hpp>
 #include <adaptseg/core/error.hpp>
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -35,15 +37,19 @@ enum class FitStatus {
   kNumericalFailure,  ///< the covariance could not be factorised along the path; best point kept.
 };
 
-/// Readable name of a `FitStatus`.
+/// Every FitStatus by name.
+inline constexpr std::array<detail::NamedValue<FitStatus>, 5> kFitStatuses{{
+    {FitStatus::kNotOptimized, "not_optimized"},
+    {FitStatus::kConverged, "converged"},
+    {FitStatus::kMaxIterations, "max_iterations"},
+    {FitStatus::kLineSearchFailed, "line_search_failed"},
+    {FitStatus::kNumericalFailure, "numerical_failure"},
+}};
+
+/// Readable name of a `FitStatus`: "converged", say; "unknown" for a value out of range.
 [[nodiscard]] inline std::string_view to_string(FitStatus s) {
-  switch (s) {
-    case FitStatus::kNotOptimized: return "not_optimized";
-    case FitStatus::kConverged: return "converged";
-    case FitStatus::kMaxIterations: return "max_iterations";
-    case FitStatus::kLineSearchFailed: return "line_search_failed";
-    case FitStatus::kNumericalFailure: return "numerical_failure";
-  }
+  for (const auto& row : kFitStatuses)
+    if (row.value == s) return row.name;
   return "unknown";
 }
 

@@ -198,13 +198,13 @@ class OnnxSegmenter {
 
   /// Labels: CV_8UC1, `image.height_px x image.width_px`, argmax of the logits (ties to the
   /// lower index); `image.ignore_label` on pixels without RGB content (see OnnxParams).
-  /// @throws std::invalid_argument for an image without RGB (`image.rgb` empty, e.g. a field
+  /// @throws std::invalid_argument for an image without RGB (`image.bgr` empty, e.g. a field
   ///         with labels only), an RGB that is not CV_8UC3 of `width_px x height_px`, or a
   ///         size the network cannot take.
   [[nodiscard]] cv::Mat segment(const Image& image) {
     if (params_.test_time_mirror) return segment_with_probabilities(image).labels;
     cv::Mat labels = argmax(logits(image));
-    if (params_.black_is_no_data) labels.setTo(cv::Scalar(image.ignore_label), no_data_mask(image.rgb));
+    if (params_.black_is_no_data) labels.setTo(cv::Scalar(image.ignore_label), no_data_mask(image.bgr));
     return labels;
   }
 
@@ -217,8 +217,8 @@ class OnnxSegmenter {
     if (params_.test_time_mirror) {
       softmax_in_place(s.probabilities);
       Image mirrored = image;
-      mirrored.rgb = cv::Mat();  // a new buffer: `image` shares its pixels with the copy
-      cv::flip(image.rgb, mirrored.rgb, 1);
+      mirrored.bgr = cv::Mat();  // a new buffer: `image` shares its pixels with the copy
+      cv::flip(image.bgr, mirrored.bgr, 1);
       std::vector<cv::Mat> back = logits(mirrored);
       softmax_in_place(back);
       cv::Mat flipped;
@@ -232,7 +232,7 @@ class OnnxSegmenter {
       softmax_in_place(s.probabilities);
     }
     if (params_.black_is_no_data) {
-      const cv::Mat mask = no_data_mask(image.rgb);
+      const cv::Mat mask = no_data_mask(image.bgr);
       s.labels.setTo(cv::Scalar(image.ignore_label), mask);
       for (auto& p : s.probabilities) p.setTo(cv::Scalar(0.0), mask);
     }
@@ -256,10 +256,10 @@ class OnnxSegmenter {
     check_image(image);
     const cv::Size in = input_size();
     const cv::Size out_size(image.width_px, image.height_px);
-    cv::Mat rgb = image.rgb;
+    cv::Mat rgb = image.bgr;
     if (rgb.size() != in) {
       const bool shrink = rgb.cols > in.width;
-      cv::resize(image.rgb, rgb, in, 0, 0, shrink ? cv::INTER_AREA : cv::INTER_LINEAR);
+      cv::resize(image.bgr, rgb, in, 0, 0, shrink ? cv::INTER_AREA : cv::INTER_LINEAR);
     }
     net_.setInput(to_blob(rgb));
     cv::Mat out = net_.forward();
@@ -477,17 +477,17 @@ class OnnxSegmenter {
   }
 
   void check_image(const Image& image) const {
-    detail::require(!image.rgb.empty(),
-                    "OnnxSegmenter: the image has no RGB (Image::rgb is empty, e.g. a "
+    detail::require(!image.bgr.empty(),
+                    "OnnxSegmenter: the image has no RGB (Image::bgr is empty, e.g. a "
                     "field without an image); ERFNet segments RGB images only",
                     "empty rgb");
-    detail::require(image.rgb.type() == CV_8UC3, "OnnxSegmenter: Image::rgb must be 8-bit 3-channel BGR (CV_8UC3)",
-                    "type " + std::to_string(image.rgb.type()));
-    detail::require(image.rgb.cols == image.width_px && image.rgb.rows == image.height_px,
-                    "OnnxSegmenter: Image::rgb size differs from width_px x height_px",
-                    std::to_string(image.rgb.cols) + "x" + std::to_string(image.rgb.rows) + " vs " +
+    detail::require(image.bgr.type() == CV_8UC3, "OnnxSegmenter: Image::bgr must be 8-bit 3-channel BGR (CV_8UC3)",
+                    "type " + std::to_string(image.bgr.type()));
+    detail::require(image.bgr.cols == image.width_px && image.bgr.rows == image.height_px,
+                    "OnnxSegmenter: Image::bgr size differs from width_px x height_px",
+                    std::to_string(image.bgr.cols) + "x" + std::to_string(image.bgr.rows) + " vs " +
                         std::to_string(image.width_px) + "x" + std::to_string(image.height_px));
-    check_size(image.rgb.size(), "OnnxSegmenter (image)");
+    check_size(image.bgr.size(), "OnnxSegmenter (image)");
   }
 
   /// NCHW float blob, `(v / 255 - mean) / std` in the network's channel order.

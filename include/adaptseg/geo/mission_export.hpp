@@ -23,6 +23,7 @@
 /// const adaptseg::MissionFile back = adaptseg::read_qgc_plan(plan);
 /// @endcode
 
+#include <adaptseg/core/detail/named_rows.hpp>
 #include <adaptseg/core/error.hpp>
 #include <adaptseg/core/lawnmower_planner.hpp>
 #include <adaptseg/geo/detail/export_text.hpp>
@@ -224,13 +225,17 @@ enum class ExportFormat {
   geojson,   ///< GeoJSON (RFC 7946), `mission.geojson`
 };
 
+/// Every format by its name on the command line.
+inline constexpr std::array<detail::NamedValue<ExportFormat>, 3> kExportFormats{{
+    {ExportFormat::qgc_plan, "plan"},
+    {ExportFormat::wpl, "wpl"},
+    {ExportFormat::geojson, "geojson"},
+}};
+
 /// "plan", "wpl" or "geojson" -> ExportFormat.
 /// @throws std::invalid_argument for anything else.
 inline ExportFormat parse_export_format(std::string_view name) {
-  if (name == "plan") return ExportFormat::qgc_plan;
-  if (name == "wpl") return ExportFormat::wpl;
-  if (name == "geojson") return ExportFormat::geojson;
-  throw std::invalid_argument("unknown export format '" + std::string(name) + "' (known: plan, wpl, geojson)");
+  return detail::value_named(kExportFormats, name, "export format");
 }
 
 /// The conventional file name of a format: mission.plan, mission.waypoints, mission.geojson.

@@ -9,8 +9,10 @@
 /// mavlink-get-set-flightmode.html) and each vehicle's FLTMODE1 parameter (Copter GUIDED 4,
 /// Plane and Rover GUIDED 15).
 
+#include <adaptseg/core/detail/named_rows.hpp>
 #include <adaptseg/mavlink/enums.hpp>
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -31,13 +33,17 @@ enum class Firmware {
   return Firmware::other;
 }
 
-/// `"PX4"`, `"ArduPilot"`, `"other"`.
+/// Every Firmware by name.
+inline constexpr std::array<adaptseg::detail::NamedValue<Firmware>, 3> kFirmwares{{
+    {Firmware::px4, "PX4"},
+    {Firmware::ardupilot, "ArduPilot"},
+    {Firmware::other, "other"},
+}};
+
+/// `"PX4"`, `"ArduPilot"`, `"other"` (also for a value out of range).
 [[nodiscard]] inline std::string to_string(Firmware f) {
-  switch (f) {
-    case Firmware::px4: return "PX4";
-    case Firmware::ardupilot: return "ArduPilot";
-    case Firmware::other: break;
-  }
+  for (const auto& row : kFirmwares)
+    if (row.value == f) return row.name;
   return "other";
 }
 

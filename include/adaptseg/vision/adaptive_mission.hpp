@@ -96,7 +96,7 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
     }
     // With the backend's class probabilities where the decision reads them (a coverage that ranks
     // cells: the top-level images' decision inputs, a descent's scene check).
-    const bool probabilities = descent_coverage_rule(options.coverage).ranks_cells;
+    const bool probabilities = descent_coverage_info(options.coverage).ranks_cells;
     auto visit = mission.visit_without_fusion(w->waypoint, w->level, probabilities);
     planner.report(visit.image,
                    Segmentation{visit.labels, std::move(visit.probabilities), std::move(visit.member_votes)},

@@ -68,8 +68,8 @@ namespace adaptseg {
 /// @code
 /// adaptseg::AdaptivePlanner planner(area, backend, policy, options);
 /// while (const auto w = planner.next()) {
-///   const cv::Mat rgb = fly_and_shoot(w->waypoint.position);         // the UAV's part
-///   const auto step = planner.report(planner.image_at(measured_pose(), rgb));
+///   const cv::Mat bgr = fly_and_shoot(w->waypoint.position);         // the UAV's part
+///   const auto step = planner.report(planner.image_at(measured_pose(), bgr));
 ///   if (step.decision && step.decision->decision.descend) { /* a sub-lawnmower comes (next) */ }
 /// }
 /// const adaptseg::SemanticMap& map = planner.map();
@@ -91,8 +91,8 @@ class AdaptivePlanner {
         backend_(backend),
         policy_(policy),
         options_(std::move(options)),
-        schedule_(descent_schedule_rule(options_.schedule)),
-        coverage_(descent_coverage_rule(options_.coverage)) {
+        schedule_(descent_schedule_info(options_.schedule)),
+        coverage_(descent_coverage_info(options_.coverage)) {
     const auto t0 = std::chrono::steady_clock::now();
     policy_.begin_mission();
     if (area_.valid_mask.empty()) {
@@ -259,23 +259,23 @@ class AdaptivePlanner {
     return accept(image, segmentation, segmentation_s, elapsed_s, t0);
   }
 
-  /// The Image of a camera frame `rgb` (CV_8UC3 of the camera's size, or empty) taken at
+  /// The Image of a camera frame `bgr` (CV_8UC3, B, G, R of the camera's size, or empty) taken at
   /// `pose`: x, y [m] in the field frame, z the altitude above ground [m]. Nadir camera whose
   /// image x axis is turned `yaw_deg` counter-clockwise from the field's x axis (Image::yaw_deg;
   /// 0: the plan's heading); the GSD follows from the altitude, the footprint is centred under
   /// the camera, snapped to map pixels as SimulatedSensor does, and turned by the yaw when fused.
   /// @throws std::invalid_argument for a pose or yaw that is not finite or an altitude <= 0,
-  ///         and an RGB image of another size or type.
-  [[nodiscard]] Image image_at(const Eigen::Vector3d& pose, cv::Mat rgb = {}, double yaw_deg = 0.0) const {
+  ///         and a colour image of another size or type.
+  [[nodiscard]] Image image_at(const Eigen::Vector3d& pose, cv::Mat bgr = {}, double yaw_deg = 0.0) const {
     detail::require(pose.allFinite(), "AdaptivePlanner::image_at: the pose must be finite", pose.transpose());
     detail::require(std::isfinite(yaw_deg), "AdaptivePlanner::image_at: yaw_deg must be finite", yaw_deg);
     detail::require(
-        rgb.empty() || (rgb.type() == CV_8UC3 && rgb.cols == camera_.width_px() && rgb.rows == camera_.height_px()),
-        "AdaptivePlanner::image_at: rgb must be CV_8UC3 of the camera's size " + std::to_string(camera_.width_px()) +
+        bgr.empty() || (bgr.type() == CV_8UC3 && bgr.cols == camera_.width_px() && bgr.rows == camera_.height_px()),
+        "AdaptivePlanner::image_at: bgr must be CV_8UC3 of the camera's size " + std::to_string(camera_.width_px()) +
             "x" + std::to_string(camera_.height_px()),
-        std::to_string(rgb.cols) + "x" + std::to_string(rgb.rows));
+        std::to_string(bgr.cols) + "x" + std::to_string(bgr.rows));
     Image img;
-    img.rgb = std::move(rgb);
+    img.bgr = std::move(bgr);
     img.position = pose;
     img.gsd_cm = camera_.gsd_cm(pose.z());
     img.width_px = camera_.width_px();
@@ -302,7 +302,7 @@ class AdaptivePlanner {
 
   /// The sub-lawnmower a descent at top-level waypoint `top_index` flies at `gsd_cm` once the
   /// region's top-level image is fused: sub_plan() with the cells `options().coverage` flies
-  /// (DescentCoverageRule::flies, given the region's map; DescentCoverage::interest: only the
+  /// (DescentCoverageInfo::flies, given the region's map; DescentCoverage::interest: only the
   /// cells whose ground, grown by one top-level pixel and clipped to the region, shows a label of
   /// interest; visiting order unchanged). A coverage that ranks cells offers subsets of it.
   /// @throws std::invalid_argument as sub_plan().
@@ -565,9 +565,9 @@ class AdaptivePlanner {
                     "AdaptivePlanner::report: the image must have the camera's size " +
                         std::to_string(camera_.width_px()) + "x" + std::to_string(camera_.height_px()),
                     std::to_string(image.width_px) + "x" + std::to_string(image.height_px));
-    detail::require(image.rgb.empty() || image.rgb.size() == cv::Size(image.width_px, image.height_px),
+    detail::require(image.bgr.empty() || image.bgr.size() == cv::Size(image.width_px, image.height_px),
                     "AdaptivePlanner::report: the image's rgb must be of its size",
-                    std::to_string(image.rgb.cols) + "x" + std::to_string(image.rgb.rows));
+                    std::to_string(image.bgr.cols) + "x" + std::to_string(image.bgr.rows));
     detail::require(image.footprint_px.width > 0 && image.footprint_px.height > 0 && image.gsd_cm > 0.0,
                     "AdaptivePlanner::report: the image has no footprint (make it with image_at())", image.gsd_cm);
     detail::require(std::isfinite(image.yaw_deg), "AdaptivePlanner::report: the image's yaw_deg must be finite",
@@ -869,8 +869,8 @@ class AdaptivePlanner {
   Backend& backend_;
   Policy& policy_;
   AdaptiveOptions options_;
-  const DescentScheduleRule& schedule_;  ///< options_.schedule's
-  const DescentCoverageRule& coverage_;  ///< options_.coverage's
+  const DescentScheduleInfo& schedule_;  ///< options_.schedule's
+  const DescentCoverageInfo& coverage_;  ///< options_.coverage's
   std::vector<double> candidates_;
   double top_gsd_cm_ = 0.0;  ///< the GSD the top level is flown at
   std::vector<Waypoint> top_;
@@ -896,7 +896,7 @@ class AdaptivePlanner {
   GridInputs region_inputs_;  ///< the last top-level image's inputs (buffers reused)
   GridInputs scene_inputs_;   ///< the last descent image's inputs over its cell (the scene check)
   /// Per top-level waypoint, the last top-level waypoint of its window: where the window's tour
-  /// starts (DescentScheduleRule::window_last).
+  /// starts (DescentScheduleInfo::window_last).
   std::vector<std::size_t> window_last_;
   // A schedule that defers descents (DescentSchedule::tour, row): the tour of the window being flown.
   std::vector<ChosenDescent> queued_;    ///< every descent deferred in the window, in decision order

@@ -173,7 +173,7 @@ template <SegmentationBackend Backend>
   const std::vector<int>& interest = adaptive.mission.interest;
   const CameraModel camera(adaptive.mission.camera);
 
-  const bool ranked = descent_coverage_rule(adaptive.coverage).ranks_cells;
+  const bool ranked = descent_coverage_info(adaptive.coverage).ranks_cells;
   const std::vector<double> alternative_tops = ranked ? detail::alternative_top_gsds(options) : std::vector<double>{};
   std::vector<RegionSample> samples;
   std::vector<std::vector<RegionSample>> by_field;

@@ -383,7 +383,7 @@ struct DecisionModel {
         detail::yaml_error(where, "candidate GSDs must be positive and finer than top_gsd_cm");
     if (!(calibration_segmentation_time_s >= 0.0))
       detail::yaml_error(where, "'calibration.segmentation_time_s' must be >= 0");
-    if (descent_coverage_rule(coverage).ranks_cells && !decision_function.model().cells())
+    if (descent_coverage_info(coverage).ranks_cells && !decision_function.model().cells())
       detail::yaml_error(where, "descent_coverage '" + std::string(to_string(coverage)) +
                                     "' needs a cell gain model ('gain_model.cells')");
   }

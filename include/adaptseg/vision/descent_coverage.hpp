@@ -2,7 +2,7 @@
 /// @file
 /// What a descent re-maps (DescentCoverage, an AdaptiveOptions setting), one place per
 /// coverage: its name, which cells it flies (cell_shows_interest for `interest`) and whether it
-/// ranks them (DescentCoverageRule). The adaptive planner and calibration ask a coverage's rule,
+/// ranks them (DescentCoverageInfo). The adaptive planner and calibration ask a coverage's row,
 /// never the coverage's name; a new coverage is a new row of kDescentCoverages.
 
 #include <adaptseg/core/detail/named_rows.hpp>
@@ -34,10 +34,10 @@ namespace adaptseg {
 ///   with none of the input are never re-mapped.
 enum class DescentCoverage { region, interest, ranked };
 
-/// The DescentCoverage::interest rule for one sub-lawnmower cell: true if some pixel of
+/// Whether DescentCoverage::interest flies one sub-lawnmower cell: true if some pixel of
 /// `labels` (the region's top-level segmentation on a grid of `grid_gsd_cm`) inside `cell`,
 /// grown by one top-level pixel (`top_gsd_cm`) on every side and clipped to the image, carries
-/// a class in `interest`. One rule for the planner and for calibration, so that a model's
+/// a class in `interest`. One test for the planner and for calibration, so that a model's
 /// samples are taken as its missions fly.
 /// @throws std::invalid_argument unless `labels` is CV_8UC1 and both GSDs are finite and > 0.
 [[nodiscard]] inline bool cell_shows_interest(const cv::Mat& labels, cv::Rect cell, double top_gsd_cm,
@@ -60,7 +60,7 @@ enum class DescentCoverage { region, interest, ranked };
 /// A coverage as the adaptive planner and calibration use it. A descent re-maps cells of its
 /// region's sub-lawnmower: those with field that the coverage `flies`, and, where it
 /// `ranks_cells`, the k best of those (one candidate per k, the decision chooses k).
-struct DescentCoverageRule {
+struct DescentCoverageInfo {
   DescentCoverage coverage;
   const char* name;  ///< in model files and on the command line
   /// Whether a sub-lawnmower cell with field is flown, given the region's top-level labels
@@ -78,19 +78,26 @@ struct DescentCoverageRule {
 };
 
 /// Every coverage, one row each.
-inline constexpr std::array<DescentCoverageRule, 3> kDescentCoverages{{
+inline constexpr std::array<DescentCoverageInfo, 3> kDescentCoverages{{
     {DescentCoverage::region, "region", nullptr, false},
     {DescentCoverage::interest, "interest", cell_shows_interest, false},
     {DescentCoverage::ranked, "ranked", nullptr, true},
 }};
 
-/// The rule of coverage `c`.
-[[nodiscard]] inline const DescentCoverageRule& descent_coverage_rule(DescentCoverage c) {
-  return detail::row_of(kDescentCoverages, &DescentCoverageRule::coverage, c, "descent coverage");
+/// The row of coverage `c`.
+[[nodiscard]] inline const DescentCoverageInfo& descent_coverage_info(DescentCoverage c) {
+  return detail::row_of(kDescentCoverages, &DescentCoverageInfo::coverage, c, "descent coverage");
+}
+
+/// The names before adaptseg 0.3 ("rule" now means a decision rule only); kept until 0.4.
+using DescentCoverageRule [[deprecated("renamed adaptseg::DescentCoverageInfo in adaptseg 0.3")]] = DescentCoverageInfo;
+[[deprecated("renamed adaptseg::descent_coverage_info in adaptseg 0.3")]] inline const DescentCoverageInfo&
+descent_coverage_rule(DescentCoverage c) {
+  return descent_coverage_info(c);
 }
 
 /// The name used in files and on the command line: "region", "interest" or "ranked".
-[[nodiscard]] inline const char* to_string(DescentCoverage c) { return descent_coverage_rule(c).name; }
+[[nodiscard]] inline const char* to_string(DescentCoverage c) { return descent_coverage_info(c).name; }
 
 /// Parses a coverage's name.
 /// @throws std::invalid_argument for anything else.

@@ -247,7 +247,7 @@ struct FrontAwareRule {
     const CalibrationOptions& options = in.options;
     const std::span<const Field> fields = in.fields;
     check_options(options);
-    const bool ranked = descent_coverage_rule(in.adaptive.coverage).ranks_cells;
+    const bool ranked = descent_coverage_info(in.adaptive.coverage).ranks_cells;
     const std::vector<ReferenceCurve> reference(in.reference.begin(), in.reference.end());
     // What each training field's top-level images show along the flight, where σ̂'s prior is
     // estimated from them (one top-level mission per field).

@@ -42,10 +42,10 @@ namespace adaptseg {
 
 /// One camera frame, as a segmentation backend receives it.
 struct Image {
-  /// The colour image, I_h x I_w, CV_8UC3 in OpenCV's channel order, **B, G, R** (the member
-  /// keeps its historical name); empty when the field has no colour image. A backend whose
-  /// network wants RGB swaps the channels itself (OnnxSegmenter does, from its model file).
-  cv::Mat rgb;
+  /// The colour image, I_h x I_w, CV_8UC3 in OpenCV's channel order, **B, G, R** (`rgb` before
+  /// adaptseg 0.3); empty when the field has no colour image. A backend whose network wants RGB
+  /// swaps the channels itself (OnnxSegmenter does, from its model file).
+  cv::Mat bgr;
   /// Simulation only: the orthomosaic's labels under the footprint at the orthomosaic's
   /// resolution, in the camera's orientation (CV_8UC1 of the footprint's size: row r, column c
   /// is the orthomosaic pixel under point (c + 0.5, r + 0.5) of FootprintFrame; the ignore

@@ -34,7 +34,7 @@ struct CalibrationSamples {
 /// Flies every top-level region of `field` at `top_gsd_cm` and at each of `candidate_gsd_cm`
 /// and returns one RegionSample per (region, candidate). Regions without a valid pixel are
 /// skipped; candidates finer than the field's GSD are skipped. `coverage`: what each
-/// sub-lawnmower covers, as AdaptivePlanner::descent_plan (DescentCoverageRule::flies; a
+/// sub-lawnmower covers, as AdaptivePlanner::descent_plan (DescentCoverageInfo::flies; a
 /// (region, candidate) whose sub-lawnmower has no cell is skipped: the planner offers no such
 /// descent; with a coverage that ranks cells, DescentCoverage::ranked, every cell it flies is
 /// flown, and every cell also gives a CellSample: its decision inputs in the top-level image, segmented
@@ -60,8 +60,8 @@ template <SegmentationBackend Backend>
   const int n = field.num_classes();
   // The top-level lawnmower over the whole field: every sample's field terms are measured
   // against its map.
-  const DescentCoverageRule& rule = descent_coverage_rule(coverage);
-  const bool ranked = rule.ranks_cells;
+  const DescentCoverageInfo& covers = descent_coverage_info(coverage);
+  const bool ranked = covers.ranks_cells;
   const auto tops = planner.plan(field.area(), top_gsd_cm, {0.0, 0.0}, keep);
   std::vector<Image> top_images;
   std::vector<Segmentation> top_segmentations;
@@ -103,8 +103,8 @@ template <SegmentationBackend Backend>
       field_without_region -= here;
     }
     const auto keep_cell = [&](const Area& a) {
-      return keep(a) && (!rule.flies || rule.flies(top_map.labels(), field.pixel_rect(a) - region.tl(), top_gsd_cm,
-                                                   field.gsd_cm(), interest));
+      return keep(a) && (!covers.flies || covers.flies(top_map.labels(), field.pixel_rect(a) - region.tl(), top_gsd_cm,
+                                                       field.gsd_cm(), interest));
     };
     // The decision inputs of the top-level image on the region's map grid (ranked only).
     const std::vector<cv::Mat> top_planes =
@@ -117,7 +117,7 @@ template <SegmentationBackend Backend>
       if (sub.empty()) continue;
       SemanticMap local(region.size(), field.ignore_label());
       // Cells a coverage leaves out keep their top-level labels, as in the mission's map.
-      if (rule.flies) local.fuse(top_local, top_labels);
+      if (covers.flies) local.fuse(top_local, top_labels);
       // Ranked: each finer image's own decision inputs over its cell (the scene check's proxy).
       std::vector<CellInputs> fine_inputs;
       for (const auto& w : sub) {

@@ -74,7 +74,7 @@ class SimulatedSensor {
     img.ground_truth = cut(field_.labels(), cv::Scalar(field_.ignore_label()));
     if (field_.has_image()) {
       const cv::Mat rgb = cut(field_.image(), cv::Scalar(0, 0, 0));
-      cv::resize(rgb, img.rgb, cv::Size(img.width_px, img.height_px), 0, 0, cv::INTER_AREA);
+      cv::resize(rgb, img.bgr, cv::Size(img.width_px, img.height_px), 0, 0, cv::INTER_AREA);
     }
     return img;
   }
