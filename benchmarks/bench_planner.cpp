@@ -4,7 +4,7 @@
 // starts (by the oracle or a network), so the network's time is not in it; the simulated camera
 // and the scoring are outside it too.
 //
-//   bench_planner --decision-model MODEL.yaml --field DIR [--field DIR ...] [--segmenter erfnet --network NET]
+//   bench_planner --decision-model MODEL.yaml --field DIR [--field DIR ...] [--segmenter network --network NET]
 //                 [--planner-threads N] [--repeat R] [--strategy adaptive|nonadaptive|tour|row]
 //
 // Prints one Markdown row per field: waypoints, descents / decisions, median / 95th percentile /

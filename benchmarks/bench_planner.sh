@@ -51,7 +51,7 @@ if [ -n "${MODELS_ONLY:-}" ]; then
     "$calibrate" --field "$w" --region 0,0,0.5,1 --out "$out/oracle-weedmap.yaml" --seg-time-s 0.1 >"$out/oracle-weedmap.log" 2>&1
   for backend in oracle mobilenetv2-dubai erfnet-dubai; do
     args=()
-    [ "$backend" = oracle ] || args=(--segmenter erfnet --network "examples/models/$backend" --threads 2
+    [ "$backend" = oracle ] || args=(--segmenter network --network "examples/models/$backend" --threads 2
                                      --segmentation-cache "$out/cache")
     for cls in vegetation building; do model "$backend" "$cls" "${args[@]}"; done
   done
@@ -67,7 +67,7 @@ for threads in 1 2; do
 done
 for backend in oracle mobilenetv2-dubai erfnet-dubai; do
   args=()
-  [ "$backend" = oracle ] || args=(--segmenter erfnet --network "examples/models/$backend" --threads 2)
+  [ "$backend" = oracle ] || args=(--segmenter network --network "examples/models/$backend" --threads 2)
   for cls in vegetation building; do
     cache=()
     [ "$backend" = oracle ] || cache=(--segmentation-cache "$out/cache")

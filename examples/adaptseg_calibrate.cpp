@@ -6,7 +6,7 @@
 //                      --out model.yaml
 //   adaptseg_calibrate --train examples/data/dubai-tile-1 --train examples/data/dubai-tile-2:0,0,1,0.5
 //                      --interest road --out roads.yaml
-//   adaptseg_calibrate --field examples/data/dubai-tile-4 --segmenter erfnet
+//   adaptseg_calibrate --field examples/data/dubai-tile-4 --segmenter network
 //                      --network examples/models/ensemble-dubai --out ensemble-model.yaml
 
 #include "common/cell_csv.hpp"

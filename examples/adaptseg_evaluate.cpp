@@ -5,7 +5,7 @@
 //   adaptseg_evaluate --train examples/data/weedmap-000:0,0,0.5,1
 //                     --test examples/data/weedmap-000:0.5,0,1,1 --segmenter oracle --out out/eval
 //   adaptseg_evaluate --train examples/data/dubai-tile-4 --test examples/data/dubai-tile-6
-//                     --segmenter erfnet --network examples/models/ensemble-dubai --out out/eval-ensemble
+//                     --segmenter network --network examples/models/ensemble-dubai --out out/eval-ensemble
 
 #include "common/cell_csv.hpp"
 #include "common/segmenters.hpp"

@@ -27,7 +27,7 @@
 // classes, labels of interest, camera, and optionally its geo-reference), DIR/valid_mask.png
 // (where the field is), DIR/poses.csv (in the area's frame, file,x,y,z,yaw_deg; or from GNSS,
 // file,latitude_deg,longitude_deg,relative_altitude_m,heading_deg), and per image DIR/rgb/FILE
-// (the camera image, for --segmenter erfnet) and/or DIR/labels/FILE (ground-truth labels under
+// (the camera image, for --segmenter network) and/or DIR/labels/FILE (ground-truth labels under
 // the footprint at map resolution, in the camera's orientation, for --segmenter oracle).
 // --record-gnss records GNSS poses; --area SITE (the file adaptseg_plan takes) gives the area
 // and its frame for a folder of GNSS poses, and lays the top-level grid centred on it as
@@ -307,8 +307,8 @@ void fly(const ImageSetInfo& info, Backend& backend, Policy& policy, const adapt
       ex::Shot shot = s.camera->take(at, idle);
       if (vehicle && s.flight.pose_from_exif)
         shot.pose = exif_pose(shot, *info.geo, vehicle->last_position(), 0.5 * w->waypoint.footprint.height_m());
-      if (s.segmenter == "erfnet" && shot.bgr.empty())
-        throw std::invalid_argument(shot.name + ": no camera image for the network (--segmenter erfnet)");
+      if (s.segmenter == "network" && shot.bgr.empty())
+        throw std::invalid_argument(shot.name + ": no camera image for the network (--segmenter network)");
       // The pose and heading measured, not the ones planned.
       adaptseg::Image image = planner.image_at(shot.pose.position, shot.bgr, shot.pose.yaw_deg);
       if (s.segmenter == "oracle") ex::attach_labels(image, std::move(shot.labels), shot.name + " (labels)");
@@ -454,14 +454,16 @@ int main(int argc, char** argv) {
   app.add_option("--strategy", strategy, "decision policy")
       ->check(CLI::IsMember(adaptseg::examples::strategy_names(true)))
       ->capture_default_str();
-  app.add_option("--segmenter", segmenter,
-                 "oracle: the ground-truth labels of the folder or the simulated camera; erfnet: the camera's RGB "
-                 "images")
-      ->check(CLI::IsMember({"oracle", "erfnet"}))
+  ex::accept_old_value(app.add_option("--segmenter", segmenter,
+                                      "oracle: the ground-truth labels of the folder or the simulated camera; network: "
+                                      "the camera's colour images segmented by --network"),
+                       "erfnet", "network")
+      ->check(CLI::IsMember({"oracle", "network"}))
       ->capture_default_str();
-  CLI::Option* network_opt = app.add_option("--network", network,
-                                            "network of --segmenter erfnet: a model directory (model.onnx, model.yaml) "
-                                            "or an ensemble directory (ensemble.yaml)");
+  CLI::Option* network_opt =
+      app.add_option("--network", network,
+                     "network of --segmenter network: a model directory (model.onnx, model.yaml) "
+                     "or an ensemble directory (ensemble.yaml)");
   adaptseg::examples::accept_old_spelling(app, network_opt, "--model-file", network);
   app.add_option("--budget-s", budget_s,
                  "mission-time budget [s]: a descent is flown only where it and the rest fit, each image at a bound of "
@@ -604,7 +606,7 @@ int main(int argc, char** argv) {
     if (!camera_folder.empty() && segmenter == "oracle")
       throw std::invalid_argument(
           "--camera-folder gives camera images without labels: segment them with "
-          "--segmenter erfnet --network DIR (the oracle needs ground truth)");
+          "--segmenter network --network DIR (the oracle needs ground truth)");
     if (!s.exports.geo_origin.empty() && simulate_field.empty())
       throw std::invalid_argument(
           "--geo-origin is for --record-from and --simulate-camera; the folder's frame is area.yaml's geo: (or "
@@ -671,9 +673,9 @@ int main(int argc, char** argv) {
     // The camera: the simulated one, a watched folder, or the recorded folder.
     std::unique_ptr<ex::CameraSource> camera;
     if (sim_field) {
-      if (segmenter == "erfnet" && !sim_field->has_image())
+      if (segmenter == "network" && !sim_field->has_image())
         throw std::invalid_argument("--simulate-camera: field '" + sim_field->name() +
-                                    "' has no image for --segmenter erfnet (its labels serve --segmenter oracle)");
+                                    "' has no image for --segmenter network (its labels serve --segmenter oracle)");
       const bool other_frame = !area_file.empty() || !images_dir.empty();
       camera = std::make_unique<ex::SimulatedCamera>(
           *sim_field, model.camera, other_frame ? info.geo : std::optional<adaptseg::FieldGeo>{}, info.area.map_gsd_cm);
@@ -694,7 +696,7 @@ int main(int argc, char** argv) {
                                    : " (0.4 x the finest footprint's smaller side; --pose-tolerance-m)");
       camera =
           std::make_unique<ex::RecordedCamera>(images_dir, ex::read_poses(images_dir, info, area_file.empty()),
-                                               tolerance, segmenter == "erfnet", segmenter == "oracle", model.camera);
+                                               tolerance, segmenter == "network", segmenter == "oracle", model.camera);
     }
     s.camera = camera.get();
     if (info.geo && s.flight.connection.empty()) s.exports.check_altitude(options.top_gsd_cm, model.camera);
@@ -703,7 +705,7 @@ int main(int argc, char** argv) {
       adaptseg::examples::AnyBackend any(oracle);  // as with_network's: one backend type to compile for
       fly_strategy(strategy, model, info, any, options, s);
     } else {
-      if (network.empty()) throw std::invalid_argument("--segmenter erfnet needs --network");
+      if (network.empty()) throw std::invalid_argument("--segmenter network needs --network");
       adaptseg::OnnxParams params;
       params.expected_classes = names;
       params.camera_width_px = m.image_width_px;

@@ -3,7 +3,7 @@
 //   adaptseg_mission --field examples/data/weedmap-000 --strategy lawnmower --gsd 3.0
 //                    --segmenter oracle --out out/lawnmower-3.0
 //   adaptseg_mission --field examples/data/dubai-tile-6 --strategy lawnmower --gsd 15
-//                    --segmenter erfnet --network examples/models/ensemble-dubai --out out/ensemble-15
+//                    --segmenter network --network examples/models/ensemble-dubai --out out/ensemble-15
 //   adaptseg_mission --field DIR --strategy adaptive --decision-model model.yaml --out OUT [--budget-s 900]
 //
 // Writes OUT/result.json (scores, time, waypoints, decisions), OUT/path.png and OUT/map.png

@@ -220,7 +220,7 @@ decision)
   cmake --build build/release -j2 --target adaptseg_calibrate >/dev/null
   mkdir -p out/loto
   for cls in "${classes[@]}"; do
-    build/release/examples/adaptseg_calibrate "${trains[@]}" --interest "$cls" --segmenter erfnet --network "$deploy" \
+    build/release/examples/adaptseg_calibrate "${trains[@]}" --interest "$cls" --segmenter network --network "$deploy" \
       "${crossed[@]}" --threads "${LOTO_THREADS:-2}" --segmentation-cache out/results/segmentation-cache \
       --out "$deploy/decision-$cls.yaml" >"out/loto/decision-$cls.log" 2>&1 ||
       { echo "calibration for $cls failed: out/loto/decision-$cls.log" >&2; exit 1; }

@@ -235,8 +235,6 @@ struct CalibrationCli {
   std::string top_level = "undominated";
 
   void add_to(CLI::App& app) {
-    std::vector<std::string> coverages;
-    for (const DescentCoverageInfo& c : kDescentCoverages) coverages.emplace_back(c.name);
     options_ = {
         app.add_option("--rule", rule,
                        "decision rule: front-aware (descend while descents beat the lawnmower curve; no threshold) "
@@ -250,13 +248,14 @@ struct CalibrationCli {
                        "(only the cells where the top-level image shows a label of interest) or ranked (the cells "
                        "ranked by a decision input of the top-level image, e.g. the network's expected error about "
                        "L; the number of cells chosen in flight); saved in the model")
-            ->check(CLI::IsMember(coverages))
+            ->check(CLI::IsMember(detail::names_of(kDescentCoverages)))
             ->capture_default_str(),
         app.add_option("--cell-input", cell_inputs,
                        "coverage ranked: the decision inputs tried for ranking and forecasting cells, comma-separated "
                        "(default: sigma, boundary, ambiguity, expected_error, second_choice, those the backend gives; "
                        "the one that ranks the training fields' cells best is saved in the model)")
-            ->delimiter(','),
+            ->delimiter(',')
+            ->check(CLI::IsMember(detail::names_of(kDecisionInputs))),
         app.add_option("--slope-pooling", slope_poolings,
                        "coverage ranked, several training fields: how the cell gain model's slopes may pool the "
                        "fields, tried with every confidence level on the training fields, comma-separated: cells "
@@ -264,7 +263,7 @@ struct CalibrationCli {
                        "effects); cells is kept unless fields beats it on the folds beyond their noise (one standard "
                        "error), and the one kept is saved in the model")
             ->delimiter(',')
-            ->check(CLI::IsMember({"cells", "fields"}))
+            ->check(CLI::IsMember(detail::names_of(kSlopePoolings)))
             ->capture_default_str(),
         app.add_option("--curve", curve,
                        "front-aware rule with --coverage ranked: the lawnmower curve a descent is compared with, "
@@ -278,7 +277,7 @@ struct CalibrationCli {
                        "whose lawnmower falls least short of the faster ones on the training fields' curves, field by "
                        "field (undominated), or from there a finer one while the predicted curve rises faster per "
                        "second up to it than beyond it (hull); saved in the model")
-            ->check(CLI::IsMember({"undominated", "hull"}))
+            ->check(CLI::IsMember(detail::names_of(kTopLevelChoices)))
             ->capture_default_str(),
         app.add_option("--gain-inputs", gain_inputs,
                        "what the GP I predicts the accuracy gain from: delta-sigma (the paper's) or "

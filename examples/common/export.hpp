@@ -32,7 +32,7 @@ struct ExportCli {
                    "(wpl: QGC WPL 110), OUT/mission.geojson (geojson); repeat or comma-separate; needs a "
                    "geo-reference")
         ->delimiter(',')
-        ->check(CLI::IsMember({"plan", "wpl", "geojson"}));
+        ->check(CLI::IsMember(detail::names_of(kExportFormats)));
     app.add_option("--geo-origin", geo_origin,
                    "LAT,LON,ALT,HEADING: WGS84 position [deg] and ellipsoidal height [m] of the field "
                    "directory's frame origin, and the compass bearing [deg] of its +x axis; replaces "

@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <string>
+#include <vector>
 
 namespace adaptseg::examples {
 
@@ -29,6 +30,28 @@ CLI::Option* accept_old_spelling(CLI::App& app, CLI::Option* current, const std:
   return old;
 }
 
+/// The old values given on this command line (accept_old_value()), for tell_old_spellings().
+inline std::vector<std::string>& old_values_given() {
+  static std::vector<std::string> given;
+  return given;
+}
+
+/// Accepts `old_value` as another spelling of `new_value` for `option` (a choice renamed, as
+/// `--segmenter network` became `--segmenter network`): the option stores `new_value`, and once
+/// the command line has parsed, tell_old_spellings() names the new spelling on standard error.
+/// Call it before the option's choices are checked (before `->check(CLI::IsMember(...))`).
+inline CLI::Option* accept_old_value(CLI::Option* option, const std::string& old_value, const std::string& new_value) {
+  const std::string notice = option->get_name() + " " + old_value + " is deprecated and goes in adaptseg 0.4: use " +
+                             option->get_name() + " " + new_value;
+  return option->transform(
+      [=](std::string value) {
+        if (value != old_value) return value;
+        old_values_given().push_back(notice);
+        return new_value;
+      },
+      "", "old value " + old_value);
+}
+
 /// Before parsing: each old spelling of `app` excludes every option its current spelling
 /// excludes (or is excluded by) and needs what it needs, so that a program states its rules
 /// once, for the current names.
@@ -47,12 +70,15 @@ inline void inherit_old_spellings(CLI::App& app) {
   }
 }
 
-/// After a successful parse: one line on stderr per old spelling given (accept_old_spelling()).
+/// After a successful parse: one line on stderr per old spelling given (accept_old_spelling(),
+/// accept_old_value()).
 inline void tell_old_spellings(const CLI::App& app) {
   for (const CLI::Option* o : app.get_options())
     if (o->get_group() == kOldSpellings && o->count() > 0)
       std::fprintf(stderr, "%s is deprecated and goes in adaptseg 0.4: %s\n", o->get_name().c_str(),
                    o->get_description().c_str());
+  for (const std::string& notice : old_values_given()) std::fprintf(stderr, "%s\n", notice.c_str());
+  old_values_given().clear();
 }
 
 }  // namespace adaptseg::examples

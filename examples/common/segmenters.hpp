@@ -306,30 +306,32 @@ inline std::vector<std::string> network_training_fields(const std::filesystem::p
 /// The backend options shared by adaptseg_mission, adaptseg_calibrate and adaptseg_evaluate.
 struct SegmenterOptions {
   std::string name = "oracle";
-  std::filesystem::path network;     ///< ERFNet: model directory, or the .onnx (metadata: same stem .yaml)
-  int threads = 0;                   ///< ERFNet: OpenCV threads (0: OpenCV's default)
-  std::filesystem::path cache_root;  ///< ERFNet: where calibration keeps segmentations on disk (empty: nowhere)
-  /// ERFNet, calibration: networks for the training fields --network was trained on, each such
+  std::filesystem::path network;     ///< network: model directory, or the .onnx (metadata: same stem .yaml)
+  int threads = 0;                   ///< network: OpenCV threads (0: OpenCV's default)
+  std::filesystem::path cache_root;  ///< network: where calibration keeps segmentations on disk (empty: nowhere)
+  /// network, calibration: networks for the training fields --network was trained on, each such
   /// field segmented by the first of them that never saw it (cross-fitting, calibrate()).
   std::vector<std::filesystem::path> calibration_networks;
 
   void add_to(CLI::App& app) {
-    app.add_option("--segmenter", name,
-                   "segmentation backend: oracle (ground truth, simulation only) or erfnet (needs --network)")
-        ->check(CLI::IsMember({"oracle", "erfnet"}))
+    accept_old_value(app.add_option("--segmenter", name,
+                                    "segmentation backend: oracle (ground truth, simulation only) or network (an ONNX "
+                                    "network or an ensemble of them, --network)"),
+                     "erfnet", "network")
+        ->check(CLI::IsMember({"oracle", "network"}))
         ->capture_default_str();
     CLI::Option* net =
         app.add_option("--network", network,
-                       "network of --segmenter erfnet (the ONNX backend): a directory with model.onnx + model.yaml, "
+                       "network of --segmenter network (the ONNX backend): a directory with model.onnx + model.yaml, "
                        "an .onnx file with its .yaml next to it (examples/models/erfnet-dubai, "
                        "examples/models/mobilenetv2-dubai), or an ensemble directory with ensemble.yaml "
                        "(examples/models/ensemble-dubai: the mean of its members' probabilities)");
     accept_old_spelling(app, net, "--model-file", network);
-    app.add_option("--threads", threads, "ERFNet: OpenCV threads (0: OpenCV's default; at most 256)")
+    app.add_option("--threads", threads, "network: OpenCV threads (0: OpenCV's default; at most 256)")
         ->check(CLI::Range(0, 256))
         ->capture_default_str();
     app.add_option("--segmentation-cache", cache_root,
-                   "ERFNet: keep calibration's segmentations on disk below this directory (one folder per network "
+                   "network: keep calibration's segmentations on disk below this directory (one folder per network "
                    "and weights), so that calibrations over the same fields segment each image once; missions "
                    "always segment (their time is measured)");
   }
@@ -351,18 +353,18 @@ struct SegmenterOptions {
   /// Where calibration keeps the network's segmentations (--segmentation-cache), if anywhere:
   /// a folder named by the network and the hash of its files (model_file_digest()).
   [[nodiscard]] std::optional<std::filesystem::path> calibration_cache() const {
-    if (name != "erfnet" || cache_root.empty()) return std::nullopt;
+    if (name != "network" || cache_root.empty()) return std::nullopt;
     return cache_root / model_file_digest(network);
   }
 
   /// @throws std::invalid_argument for a model file given to the oracle or missing for ERFNet.
   void validate() const {
-    if (name == "erfnet" && network.empty())
-      throw std::invalid_argument("--segmenter erfnet needs --network (e.g. examples/models/erfnet-dubai)");
+    if (name == "network" && network.empty())
+      throw std::invalid_argument("--segmenter network needs --network (e.g. examples/models/mobilenetv2-dubai)");
     if (name == "oracle" && !network.empty())
-      throw std::invalid_argument("--network applies to --segmenter erfnet only");
+      throw std::invalid_argument("--network applies to --segmenter network only");
     if (name == "oracle" && !calibration_networks.empty())
-      throw std::invalid_argument("--calibration-network applies to --segmenter erfnet only");
+      throw std::invalid_argument("--calibration-network applies to --segmenter network only");
   }
 
   /// Per training field, the network that segments it in calibration: --network where it was

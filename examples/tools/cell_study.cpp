@@ -12,7 +12,7 @@
 // the mean capture of the input that model's planner ranks cells by. --csv writes every cell.
 //
 //   adaptseg_cell_study --field examples/data/dubai-tile-4 --field examples/data/dubai-tile-6
-//       --classes building,road,vegetation,water --segmenter erfnet
+//       --classes building,road,vegetation,water --segmenter network
 //       --network examples/models/mobilenetv2-dubai --csv out/cells.csv
 
 #include "common/cell_csv.hpp"

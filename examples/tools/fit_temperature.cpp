@@ -139,7 +139,7 @@ int main(int argc, char** argv) {
   bool write = false;
   adaptseg::examples::CommonOptions common;
   adaptseg::examples::SegmenterOptions segmenter;
-  segmenter.name = "erfnet";
+  segmenter.name = "network";
   std::optional<double> set;
   app.add_option("--field", field_spec, "validation field DIR[:x0,y0,x1,y1] (not with --set)");
   app.add_option("--set", set, "no fit: write this temperature into the model's model.yaml")
@@ -158,8 +158,8 @@ int main(int argc, char** argv) {
   segmenter.add_to(app);
   if (const auto code = adaptseg::examples::parse_command_line(app, argc, argv)) return *code;
   try {
-    if (segmenter.name != "erfnet")
-      throw std::invalid_argument("--segmenter must be erfnet: the oracle needs no temperature");
+    if (segmenter.name != "network")
+      throw std::invalid_argument("--segmenter must be network: the oracle needs no temperature");
     if (set) {
       if (!field_spec.empty() || write || at)
         throw std::invalid_argument("--set writes a given temperature: no --field, --write or --at with it");

@@ -35,13 +35,20 @@ adaptseg_calibrate)
   expect_error "is not a region x0,y0,x1,y1 (fractions 0..1); write DIR:x0,y0,x1,y1" --train "$weedmap:0.5,0,1" \
     --out "$work/m.yaml"
   expect_error "field directory not found" --train "$work/none" --out "$work/m.yaml"
+  # A setting's choices are its table's names (decision inputs, slope poolings, top-level choices).
+  expect_error "--cell-input: confusion not in {sigma,boundary,ambiguity,expected_error,second_choice," \
+    --field "$weedmap" --out "$work/m.yaml" --cell-input sigma,confusion
+  expect_error "--slope-pooling: field not in {cells,fields}" --field "$weedmap" \
+    --out "$work/m.yaml" --slope-pooling field
+  expect_error "--top-level: convex not in {undominated,hull}" --field "$weedmap" \
+    --out "$work/m.yaml" --top-level convex
   expect_error "max_vertical_speed_mps must be finite and >= 0" --field "$weedmap" --out "$work/m.yaml" \
     --vertical-speed -1
   # Cross-fitting: a field every network given was trained on, a flag the oracle has no use for.
   expect_error "every network given was trained on calibration field 'dubai-tile-1' (as --network" \
-    --train "$dubai" --out "$work/m.yaml" --segmenter erfnet --network "$examples/models/mobilenetv2-dubai" \
+    --train "$dubai" --out "$work/m.yaml" --segmenter network --network "$examples/models/mobilenetv2-dubai" \
     --calibration-network "$examples/models/erfnet-dubai"
-  expect_error "--calibration-network applies to --segmenter erfnet only" --field "$weedmap" --out "$work/m.yaml" \
+  expect_error "--calibration-network applies to --segmenter network only" --field "$weedmap" --out "$work/m.yaml" \
     --calibration-network "$examples/models/erfnet-dubai"
   # A network whose model.yaml names no training fields: whether it saw a field cannot be told.
   mkdir -p "$work/unnamed"
@@ -49,7 +56,7 @@ adaptseg_calibrate)
   awk '/^training:/ { skip = 1; next } skip && /^[^ ]/ { skip = 0 } !skip' \
     "$examples/models/mobilenetv2-dubai/model.yaml" >"$work/unnamed/model.yaml"
   expect_error "--calibration-network: --network $work/unnamed names no training fields" --train "$dubai" \
-    --out "$work/m.yaml" --segmenter erfnet --network "$work/unnamed" \
+    --out "$work/m.yaml" --segmenter network --network "$work/unnamed" \
     --calibration-network "$examples/models/erfnet-dubai"
   # None of them wrote a model.
   [ ! -e "$work/m.yaml" ] || fail "a refused calibration wrote $work/m.yaml"
@@ -68,7 +75,7 @@ adaptseg_evaluate)
   expect_error "--decision-model excludes --calibration-network" --test "$dubai" --decision-model "$weedmap_model" --out "$work/o" \
     --calibration-network "$examples/models/erfnet-dubai"
   expect_error "every network given was trained on calibration field 'dubai-tile-1[0,0,0.5,1]'" \
-    --train "$dubai:0,0,0.5,1" --test "$dubai" --out "$work/o" --no-plots --segmenter erfnet \
+    --train "$dubai:0,0,0.5,1" --test "$dubai" --out "$work/o" --no-plots --segmenter network \
     --network "$examples/models/mobilenetv2-dubai" --calibration-network "$examples/models/erfnet-dubai"
   # The lawnmowers fly the model's camera and speed limits too: explicit ones must agree.
   expect_error "--vertical-speed 1.0000 differs from the decision model's 0.0000" --test "$weedmap" \

@@ -90,8 +90,8 @@ fi
 grep -q "excludes" "$work/log" || fail "no clear error for --coverage with --model: $(tail -3 "$work/log")"
 # The old spellings (--model, --calibration-model-file) inherit the exclusions stated for the new.
 for flags in "--model $work/e/model.yaml --coverage region" \
-  "--model $work/e/model.yaml --segmenter erfnet --network $examples/models/mobilenetv2-dubai --calibration-network $examples/models/mobilenetv2-dubai-loto/tile-1" \
-  "--decision-model $work/e/model.yaml --segmenter erfnet --network $examples/models/mobilenetv2-dubai --calibration-model-file $examples/models/mobilenetv2-dubai-loto/tile-1"; do
+  "--model $work/e/model.yaml --segmenter network --network $examples/models/mobilenetv2-dubai --calibration-network $examples/models/mobilenetv2-dubai-loto/tile-1" \
+  "--decision-model $work/e/model.yaml --segmenter network --network $examples/models/mobilenetv2-dubai --calibration-model-file $examples/models/mobilenetv2-dubai-loto/tile-1"; do
   # shellcheck disable=SC2086  # the flags split at spaces
   if "$evaluate" $flags --test "$examples/data/dubai-tile-6" --out "$work/x" >"$work/log" 2>&1; then
     fail "accepted: $flags"

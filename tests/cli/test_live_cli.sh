@@ -272,10 +272,10 @@ PY
 # and cropped to 16:9, which is refused saying what to do.
 dubai="$examples/data/dubai-tile-4:0,0,0.5,0.5"
 net="$examples/models/mobilenetv2-dubai"
-"$calibrate" --field "$dubai" --segmenter erfnet --network "$net" "${times[@]}" --out "$work/dubai.yaml" \
+"$calibrate" --field "$dubai" --segmenter network --network "$net" "${times[@]}" --out "$work/dubai.yaml" \
   >/dev/null 2>"$work/err" || fail "calibrating with the network: $(cat "$work/err")"
 "$live" --record-from "$dubai" --decision-model "$work/dubai.yaml" --images "$work/dubai" >/dev/null || fail "recording Dubai"
-network=(--segmenter erfnet --network "$net" "${times[@]}")
+network=(--segmenter network --network "$net" "${times[@]}")
 "$live" --images "$work/dubai" --decision-model "$work/dubai.yaml" "${network[@]}" --out "$work/live-dubai" \
   >"$work/dubai.out" 2>"$work/err" || fail "live, network: $(cat "$work/err")"
 cp -r "$work/dubai" "$work/dubai-large"

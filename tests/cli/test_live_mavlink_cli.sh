@@ -97,7 +97,7 @@ fly() {
 # refused at the first picture (exit 2, one line, nothing lost).
 dubai="$examples/data/dubai-tile-4:0,0,0.5,0.5"
 net="$examples/models/mobilenetv2-dubai"
-"$calibrate" --field "$dubai" --segmenter erfnet --network "$net" "${times[@]}" --out "$work/dubai.yaml" \
+"$calibrate" --field "$dubai" --segmenter network --network "$net" "${times[@]}" --out "$work/dubai.yaml" \
   >/dev/null 2>"$work/err" || fail "calibrating with the network: $(cat "$work/err")"
 "$live" --record-from "$dubai" --decision-model "$work/dubai.yaml" --images "$work/dubai" --record-gnss --geo-origin 25.2,55.3,10,30 --grid centred \
   >/dev/null || fail "recording Dubai"
@@ -127,7 +127,7 @@ PY
 # The WeedMap flights (home at the field's frame origin) and the camera folder's (home at the
 # Dubai quarter's), side by side.
 weedmap=("${flight[@]}" --fence-margin-m "$margin")
-camera=(--mavlink udpin:127.0.0.1:0 --images "$work/dubai" --image-pose exif --segmenter erfnet --network "$net"
+camera=(--mavlink udpin:127.0.0.1:0 --images "$work/dubai" --image-pose exif --segmenter network --network "$net"
         --decision-model "$work/dubai.yaml" "${times[@]}" --arrival-max-speed-mps 0.1 --link-timeout-s 2 --camera-timeout-s 5
         --grid centred)
 fly complete "--home 47.4,8.5" "${weedmap[@]}" --trigger autopilot

@@ -28,11 +28,11 @@ bad_inputs)
   expect_error "max_vertical_speed_mps must be finite and >= 0" --field "$field" --gsd 3 --vertical-speed -0.5 \
     --out "$work/o"
   expect_error "fixed_segmentation_time_s" --field "$field" --gsd 3 --seg-time-s -1 --out "$work/o"
-  expect_error "needs --network" --field "$field" --gsd 3 --segmenter erfnet --out "$work/o"
-  expect_error "applies to --segmenter erfnet only" --field "$field" --gsd 3 --network "$work" --out "$work/o"
-  expect_error "not found" --field "$field" --gsd 3 --segmenter erfnet --network "$work/none" --out "$work/o"
+  expect_error "needs --network" --field "$field" --gsd 3 --segmenter network --out "$work/o"
+  expect_error "applies to --segmenter network only" --field "$field" --gsd 3 --network "$work" --out "$work/o"
+  expect_error "not found" --field "$field" --gsd 3 --segmenter network --network "$work/none" --out "$work/o"
   # The bundled ERFNet knows the Dubai classes, not WeedMap's.
-  expect_error "classes" --field "$field" --gsd 3 --segmenter erfnet --network "$examples/models/erfnet-dubai" \
+  expect_error "classes" --field "$field" --gsd 3 --segmenter network --network "$examples/models/erfnet-dubai" \
     --out "$work/o"
   # A decision model of another class set (WeedMap's, flown on Dubai).
   expect_error "decision model was calibrated for classes [soil, crop, weed] but field 'dubai-tile-1' has" \
@@ -41,13 +41,13 @@ bad_inputs)
   # A model calibrated with one backend flown with another: refused, naming both (a network by its
   # folder and the hash of its weights and metadata).
   expect_error "decision model was calibrated with segmenter 'oracle' but the mission uses 'erfnet:erfnet-dubai-" \
-    --field "$examples/data/dubai-tile-1" --strategy adaptive --segmenter erfnet \
+    --field "$examples/data/dubai-tile-1" --strategy adaptive --segmenter network \
     --network "$examples/models/erfnet-dubai" \
     --decision-model "$examples/../tests/data/decision_model/dubai_road_front_aware.yaml" --out "$work/o"
   sed 's/^  segmenter: oracle/  segmenter: "erfnet:mobilenetv2-dubai-0123456789abcdef"/' \
     "$examples/../tests/data/decision_model/dubai_road_front_aware.yaml" >"$work/mobilenet-model.yaml"
   expect_error "calibrated with segmenter 'erfnet:mobilenetv2-dubai-0123456789abcdef' but the mission uses 'erfnet:erfnet-dubai-" \
-    --field "$examples/data/dubai-tile-1" --strategy adaptive --segmenter erfnet \
+    --field "$examples/data/dubai-tile-1" --strategy adaptive --segmenter network \
     --network "$examples/models/erfnet-dubai" --decision-model "$work/mobilenet-model.yaml" --out "$work/o"
   expect_error "'0.5,0,1' is not a region x0,y0,x1,y1 (fractions 0..1); write DIR:x0,y0,x1,y1" \
     --field "$field:0.5,0,1" --gsd 3 --out "$work/o"
@@ -69,7 +69,7 @@ bad_inputs)
   # The old spellings (--model, --model-file) and the new given together: refused.
   expect_error "excludes" --field "$examples/data/dubai-tile-1" --strategy adaptive \
     --model "$work/mobilenet-model.yaml" --decision-model "$work/mobilenet-model.yaml" --out "$work/o"
-  expect_error "excludes" --field "$field" --gsd 3 --segmenter erfnet --network "$work" --model-file "$work" \
+  expect_error "excludes" --field "$field" --gsd 3 --segmenter network --network "$work" --model-file "$work" \
     --out "$work/o"
   [ ! -e "$work/o" ] || fail "an error must be reported before the mission writes anything"
   # The old spellings still fly, until adaptseg 0.4, with one line each on stderr naming the new.
@@ -82,7 +82,9 @@ bad_inputs)
     fail "want one notice for --model: $(cat "$work/old.err")"
   [ "$(grep -c -- "--model-file is deprecated and goes in adaptseg 0.4: use --network" "$work/old.err")" = 1 ] ||
     fail "want one notice for --model-file: $(cat "$work/old.err")"
-  echo "ok: the old spellings --model and --model-file, each with one notice"
+  [ "$(grep -c -- "--segmenter erfnet is deprecated and goes in adaptseg 0.4: use --segmenter network" \
+    "$work/old.err")" = 1 ] || fail "want one notice for --segmenter erfnet: $(cat "$work/old.err")"
+  echo "ok: the old spellings --model, --model-file and --segmenter erfnet, each with one notice"
   rm -rf "$work/old"
   # With overlap the lawnmower takes more images over the same field and says so in result.json.
   for o in 0 0.5,0.25; do
@@ -143,7 +145,7 @@ erfnet_sweep)
   tile="$examples/data/dubai-tile-6"
   for net in erfnet-dubai mobilenetv2-dubai ensemble-dubai; do
     for gsd in 5 15; do
-      "$mission" --field "$tile" --strategy lawnmower --gsd "$gsd" --segmenter erfnet \
+      "$mission" --field "$tile" --strategy lawnmower --gsd "$gsd" --segmenter network \
         --network "$examples/models/$net" --seg-time-s 0.1 --plan-time-s 0 \
         --out "$work/$net-$gsd" >/dev/null || fail "$net mission at $gsd failed"
     done
@@ -184,7 +186,7 @@ cross_fit)
   # network given again, the evaluation MobileNetV2 (tiles 1, 2, 3, 5). The model names the
   # missions' network and, per field, the one that segmented it; without the flag no field_segmenters.
   [ -x "$calibrate" ] || fail "cross_fit needs the adaptseg_calibrate binary as 5th argument"
-  common=(--field "$examples/data/dubai-tile-4" --region 0,0,0.5,0.5 --segmenter erfnet --threads 1
+  common=(--field "$examples/data/dubai-tile-4" --region 0,0,0.5,0.5 --segmenter network --threads 1
           --network "$examples/models/mobilenetv2-dubai-all" --seg-time-s 0.1 --plan-time-s 0 --confidence 1
           --interest water --top-factor 3 --candidate-factors 1 --lawnmower-factors 1,3)
   "$calibrate" "${common[@]}" --calibration-network "$examples/models/mobilenetv2-dubai-all" \
@@ -212,7 +214,7 @@ cross_fit)
   "$calibrate" "${net_common[@]}" --out "$work/net.yaml" 2>"$work/net.log" || fail "calibration with the copy failed"
   fly() {
     "$mission" --field "$examples/data/dubai-tile-4:0,0,0.5,0.5" --strategy adaptive --decision-model "$work/net.yaml" \
-      --segmenter erfnet --network "$work/net" --threads 1 --seg-time-s 0.1 --plan-time-s 0 --out "$work/fly" \
+      --segmenter network --network "$work/net" --threads 1 --seg-time-s 0.1 --plan-time-s 0 --out "$work/fly" \
       >"$work/fly.log" 2>&1
   }
   fly || fail "the model refused its own network: $(tail -2 "$work/fly.log")"

@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace adaptseg::detail {
 
@@ -40,6 +41,15 @@ template <typename Row, std::size_t N>
     names += std::string(k == 0 ? "'" : k + 1 == N ? " or '" : ", '") + std::string(table[k].name) + "'";
   }
   throw std::invalid_argument(std::string(what) + " must be " + names + ", not '" + std::string(name) + "'");
+}
+
+/// Every row's name, in the table's order (a program's choices for a setting).
+template <typename Row, std::size_t N>
+[[nodiscard]] std::vector<std::string> names_of(const std::array<Row, N>& table) {
+  std::vector<std::string> names;
+  names.reserve(N);
+  for (const Row& r : table) names.emplace_back(r.name);
+  return names;
 }
 
 /// The name of `value` in a table of NamedValue rows.
