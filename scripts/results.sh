@@ -34,17 +34,19 @@
 #   beside the oracle's runs of the same folds (part oracle-default's Dubai runs, when there).
 #   Every network segments its own tile once into the segmentation cache.
 # loto-proxy: until the six leave-one-tile-out networks are trained, a stand-in for loto on the
-#   tiles that have a network of MobileNetV2 that never saw them: tiles 1 and 2 flown by
-#   mobilenetv2-dubai-loto/tile-1 and tile-2, tiles 4 and 6 by mobilenetv2-dubai (trained on 1, 2,
-#   3, 5); each calibrated on the other three of the four, each calibration field segmented by a
-#   network of these three that never saw it (--calibration-network, the first that fits). 16
-#   runs, every field of each run, calibration and mission, new ground to the network that
-#   segments it; but three calibration fields only, two recipes, the leave-one-tile-out networks
-#   untempered, and mobilenetv2-dubai's temperature fitted on tile 4. (Before 2026-11-29's
-#   second session: tiles 1, 4 and 6 only, two calibration fields each, 12 runs.)
+#   tiles that have a network of MobileNetV2 that never saw them: each tile with a bundled
+#   mobilenetv2-dubai-loto/tile-k flown by it, tiles 4 and 6 otherwise by mobilenetv2-dubai
+#   (trained on 1, 2, 3, 5); each calibrated on the other tiles of the set, each calibration
+#   field segmented by a network of these that never saw it (--calibration-network, the first
+#   that fits: the leave-one-tile-out networks before mobilenetv2-dubai). With tiles 1, 2 and 3
+#   bundled: tiles 1, 2, 3, 4, 6, 20 runs. Every field of each run, calibration and mission, new
+#   ground to the network that segments it; but fewer calibration fields than loto, two recipes,
+#   the leave-one-tile-out networks untempered, and mobilenetv2-dubai's temperature fitted on
+#   tile 4. TILES="1 2 4 6" (environment) flies the four-tile stand-in of 2026-11-29's second
+#   and third sessions (16 runs; before them tiles 1, 4 and 6, 12 runs).
 #   CONFIG (environment; default loto-proxy) names the configuration and EXTRA adds flags, e.g.
-#   CONFIG=loto-proxy-hull EXTRA="--top-level hull". About 10 minutes on 2 cores with 2 jobs
-#   (segmentations cached in out/results/segmentation-cache).
+#   CONFIG=loto-proxy-hull EXTRA="--top-level hull". About 10 minutes for four tiles on 2 cores
+#   with 2 jobs (segmentations cached in out/results/segmentation-cache).
 # ensemble: field mIoU of the bundled networks and of their ensemble (examples/models/ensemble-dubai)
 #   on the same whole-field lawnmowers of tiles 4 and 6 at 5, 10 and 15 cm/px
 #   (examples/tools/eval_ensemble.py, PyTorch on the exported weights), each network also with
@@ -146,7 +148,7 @@ fixed=(--seg-time-s 0.1 --plan-time-s 0)
 paper=(--rule utility --gain-inputs delta-sigma --coverage region --no-plots)
 # A bundled network (--network examples/models/NET), one thread per run; calibration keeps the
 # network's segmentations on disk, so that the runs over the same tiles segment each image once.
-network=(--segmenter erfnet --threads 1 --segmentation-cache "out/results/segmentation-cache")
+network=(--segmenter network --threads 1 --segmentation-cache "out/results/segmentation-cache")
 # The networks of part network (environment NETS: a subset, e.g. NETS=ensemble-dubai reruns
 # only the ensemble's runs and keeps the others').
 nets=${NETS:-erfnet-dubai mobilenetv2-dubai ensemble-dubai}
@@ -373,7 +375,7 @@ if [ "$part" = cells ]; then
     for t in 4 6; do
       for cls in $classes; do
         build/release/examples/adaptseg_cell_study --field "$(dubai "$t")" --classes "$cls" --gsd 5 \
-          --segmenter erfnet --network "examples/models/$net" --threads "$jobs" \
+          --segmenter network --network "examples/models/$net" --threads "$jobs" \
           --decision-model "$root/network/$net-$cls-fly$t/model.yaml" --csv "$out/$net-$cls-$t.csv" >"$out/$net-$cls-$t.md" 2>/dev/null
       done
     done
@@ -439,13 +441,27 @@ if [ "$part" = loto-proxy ]; then
   loto=examples/models/mobilenetv2-dubai-loto evaluation=examples/models/mobilenetv2-dubai
   config=${CONFIG:-loto-proxy}
   read -r -a extra <<<"${EXTRA:-}"
-  tiles=(1 2 4 6)
-  crossed=(--calibration-network "$loto/tile-1" --calibration-network "$loto/tile-2" --calibration-network "$evaluation")
+  # Every tile with a network of the recipe that never saw it: its leave-one-tile-out network
+  # where one is bundled, else (tiles 4 and 6) the evaluation network. TILES (environment)
+  # restricts the set, e.g. TILES="1 2 4 6" for the four-tile stand-in of before.
+  tiles=() crossed=()
+  declare -A flier=()
+  for k in 1 2 3 4 5 6; do
+    if [ -s "$loto/tile-$k/model.onnx" ]; then
+      flier[$k]=$loto/tile-$k
+      crossed+=(--calibration-network "$loto/tile-$k")
+    elif [ "$k" = 4 ] || [ "$k" = 6 ]; then
+      flier[$k]=$evaluation
+    else
+      continue
+    fi
+    case " ${TILES:-$k} " in *" $k "*) tiles+=("$k") ;; esac
+  done
+  crossed+=(--calibration-network "$evaluation")
   rm -rf "${root:?}/$config"
   for cls in $classes; do
     for t in "${tiles[@]}"; do
-      net=$evaluation
-      [ "$t" -le 2 ] && net=$loto/tile-$t
+      net=${flier[$t]}
       train=()
       for k in "${tiles[@]}"; do [ "$k" != "$t" ] && train+=(--train "$(dubai "$k")"); done
       run "$config" "$cls-tile-$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
@@ -550,7 +566,7 @@ if [ "$part" = proxy-check ]; then
       [ "$set" = never-seen ] && tiles="4 6"
       fields=()
       for t in $tiles; do fields+=(--field "$(dubai "$t")"); done
-      build/release/examples/adaptseg_cell_study "${fields[@]}" --classes "${classes// /,}" --gsd 12.5,10,5 --segmenter erfnet \
+      build/release/examples/adaptseg_cell_study "${fields[@]}" --classes "${classes// /,}" --gsd 12.5,10,5 --segmenter network \
         --network "examples/models/$net" --threads 1 --seg-time-s 0.1 --plan-time-s 0 \
         --csv "$out/$net-$set.csv" >"$out/$net-$set.md" 2>"$out/$net-$set.log" &
       throttle
