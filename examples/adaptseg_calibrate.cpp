@@ -115,13 +115,15 @@ int main(int argc, char** argv) {
     }
     if (!cell_samples_csv.empty()) {
       std::ostringstream os;
-      os << "field,region,top_gsd_cm,sub_gsd_cm,field_px,field_share,field_sigma,relabelled,field_gain";
+      os << "field,region,top_gsd_cm,sub_gsd_cm,field_px,field_share,field_sigma,relabelled,field_gain,delta_tp,"
+            "delta_fp,field_tp,field_fp,field_fn";
       adaptseg::examples::write_input_columns_header(os);
       os << '\n';
       for (const auto& c : cal.cell_samples) {
         os << adaptseg::examples::csv_field(fields[c.field].name()) << ',' << c.region << ',' << c.top_gsd_cm << ','
            << c.sub_gsd_cm << ',' << c.top.field_px << ',' << c.field_share << ',' << c.field_sigma << ','
-           << c.relabelled << ',' << c.field_gain;
+           << c.relabelled << ',' << c.field_gain << ',' << c.delta_tp << ',' << c.delta_fp << ',' << c.field_tp << ','
+           << c.field_fp << ',' << c.field_fn;
         adaptseg::examples::write_input_columns(os, c.top, c.fine);
         os << '\n';
       }

@@ -8,14 +8,18 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <span>
 #include <sstream>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -252,6 +256,28 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
   CHECK(by_error.at(3.0, 1.0).proxy_slope == doctest::Approx(by_error.at(3.0, 1.0).gain_slope).epsilon(1e-9));
   for (const CellSample& c : cal.cell_samples)
     if (c.sub_gsd_cm == 1.0) CHECK(c.fine.value(DecisionInput::expected_error) == 0.0);
+  // In pixels: an exact re-mapping only corrects (misses found, false positives removed), and
+  // a cell's field gain has the sign of what it corrected; the field's own counts are one per
+  // field and top-level GSD.
+  std::size_t corrected = 0;
+  for (const CellSample& c : cal.cell_samples) {
+    CHECK(c.field_tp + c.field_fp + c.field_fn > 0);
+    CHECK(c.field_tp > 0);
+    if (c.sub_gsd_cm != 1.0) continue;
+    CHECK(c.delta_tp >= 0);
+    CHECK(c.delta_fp <= 0);
+    if (c.field_gain > 1e-12) CHECK((c.delta_tp > 0 || c.delta_fp < 0));
+    if (c.delta_tp == 0 && c.delta_fp == 0) CHECK(c.field_gain == doctest::Approx(0.0).epsilon(1e-12));
+    corrected += c.delta_tp > 0 || c.delta_fp < 0;
+  }
+  CHECK(corrected > 0);
+  std::map<std::pair<std::size_t, double>, std::array<std::int64_t, 3>> field_counts;
+  std::size_t same = 0;
+  for (const CellSample& c : cal.cell_samples) {
+    const std::array<std::int64_t, 3> k{c.field_tp, c.field_fp, c.field_fn};
+    same += field_counts.emplace(std::pair{c.field, c.top_gsd_cm}, k).first->second == k;
+  }
+  CHECK(same == cal.cell_samples.size());
   // Cells seen from the coarsest candidate GSD too (the alternative top level), re-mapped below it.
   CHECK(cells->top_gsds() == std::vector<double>{2.0, 3.0});
   CHECK(std::any_of(cal.cell_samples.begin(), cal.cell_samples.end(),

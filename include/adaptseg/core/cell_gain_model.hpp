@@ -15,6 +15,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <numeric>
 #include <span>
@@ -73,6 +74,18 @@ struct CellSample {
   double relabelled = 0.0;
   /// Field mIoU over L of the top-level map with only this cell re-mapped, minus without.
   double field_gain = 0.0;
+  /// The same comparison in pixels, summed over the classes of L (as RealisedDescent's): how
+  /// many more true positives and false positives the field's map holds with the cell re-mapped
+  /// (false negatives change by −delta_tp). A field's IoU of a class moves by about
+  /// (ΔTP − IoU·ΔFP) / (TP + FP + FN): what a false positive costs depends on the field's own
+  /// IoU, which a gain measured on a training field carries with it.
+  std::int64_t delta_tp = 0;
+  std::int64_t delta_fp = 0;
+  /// The field's top-level map over L, in pixels summed over its classes: true positives, false
+  /// positives, false negatives (its IoU and union, the exchange rate above).
+  std::int64_t field_tp = 0;
+  std::int64_t field_fp = 0;
+  std::int64_t field_fn = 0;
 
   /// The field gain per unit of the cell's field share and of the field's σ (≈ the share of
   /// the cell's pixels corrected; RegionSample::normalized_field_gain for a region).

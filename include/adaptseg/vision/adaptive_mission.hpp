@@ -15,7 +15,6 @@
 #include <opencv2/core.hpp>
 
 #include <algorithm>
-#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -133,20 +132,10 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
     without -= with_it;
     without += without_it;
     r.field_gain = final_miou - without.miou(interest).value_or(0.0);
-    for (int c : interest) {
-      const auto counts = [&](const ConfusionMatrix& m) {
-        std::int64_t fp = 0, fn = 0;
-        for (int k = 0; k <= n; ++k)
-          if (k != c) fn += m.count(c, k);
-        for (int k = 0; k < n; ++k)
-          if (k != c) fp += m.count(k, c);
-        return std::array<std::int64_t, 3>{m.count(c, c), fp, fn};
-      };
-      const auto a = counts(with_it), b = counts(without_it);
-      r.delta_tp += a[0] - b[0];
-      r.delta_fp += a[1] - b[1];
-      r.delta_fn += a[2] - b[2];
-    }
+    const PixelCounts a = with_it.counts(interest), b = without_it.counts(interest);
+    r.delta_tp = a.tp - b.tp;
+    r.delta_fp = a.fp - b.fp;
+    r.delta_fn = a.fn - b.fn;
     result.realised.push_back(r);
   }
   return result;

@@ -44,6 +44,13 @@ namespace adaptseg {
   return valid == 0 ? 0.0 : static_cast<double>(hits) / static_cast<double>(valid);
 }
 
+/// A class's true positives, false positives and false negatives [px] (ConfusionMatrix::counts).
+struct PixelCounts {
+  std::int64_t tp = 0;
+  std::int64_t fp = 0;
+  std::int64_t fn = 0;
+};
+
 /// Pixel counts of (true class, predicted class) over valid pixels. A prediction that is
 /// no class (the ignore label, or never observed) counts in an extra "none" column, so it
 /// is a false negative for the true class and a false positive for none.
@@ -101,20 +108,41 @@ class ConfusionMatrix {
     return all == 0 ? 0.0 : static_cast<double>(in) / static_cast<double>(all);
   }
 
+  /// True positives, false positives and false negatives of class `c` [px] (a pixel of class
+  /// `c` left without a label is a false negative).
+  /// @throws std::invalid_argument for a class out of range.
+  [[nodiscard]] PixelCounts counts(int c) const {
+    detail::require(c >= 0 && c < n_, "ConfusionMatrix::counts: class out of range", c);
+    PixelCounts out{count(c, c), 0, 0};
+    for (int k = 0; k <= n_; ++k)
+      if (k != c) out.fn += count(c, k);
+    for (int k = 0; k < n_; ++k)
+      if (k != c) out.fp += count(k, c);
+    return out;
+  }
+
+  /// The same summed over `classes`.
+  /// @throws std::invalid_argument for a class out of range.
+  [[nodiscard]] PixelCounts counts(std::span<const int> classes) const {
+    PixelCounts sum;
+    for (int c : classes) {
+      const PixelCounts one = counts(c);
+      sum.tp += one.tp;
+      sum.fp += one.fp;
+      sum.fn += one.fn;
+    }
+    return sum;
+  }
+
   /// IoU = TP / (TP + FP + FN) of class `c`; nullopt if `c` occurs in neither the truth nor
   /// the prediction.
   /// @throws std::invalid_argument for a class out of range.
   [[nodiscard]] std::optional<double> iou(int c) const {
     detail::require(c >= 0 && c < n_, "ConfusionMatrix::iou: class out of range", c);
-    const std::int64_t tp = count(c, c);
-    std::int64_t fn = 0, fp = 0;
-    for (int k = 0; k <= n_; ++k)
-      if (k != c) fn += count(c, k);
-    for (int k = 0; k < n_; ++k)
-      if (k != c) fp += count(k, c);
-    const std::int64_t uni = tp + fp + fn;
+    const PixelCounts k = counts(c);
+    const std::int64_t uni = k.tp + k.fp + k.fn;
     if (uni == 0) return std::nullopt;
-    return static_cast<double>(tp) / static_cast<double>(uni);
+    return static_cast<double>(k.tp) / static_cast<double>(uni);
   }
 
   /// Mean IoU over `classes`, averaging those that occur in the truth or the prediction

@@ -75,6 +75,7 @@ template <SegmentationBackend Backend>
   ConfusionMatrix field_cm(n);
   field_cm.add(field.labels(), field_map.labels(), field.ignore_label());
   const double field_miou = field_cm.miou(interest).value_or(0.0);
+  const PixelCounts field_counts = field_cm.counts(interest);
   const double field_sigma = semantic_ratio(field_map.labels(), interest, field.ignore_label());
   const double field_px_total = std::max(1, field.valid_pixels());
   const cv::Rect grid(0, 0, field.width_px(), field.height_px());
@@ -175,6 +176,12 @@ template <SegmentationBackend Backend>
         cell_cm -= before_cell;
         cell_cm += after_cell;
         c.field_gain = cell_cm.miou(interest).value_or(0.0) - field_miou;
+        const PixelCounts now = after_cell.counts(interest), was = before_cell.counts(interest);
+        c.delta_tp = now.tp - was.tp;
+        c.delta_fp = now.fp - was.fp;
+        c.field_tp = field_counts.tp;
+        c.field_fp = field_counts.fp;
+        c.field_fn = field_counts.fn;
         out.cells.push_back(c);
       }
       s.top_gsd_cm = top_gsd_cm;
