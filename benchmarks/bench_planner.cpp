@@ -45,7 +45,7 @@ struct Steps {
 
 template <class Backend>
 Steps fly(const adaptseg::Field& field, Backend& backend, const adaptseg::DecisionModel& model,
-          const adaptseg::examples::StrategyInfo& strategy) {
+          const adaptseg::StrategyInfo& strategy) {
   using namespace adaptseg;
   MissionOptions mo;
   mo.interest = field.class_indices(model.interest);
@@ -97,15 +97,15 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--repeat", repeat, "missions per field (the steps of all are pooled)")->capture_default_str();
   app.add_option("--strategy", strategy, "decision strategy")
-      ->check(CLI::IsMember(adaptseg::examples::strategy_names(true)))
+      ->check(CLI::IsMember(adaptseg::strategy_names(true)))
       ->capture_default_str();
   app.add_option("--label", label, "first column of the rows (default: the segmenter)");
   segmenter.add_to(app);
   if (const auto code = adaptseg::examples::parse_command_line(app, argc, argv)) return *code;
   try {
     const adaptseg::DecisionModel model = adaptseg::DecisionModel::load(model_path);
-    const auto& info = adaptseg::examples::strategy_info(strategy);
-    if (info.policy != adaptseg::examples::StrategyPolicy::decision_function)
+    const auto& info = adaptseg::strategy_info(strategy);
+    if (info.policy != adaptseg::StrategyPolicy::decision_function)
       throw std::invalid_argument("--strategy must fly the decision function");
     if (label.empty()) label = segmenter.name;
     Steps everything;  // every field's steps pooled: the row "all" when there are several

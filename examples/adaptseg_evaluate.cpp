@@ -227,8 +227,8 @@ int main(int argc, char** argv) {
                      "realised_delta_fp,realised_delta_fn\n";
     // The strategies that fly the model, after the lawnmowers, in the table's order on every
     // test field; the table beside the results for the figures.
-    const std::vector<std::string> model_strategies = adaptseg::examples::strategy_names(true);
-    adaptseg::examples::write_text(out_dir / "strategies.csv", adaptseg::examples::strategies_csv());
+    const std::vector<std::string> model_strategies = adaptseg::strategy_names(true);
+    adaptseg::examples::write_text(out_dir / "strategies.csv", adaptseg::strategies_csv());
     const std::size_t total_runs = tests.size() * (lawnmower_factors.size() + model_strategies.size());
     std::size_t run_index = 0;
     for (const auto& field : tests) {
@@ -240,25 +240,26 @@ int main(int argc, char** argv) {
       struct Row {
         std::string strategy;
         double gsd;
-        adaptseg::examples::StrategyRun run;
+        adaptseg::StrategyRun run;
       };
       std::vector<Row> rows;
       std::vector<adaptseg::CurvePoint> curve;
       const auto fly = [&](const std::string& strategy, double gsd) {  // gsd: lawnmower GSD, or the model's top
         ++run_index;
+        const bool flies_model = adaptseg::strategy_info(strategy).flies_model();
         std::fprintf(stderr, "[%6.1f s] (%zu/%zu) %s: %s%s ...", elapsed(), run_index, total_runs, field.name().c_str(),
-                     strategy.c_str(), strategy == "lawnmower" ? (" " + fmt(gsd, 2) + " cm/px").c_str() : "");
+                     strategy.c_str(), flies_model ? "" : (" " + fmt(gsd, 2) + " cm/px").c_str());
         progress_open = true;
         auto run = segmenter.with_backend(field, mo.camera, [&](auto& backend) {
-          return adaptseg::examples::run_strategy(field, backend, strategy, gsd, &model, mo,
-                                                  strategy == "lawnmower" ? std::nullopt : budget_s);
+          return adaptseg::run_strategy(field, backend, strategy, gsd, &model, mo,
+                                        flies_model ? budget_s : std::nullopt);
         });
         std::fprintf(stderr, " %zu images, %.1f s, mIoU %.4f\n", run.mission.waypoints.size(), run.mission.total_s(),
                      run.mission.miou_interest().value_or(NAN));
         progress_open = false;
         // A model-based strategy reports the GSD its top level flew at (the policy may choose
         // another than the model's nominal one: ChoosesTopLevel).
-        if (strategy != "lawnmower")
+        if (flies_model)
           for (const auto& w : run.mission.waypoints)
             if (w.level == 0) {
               gsd = w.waypoint.gsd_cm;
@@ -267,7 +268,7 @@ int main(int argc, char** argv) {
         rows.push_back({strategy, gsd, std::move(run)});
       };
       for (double f : lawnmower_factors) {
-        fly("lawnmower", f * field.gsd_cm());
+        fly(adaptseg::kLawnmowerStrategy, f * field.gsd_cm());
         curve.push_back({rows.back().run.mission.total_s(), rows.back().run.mission.miou_interest().value_or(0.0)});
       }
       for (const std::string& s : model_strategies) fly(s, model.top_gsd_cm);
@@ -296,7 +297,8 @@ int main(int argc, char** argv) {
         }
         if (row.run.decisions)
           write_decisions(decisions_csv, field.name(), row.strategy, *row.run.decisions, row.run.realised);
-        const std::string name = row.strategy + (row.strategy == "lawnmower" ? "-" + fmt(row.gsd, 2) : "");
+        const bool lawnmower = !adaptseg::strategy_info(row.strategy).flies_model();
+        const std::string name = row.strategy + (lawnmower ? "-" + fmt(row.gsd, 2) : "");
         const fs::path dir = field_dir / name;
         fs::create_directories(dir);
         auto json = adaptseg::examples::result_json(field, m, mo, row.run.decisions ? &*row.run.decisions : nullptr);

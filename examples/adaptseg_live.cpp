@@ -394,9 +394,9 @@ void fly(const ImageSetInfo& info, Backend& backend, Policy& policy, const adapt
 template <adaptseg::SegmentationBackend Backend>
 void fly_strategy(const std::string& strategy, const adaptseg::DecisionModel& model, const ImageSetInfo& info,
                   Backend& backend, const adaptseg::AdaptiveOptions& options, const LiveSettings& s) {
-  adaptseg::examples::check_segmenter(model, backend.name());
-  const adaptseg::examples::StrategyInfo& row = adaptseg::examples::strategy_info(strategy);
-  if (row.policy == adaptseg::examples::StrategyPolicy::linear) {
+  adaptseg::check_segmenter(model, backend.name());
+  const adaptseg::StrategyInfo& row = adaptseg::strategy_info(strategy);
+  if (row.policy == adaptseg::StrategyPolicy::linear) {
     adaptseg::LinearDecision policy(model.linear);
     fly(info, backend, policy, options, s);
     return;
@@ -452,7 +452,7 @@ int main(int argc, char** argv) {
       ->needs(record)
       ->capture_default_str();
   app.add_option("--strategy", strategy, "decision policy")
-      ->check(CLI::IsMember(adaptseg::examples::strategy_names(true)))
+      ->check(CLI::IsMember(adaptseg::strategy_names(true)))
       ->capture_default_str();
   ex::accept_old_value(app.add_option("--segmenter", segmenter,
                                       "oracle: the ground-truth labels of the folder or the simulated camera; network: "
@@ -702,7 +702,7 @@ int main(int argc, char** argv) {
     if (info.geo && s.flight.connection.empty()) s.exports.check_altitude(options.top_gsd_cm, model.camera);
     if (segmenter == "oracle") {
       adaptseg::OracleSegmenter oracle(static_cast<int>(info.classes.size()));
-      adaptseg::examples::AnyBackend any(oracle);  // as with_network's: one backend type to compile for
+      adaptseg::AnyBackend any(oracle);  // as with_network's: one backend type to compile for
       fly_strategy(strategy, model, info, any, options, s);
     } else {
       if (network.empty()) throw std::invalid_argument("--segmenter network needs --network");

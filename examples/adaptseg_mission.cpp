@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Fly one UAV mapping mission over a field (simulated) and score it.", "adaptseg_mission"};
   std::string field_spec;
   fs::path out_dir, decision_model;
-  std::string strategy = "lawnmower";
+  std::string strategy = adaptseg::kLawnmowerStrategy;
   double gsd_cm = 0.0;
   std::optional<double> budget_s;
   adaptseg::examples::CommonOptions common;
@@ -33,7 +33,7 @@ int main(int argc, char** argv) {
   app.add_option("--field", field_spec, "field directory (field.yaml, labels.png, [image]), optionally DIR:x0,y0,x1,y1")
       ->required();
   app.add_option("--strategy", strategy, "mission strategy")
-      ->check(CLI::IsMember(adaptseg::examples::strategy_names()))
+      ->check(CLI::IsMember(adaptseg::strategy_names()))
       ->capture_default_str();
   app.add_option("--gsd", gsd_cm, "lawnmower GSD [cm/px] (>= the field's GSD)");
   CLI::Option* model_opt = app.add_option("--decision-model", decision_model,
@@ -58,28 +58,28 @@ int main(int argc, char** argv) {
     adaptseg::MissionOptions options = common.resolve(field);
     std::optional<adaptseg::DecisionModel> model;
     if (!decision_model.empty()) model = adaptseg::DecisionModel::load(decision_model);
-    if (strategy != "lawnmower" && model) common.check_camera_matches(app, *model);
-    if (budget_s && strategy == "lawnmower")
-      throw std::invalid_argument("--budget-s applies to adaptive strategies only");
+    const bool lawnmower = !adaptseg::strategy_info(strategy).flies_model();
+    if (!lawnmower && model) common.check_camera_matches(app, *model);
+    if (budget_s && lawnmower) throw std::invalid_argument("--budget-s applies to adaptive strategies only");
     const adaptseg::LawnmowerOverlap overlap =
         overlap_text.empty() ? adaptseg::LawnmowerOverlap{} : adaptseg::examples::parse_overlap(overlap_text);
-    if (strategy != "lawnmower" && overlap != adaptseg::LawnmowerOverlap{})
+    if (!lawnmower && overlap != adaptseg::LawnmowerOverlap{})
       throw std::invalid_argument("--overlap applies to --strategy lawnmower only");
     segmenter.validate();
-    const auto camera = strategy != "lawnmower" && model ? model->camera : options.camera;
+    const auto camera = !lawnmower && model ? model->camera : options.camera;
     // Before flying: a mission whose export would fly above the ceiling is refused.
-    if (strategy == "lawnmower" && gsd_cm > 0.0) exports.check_altitude(gsd_cm, camera);
-    if (strategy != "lawnmower" && model) exports.check_altitude(model->top_gsd_cm, camera);
+    if (lawnmower && gsd_cm > 0.0) exports.check_altitude(gsd_cm, camera);
+    if (!lawnmower && model) exports.check_altitude(model->top_gsd_cm, camera);
     const auto run = segmenter.with_backend(field, camera, [&](auto& backend) {
-      return adaptseg::examples::run_strategy(field, backend, strategy, gsd_cm, model ? &*model : nullptr, options,
-                                              budget_s, overlap);
+      return adaptseg::run_strategy(field, backend, strategy, gsd_cm, model ? &*model : nullptr, options, budget_s,
+                                    overlap);
     });
     const adaptseg::MissionResult& result = run.mission;
-    if (strategy != "lawnmower") options.camera = model->camera, options.timing = model->timing;
+    if (!lawnmower) options.camera = model->camera, options.timing = model->timing;
 
     fs::create_directories(out_dir);
     auto json = adaptseg::examples::result_json(field, result, options, run.decisions ? &*run.decisions : nullptr);
-    if (strategy == "lawnmower") {
+    if (lawnmower) {
       json["gsd_cm"] = gsd_cm;
       json["overlap"] = {{"along", overlap.along}, {"across", overlap.across}};
     }
@@ -88,8 +88,7 @@ int main(int argc, char** argv) {
     exports.write(field, result, options, out_dir);
     std::vector<adaptseg::Waypoint> path;
     for (const auto& w : result.waypoints) path.push_back(w.waypoint);
-    const std::string what =
-        strategy == "lawnmower" ? strategy + " at " + adaptseg::examples::fmt(gsd_cm, 2) + " cm/px" : strategy;
+    const std::string what = lawnmower ? strategy + " at " + adaptseg::examples::fmt(gsd_cm, 2) + " cm/px" : strategy;
     const auto mi = result.miou_interest();
     const auto ma = result.miou_all();
     adaptseg::examples::write_png(

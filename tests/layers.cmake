@@ -6,6 +6,7 @@
 #   erfnet (adaptseg::erfnet)   + OpenCV DNN
 #   geo    (adaptseg::geo)      vision's + GeographicLib, nlohmann_json
 #   gdal   (adaptseg::gdal)     geo's + GDAL
+#   sim    (adaptseg::sim)      vision's: the experiment layer (strategies flown in simulation)
 #   mavlink (adaptseg::mavlink) no library: the C++ standard library only (core's headers allowed,
 #                               but its target gives no Eigen)
 # One line per breach, naming the header, the include and the component; fails if any.
@@ -20,7 +21,8 @@ set(_rules
   "erfnet!core vision erfnet!^(opencv2/|yaml-cpp/)"
   "geo!core vision geo!^(opencv2/(core|imgproc|imgcodecs)|yaml-cpp/|GeographicLib/|nlohmann/)"
   "gdal!core vision geo gdal!^(opencv2/(core|imgproc|imgcodecs)|yaml-cpp/|GeographicLib/|nlohmann/|gdal|cpl_|ogr)"
-  "mavlink!core mavlink!^$")
+  "mavlink!core mavlink!^$"
+  "sim!core vision sim!^(opencv2/(core|imgproc|imgcodecs)|yaml-cpp/)")
 # What counts as a library (anything else is the standard library, Eigen, LBFGSpp or an intrinsic).
 set(_library "^(opencv2/|yaml-cpp/|GeographicLib/|nlohmann/|gdal|cpl_|ogr)")
 set(_breaches 0)
@@ -75,7 +77,7 @@ endforeach()
 file(GLOB _stray "${INCLUDE_DIR}/*.hpp")
 foreach(_header IN LISTS _stray)
   get_filename_component(_name "${_header}" NAME_WE)
-  if(NOT _name MATCHES "^(core|vision|erfnet|geo|gdal|mavlink|planner)$")
+  if(NOT _name MATCHES "^(core|vision|erfnet|geo|gdal|mavlink|sim|planner)$")
     message(SEND_ERROR "adaptseg/${_name}.hpp: a header outside the component folders")
     math(EXPR _breaches "${_breaches} + 1")
   endif()

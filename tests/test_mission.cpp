@@ -11,12 +11,7 @@ using namespace adaptseg;
 namespace t = adaptseg::test;
 
 namespace {
-MissionOptions deterministic() {
-  MissionOptions o;
-  o.fixed_segmentation_time_s = 0.1;
-  o.fixed_planning_time_s = 0.0;
-  return o;
-}
+MissionOptions deterministic() { return t::deterministic_options(); }
 }  // namespace
 
 TEST_CASE("mission: WeedMap lawnmower at the field's GSD maps every valid pixel exactly") {

@@ -1,6 +1,7 @@
 #pragma once
 // Helpers shared by the tests: synthetic fields, temporary directories, bundled data paths.
 
+#include <adaptseg/core/mission_options.hpp>
 #include <adaptseg/vision/field.hpp>
 
 #include <opencv2/core.hpp>
@@ -17,6 +18,15 @@
 #include <unistd.h>
 
 namespace adaptseg::test {
+
+/// Mission options whose times do not depend on the machine: 0.1 s charged per image, nothing
+/// for planning (the oracle sweeps' setting).
+inline MissionOptions deterministic_options() {
+  MissionOptions o;
+  o.fixed_segmentation_time_s = 0.1;
+  o.fixed_planning_time_s = 0.0;
+  return o;
+}
 
 /// Path of a bundled example field (examples/data/NAME).
 inline std::filesystem::path example_field(const std::string& name) {

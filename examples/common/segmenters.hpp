@@ -6,6 +6,7 @@
 #include <adaptseg/core/lawnmower_planner.hpp>
 #include <adaptseg/erfnet/ensemble_segmenter.hpp>
 #include <adaptseg/erfnet/onnx_segmenter.hpp>
+#include <adaptseg/vision/any_backend.hpp>
 #include <adaptseg/vision/calibration.hpp>
 #include <adaptseg/vision/field.hpp>
 #include <adaptseg/vision/oracle_segmenter.hpp>
@@ -103,26 +104,6 @@ inline std::string model_file_digest(const std::filesystem::path& model_file) {
 inline std::string network_name(const std::filesystem::path& model_file) {
   return (EnsembleSegmenter::is_ensemble_dir(model_file) ? "ensemble:" : "erfnet:") + model_file_digest(model_file);
 }
-
-/// A backend with probabilities behind one type (it borrows `backend`): calibrate() takes one
-/// backend type for all training fields, and cross-fitting segments them with several networks.
-class AnyBackend {
- public:
-  template <SegmentationBackend B>
-  requires SegmentsWithProbabilities<B>
-  explicit AnyBackend(B& backend)
-      : name_(backend.name()),
-        segment_([&backend](const Image& image) { return backend.segment(image); }),
-        probabilities_([&backend](const Image& image) { return backend.segment_with_probabilities(image); }) {}
-  [[nodiscard]] std::string name() const { return name_; }
-  [[nodiscard]] cv::Mat segment(const Image& image) { return segment_(image); }
-  [[nodiscard]] Segmentation segment_with_probabilities(const Image& image) { return probabilities_(image); }
-
- private:
-  std::string name_;
-  std::function<cv::Mat(const Image&)> segment_;
-  std::function<Segmentation(const Image&)> probabilities_;
-};
 
 /// Calls `f(backend)` with the network backend of `model_file` behind AnyBackend: an
 /// EnsembleSegmenter for an ensemble directory (ensemble.yaml), else an OnnxSegmenter

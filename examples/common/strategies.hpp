@@ -1,10 +1,11 @@
 #pragma once
-// Running any strategy by name, and parsing field specifications, for the example programs.
+// Field specifications, regions and overlaps as the programs read them, and the programs' one
+// instantiation of run_strategy() (the strategies themselves: <adaptseg/sim/strategy.hpp>).
 
 #include "cli.hpp"
 
-#include <adaptseg/core/linear_decision.hpp>
-#include <adaptseg/vision/adaptive_mission.hpp>
+#include <adaptseg/sim/strategy.hpp>
+#include <adaptseg/vision/any_backend.hpp>
 #include <adaptseg/vision/decision_model.hpp>
 #ifdef ADAPTSEG_HAVE_GDAL
 #include <adaptseg/gdal/gdal_io.hpp>
@@ -22,74 +23,6 @@
 #include <vector>
 
 namespace adaptseg::examples {
-
-class AnyBackend;  // segmenters.hpp
-
-/// What a strategy flies.
-enum class StrategyPolicy {
-  lawnmower,          ///< one fixed GSD (`--gsd`), no decision
-  decision_function,  ///< the calibrated decision function of the model (paper §3.2)
-  linear,             ///< the conference version's linear rule, from the model's σ range
-};
-
-/// One row of the table of strategies: everything a program or a figure needs to know about a
-/// strategy. To add one, add its row here; adaptseg_mission, adaptseg_evaluate, adaptseg_live
-/// and examples/tools/plot_evaluation.py (through the `strategies.csv` adaptseg_evaluate writes)
-/// read it.
-struct StrategyInfo {
-  std::string_view name;  ///< on the command line and in results.csv
-  StrategyPolicy policy;
-  DescentSchedule schedule;  ///< when the chosen descents are flown (not lawnmower)
-  bool online;               ///< decision_function: learns in flight (DecisionFunction::set_online)
-  std::string_view label;    ///< in the figures' legends
-};
-
-/// Every strategy, in the order adaptseg_evaluate flies them on a test field (the lawnmowers
-/// first). adaptive / nonadaptive: the decision model with online updates on / off, descents
-/// flown at once (the paper); tour: adaptive, but the whole top level first and the chosen
-/// descents after it as one low-altitude tour where that is cheaper; row: the same per
-/// lawnmower row, staying low between a row's inspections.
-inline constexpr std::array<StrategyInfo, 6> kStrategyTable{{
-    {"lawnmower", StrategyPolicy::lawnmower, DescentSchedule::immediate, false, "lawnmower (fixed altitude)"},
-    {"nonadaptive", StrategyPolicy::decision_function, DescentSchedule::immediate, false, "non-adaptive"},
-    {"adaptive", StrategyPolicy::decision_function, DescentSchedule::immediate, true, "adaptive"},
-    {"tour", StrategyPolicy::decision_function, DescentSchedule::tour, true, "tour (at once or after the survey)"},
-    {"row", StrategyPolicy::decision_function, DescentSchedule::row, true, "row (at once or after each row)"},
-    {"linear", StrategyPolicy::linear, DescentSchedule::immediate, false, "linear (ECMR 2021)"},
-}};
-
-/// The names of the strategies of `kStrategyTable` (all of them, or only those that fly a
-/// calibrated model: every one but the lawnmower), in its order.
-inline std::vector<std::string> strategy_names(bool model_based_only = false) {
-  std::vector<std::string> names;
-  for (const auto& s : kStrategyTable)
-    if (!model_based_only || s.policy != StrategyPolicy::lawnmower) names.emplace_back(s.name);
-  return names;
-}
-
-/// The row of strategy `name`.
-/// @throws std::invalid_argument naming every strategy for an unknown name.
-inline const StrategyInfo& strategy_info(std::string_view name) {
-  for (const auto& s : kStrategyTable)
-    if (s.name == name) return s;
-  std::string known;
-  for (const auto& s : kStrategyTable) known += (known.empty() ? "" : ", ") + std::string(s.name);
-  throw std::invalid_argument("unknown strategy '" + std::string(name) + "' (one of: " + known + ")");
-}
-
-/// The table as CSV (`name,policy,schedule,online,label`), which adaptseg_evaluate writes beside
-/// results.csv for the figures.
-inline std::string strategies_csv() {
-  std::string out = "name,policy,schedule,online,label\n";
-  for (const auto& s : kStrategyTable) {
-    const char* policy = s.policy == StrategyPolicy::lawnmower           ? "lawnmower"
-                         : s.policy == StrategyPolicy::decision_function ? "decision_function"
-                                                                         : "linear";
-    out += std::string(s.name) + ',' + policy + ',' + to_string(s.schedule) + ',' + (s.online ? "true" : "false") +
-           ",\"" + std::string(s.label) + "\"\n";
-  }
-  return out;
-}
 
 /// "a,b,c,d" -> four numbers; `what` describes the expected text in the error.
 /// @throws std::invalid_argument for anything else.
@@ -183,30 +116,11 @@ inline bool write_geo_maps(const Field& field, const cv::Mat& labels, const cv::
 #endif
 }
 
-/// Throws unless `model` was calibrated with the backend named `segmenter` (a network's name
-/// holds its weights' identity: network_name()).
-/// @throws std::invalid_argument naming both.
-inline void check_segmenter(const DecisionModel& model, const std::string& segmenter) {
-  if (model.segmenter != segmenter)
-    throw std::invalid_argument("the decision model was calibrated with segmenter '" + model.segmenter +
-                                "' but the mission uses '" + segmenter +
-                                "': calibrate with the backend the mission flies (adaptseg_calibrate --segmenter, "
-                                "--network)");
-}
-
-/// One flown strategy: the mission, and the decisions for the model-based ones.
-struct StrategyRun {
-  MissionResult mission;
-  std::optional<std::vector<DecisionRecord>> decisions;
-  std::vector<RealisedDescent> realised{};  ///< simulation: what each descent gained
-};
-
-/// Flies `strategy` over `field`. Lawnmower: at `gsd_cm`, with `overlap`. Others: from
-/// `model`'s top GSD with its candidates, camera and timing (the mission options' camera and
-/// timing are replaced by the model's), within `budget_s` if set. Compiled once, in
-/// strategies.cpp (the adaptseg_examples_common library), for every program.
-StrategyRun run_strategy(const Field& field, AnyBackend& backend, const std::string& strategy, double gsd_cm,
-                         const DecisionModel* model, MissionOptions options, std::optional<double> budget_s,
-                         LawnmowerOverlap overlap = {});
-
 }  // namespace adaptseg::examples
+
+/// run_strategy() for the programs' one backend type, compiled once, in strategies.cpp (the
+/// adaptseg_examples_common library): a program that includes this header does not instantiate
+/// the planner and its policies again.
+extern template adaptseg::StrategyRun adaptseg::run_strategy<adaptseg::AnyBackend>(
+    const adaptseg::Field&, adaptseg::AnyBackend&, const std::string&, double, const adaptseg::DecisionModel*,
+    adaptseg::MissionOptions, std::optional<double>, adaptseg::LawnmowerOverlap);

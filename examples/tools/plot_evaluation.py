@@ -30,7 +30,7 @@ from lawnmower_envelope import upper_envelope  # noqa: E402
 from per_image_table import MIN_TRUTH_SIGMA, by_gsd  # noqa: E402
 
 # How each strategy is drawn (its legend label comes from the table of strategies,
-# OUTDIR/strategies.csv, written by adaptseg_evaluate from examples/common/strategies.hpp).
+# OUTDIR/strategies.csv, written by adaptseg_evaluate from kStrategyTable, include/adaptseg/sim/strategy.hpp).
 # Hollow ones are drawn over the filled ones: the non-adaptive, tour and row strategies often fly
 # adaptive's mission, and both stay visible where they coincide. A strategy without a style here
 # is drawn with DEFAULT_STYLE.

@@ -10,6 +10,7 @@
 #include <adaptseg/vision/adaptive_mission.hpp>
 #include <adaptseg/vision/adaptive_options.hpp>
 #include <adaptseg/vision/adaptive_planner.hpp>
+#include <adaptseg/vision/any_backend.hpp>
 #include <adaptseg/vision/calibration.hpp>
 #include <adaptseg/vision/calibration_options.hpp>
 #include <adaptseg/vision/decision_model.hpp>

@@ -19,7 +19,7 @@ step("install" "${CMAKE_COMMAND}" --install "${BUILD_DIR}" --prefix "${WORK_DIR}
 step("configuring the consumer" "${CMAKE_COMMAND}" -S "${SOURCE_DIR}" -B "${WORK_DIR}/build" ${prefix}
      -DCMAKE_BUILD_TYPE=Release)
 step("building the consumer" "${CMAKE_COMMAND}" --build "${WORK_DIR}/build")
-set(exes consumer consumer_core consumer_geo consumer_erfnet)
+set(exes consumer consumer_core consumer_geo consumer_sim consumer_erfnet)
 if(EXISTS "${WORK_DIR}/prefix/share/cmake/adaptseg/adaptsegGdalTargets.cmake")  # installed with GDAL
   list(APPEND exes consumer_gdal)
 endif()

@@ -1,0 +1,6 @@
+#pragma once
+/// @file
+/// Umbrella header of the sim component (CMake target adaptseg::sim; vision's dependencies): the
+/// experiment layer, the strategies a mission flies in simulation and the flight of one of them.
+
+#include <adaptseg/sim/strategy.hpp>

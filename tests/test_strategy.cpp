@@ -1,0 +1,107 @@
+#include "test_support.hpp"
+
+#include <adaptseg/sim/strategy.hpp>
+#include <adaptseg/vision/any_backend.hpp>
+#include <adaptseg/vision/oracle_segmenter.hpp>
+
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace adaptseg;
+namespace t = adaptseg::test;
+using doctest::Contains;
+
+namespace {
+MissionOptions deterministic() { return t::deterministic_options(); }
+
+/// An oracle under another name: what a model calibrated with the oracle must refuse.
+struct RenamedOracle {
+  OracleSegmenter oracle;
+  [[nodiscard]] std::string name() const { return "erfnet:another"; }
+  [[nodiscard]] cv::Mat segment(const Image& image) { return oracle.segment(image); }
+  [[nodiscard]] Segmentation segment_with_probabilities(const Image& image) {
+    return oracle.segment_with_probabilities(image);
+  }
+};
+}  // namespace
+
+TEST_CASE("strategy table: one row per strategy, the lawnmower first, unknown names refused") {
+  const std::vector<std::string> all = strategy_names();
+  REQUIRE(all.size() == kStrategyTable.size());
+  CHECK(all.front() == std::string(kLawnmowerStrategy));
+  const std::vector<std::string> model_based = strategy_names(true);
+  CHECK(model_based.size() == all.size() - 1);
+  for (const std::string& name : model_based) CHECK(strategy_info(name).flies_model());
+  CHECK_FALSE(strategy_info(kLawnmowerStrategy).flies_model());
+  CHECK(strategy_info("adaptive").online);
+  CHECK_FALSE(strategy_info("nonadaptive").online);
+  CHECK(strategy_info("tour").schedule == DescentSchedule::tour);
+  CHECK(strategy_info("linear").policy == StrategyPolicy::linear);
+  CHECK_THROWS_WITH_AS((void)strategy_info("adaptiv"), Contains("strategy must be 'lawnmower', 'nonadaptive'"),
+                       std::invalid_argument);
+  // strategies.csv: the header and one line per row, policy and schedule by name.
+  std::istringstream csv(strategies_csv());
+  std::string line;
+  std::vector<std::string> lines;
+  while (std::getline(csv, line)) lines.push_back(line);
+  REQUIRE(lines.size() == kStrategyTable.size() + 1);
+  CHECK(lines[0] == "name,policy,schedule,online,label");
+  CHECK(lines[1] == "lawnmower,lawnmower,immediate,false,\"lawnmower (fixed altitude)\"");
+  CHECK(lines[4] == "tour,decision_function,tour,true,\"tour (at once or after the survey)\"");
+}
+
+TEST_CASE("run_strategy: the lawnmower flies as run_lawnmower_mission, and bad settings are refused") {
+  const Field f = Field::load(t::example_field("weedmap-000"));
+  OracleSegmenter oracle(f.num_classes());
+  AnyBackend any(oracle);
+  const StrategyRun run = run_strategy(f, any, kLawnmowerStrategy, 3.0, nullptr, deterministic(), std::nullopt);
+  const MissionResult direct = run_lawnmower_mission(f, 3.0, oracle, deterministic());
+  CHECK_FALSE(run.decisions.has_value());
+  CHECK(run.mission.waypoints.size() == direct.waypoints.size());
+  CHECK(run.mission.total_s() == direct.total_s());
+  CHECK(run.mission.miou_interest().value() == direct.miou_interest().value());
+  CHECK(run.mission.segmenter == "oracle");
+  const auto fly = [&](const std::string& strategy, double gsd, const DecisionModel* model, LawnmowerOverlap o = {}) {
+    return run_strategy(f, any, strategy, gsd, model, deterministic(), std::nullopt, o);
+  };
+  CHECK_THROWS_WITH_AS((void)fly("lawnmower", 0.0, nullptr), Contains("needs --gsd"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)fly("lawnmower", NAN, nullptr), Contains("(got nan)"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)fly("lawnmower", 0.5, nullptr), Contains("is finer than field 'weedmap-000'"),
+                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)fly("adaptive", 3.0, nullptr), Contains("--strategy adaptive needs --decision-model"),
+                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)fly("adaptive", 3.0, nullptr, LawnmowerOverlap{0.2, 0.2}),
+                       Contains("--overlap applies to --strategy lawnmower only"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)fly("bogus", 3.0, nullptr), Contains("strategy must be"), std::invalid_argument);
+}
+
+TEST_CASE("run_strategy: a decision model flies with its backend only, online or frozen as its row says") {
+  const Field f = Field::load(t::example_field("weedmap-000"));
+  const DecisionModel model =
+      DecisionModel::load(std::string(ADAPTSEG_TEST_DATA_DIR) + "/decision_model/weedmap_utility.yaml");
+  OracleSegmenter oracle(f.num_classes());
+  AnyBackend any(oracle);
+  const StrategyRun adaptive = run_strategy(f, any, "adaptive", 0.0, &model, deterministic(), std::nullopt);
+  const StrategyRun frozen = run_strategy(f, any, "nonadaptive", 0.0, &model, deterministic(), std::nullopt);
+  REQUIRE(adaptive.decisions.has_value());
+  REQUIRE(frozen.decisions.has_value());
+  CHECK_FALSE(adaptive.decisions->empty());
+  CHECK(adaptive.mission.strategy == "adaptive");
+  CHECK(frozen.mission.strategy == "nonadaptive");
+  // The model's top level, not the GSD passed (that is the lawnmower's).
+  CHECK(adaptive.mission.waypoints.front().waypoint.gsd_cm == doctest::Approx(model.top_gsd_cm));
+  CHECK(adaptive.realised.size() ==
+        static_cast<std::size_t>(std::count_if(adaptive.decisions->begin(), adaptive.decisions->end(),
+                                               [](const DecisionRecord& d) { return d.decision.descend; })));
+  RenamedOracle renamed{OracleSegmenter(f.num_classes())};
+  AnyBackend other(renamed);
+  CHECK_THROWS_WITH_AS((void)run_strategy(f, other, "adaptive", 0.0, &model, deterministic(), std::nullopt),
+                       Contains("calibrated with segmenter 'oracle' but the mission uses 'erfnet:another'"),
+                       std::invalid_argument);
+}
