@@ -41,15 +41,19 @@ inline std::vector<std::string>& old_values_given() {
 /// the command line has parsed, tell_old_spellings() names the new spelling on standard error.
 /// Call it before the option's choices are checked (before `->check(CLI::IsMember(...))`).
 inline CLI::Option* accept_old_value(CLI::Option* option, const std::string& old_value, const std::string& new_value) {
+  // The value taken by const reference: a callable taking it by value trips GCC 12's
+  // -Wmaybe-uninitialized at -O3 (a false positive inside std::function).
+  struct Rename {
+    std::string from, to, notice;
+    std::string operator()(const std::string& value) const {
+      if (value != from) return value;
+      old_values_given().push_back(notice);
+      return to;
+    }
+  };
   const std::string notice = option->get_name() + " " + old_value + " is deprecated and goes in adaptseg 0.4: use " +
                              option->get_name() + " " + new_value;
-  return option->transform(
-      [=](std::string value) {
-        if (value != old_value) return value;
-        old_values_given().push_back(notice);
-        return new_value;
-      },
-      "", "old value " + old_value);
+  return option->transform(Rename{old_value, new_value, notice}, "", "old value " + old_value);
 }
 
 /// Before parsing: each old spelling of `app` excludes every option its current spelling
