@@ -73,7 +73,8 @@ TEST_CASE("decision inputs: each per-pixel quantity on hand-computed pixels") {
     CHECK(std::isnan(at(pixel_input_values(1, p, in1, none), DecisionInput::split)));
   }
   CHECK(parse_decision_input("expected_error") == DecisionInput::expected_error);
-  CHECK_THROWS_WITH_AS((void)parse_decision_input("error"), doctest::Contains("one of sigma, boundary, ambiguity"),
+  CHECK_THROWS_WITH_AS((void)parse_decision_input("error"),
+                       doctest::Contains("decision input must be 'sigma', 'boundary', 'ambiguity'"),
                        std::invalid_argument);
   for (const auto& row : kDecisionInputs) CHECK(parse_decision_input(row.name) == row.input);
 }
