@@ -42,8 +42,8 @@
 #   bundled: tiles 1, 2, 3, 4, 6, 20 runs. Every field of each run, calibration and mission, new
 #   ground to the network that segments it; but fewer calibration fields than loto, two recipes,
 #   the leave-one-tile-out networks untempered, and mobilenetv2-dubai's temperature fitted on
-#   tile 4. TILES="1 2 4 6" (environment) flies the four-tile stand-in of 2026-11-29's second
-#   and third sessions (16 runs; before them tiles 1, 4 and 6, 12 runs).
+#   tile 4. TILES="1 2 4 6" LOTO_TILES="1 2" (environment) flies the four-tile stand-in of
+#   2026-11-29's second and third sessions (16 runs; before them tiles 1, 4 and 6, 12 runs).
 #   CONFIG (environment; default loto-proxy) names the configuration and EXTRA adds flags, e.g.
 #   CONFIG=loto-proxy-hull EXTRA="--top-level hull". About 10 minutes for four tiles on 2 cores
 #   with 2 jobs (segmentations cached in out/results/segmentation-cache).
@@ -443,11 +443,12 @@ if [ "$part" = loto-proxy ]; then
   read -r -a extra <<<"${EXTRA:-}"
   # Every tile with a network of the recipe that never saw it: its leave-one-tile-out network
   # where one is bundled, else (tiles 4 and 6) the evaluation network. TILES (environment)
-  # restricts the set, e.g. TILES="1 2 4 6" for the four-tile stand-in of before.
+  # restricts the tiles, LOTO_TILES the leave-one-tile-out networks used: TILES="1 2 4 6"
+  # LOTO_TILES="1 2" is the four-tile stand-in of before.
   tiles=() crossed=()
   declare -A flier=()
   for k in 1 2 3 4 5 6; do
-    if [ -s "$loto/tile-$k/model.onnx" ]; then
+    if [ -s "$loto/tile-$k/model.onnx" ] && [[ " ${LOTO_TILES:-$k} " == *" $k "* ]]; then
       flier[$k]=$loto/tile-$k
       crossed+=(--calibration-network "$loto/tile-$k")
     elif [ "$k" = 4 ] || [ "$k" = 6 ]; then
