@@ -733,6 +733,7 @@ TEST_CASE("fit: deterministic restarts and summary") {
   const auto sc = c.fit(x, y, {.restarts = 0, .max_iterations = 1});
   CHECK(sc.status == FitStatus::kMaxIterations);
   CHECK(adaptseg::to_string(sc.status) == "max_iterations");
+  CHECK(adaptseg::to_string(static_cast<FitStatus>(99)) == "unknown");
 
   auto d = a;
   const auto sd = d.fit(x, y, {.optimize = false});

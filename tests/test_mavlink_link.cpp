@@ -325,6 +325,8 @@ TEST_CASE("link: connect learns the autopilot and asks for its position and GPS 
   CHECK(v.system_id == 1);
   CHECK(v.component_id == 1);
   CHECK(v.firmware() == mv::Firmware::px4);
+  CHECK(mv::to_string(v.firmware()) == "PX4");
+  CHECK(mv::to_string(static_cast<mv::Firmware>(7)) == "other");
   CHECK(v.armed());
   CHECK(v.mode() == "Position");
   std::map<std::uint32_t, float> intervals;

@@ -47,11 +47,7 @@ inline constexpr std::array<detail::NamedValue<FitStatus>, 5> kFitStatuses{{
 }};
 
 /// Readable name of a `FitStatus`: "converged", say; "unknown" for a value out of range.
-[[nodiscard]] inline std::string_view to_string(FitStatus s) {
-  for (const auto& row : kFitStatuses)
-    if (row.value == s) return row.name;
-  return "unknown";
-}
+[[nodiscard]] inline std::string_view to_string(FitStatus s) { return detail::name_or(kFitStatuses, s, "unknown"); }
 
 /// Model options (`GaussianProcess<K>::Options`), validated once by the constructor.
 struct GpOptions {

@@ -41,11 +41,7 @@ inline constexpr std::array<adaptseg::detail::NamedValue<Firmware>, 3> kFirmware
 }};
 
 /// `"PX4"`, `"ArduPilot"`, `"other"` (also for a value out of range).
-[[nodiscard]] inline std::string to_string(Firmware f) {
-  for (const auto& row : kFirmwares)
-    if (row.value == f) return row.name;
-  return "other";
-}
+[[nodiscard]] inline std::string to_string(Firmware f) { return adaptseg::detail::name_or(kFirmwares, f, "other"); }
 
 /// PX4's custom modes: custom_mode = main mode << 16 | sub mode << 24.
 namespace px4_mode {

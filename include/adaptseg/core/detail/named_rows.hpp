@@ -59,6 +59,17 @@ template <typename Enum, std::size_t N>
   return row_of(table, &NamedValue<Enum>::value, value, what).name;
 }
 
+/// The name of `value` in a table of NamedValue rows, or `fallback` where the table has none (an
+/// enum that also holds values without a name of their own, e.g. a firmware the library does
+/// not know).
+template <typename Enum, std::size_t N>
+[[nodiscard]] const char* name_or(const std::array<NamedValue<Enum>, N>& table, Enum value,
+                                  const char* fallback) noexcept {
+  for (const NamedValue<Enum>& r : table)
+    if (r.value == value) return r.name;
+  return fallback;
+}
+
 /// The value named `name` in a table of NamedValue rows.
 /// @throws std::invalid_argument "<what> must be 'a', 'b' or 'c', not '<name>'" for another name.
 template <typename Enum, std::size_t N>
