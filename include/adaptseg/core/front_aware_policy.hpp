@@ -268,8 +268,7 @@ class FrontAwarePolicy {
     const double t0 = c.elapsed_s + c.rest_s;
     // The predicted curve's mIoU relative to the top level's (field_curve) or absolute.
     double curve_level = 0.0;
-    const bool shared_factor = params_.field_curve && model_.cells() && c.region_share > 0.0 && weight > 0.0;
-    if (shared_factor) {
+    if (params_.field_curve && model_.cells() && c.region_share > 0.0 && weight > 0.0) {
       const double x = field_input_estimate(c);
       curves.clear();
       if (params_.curve_ratio)
@@ -305,6 +304,8 @@ class FrontAwarePolicy {
         relabelled = {f.relabelled, f.relabelled_noisy_std, 0.0, 0.0, 0.0, 0.0};
       }
       const double gain = scaled(base);
+      const double gain_var =
+          scale_mean_ * scale_mean_ * base_sd * base_sd + scale_var_ * base * base + gain * gain * sigma_cv2;
       s.predicted_field_gain = gain;
       if (std::isfinite(relabelled.mean)) s.predicted_relabelled = std::abs(scale_mean_) * relabelled.mean;
       s.utility = utility(gain, cand.extra_time_s);
@@ -318,13 +319,6 @@ class FrontAwarePolicy {
       const double n = static_cast<double>(curves.size());
       const double rise = rise_sum / n;
       const double rise_var = curves.size() > 1 ? std::max(0.0, (rise_sq - n * rise * rise) / (n - 1.0)) : 0.0;
-      // What the field factor s and σ̂ leave uncertain: with the field's own curve (shared_factor)
-      // they scale the gain and the rise alike, so they move the margin ĝ − ΔD̄ by its own
-      // size, not by the gain's (the class comment).
-      const double unscaled_rise = shared_factor && scale_mean_ > 0.0 ? rise / scale_mean_ : 0.0;
-      const double moved = base - unscaled_rise;
-      const double gain_var = scale_mean_ * scale_mean_ * base_sd * base_sd + scale_var_ * moved * moved +
-                              std::pow(gain - (shared_factor ? rise : 0.0), 2) * sigma_cv2;
       const double lower = gain - rise - params_.confidence * std::sqrt(gain_var + rise_var);
       s.predicted_front_margin =
           mean_top_miou(c) + forecast_gain_ + gain - curve_level - mean_curve_miou(curves, t0 + cand.extra_time_s);
