@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reproduces docs/results.md and the measurements of the journal it links to (docs/journal/).
-#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|loto|loto-proxy|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed|all-tiles] [JOBS]
+#   bash scripts/results.sh [all|oracle|oracle-default|paper|network|loto|loto-proxy|new-ground-check|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed|all-tiles] [JOBS]
 #   (default: all, one job per core)
 #
 # oracle: the paper's experiment with the ground-truth oracle, deterministic (fixed 0.1 s per
@@ -38,15 +38,24 @@
 #   mobilenetv2-dubai-loto/tile-k flown by it, tiles 4 and 6 otherwise by mobilenetv2-dubai
 #   (trained on 1, 2, 3, 5); each calibrated on the other tiles of the set, each calibration
 #   field segmented by a network of these that never saw it (--calibration-network, the first
-#   that fits: the leave-one-tile-out networks before mobilenetv2-dubai). With tiles 1, 2 and 3
-#   bundled: tiles 1, 2, 3, 4, 6, 20 runs. Every field of each run, calibration and mission, new
-#   ground to the network that segments it; but fewer calibration fields than loto, two recipes,
-#   the leave-one-tile-out networks untempered, and mobilenetv2-dubai's temperature fitted on
-#   tile 4. TILES="1 2 4 6" LOTO_TILES="1 2" (environment) flies the four-tile stand-in of
-#   2026-11-29's second and third sessions (16 runs; before them tiles 1, 4 and 6, 12 runs).
+#   that fits: the leave-one-tile-out networks before mobilenetv2-dubai). With tiles 1 to 4
+#   bundled: tiles 1, 2, 3, 4, 6, 20 runs (the first four by their own networks). Every field of
+#   each run, calibration and mission, new ground to the network that segments it; but fewer
+#   calibration fields than loto, two recipes, the leave-one-tile-out networks untempered, and
+#   mobilenetv2-dubai's temperature fitted on tile 4. TILES="1 2 4 6" LOTO_TILES="1 2"
+#   (environment) flies the four-tile stand-in of 2026-11-29's second and third sessions (16
+#   runs; before them tiles 1, 4 and 6, 12 runs).
 #   CONFIG (environment; default loto-proxy) names the configuration and EXTRA adds flags, e.g.
-#   CONFIG=loto-proxy-hull EXTRA="--top-level hull". About 10 minutes for four tiles on 2 cores
-#   with 2 jobs (segmentations cached in out/results/segmentation-cache).
+#   CONFIG=loto-proxy-hull EXTRA="--top-level hull". About 13 minutes for five tiles on 2 cores
+#   with 2 jobs beside a training (segmentations cached in out/results/segmentation-cache).
+#   TILES="1 2 3 4 6" LOTO_TILES="1 2 3 4" keeps flying these five once tile 5's network is bundled.
+# new-ground-check: what a network's behaviour on new ground lets the decision forecast, on the
+#   stand-in's tiles (examples/tools/new_ground_check.py): each tile's cell samples, segmented by
+#   the network that flies it in loto-proxy (adaptseg_calibrate --cell-samples-csv, into
+#   new-ground-check/), each field's descents forecast from the other fields' cells (the cell gain
+#   model's normalised gain against the field's own exchange rate of false positives), and the
+#   whole-field lawnmower rise against the cells summed and against what each run's model
+#   predicted. Needs loto-proxy (CONFIG names another run of it); about 4 minutes on 2 cores.
 # ensemble: field mIoU of the bundled networks and of their ensemble (examples/models/ensemble-dubai)
 #   on the same whole-field lawnmowers of tiles 4 and 6 at 5, 10 and 15 cm/px
 #   (examples/tools/eval_ensemble.py, PyTorch on the exported weights), each network also with
@@ -130,9 +139,9 @@
 set -euo pipefail
 part=${1:-all}
 jobs=${2:-$(nproc 2>/dev/null || echo 2)}
-case "$part" in all | oracle | oracle-default | paper | network | loto | loto-proxy | ensemble | ensemble-split | cells | curve-check | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | z-choice-network | \
+case "$part" in all | oracle | oracle-default | paper | network | loto | loto-proxy | new-ground-check | ensemble | ensemble-split | cells | curve-check | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | z-choice-network | \
   cross-fit | network-variants | proxy-check | vertical-speed | all-tiles) ;;
-  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|loto|loto-proxy|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed|all-tiles] [JOBS]" >&2
+  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|loto|loto-proxy|new-ground-check|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed|all-tiles] [JOBS]" >&2
     exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
@@ -437,16 +446,16 @@ if [ "$part" = loto ]; then
   exit 0
 fi
 
-if [ "$part" = loto-proxy ]; then
-  loto=examples/models/mobilenetv2-dubai-loto evaluation=examples/models/mobilenetv2-dubai
-  config=${CONFIG:-loto-proxy}
-  read -r -a extra <<<"${EXTRA:-}"
-  # Every tile with a network of the recipe that never saw it: its leave-one-tile-out network
-  # where one is bundled, else (tiles 4 and 6) the evaluation network. TILES (environment)
-  # restricts the tiles, LOTO_TILES the leave-one-tile-out networks used: TILES="1 2 4 6"
-  # LOTO_TILES="1 2" is the four-tile stand-in of before.
-  tiles=() crossed=()
-  declare -A flier=()
+# The stand-in's networks (loto-proxy, new-ground-check): every tile with a network of the recipe
+# that never saw it, its leave-one-tile-out network where one is bundled, else (tiles 4 and 6)
+# the evaluation network; into `stand_in` (its tiles), `flier` (the network per tile) and
+# `crossed` (the calibration networks, --calibration-network ...). TILES (environment) restricts
+# the tiles, LOTO_TILES the leave-one-tile-out networks used: TILES="1 2 4 6" LOTO_TILES="1 2" is
+# the four-tile stand-in of before.
+stand_in_networks() {
+  local loto=examples/models/mobilenetv2-dubai-loto evaluation=examples/models/mobilenetv2-dubai k
+  stand_in=() crossed=()
+  declare -g -A flier=()
   for k in 1 2 3 4 5 6; do
     if [ -s "$loto/tile-$k/model.onnx" ] && [[ " ${LOTO_TILES:-$k} " == *" $k "* ]]; then
       flier[$k]=$loto/tile-$k
@@ -456,15 +465,21 @@ if [ "$part" = loto-proxy ]; then
     else
       continue
     fi
-    case " ${TILES:-$k} " in *" $k "*) tiles+=("$k") ;; esac
+    case " ${TILES:-$k} " in *" $k "*) stand_in+=("$k") ;; esac
   done
   crossed+=(--calibration-network "$evaluation")
+}
+
+if [ "$part" = loto-proxy ]; then
+  config=${CONFIG:-loto-proxy}
+  read -r -a extra <<<"${EXTRA:-}"
+  stand_in_networks
   rm -rf "${root:?}/$config"
   for cls in $classes; do
-    for t in "${tiles[@]}"; do
+    for t in "${stand_in[@]}"; do
       net=${flier[$t]}
       train=()
-      for k in "${tiles[@]}"; do [ "$k" != "$t" ] && train+=(--train "$(dubai "$k")"); done
+      for k in "${stand_in[@]}"; do [ "$k" != "$t" ] && train+=(--train "$(dubai "$k")"); done
       run "$config" "$cls-tile-$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
         --network "$net" "${crossed[@]}" "${network[@]}" --no-plots "${extra[@]}"
     done
@@ -473,6 +488,27 @@ if [ "$part" = loto-proxy ]; then
   check
   /usr/bin/python3 examples/tools/sweep_table.py "$config=$(dir_list "$root/$config"/*/)"
   /usr/bin/python3 examples/tools/descent_table.py "$root/$config"/*/
+  exit 0
+fi
+
+if [ "$part" = new-ground-check ]; then
+  config=${CONFIG:-loto-proxy}
+  [ -d "$root/$config" ] || { echo "run 'bash $0 loto-proxy' first" >&2; exit 1; }
+  stand_in_networks
+  mkdir -p "$root/new-ground-check"
+  # Every stand-in tile's cell samples, each tile segmented by the network that flies it there:
+  # the first tile's network segments its own tile, and every other tile (one of its training
+  # tiles) is segmented by the first calibration network that never saw it, as in the flights.
+  for cls in $classes; do
+    train=()
+    for k in "${stand_in[@]}"; do train+=(--train "$(dubai "$k")"); done
+    build/release/examples/adaptseg_calibrate "${train[@]}" --interest "$cls" --network "${flier[${stand_in[0]}]}" \
+      "${crossed[@]}" "${network[@]}" --out "$root/new-ground-check/model-$cls.yaml" \
+      --cell-samples-csv "$root/new-ground-check/cells-$cls.csv" >"$root/new-ground-check/calibrate-$cls.log" 2>&1 &
+    throttle
+  done
+  wait
+  /usr/bin/python3 examples/tools/new_ground_check.py "$root/new-ground-check" "$root/$config"
   exit 0
 fi
 
