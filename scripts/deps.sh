@@ -3,8 +3,8 @@
 #   scripts/deps.sh build   compiler, CMake and the C++ libraries (library, examples, tests)
 #   scripts/deps.sh test    build + what the test suite runs (Python for the data converters,
 #                           GDAL's ogrinfo, gdalinfo, gdal_translate, gdaltransform for the
-#                           exports and GeoTIFF fields, doxygen for docs:doxygen, pyflakes3 and
-#                           clang-format for the lint tests)
+#                           exports and GeoTIFF fields, doxygen for docs:doxygen, pyflakes3,
+#                           clang-format and clang-tidy for the lint tests)
 #   scripts/deps.sh docs    doxygen, for the API reference (scripts/docs.sh)
 #   scripts/deps.sh bench   test + what the benchmarks compare against (scikit-learn, with
 #                           OpenBLAS as well as the reference BLAS)
@@ -21,7 +21,7 @@ build=(cmake g++ make pkg-config libeigen3-dev libopencv-dev doctest-dev liblbfg
 python=(python3 python3-numpy python3-opencv python3-yaml python3-pil)
 case "${1:-build}" in
   build) want=("${build[@]}") ;;
-  test) want=("${build[@]}" "${python[@]}" gdal-bin doxygen pyflakes3 clang-format-14) ;;
+  test) want=("${build[@]}" "${python[@]}" gdal-bin doxygen pyflakes3 clang-format-14 clang-tidy-14) ;;
   docs) want=(doxygen) ;;
   bench) want=("${build[@]}" "${python[@]}" gdal-bin doxygen python3-sklearn python3-torch libopenblas0-pthread) ;;
   plots) want=("${build[@]}" "${python[@]}" python3-matplotlib) ;;

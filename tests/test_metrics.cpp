@@ -25,11 +25,14 @@ TEST_CASE("metrics: IoU and mIoU on a hand-computed example") {
   const cv::Mat pred = (cv::Mat_<std::uint8_t>(1, 6) << 0, 1, 1, 1, 255, 2);
   ConfusionMatrix cm(3);
   cm.add(truth, pred, 255);
-  CHECK(cm.total() == 5);                                  // the ignore truth pixel is skipped
-  CHECK(cm.count(2, 3) == 1);                              // weed predicted as none
-  CHECK(cm.iou(0).value() == doctest::Approx(1.0 / 2.0));  // TP 1, FN 1
-  CHECK(cm.iou(1).value() == doctest::Approx(2.0 / 3.0));  // TP 2, FP 1
-  CHECK(cm.iou(2).value() == doctest::Approx(0.0));        // FN 1
+  CHECK(cm.total() == 5);      // the ignore truth pixel is skipped
+  CHECK(cm.count(2, 3) == 1);  // weed predicted as none
+  CHECK_THROWS_WITH_AS((void)cm.count(3, 0), doctest::Contains("truth, prediction (got 3, 0)"), std::invalid_argument);
+  CHECK_THROWS_AS((void)cm.count(0, 4), std::invalid_argument);
+  CHECK_THROWS_AS((void)cm.count(-1, 4), std::invalid_argument);  // not index 0 by wrapping around
+  CHECK(cm.iou(0).value() == doctest::Approx(1.0 / 2.0));         // TP 1, FN 1
+  CHECK(cm.iou(1).value() == doctest::Approx(2.0 / 3.0));         // TP 2, FP 1
+  CHECK(cm.iou(2).value() == doctest::Approx(0.0));               // FN 1
   const std::vector<int> l{1, 2};
   CHECK(cm.miou(l).value() == doctest::Approx((2.0 / 3.0 + 0.0) / 2.0));
   CHECK(cm.miou_all().value() == doctest::Approx((0.5 + 2.0 / 3.0 + 0.0) / 3.0));

@@ -593,7 +593,7 @@ inline void write_gsd_geotiff(const std::filesystem::path& file, const MapGrid& 
                             "write_gsd_geotiff: gsd_cm must be CV_32F of the map grid's size",
                             std::to_string(gsd_cm.cols) + "x" + std::to_string(gsd_cm.rows));
   cv::Mat out = gsd_cm.clone();
-  out.setTo(0.0f, out == std::numeric_limits<float>::infinity());
+  out.setTo(0.0, out == std::numeric_limits<double>::infinity());
   detail::Dataset d = detail::create_on_field_grid(file, grid, GDT_Float32, {"COMPRESS=DEFLATE", "TILED=YES"});
   d->GetRasterBand(1)->SetDescription("gsd_cm");
   d->GetRasterBand(1)->SetNoDataValue(0.0);

@@ -104,7 +104,10 @@ class FenceRouter {
     std::vector<char> to_goal(n, 0);
     for (std::size_t i = 0; i < n; ++i) to_goal[i] = clear(vias_[i], b) ? 1 : 0;
     while (!queue.empty()) {
-      const auto [d, i] = queue.top();
+      // Named copies, not a structured binding: a lambda below captures them, which Clang
+      // accepts only from version 16.
+      const double d = queue.top().first;
+      const std::size_t i = queue.top().second;
       queue.pop();
       if (d > dist[i]) continue;
       if (i == goal) break;

@@ -60,7 +60,7 @@ class ConfusionMatrix {
   explicit ConfusionMatrix(int num_classes) : n_(num_classes) {
     detail::require(num_classes >= 1 && num_classes <= 255, "ConfusionMatrix: num_classes must be in 1..255",
                     num_classes);
-    counts_.assign(static_cast<std::size_t>(n_ * (n_ + 1)), 0);
+    counts_.assign(static_cast<std::size_t>(n_) * static_cast<std::size_t>(n_ + 1), 0);
   }
 
   [[nodiscard]] int num_classes() const noexcept { return n_; }
@@ -78,14 +78,19 @@ class ConfusionMatrix {
       for (int c = 0; c < truth.cols; ++c) {
         if (t[c] == ignore_label || t[c] >= n_) continue;
         const int pred = p[c] < n_ ? p[c] : n_;
-        ++counts_[static_cast<std::size_t>(t[c] * (n_ + 1) + pred)];
+        ++counts_[index(t[c], pred)];
       }
     }
   }
 
   /// Pixels of true class `truth` predicted as `predicted` (`num_classes()` = none).
+  /// @throws std::invalid_argument unless 0 <= truth < num_classes() and 0 <= predicted <= num_classes().
   [[nodiscard]] std::int64_t count(int truth, int predicted) const {
-    return counts_.at(static_cast<std::size_t>(truth * (n_ + 1) + predicted));
+    detail::require(truth >= 0 && truth < n_ && predicted >= 0 && predicted <= n_,
+                    "ConfusionMatrix::count: truth must be in 0..num_classes() - 1 and prediction in "
+                    "0..num_classes() (num_classes(): none); truth, prediction",
+                    std::to_string(truth) + ", " + std::to_string(predicted));
+    return counts_[index(truth, predicted)];
   }
 
   [[nodiscard]] std::int64_t total() const {
@@ -185,6 +190,12 @@ class ConfusionMatrix {
   }
 
  private:
+  /// The row-major index of a cell of the (num_classes() × (num_classes() + 1)) counts, in
+  /// std::size_t before the product.
+  [[nodiscard]] std::size_t index(int truth, int predicted) const noexcept {
+    return static_cast<std::size_t>(truth) * static_cast<std::size_t>(n_ + 1) + static_cast<std::size_t>(predicted);
+  }
+
   int n_;
   std::vector<std::int64_t> counts_;
 };

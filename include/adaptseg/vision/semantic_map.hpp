@@ -27,7 +27,7 @@ class SemanticMap {
     detail::require(unknown_label >= 0 && unknown_label <= 255, "SemanticMap: unknown_label must be in 0..255",
                     unknown_label);
     labels_ = cv::Mat(size, CV_8UC1, cv::Scalar(unknown_label));
-    gsd_ = cv::Mat(size, CV_32F, cv::Scalar(std::numeric_limits<float>::infinity()));
+    gsd_ = cv::Mat(size, CV_32F, cv::Scalar(std::numeric_limits<double>::infinity()));
   }
 
   /// Fuses the segmentation `labels` (I_h x I_w, CV_8UC1) of `image` into the map: each

@@ -50,6 +50,9 @@ namespace detail {
 
 /// Defines `name(params)`, which runs `name##_body<Bytes>(args)` for the widest instruction
 /// set of `gp_simd_level()`, with `name##_avx512` and `name##_avx2` compiled for those.
+/// `params` and `args` are parenthesised lists, spliced after a name as they are: they cannot
+/// take parentheses of their own (clang-tidy's bugprone-macro-parentheses, off for the macro).
+// NOLINTBEGIN(bugprone-macro-parentheses)
 #if defined(ADAPTSEG_GP_DISPATCH)
 #define ADAPTSEG_GP_DISPATCHED(ret, name, params, args)                                       \
   [[gnu::target("avx512f")]] inline ret name##_avx512 params { return name##_body<64> args; } \
@@ -67,6 +70,7 @@ namespace detail {
   inline ret name params { return name##_body<16> args; } \
   static_assert(true, "a use ends with a semicolon")
 #endif
+// NOLINTEND(bugprone-macro-parentheses)
 
 /// GCC vector types of 16, 32 and 64 bytes (spelled out: the attribute is not applied to a
 /// dependent size).
