@@ -711,8 +711,8 @@ int main(int argc, char** argv) {
       params.camera_width_px = m.image_width_px;
       params.camera_height_px = m.image_height_px;
       params.resize_to_network = true;
-      adaptseg::examples::with_network(
-          network, std::move(params), [&](auto& backend) { fly_strategy(strategy, model, info, backend, options, s); });
+      adaptseg::with_network(network, std::move(params),
+                             [&](auto& backend) { fly_strategy(strategy, model, info, backend, options, s); });
     }
     return 0;
   } catch (const std::exception& e) {

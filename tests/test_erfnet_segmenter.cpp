@@ -11,6 +11,7 @@
 
 #include <adaptseg/core/lawnmower_planner.hpp>
 #include <adaptseg/erfnet/erfnet_segmenter.hpp>  // the old name: it must still bring OnnxSegmenter in
+#include <adaptseg/erfnet/network_identity.hpp>
 #include <adaptseg/erfnet/onnx_segmenter.hpp>
 #include <adaptseg/vision/metrics.hpp>
 #include <adaptseg/vision/oracle_segmenter.hpp>
@@ -400,4 +401,38 @@ TEST_CASE("erfnet: the deployment model (all six tiles) keeps the backend contra
   CAPTURE(ca.miou_all().value());
   CAPTURE(ce.miou_all().value());
   CHECK(ca.miou_all().value() > ce.miou_all().value() + 0.02);
+}
+
+TEST_CASE(
+    "network identity: the folder's name and its files' hash, and another network for other weights or temperature") {
+  const std::filesystem::path models = std::filesystem::path(ADAPTSEG_EXAMPLES_DIR) / "models";
+  const auto [onnx, metadata] = network_files(models / "mobilenetv2-dubai");
+  CHECK(onnx == models / "mobilenetv2-dubai" / "model.onnx");
+  CHECK(metadata == models / "mobilenetv2-dubai" / "model.yaml");
+  CHECK(network_files(onnx) == std::pair{onnx, metadata});  // the .onnx itself: its .yaml beside it
+  const std::string id = network_digest(models / "mobilenetv2-dubai");
+  CHECK(id.rfind("mobilenetv2-dubai-", 0) == 0);
+  CHECK(id.size() == std::string("mobilenetv2-dubai-").size() + 16);
+  CHECK(network_name(models / "mobilenetv2-dubai") == "erfnet:" + id);
+  CHECK(network_name(models / "ensemble-dubai").rfind("ensemble:ensemble-dubai-", 0) == 0);
+  const std::vector<std::string> seen = network_training_fields(models / "mobilenetv2-dubai");
+  CHECK(std::find(seen.begin(), seen.end(), "dubai-tile-1") != seen.end());
+  CHECK(std::find(seen.begin(), seen.end(), "dubai-tile-4") == seen.end());
+
+  // A copy under the same folder name: the same network; another temperature or other weights
+  // in that folder: another one.
+  t::TempDir dir;
+  const std::filesystem::path copy = dir.path() / "mobilenetv2-dubai";
+  std::filesystem::create_directories(copy);
+  std::filesystem::copy_file(onnx, copy / "model.onnx");
+  std::filesystem::copy_file(metadata, copy / "model.yaml");
+  CHECK(network_digest(copy) == id);
+  { std::ofstream(copy / "model.yaml", std::ios::app) << "# re-tempered\n"; }
+  const std::string tempered = network_digest(copy);
+  CHECK(tempered != id);
+  { std::ofstream(copy / "model.onnx", std::ios::app | std::ios::binary) << '\0'; }
+  CHECK(network_digest(copy) != tempered);
+  // An ensemble is another ensemble when a member changes.
+  const std::string ensemble = ensemble_digest(models / "ensemble-dubai");
+  CHECK(ensemble == network_digest(models / "ensemble-dubai"));
 }

@@ -1,8 +1,10 @@
 #include "test_support.hpp"
 
+#include <adaptseg/sim/cached_backend.hpp>
 #include <adaptseg/sim/strategy.hpp>
 #include <adaptseg/vision/any_backend.hpp>
 #include <adaptseg/vision/oracle_segmenter.hpp>
+#include <adaptseg/vision/simulated_sensor.hpp>
 
 #include <doctest/doctest.h>
 
@@ -29,7 +31,73 @@ struct RenamedOracle {
     return oracle.segment_with_probabilities(image);
   }
 };
+
+/// The oracle, counting what it is asked: what CachedBackend must spare.
+struct CountingOracle {
+  OracleSegmenter oracle;
+  int labels = 0, with_probabilities = 0;
+  [[nodiscard]] std::string name() const { return oracle.name(); }
+  [[nodiscard]] cv::Mat segment(const Image& image) {
+    ++labels;
+    return oracle.segment(image);
+  }
+  [[nodiscard]] Segmentation segment_with_probabilities(const Image& image) {
+    ++with_probabilities;
+    return oracle.segment_with_probabilities(image);
+  }
+};
+
+bool same(const cv::Mat& a, const cv::Mat& b) {
+  return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0.0;
+}
 }  // namespace
+
+TEST_CASE("CachedBackend: each image segmented once, in memory and on disk, probabilities kept once asked twice") {
+  const Field f = Field::load(t::example_field("weedmap-000"));
+  const SimulatedSensor sensor(f, CameraModel{});
+  const auto plan = LawnmowerPlanner(sensor.camera()).plan(f.area(), 3.0 * f.gsd_cm());
+  REQUIRE(plan.size() >= 2);
+  const Image a = sensor.capture(plan[0]), b = sensor.capture(plan[1]);
+  t::TempDir dir;
+  CountingOracle inner{OracleSegmenter(f.num_classes())};
+  CachedBackend<CountingOracle> cached(inner, dir.path() / "oracle");
+  CHECK(cached.name() == inner.name());
+  const cv::Mat la = cached.segment(a);
+  CHECK(same(la, inner.oracle.segment(a)));
+  CHECK(same(cached.segment(a), la));
+  CHECK(inner.labels == 1);  // the second from memory
+  (void)cached.segment(b);
+  CHECK(inner.labels == 2);  // another footprint, another image
+  // Probabilities: computed when asked, kept (memory and disk) from the second ask on.
+  const Segmentation pa = cached.segment_with_probabilities(a);
+  CHECK(same(pa.labels, la));
+  REQUIRE(pa.probabilities.size() == static_cast<std::size_t>(f.num_classes()));
+  (void)cached.segment_with_probabilities(a);
+  const Segmentation third = cached.segment_with_probabilities(a);
+  CHECK(inner.with_probabilities == 2);
+  for (std::size_t c = 0; c < pa.probabilities.size(); ++c) CHECK(same(third.probabilities[c], pa.probabilities[c]));
+  // A copy each time: changing what it returned changes nothing kept.
+  cv::Mat changed = cached.segment(a);
+  changed.setTo(0);
+  CHECK(same(cached.segment(a), la));
+
+  // Another run over the same folder: nothing segmented again, labels and probabilities as kept.
+  CountingOracle second{OracleSegmenter(f.num_classes())};
+  CachedBackend<CountingOracle> again(second, dir.path() / "oracle");
+  CHECK(same(again.segment(a), la));
+  CHECK(same(again.segment(b), inner.oracle.segment(b)));
+  const Segmentation from_disk = again.segment_with_probabilities(a);
+  CHECK(second.labels + second.with_probabilities == 0);
+  for (std::size_t c = 0; c < pa.probabilities.size(); ++c)
+    CHECK(same(from_disk.probabilities[c], pa.probabilities[c]));
+  // A file cut short is not read: the image is segmented again.
+  for (const auto& file : std::filesystem::directory_iterator(dir.path() / "oracle"))
+    std::filesystem::resize_file(file.path(), 10);
+  CountingOracle third_run{OracleSegmenter(f.num_classes())};
+  CachedBackend<CountingOracle> cut(third_run, dir.path() / "oracle");
+  CHECK(same(cut.segment(a), la));
+  CHECK(third_run.labels == 1);
+}
 
 TEST_CASE("strategy table: one row per strategy, the lawnmower first, unknown names refused") {
   const std::vector<std::string> all = strategy_names();

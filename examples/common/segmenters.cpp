@@ -58,11 +58,11 @@ CalibrationResult calibrate_fields(const SegmenterOptions& segmenter, std::span<
       OnnxParams p = segmenter.network_params(fields.front(), options.adaptive.mission.camera);
       p.name = network_name(file);
       std::optional<std::filesystem::path> cache;
-      if (!segmenter.cache_root.empty()) cache = segmenter.cache_root / model_file_digest(file);
+      if (!segmenter.cache_root.empty()) cache = segmenter.cache_root / network_digest(file);
       if (EnsembleSegmenter::is_ensemble_dir(file)) {
         net = std::make_unique<OwnedCalibrationNetwork<EnsembleSegmenter>>(std::move(cache), file, std::move(p));
       } else {
-        const auto [onnx, metadata] = model_paths(file);
+        const auto [onnx, metadata] = network_files(file);
         net = std::make_unique<OwnedCalibrationNetwork<OnnxSegmenter>>(std::move(cache), onnx, metadata, std::move(p));
       }
     }

@@ -179,7 +179,7 @@ int main(int argc, char** argv) {
     if (adaptseg::EnsembleSegmenter::is_ensemble_dir(segmenter.network))
       throw std::invalid_argument("--network " + segmenter.network.string() +
                                   " is an ensemble: fit each member's temperature on its own folder");
-    const auto [onnx, metadata] = adaptseg::examples::model_paths(segmenter.network);
+    const auto [onnx, metadata] = adaptseg::network_files(segmenter.network);
     // Its logits, not AnyBackend's labels: the network itself, built as with_backend builds it.
     adaptseg::OnnxSegmenter net(onnx, metadata, segmenter.network_params(field, mo.camera));
     const double temperature_was = net.model_info().temperature;

@@ -1,6 +1,8 @@
 #pragma once
 /// @file
 /// Umbrella header of the sim component (CMake target adaptseg::sim; vision's dependencies): the
-/// experiment layer, the strategies a mission flies in simulation and the flight of one of them.
+/// experiment layer, the strategies a mission flies in simulation and the flight of one of them,
+/// and a backend that segments each image once (CachedBackend).
 
+#include <adaptseg/sim/cached_backend.hpp>
 #include <adaptseg/sim/strategy.hpp>
