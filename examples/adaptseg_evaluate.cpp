@@ -11,6 +11,8 @@
 #include "common/segmenters.hpp"
 #include "common/strategies.hpp"
 
+#include <adaptseg/sim/decision_table.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -26,69 +28,6 @@ using adaptseg::examples::fmt;
 std::string csv(const std::string& s) { return adaptseg::examples::csv_field(s); }
 
 std::string csv(const std::optional<double>& v) { return v ? fmt(*v, 6) : ""; }
-
-std::string csv_finite(double v) { return std::isfinite(v) ? fmt(v, 6) : ""; }
-
-/// One row per decision: what was forecast for the chosen candidate (or for the best-scored one
-/// when continuing), what the descent changed, and, in simulation, what it gained.
-void write_decisions(std::ostream& os, const std::string& field, const std::string& strategy,
-                     const std::vector<adaptseg::DecisionRecord>& decisions,
-                     const std::vector<adaptseg::RealisedDescent>& realised) {
-  std::size_t next_realised = 0;
-  for (std::size_t k = 0; k < decisions.size(); ++k) {
-    const auto& d = decisions[k];
-    // The candidate the row describes: the chosen one, else the one with the best forecast (field
-    // gain where the rule makes one, else ΔmIoU).
-    std::optional<std::size_t> c;
-    if (d.decision.descend) c = adaptseg::chosen_candidate(d.decision, d.candidates, strategy);
-    for (std::size_t i = 0; !d.decision.descend && i < d.candidates.size() && i < d.decision.scores.size(); ++i) {
-      const auto& s = d.decision.scores[i];
-      const bool by_gain = std::isfinite(s.predicted_field_gain);
-      if (!c || (by_gain ? s.predicted_field_gain > d.decision.scores[*c].predicted_field_gain
-                         : s.predicted_delta_miou < d.decision.scores[*c].predicted_delta_miou))
-        c = i;
-    }
-    const adaptseg::RealisedDescent* r = nullptr;
-    if (next_realised < realised.size() && realised[next_realised].decision == k) r = &realised[next_realised++];
-    os << csv(field) << ',' << strategy << ',' << k << ',' << d.waypoint_index << ',' << fmt(d.sigma, 6) << ','
-       << (d.decision.descend ? "descend" : "continue") << ',';
-    if (c) {
-      const auto& cand = d.candidates[*c];
-      os << fmt(cand.gsd_cm, 3) << ',' << cand.images << ',' << fmt(cand.extra_time_s, 3) << ',';
-      if (*c < d.decision.scores.size()) {
-        const auto& s = d.decision.scores[*c];
-        os << fmt(s.predicted_delta_sigma, 6) << ',' << fmt(s.predicted_delta_miou, 6) << ','
-           << fmt(s.predicted_delta_miou_std, 6) << ',' << csv_finite(s.predicted_relabelled) << ','
-           << csv_finite(s.predicted_field_gain) << ',' << csv_finite(s.predicted_front_margin) << ',';
-      } else {
-        os << ",,,,,,";
-      }
-    } else {
-      os << ",,,,,,,,,";
-    }
-    if (d.outcome)
-      os << fmt(d.outcome->sigma_sub, 6) << ',' << fmt(d.outcome->relabelled.share, 6) << ','
-         << fmt(d.outcome->relabelled.interest_share, 6) << ',';
-    else
-      os << ",,,";
-    if (r)
-      os << fmt(r->region_delta_miou(), 6) << ',' << fmt(r->field_gain, 6) << ',';
-    else
-      os << ",,";
-    if (c) os << (d.candidates[*c].deferred ? "tour" : "now");
-    os << ',';
-    if (d.outcome)
-      os << csv_finite(d.outcome->top_input) << ',' << csv_finite(d.outcome->fine_input);
-    else
-      os << ',';
-    os << ',';
-    if (r)
-      os << r->delta_tp << ',' << r->delta_fp << ',' << r->delta_fn;
-    else
-      os << ",,";
-    os << '\n';
-  }
-}
 
 /// Legs of the mission between waypoints at different altitudes (climbs and descents).
 int altitude_changes(const adaptseg::MissionResult& m) {
@@ -219,12 +158,7 @@ int main(int argc, char** argv) {
                "time_planning,images,front_margin,descents,altitude_changes,curve_front_margin\n";
     per_image
         << "field,strategy,gsd_cm,image,level,image_gsd_cm,sigma,image_miou_interest,image_miou_all,truth_sigma\n";
-    decisions_csv << "field,strategy,decision,image,sigma,action,gsd_cm,images,extra_time_s,forecast_delta_sigma,"
-                     "forecast_delta_miou,forecast_delta_miou_std,forecast_relabelled_interest,forecast_field_gain,"
-                     "forecast_front_margin,"
-                     "observed_sigma_sub,observed_relabelled,observed_relabelled_interest,realised_region_delta_miou,"
-                     "realised_field_gain,flown,observed_top_input,observed_fine_input,realised_delta_tp,"
-                     "realised_delta_fp,realised_delta_fn\n";
+    decisions_csv << adaptseg::decisions_csv_header();
     // The strategies that fly the model, after the lawnmowers, in the table's order on every
     // test field; the table beside the results for the figures.
     const std::vector<std::string> model_strategies = adaptseg::strategy_names(true);
@@ -296,7 +230,8 @@ int main(int argc, char** argv) {
                     << csv(w.image_miou_interest) << ',' << csv(w.image_miou_all) << ',' << csv(w.truth_ratio) << '\n';
         }
         if (row.run.decisions)
-          write_decisions(decisions_csv, field.name(), row.strategy, *row.run.decisions, row.run.realised);
+          adaptseg::write_decisions_csv(decisions_csv, field.name(), row.strategy, *row.run.decisions,
+                                        row.run.realised);
         const bool lawnmower = !adaptseg::strategy_info(row.strategy).flies_model();
         const std::string name = row.strategy + (lawnmower ? "-" + fmt(row.gsd, 2) : "");
         const fs::path dir = field_dir / name;

@@ -1,6 +1,8 @@
+#include "comma_locale.hpp"
 #include "test_support.hpp"
 
 #include <adaptseg/sim/cached_backend.hpp>
+#include <adaptseg/sim/decision_table.hpp>
 #include <adaptseg/sim/strategy.hpp>
 #include <adaptseg/vision/any_backend.hpp>
 #include <adaptseg/vision/oracle_segmenter.hpp>
@@ -172,4 +174,64 @@ TEST_CASE("run_strategy: a decision model flies with its backend only, online or
   CHECK_THROWS_WITH_AS((void)run_strategy(f, other, "adaptive", 0.0, &model, deterministic(), std::nullopt),
                        Contains("calibrated with segmenter 'oracle' but the mission uses 'erfnet:another'"),
                        std::invalid_argument);
+}
+
+TEST_CASE("decisions.csv: one column table for the header and every row, in any locale") {
+  const std::string header = decisions_csv_header();
+  CHECK(header.rfind("field,strategy,decision,image,sigma,action,gsd_cm,images,extra_time_s,", 0) == 0);
+  CHECK(header.find(",realised_field_gain,flown,") != std::string::npos);
+  CHECK(header.substr(header.size() - 18) == "realised_delta_fn\n");
+  const auto columns = [](const std::string& line) { return std::count(line.begin(), line.end(), ',') + 1; };
+  CHECK(columns(header.substr(0, header.size() - 1)) == static_cast<long>(kDecisionColumns.size()));
+
+  const Field f = Field::load(t::example_field("dubai-tile-1"));
+  const DecisionModel model =
+      DecisionModel::load(std::string(ADAPTSEG_TEST_DATA_DIR) + "/decision_model/dubai_road_front_aware.yaml");
+  OracleSegmenter oracle(f.num_classes());
+  AnyBackend any(oracle);
+  const StrategyRun run = run_strategy(f, any, "adaptive", 0.0, &model, deterministic(), std::nullopt);
+  REQUIRE(run.decisions.has_value());
+  REQUIRE_FALSE(run.realised.empty());  // at least one descent, to see its realised columns
+  const std::vector<DecisionRow> rows = decision_rows("a field, quoted", "adaptive", *run.decisions, run.realised);
+  REQUIRE(rows.size() == run.decisions->size());
+  std::ostringstream os;
+  {
+    const t::CommaLocale comma;  // a global locale with a decimal comma must not reach the file
+    write_decisions_csv(os, "a field, quoted", "adaptive", *run.decisions, run.realised);
+  }
+  std::istringstream in(os.str());
+  std::string line;
+  std::size_t k = 0, descents = 0;
+  while (std::getline(in, line)) {
+    REQUIRE(k < rows.size());
+    std::string start = "\"a field, quoted\",adaptive,";
+    start += std::to_string(k);
+    start += ',';
+    CHECK(line.rfind(start, 0) == 0);
+    CHECK(columns(line) == static_cast<long>(kDecisionColumns.size()) + 1);  // the quoted comma
+    const DecisionRow& r = rows[k];
+    CHECK(line.find(r.record->decision.descend ? ",descend," : ",continue,") != std::string::npos);
+    if (r.record->decision.descend) {
+      ++descents;
+      REQUIRE(r.realised != nullptr);
+      REQUIRE(r.candidate.has_value());
+      CHECK(r.chosen()->gsd_cm == doctest::Approx(r.record->decision.gsd_cm));
+      // Every column of a descent in simulation has a value but those the rule does not forecast.
+      for (const DecisionColumn& c : kDecisionColumns)
+        if (std::string(c.name).rfind("forecast_", 0) != 0 && std::string(c.name).rfind("observed_", 0) != 0)
+          CHECK_MESSAGE(!c.value(r).empty(), c.name);
+      CHECK(kDecisionColumns[19].value(r) == adaptseg::detail::format_fixed(r.realised->field_gain, 6));
+    } else {
+      CHECK(r.realised == nullptr);
+      CHECK(kDecisionColumns[23].value(r).empty());  // realised_delta_tp
+    }
+    CHECK(line.find(".") != std::string::npos);  // numbers with a decimal point, not a comma
+    ++k;
+  }
+  CHECK(k == rows.size());
+  CHECK(descents == run.realised.size());
+  CHECK(std::string(kDecisionColumns[19].name) == "realised_field_gain");
+  CHECK(std::string(kDecisionColumns[23].name) == "realised_delta_tp");
+  CHECK(adaptseg::detail::format_fixed(-0.5, 3) == "-0.500");
+  CHECK(adaptseg::detail::format_fixed(1234567.0, 1) == "1234567.0");
 }

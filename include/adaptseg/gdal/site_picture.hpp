@@ -7,6 +7,7 @@
 
 #include <adaptseg/gdal/site_plan.hpp>
 #include <adaptseg/gdal/survey_site.hpp>
+#include <adaptseg/vision/detail/number_text.hpp>
 #include <adaptseg/vision/visualization.hpp>
 
 #include <opencv2/core.hpp>
@@ -114,8 +115,8 @@ inline double round_scale_length_m(double most_m) {
   cv::rectangle(out, cv::Rect(x0 + bar_px / 2, y - 6, bar_px - bar_px / 2, 6), cv::Scalar(255, 255, 255), cv::FILLED);
   cv::rectangle(out, cv::Rect(x0, y - 6, bar_px, 6), cv::Scalar(0, 0, 0), 1);
   detail::put_text(out, "0", {x0 - 4, y + 20}, 0.5);
-  const std::string label = (bar_m >= 1000.0 ? detail::fixed(bar_m / 1000.0, bar_m >= 10000.0 ? 0 : 1) + " km"
-                                             : detail::fixed(bar_m, bar_m >= 1.0 ? 0 : 1) + " m");
+  const std::string label = (bar_m >= 1000.0 ? detail::format_fixed(bar_m / 1000.0, bar_m >= 10000.0 ? 0 : 1) + " km"
+                                             : detail::format_fixed(bar_m, bar_m >= 1.0 ? 0 : 1) + " m");
   detail::put_text(out, label, {x0 + bar_px - 10, y + 20}, 0.5);
   // North in the frame is (cos h, sin h); the image's y runs down.
   const double h = site.geo.heading_deg * std::numbers::pi / 180.0;

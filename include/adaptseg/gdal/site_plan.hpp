@@ -28,12 +28,12 @@
 #include <adaptseg/geo/georeference.hpp>
 #include <adaptseg/geo/mission_export.hpp>
 #include <adaptseg/geo/sorties.hpp>
+#include <adaptseg/vision/detail/number_text.hpp>
 
 #include <Eigen/Core>
 
 #include <cmath>
 #include <cstddef>
-#include <cstdio>
 #include <limits>
 #include <optional>
 #include <span>
@@ -132,17 +132,11 @@ struct SitePlan {
 
 namespace detail {
 
-inline std::string fixed(double v, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
-
 inline std::string where_text(const GeoPoint& g) {
   std::string s(1, '(');  // not "(" + ...: GCC 12's -Wrestrict misfires on it
-  s += fixed(g.latitude_deg, 6);
+  s += format_fixed(g.latitude_deg, 6);
   s += ", ";
-  s += fixed(g.longitude_deg, 6);
+  s += format_fixed(g.longitude_deg, 6);
   s += ')';
   return s;
 }
@@ -180,11 +174,11 @@ inline std::string where_text(const GeoPoint& g) {
   SitePlan plan;
   plan.height_m = camera.altitude_m(options.gsd_cm);
   if (plan.height_m < options.min_altitude_m)
-    throw std::invalid_argument("the survey would fly " + detail::fixed(plan.height_m, 2) + " m above the ground at " +
-                                detail::fixed(options.gsd_cm, 2) + " cm/px, below the minimum altitude " +
-                                detail::fixed(options.min_altitude_m, 1) + " m: with this camera fly at least " +
-                                detail::fixed(std::ceil(camera.gsd_cm(options.min_altitude_m) * 100.0) / 100.0, 2) +
-                                " cm/px");
+    throw std::invalid_argument(
+        "the survey would fly " + detail::format_fixed(plan.height_m, 2) + " m above the ground at " +
+        detail::format_fixed(options.gsd_cm, 2) + " cm/px, below the minimum altitude " +
+        detail::format_fixed(options.min_altitude_m, 1) + " m: with this camera fly at least " +
+        detail::format_fixed(std::ceil(camera.gsd_cm(options.min_altitude_m) * 100.0) / 100.0, 2) + " cm/px");
 
   // Home on the site, or a hint why not.
   SiteSurveyOptions survey = options.survey;
@@ -194,26 +188,27 @@ inline std::string where_text(const GeoPoint& g) {
     const double from_centre = geodesic_distance_m(site.centre(), plan.home);
     if (looks_swapped(site, plan.home, 1000.0))
       throw std::invalid_argument("the take-off point " + detail::where_text(plan.home) + " lies " +
-                                  detail::fixed(from_centre / 1000.0, 0) + " km from the site, whose centre is " +
-                                  detail::where_text(site.centre()) +
+                                  detail::format_fixed(from_centre / 1000.0, 0) +
+                                  " km from the site, whose centre is " + detail::where_text(site.centre()) +
                                   "; swapped, it would lie on the site: are the site's latitude and longitude swapped "
                                   "(GeoJSON and KML list longitude first), or the take-off point's (LAT,LON)?");
     if (from_centre > site.radius_m() + 10e3)
       throw std::invalid_argument("the take-off point " + detail::where_text(plan.home) + " lies " +
-                                  detail::fixed(from_centre / 1000.0, 1) + " km from the site, whose centre is " +
-                                  detail::where_text(site.centre()) + ": take off on the site");
+                                  detail::format_fixed(from_centre / 1000.0, 1) +
+                                  " km from the site, whose centre is " + detail::where_text(site.centre()) +
+                                  ": take off on the site");
     plan.home_xy = frame.to_field(plan.home).head<2>();
     if (!site.contains(plan.home_xy))
       throw std::invalid_argument(
           "the take-off point " + detail::where_text(plan.home) + " lies " +
-          detail::fixed(site.distance_to_edge_m(plan.home_xy), 1) +
+          detail::format_fixed(site.distance_to_edge_m(plan.home_xy), 1) +
           " m off the site (outside its outline or in a hole): take off on the site, inside the "
           "geofence the plan carries");
     survey.start_xy = plan.home_xy;
   }
   plan.survey = survey_site(site, camera, options.gsd_cm, survey);
   if (plan.survey.waypoints.empty())
-    throw std::invalid_argument("no waypoint lies " + detail::fixed(survey.inside_margin_m, 1) +
+    throw std::invalid_argument("no waypoint lies " + detail::format_fixed(survey.inside_margin_m, 1) +
                                 " m inside the site: it is narrower than twice the inside margin");
   if (!options.home) {
     plan.home_xy = plan.survey.waypoints.front().position.head<2>();
@@ -226,9 +221,9 @@ inline std::string where_text(const GeoPoint& g) {
     if (!dem->elevation_m(plan.home.latitude_deg, plan.home.longitude_deg) &&
         looks_swapped(site, dem->centre(), dem->radius_m()))
       throw std::invalid_argument("the DEM '" + dem->file().string() + "' covers " +
-                                  detail::fixed(dem->radius_m() / 1000.0, 1) + " km around " +
+                                  detail::format_fixed(dem->radius_m() / 1000.0, 1) + " km around " +
                                   detail::where_text(dem->centre()) + ", " +
-                                  detail::fixed(geodesic_distance_m(site.centre(), dem->centre()) / 1000.0, 0) +
+                                  detail::format_fixed(geodesic_distance_m(site.centre(), dem->centre()) / 1000.0, 0) +
                                   " km from the site, whose centre is " + detail::where_text(site.centre()) +
                                   "; swapped, the site would lie on it: are the site's latitude and longitude swapped "
                                   "(GeoJSON and KML list longitude first)?");
@@ -236,9 +231,9 @@ inline std::string where_text(const GeoPoint& g) {
     for (std::size_t i = 0; i < path.size(); ++i)
       if (plan.terrain->clearance_m[i] < options.min_altitude_m)
         throw std::invalid_argument(
-            "waypoint " + std::to_string(i) + " flies " + detail::fixed(plan.terrain->clearance_m[i], 1) +
+            "waypoint " + std::to_string(i) + " flies " + detail::format_fixed(plan.terrain->clearance_m[i], 1) +
             " m above the highest ground under its footprint (DEM), below the minimum altitude " +
-            detail::fixed(options.min_altitude_m, 1) + " m: fly a coarser GSD");
+            detail::format_fixed(options.min_altitude_m, 1) + " m: fly a coarser GSD");
   }
 
   // The geofence (simplified by at most a quarter of the margin, so waypoints stay 3/4 of it
@@ -259,7 +254,8 @@ inline std::string where_text(const GeoPoint& g) {
     try {
       return router.route(a, b);
     } catch (const std::invalid_argument&) {
-      throw std::invalid_argument("no route inside the geofence " + what + " keeps " + detail::fixed(0.5 * margin, 1) +
+      throw std::invalid_argument("no route inside the geofence " + what + " keeps " +
+                                  detail::format_fixed(0.5 * margin, 1) +
                                   " m from its edges: the site is too narrow there for the inside margin");
     }
   };
@@ -348,8 +344,8 @@ inline std::string where_text(const GeoPoint& g) {
         };
         throw std::invalid_argument(
             (at == 0 ? "the leg from the take-off to " + name(0) : "the leg from " + name(at - 1) + " to " + name(at)) +
-            " passes " + detail::fixed(low, 1) + " m above the ground (DEM), below the minimum altitude " +
-            detail::fixed(options.min_altitude_m, 1) + " m: fly a coarser GSD");
+            " passes " + detail::format_fixed(low, 1) + " m above the ground (DEM), below the minimum altitude " +
+            detail::format_fixed(options.min_altitude_m, 1) + " m: fly a coarser GSD");
       }
     }
   }
@@ -358,26 +354,28 @@ inline std::string where_text(const GeoPoint& g) {
   auto& warn = plan.warnings;
   const double area = site.area_m2();
   if (area < options.warn_min_area_m2 || area > options.warn_max_area_m2)
-    warn.push_back("the site's area is " + detail::fixed(area, 0) + " m^2 (" + detail::fixed(area / 1e4, 2) +
-                   " ha), outside " + detail::fixed(options.warn_min_area_m2, 0) + " m^2 .. " +
-                   detail::fixed(options.warn_max_area_m2 / 1e6, 0) +
+    warn.push_back("the site's area is " + detail::format_fixed(area, 0) + " m^2 (" +
+                   detail::format_fixed(area / 1e4, 2) + " ha), outside " +
+                   detail::format_fixed(options.warn_min_area_m2, 0) + " m^2 .. " +
+                   detail::format_fixed(options.warn_max_area_m2 / 1e6, 0) +
                    " km^2: is it the polygon you meant, in the units you meant?");
   if (path.size() > options.warn_waypoints)
     warn.push_back("the plan has " + std::to_string(path.size()) + " waypoints, more than " +
-                   std::to_string(options.warn_waypoints) + ": check the GSD (" + detail::fixed(options.gsd_cm, 2) +
-                   " cm/px) against the site's " + detail::fixed(area / 1e4, 1) + " ha");
+                   std::to_string(options.warn_waypoints) + ": check the GSD (" +
+                   detail::format_fixed(options.gsd_cm, 2) + " cm/px) against the site's " +
+                   detail::format_fixed(area / 1e4, 1) + " ha");
   if (plan.flight_s > options.warn_flight_s)
-    warn.push_back("the plan flies " + detail::fixed(plan.flight_s / 3600.0, 1) + " h in " +
+    warn.push_back("the plan flies " + detail::format_fixed(plan.flight_s / 3600.0, 1) + " h in " +
                    std::to_string(plan.sorties.size()) + " sortie(s), more than " +
-                   detail::fixed(options.warn_flight_s / 3600.0, 1) + " h");
+                   detail::format_fixed(options.warn_flight_s / 3600.0, 1) + " h");
   if (!options.max_flight_s && plan.flight_s > options.warn_sortie_s)
-    warn.push_back("its one sortie flies " + detail::fixed(plan.flight_s / 60.0, 0) + " min, longer than " +
-                   detail::fixed(options.warn_sortie_s / 60.0, 0) +
+    warn.push_back("its one sortie flies " + detail::format_fixed(plan.flight_s / 60.0, 0) + " min, longer than " +
+                   detail::format_fixed(options.warn_sortie_s / 60.0, 0) +
                    " min: split it into sorties that fit a battery (a flight-time limit)");
   if (plan.terrain && plan.terrain->highest_rise_m > 0.0)
-    warn.push_back("the ground under the survey rises " + detail::fixed(plan.terrain->highest_rise_m, 1) +
+    warn.push_back("the ground under the survey rises " + detail::format_fixed(plan.terrain->highest_rise_m, 1) +
                    " m above home: set the autopilot's return altitude (PX4 RTL_RETURN_ALT, ArduPilot RTL_ALT) above " +
-                   detail::fixed(plan.terrain->highest_rise_m + options.min_altitude_m, 1) + " m");
+                   detail::format_fixed(plan.terrain->highest_rise_m + options.min_altitude_m, 1) + " m");
   if (geodesic_distance_m(site.centre(), GeoPoint{0.0, 0.0, 0.0}) < 10e3)
     warn.push_back("the site lies at latitude and longitude (0, 0), in the Gulf of Guinea: are its coordinates unset?");
   return plan;

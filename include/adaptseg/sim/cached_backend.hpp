@@ -5,8 +5,8 @@
 /// segments each image once, in memory and, with a folder, on disk across runs.
 
 #include <adaptseg/core/detail/fnv1a.hpp>
-#include <adaptseg/vision/segmentation_backend.hpp>
 #include <adaptseg/vision/image.hpp>
+#include <adaptseg/vision/segmentation_backend.hpp>
 
 #include <opencv2/core.hpp>
 

@@ -24,6 +24,15 @@ namespace adaptseg::detail {
   return std::string(buf.data(), end);
 }
 
+/// `v` in fixed notation with `digits` digits after the point, as printf's "%.*f" writes it in
+/// the C locale ("nan", "inf", "-inf" for non-finite values).
+[[nodiscard]] inline std::string format_fixed(double v, int digits) {
+  std::array<char, 400> buf{};  // the longest double in fixed notation (309 digits) and its decimals
+  const auto [end, ec] = std::to_chars(buf.data(), buf.data() + buf.size(), v, std::chars_format::fixed, digits);
+  if (ec != std::errc{}) return format_number(v);  // more than 80 decimals asked for: the shortest text
+  return std::string(buf.data(), end);
+}
+
 /// `text` as a finite double if it is exactly one number (no surrounding characters); a
 /// leading '+' is accepted. nullopt otherwise.
 [[nodiscard]] inline std::optional<double> parse_number(std::string_view text) {
