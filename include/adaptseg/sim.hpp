@@ -6,5 +6,6 @@
 /// decisions (decisions.csv).
 
 #include <adaptseg/sim/cached_backend.hpp>
+#include <adaptseg/sim/csv.hpp>
 #include <adaptseg/sim/decision_table.hpp>
 #include <adaptseg/sim/strategy.hpp>

@@ -7,6 +7,7 @@
 /// fixed notation, whatever the C locale (std::to_chars).
 
 #include <adaptseg/core/decision.hpp>
+#include <adaptseg/sim/csv.hpp>
 #include <adaptseg/vision/adaptive_mission.hpp>
 #include <adaptseg/vision/adaptive_options.hpp>
 #include <adaptseg/vision/detail/number_text.hpp>
@@ -41,18 +42,6 @@ struct DecisionRow {
 };
 
 namespace detail {
-/// A CSV field: as it is, or quoted (quotes doubled) where it holds a comma, a quote or a line
-/// break (RFC 4180).
-[[nodiscard]] inline std::string csv_field(std::string_view s) {
-  if (s.find_first_of(",\"\n") == std::string_view::npos) return std::string(s);
-  std::string q(1, '"');
-  for (char c : s) {
-    if (c == '"') q += '"';
-    q += c;
-  }
-  q += '"';
-  return q;
-}
 /// `v` with 6 decimals; empty where it is not finite (a forecast the rule does not make).
 [[nodiscard]] inline std::string finite6(double v) { return std::isfinite(v) ? format_fixed(v, 6) : std::string(); }
 }  // namespace detail
@@ -65,20 +54,27 @@ struct DecisionColumn {
 
 /// Every column of decisions.csv, in order (docs/data_format.md says what each holds).
 inline const std::array<DecisionColumn, 26> kDecisionColumns{{
-    {"field", [](const DecisionRow& r) { return detail::csv_field(r.field); }},
+    {"field", [](const DecisionRow& r) { return csv_field(r.field); }},
     {"strategy", [](const DecisionRow& r) { return std::string(r.strategy); }},
     {"decision", [](const DecisionRow& r) { return std::to_string(r.index); }},
     {"image", [](const DecisionRow& r) { return std::to_string(r.record->waypoint_index); }},
     {"sigma", [](const DecisionRow& r) { return detail::format_fixed(r.record->sigma, 6); }},
     {"action", [](const DecisionRow& r) { return std::string(r.record->decision.descend ? "descend" : "continue"); }},
-    {"gsd_cm", [](const DecisionRow& r) { return r.chosen() ? detail::format_fixed(r.chosen()->gsd_cm, 3) : std::string(); }},
+    {"gsd_cm",
+     [](const DecisionRow& r) { return r.chosen() ? detail::format_fixed(r.chosen()->gsd_cm, 3) : std::string(); }},
     {"images", [](const DecisionRow& r) { return r.chosen() ? std::to_string(r.chosen()->images) : std::string(); }},
     {"extra_time_s",
-     [](const DecisionRow& r) { return r.chosen() ? detail::format_fixed(r.chosen()->extra_time_s, 3) : std::string(); }},
+     [](const DecisionRow& r) {
+       return r.chosen() ? detail::format_fixed(r.chosen()->extra_time_s, 3) : std::string();
+     }},
     {"forecast_delta_sigma",
-     [](const DecisionRow& r) { return r.score() ? detail::format_fixed(r.score()->predicted_delta_sigma, 6) : std::string(); }},
+     [](const DecisionRow& r) {
+       return r.score() ? detail::format_fixed(r.score()->predicted_delta_sigma, 6) : std::string();
+     }},
     {"forecast_delta_miou",
-     [](const DecisionRow& r) { return r.score() ? detail::format_fixed(r.score()->predicted_delta_miou, 6) : std::string(); }},
+     [](const DecisionRow& r) {
+       return r.score() ? detail::format_fixed(r.score()->predicted_delta_miou, 6) : std::string();
+     }},
     {"forecast_delta_miou_std",
      [](const DecisionRow& r) {
        return r.score() ? detail::format_fixed(r.score()->predicted_delta_miou_std, 6) : std::string();
@@ -88,7 +84,9 @@ inline const std::array<DecisionColumn, 26> kDecisionColumns{{
     {"forecast_field_gain",
      [](const DecisionRow& r) { return r.score() ? detail::finite6(r.score()->predicted_field_gain) : std::string(); }},
     {"forecast_front_margin",
-     [](const DecisionRow& r) { return r.score() ? detail::finite6(r.score()->predicted_front_margin) : std::string(); }},
+     [](const DecisionRow& r) {
+       return r.score() ? detail::finite6(r.score()->predicted_front_margin) : std::string();
+     }},
     {"observed_sigma_sub",
      [](const DecisionRow& r) {
        return r.record->outcome ? detail::format_fixed(r.record->outcome->sigma_sub, 6) : std::string();
@@ -102,7 +100,9 @@ inline const std::array<DecisionColumn, 26> kDecisionColumns{{
        return r.record->outcome ? detail::format_fixed(r.record->outcome->relabelled.interest_share, 6) : std::string();
      }},
     {"realised_region_delta_miou",
-     [](const DecisionRow& r) { return r.realised ? detail::format_fixed(r.realised->region_delta_miou(), 6) : std::string(); }},
+     [](const DecisionRow& r) {
+       return r.realised ? detail::format_fixed(r.realised->region_delta_miou(), 6) : std::string();
+     }},
     {"realised_field_gain",
      [](const DecisionRow& r) { return r.realised ? detail::format_fixed(r.realised->field_gain, 6) : std::string(); }},
     {"flown",
@@ -110,7 +110,9 @@ inline const std::array<DecisionColumn, 26> kDecisionColumns{{
        return r.chosen() ? std::string(r.chosen()->deferred ? "tour" : "now") : std::string();
      }},
     {"observed_top_input",
-     [](const DecisionRow& r) { return r.record->outcome ? detail::finite6(r.record->outcome->top_input) : std::string(); }},
+     [](const DecisionRow& r) {
+       return r.record->outcome ? detail::finite6(r.record->outcome->top_input) : std::string();
+     }},
     {"observed_fine_input",
      [](const DecisionRow& r) {
        return r.record->outcome ? detail::finite6(r.record->outcome->fine_input) : std::string();
@@ -154,7 +156,8 @@ inline const std::array<DecisionColumn, 26> kDecisionColumns{{
                                      : s.predicted_delta_miou < d.decision.scores[*row.candidate].predicted_delta_miou))
         row.candidate = i;
     }
-    if (next_realised < realised.size() && realised[next_realised].decision == k) row.realised = &realised[next_realised++];
+    if (next_realised < realised.size() && realised[next_realised].decision == k)
+      row.realised = &realised[next_realised++];
     rows.push_back(row);
   }
   return rows;
