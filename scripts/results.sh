@@ -13,7 +13,9 @@
 #   Independent runs in parallel; on 2 cores the defaults take about 7 minutes, the paper's
 #   configuration about 19 (its threshold search flies every setting over every training field).
 #   oracle-default flies the defaults alone, paper the paper's configuration alone (the defaults'
-#   runs, which its table compares with, from an earlier oracle-default).
+#   runs, which its table compares with, from an earlier oracle-default). oracle-default takes
+#   CONFIG (environment: the folder, default oracle-default) and EXTRA (more flags for every run,
+#   e.g. EXTRA="--top-level undominated,hull").
 # network: the same with the bundled networks (examples/models/mobilenetv2-dubai, erfnet-dubai,
 #   and ensemble-dubai, the mean of the two; measured segmentation times) on the two tiles they
 #   never trained on (4 and 6), each initialised on the five other tiles (the networks' training
@@ -31,8 +33,12 @@
 #   k, its decision function calibrated on the other five tiles, each segmented by the network
 #   of the same recipe that never saw it (--calibration-network), as the deployment network's
 #   decision model is calibrated for a new site; 24 runs, measured segmentation times. Printed
-#   beside the oracle's runs of the same folds (part oracle-default's Dubai runs, when there).
-#   Every network segments its own tile once into the segmentation cache.
+#   beside the oracle's runs of the same folds (part oracle-default's Dubai runs, when there;
+#   ORACLE_CONFIG names another folder of them). Every network segments its own tile once into
+#   the segmentation cache. CONFIG (environment) names the folder (default loto), EXTRA adds
+#   flags to every run: CONFIG=loto-hull EXTRA="--top-level hull" ORACLE_CONFIG=oracle-hull.
+#   Last, the issue's targets (examples/tools/loto_targets.py; several configurations side by
+#   side: loto_targets.py --oracle out/results/oracle-default a=out/results/loto b=...).
 # loto-proxy: until the six leave-one-tile-out networks are trained, a stand-in for loto on the
 #   tiles that have a network of MobileNetV2 that never saw them: each tile with a bundled
 #   mobilenetv2-dubai-loto/tile-k flown by it, tiles 4 and 6 otherwise by mobilenetv2-dubai
@@ -430,19 +436,25 @@ if [ "$part" = loto ]; then
     [ -s "$loto/tile-$k/model.onnx" ] || { echo "no $loto/tile-$k: bash scripts/loto.sh recipe-cpu, then bundle" >&2; exit 1; }
     crossed+=(--calibration-network "$loto/tile-$k")
   done
-  rm -rf "${root:?}/loto"
+  config=${CONFIG:-loto} oracle=${ORACLE_CONFIG:-oracle-default}
+  read -r -a extra <<<"${EXTRA:-}"
+  rm -rf "${root:?}/$config"
   for cls in $classes; do
     for t in 1 2 3 4 5 6; do
       train_except "$t"
-      run loto "mobilenetv2-loto-$cls-tile-$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
-        --network "$loto/tile-$t" "${network[@]}" "${crossed[@]}"
+      run "$config" "mobilenetv2-loto-$cls-tile-$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
+        --network "$loto/tile-$t" "${network[@]}" "${crossed[@]}" --no-plots "${extra[@]}"
     done
   done
   wait
   check
-  labels=("loto=$(dir_list "$root/loto"/*/)")
-  [ -d "$root/oracle-default" ] && labels+=("oracle=$(dir_list "$root/oracle-default"/dubai-*/)")
+  labels=("$config=$(dir_list "$root/$config"/*/)")
+  [ -d "$root/$oracle" ] && labels+=("oracle=$(dir_list "$root/$oracle"/dubai-*/)")
   /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
+  /usr/bin/python3 examples/tools/descent_table.py "$root/$config"/*/
+  targets=("$config=$root/$config")
+  [ -d "$root/$oracle" ] && targets=(--oracle "$root/$oracle" "${targets[@]}")
+  /usr/bin/python3 examples/tools/loto_targets.py "${targets[@]}"
   exit 0
 fi
 
@@ -659,7 +671,7 @@ fi
 
 if [ "$part" != network ]; then
   configs=(oracle-default oracle-paper)
-  [ "$part" = oracle-default ] && configs=(oracle-default)
+  [ "$part" = oracle-default ] && configs=("${CONFIG:-oracle-default}")
   if [ "$part" = paper ]; then
     [ -d "$root/oracle-default" ] || { echo "run 'bash $0 oracle-default' first" >&2; exit 1; }
     configs=(oracle-paper)
@@ -668,15 +680,16 @@ if [ "$part" != network ]; then
   for config in "${configs[@]}"; do
     extra=("${fixed[@]}")
     [ "$config" = oracle-paper ] && extra+=("${paper[@]}")
+    [ "$part" = oracle-default ] && read -r -a more <<<"${EXTRA:-}" && extra+=("${more[@]}")
     sweep "$config" "${extra[@]}"
   done
   wait
   check
   runs() { ls -d "$root/$1"/*/ | sed 's:/$::' | paste -sd, -; }
   if [ "$part" = oracle-default ]; then
-    /usr/bin/python3 examples/tools/sweep_table.py "defaults=$(runs oracle-default)"
-    /usr/bin/python3 examples/tools/per_image_table.py "$root/oracle-default/weedmap-train-left" \
-      "$root/oracle-default/weedmap-train-right"
+    /usr/bin/python3 examples/tools/sweep_table.py "defaults=$(runs "${configs[0]}")"
+    /usr/bin/python3 examples/tools/per_image_table.py "$root/${configs[0]}/weedmap-train-left" \
+      "$root/${configs[0]}/weedmap-train-right"
   elif [ "$part" = paper ]; then
     /usr/bin/python3 examples/tools/sweep_table.py "defaults=$(runs oracle-default)" "paper=$(runs oracle-paper)"
   else

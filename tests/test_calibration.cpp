@@ -44,6 +44,17 @@ CalibrationOptions small_options() {
   o.fit.restarts = 1;
   return o;
 }
+
+/// Two blob fields of the same kind, and small_options() with ranked cells and z in {0, 1}.
+std::vector<Field> two_blob_fields() {
+  return {t::blob_field(1300, 1000, 1.0, 4, 15), t::blob_field(1000, 1300, 1.0, 11, 15)};
+}
+CalibrationOptions ranked_options() {
+  CalibrationOptions o = small_options();
+  o.adaptive.coverage = DescentCoverage::ranked;
+  o.confidences = {0.0, 1.0};
+  return o;
+}
 }  // namespace
 
 TEST_CASE("calibration: region samples pair every region with every candidate") {
@@ -204,13 +215,9 @@ TEST_CASE("calibration: by default the front-aware rule, its confidence chosen o
 }
 
 TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the input that ranks them best is chosen") {
-  const Field a = t::blob_field(1300, 1000, 1.0, 4, 15);
-  const Field b = t::blob_field(1000, 1300, 1.0, 11, 15);
-  OracleSegmenter oracle(a.num_classes());
-  CalibrationOptions options = small_options();
-  options.adaptive.coverage = DescentCoverage::ranked;
-  options.confidences = {0.0, 1.0};
-  const std::vector<Field> fields{a, b};
+  const std::vector<Field> fields = two_blob_fields();
+  OracleSegmenter oracle(fields.front().num_classes());
+  CalibrationOptions options = ranked_options();
   const CalibrationResult cal = calibrate(std::span<const Field>(fields), oracle, options);
   REQUIRE_FALSE(cal.cell_samples.empty());
   // Every input about L is known from the oracle (it gives probabilities) and scored; the
@@ -411,6 +418,79 @@ TEST_CASE("calibration: another slope pooling replaces the first only where the 
   // Of several beyond the noise, the best mean; one alone is the one.
   CHECK(select({trial({0.0, 0.0, 0.0}), trial({0.01, 0.011, 0.012}), trial({0.02, 0.021, 0.022})}) == 2);
   CHECK(select({trial({0.0, 0.01})}) == 0);
+}
+
+TEST_CASE(
+    "calibration: several top-level choices, each with every setting, the first kept unless another's is better") {
+  const std::vector<Field> fields = two_blob_fields();
+  OracleSegmenter oracle(fields.front().num_classes());
+  CalibrationOptions options = ranked_options();
+  options.slope_poolings = {SlopePooling::cells};
+  options.top_levels = {TopLevelChoice::hull, TopLevelChoice::undominated};
+  const CalibrationResult cal = calibrate(std::span<const Field>(fields), oracle, options);
+  // Every z with each choice, named by it; the one kept first, and the model's rule flies it.
+  REQUIRE(cal.trials.size() == 4);
+  int hull = 0, undominated = 0;
+  for (const auto& trial : cal.trials) {
+    hull += trial.description.ends_with(" top=hull");
+    undominated += trial.description.ends_with(" top=undominated");
+  }
+  CHECK(hull == 2);
+  CHECK(undominated == 2);
+  const FrontAwarePolicy& rule = std::get<FrontAwarePolicy>(cal.decision_function.rule());
+  CHECK(cal.trials.front().description.ends_with(" top=" + to_string(rule.params().top_level)));
+  // The first choice (hull) kept unless the other's best z has a larger mean margin.
+  double best_hull = -1.0, best_undominated = -1.0;
+  for (const auto& trial : cal.trials)
+    (trial.description.ends_with(" top=hull") ? best_hull : best_undominated) =
+        std::max(trial.description.ends_with(" top=hull") ? best_hull : best_undominated, trial.front_margin);
+  CHECK(rule.params().top_level == (best_undominated > best_hull ? TopLevelChoice::undominated : TopLevelChoice::hull));
+  // One choice: no name in the trials; none: the parameters' own (as before the list).
+  options.top_levels = {TopLevelChoice::undominated};
+  CHECK(calibrate(std::span<const Field>(fields), oracle, options).trials.front().description.find("top=") ==
+        std::string::npos);
+  options.top_levels.clear();
+  options.front_aware.top_level = TopLevelChoice::hull;
+  const CalibrationResult own = calibrate(std::span<const Field>(fields), oracle, options);
+  CHECK(own.trials.size() == 2);
+  CHECK(std::get<FrontAwarePolicy>(own.decision_function.rule()).params().top_level == TopLevelChoice::hull);
+  // A choice named twice is refused up front.
+  options.top_levels = {TopLevelChoice::hull, TopLevelChoice::hull};
+  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
+                       doctest::Contains("top_levels names a choice twice"), std::invalid_argument);
+}
+
+TEST_CASE("calibration: the setting kept, per top level its pooling's best z, then the best top level") {
+  const auto trial = [](std::vector<double> margins) {
+    RuleTrial t;
+    for (double m : margins) t.front_margin += m / static_cast<double>(margins.size());
+    t.margins = std::move(margins);
+    return t;
+  };
+  using adaptseg::detail::FrontAwareSetting;
+  adaptseg::detail::FrontAwareGrid grid;
+  grid.poolings = {SlopePooling::cells, SlopePooling::fields};
+  grid.top_levels = {TopLevelChoice::undominated, TopLevelChoice::hull};
+  // Settings in the search's order: pooling, then top level, then z.
+  std::vector<FrontAwareSetting> settings;
+  for (std::size_t p = 0; p < 2; ++p)
+    for (std::size_t l = 0; l < 2; ++l)
+      for (double z : {0.0, 1.0}) settings.push_back({.pooling = p, .top_level = l, .z = z, .params = {}});
+  const auto choose = [&](const std::vector<RuleTrial>& trials) {
+    return adaptseg::detail::choose_setting(trials, settings, grid);
+  };
+  const RuleTrial zero = trial({0.0, 0.0, 0.0}), small = trial({0.001, 0.0, 0.0});
+  // All alike: the first level, the first pooling, the larger z.
+  CHECK(choose({zero, zero, zero, zero, zero, zero, zero, zero}) == 1);
+  // The second top level better (hull, cells, z = 0): kept.
+  CHECK(choose({zero, zero, small, zero, zero, zero, zero, zero}) == 2);
+  // The second pooling better than the first within its level on average, but not beyond the
+  // folds' noise: that level's first pooling stays, and so the first level (equal means).
+  const RuleTrial noisy = trial({0.002, -0.001, 0.0});
+  CHECK(choose({zero, zero, zero, zero, noisy, zero, zero, zero}) == 1);
+  // Beyond the noise (better on every fold): that pooling, and with it its level.
+  const RuleTrial clear = trial({0.002, 0.003, 0.002});
+  CHECK(choose({zero, zero, zero, zero, zero, zero, clear, zero}) == 6);
 }
 
 TEST_CASE("calibration: confidence levels the training fields cannot tell apart go to the more cautious") {

@@ -232,7 +232,7 @@ struct CalibrationCli {
   std::vector<std::string> cell_inputs;
   std::vector<std::string> slope_poolings{"cells", "fields"};
   std::string curve = "corrected";
-  std::string top_level = "undominated";
+  std::vector<std::string> top_levels{"undominated"};
 
   void add_to(CLI::App& app) {
     options_ = {
@@ -272,11 +272,14 @@ struct CalibrationCli {
                        "lawnmowers' rise against the predicted one (corrected)")
             ->check(CLI::IsMember({"training", "field", "corrected"}))
             ->capture_default_str(),
-        app.add_option("--top-level", top_level,
-                       "front-aware rule with --coverage ranked: the top-level GSD among those calibrated, the one "
-                       "whose lawnmower falls least short of the faster ones on the training fields' curves, field by "
-                       "field (undominated), or from there a finer one while the predicted curve rises faster per "
-                       "second up to it than beyond it (hull); saved in the model")
+        app.add_option("--top-level", top_levels,
+                       "front-aware rule with --coverage ranked: how the top-level GSD is chosen among those "
+                       "calibrated, the one whose lawnmower falls least short of the faster ones on the training "
+                       "fields' curves, field by field (undominated), or from there a finer one while the predicted "
+                       "curve rises faster per second up to it than beyond it (hull); comma-separated, each tried "
+                       "with every confidence level on the training fields, the first kept unless another has a "
+                       "better mean front margin; the one kept is saved in the model")
+            ->delimiter(',')
             ->check(CLI::IsMember(detail::names_of(kTopLevelChoices)))
             ->capture_default_str(),
         app.add_option("--gain-inputs", gain_inputs,
@@ -311,6 +314,7 @@ struct CalibrationCli {
 
   /// Sets the rule and the settings it tries, the descent coverage, I's inputs and the time
   /// charged per image of `options` (`common`: the programs' --seg-time-s and --plan-time-s).
+  /// @throws std::invalid_argument as check_calibration_options (a choice given twice).
   void apply(CalibrationOptions& options, const CommonOptions& common) const {
     options.threshold_steps = threshold_steps;
     options.rule = rule;
@@ -321,7 +325,8 @@ struct CalibrationCli {
     options.adaptive.coverage = parse_descent_coverage(coverage);
     options.front_aware.field_curve = curve == "field" || curve == "corrected";
     options.front_aware.curve_ratio = curve == "corrected";
-    options.front_aware.top_level = parse_top_level_choice(top_level);
+    options.top_levels.clear();
+    for (const auto& name : top_levels) options.top_levels.push_back(parse_top_level_choice(name));
     options.cell_inputs.clear();
     for (const auto& name : cell_inputs) options.cell_inputs.push_back(parse_decision_input(name));
     options.slope_poolings.clear();
@@ -330,6 +335,7 @@ struct CalibrationCli {
                                                                   : GainModel::GainInputs::delta_sigma;
     options.segmentation_time_s = segmentation_time_s.value_or(common.seg_time_s.value_or(0.1));
     options.planning_time_s = common.plan_time_s.value_or(0.0);
+    check_calibration_options(options);  // a repeated choice refused before any field is read
   }
 
  private:

@@ -42,6 +42,10 @@ adaptseg_calibrate)
     --out "$work/m.yaml" --slope-pooling field
   expect_error "--top-level: convex not in {undominated,hull}" --field "$weedmap" \
     --out "$work/m.yaml" --top-level convex
+  expect_error "--top-level: convex not in {undominated,hull}" --field "$weedmap" \
+    --out "$work/m.yaml" --top-level hull,convex
+  expect_error "top_levels names a choice twice: (got hull)" --field "$weedmap" --out "$work/m.yaml" \
+    --top-level hull,hull
   expect_error "max_vertical_speed_mps must be finite and >= 0" --field "$weedmap" --out "$work/m.yaml" \
     --vertical-speed -1
   # Cross-fitting: a field every network given was trained on, a flag the oracle has no use for.

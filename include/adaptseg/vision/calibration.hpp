@@ -27,21 +27,30 @@
 
 namespace adaptseg {
 
+/// Refuses options calibrate() cannot use, before it reads a field: a declared segmentation
+/// time that is negative or not finite, an unknown rule, or settings the rule cannot search
+/// (the rule's check_options, e.g. an empty or repeated list of settings to try).
+/// @throws std::invalid_argument naming the option.
+inline void check_calibration_options(const CalibrationOptions& options) {
+  detail::require(std::isfinite(options.segmentation_time_s) && options.segmentation_time_s >= 0.0,
+                  "calibrate: segmentation_time_s must be finite and >= 0", options.segmentation_time_s);
+  detail::require(is_rule_name(options.rule), "calibrate: the rule must be " + rule_names_text() + "; rule",
+                  options.rule);
+  for_each_rule([&]<class Rule>() {
+    if (options.rule == Rule::kName) Rule::check_options(options);
+  });
+}
+
 namespace detail {
 
 /// calibrate()'s settings of the adaptive missions it flies: `options.adaptive` with the labels
 /// of interest filled from the first field, and the declared segmentation and planning times.
 /// @throws std::invalid_argument for no field, fields with other class sets than the first's,
-///         an unknown rule, invalid options (the rule's check_options) or no label of interest.
+///         invalid options (check_calibration_options) or no label of interest.
 [[nodiscard]] inline AdaptiveOptions calibration_settings(std::span<const Field> fields,
                                                           const CalibrationOptions& options) {
   require(!fields.empty(), "calibrate: at least one training field is needed; count", fields.size());
-  require(std::isfinite(options.segmentation_time_s) && options.segmentation_time_s >= 0.0,
-          "calibrate: segmentation_time_s must be finite and >= 0", options.segmentation_time_s);
-  require(is_rule_name(options.rule), "calibrate: the rule must be " + rule_names_text() + "; rule", options.rule);
-  for_each_rule([&]<class Rule>() {
-    if (options.rule == Rule::kName) Rule::check_options(options);
-  });
+  check_calibration_options(options);
   const auto names = [](const Field& f) {
     std::vector<std::string> v;
     for (const auto& c : f.classes()) v.push_back(c.name);

@@ -89,6 +89,11 @@ struct CalibrationOptions {
   /// of their paired margins (detail::select_pooling). One training field: the first only (a
   /// field's own slope either way).
   std::vector<SlopePooling> slope_poolings{SlopePooling::cells, SlopePooling::fields};
+  /// Front-aware rule, DescentCoverage::ranked: the top-level choices tried (TopLevelChoice;
+  /// each replaces `front_aware.top_level`), each with every pooling and z; the first is kept
+  /// unless another's best setting has a larger mean front margin on the folds. Without ranked
+  /// cells: the first only. Empty (the default): `front_aware.top_level` alone.
+  std::vector<TopLevelChoice> top_levels{};
   /// Front-aware rule, σ̂'s prior (FrontAwarePolicy `sigma_prior_weight` k, `sigma_prior_sd` τ)
   /// with several training fields: `given` keeps `front_aware`'s; `spread` estimates τ on the
   /// training fields (estimate_sigma_prior) and keeps k; `estimated` estimates both. Each fold

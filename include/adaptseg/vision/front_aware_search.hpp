@@ -1,0 +1,346 @@
+#pragma once
+/// @file
+/// The front-aware rule's calibration search (FrontAwareRule::search, front_aware_rule.hpp):
+/// its settings (the confidence level z, the cell gain model's slope pooling, the top-level
+/// choice) tried on the training fields, each field flown with a model fitted without it, and
+/// σ̂'s prior estimated from their top-level images. docs/method.md, "The front-aware rule".
+
+#include <adaptseg/core/front_aware_policy.hpp>
+#include <adaptseg/vision/calibration_options.hpp>
+#include <adaptseg/vision/detail/number_text.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace adaptseg {
+
+/// The prior of a new field's σ the front-aware rule's σ̂ shrinks towards
+/// (FrontAwarePolicy::Params `sigma_prior_weight` k and `sigma_prior_sd` τ).
+struct SigmaPrior {
+  double weight = 0.25;  ///< k = v / τ² [fields]
+  double sd = 0.0;       ///< τ
+};
+
+/// The top-level images of one training field as the UAV sees them, in flight order: each
+/// image's σ and its region's share of the field (DecisionContext::sigma, region_share).
+struct TopLevelTrace {
+  double field_sigma = 0.0;  ///< σ of the field's top-level map (ReferenceCurve::field_sigma)
+  std::vector<double> sigma;
+  std::vector<double> share;
+};
+
+/// k and τ of σ̂'s hierarchical model (FrontAwarePolicy) estimated on training fields:
+/// τ² the sample variance of the fields' σ; v, the spread of the mean σ of a seen share S
+/// (variance v / S about the field's, hence v·(1 − S) / S about the whole field's mean m), is
+/// the mean over the fields and over the prefixes of each flight (0 < S <= 0.9) of
+/// (m_S − m)²·S / (1 − S), so that it holds the fields' spatial correlation along the flight
+/// as the UAV meets it; k = v / τ², kept in [0.01, 100]. std::nullopt for fewer than two
+/// fields or a field without a top-level image.
+[[nodiscard]] inline std::optional<SigmaPrior> estimate_sigma_prior(std::span<const TopLevelTrace> fields) {
+  if (fields.size() < 2) return std::nullopt;
+  double mean = 0.0;
+  for (const auto& f : fields) mean += f.field_sigma / static_cast<double>(fields.size());
+  double tau2 = 0.0, v = 0.0;
+  std::size_t prefixes = 0;
+  for (const auto& f : fields) {
+    tau2 += (f.field_sigma - mean) * (f.field_sigma - mean) / static_cast<double>(fields.size() - 1);
+    double total = 0.0, total_interest = 0.0;
+    for (std::size_t i = 0; i < f.share.size(); ++i) total += f.share[i], total_interest += f.share[i] * f.sigma[i];
+    if (!(total > 0.0)) return std::nullopt;
+    const double m = total_interest / total;
+    double seen = 0.0, seen_interest = 0.0;
+    for (std::size_t i = 0; i + 1 < f.share.size(); ++i) {
+      seen += f.share[i] / total;
+      seen_interest += f.share[i] / total * f.sigma[i];
+      if (seen <= 0.0 || seen > 0.9) continue;  // near the end (m_S − m)² / (1 − S) is all noise
+      const double d = seen_interest / seen - m;
+      v += d * d * seen / (1.0 - seen);
+      ++prefixes;
+    }
+  }
+  if (prefixes > 0) v /= static_cast<double>(prefixes);
+  const double k = tau2 > 0.0 ? std::clamp(v / tau2, 0.01, 100.0) : 100.0;
+  return SigmaPrior{k, std::sqrt(tau2)};
+}
+
+namespace detail {
+
+/// Records what each top-level image shows (σ, region share) and never descends.
+struct TopLevelRecorder {
+  TopLevelTrace trace;
+  void begin_mission() {
+    trace.sigma.clear();
+    trace.share.clear();
+  }
+  Decision decide(const DecisionContext& c) {
+    trace.sigma.push_back(c.sigma);
+    trace.share.push_back(c.region_share);
+    return {};
+  }
+  void observe(const DescentOutcome&) {}
+  [[nodiscard]] std::string name() const { return "top-level"; }
+};
+
+/// Which of several settings of the same folds to keep (`trials`, the best of each slope
+/// pooling, CalibrationOptions::slope_poolings' order): the first, unless another beats it on
+/// the folds by more than one standard error of their paired differences, m̄ − m̄₁ >
+/// sd(m − m₁) / sqrt(n) over the n folds (the one-standard-error rule of cross-validation,
+/// Breiman et al. 1984, towards the first, the default); of those that do, the best mean.
+/// Five training fields tell two poolings apart poorly, and a setting the folds prefer by less
+/// than their own scatter is as likely to lose on a new field (docs/results.md, "Slopes pooled
+/// over the cells or over the fields, chosen by the folds").
+inline std::size_t select_pooling(std::span<const RuleTrial* const> trials) {
+  std::size_t best = 0;
+  const std::vector<double>& first = trials.front()->margins;
+  for (std::size_t k = 1; k < trials.size(); ++k) {
+    const std::vector<double>& m = trials[k]->margins;
+    if (m.size() != first.size() || m.size() < 2) continue;
+    const double n = static_cast<double>(m.size());
+    double mean = 0.0;
+    for (std::size_t f = 0; f < m.size(); ++f) mean += (m[f] - first[f]) / n;
+    double ss = 0.0;
+    for (std::size_t f = 0; f < m.size(); ++f) ss += std::pow(m[f] - first[f] - mean, 2);
+    if (mean > std::sqrt(ss / (n - 1.0) / n) && trials[k]->front_margin > trials[best]->front_margin) best = k;
+  }
+  return best;
+}
+
+/// A trial's name: its z, its slope pooling and its top-level choice where the search tried
+/// several.
+inline std::string z_text(double z, const SlopePooling* pooling = nullptr, const TopLevelChoice* top_level = nullptr) {
+  std::string s = "front-aware z=" + format_number(z);
+  if (pooling) s += " slopes=" + to_string(*pooling);
+  if (top_level) s += " top=" + to_string(*top_level);
+  return s;
+}
+
+/// One fold of the search: a training field flown with a model fitted without it (one field:
+/// the field or one of its halves, with the whole field's model).
+struct FrontAwareFold {
+  const Field* field;
+  const std::vector<CurvePoint>* curve;
+  GainModel model;
+  std::vector<ReferenceCurve> reference;
+  std::optional<SigmaPrior> sigma_prior;  ///< estimated without the field
+  std::vector<CellSample> cells;          ///< the other fields' (ranked, several fields)
+};
+
+/// What the search tries beyond z: the slope poolings (several only where the cell gain model
+/// pools several fields) and the top-level choices (several only with ranked cells, which
+/// predict each field's curve at every top level).
+struct FrontAwareGrid {
+  std::vector<SlopePooling> poolings;
+  std::vector<TopLevelChoice> top_levels;
+  bool ranked = false;  ///< DescentCoverage::ranked
+  bool pools = false;   ///< ranked with several training fields
+};
+
+/// One setting tried: its pooling and top level (indices into FrontAwareGrid), z, the
+/// parameters flown.
+struct FrontAwareSetting {
+  std::size_t pooling = 0;
+  std::size_t top_level = 0;
+  double z = 0.0;
+  FrontAwarePolicy::Params params;
+};
+
+/// `p` with σ̂'s prior `prior` as `source` says (`given`, or no estimate: unchanged).
+inline void apply_sigma_prior(FrontAwarePolicy::Params& p, const std::optional<SigmaPrior>& prior,
+                              CalibrationOptions::SigmaPriorSource source) {
+  if (!prior || source == CalibrationOptions::SigmaPriorSource::given) return;
+  p.sigma_prior_sd = prior->sd;
+  if (source == CalibrationOptions::SigmaPriorSource::estimated) p.sigma_prior_weight = prior->weight;
+}
+
+/// What each training field's top-level images show along the flight, where σ̂'s prior is
+/// estimated from them (one top-level mission per field; otherwise none).
+template <class Fly>
+std::vector<TopLevelTrace> top_level_traces(const RuleSearchInputs& in, std::span<const ReferenceCurve> reference,
+                                            Fly& fly) {
+  std::vector<TopLevelTrace> traces;
+  if (in.fields.size() < 2 || in.options.sigma_prior == CalibrationOptions::SigmaPriorSource::given) return traces;
+  for (std::size_t f = 0; f < in.fields.size(); ++f) {
+    TopLevelRecorder recorder;
+    double unused = 0.0;
+    (void)fly(in.fields[f], recorder, in.curves[f], unused);
+    recorder.trace.field_sigma = reference[f].field_sigma;
+    traces.push_back(std::move(recorder.trace));
+  }
+  return traces;
+}
+
+/// One fold per training field, its model fitted without it (one field: its layouts, the whole
+/// field's model); each fold's σ̂ prior from the other fields' `traces` (where there are any)
+/// and, with ranked cells, the other fields' cells.
+inline std::vector<FrontAwareFold> front_aware_folds(const RuleSearchInputs& in,
+                                                     std::span<const ReferenceCurve> reference,
+                                                     std::span<const TopLevelTrace> traces, bool ranked) {
+  std::vector<FrontAwareFold> folds;
+  const std::vector<ReferenceCurve> all(reference.begin(), reference.end());
+  if (in.fields.size() == 1) {
+    folds.push_back({&in.fields.front(), &in.curves.front(), in.model, all, std::nullopt, {}});
+    for (std::size_t k = 0; k < in.halves.size(); ++k)
+      folds.push_back({&in.halves[k], &in.half_curves[k], in.model, all, std::nullopt, {}});
+    return folds;
+  }
+  for (std::size_t k = 0; k < in.fields.size(); ++k) {
+    std::vector<RegionSample> rest;
+    std::vector<ReferenceCurve> rest_reference;
+    std::vector<TopLevelTrace> rest_traces;
+    std::vector<CellSample> rest_cells;
+    for (std::size_t j = 0; j < in.fields.size(); ++j) {
+      if (j == k) continue;
+      rest.insert(rest.end(), in.samples[j].begin(), in.samples[j].end());
+      rest_reference.push_back(reference[j]);
+      if (!traces.empty()) rest_traces.push_back(traces[j]);
+      if (ranked) rest_cells.insert(rest_cells.end(), in.cells[j].begin(), in.cells[j].end());
+    }
+    GainModel m = GainModel::fit(rest, in.options.fit);
+    m.set_refit_every(in.options.refit_every);
+    folds.push_back({&in.fields[k], &in.curves[k], std::move(m), std::move(rest_reference),
+                     estimate_sigma_prior(rest_traces), std::move(rest_cells)});
+  }
+  return folds;
+}
+
+/// Field k's factor s under `model`, which did not see it: the least-squares scale of the
+/// model's forecasts onto what was realised (with `cells`: the cells' forecast gains onto their
+/// realised gains; otherwise C's relabelled shares onto the region samples'); nullopt where
+/// nothing was forecast.
+inline std::optional<double> field_scale(const GainModel& model, bool cells, std::span<const CellSample> cell_samples,
+                                         std::span<const RegionSample> samples) {
+  double num = 0.0, den = 0.0;
+  if (cells) {
+    for (const CellSample& c : cell_samples) {
+      const double f = model.cells()->cell_gain(c.top_gsd_cm, c.sub_gsd_cm, c.top) * c.top.field_px;
+      num += f * c.normalized_gain() * c.top.field_px;
+      den += f * f;
+    }
+  } else {
+    for (const RegionSample& s : samples) {
+      const GainForecast f = model.forecast(s.delta_h_m, s.sigma_top);
+      num += f.relabelled * s.relabelled.interest_share;
+      den += f.relabelled * f.relabelled;
+    }
+  }
+  if (!(den > 0.0)) return std::nullopt;
+  return num / den;
+}
+
+/// The folds' models with slope pooling `pooling` (with several fields pooled, each fold's
+/// cell gain model refitted so), and `base` with the field factor's prior spread ω estimated
+/// from them: the spread of s about 1 over the training fields (at least 0.1).
+inline std::vector<GainModel> pooled_fold_models(const RuleSearchInputs& in, std::span<const FrontAwareFold> folds,
+                                                 const FrontAwareGrid& grid, SlopePooling pooling,
+                                                 FrontAwarePolicy::Params& base) {
+  std::vector<GainModel> models;
+  std::vector<double> scales;
+  for (std::size_t k = 0; k < folds.size(); ++k) {
+    GainModel m = folds[k].model;
+    if (grid.pools) m.set_cells(CellGainModel::fit(folds[k].cells, in.adaptive.cell_input, pooling));
+    if (grid.pools || in.fields.size() >= 2)
+      if (const auto s =
+              field_scale(m, grid.pools, in.cells.empty() ? std::span<const CellSample>{} : in.cells[k], in.samples[k]))
+        scales.push_back(*s);
+    models.push_back(std::move(m));
+  }
+  if (scales.size() >= 2) {
+    double ss = 0.0;
+    for (double s : scales) ss += (s - 1.0) * (s - 1.0);
+    base.scale_prior_sd = std::max(0.1, std::sqrt(ss / static_cast<double>(scales.size())));
+  }
+  return models;
+}
+
+/// The setting kept (an index into `trials` and `settings`, in the same order): per pooling and
+/// top level, its z of best mean front margin (ties to the larger z); per top level, the first
+/// pooling's unless another beats it by more than the folds' noise (select_pooling); of the
+/// top levels, the first's unless another has a larger mean front margin.
+inline std::size_t choose_setting(std::span<const RuleTrial> trials, std::span<const FrontAwareSetting> settings,
+                                  const FrontAwareGrid& grid) {
+  const std::size_t none = trials.size();
+  std::vector<std::vector<std::size_t>> best(grid.top_levels.size(),
+                                             std::vector<std::size_t>(grid.poolings.size(), none));
+  for (std::size_t k = 0; k < trials.size(); ++k) {
+    std::size_t& b = best[settings[k].top_level][settings[k].pooling];
+    if (b == none || trials[k].front_margin > trials[b].front_margin ||
+        (trials[k].front_margin == trials[b].front_margin && settings[k].z > settings[b].z))
+      b = k;
+  }
+  std::size_t chosen = none;
+  for (const std::vector<std::size_t>& of_level : best) {
+    std::vector<const RuleTrial*> candidates;
+    for (std::size_t b : of_level) candidates.push_back(&trials[b]);
+    const std::size_t k = of_level[select_pooling(candidates)];
+    if (chosen == none || trials[k].front_margin > trials[chosen].front_margin) chosen = k;
+  }
+  return chosen;
+}
+
+}  // namespace detail
+
+/// The front-aware rule's calibration search (FrontAwareRule::search, which documents it):
+/// every setting of `in.options` flown over the folds by `fly`, the one kept first in the
+/// trials, the rule with it over the model of every field.
+template <class Fly>
+[[nodiscard]] RuleSearchResult search_front_aware(const RuleSearchInputs& in, Fly&& fly) {
+  const CalibrationOptions& options = in.options;
+  const std::vector<ReferenceCurve> reference(in.reference.begin(), in.reference.end());
+  detail::FrontAwareGrid grid;
+  grid.ranked = descent_coverage_info(in.adaptive.coverage).ranks_cells;
+  grid.pools = grid.ranked && in.fields.size() >= 2;
+  grid.poolings = grid.pools ? options.slope_poolings : std::vector<SlopePooling>{options.slope_poolings.front()};
+  grid.top_levels =
+      options.top_levels.empty() ? std::vector<TopLevelChoice>{options.front_aware.top_level} : options.top_levels;
+  if (!grid.ranked) grid.top_levels.resize(1);
+  const std::vector<TopLevelTrace> traces = detail::top_level_traces(in, reference, fly);
+  const std::vector<detail::FrontAwareFold> folds = detail::front_aware_folds(in, reference, traces, grid.ranked);
+  FrontAwarePolicy::Params base = options.front_aware;
+  base.online = true;
+  detail::apply_sigma_prior(base, estimate_sigma_prior(traces), options.sigma_prior);
+  std::vector<RuleTrial> trials;
+  std::vector<detail::FrontAwareSetting> settings;
+  for (std::size_t pi = 0; pi < grid.poolings.size(); ++pi) {
+    FrontAwarePolicy::Params pooled = base;
+    const std::vector<GainModel> models = detail::pooled_fold_models(in, folds, grid, grid.poolings[pi], pooled);
+    for (std::size_t ti = 0; ti < grid.top_levels.size(); ++ti)
+      for (double z : options.confidences) {
+        FrontAwarePolicy::Params p = pooled;
+        p.confidence = z;
+        p.top_level = grid.top_levels[ti];
+        RuleTrial t;
+        t.description = detail::z_text(z, grid.poolings.size() > 1 ? &grid.poolings[pi] : nullptr,
+                                       grid.top_levels.size() > 1 ? &grid.top_levels[ti] : nullptr);
+        for (std::size_t k = 0; k < folds.size(); ++k) {
+          FrontAwarePolicy::Params fold_params = p;  // σ̂'s prior: the fold's estimate replaces all fields'
+          detail::apply_sigma_prior(fold_params, folds[k].sigma_prior, options.sigma_prior);
+          FrontAwarePolicy policy(models[k], folds[k].reference, fold_params);
+          double margin = 0.0;
+          const AdaptiveResult r = fly(*folds[k].field, policy, *folds[k].curve, margin);
+          detail::add_to_trial(t, r, margin);
+        }
+        trials.push_back(std::move(t));
+        settings.push_back({pi, ti, z, p});
+      }
+  }
+  const std::size_t best = detail::choose_setting(trials, settings, grid);
+  std::rotate(trials.begin(), trials.begin() + static_cast<std::ptrdiff_t>(best),
+              trials.begin() + static_cast<std::ptrdiff_t>(best) + 1);
+  // The model of every field, its cell gain model pooled as chosen.
+  GainModel model = in.model;
+  const SlopePooling pooling = grid.poolings[settings[best].pooling];
+  if (grid.ranked && model.cells() && model.cells()->pooling() != pooling) {
+    std::vector<CellSample> all;
+    for (const auto& c : in.cells) all.insert(all.end(), c.begin(), c.end());
+    model.set_cells(CellGainModel::fit(all, in.adaptive.cell_input, pooling));
+  }
+  return {DecisionFunction(FrontAwarePolicy(std::move(model), reference, settings[best].params)), std::move(trials)};
+}
+
+}  // namespace adaptseg
