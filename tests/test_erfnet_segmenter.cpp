@@ -13,6 +13,7 @@
 #include <adaptseg/erfnet/erfnet_segmenter.hpp>  // the old name: it must still bring OnnxSegmenter in
 #include <adaptseg/erfnet/network_identity.hpp>
 #include <adaptseg/erfnet/onnx_segmenter.hpp>
+#include <adaptseg/vision/decision_model.hpp>
 #include <adaptseg/vision/metrics.hpp>
 #include <adaptseg/vision/oracle_segmenter.hpp>
 
@@ -373,6 +374,29 @@ TEST_CASE("erfnet: clear errors for bad models, bad parameters and images withou
   mismatch.width_px = 481;
   CHECK_THROWS_WITH_AS((void)erfnet.segment(mismatch), doctest::Contains("width_px x height_px"),
                        std::invalid_argument);
+}
+
+TEST_CASE(
+    "erfnet: the deployment model's bundled decision models name it and the networks that never saw their tiles") {
+  // examples/models/mobilenetv2-dubai-all/decision-<class>.yaml (scripts/loto.sh decision): a
+  // new site flies them with this network, so each must name this network as it is now (its
+  // weights and temperature) and each calibration tile's network of the same recipe that never
+  // saw it; a retrained or re-tempered network makes them stale, and this says so.
+  const fs::path models = fs::path(ADAPTSEG_EXAMPLES_DIR) / "models";
+  const fs::path all = models / "mobilenetv2-dubai-all";
+  for (const char* cls : {"building", "road", "vegetation", "water"}) {
+    CAPTURE(cls);
+    const DecisionModel m = DecisionModel::load(all / ("decision-" + std::string(cls) + ".yaml"));
+    CHECK(m.segmenter == network_name(all));
+    CHECK(m.interest == std::vector<std::string>{cls});
+    REQUIRE(m.calibration_fields.size() == 6);
+    REQUIRE(m.field_segmenters.size() == 6);
+    for (std::size_t k = 0; k < 6; ++k) {
+      const std::string tile = "tile-" + std::to_string(k + 1);
+      CHECK(m.calibration_fields[k] == "dubai-" + tile);
+      CHECK(m.field_segmenters[k] == network_name(models / "mobilenetv2-dubai-loto" / tile));
+    }
+  }
 }
 
 TEST_CASE("erfnet: the deployment model (all six tiles) keeps the backend contract and its metadata says what it saw") {
