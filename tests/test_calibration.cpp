@@ -49,6 +49,13 @@ CalibrationOptions small_options() {
 std::vector<Field> two_blob_fields() {
   return {t::blob_field(1300, 1000, 1.0, 4, 15), t::blob_field(1000, 1300, 1.0, 11, 15)};
 }
+/// A trial of the folds' margins `margins`, its front margin their mean.
+RuleTrial trial(std::vector<double> margins) {
+  RuleTrial t;
+  for (double m : margins) t.front_margin += m / static_cast<double>(margins.size());
+  t.margins = std::move(margins);
+  return t;
+}
 CalibrationOptions ranked_options() {
   CalibrationOptions o = small_options();
   o.adaptive.coverage = DescentCoverage::ranked;
@@ -394,12 +401,6 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
 }
 
 TEST_CASE("calibration: another slope pooling replaces the first only where the folds prefer it beyond their noise") {
-  const auto trial = [](std::vector<double> margins) {
-    RuleTrial t;
-    for (double m : margins) t.front_margin += m / static_cast<double>(margins.size());
-    t.margins = std::move(margins);
-    return t;
-  };
   const auto select = [](const std::vector<RuleTrial>& trials) {
     std::vector<const RuleTrial*> p;
     for (const auto& t : trials) p.push_back(&t);
@@ -461,12 +462,6 @@ TEST_CASE(
 }
 
 TEST_CASE("calibration: the setting kept, per top level its pooling's best z, then the best top level") {
-  const auto trial = [](std::vector<double> margins) {
-    RuleTrial t;
-    for (double m : margins) t.front_margin += m / static_cast<double>(margins.size());
-    t.margins = std::move(margins);
-    return t;
-  };
   using adaptseg::detail::FrontAwareSetting;
   adaptseg::detail::FrontAwareGrid grid;
   grid.poolings = {SlopePooling::cells, SlopePooling::fields};

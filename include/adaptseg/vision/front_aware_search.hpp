@@ -244,7 +244,7 @@ inline std::vector<GainModel> pooled_fold_models(const RuleSearchInputs& in, std
   for (std::size_t k = 0; k < folds.size(); ++k) {
     GainModel m = folds[k].model;
     if (grid.pools) m.set_cells(CellGainModel::fit(folds[k].cells, in.adaptive.cell_input, pooling));
-    if (grid.pools || in.fields.size() >= 2)
+    if (in.fields.size() >= 2)  // several fields (grid.pools implies them)
       if (const auto s =
               field_scale(m, grid.pools, in.cells.empty() ? std::span<const CellSample>{} : in.cells[k], in.samples[k]))
         scales.push_back(*s);
