@@ -13,7 +13,8 @@
 #       at most LOTO_STEP_CAP steps (environment; default 1784, the deployment network's
 #       schedule), batches made on the GPU (--sampler device, PREFETCH batches ahead, default 2),
 #       checkpoints to $OUT/loto-<k>.pt (7.5 MB each) and the logs
-#       to $OUT/loto-logs.tar.gz. TILES: the held-out tiles (default 1,2,3,4,5,6). STEPS > 0
+#       to $OUT/loto-logs.tar.gz, seed LOTO_SEED (environment; default 0, the bundled networks').
+#       TILES: the held-out tiles (default 1,2,3,4,5,6). STEPS > 0
 #       trains that many steps instead of fitting MINUTES, on the CPU if there is no GPU (a
 #       rehearsal of the call here).
 #   bash scripts/loto.sh eval DIR
@@ -45,6 +46,12 @@
 #       field's network) into examples/models/mobilenetv2-dubai-all/decision-<class>.yaml, logs in
 #       out/loto/decision-<class>.log. What a user flies a new site with (docs/programs.md,
 #       "A new site"). Segmentations are cached in out/results/segmentation-cache.
+#   LOTO_SEED=1 LOTO_WORK=out/loto-seed1 LOTO_BUNDLE=out/loto-seed1/bundle bash scripts/loto.sh ...
+#       another seed of the six: train and recipe-cpu train with LOTO_SEED; eval, recipe-cpu and
+#       bundle work in LOTO_WORK (default out/loto); bundle fills LOTO_BUNDLE (default
+#       examples/models/mobilenetv2-dubai-loto) and sets the deployment network's temperature
+#       only from the default folder; decision reads LOTO_BUNDLE and writes into LOTO_WORK unless
+#       it is the default. scripts/results.sh loto flies such a folder with LOTO_NETWORKS.
 #   bash scripts/loto.sh cpu TILE [--resume]
 #       here, no accelerator: one training of examples/models/mobilenetv2-dubai's CPU recipe
 #       (2000 steps of 8 crops) on the five tiles but TILE, exported to out/loto-cpu/model-TILE
@@ -58,6 +65,10 @@ cd "$(dirname "$0")/.."
 # The interpreter with PyTorch: a device machine's plain python3, else Debian's (this machine's).
 py=${PYTHON:-$(python3 -c 'import torch, cv2' 2>/dev/null && echo python3 || echo /usr/bin/python3)}
 tiles_all=(1 2 3 4 5 6)
+# Where recipe-cpu, eval and bundle work (LOTO_WORK), and the folder bundle fills and decision
+# reads (LOTO_BUNDLE): another seed's networks go beside the bundled ones, never over them.
+wroot=${LOTO_WORK:-out/loto}
+dest=${LOTO_BUNDLE:-examples/models/mobilenetv2-dubai-loto}
 train_fields() {  # every bundled tile but $1, comma-separated
   local k=$1 out=""
   for t in "${tiles_all[@]}"; do [ "$t" = "$k" ] || out+="${out:+,}dubai-tile-$t"; done
@@ -90,7 +101,7 @@ train)
   pids=()
   for k in "${tiles[@]}"; do
     "$py" examples/tools/train_segnet.py --arch mobilenetv2 --encoder-weights .device/mnv2_enc.pt \
-      --frozen-blocks 4 --no-image-pooling --lr 1e-3 --weight-decay 0.01 --ema 0.998 --augment altitude --seed 0 \
+      --frozen-blocks 4 --no-image-pooling --lr 1e-3 --weight-decay 0.01 --ema 0.998 --augment altitude --seed "${LOTO_SEED:-0}" \
       --sampler "$sampler" --prefetch "${PREFETCH:-2}" --device "$device" --train-fields "$(train_fields "$k")" --val-field "dubai-tile-$k" \
       --test-field none --threads 1 --val-every 0 --ckpt-every 100 --log-every 50 --no-export \
       "${schedule[@]}" --work-dir "$work/loto-$k" --model-dir "$work/unused-$k" >"$work/loto-$k.log" 2>&1 &
@@ -107,22 +118,22 @@ train)
   ;;
 eval)
   dir=${2:?directory with loto-<k>.pt}
-  mkdir -p out/loto
+  mkdir -p "$wroot"
   for ckpt in "$dir"/loto-*.pt; do
     k=${ckpt##*/loto-}
     k=${k%.pt}
-    work=out/loto/work-$k
+    work=$wroot/work-$k
     mkdir -p "$work"
     cp "$ckpt" "$work/checkpoint.pt"
-    "$py" examples/tools/train_segnet.py --arch mobilenetv2 --work-dir "$work" --model-dir "out/loto/model-$k" \
+    "$py" examples/tools/train_segnet.py --arch mobilenetv2 --work-dir "$work" --model-dir "$wroot/model-$k" \
       --export-only --train-fields "$(train_fields "$k")" --val-field "dubai-tile-$k" --test-field none \
-      >"out/loto/export-$k.log" 2>&1 || { echo "export of $ckpt failed: out/loto/export-$k.log" >&2; exit 1; }
+      >"$wroot/export-$k.log" 2>&1 || { echo "export of $ckpt failed: $wroot/export-$k.log" >&2; exit 1; }
     echo "== held out dubai-tile-$k (trained on $(train_fields "$k"))"
-    "$py" examples/tools/eval_ensemble.py --members "loto$k=out/loto/model-$k" \
-      --fields "examples/data/dubai-tile-$k" --bands 1,2,3 --json "out/loto/eval-$k.json"
+    "$py" examples/tools/eval_ensemble.py --members "loto$k=$wroot/model-$k" \
+      --fields "examples/data/dubai-tile-$k" --bands 1,2,3 --json "$wroot/eval-$k.json"
   done
   # The estimate: each held-out tile's field mIoU per GSD, their mean, and per class.
-  "$py" - out/loto/eval-*.json <<'PY'
+  "$py" - "$wroot"/eval-*.json <<'PY'
 import json, sys
 rows, classes = [], None
 for path in sys.argv[1:]:
@@ -146,25 +157,25 @@ PY
 recipe-cpu)
   IFS=, read -r -a tiles <<<"${2:-1,2,3,4,5,6}"
   [ -s .device/mnv2_enc.pt ] || { echo "no .device/mnv2_enc.pt: run 'bash $0 weights' here first" >&2; exit 2; }
-  mkdir -p out/loto
+  mkdir -p "$wroot"
   for k in "${tiles[@]}"; do
-    work=out/loto/work-$k
+    work=$wroot/work-$k
     if [ ! -s "$work/done" ]; then
       resume=()
       [ -s "$work/checkpoint.pt" ] && resume=(--resume)
       "$py" examples/tools/train_segnet.py --arch mobilenetv2 --encoder-weights .device/mnv2_enc.pt \
-        --frozen-blocks 4 --no-image-pooling --lr 1e-3 --weight-decay 0.01 --ema 0.998 --augment altitude --seed 0 \
+        --frozen-blocks 4 --no-image-pooling --lr 1e-3 --weight-decay 0.01 --ema 0.998 --augment altitude --seed "${LOTO_SEED:-0}" \
         --sampler cpu --device cpu --workers 1 --threads "${LOTO_THREADS:-2}" --train-fields "$(train_fields "$k")" \
         --val-field "dubai-tile-$k" --test-field none --val-every 0 --ckpt-every 100 --log-every 50 --no-export \
-        --steps 1784 --batch 32 --crop 300 --warmup 100 --work-dir "$work" --model-dir "out/loto/unused-$k" \
-        "${resume[@]}" >>"out/loto/train-$k.log" 2>&1 || { echo "training $k failed: out/loto/train-$k.log" >&2; exit 1; }
+        --steps 1784 --batch 32 --crop 300 --warmup 100 --work-dir "$work" --model-dir "$wroot/unused-$k" \
+        "${resume[@]}" >>"$wroot/train-$k.log" 2>&1 || { echo "training $k failed: $wroot/train-$k.log" >&2; exit 1; }
       date -u +%FT%TZ >"$work/done"
     fi
-    "$py" examples/tools/train_segnet.py --arch mobilenetv2 --work-dir "$work" --model-dir "out/loto/model-$k" \
+    "$py" examples/tools/train_segnet.py --arch mobilenetv2 --work-dir "$work" --model-dir "$wroot/model-$k" \
       --export-only --train-fields "$(train_fields "$k")" --val-field "dubai-tile-$k" --test-field none \
-      >"out/loto/export-$k.log" 2>&1 || { echo "export of tile $k failed: out/loto/export-$k.log" >&2; exit 1; }
-    "$py" examples/tools/eval_ensemble.py --members "loto$k=out/loto/model-$k" \
-      --fields "examples/data/dubai-tile-$k" --bands 1,2,3 --json "out/loto/eval-$k.json"
+      >"$wroot/export-$k.log" 2>&1 || { echo "export of tile $k failed: $wroot/export-$k.log" >&2; exit 1; }
+    "$py" examples/tools/eval_ensemble.py --members "loto$k=$wroot/model-$k" \
+      --fields "examples/data/dubai-tile-$k" --bands 1,2,3 --json "$wroot/eval-$k.json"
   done
   ;;
 bundle)
@@ -172,17 +183,16 @@ bundle)
   configure_for results build/release >/dev/null
   cmake --build build/release -j2 --target adaptseg_fit_temperature >/dev/null
   fit=build/release/examples/adaptseg_fit_temperature
-  dest=examples/models/mobilenetv2-dubai-loto
   declare -A fitted src
-  mkdir -p out/loto
+  mkdir -p "$wroot"
   for k in "${tiles_all[@]}"; do
-    # The network trained here (out/loto/model-k), else the one bundled already (committed).
-    src[$k]=out/loto/model-$k
+    # The network trained here ($wroot/model-k), else the one bundled already (committed).
+    src[$k]=$wroot/model-$k
     [ -s "${src[$k]}/model.onnx" ] || src[$k]=$dest/tile-$k
-    [ -s "${src[$k]}/model.onnx" ] || { echo "no out/loto/model-$k nor $dest/tile-$k: bash $0 recipe-cpu $k (or eval)" >&2; exit 1; }
-    "$fit" --network "${src[$k]}" --field "examples/data/dubai-tile-$k" --threads 2 >"out/loto/temperature-$k.log"
-    fitted[$k]=$(sed -n 's/^temperature: \([0-9.]*\).*/\1/p' "out/loto/temperature-$k.log")
-    [ -n "${fitted[$k]}" ] || { echo "no temperature in out/loto/temperature-$k.log" >&2; exit 1; }
+    [ -s "${src[$k]}/model.onnx" ] || { echo "no $wroot/model-$k nor $dest/tile-$k: bash $0 recipe-cpu $k (or eval)" >&2; exit 1; }
+    "$fit" --network "${src[$k]}" --field "examples/data/dubai-tile-$k" --threads 2 >"$wroot/temperature-$k.log"
+    fitted[$k]=$(sed -n 's/^temperature: \([0-9.]*\).*/\1/p' "$wroot/temperature-$k.log")
+    [ -n "${fitted[$k]}" ] || { echo "no temperature in $wroot/temperature-$k.log" >&2; exit 1; }
   done
   median() { printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { print (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2) }'; }
   mkdir -p "$dest"
@@ -193,20 +203,21 @@ bundle)
     t=$(median "${others[@]}")
     mkdir -p "$dest/tile-$k"
     if [ "${src[$k]}" != "$dest/tile-$k" ]; then
-      for f in model.onnx model.yaml train_log.csv val_log.csv val_ema_log.csv; do cp "out/loto/model-$k/$f" "$dest/tile-$k/"; done
-      cp "out/loto/eval-$k.json" "$dest/tile-$k/held_out_eval.json"
-      [ ! -f "out/loto/train-$k.log" ] || cp "out/loto/train-$k.log" "$dest/tile-$k/train.log"
+      for f in model.onnx model.yaml train_log.csv val_log.csv val_ema_log.csv; do cp "$wroot/model-$k/$f" "$dest/tile-$k/"; done
+      cp "$wroot/eval-$k.json" "$dest/tile-$k/held_out_eval.json"
+      [ ! -f "$wroot/train-$k.log" ] || cp "$wroot/train-$k.log" "$dest/tile-$k/train.log"
     fi
     "$fit" --network "$dest/tile-$k" --set "$t" >/dev/null
     echo "dubai-tile-$k,${fitted[$k]},$t" >>"$dest/temperatures.csv"
   done
-  "$fit" --network examples/models/mobilenetv2-dubai-all --set "$(median "${fitted[@]}")"
+  # The deployment network's temperature comes from the bundled networks' fits alone.
+  [ "$dest" != examples/models/mobilenetv2-dubai-loto ] ||
+    "$fit" --network examples/models/mobilenetv2-dubai-all --set "$(median "${fitted[@]}")"
   cat "$dest/temperatures.csv"
   ;;
 decision)
   read -r -a classes <<<"${2:-building road vegetation water}"
   deploy=examples/models/mobilenetv2-dubai-all
-  dest=examples/models/mobilenetv2-dubai-loto
   trains=() crossed=()
   for k in "${tiles_all[@]}"; do
     grep -q '^temperature:' "$dest/tile-$k/model.yaml" 2>/dev/null ||
@@ -218,13 +229,16 @@ decision)
   source scripts/configure.sh
   configure_for results build/release >/dev/null
   cmake --build build/release -j2 --target adaptseg_calibrate >/dev/null
-  mkdir -p out/loto
+  # The bundled decision models come from the bundled networks; another folder's go to LOTO_WORK.
+  models=$deploy
+  [ "$dest" = examples/models/mobilenetv2-dubai-loto ] || models=$wroot
+  mkdir -p "$wroot"
   for cls in "${classes[@]}"; do
     build/release/examples/adaptseg_calibrate "${trains[@]}" --interest "$cls" --segmenter network --network "$deploy" \
       "${crossed[@]}" --threads "${LOTO_THREADS:-2}" --segmentation-cache out/results/segmentation-cache \
-      --out "$deploy/decision-$cls.yaml" >"out/loto/decision-$cls.log" 2>&1 ||
-      { echo "calibration for $cls failed: out/loto/decision-$cls.log" >&2; exit 1; }
-    echo "$deploy/decision-$cls.yaml"
+      --out "$models/decision-$cls.yaml" >"$wroot/decision-$cls.log" 2>&1 ||
+      { echo "calibration for $cls failed: $wroot/decision-$cls.log" >&2; exit 1; }
+    echo "$models/decision-$cls.yaml"
   done
   ;;
 cpu)
@@ -244,7 +258,7 @@ cpu)
     --field "examples/data/dubai-tile-$k" --threads 2 --write
   ;;
 *)
-  sed -n '2,54p' "$0" >&2
+  sed -n '2,62p' "$0" >&2
   exit 2
   ;;
 esac

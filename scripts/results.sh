@@ -37,6 +37,7 @@
 #   ORACLE_CONFIG names another folder of them). Every network segments its own tile once into
 #   the segmentation cache. CONFIG (environment) names the folder (default loto), EXTRA adds
 #   flags to every run: CONFIG=loto-hull EXTRA="--top-level hull" ORACLE_CONFIG=oracle-hull.
+#   LOTO_NETWORKS names another folder of tile-1 ... tile-6 networks (another seed, say).
 #   Last, the targets (examples/tools/loto_targets.py; several configurations side by
 #   side: loto_targets.py --oracle out/results/oracle-default a=out/results/loto b=...).
 # loto-proxy: until the six leave-one-tile-out networks are trained, a stand-in for loto on the
@@ -430,7 +431,7 @@ if [ "$part" = ensemble-split ]; then
 fi
 
 if [ "$part" = loto ]; then
-  loto=examples/models/mobilenetv2-dubai-loto
+  loto=${LOTO_NETWORKS:-examples/models/mobilenetv2-dubai-loto}
   crossed=()
   for k in 1 2 3 4 5 6; do
     [ -s "$loto/tile-$k/model.onnx" ] || { echo "no $loto/tile-$k: bash scripts/loto.sh recipe-cpu, then bundle" >&2; exit 1; }
