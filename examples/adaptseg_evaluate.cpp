@@ -166,11 +166,12 @@ int main(int argc, char** argv) {
     const std::size_t total_runs = tests.size() * (lawnmower_factors.size() + model_strategies.size());
     std::size_t run_index = 0;
     for (const auto& field : tests) {
-      // Every strategy, the lawnmowers too, flies the model's camera and speed limits (equal to
+      // Every strategy, the lawnmowers too, flies the model's camera, speed limits and map fusion (equal to
       // the options when the model is calibrated here; checked against explicit ones above).
       adaptseg::MissionOptions mo = common.resolve(field);
       mo.camera = model.camera;
       mo.timing = model.timing;
+      mo.map_fusion = model.map_fusion;
       struct Row {
         std::string strategy;
         double gsd;

@@ -164,6 +164,7 @@ void write_outputs(const Planner& planner, const ImageSetInfo& info, const std::
   nlohmann::json j{{"field", info.name},
                    {"strategy", policy_name},
                    {"schedule", adaptseg::to_string(options.schedule)},
+                   {"map_fusion", adaptseg::to_string(options.mission.map_fusion)},
                    {"segmenter", backend_name},
                    {"top_gsd_cm", planner.top_gsd_cm()},
                    {"images", wps.size()},

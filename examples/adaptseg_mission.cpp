@@ -75,7 +75,8 @@ int main(int argc, char** argv) {
                                     overlap);
     });
     const adaptseg::MissionResult& result = run.mission;
-    if (!lawnmower) options.camera = model->camera, options.timing = model->timing;
+    if (!lawnmower)
+      options.camera = model->camera, options.timing = model->timing, options.map_fusion = model->map_fusion;
 
     fs::create_directories(out_dir);
     auto json = adaptseg::examples::result_json(field, result, options, run.decisions ? &*run.decisions : nullptr);

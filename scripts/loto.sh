@@ -128,6 +128,11 @@ eval)
     "$py" examples/tools/train_segnet.py --arch mobilenetv2 --work-dir "$work" --model-dir "$wroot/model-$k" \
       --export-only --train-fields "$(train_fields "$k")" --val-field "dubai-tile-$k" --test-field none \
       >"$wroot/export-$k.log" 2>&1 || { echo "export of $ckpt failed: $wroot/export-$k.log" >&2; exit 1; }
+    # The device call's training logs beside the network, as recipe-cpu leaves them.
+    if [ -s "$dir/loto-logs.tar.gz" ]; then
+      tar xzf "$dir/loto-logs.tar.gz" -C "$wroot/model-$k" --strip-components 2 "./loto-$k/"
+      tar xzf "$dir/loto-logs.tar.gz" -O "./loto-$k.log" >"$wroot/train-$k.log"
+    fi
     echo "== held out dubai-tile-$k (trained on $(train_fields "$k"))"
     "$py" examples/tools/eval_ensemble.py --members "loto$k=$wroot/model-$k" \
       --fields "examples/data/dubai-tile-$k" --bands 1,2,3 --json "$wroot/eval-$k.json"

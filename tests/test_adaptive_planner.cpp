@@ -678,6 +678,38 @@ TEST_CASE("AdaptivePlanner: stepping by hand over WeedMap gives run_adaptive_mis
   }
 }
 
+TEST_CASE("AdaptivePlanner (pooled map): stepping by hand gives run_adaptive_mission's map; labels alone are refused") {
+  const Field f = Field::load(t::example_field("weedmap-000"));
+  OracleSegmenter oracle(f.num_classes());
+  AdaptiveOptions o = weedmap_options(f);
+  o.mission.map_fusion = MapFusion::pooled;
+  Scripted sim_policy{.gsd = 1.5, .which = {0, 2, 3, 5}};
+  const AdaptiveResult sim = run_adaptive_mission(f, oracle, sim_policy, o, "scripted");
+  REQUIRE(sim.descents() >= 2);
+  Scripted live_policy{.gsd = 1.5, .which = {0, 2, 3, 5}};
+  Planner planner(SurveyArea::of(f), oracle, live_policy, o);
+  CHECK(planner.map().fusion() == MapFusion::pooled);
+  (void)fly(planner, f);
+  CHECK(cv::countNonZero(planner.map().labels() != sim.mission.fused_labels) == 0);
+  // The oracle's looks are sure where they are finest: the map is the paper's.
+  o.mission.map_fusion = MapFusion::finest;
+  Scripted finest_policy{.gsd = 1.5, .which = {0, 2, 3, 5}};
+  const AdaptiveResult finest = run_adaptive_mission(f, oracle, finest_policy, o, "scripted");
+  CHECK(sim.mission.miou_interest().value() == doctest::Approx(finest.mission.miou_interest().value()).epsilon(1e-3));
+  // Labels without probabilities cannot be pooled: refused, the waypoint still pending.
+  o.mission.map_fusion = MapFusion::pooled;
+  Scripted never{.gsd = 0.5};
+  Planner live(SurveyArea::of(f), oracle, never, o);
+  const auto w = live.next();
+  REQUIRE(w.has_value());
+  const Image img = SimulatedSensor(f, live.camera()).capture(w->waypoint);
+  CHECK_THROWS_WITH_AS((void)live.report(img, oracle.segment(img), 0.1),
+                       doctest::Contains("map fusion 'pooled' needs the class probabilities behind the labels"),
+                       std::invalid_argument);
+  CHECK(live.pending().has_value());
+  CHECK(live.report(img, oracle.segment_with_probabilities(img), 0.1).waypoint.index == 0);
+}
+
 TEST_CASE("AdaptivePlanner: next() repeats the pending waypoint and is nullopt once done") {
   const Field f = t::blob_field(1500, 1100, 1.0, 5, 40);
   OracleSegmenter oracle(f.num_classes());

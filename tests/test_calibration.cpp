@@ -767,6 +767,23 @@ TEST_CASE("decision model: file round trip and compatibility checks") {
     CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "bad.yaml"),
                          doctest::Contains("'region', 'interest' or 'ranked'"), std::invalid_argument);
   }
+  {  // the map fusion: kept when pooled and flown by the model's missions; absent (finest) when not
+    CHECK(back.map_fusion == MapFusion::finest);
+    CHECK(t::read_file(tmp.path() / "model.yaml").find("map_fusion") == std::string::npos);
+    DecisionModel pooled = m;
+    pooled.map_fusion = MapFusion::pooled;
+    pooled.save(tmp.path() / "pooled.yaml");
+    const std::string text = t::read_file(tmp.path() / "pooled.yaml");
+    CHECK(text.find("map_fusion: pooled\n") != std::string::npos);
+    const DecisionModel pooled_back = DecisionModel::load(tmp.path() / "pooled.yaml");
+    CHECK(pooled_back.map_fusion == MapFusion::pooled);
+    CHECK(pooled_back.adaptive_options(MissionOptions{}).mission.map_fusion == MapFusion::pooled);
+    t::write_file(tmp.path() / "bad_fusion.yaml",
+                  std::string(text).replace(text.find("map_fusion: pooled"), 18, "map_fusion: mean"));
+    CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "bad_fusion.yaml"),
+                         doctest::Contains("map fusion must be 'finest' or 'pooled', not 'mean'"),
+                         std::invalid_argument);
+  }
   {  // the vertical speed limit: kept when set, absent from the file (0) when not
     CHECK(back.timing.max_vertical_speed_mps == 0.0);
     CHECK(t::read_file(tmp.path() / "model.yaml").find("vertical") == std::string::npos);

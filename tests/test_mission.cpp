@@ -113,3 +113,29 @@ TEST_CASE("mission: a backend that breaks the contract is reported by name") {
   CHECK_THROWS_WITH_AS((void)run_lawnmower_mission(f, 1.0, broken, {}), doctest::Contains("'broken'"),
                        std::invalid_argument);
 }
+
+namespace {
+/// The oracle's labels without its probabilities: a labels-only backend.
+struct LabelsOnlyOracle {
+  OracleSegmenter oracle;
+  [[nodiscard]] std::string name() const { return "labels-only"; }
+  [[nodiscard]] cv::Mat segment(const Image& image) const { return oracle.segment(image); }
+};
+}  // namespace
+
+TEST_CASE("mission: a pooled map maps WeedMap at the field's GSD exactly and needs the class probabilities") {
+  const Field f = Field::load(t::example_field("weedmap-000"));
+  OracleSegmenter oracle(f.num_classes());
+  MissionOptions o = deterministic();
+  o.map_fusion = MapFusion::pooled;
+  const MissionResult r = run_lawnmower_mission(f, f.gsd_cm(), oracle, o);
+  CHECK(r.miou_all().value() == 1.0);
+  // The same images and times as the paper's fusion: only the map's rule differs.
+  const MissionResult finest = run_lawnmower_mission(f, f.gsd_cm(), oracle, deterministic());
+  CHECK(r.total_s() == finest.total_s());
+  CHECK(cv::countNonZero(r.fused_labels != finest.fused_labels) == 0);
+  LabelsOnlyOracle labels_only{OracleSegmenter(f.num_classes())};
+  CHECK_THROWS_WITH_AS((void)run_lawnmower_mission(f, f.gsd_cm(), labels_only, o),
+                       doctest::Contains("map fusion 'pooled' needs a backend that gives class probabilities"),
+                       std::invalid_argument);
+}

@@ -166,3 +166,94 @@ TEST_CASE("semantic map: fuse writes what resampling the labels onto the footpri
     CHECK(cv::countNonZero(map.gsd_cm() != ref_gsd) == 0);
   }
 }
+
+namespace {
+/// A segmentation of a w x h image: every pixel `label`, with probability `p` on it and the rest
+/// spread evenly over the other classes.
+Segmentation uniform_segmentation(int w, int h, int classes, int label, float p) {
+  Segmentation s{cv::Mat(h, w, CV_8UC1, cv::Scalar(label)), {}};
+  for (int c = 0; c < classes; ++c)
+    s.probabilities.emplace_back(h, w, CV_32F,
+                                 cv::Scalar(c == label ? p : (1.0f - p) / static_cast<float>(classes - 1)));
+  return s;
+}
+}  // namespace
+
+TEST_CASE("map, pooled: a sure coarse look keeps what an unsure finer look contradicts, a sure finer look wins") {
+  // 3 classes. The coarse image (GSD 3) is sure of class 0; a finer image (GSD 1) says class 1.
+  // Pooled sums: class 0: log(0.9) / 3 + log(q0) / 1; class 1: log(0.05) / 3 + log(p) / 1.
+  SemanticMap map(cv::Size(8, 6), 255, MapFusion::pooled), unsure(cv::Size(8, 6), 255, MapFusion::pooled);
+  CHECK(map.fusion() == MapFusion::pooled);
+  map.fuse(image_at({0, 0, 8, 6}, 3.0), uniform_segmentation(4, 3, 3, 0, 0.9f));
+  unsure.fuse(image_at({0, 0, 8, 6}, 3.0), uniform_segmentation(4, 3, 3, 0, 0.9f));
+  CHECK(cv::countNonZero(map.labels() == 0) == 48);
+  CHECK(map.gsd_cm().at<float>(0, 0) == 3.0f);
+  // Unsure (0.4 against 0.3, 0.3): 0's sum log(0.9)/3 + log(0.3) = -1.239 > 1's log(0.05)/3 + log(0.4) = -1.915.
+  unsure.fuse(image_at({0, 0, 4, 3}, 1.0), uniform_segmentation(4, 3, 3, 1, 0.4f));
+  CHECK(cv::countNonZero(unsure.labels() == 0) == 48);
+  CHECK(unsure.gsd_cm().at<float>(0, 0) == 1.0f);  // the finest look is still recorded
+  // Sure (0.95): 1's sum log(0.05)/3 + log(0.95) = -1.050 > 0's log(0.9)/3 + log(0.025) = -3.724.
+  map.fuse(image_at({0, 0, 4, 3}, 1.0), uniform_segmentation(4, 3, 3, 1, 0.95f));
+  CHECK(cv::countNonZero(map.labels() == 1) == 12);
+  CHECK(cv::countNonZero(map.labels() == 0) == 36);
+  // Finest-wins maps the unsure look's quarter as class 1 all the same.
+  SemanticMap finest(cv::Size(8, 6));
+  finest.fuse(image_at({0, 0, 8, 6}, 3.0), uniform_segmentation(4, 3, 3, 0, 0.9f));
+  finest.fuse(image_at({0, 0, 4, 3}, 1.0), uniform_segmentation(4, 3, 3, 1, 0.4f));
+  CHECK(cv::countNonZero(finest.labels() == 1) == 12);
+}
+
+TEST_CASE("map, pooled: one-hot looks give finest-wins, and the oracle's lawnmowers map the ground truth") {
+  // A finer look's weight (1 / GSD) exceeds a coarser one's, so where every look is sure the
+  // finest decides, as with MapFusion::finest.
+  const Field f = t::blob_field(1300, 900, 1.0, 3, 20);
+  const SimulatedSensor sensor(f, CameraModel{});
+  OracleSegmenter oracle(f.num_classes());
+  SemanticMap pooled(f.labels().size(), f.ignore_label(), MapFusion::pooled);
+  SemanticMap finest(f.labels().size(), f.ignore_label());
+  const LawnmowerPlanner planner(sensor.camera());
+  for (double gsd : {3.0, 1.0})
+    for (const auto& w : planner.plan(f.area(), gsd)) {
+      const Image img = sensor.capture(w);
+      const Segmentation s = oracle.segment_with_probabilities(img);
+      pooled.fuse(img, s);
+      finest.fuse(img, s.labels);
+    }
+  const cv::Mat truth = f.labels() != f.ignore_label();
+  CHECK(cv::countNonZero((pooled.labels() != f.labels()) & truth) == 0);
+  CHECK(cv::countNonZero(pooled.labels() != finest.labels()) == 0);
+  CHECK(cv::countNonZero(pooled.gsd_cm() != finest.gsd_cm()) == 0);
+}
+
+TEST_CASE("map, pooled: labels alone, missing or mismatched probabilities are refused") {
+  SemanticMap map(cv::Size(8, 6), 255, MapFusion::pooled);
+  const Image img = image_at({0, 0, 4, 3}, 1.0);
+  CHECK_THROWS_WITH_AS(map.fuse(img, cv::Mat(3, 4, CV_8UC1, cv::Scalar(1))),
+                       doctest::Contains("a pooled map needs the class probabilities"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(map.fuse(img, Segmentation{cv::Mat(3, 4, CV_8UC1, cv::Scalar(1)), {}}),
+                       doctest::Contains("needs the class probabilities"), std::invalid_argument);
+  Segmentation wrong_size = uniform_segmentation(4, 3, 3, 0, 0.9f);
+  wrong_size.probabilities[1] = cv::Mat(2, 2, CV_32F, cv::Scalar(0.05f));
+  CHECK_THROWS_WITH_AS(map.fuse(img, wrong_size), doctest::Contains("CV_32FC1 planes of the image's size"),
+                       std::invalid_argument);
+  map.fuse(img, uniform_segmentation(4, 3, 3, 0, 0.9f));
+  CHECK_THROWS_WITH_AS(map.fuse(img, uniform_segmentation(4, 3, 4, 0, 0.9f)),
+                       doctest::Contains("number of class planes changed"), std::invalid_argument);
+  CHECK(to_string(MapFusion::pooled) == std::string("pooled"));
+  CHECK(parse_map_fusion("finest") == MapFusion::finest);
+  CHECK_THROWS_WITH_AS(static_cast<void>(parse_map_fusion("mean")),
+                       doctest::Contains("map fusion must be 'finest' or 'pooled', not 'mean'"), std::invalid_argument);
+}
+
+TEST_CASE("map, pooled: a turned camera pools where fuse(labels) would write") {
+  const cv::Rect fp(3, 1, 12, 9);
+  Segmentation s = uniform_segmentation(4, 3, 3, 2, 0.8f);
+  Image img = image_at(fp, 3.0);
+  img.yaw_deg = 33.0;
+  SemanticMap pooled(cv::Size(20, 14), 255, MapFusion::pooled), finest(cv::Size(20, 14));
+  pooled.fuse(img, s);
+  finest.fuse(img, s.labels);
+  CHECK(cv::countNonZero(finest.labels() != 255) > 0);
+  CHECK(cv::countNonZero(pooled.labels() != finest.labels()) == 0);
+  CHECK(cv::countNonZero(pooled.gsd_cm() != finest.gsd_cm()) == 0);
+}

@@ -115,6 +115,7 @@ struct CommonOptions {
   std::vector<std::string> interest_names;
   std::optional<double> seg_time_s;
   std::optional<double> plan_time_s;
+  std::string map_fusion = to_string(MissionOptions{}.map_fusion);
 
   void add_to(CLI::App& app) {
     auto& cam = mission.camera;
@@ -149,6 +150,11 @@ struct CommonOptions {
     app.add_option("--interest", interest_names,
                    "labels of interest, comma-separated (default: the field's 'interest')")
         ->delimiter(',');
+    app.add_option("--map-fusion", map_fusion,
+                   "how the map combines the images of one pixel: 'finest' (the finest GSD's label, the paper's) or "
+                   "'pooled' (the class probabilities pooled, each image weighted by 1 / GSD; needs a network)")
+        ->check(CLI::IsMember(detail::names_of(kMapFusions)))
+        ->capture_default_str();
   }
 
   /// `--camera NAME`: the preset's camera, then the camera options given explicitly on top of it
@@ -191,6 +197,9 @@ struct CommonOptions {
     differs("--speed", mission.timing.max_speed_mps, model.timing.max_speed_mps);
     differs("--accel", mission.timing.max_accel_mps2, model.timing.max_accel_mps2);
     differs("--vertical-speed", mission.timing.max_vertical_speed_mps, model.timing.max_vertical_speed_mps);
+    if (app.count("--map-fusion") > 0 && map_fusion != to_string(model.map_fusion))
+      throw std::invalid_argument("--map-fusion " + map_fusion + " differs from the decision model's " +
+                                  to_string(model.map_fusion) + " (the model was calibrated with its maps)");
   }
 
   /// Resolves names against the field and validates the values (throws invalid_argument).
@@ -212,6 +221,7 @@ struct CommonOptions {
     realistic("--vertical-speed", out.timing.max_vertical_speed_mps, "m/s");
     out.fixed_segmentation_time_s = seg_time_s;
     out.fixed_planning_time_s = plan_time_s;
+    out.map_fusion = parse_map_fusion(map_fusion);
     if (!interest_names.empty()) out.interest = field.class_indices(interest_names);
     if (out.interest.empty() && field.interest().empty())
       throw std::invalid_argument("no labels of interest: field '" + field.name() + "' names none; pass --interest");
@@ -426,6 +436,7 @@ inline nlohmann::json result_json(const Field& field, const MissionResult& r, co
   j["timing"] = {{"max_speed_mps", opt.timing.max_speed_mps},
                  {"max_accel_mps2", opt.timing.max_accel_mps2},
                  {"max_vertical_speed_mps", opt.timing.max_vertical_speed_mps}};
+  j["map_fusion"] = to_string(opt.map_fusion);
   j["adaptseg_version"] = kVersion;
   return j;
 }

@@ -21,6 +21,7 @@
 #include <adaptseg/core/lawnmower_curve.hpp>
 #include <adaptseg/core/lawnmower_planner.hpp>
 #include <adaptseg/core/linear_decision.hpp>
+#include <adaptseg/core/map_fusion.hpp>
 #include <adaptseg/core/mission_options.hpp>
 #include <adaptseg/core/timing.hpp>
 #include <adaptseg/core/utility_policy.hpp>

@@ -48,6 +48,8 @@ adaptseg_calibrate)
     --top-level hull,hull
   expect_error "max_vertical_speed_mps must be finite and >= 0" --field "$weedmap" --out "$work/m.yaml" \
     --vertical-speed -1
+  expect_error "--map-fusion: mean not in {finest,pooled}" --field "$weedmap" --out "$work/m.yaml" \
+    --map-fusion mean
   # Cross-fitting: a field every network given was trained on, a flag the oracle has no use for.
   expect_error "every network given was trained on calibration field 'dubai-tile-1' (as --network" \
     --train "$dubai" --out "$work/m.yaml" --segmenter network --network "$examples/models/mobilenetv2-dubai" \
@@ -86,6 +88,8 @@ adaptseg_evaluate)
     --decision-model "$weedmap_model" --out "$work/o" --no-plots --vertical-speed 1
   expect_error "--speed 3.0000 differs from the decision model's 2.0000" --test "$weedmap" --decision-model "$weedmap_model" \
     --out "$work/o" --no-plots --speed 3
+  expect_error "--map-fusion pooled differs from the decision model's finest" --test "$weedmap" \
+    --decision-model "$weedmap_model" --out "$work/o" --no-plots --map-fusion pooled
   expect_error "--camera dji-phantom4-rtk (5472x3648 px, 13.20 mm sensor, 8.80 mm focal) differs from the decision model's camera (480x360 px, 4.80 mm sensor, 5.50 mm focal)" \
     --test "$weedmap" --decision-model "$weedmap_model" --out "$work/o" --no-plots --camera dji-phantom4-rtk
   ;;

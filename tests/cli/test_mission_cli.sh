@@ -237,6 +237,18 @@ PY
   fly && fail "changed weights in the same folder were flown with the old model"
   grep -q "calibrated with segmenter" "$work/fly.log" || fail "no message naming the segmenters: $(tail -2 "$work/fly.log")"
   echo "ok: a model refuses its network's folder with other weights or another temperature"
+  # A pooled map (--map-fusion pooled): the model records it, and a mission flown with the model
+  # pools its maps without being told and says so in result.json.
+  "$calibrate" "${common[@]}" --map-fusion pooled --out "$work/pooled.yaml" 2>"$work/pooled.log" ||
+    fail "pooled calibration failed: $(tail -3 "$work/pooled.log")"
+  grep -qx 'map_fusion: pooled' "$work/pooled.yaml" || fail "the pooled model does not say so"
+  ! grep -q map_fusion "$work/plain.yaml" || fail "a model of the paper's fusion names map_fusion"
+  "$mission" --field "$examples/data/dubai-tile-4:0,0,0.5,0.5" --strategy adaptive --decision-model "$work/pooled.yaml" \
+    --segmenter network --network "$examples/models/mobilenetv2-dubai-all" --threads 1 --seg-time-s 0.1 \
+    --plan-time-s 0 --out "$work/pooled-fly" >"$work/pooled-fly.log" 2>&1 ||
+    fail "the pooled model did not fly: $(tail -2 "$work/pooled-fly.log")"
+  grep -q '"map_fusion": "pooled"' "$work/pooled-fly/result.json" || fail "result.json does not say the map was pooled"
+  echo "ok: a pooled model is recorded and flown pooled"
   ;;
 determinism)
   # The same inputs and seed give byte-identical outputs (times fixed by

@@ -6,6 +6,7 @@
 
 #include <adaptseg/core/camera.hpp>
 #include <adaptseg/core/error.hpp>
+#include <adaptseg/core/map_fusion.hpp>
 #include <adaptseg/core/timing.hpp>
 
 #include <cmath>
@@ -25,6 +26,9 @@ struct MissionOptions {
   std::optional<double> fixed_segmentation_time_s{};
   /// If set, every waypoint costs this planning time [s] instead of the measured one.
   std::optional<double> fixed_planning_time_s{};
+  /// How the field map combines the images of one pixel (MapFusion); `pooled` reads the
+  /// backend's class probabilities.
+  MapFusion map_fusion = MapFusion::finest;
 };
 
 namespace detail {

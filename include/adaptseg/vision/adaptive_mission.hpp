@@ -83,7 +83,7 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
     double gsd_cm;
   };
   std::vector<Pending> descents;
-  SemanticMap top_only(field.labels().size(), field.ignore_label());
+  SemanticMap top_only(field.labels().size(), field.ignore_label(), options.mission.map_fusion);
   while (const auto w = planner.next()) {
     mission.charge_planning(planner.take_planning_s());
     if (w->level == 1 && w->step == 0) {  // a descent starts: its region's map before it
@@ -94,13 +94,14 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
                           covered & cv::Rect(0, 0, field.width_px(), field.height_px()), w->waypoint.gsd_cm});
     }
     // With the backend's class probabilities where the decision reads them (a coverage that ranks
-    // cells: the top-level images' decision inputs, a descent's scene check).
-    const bool probabilities = descent_coverage_info(options.coverage).ranks_cells;
+    // cells: the top-level images' decision inputs, a descent's scene check) or the map does
+    // (MapFusion::pooled).
+    const bool probabilities =
+        descent_coverage_info(options.coverage).ranks_cells || options.mission.map_fusion == MapFusion::pooled;
     auto visit = mission.visit_without_fusion(w->waypoint, w->level, probabilities);
-    planner.report(visit.image,
-                   Segmentation{visit.labels, std::move(visit.probabilities), std::move(visit.member_votes)},
-                   visit.record->segmentation_s, mission.elapsed_s());
-    if (w->level == 0) top_only.fuse(visit.image, visit.labels);
+    const Segmentation segmentation{visit.labels, std::move(visit.probabilities), std::move(visit.member_votes)};
+    planner.report(visit.image, segmentation, visit.record->segmentation_s, mission.elapsed_s());
+    if (w->level == 0) top_only.fuse(visit.image, segmentation);
   }
   // In decision order (a tour flies them in its own).
   std::sort(descents.begin(), descents.end(),

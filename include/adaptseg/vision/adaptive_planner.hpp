@@ -87,7 +87,7 @@ class AdaptivePlanner {
       : camera_(options.mission.camera),
         timing_(options.mission.timing),
         area_(std::move(area)),
-        map_(grid_size(area_), area_.ignore_label),
+        map_(grid_size(area_), area_.ignore_label, options.mission.map_fusion),
         backend_(backend),
         policy_(policy),
         options_(std::move(options)),
@@ -215,11 +215,13 @@ class AdaptivePlanner {
   PlannerStep report(const Image& image, std::optional<double> elapsed_s = std::nullopt) {
     check_report(image, elapsed_s);
     const auto t0 = std::chrono::steady_clock::now();
-    // With the backend's class probabilities where it gives them and the decision reads them
-    // (a coverage that ranks cells: the cells' decision inputs at the top level,
-    // image_summary.hpp, and in a descent's images the scene check's); otherwise the labels alone.
-    Segmentation s = coverage_.ranks_cells ? segment_with_probabilities_checked(backend_, image, area_.num_classes)
+    // With the backend's class probabilities where it gives them and the decision or the map reads
+    // them (a coverage that ranks cells: the cells' decision inputs at the top level,
+    // image_summary.hpp, and in a descent's images the scene check's; MapFusion::pooled);
+    // otherwise the labels alone.
+    Segmentation s = wants_probabilities() ? segment_with_probabilities_checked(backend_, image, area_.num_classes)
                                            : Segmentation{segment_checked(backend_, image, area_.num_classes), {}};
+    check_pooled(s, "the backend gives none");
     const auto segmented = std::chrono::steady_clock::now();
     const double segmentation_s = std::chrono::duration<double>(segmented - t0).count();  // as Mission measures it
     return accept(image, s, segmentation_s, elapsed_s, segmented);
@@ -256,6 +258,7 @@ class AdaptivePlanner {
                         "AdaptivePlanner::report: the member votes reported");
     detail::require(std::isfinite(segmentation_s) && segmentation_s >= 0.0,
                     "AdaptivePlanner::report: segmentation_s must be finite and >= 0", segmentation_s);
+    check_pooled(segmentation, "none were reported");
     return accept(image, segmentation, segmentation_s, elapsed_s, t0);
   }
 
@@ -451,7 +454,7 @@ class AdaptivePlanner {
         fine_mass_ += c.mass(options_.cell_input);
       }
     }
-    map_.fuse(image, labels);
+    map_.fuse(image, segmentation);
 
     // A budget that can no longer afford the rest of the descent (the bound of a step, learned
     // since the descent was chosen, may have grown) ends it here.
@@ -554,6 +557,19 @@ class AdaptivePlanner {
   void charge_measured_planning(double s) {
     untaken_planning_s_ += s;
     if (!options_.mission.fixed_planning_time_s) planning_s_ += s;
+  }
+
+  /// Whether the planner needs the class probabilities behind each image's labels: for the
+  /// decision inputs of a coverage that ranks cells, and for a pooled map.
+  [[nodiscard]] bool wants_probabilities() const noexcept {
+    return coverage_.ranks_cells || map_.fusion() == MapFusion::pooled;
+  }
+
+  /// @throws std::invalid_argument for a pooled map and a segmentation without probabilities.
+  void check_pooled(const Segmentation& s, const char* why) const {
+    detail::require(map_.fusion() == MapFusion::finest || !s.probabilities.empty(),
+                    "AdaptivePlanner::report: map fusion 'pooled' needs the class probabilities behind the labels",
+                    why);
   }
 
   void check_report(const Image& image, std::optional<double> elapsed_s) const {

@@ -189,8 +189,9 @@ template <SegmentationBackend Backend>
   std::vector<CellSample> cell_samples;
   std::vector<std::vector<CellSample>> cells_by_field;
   for (std::size_t k = 0; k < fields.size(); ++k) {
-    CalibrationSamples c = collect_samples(fields[k], *backends[k], camera, adaptive.top_gsd_cm,
-                                           adaptive.candidate_gsd_cm, interest, adaptive.coverage, k);
+    CalibrationSamples c =
+        collect_samples(fields[k], *backends[k], camera, adaptive.top_gsd_cm, adaptive.candidate_gsd_cm, interest,
+                        adaptive.coverage, k, adaptive.mission.map_fusion);
     by_field.push_back(std::move(c.regions));
     detail::require(!by_field.back().empty(), "calibrate: the training field gave no region sample", fields[k].name());
     samples.insert(samples.end(), by_field.back().begin(), by_field.back().end());
@@ -200,8 +201,8 @@ template <SegmentationBackend Backend>
       std::vector<double> below;
       for (double g : adaptive.candidate_gsd_cm)
         if (g < top) below.push_back(g);
-      CalibrationSamples alt =
-          collect_samples(fields[k], *backends[k], camera, top, below, interest, adaptive.coverage, k);
+      CalibrationSamples alt = collect_samples(fields[k], *backends[k], camera, top, below, interest, adaptive.coverage,
+                                               k, adaptive.mission.map_fusion);
       cells_by_field.back().insert(cells_by_field.back().end(), alt.cells.begin(), alt.cells.end());
     }
     cell_samples.insert(cell_samples.end(), cells_by_field.back().begin(), cells_by_field.back().end());
@@ -316,6 +317,7 @@ template <SegmentationBackend Backend>
   if (std::any_of(backends.begin(), backends.end(), [&](const std::string& b) { return b != segmenter; }))
     m.field_segmenters = backends;
   for (const auto& c : first.classes()) m.classes.push_back(c.name);
+  m.map_fusion = options.adaptive.mission.map_fusion;
   const auto& interest =
       options.adaptive.mission.interest.empty() ? first.interest() : options.adaptive.mission.interest;
   for (int i : interest) m.interest.push_back(first.classes().at(static_cast<std::size_t>(i)).name);

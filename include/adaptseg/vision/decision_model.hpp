@@ -83,13 +83,18 @@ struct DecisionModel {
   /// differs from `segmenter` (a network that never saw that field; calibrate()); empty when
   /// `segmenter` segmented every field (the file then has no `field_segmenters`).
   std::vector<std::string> field_segmenters{};
+  /// How the missions' maps combine images (its samples and curves were measured so); files
+  /// without the key are `finest`, the paper's.
+  MapFusion map_fusion = MapFusion::finest;
 
   /// The planner options of a mission flown with this model: its camera, timing, top and
-  /// candidate GSDs and descent coverage, with `mission`'s labels of interest and fixed times.
+  /// candidate GSDs, descent coverage and map fusion, with `mission`'s labels of interest and
+  /// fixed times.
   [[nodiscard]] AdaptiveOptions adaptive_options(MissionOptions mission,
                                                  std::optional<double> budget_s = std::nullopt) const {
     mission.camera = camera;
     mission.timing = timing;
+    mission.map_fusion = map_fusion;
     AdaptiveOptions o{std::move(mission), top_gsd_cm, candidate_gsd_cm, budget_s, coverage};
     if (const auto& cells = decision_function.model().cells()) o.cell_input = cells->input();
     return o;
@@ -169,6 +174,8 @@ struct DecisionModel {
     e << YAML::Key << "candidate_gsd_cm" << YAML::Value;
     emit_numbers(e, candidate_gsd_cm);
     e << YAML::Key << "descent_coverage" << YAML::Value << to_string(coverage);
+    // Written only when not the paper's, so that earlier models keep their bytes.
+    if (map_fusion != MapFusion::finest) e << YAML::Key << "map_fusion" << YAML::Value << to_string(map_fusion);
     e << YAML::Key << "linear" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "sigma_low" << YAML::Value
       << num(linear.sigma_low) << YAML::Key << "sigma_high" << YAML::Value << num(linear.sigma_high) << YAML::EndMap;
     const GainModel& gm = decision_function.model();
@@ -272,6 +279,7 @@ struct DecisionModel {
     m.top_gsd_cm = r.number("top_gsd_cm");
     m.candidate_gsd_cm = r.numbers("candidate_gsd_cm");
     if (r.has("descent_coverage")) m.coverage = parse_descent_coverage(r.text("descent_coverage"));
+    if (r.has("map_fusion")) m.map_fusion = parse_map_fusion(r.text("map_fusion"));
     const auto lin = r.map("linear");
     m.linear = {lin.number("sigma_low"), lin.number("sigma_high")};
     (void)LinearDecision(m.linear);

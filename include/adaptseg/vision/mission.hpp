@@ -68,7 +68,7 @@ class Mission {
   Mission(const Field& field, Backend& backend, MissionOptions options, std::string strategy)
       : sensor_(field, CameraModel(options.camera)),
         timing_(options.timing),
-        map_(field.labels().size(), field.ignore_label()),
+        map_(field.labels().size(), field.ignore_label(), options.map_fusion),
         backend_(backend),
         options_(std::move(options)) {
     detail::check_fixed_times(options_);
@@ -113,8 +113,15 @@ class Mission {
 
   /// Flies to `w`, takes and segments the image, fuses it into the map and records it.
   Visit visit(const Waypoint& w, int level) {
-    Visit v = visit_without_fusion(w, level);
-    map_.fuse(v.image, v.labels);
+    if (map_.fusion() == MapFusion::finest) {
+      Visit v = visit_without_fusion(w, level);
+      map_.fuse(v.image, v.labels);
+      return v;
+    }
+    Visit v = visit_without_fusion(w, level, true);
+    detail::require(!v.probabilities.empty(),
+                    "Mission: map fusion 'pooled' needs a backend that gives class probabilities", result_.segmenter);
+    map_.fuse(v.image, Segmentation{v.labels, v.probabilities});
     return v;
   }
 

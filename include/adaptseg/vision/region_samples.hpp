@@ -39,7 +39,10 @@ struct CalibrationSamples {
 /// descent; with a coverage that ranks cells, DescentCoverage::ranked, every cell it flies is
 /// flown, and every cell also gives a CellSample: its decision inputs in the top-level image, segmented
 /// with the backend's class probabilities where it gives them, and what re-mapping it alone
-/// changes). Each sample's `field` is `field_index`.
+/// changes). Each sample's `field` is `field_index`. `fusion`: how the maps combine the images
+/// (MissionOptions::map_fusion); with MapFusion::pooled every image is segmented with its class
+/// probabilities and a descent's region map pools the top-level image with the finer ones, as the
+/// mission's map does.
 /// @throws std::invalid_argument for a top GSD finer than the field's or candidates not finer
 ///         than the top, or an empty `interest`.
 template <SegmentationBackend Backend>
@@ -47,7 +50,7 @@ template <SegmentationBackend Backend>
                                                  double top_gsd_cm, const std::vector<double>& candidate_gsd_cm,
                                                  const std::vector<int>& interest,
                                                  DescentCoverage coverage = DescentCoverage::region,
-                                                 std::size_t field_index = 0) {
+                                                 std::size_t field_index = 0, MapFusion fusion = MapFusion::finest) {
   detail::require(top_gsd_cm >= field.gsd_cm() * (1.0 - 1e-9),
                   "collect_region_samples: top_gsd_cm is finer than the field's GSD", top_gsd_cm);
   detail::require(!interest.empty(), "collect_region_samples: no labels of interest", 0);
@@ -62,15 +65,22 @@ template <SegmentationBackend Backend>
   // against its map.
   const DescentCoverageInfo& covers = descent_coverage_info(coverage);
   const bool ranked = covers.ranks_cells;
+  const bool pooled = fusion == MapFusion::pooled;
+  const auto segment = [&](const Image& image) {
+    Segmentation s = ranked || pooled ? segment_with_probabilities_checked(backend, image, n)
+                                      : Segmentation{segment_checked(backend, image, n), {}};
+    detail::require(!pooled || !s.probabilities.empty(),
+                    "collect_samples: map fusion 'pooled' needs a backend that gives class probabilities", 0);
+    return s;
+  };
   const auto tops = planner.plan(field.area(), top_gsd_cm, {0.0, 0.0}, keep);
   std::vector<Image> top_images;
   std::vector<Segmentation> top_segmentations;
-  SemanticMap field_map(field.labels().size(), field.ignore_label());
+  SemanticMap field_map(field.labels().size(), field.ignore_label(), fusion);
   for (const auto& top : tops) {
     top_images.push_back(sensor.capture(top));
-    top_segmentations.push_back(ranked ? segment_with_probabilities_checked(backend, top_images.back(), n)
-                                       : Segmentation{segment_checked(backend, top_images.back(), n), {}});
-    field_map.fuse(top_images.back(), top_segmentations.back().labels);
+    top_segmentations.push_back(segment(top_images.back()));
+    field_map.fuse(top_images.back(), top_segmentations.back());
   }
   ConfusionMatrix field_cm(n);
   field_cm.add(field.labels(), field_map.labels(), field.ignore_label());
@@ -83,15 +93,16 @@ template <SegmentationBackend Backend>
   for (std::size_t t = 0; t < tops.size(); ++t) {
     const Waypoint& top = tops[t];
     const Image& top_image = top_images[t];
-    const cv::Mat& top_labels = top_segmentations[t].labels;
+    const Segmentation& top_segmentation = top_segmentations[t];
+    const cv::Mat& top_labels = top_segmentation.labels;
     const ConfusionMatrix top_cm = image_confusion(top_image, top_labels, n);
     const double sigma_top = semantic_ratio(top_labels, interest, top_image.ignore_label);
     const cv::Rect region = top_image.footprint_px;
     // What the UAV knows when it plans the descent: the top-level segmentation on the map grid.
     Image top_local = top_image;  // pixel frame shifted to the region
     top_local.footprint_px -= region.tl();
-    SemanticMap top_map(region.size(), field.ignore_label());
-    top_map.fuse(top_local, top_labels);
+    SemanticMap top_map(region.size(), field.ignore_label(), fusion);
+    top_map.fuse(top_local, top_segmentation);
     // The region's field pixels: where relabelling is counted.
     cv::Mat field_px(region.size(), CV_8UC1, cv::Scalar(0));
     const cv::Rect inside = region & grid;
@@ -116,17 +127,17 @@ template <SegmentationBackend Backend>
       // Fuse the sub-lawnmower into a map of the region alone (pixel frame shifted).
       const auto sub = planner.plan(top.footprint, g, Eigen::Vector2d(top.position.x(), top.position.y()), keep_cell);
       if (sub.empty()) continue;
-      SemanticMap local(region.size(), field.ignore_label());
-      // Cells a coverage leaves out keep their top-level labels, as in the mission's map.
-      if (covers.flies) local.fuse(top_local, top_labels);
+      SemanticMap local(region.size(), field.ignore_label(), fusion);
+      // Cells a coverage leaves out keep their top-level labels, as in the mission's map; a
+      // pooled map pools the finer images with the top-level one everywhere.
+      if (covers.flies || pooled) local.fuse(top_local, top_segmentation);
       // Ranked: each finer image's own decision inputs over its cell (the scene check's proxy).
       std::vector<CellInputs> fine_inputs;
       for (const auto& w : sub) {
         Image img = sensor.capture(w);
-        const Segmentation seg = ranked ? segment_with_probabilities_checked(backend, img, n)
-                                        : Segmentation{segment_checked(backend, img, n), {}};
+        const Segmentation seg = segment(img);
         img.footprint_px -= region.tl();
-        local.fuse(img, seg.labels);
+        local.fuse(img, seg);
         if (!ranked) continue;
         const cv::Rect cell =
             ((field.pixel_rect(w.footprint) & inside) - region.tl()) & cv::Rect(0, 0, region.width, region.height);
@@ -204,8 +215,10 @@ template <SegmentationBackend Backend>
                                                                const std::vector<double>& candidate_gsd_cm,
                                                                const std::vector<int>& interest,
                                                                DescentCoverage coverage = DescentCoverage::region,
-                                                               std::size_t field_index = 0) {
-  return collect_samples(field, backend, camera, top_gsd_cm, candidate_gsd_cm, interest, coverage, field_index).regions;
+                                                               std::size_t field_index = 0,
+                                                               MapFusion fusion = MapFusion::finest) {
+  return collect_samples(field, backend, camera, top_gsd_cm, candidate_gsd_cm, interest, coverage, field_index, fusion)
+      .regions;
 }
 
 }  // namespace adaptseg
