@@ -383,7 +383,8 @@ TEST_CASE(
   // examples/models/mobilenetv2-dubai-all/decision-<class>.yaml (scripts/loto.sh decision): a
   // new site flies them with this network, so each must name this network as it is now (its
   // weights and temperature) and each calibration tile's network of the same recipe that never
-  // saw it; a retrained or re-tempered network makes them stale, and this says so.
+  // saw it; a retrained or re-tempered network makes them stale, and this says so. They pool
+  // their maps (docs/results.md, "Pooled maps and a second seed").
   const fs::path models = fs::path(ADAPTSEG_EXAMPLES_DIR) / "models";
   const fs::path all = models / "mobilenetv2-dubai-all";
   for (const char* cls : {"building", "road", "vegetation", "water"}) {
@@ -391,6 +392,7 @@ TEST_CASE(
     const DecisionModel m = DecisionModel::load(all / ("decision-" + std::string(cls) + ".yaml"));
     CHECK(m.segmenter == network_name(all));
     CHECK(m.interest == std::vector<std::string>{cls});
+    CHECK(m.map_fusion == MapFusion::pooled);
     REQUIRE(m.calibration_fields.size() == 6);
     REQUIRE(m.field_segmenters.size() == 6);
     for (std::size_t k = 0; k < 6; ++k) {
