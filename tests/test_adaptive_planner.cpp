@@ -678,7 +678,8 @@ TEST_CASE("AdaptivePlanner: stepping by hand over WeedMap gives run_adaptive_mis
   }
 }
 
-TEST_CASE("AdaptivePlanner (pooled map): stepping by hand gives run_adaptive_mission's map; labels alone are refused") {
+TEST_CASE(
+    "AdaptivePlanner (pooled map): stepping by hand gives run_adaptive_mission's map, and labels alone are refused") {
   const Field f = Field::load(t::example_field("weedmap-000"));
   OracleSegmenter oracle(f.num_classes());
   AdaptiveOptions o = weedmap_options(f);
