@@ -66,12 +66,11 @@ template <SegmentationBackend Backend>
   const DescentCoverageInfo& covers = descent_coverage_info(coverage);
   const bool ranked = covers.ranks_cells;
   const bool pooled = fusion == MapFusion::pooled;
+  // With probabilities where the cells' inputs or a pooled map read them (SemanticMap::fuse
+  // refuses a pooled map a segmentation without them).
   const auto segment = [&](const Image& image) {
-    Segmentation s = ranked || pooled ? segment_with_probabilities_checked(backend, image, n)
-                                      : Segmentation{segment_checked(backend, image, n), {}};
-    detail::require(!pooled || !s.probabilities.empty(),
-                    "collect_samples: map fusion 'pooled' needs a backend that gives class probabilities", 0);
-    return s;
+    return ranked || pooled ? segment_with_probabilities_checked(backend, image, n)
+                            : Segmentation{segment_checked(backend, image, n), {}};
   };
   const auto tops = planner.plan(field.area(), top_gsd_cm, {0.0, 0.0}, keep);
   std::vector<Image> top_images;
