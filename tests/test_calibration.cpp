@@ -555,17 +555,18 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
   old.erase(at, old.find('\n', at) + 1 - at);
   std::ofstream(tmp.path() / "old.yaml") << old;
   CHECK(rule_of(DecisionModel::load(tmp.path() / "old.yaml")).sigma_prior_sd == 0.0);
-  CHECK_FALSE(rule_of(back).field_curve);
-  CHECK_FALSE(rule_of(back).curve_ratio);
+  CHECK(rule_of(back).curve == CurveSource::training);
   // The lawnmower curve's kind is kept (files without the keys: the training fields' curves).
   DecisionModel corrected = model;
   auto& policy = std::get<FrontAwarePolicy>(corrected.decision_function.rule());
   FrontAwarePolicy::Params p = policy.params();
-  p.field_curve = p.curve_ratio = true;
-  policy.set_params(p);
-  corrected.save(tmp.path() / "corrected.yaml");
-  CHECK(rule_of(DecisionModel::load(tmp.path() / "corrected.yaml")).field_curve);
-  CHECK(rule_of(DecisionModel::load(tmp.path() / "corrected.yaml")).curve_ratio);
+  for (const CurveSource source : {CurveSource::field, CurveSource::corrected}) {
+    p.curve = source;
+    policy.set_params(p);
+    corrected.save(tmp.path() / "corrected.yaml");
+    CHECK(rule_of(DecisionModel::load(tmp.path() / "corrected.yaml")).curve == source);
+  }
+  p.curve = CurveSource::corrected;
   // So is the top-level rule (files without the key: undominated); a name it does not know is refused.
   CHECK(rule_of(back).top_level == TopLevelChoice::undominated);
   p.top_level = TopLevelChoice::hull;

@@ -453,7 +453,7 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     std::vector<Decision> training, field;
     for (double beta : {0.5, 2.0}) {
       FrontAwarePolicy t(with_cells(beta), reference, {});
-      FrontAwarePolicy f(with_cells(beta), reference, {.field_curve = true});
+      FrontAwarePolicy f(with_cells(beta), reference, {.curve = CurveSource::field});
       training.push_back(t.decide(s.region(0, 0.1)));
       field.push_back(f.decide(s.region(0, 0.1)));
     }
@@ -463,7 +463,7 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     // The predicted curve rises with the field's input: after five regions that hold little of
     // it, the same cells are worth a descent; after five that hold as much, flying lower is.
     for (const double elsewhere : {0.001, 0.1}) {
-      FrontAwarePolicy p(with_cells(1.0), reference, {.field_curve = true});
+      FrontAwarePolicy p(with_cells(1.0), reference, {.curve = CurveSource::field});
       for (int k = 0; k < 5; ++k) {
         DecisionContext seen = s.region(0, elsewhere);
         seen.candidates = {};
@@ -483,8 +483,8 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     const std::vector<ReferenceCurve> alike{{"a", {{1.0, 0.95}, {3.0, 0.75}}, 0.2, 0.1}};
     for (double beta : {0.5, 1.0}) {
       FrontAwarePolicy training(with_cells(beta), alike, {});
-      FrontAwarePolicy corrected(with_cells(beta), alike, {.field_curve = true, .curve_ratio = true});
-      FrontAwarePolicy field(with_cells(beta), alike, {.field_curve = true});
+      FrontAwarePolicy corrected(with_cells(beta), alike, {.curve = CurveSource::corrected});
+      FrontAwarePolicy field(with_cells(beta), alike, {.curve = CurveSource::field});
       const Decision t = training.decide(s.region(0, 0.1));
       const Decision c = corrected.decide(s.region(0, 0.1));
       const Decision f = field.decide(s.region(0, 0.1));
@@ -499,7 +499,7 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
       ReferenceCurve by_top = alike.front();
       by_top.field_input = 0.3;
       by_top.top_inputs = {{1.5, 0.3}, {3.0, 0.1}};
-      FrontAwarePolicy per_top(with_cells(beta), {by_top}, {.field_curve = true, .curve_ratio = true});
+      FrontAwarePolicy per_top(with_cells(beta), {by_top}, {.curve = CurveSource::corrected});
       const Decision pt = per_top.decide(s.region(0, 0.1));
       for (std::size_t k = 0; k < 2; ++k)
         CHECK(pt.scores[k].predicted_front_margin == doctest::Approx(t.scores[k].predicted_front_margin));
@@ -511,12 +511,11 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     const std::vector<ReferenceCurve> two{{"a", {{1.0, 0.875}, {3.0, 0.75}}, 0.2, 0.1},
                                           {"b", {{1.0, 1.125}, {3.0, 0.75}}, 0.2, 0.1}};
     const std::vector<ReferenceCurve> mean{{"m", {{1.0, 1.0}, {3.0, 0.75}}, 0.2, 0.1}};
-    const FrontAwarePolicy::Params p{
-        .confidence = 1.5, .scale_prior_sd = 0.01, .field_curve = true, .curve_ratio = true};
+    const FrontAwarePolicy::Params p{.confidence = 1.5, .scale_prior_sd = 0.01, .curve = CurveSource::corrected};
     FrontAwarePolicy spread(with_cells(1.0), two, p);
     FrontAwarePolicy single(with_cells(1.0), mean, p);
     FrontAwarePolicy uncorrected(with_cells(1.0), mean,
-                                 {.confidence = 1.5, .scale_prior_sd = 0.01, .field_curve = true});
+                                 {.confidence = 1.5, .scale_prior_sd = 0.01, .curve = CurveSource::field});
     const Decision a = spread.decide(rich.region(0, 0.1));
     const Decision b = single.decide(rich.region(0, 0.1));
     CHECK(a.scores[1].predicted_front_margin == doctest::Approx(b.scores[1].predicted_front_margin));
@@ -575,8 +574,8 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     coarser.cells = cells(2, 0.1);
     two_gsds.offers.push_back(coarser);
     two_gsds.lawnmowers = {{1.0, 185.0}, {2.0, 90.0}, {3.0, 40.0}};
-    for (const bool field_curve : {false, true}) {
-      FrontAwarePolicy adaptive(m, flat, {.online = true, .field_curve = field_curve});
+    for (const CurveSource curve : {CurveSource::training, CurveSource::field}) {
+      FrontAwarePolicy adaptive(m, flat, {.online = true, .curve = curve});
       const Decision d = adaptive.decide(two_gsds.region(0, 0.1));
       REQUIRE(d.descend);
       REQUIRE(d.gsd_cm == 1.0);

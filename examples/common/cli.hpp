@@ -237,11 +237,11 @@ struct CalibrationCli {
   std::string coverage = "ranked";
   std::string gain_inputs = "delta-sigma-height";
   std::vector<double> confidences = kDefaultConfidences;
-  std::string sigma_prior = "given";
+  std::string sigma_prior = to_string(CalibrationOptions{}.sigma_prior);
   std::optional<double> segmentation_time_s;
   std::vector<std::string> cell_inputs;
   std::vector<std::string> slope_poolings{"cells", "fields"};
-  std::string curve = "corrected";
+  std::string curve = to_string(CurveSource::corrected);  // the programs' default, not the struct's
   std::vector<std::string> top_levels{"undominated"};
 
   void add_to(CLI::App& app) {
@@ -280,7 +280,7 @@ struct CalibrationCli {
                        "the training fields' (training), this field's as the cell gain model predicts it from "
                        "the top-level images (field), or that prediction scaled per training field by its real "
                        "lawnmowers' rise against the predicted one (corrected)")
-            ->check(CLI::IsMember({"training", "field", "corrected"}))
+            ->check(CLI::IsMember(detail::names_of(kCurveSources)))
             ->capture_default_str(),
         app.add_option("--top-level", top_levels,
                        "front-aware rule with --coverage ranked: how the top-level GSD is chosen among those "
@@ -307,7 +307,7 @@ struct CalibrationCli {
                        "front-aware rule with several training fields: the prior of the field's share of L "
                        "(sigma-hat): given (weight 0.25 fields, no spread), spread (its spread over the training "
                        "fields enters the lower bound) or estimated (weight and spread from the training fields)")
-            ->check(CLI::IsMember({"given", "spread", "estimated"}))
+            ->check(CLI::IsMember(detail::names_of(kSigmaPriorSources)))
             ->capture_default_str(),
         app.add_option("--calibration-seg-time-s", segmentation_time_s,
                        "segmentation time charged per image during calibration [s], recorded in the model "
@@ -329,12 +329,9 @@ struct CalibrationCli {
     options.threshold_steps = threshold_steps;
     options.rule = rule;
     options.confidences = confidences;
-    options.sigma_prior = sigma_prior == "spread"      ? CalibrationOptions::SigmaPriorSource::spread
-                          : sigma_prior == "estimated" ? CalibrationOptions::SigmaPriorSource::estimated
-                                                       : CalibrationOptions::SigmaPriorSource::given;
+    options.sigma_prior = parse_sigma_prior_source(sigma_prior);
     options.adaptive.coverage = parse_descent_coverage(coverage);
-    options.front_aware.field_curve = curve == "field" || curve == "corrected";
-    options.front_aware.curve_ratio = curve == "corrected";
+    options.front_aware.curve = parse_curve_source(curve);
     options.top_levels.clear();
     for (const auto& name : top_levels) options.top_levels.push_back(parse_top_level_choice(name));
     options.cell_inputs.clear();

@@ -57,6 +57,41 @@ inline constexpr std::array<detail::NamedValue<TopLevelChoice>, 2> kTopLevelChoi
   return detail::value_named(kTopLevelChoices, name, "top-level choice");
 }
 
+/// The lawnmower curve a descent is compared with (FrontAwarePolicy::Params::curve, `--curve`):
+/// - `training`: the training fields' own curves (the lawnmowers' times this field's);
+/// - `field`: with a cell gain model, this field's curve as the model predicts it (what
+///   re-mapping the whole field at each lawnmower GSD would gain, from the field's mean input
+///   estimated from its top-level images so far). The field factor s and σ̂ then scale the
+///   descent's gain and the curve's rise alike;
+/// - `corrected`: that prediction corrected by what the training fields' real lawnmowers did.
+///   For each training field f and lawnmower GSD g, its real rise from the top GSD against the
+///   rise the cell gain model predicts for it, r_f = (D_f(g) − D_f(top)) / (β(top, g)·X_f / σ_f),
+///   clamped to [1/4, 4] (1 where f's X_f or σ_f is unknown or nothing is predicted), scales this
+///   field's predicted rise to g: one curve per training field, their mean the curve a descent
+///   is compared with and their spread the sd_D of the lower bound. Single cells re-mapped alone
+///   inside a coarse map, which the model is fitted on, predict a network's lawnmower poorly: it
+///   re-maps every cell with its neighbours (docs/results.md, "The field curve against the real
+///   ones").
+/// Without a cell gain model `field` and `corrected` read the training fields' curves.
+enum class CurveSource { training, field, corrected };
+
+/// Every curve source by name (`--curve` of the programs; the model file keeps the flags
+/// `field_curve` and `curve_ratio` of earlier versions, docs/data_format.md).
+inline constexpr std::array<detail::NamedValue<CurveSource>, 3> kCurveSources{{
+    {CurveSource::training, "training"},
+    {CurveSource::field, "field"},
+    {CurveSource::corrected, "corrected"},
+}};
+
+/// The name of a curve source.
+[[nodiscard]] inline std::string to_string(CurveSource c) { return detail::name_of(kCurveSources, c, "curve source"); }
+
+/// Parses a curve source's name.
+/// @throws std::invalid_argument for anything but `training`, `field` or `corrected`.
+[[nodiscard]] inline CurveSource parse_curve_source(std::string_view name) {
+  return detail::value_named(kCurveSources, name, "curve source");
+}
+
 /// A training field's fixed-altitude lawnmower curve by GSD: the front-aware rule's yardstick.
 struct ReferenceCurve {
   std::string field;             ///< the training field's name
@@ -66,7 +101,7 @@ struct ReferenceCurve {
   double field_sigma = 0.0;
   /// The mean over the field's top-level images of the cell gain model's input (its value per
   /// field pixel); 0: unknown (models without cells). The mean over the reference curves is the
-  /// prior of a new field's (Params::field_curve). At the nominal top-level GSD.
+  /// prior of a new field's (CurveSource::field). At the nominal top-level GSD.
   double field_input = 0.0;
   /// The same mean at every top-level GSD the cell gain model was calibrated for (the nominal
   /// one and finer ones the rule may choose, ChoosesTopLevel), as (GSD, input) pairs: a finer
@@ -138,22 +173,9 @@ class FrontAwarePolicy {
     double scale_prior_sd = 0.5;       ///< ω > 0, prior spread of the field factor s
     double sigma_prior_weight = 0.25;  ///< k > 0: weight of the training fields' σ in σ̂ [fields]
     double sigma_prior_sd = 0.0;       ///< τ >= 0: spread of a field's σ about the training fields' mean
-    /// With a cell gain model: the lawnmower curve a descent is compared with is predicted for
-    /// this field by the same model (what re-mapping the whole field at each lawnmower GSD would
-    /// gain, from the field's mean input estimated from its top-level images so far) instead of
-    /// taken from the training fields' curves. The field factor s and σ̂ then scale the descent's
-    /// gain and the curve's rise alike.
-    bool field_curve = false;
-    /// With `field_curve`: the predicted curve corrected by what the training fields' real
-    /// lawnmowers did. For each training field f and lawnmower GSD g, its real rise from the top
-    /// GSD against the rise the cell gain model predicts for it, r_f = (D_f(g) − D_f(top)) /
-    /// (β(top, g)·X_f / σ_f), clamped to [1/4, 4] (1 where f's X_f or σ_f is unknown or nothing is
-    /// predicted), scales this field's predicted rise to g: one curve per training field, their
-    /// mean the curve a descent is compared with and their spread the sd_D of the lower bound
-    /// (see the class comment). Single cells re-mapped alone inside a coarse map, which the model
-    /// is fitted on, predict a network's lawnmower poorly: it re-maps every cell with its
-    /// neighbours (docs/results.md, "The field curve against the real ones").
-    bool curve_ratio = false;
+    /// The lawnmower curve a descent is compared with (CurveSource; `corrected` is the
+    /// programs' default, this struct's the training fields' curves).
+    CurveSource curve = CurveSource::training;
     /// How top_gsd() chooses the top level (TopLevelChoice).
     TopLevelChoice top_level = TopLevelChoice::undominated;
 
@@ -266,12 +288,12 @@ class FrontAwarePolicy {
     }
     const auto [weight, sigma_cv2] = gain_weight(c);
     const double t0 = c.elapsed_s + c.rest_s;
-    // The predicted curve's mIoU relative to the top level's (field_curve) or absolute.
+    // The predicted curve's mIoU relative to the top level's (curve not `training`) or absolute.
     double curve_level = 0.0;
-    if (params_.field_curve && model_.cells() && c.region_share > 0.0 && weight > 0.0) {
+    if (params_.curve != CurveSource::training && model_.cells() && c.region_share > 0.0 && weight > 0.0) {
       const double x = field_input_estimate(c);
       curves.clear();
-      if (params_.curve_ratio)
+      if (params_.curve == CurveSource::corrected)
         for (const auto& r : reference_) curves.push_back(field_curve(c, x, weight / c.region_share, &r));
       else
         curves.push_back(field_curve(c, x, weight / c.region_share, nullptr));
@@ -464,7 +486,7 @@ class FrontAwarePolicy {
     return base >= 0.0 ? scale_mean_ * base : std::abs(scale_mean_) * base;
   }
 
-  /// X̂, the field's mean input per field pixel (Params::field_curve): the top-level regions
+  /// X̂, the field's mean input per field pixel (CurveSource::field): the top-level regions
   /// seen so far, the unseen part shrunk towards the training fields' mean at this top level
   /// with σ̂'s weight k.
   [[nodiscard]] double field_input_estimate(const DecisionContext& c) const {
@@ -478,11 +500,11 @@ class FrontAwarePolicy {
     return seen_input_ + unseen * rest;
   }
 
-  /// The lawnmower curve of this field as the cell gain model predicts it (Params::field_curve),
+  /// The lawnmower curve of this field as the cell gain model predicts it (CurveSource::field),
   /// relative to the top level's mIoU: at each lawnmower GSD g finer than the top level,
   /// s·β(top, g)·X̂·(1 / σ̂) (s applied by scaled()), `x` = X̂ (field_input_estimate),
   /// `inv_sigma` = 1 / σ̂; 0 at the top level; its upper envelope. With a training field
-  /// `corrected_by`, each rise times that field's real / predicted rise (Params::curve_ratio).
+  /// `corrected_by`, each rise times that field's real / predicted rise (CurveSource::corrected).
   [[nodiscard]] std::vector<CurvePoint> field_curve(const DecisionContext& c, double x, double inv_sigma,
                                                     const ReferenceCurve* corrected_by) const {
     std::vector<CurvePoint> curve;
@@ -495,7 +517,7 @@ class FrontAwarePolicy {
     return upper_envelope(std::move(curve));
   }
 
-  /// Params::curve_ratio's r_f: training field `r`'s real lawnmower rise from GSD `top` to `g`
+  /// CurveSource::corrected's r_f: training field `r`'s real lawnmower rise from GSD `top` to `g`
   /// over the one the cell gain model predicts for it, slope·X_f / σ_f (X_f at `top`); clamped
   /// to [1/4, 4]; 1 where nothing is predicted.
   static double rise_ratio(const ReferenceCurve& r, double top, double g, double slope) {

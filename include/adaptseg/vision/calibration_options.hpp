@@ -7,6 +7,7 @@
 
 #include <adaptseg/core/cell_gain_model.hpp>
 #include <adaptseg/core/decision_function.hpp>
+#include <adaptseg/core/detail/named_rows.hpp>
 #include <adaptseg/core/lawnmower_curve.hpp>
 #include <adaptseg/core/linear_decision.hpp>
 #include <adaptseg/vision/adaptive_mission.hpp>
@@ -14,9 +15,11 @@
 #include <adaptseg/vision/region_samples.hpp>
 
 #include <algorithm>
+#include <array>
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace adaptseg {
@@ -108,6 +111,24 @@ struct CalibrationOptions {
   UtilityPolicy::Params utility{};
   int threshold_steps = 10;  ///< utility thresholds tried per weighting
 };
+
+/// Every source of σ̂'s prior by name (`--sigma-prior` of the programs).
+inline constexpr std::array<detail::NamedValue<CalibrationOptions::SigmaPriorSource>, 3> kSigmaPriorSources{{
+    {CalibrationOptions::SigmaPriorSource::given, "given"},
+    {CalibrationOptions::SigmaPriorSource::spread, "spread"},
+    {CalibrationOptions::SigmaPriorSource::estimated, "estimated"},
+}};
+
+/// The name of a source of σ̂'s prior.
+[[nodiscard]] inline std::string to_string(CalibrationOptions::SigmaPriorSource s) {
+  return detail::name_of(kSigmaPriorSources, s, "sigma prior source");
+}
+
+/// Parses a source of σ̂'s prior by name.
+/// @throws std::invalid_argument for anything but `given`, `spread` or `estimated`.
+[[nodiscard]] inline CalibrationOptions::SigmaPriorSource parse_sigma_prior_source(std::string_view name) {
+  return detail::value_named(kSigmaPriorSources, name, "sigma prior source");
+}
 
 /// One setting of the rule tried on the training fields.
 struct RuleTrial {

@@ -42,8 +42,9 @@ struct FrontAwareRule {
     e << YAML::Key << "scale_prior_sd" << YAML::Value << num(p.scale_prior_sd);
     e << YAML::Key << "sigma_prior_weight" << YAML::Value << num(p.sigma_prior_weight);
     e << YAML::Key << "sigma_prior_sd" << YAML::Value << num(p.sigma_prior_sd);
-    if (p.field_curve) e << YAML::Key << "field_curve" << YAML::Value << detail::flag_text(true);
-    if (p.curve_ratio) e << YAML::Key << "curve_ratio" << YAML::Value << detail::flag_text(true);
+    // The curve source as the flags of earlier versions, so that their files keep their bytes.
+    if (p.curve != CurveSource::training) e << YAML::Key << "field_curve" << YAML::Value << detail::flag_text(true);
+    if (p.curve == CurveSource::corrected) e << YAML::Key << "curve_ratio" << YAML::Value << detail::flag_text(true);
     if (p.top_level != TopLevelChoice::undominated)
       e << YAML::Key << "top_level" << YAML::Value << to_string(p.top_level);
     e << YAML::Key << "reference" << YAML::Value << YAML::BeginSeq;
@@ -106,9 +107,15 @@ struct FrontAwareRule {
                              .scale_prior_sd = rule.number("scale_prior_sd"),
                              .sigma_prior_weight = rule.number("sigma_prior_weight"),
                              .sigma_prior_sd = rule.has("sigma_prior_sd") ? rule.number("sigma_prior_sd") : 0.0,
-                             .field_curve = rule.has("field_curve") && rule.flag("field_curve"),
-                             .curve_ratio = rule.has("curve_ratio") && rule.flag("curve_ratio"),
+                             .curve = read_curve(rule),
                              .top_level = rule.has("top_level") ? read_top_level(rule) : TopLevelChoice::undominated});
+  }
+
+  /// The curve source of the flags `field_curve` and `curve_ratio` (absent: false; the ratio
+  /// alone, which earlier versions ignored, reads the training fields' curves as they did).
+  [[nodiscard]] static CurveSource read_curve(const detail::YamlReader& rule) {
+    if (!(rule.has("field_curve") && rule.flag("field_curve"))) return CurveSource::training;
+    return rule.has("curve_ratio") && rule.flag("curve_ratio") ? CurveSource::corrected : CurveSource::field;
   }
 
   /// `rule.top_level`, naming the file where it is not a TopLevelChoice.
