@@ -180,7 +180,7 @@ TEST_CASE("decisions.csv: one column table for the header and every row, in any 
   const std::string header = decisions_csv_header();
   CHECK(header.rfind("field,strategy,decision,image,sigma,action,gsd_cm,images,extra_time_s,", 0) == 0);
   CHECK(header.find(",realised_field_gain,flown,") != std::string::npos);
-  CHECK(header.substr(header.size() - 18) == "realised_delta_fn\n");
+  CHECK(header.find(",realised_delta_fn,forecast_curve_rise,forecast_end_s\n") != std::string::npos);
   const auto columns = [](const std::string& line) { return std::count(line.begin(), line.end(), ',') + 1; };
   CHECK(columns(header.substr(0, header.size() - 1)) == static_cast<long>(kDecisionColumns.size()));
 
@@ -221,6 +221,11 @@ TEST_CASE("decisions.csv: one column table for the header and every row, in any 
         if (std::string(c.name).rfind("forecast_", 0) != 0 && std::string(c.name).rfind("observed_", 0) != 0)
           CHECK_MESSAGE(!c.value(r).empty(), c.name);
       CHECK(kDecisionColumns[19].value(r) == adaptseg::detail::format_fixed(r.realised->field_gain, 6));
+      // The front-aware rule's curve: a rise over the descent's time, from the mission's forecast end.
+      const CandidateScore& score = *r.score();
+      CHECK(score.predicted_curve_rise >= 0.0);
+      CHECK(score.predicted_end_s >= r.chosen()->extra_time_s);
+      CHECK(score.predicted_field_gain > score.predicted_curve_rise);  // z >= 0: the descent beat the rise
     } else {
       CHECK(r.realised == nullptr);
       CHECK(kDecisionColumns[23].value(r).empty());  // realised_delta_tp

@@ -10,7 +10,21 @@ IoU moves by about (ΔTP − IoU·ΔFP) / (TP + FP + FN): a false positive remov
 a miss corrected, one added costs as much. Then, over all descents: how often the region's gain
 and the field's disagree in sign, and for those, whether the descent added false positives.
 
-Usage: descent_table.py [--strategy adaptive] RUN_DIR [RUN_DIR ...]
+With --curve, per descent also the lawnmower curve it had to beat: the rise the rule predicted
+over the descent's extra time (forecast_curve_rise) against the rise of the field's real curve
+(results.csv's lawnmowers, upper envelope, linear between points, flat beyond the last, as the
+front margin reads it) over the same seconds, ending at the forecast end (forecast_end_s), and
+each descent's margin, forecast (forecast gain − predicted rise) and realised (realised gain −
+real rise). Where the rule predicts the rise too steep it keeps descents that would have paid;
+too flat, it takes descents that the curve outruns.
+
+With --hindsight, per run: what the mission would have ended at had it flown only its best
+descents, known in hindsight. Its descents sorted by realised gain per second, the prefix whose
+top-level lawnmower (results.csv: the lawnmower at the mission's top GSD) plus their realised
+gains and extra times ends highest above the real curve: whether the descents a rule took hold
+any that pay (selection) or none (the candidates themselves). Gains taken as additive.
+
+Usage: descent_table.py [--strategy adaptive] [--curve | --hindsight] RUN_DIR [RUN_DIR ...]
 """
 
 from __future__ import annotations
@@ -19,6 +33,8 @@ import argparse
 import csv
 import math
 from pathlib import Path
+
+from lawnmower_envelope import envelope_at, upper_envelope  # the same tool folder
 
 
 def number(text: str) -> float:
@@ -36,11 +52,80 @@ def correlation(x: list[float], y: list[float]) -> float:
     return sxy / (sx * sy) if sx > 0 and sy > 0 else math.nan
 
 
-def main() -> int:
+def real_curves(run: Path) -> dict[str, list[tuple[float, float]]]:
+    """Per field, the upper envelope of the run's lawnmowers (results.csv)."""
+    points: dict[str, list[tuple[float, float]]] = {}
+    with open(run / "results.csv", newline="") as f:
+        for r in csv.DictReader(f):
+            if r["strategy"] == "lawnmower":
+                points.setdefault(r["field"], []).append((float(r["time_total"]), float(r["miou_interest"])))
+    return {field: upper_envelope(p) for field, p in points.items()}
+
+
+def curve_table(rows: list[tuple[str, dict]], curves: dict[tuple[str, str], list]) -> None:
+    print("| run | decision | GSD [cm/px] | extra time [s] | forecast end [s] | forecast gain | predicted rise | "
+          "real rise | forecast margin | realised margin |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    predicted, real, paid, forecast_margin = [], [], 0, []
+    for run, d in rows:
+        if d.get("forecast_curve_rise", "") in ("", None) or d.get("forecast_end_s", "") in ("", None):
+            raise SystemExit(f"{run}: no forecast_curve_rise / forecast_end_s (written by adaptseg_evaluate since "
+                             "2026-11-30) or a rule that predicts no curve")
+        env = curves[(run, d["field"])]
+        end, extra = number(d["forecast_end_s"]), number(d["extra_time_s"])
+        rise, real_rise = number(d["forecast_curve_rise"]), envelope_at(env, end) - envelope_at(env, end - extra)
+        fg, rg = number(d["forecast_field_gain"]), number(d["realised_field_gain"])
+        print(f"| {run} | {d['decision']} | {number(d['gsd_cm']):g} | {extra:.1f} | {end:.1f} | {fg:+.4f} | "
+              f"{rise:+.4f} | {real_rise:+.4f} | {fg - rise:+.4f} | {rg - real_rise:+.4f} |")
+        predicted.append(rise)
+        real.append(real_rise)
+        forecast_margin.append(fg - rise)
+        paid += rg > real_rise
+    print()
+    if predicted:
+        print(f"{len(predicted)} descents: predicted rise {sum(predicted):+.4f} in all against the real curve's "
+              f"{sum(real):+.4f} (correlation {correlation(predicted, real):+.2f}); {paid} of {len(predicted)} "
+              f"gained more than the real curve rose in their seconds")
+
+
+def hindsight_table(runs: list[str], rows: list[tuple[str, dict]], strategy: str) -> None:
+    print("| run | descents | margin flown | best prefix: descents | its margin |")
+    print("| --- | ---: | ---: | ---: | ---: |")
+    flown_above = best_above = 0
+    for run in runs:
+        path = Path(run)
+        with open(path / "results.csv", newline="") as f:
+            results = list(csv.DictReader(f))
+        for field, env in real_curves(path).items():
+            mission = next(r for r in results if r["field"] == field and r["strategy"] == strategy)
+            top = next(r for r in results if r["field"] == field and r["strategy"] == "lawnmower"
+                       and abs(float(r["gsd_cm"]) - float(mission["gsd_cm"])) < 1e-6)
+            t, m = float(top["time_total"]), float(top["miou_interest"])
+            descents = sorted(((number(d["realised_field_gain"]), number(d["extra_time_s"]))
+                               for name, d in rows if name == path.name and d["field"] == field),
+                              key=lambda gt: -gt[0] / max(gt[1], 1e-9))
+            best, best_k = m - envelope_at(env, t), 0
+            for k, (g, dt) in enumerate(descents, start=1):
+                t, m = t + dt, m + g
+                if m - envelope_at(env, t) > best:
+                    best, best_k = m - envelope_at(env, t), k
+            flown = float(mission["front_margin"])
+            flown_above += flown > 0.001
+            best_above += best > 0.001
+            print(f"| {path.name} | {len(descents)} | {flown:+.4f} | {best_k} | {best:+.4f} |")
+    print()
+    print(f"{len(runs)} runs: {flown_above} above +0.001 as flown, {best_above} with their best descents only")
+
+
+def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--strategy", default="adaptive")
+    ap.add_argument("--curve", action="store_true",
+                    help="each descent against the lawnmower curve: the predicted rise and the real one")
+    ap.add_argument("--hindsight", action="store_true",
+                    help="per run, the margin of its best descents only, chosen in hindsight")
     ap.add_argument("runs", nargs="+")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     rows = []
     for run in args.runs:
         path = Path(run) / "decisions.csv"
@@ -51,6 +136,13 @@ def main() -> int:
                 if "realised_delta_tp" not in d:
                     raise SystemExit(f"{path}: no realised_delta_tp column (written by adaptseg_evaluate since 2026-11-29)")
                 rows.append((Path(run).name, d))
+    if args.hindsight:
+        hindsight_table(args.runs, rows, args.strategy)
+        return 0
+    if args.curve:
+        curves = {(Path(run).name, field): env for run in args.runs for field, env in real_curves(Path(run)).items()}
+        curve_table(rows, curves)
+        return 0
     print("| run | decision | GSD [cm/px] | images | forecast field gain | realised field gain | region gain | "
           "ΔTP [px] | ΔFP [px] |")
     print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")

@@ -112,6 +112,13 @@ struct CandidateScore {
   /// Front-aware policies: the predicted front margin of the mission if it descends here
   /// (NaN otherwise; see FrontAwarePolicy).
   double predicted_front_margin = std::numeric_limits<double>::quiet_NaN();
+  /// Front-aware policies: the predicted lawnmower curve's rise over the descent's extra time,
+  /// ΔD̄ of the lower bound (the mean over the predicted curves' upper envelopes from the
+  /// mission's forecast end without the descent to `predicted_end_s`; NaN otherwise).
+  double predicted_curve_rise = std::numeric_limits<double>::quiet_NaN();
+  /// Front-aware policies: the mission's forecast end if it descends here [s]: elapsed time,
+  /// the rest of the top-level path and the descent's extra time (NaN otherwise).
+  double predicted_end_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// The outcome of a decision: continue (`descend == false`) or re-map the region from `gsd_cm`.

@@ -344,6 +344,8 @@ class FrontAwarePolicy {
       const double lower = gain - rise - params_.confidence * std::sqrt(gain_var + rise_var);
       s.predicted_front_margin =
           mean_top_miou(c) + forecast_gain_ + gain - curve_level - mean_curve_miou(curves, t0 + cand.extra_time_s);
+      s.predicted_curve_rise = rise;
+      s.predicted_end_s = t0 + cand.extra_time_s;
       if (gain > 0.0 && lower > best) {
         best = lower;
         best_index = k;

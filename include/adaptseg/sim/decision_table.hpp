@@ -53,7 +53,7 @@ struct DecisionColumn {
 };
 
 /// Every column of decisions.csv, in order (docs/data_format.md says what each holds).
-inline const std::array<DecisionColumn, 26> kDecisionColumns{{
+inline const std::array<DecisionColumn, 28> kDecisionColumns{{
     {"field", [](const DecisionRow& r) { return csv_field(r.field); }},
     {"strategy", [](const DecisionRow& r) { return std::string(r.strategy); }},
     {"decision", [](const DecisionRow& r) { return std::to_string(r.index); }},
@@ -123,6 +123,10 @@ inline const std::array<DecisionColumn, 26> kDecisionColumns{{
      [](const DecisionRow& r) { return r.realised ? std::to_string(r.realised->delta_fp) : std::string(); }},
     {"realised_delta_fn",
      [](const DecisionRow& r) { return r.realised ? std::to_string(r.realised->delta_fn) : std::string(); }},
+    {"forecast_curve_rise",
+     [](const DecisionRow& r) { return r.score() ? detail::finite6(r.score()->predicted_curve_rise) : std::string(); }},
+    {"forecast_end_s",
+     [](const DecisionRow& r) { return r.score() ? detail::finite6(r.score()->predicted_end_s) : std::string(); }},
 }};
 
 /// The header line of decisions.csv (with its line break).

@@ -1,0 +1,64 @@
+#!/usr/bin/env python3
+"""Self-test of descent_table.py's --curve and --hindsight on a synthetic run (run by CTest;
+exit code != 0 on failure).
+
+One field whose lawnmowers map L at 0.50 in 100 s and 0.60 in 200 s (the real curve rises 0.001
+per second), flown from the first by a mission with two descents: one gains 0.02 in 10 s (it
+beats the curve), the other 0.001 in 20 s (it does not). In hindsight the first alone ends
++0.0100 above the curve (0.52 at 110 s against 0.51), both together −0.0090; the first's real
+rise over its seconds is 0.0100, against a predicted 0.0040.
+"""
+import contextlib
+import io
+import os
+import sys
+import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import descent_table  # noqa: E402
+
+RESULTS = """field,strategy,gsd_cm,miou_interest,time_total,front_margin
+f,lawnmower,15,0.50,100,0
+f,lawnmower,10,0.60,200,0
+f,adaptive,15,0.521,130,-0.009
+"""
+COLUMNS = ("field,strategy,decision,action,gsd_cm,images,extra_time_s,forecast_field_gain,realised_field_gain,"
+           "realised_region_delta_miou,realised_delta_tp,realised_delta_fp,forecast_curve_rise,forecast_end_s\n")
+DECISIONS = COLUMNS + """f,adaptive,0,descend,10,2,10,0.015,0.02,-0.05,100,-10,0.004,110
+f,adaptive,1,continue,,,,,,,,,,
+f,adaptive,2,descend,10,2,20,0.006,0.001,-0.01,5,3,0.005,130
+"""
+
+
+def table(args):
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        descent_table.main(args)
+    return out.getvalue()
+
+
+def main():
+    with tempfile.TemporaryDirectory() as tmp:
+        run = os.path.join(tmp, "run")
+        os.makedirs(run)
+        with open(os.path.join(run, "results.csv"), "w") as f:
+            f.write(RESULTS)
+        with open(os.path.join(run, "decisions.csv"), "w") as f:
+            f.write(DECISIONS)
+        hindsight = table(["--hindsight", run])
+        if "| run | 2 | -0.0090 | 1 | +0.0100 |" not in hindsight:
+            sys.exit(f"hindsight: the first descent alone should end +0.0100 above the curve:\n{hindsight}")
+        if "1 runs: 0 above +0.001 as flown, 1 with their best descents only" not in hindsight:
+            sys.exit(f"hindsight summary:\n{hindsight}")
+        curve = table(["--curve", run])
+        # decision, GSD, extra time, end, forecast gain, predicted rise, real rise, margins
+        want = "| run | 0 | 10 | 10.0 | 110.0 | +0.0150 | +0.0040 | +0.0100 | +0.0110 | +0.0100 |"
+        if want not in curve:
+            sys.exit(f"curve: no row {want}:\n{curve}")
+        if "1 of 2 gained more than the real curve rose in their seconds" not in curve:
+            sys.exit(f"curve summary:\n{curve}")
+    print("ok: descent_table.py sets each descent against the real curve and finds the best in hindsight")
+
+
+if __name__ == "__main__":
+    main()
