@@ -38,7 +38,9 @@
 #   the segmentation cache. CONFIG (environment) names the folder (default loto), EXTRA adds
 #   flags to every run: CONFIG=loto-hull EXTRA="--top-level hull" ORACLE_CONFIG=oracle-hull.
 #   LOTO_NETWORKS names another folder of tile-1 ... tile-6 networks (another seed, say).
-#   Last, the issue's targets (examples/tools/loto_targets.py; several configurations side by
+#   Then every descent against the real curve and each run's best descents in hindsight
+#   (examples/tools/descent_table.py --curve, --hindsight --gsd 10). Last, the issue's targets
+#   (examples/tools/loto_targets.py; several configurations side by
 #   side: loto_targets.py --oracle out/results/oracle-default a=out/results/loto b=...).
 # loto-proxy: until the six leave-one-tile-out networks are trained, a stand-in for loto on the
 #   tiles that have a network of MobileNetV2 that never saw them: each tile with a bundled
@@ -453,6 +455,9 @@ if [ "$part" = loto ]; then
   [ -d "$root/$oracle" ] && labels+=("oracle=$(dir_list "$root/$oracle"/dubai-*/)")
   /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
   /usr/bin/python3 examples/tools/descent_table.py "$root/$config"/*/
+  # Each descent against the real curve, and each run's best descents in hindsight.
+  /usr/bin/python3 examples/tools/descent_table.py --curve "$root/$config"/*/
+  /usr/bin/python3 examples/tools/descent_table.py --hindsight --gsd 10 "$root/$config"/*/
   targets=("$config=$root/$config")
   [ -d "$root/$oracle" ] && targets=(--oracle "$root/$oracle" "${targets[@]}")
   /usr/bin/python3 examples/tools/loto_targets.py "${targets[@]}"

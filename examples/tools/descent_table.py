@@ -22,9 +22,11 @@ With --hindsight, per run: what the mission would have ended at had it flown onl
 descents, known in hindsight. Its descents sorted by realised gain per second, the prefix whose
 top-level lawnmower (results.csv: the lawnmower at the mission's top GSD) plus their realised
 gains and extra times ends highest above the real curve: whether the descents a rule took hold
-any that pay (selection) or none (the candidates themselves). Gains taken as additive.
+any that pay (selection) or none (the candidates themselves). Gains taken as additive. With
+--gsd G also the margin of its descents to G cm/px alone, in the order flown: what the mission
+would have ended at had it descended to G only where it did.
 
-Usage: descent_table.py [--strategy adaptive] [--curve | --hindsight] RUN_DIR [RUN_DIR ...]
+Usage: descent_table.py [--strategy adaptive] [--curve | --hindsight [--gsd G]] RUN_DIR [RUN_DIR ...]
 """
 
 from __future__ import annotations
@@ -66,11 +68,11 @@ def curve_table(rows: list[tuple[str, dict]], curves: dict[tuple[str, str], list
     print("| run | decision | GSD [cm/px] | extra time [s] | forecast end [s] | forecast gain | predicted rise | "
           "real rise | forecast margin | realised margin |")
     print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
-    predicted, real, paid, forecast_margin = [], [], 0, []
+    predicted, real, paid, without = [], [], 0, 0
     for run, d in rows:
         if d.get("forecast_curve_rise", "") in ("", None) or d.get("forecast_end_s", "") in ("", None):
-            raise SystemExit(f"{run}: no forecast_curve_rise / forecast_end_s (written by adaptseg_evaluate since "
-                             "2026-11-30) or a rule that predicts no curve")
+            without += 1  # the utility rule, or a file written before 2026-11-30
+            continue
         env = curves[(run, d["field"])]
         end, extra = number(d["forecast_end_s"]), number(d["extra_time_s"])
         rise, real_rise = number(d["forecast_curve_rise"]), envelope_at(env, end) - envelope_at(env, end - extra)
@@ -79,19 +81,22 @@ def curve_table(rows: list[tuple[str, dict]], curves: dict[tuple[str, str], list
               f"{rise:+.4f} | {real_rise:+.4f} | {fg - rise:+.4f} | {rg - real_rise:+.4f} |")
         predicted.append(rise)
         real.append(real_rise)
-        forecast_margin.append(fg - rise)
         paid += rg > real_rise
     print()
+    if without:
+        print(f"{without} descents left out: no forecast_curve_rise / forecast_end_s (the utility rule predicts "
+              "no curve; adaptseg_evaluate writes them since 2026-11-30)")
     if predicted:
         print(f"{len(predicted)} descents: predicted rise {sum(predicted):+.4f} in all against the real curve's "
               f"{sum(real):+.4f} (correlation {correlation(predicted, real):+.2f}); {paid} of {len(predicted)} "
               f"gained more than the real curve rose in their seconds")
 
 
-def hindsight_table(runs: list[str], rows: list[tuple[str, dict]], strategy: str) -> None:
-    print("| run | descents | margin flown | best prefix: descents | its margin |")
-    print("| --- | ---: | ---: | ---: | ---: |")
-    flown_above = best_above = 0
+def hindsight_table(runs: list[str], rows: list[tuple[str, dict]], strategy: str, gsd: float | None) -> None:
+    only = f" | descents to {gsd:g} cm/px alone: margin" if gsd is not None else ""
+    print("| run | descents | margin flown | best prefix: descents | its margin" + only + " |")
+    print("| --- | ---: | ---: | ---: | ---: |" + (" ---: |" if gsd is not None else ""))
+    flown_above = best_above = only_above = 0
     for run in runs:
         path = Path(run)
         with open(path / "results.csv", newline="") as f:
@@ -101,9 +106,16 @@ def hindsight_table(runs: list[str], rows: list[tuple[str, dict]], strategy: str
             top = next(r for r in results if r["field"] == field and r["strategy"] == "lawnmower"
                        and abs(float(r["gsd_cm"]) - float(mission["gsd_cm"])) < 1e-6)
             t, m = float(top["time_total"]), float(top["miou_interest"])
-            descents = sorted(((number(d["realised_field_gain"]), number(d["extra_time_s"]))
-                               for name, d in rows if name == path.name and d["field"] == field),
+            flown_descents = [d for name, d in rows if name == path.name and d["field"] == field]
+            descents = sorted(((number(d["realised_field_gain"]), number(d["extra_time_s"])) for d in flown_descents),
                               key=lambda gt: -gt[0] / max(gt[1], 1e-9))
+            cell = ""
+            if gsd is not None:
+                kept = [d for d in flown_descents if abs(number(d["gsd_cm"]) - gsd) < 1e-6]
+                t_only = t + sum(number(d["extra_time_s"]) for d in kept)
+                m_only = m + sum(number(d["realised_field_gain"]) for d in kept) - envelope_at(env, t_only)
+                only_above += m_only > 0.001
+                cell = f" {m_only:+.4f} |"
             best, best_k = m - envelope_at(env, t), 0
             for k, (g, dt) in enumerate(descents, start=1):
                 t, m = t + dt, m + g
@@ -112,9 +124,10 @@ def hindsight_table(runs: list[str], rows: list[tuple[str, dict]], strategy: str
             flown = float(mission["front_margin"])
             flown_above += flown > 0.001
             best_above += best > 0.001
-            print(f"| {path.name} | {len(descents)} | {flown:+.4f} | {best_k} | {best:+.4f} |")
+            print(f"| {path.name} | {len(descents)} | {flown:+.4f} | {best_k} | {best:+.4f} |{cell}")
     print()
-    print(f"{len(runs)} runs: {flown_above} above +0.001 as flown, {best_above} with their best descents only")
+    alone = f", {only_above} with their descents to {gsd:g} cm/px alone" if gsd is not None else ""
+    print(f"{len(runs)} runs: {flown_above} above +0.001 as flown, {best_above} with their best descents only{alone}")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -124,6 +137,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="each descent against the lawnmower curve: the predicted rise and the real one")
     ap.add_argument("--hindsight", action="store_true",
                     help="per run, the margin of its best descents only, chosen in hindsight")
+    ap.add_argument("--gsd", type=float, help="with --hindsight: the margin of the descents to this GSD alone")
     ap.add_argument("runs", nargs="+")
     args = ap.parse_args(argv)
     rows = []
@@ -137,7 +151,7 @@ def main(argv: list[str] | None = None) -> int:
                     raise SystemExit(f"{path}: no realised_delta_tp column (written by adaptseg_evaluate since 2026-11-29)")
                 rows.append((Path(run).name, d))
     if args.hindsight:
-        hindsight_table(args.runs, rows, args.strategy)
+        hindsight_table(args.runs, rows, args.strategy, args.gsd)
         return 0
     if args.curve:
         curves = {(Path(run).name, field): env for run in args.runs for field, env in real_curves(Path(run)).items()}

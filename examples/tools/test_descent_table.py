@@ -50,6 +50,12 @@ def main():
             sys.exit(f"hindsight: the first descent alone should end +0.0100 above the curve:\n{hindsight}")
         if "1 runs: 0 above +0.001 as flown, 1 with their best descents only" not in hindsight:
             sys.exit(f"hindsight summary:\n{hindsight}")
+        # Both descents are to 10 cm/px: alone they end where the mission did.
+        alone = table(["--hindsight", "--gsd", "10", run])
+        if "| run | 2 | -0.0090 | 1 | +0.0100 | -0.0090 |" not in alone:
+            sys.exit(f"hindsight --gsd 10: the descents to 10 cm/px alone should end at -0.0090:\n{alone}")
+        if "| run | 2 | -0.0090 | 1 | +0.0100 | +0.0000 |" not in table(["--hindsight", "--gsd", "5", run]):
+            sys.exit("hindsight --gsd 5: no descent to 5 cm/px should leave the top-level lawnmower, margin 0")
         curve = table(["--curve", run])
         # decision, GSD, extra time, end, forecast gain, predicted rise, real rise, margins
         want = "| run | 0 | 10 | 10.0 | 110.0 | +0.0150 | +0.0040 | +0.0100 | +0.0110 | +0.0100 |"
