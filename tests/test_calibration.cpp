@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <span>
@@ -505,6 +506,79 @@ TEST_CASE("calibration: confidence levels the training fields cannot tell apart 
   }
 }
 
+TEST_CASE("calibration: gain ratios, realised over forecast field gain per descent GSD, shrunk towards 1") {
+  // One fold's flight: descents to 1 cm/px forecast 0.01 and 0.03 that realised nothing, one to
+  // 2 cm/px forecast 0.02 that realised 0.06, one to 3 cm/px forecast 0.001 that realised 1 (kept
+  // at 4), one whose rule forecast no field gain (left out).
+  AdaptiveResult flight;
+  const auto descend = [&](double gsd, double forecast, double realised) {
+    DecisionRecord rec;
+    rec.candidates = {Candidate{gsd, 5.0, 1, 10.0}};
+    rec.decision.descend = true;
+    rec.decision.gsd_cm = gsd;
+    CandidateScore score;
+    score.predicted_field_gain = forecast;
+    rec.decision.scores = {score};
+    RealisedDescent r;
+    r.decision = flight.decisions.size();
+    r.field_gain = realised;
+    flight.decisions.push_back(rec);
+    flight.realised.push_back(r);
+  };
+  descend(2.0, 0.02, 0.06);
+  descend(1.0, 0.01, 0.0);
+  descend(1.0, 0.03, 0.0);
+  descend(3.0, 0.001, 1.0);
+  descend(4.0, std::numeric_limits<double>::quiet_NaN(), 0.5);
+  const std::vector<AdaptiveResult> flights{flight};
+  const std::vector<GainRatio> ratios = detail::fold_gain_ratios(flights);
+  REQUIRE(ratios.size() == 3);
+  CHECK(ratios[0].gsd_cm == 1.0);
+  CHECK(ratios[0].ratio == doctest::Approx((0.0 + 0.04) / (0.04 + 0.04)));  // prior 2 x mean forecast 0.02
+  CHECK(ratios[1].gsd_cm == 2.0);
+  CHECK(ratios[1].ratio == doctest::Approx((0.06 + 0.04) / (0.02 + 0.04)));
+  CHECK(ratios[2].gsd_cm == 3.0);
+  CHECK(ratios[2].ratio == 4.0);
+  CHECK(detail::fold_gain_ratios({}).empty());
+}
+
+TEST_CASE("calibration: gain ratios measured on the folds where asked for, and kept in the model") {
+  const std::vector<Field> fields = two_blob_fields();
+  OracleSegmenter oracle(fields.front().num_classes());
+  CalibrationOptions options = ranked_options();
+  options.slope_poolings = {SlopePooling::cells};
+  const auto params = [](const CalibrationResult& c) {
+    return std::get<FrontAwarePolicy>(c.decision_function.rule()).params();
+  };
+  const CalibrationResult plain = calibrate(std::span<const Field>(fields), oracle, options);
+  CHECK(params(plain).gain_ratios.empty());  // not asked for
+  // The folds descend at z = 0, as the measuring flights fly them.
+  const auto z0 = std::find_if(plain.trials.begin(), plain.trials.end(),
+                               [](const RuleTrial& t) { return t.description == "front-aware z=0"; });
+  REQUIRE(z0 != plain.trials.end());
+  REQUIRE(z0->descents > 0);
+  options.gain_ratios = true;
+  const CalibrationResult measured = calibrate(std::span<const Field>(fields), oracle, options);
+  const std::vector<GainRatio> ratios = params(measured).gain_ratios;
+  REQUIRE_FALSE(ratios.empty());
+  for (const GainRatio& r : ratios) {
+    CHECK((r.gsd_cm == 1.0 || r.gsd_cm == 2.0));
+    CHECK(r.ratio >= 0.0);
+    CHECK(r.ratio <= 4.0);
+  }
+  t::TempDir tmp;
+  make_decision_model(fields, oracle.name(), options, measured).save(tmp.path() / "model.yaml");
+  const std::vector<GainRatio> back =
+      std::get<FrontAwarePolicy>(DecisionModel::load(tmp.path() / "model.yaml").decision_function.rule())
+          .params()
+          .gain_ratios;
+  REQUIRE(back.size() == ratios.size());
+  for (std::size_t k = 0; k < back.size(); ++k) {
+    CHECK(back[k].gsd_cm == ratios[k].gsd_cm);
+    CHECK(back[k].ratio == doctest::Approx(ratios[k].ratio).epsilon(1e-9));
+  }
+}
+
 TEST_CASE("calibration: several training fields pool their samples and keep every field's curve") {
   const Field a = t::blob_field(1300, 1000, 1.0, 4, 15);
   const Field b = t::blob_field(1000, 1300, 1.0, 11, 15).sub_field({0, 0, 1, 0.8});
@@ -569,6 +643,30 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
   p.curve = CurveSource::corrected;
   // So is the top-level rule (files without the key: undominated); a name it does not know is refused.
   CHECK(rule_of(back).top_level == TopLevelChoice::undominated);
+  // So are the gain ratios (files without the keys: none); lists of two lengths are refused.
+  CHECK(rule_of(back).gain_ratios.empty());
+  p.gain_ratios = {{1.0, 0.5}, {2.0, 1.25}};
+  policy.set_params(p);
+  corrected.save(tmp.path() / "ratios.yaml");
+  const std::vector<GainRatio> read_back = rule_of(DecisionModel::load(tmp.path() / "ratios.yaml")).gain_ratios;
+  REQUIRE(read_back.size() == 2);
+  CHECK(read_back[0].gsd_cm == 1.0);
+  CHECK(read_back[0].ratio == 0.5);
+  CHECK(read_back[1].gsd_cm == 2.0);
+  CHECK(read_back[1].ratio == 1.25);
+  {
+    std::stringstream ratios_text;
+    ratios_text << std::ifstream(tmp.path() / "ratios.yaml").rdbuf();
+    std::string uneven = ratios_text.str();
+    const auto ratio_at = uneven.find("  gain_ratio: [0.5, 1.25]");
+    REQUIRE(ratio_at != std::string::npos);
+    uneven.replace(ratio_at, 25, "  gain_ratio: [0.5]");
+    std::ofstream(tmp.path() / "uneven.yaml") << uneven;
+    CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "uneven.yaml"),
+                         doctest::Contains("'rule.gain_ratio' needs as many values as 'rule.gain_ratio_gsd_cm'"),
+                         std::invalid_argument);
+  }
+  p.gain_ratios.clear();
   p.top_level = TopLevelChoice::hull;
   policy.set_params(p);
   corrected.save(tmp.path() / "hull.yaml");

@@ -444,6 +444,37 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     CHECK(d.scores[0].predicted_field_gain == doctest::Approx(0.05 / 7.0 / 0.2));
     CHECK(d.scores[1].predicted_field_gain == doctest::Approx(0.10 / 7.0 / 0.2));
   }
+  SUBCASE("gain ratios measured on the folds scale every forecast of a descent to their GSD") {
+    // β = 4: the four cells forecast 0.29 against the training curve's 0.12 over their 90 s.
+    FrontAwarePolicy plain(with_cells(4.0), reference, {});
+    const Decision d = plain.decide(s.region(0, 0.1));
+    REQUIRE(d.descend);
+    REQUIRE(d.scores.size() == 2);
+    // A ratio of another GSD than the candidates', or of 1, changes nothing.
+    for (const GainRatio r : {GainRatio{2.0, 0.0}, GainRatio{1.0, 1.0}}) {
+      FrontAwarePolicy p(with_cells(4.0), reference, {.gain_ratios = {r}});
+      const Decision e = p.decide(s.region(0, 0.1));
+      CHECK(e.descend);
+      CHECK(e.candidate == d.candidate);
+      for (std::size_t k = 0; k < 2; ++k)
+        CHECK(e.scores[k].predicted_field_gain == doctest::Approx(d.scores[k].predicted_field_gain));
+    }
+    FrontAwarePolicy doubled(with_cells(4.0), reference, {.gain_ratios = {{1.0, 2.0}}});
+    const Decision twice = doubled.decide(s.region(0, 0.1));
+    for (std::size_t k = 0; k < 2; ++k)
+      CHECK(twice.scores[k].predicted_field_gain == doctest::Approx(2.0 * d.scores[k].predicted_field_gain));
+    // A quarter of the forecast no longer beats the curve: what β = 1 forecasts.
+    FrontAwarePolicy quarter(with_cells(4.0), reference, {.gain_ratios = {{1.0, 0.25}}});
+    FrontAwarePolicy beta_one(with_cells(1.0), reference, {});
+    const Decision q = quarter.decide(s.region(0, 0.1));
+    CHECK_FALSE(q.descend);
+    CHECK(q.scores[1].predicted_field_gain ==
+          doctest::Approx(beta_one.decide(s.region(0, 0.1)).scores[1].predicted_field_gain));
+    CHECK_THROWS_WITH_AS(FrontAwarePolicy(with_cells(1.0), reference, {.gain_ratios = {{1.0, -0.5}}}),
+                         doctest::Contains("gain_ratios: a ratio must be finite and >= 0"), std::invalid_argument);
+    CHECK_THROWS_WITH_AS(FrontAwarePolicy(with_cells(1.0), reference, {.gain_ratios = {{0.0, 1.0}}}),
+                         doctest::Contains("gain_ratios: a GSD must be finite and > 0"), std::invalid_argument);
+  }
   SUBCASE("against the field's own predicted curve, the forecasts' scale cancels") {
     // The training curve rises by 0.2 mIoU over 145 s: against it, a descent of twice the cells'
     // gain looks better than one of half of it. Against the curve the same model predicts for

@@ -243,6 +243,7 @@ struct CalibrationCli {
   std::vector<std::string> slope_poolings{"cells", "fields"};
   std::string curve = to_string(CurveSource::corrected);  // the programs' default, not the struct's
   std::vector<std::string> top_levels{"undominated"};
+  bool gain_ratios = false;
 
   void add_to(CLI::App& app) {
     options_ = {
@@ -303,6 +304,10 @@ struct CalibrationCli {
             ->delimiter(',')
             ->check(CLI::NonNegativeNumber)
             ->capture_default_str(),
+        app.add_flag("--gain-ratios", gain_ratios,
+                     "front-aware rule, several training fields: scale each forecast of a descent by what "
+                     "descents to its GSD realised of their forecast when the training fields were flown with "
+                     "the model of the others (measured before the search; saved in the model)"),
         app.add_option("--sigma-prior", sigma_prior,
                        "front-aware rule with several training fields: the prior of the field's share of L "
                        "(sigma-hat): given (weight 0.25 fields, no spread), spread (its spread over the training "
@@ -332,6 +337,7 @@ struct CalibrationCli {
     options.sigma_prior = parse_sigma_prior_source(sigma_prior);
     options.adaptive.coverage = parse_descent_coverage(coverage);
     options.front_aware.curve = parse_curve_source(curve);
+    options.gain_ratios = gain_ratios;
     options.top_levels.clear();
     for (const auto& name : top_levels) options.top_levels.push_back(parse_top_level_choice(name));
     options.cell_inputs.clear();

@@ -92,6 +92,14 @@ inline constexpr std::array<detail::NamedValue<CurveSource>, 3> kCurveSources{{
   return detail::value_named(kCurveSources, name, "curve source");
 }
 
+/// How much of its forecast field gain a descent to one GSD realised when the training fields
+/// were flown as new ground (FrontAwarePolicy::Params::gain_ratios; calibrate() with
+/// CalibrationOptions::gain_ratios measures it).
+struct GainRatio {
+  double gsd_cm = 0.0;  ///< the descent GSD [cm/px]
+  double ratio = 1.0;   ///< realised / forecast field gain, >= 0
+};
+
 /// A training field's fixed-altitude lawnmower curve by GSD: the front-aware rule's yardstick.
 struct ReferenceCurve {
   std::string field;             ///< the training field's name
@@ -178,6 +186,11 @@ class FrontAwarePolicy {
     CurveSource curve = CurveSource::training;
     /// How top_gsd() chooses the top level (TopLevelChoice).
     TopLevelChoice top_level = TopLevelChoice::undominated;
+    /// Per descent GSD, the factor on a candidate's forecast field gain (its mean and its
+    /// spread): what the training fields, each flown with a model that never saw it, realised
+    /// of what descents to that GSD were forecast to gain (calibrate() with
+    /// CalibrationOptions::gain_ratios). A GSD not listed: 1. Empty (the default): none.
+    std::vector<GainRatio> gain_ratios{};
 
     /// @throws std::invalid_argument naming the field.
     void validate() const {
@@ -191,6 +204,19 @@ class FrontAwarePolicy {
                       "FrontAwarePolicy::Params::sigma_prior_weight must be finite and > 0", sigma_prior_weight);
       detail::require(std::isfinite(sigma_prior_sd) && sigma_prior_sd >= 0.0 && sigma_prior_sd <= 1.0,
                       "FrontAwarePolicy::Params::sigma_prior_sd must be in [0, 1]", sigma_prior_sd);
+      for (const GainRatio& r : gain_ratios) {
+        detail::require(std::isfinite(r.gsd_cm) && r.gsd_cm > 0.0,
+                        "FrontAwarePolicy::Params::gain_ratios: a GSD must be finite and > 0", r.gsd_cm);
+        detail::require(std::isfinite(r.ratio) && r.ratio >= 0.0,
+                        "FrontAwarePolicy::Params::gain_ratios: a ratio must be finite and >= 0", r.ratio);
+      }
+    }
+
+    /// The factor on the forecast gain of a descent to `gsd_cm` (1 where none is listed).
+    [[nodiscard]] double gain_ratio(double gsd_cm) const noexcept {
+      for (const GainRatio& r : gain_ratios)
+        if (std::abs(r.gsd_cm - gsd_cm) <= 1e-9 * gsd_cm) return r.ratio;
+      return 1.0;
     }
   };
 
@@ -325,6 +351,10 @@ class FrontAwarePolicy {
         base_sd = f.relabelled_std * eta * weight;
         relabelled = {f.relabelled, f.relabelled_noisy_std, 0.0, 0.0, 0.0, 0.0};
       }
+      // What descents to this GSD realised of their forecast on the training fields as new ground.
+      const double ratio = params_.gain_ratio(cand.gsd_cm);
+      base *= ratio;
+      base_sd *= ratio;
       const double gain = scaled(base);
       const double gain_var =
           scale_mean_ * scale_mean_ * base_sd * base_sd + scale_var_ * base * base + gain * gain * sigma_cv2;

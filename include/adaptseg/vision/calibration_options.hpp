@@ -97,6 +97,16 @@ struct CalibrationOptions {
   /// unless another's best setting has a larger mean front margin on the folds. Without ranked
   /// cells: the first only. Empty (the default): `front_aware.top_level` alone.
   std::vector<TopLevelChoice> top_levels{};
+  /// Front-aware rule, several training fields: measure FrontAwarePolicy::Params::gain_ratios
+  /// on the folds before the search. Each training field is flown with the model of the others
+  /// (the first slope pooling and top-level choice, z = 0); per descent GSD, the ratio of what
+  /// its descents realised in field gain (RealisedDescent::field_gain) to what they were
+  /// forecast to gain, shrunk towards 1 by two descents' worth of forecast and kept in [0, 4],
+  /// scales every forecast of a descent to that GSD in the search and in the model
+  /// (detail::fold_gain_ratios). The training fields flown as new ground tell how the
+  /// forecast's dependence on the descent GSD transfers to a field the model never saw
+  /// (docs/method.md, "Gain ratios measured on the folds"). false (the default): none.
+  bool gain_ratios = false;
   /// Front-aware rule, σ̂'s prior (FrontAwarePolicy `sigma_prior_weight` k, `sigma_prior_sd` τ)
   /// with several training fields: `given` keeps `front_aware`'s; `spread` estimates τ on the
   /// training fields (estimate_sigma_prior) and keeps k; `estimated` estimates both. Each fold

@@ -47,6 +47,14 @@ struct FrontAwareRule {
     if (p.curve == CurveSource::corrected) e << YAML::Key << "curve_ratio" << YAML::Value << detail::flag_text(true);
     if (p.top_level != TopLevelChoice::undominated)
       e << YAML::Key << "top_level" << YAML::Value << to_string(p.top_level);
+    if (!p.gain_ratios.empty()) {
+      std::vector<double> g, r;
+      for (const GainRatio& x : p.gain_ratios) g.push_back(x.gsd_cm), r.push_back(x.ratio);
+      e << YAML::Key << "gain_ratio_gsd_cm" << YAML::Value;
+      emit_numbers(e, g);
+      e << YAML::Key << "gain_ratio" << YAML::Value;
+      emit_numbers(e, r);
+    }
     e << YAML::Key << "reference" << YAML::Value << YAML::BeginSeq;
     for (const auto& r : rule.reference()) {
       std::vector<double> g, m;
@@ -108,7 +116,20 @@ struct FrontAwareRule {
                              .sigma_prior_weight = rule.number("sigma_prior_weight"),
                              .sigma_prior_sd = rule.has("sigma_prior_sd") ? rule.number("sigma_prior_sd") : 0.0,
                              .curve = read_curve(rule),
-                             .top_level = rule.has("top_level") ? read_top_level(rule) : TopLevelChoice::undominated});
+                             .top_level = rule.has("top_level") ? read_top_level(rule) : TopLevelChoice::undominated,
+                             .gain_ratios = read_gain_ratios(rule)});
+  }
+
+  /// `rule.gain_ratio_gsd_cm` and `rule.gain_ratio` (absent: none).
+  [[nodiscard]] static std::vector<GainRatio> read_gain_ratios(const detail::YamlReader& rule) {
+    if (!rule.has("gain_ratio_gsd_cm") && !rule.has("gain_ratio")) return {};
+    const auto g = rule.numbers("gain_ratio_gsd_cm");
+    const auto r = rule.numbers("gain_ratio");
+    if (g.size() != r.size())
+      detail::yaml_error(rule.where(), "'rule.gain_ratio' needs as many values as 'rule.gain_ratio_gsd_cm'");
+    std::vector<GainRatio> out;
+    for (std::size_t i = 0; i < g.size(); ++i) out.push_back({g[i], r[i]});
+    return out;
   }
 
   /// The curve source of the flags `field_curve` and `curve_ratio` (absent: false; the ratio

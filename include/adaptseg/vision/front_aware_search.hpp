@@ -6,6 +6,7 @@
 /// σ̂'s prior estimated from their top-level images. docs/method.md, "The front-aware rule".
 
 #include <adaptseg/core/front_aware_policy.hpp>
+#include <adaptseg/vision/adaptive_mission.hpp>
 #include <adaptseg/vision/calibration_options.hpp>
 #include <adaptseg/vision/detail/number_text.hpp>
 
@@ -258,6 +259,41 @@ inline std::vector<GainModel> pooled_fold_models(const RuleSearchInputs& in, std
   return models;
 }
 
+/// Per descent GSD, realised / forecast field gain over the descents of `flights` (each an
+/// AdaptiveResult of a fold, simulated so that its descents' realised field gains are known):
+/// (Σ realised + 2·f̄) / (Σ forecast + 2·f̄), f̄ the mean forecast gain of the GSD's descents (two
+/// descents' worth of prior at ratio 1), kept in [0, 4]; in increasing GSD order. A GSD whose
+/// descents were forecast nothing positive in all is left out (ratio 1).
+inline std::vector<GainRatio> fold_gain_ratios(std::span<const AdaptiveResult> flights) {
+  struct Sums {
+    double gsd_cm, forecast, realised;
+    int n;
+  };
+  std::vector<Sums> sums;
+  for (const AdaptiveResult& r : flights)
+    for (const RealisedDescent& d : r.realised) {
+      const DecisionRecord& rec = r.decisions[d.decision];
+      const std::size_t k = chosen_candidate(rec.decision, rec.candidates, "front-aware");
+      if (k >= rec.decision.scores.size()) continue;
+      const double forecast = rec.decision.scores[k].predicted_field_gain;
+      if (!std::isfinite(forecast)) continue;
+      const double g = rec.candidates[k].gsd_cm;
+      auto it = std::find_if(sums.begin(), sums.end(), [&](const Sums& s) { return s.gsd_cm == g; });
+      if (it == sums.end()) it = sums.insert(sums.end(), {g, 0.0, 0.0, 0});
+      it->forecast += forecast;
+      it->realised += d.field_gain;
+      ++it->n;
+    }
+  std::sort(sums.begin(), sums.end(), [](const Sums& a, const Sums& b) { return a.gsd_cm < b.gsd_cm; });
+  std::vector<GainRatio> out;
+  for (const Sums& s : sums) {
+    if (!(s.forecast > 0.0)) continue;
+    const double prior = 2.0 * s.forecast / s.n;
+    out.push_back({s.gsd_cm, std::clamp((s.realised + prior) / (s.forecast + prior), 0.0, 4.0)});
+  }
+  return out;
+}
+
 /// The setting kept (an index into `trials` and `settings`, in the same order): per pooling and
 /// top level, its z of best mean front margin (ties to the larger z); per top level, the first
 /// pooling's unless another beats it by more than the folds' noise (select_pooling); of the
@@ -304,6 +340,23 @@ template <class Fly>
   FrontAwarePolicy::Params base = options.front_aware;
   base.online = true;
   detail::apply_sigma_prior(base, estimate_sigma_prior(traces), options.sigma_prior);
+  if (options.gain_ratios && in.fields.size() >= 2) {
+    // What descents to each GSD realised of their forecast on the training fields flown as new
+    // ground: the first pooling and top level, z = 0 (the most descents to learn from).
+    FrontAwarePolicy::Params first = base;
+    const std::vector<GainModel> models = detail::pooled_fold_models(in, folds, grid, grid.poolings.front(), first);
+    first.confidence = 0.0;
+    first.top_level = grid.top_levels.front();
+    std::vector<AdaptiveResult> flights;
+    for (std::size_t k = 0; k < folds.size(); ++k) {
+      FrontAwarePolicy::Params fold_params = first;
+      detail::apply_sigma_prior(fold_params, folds[k].sigma_prior, options.sigma_prior);
+      FrontAwarePolicy policy(models[k], folds[k].reference, fold_params);
+      double margin = 0.0;
+      flights.push_back(fly(*folds[k].field, policy, *folds[k].curve, margin));
+    }
+    base.gain_ratios = detail::fold_gain_ratios(flights);
+  }
   std::vector<RuleTrial> trials;
   std::vector<detail::FrontAwareSetting> settings;
   for (std::size_t pi = 0; pi < grid.poolings.size(); ++pi) {
