@@ -102,10 +102,11 @@ struct CalibrationOptions {
   /// (the first slope pooling and top-level choice, z = 0); per descent GSD, the ratio of what
   /// its descents realised in field gain (RealisedDescent::field_gain) to what they were
   /// forecast to gain, shrunk towards 1 by two descents' worth of forecast and kept in [0, 4],
-  /// scales every forecast of a descent to that GSD in the search and in the model
-  /// (detail::fold_gain_ratios). The training fields flown as new ground tell how the
-  /// forecast's dependence on the descent GSD transfers to a field the model never saw
-  /// (docs/method.md, "Gain ratios measured on the folds"). false (the default): none.
+  /// scales every forecast of a descent to that GSD (detail::fold_gain_ratios): in the model,
+  /// the ratios of every fold's flight; in the search, each fold's trials those of the other
+  /// folds' flights, as its model is fitted without its field. The training fields flown as new
+  /// ground tell how the forecast's dependence on the descent GSD transfers to a field the model
+  /// never saw (docs/method.md, "Gain ratios measured on the folds"). false (the default): none.
   bool gain_ratios = false;
   /// Front-aware rule, σ̂'s prior (FrontAwarePolicy `sigma_prior_weight` k, `sigma_prior_sd` τ)
   /// with several training fields: `given` keeps `front_aware`'s; `spread` estimates τ on the

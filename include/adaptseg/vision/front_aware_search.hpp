@@ -340,6 +340,9 @@ template <class Fly>
   FrontAwarePolicy::Params base = options.front_aware;
   base.online = true;
   detail::apply_sigma_prior(base, estimate_sigma_prior(traces), options.sigma_prior);
+  // Per fold, the gain ratios its trials fly with: measured on the other folds' flights only, as
+  // its model was fitted without its field (the model's own: on every fold's flight).
+  std::vector<std::vector<GainRatio>> fold_ratios(folds.size(), base.gain_ratios);
   if (options.gain_ratios && in.fields.size() >= 2) {
     // What descents to each GSD realised of their forecast on the training fields flown as new
     // ground: the first pooling and top level, z = 0 (the most descents to learn from).
@@ -356,6 +359,12 @@ template <class Fly>
       flights.push_back(fly(*folds[k].field, policy, *folds[k].curve, margin));
     }
     base.gain_ratios = detail::fold_gain_ratios(flights);
+    for (std::size_t k = 0; k < folds.size(); ++k) {
+      std::vector<AdaptiveResult> others;
+      for (std::size_t j = 0; j < flights.size(); ++j)
+        if (j != k) others.push_back(flights[j]);
+      fold_ratios[k] = detail::fold_gain_ratios(others);
+    }
   }
   std::vector<RuleTrial> trials;
   std::vector<detail::FrontAwareSetting> settings;
@@ -373,6 +382,7 @@ template <class Fly>
         for (std::size_t k = 0; k < folds.size(); ++k) {
           FrontAwarePolicy::Params fold_params = p;  // σ̂'s prior: the fold's estimate replaces all fields'
           detail::apply_sigma_prior(fold_params, folds[k].sigma_prior, options.sigma_prior);
+          fold_params.gain_ratios = fold_ratios[k];
           FrontAwarePolicy policy(models[k], folds[k].reference, fold_params);
           double margin = 0.0;
           const AdaptiveResult r = fly(*folds[k].field, policy, *folds[k].curve, margin);
