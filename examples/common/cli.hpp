@@ -237,7 +237,7 @@ struct CalibrationCli {
   std::string coverage = "ranked";
   std::string gain_inputs = "delta-sigma-height";
   std::vector<double> confidences = kDefaultConfidences;
-  std::string sigma_prior = to_string(CalibrationOptions{}.sigma_prior);
+  std::string sigma_prior = to_string(CalibrationOptions::kDefaultSigmaPrior);
   std::optional<double> segmentation_time_s;
   std::vector<std::string> cell_inputs;
   std::vector<std::string> slope_poolings{"cells", "fields"};

@@ -113,7 +113,8 @@ struct CalibrationOptions {
   /// training fields (estimate_sigma_prior) and keeps k; `estimated` estimates both. Each fold
   /// of the z choice uses the values estimated without its field. One field: as given.
   enum class SigmaPriorSource { given, spread, estimated };
-  SigmaPriorSource sigma_prior = SigmaPriorSource::given;
+  static constexpr SigmaPriorSource kDefaultSigmaPrior = SigmaPriorSource::given;  ///< the default below
+  SigmaPriorSource sigma_prior = kDefaultSigmaPrior;
 
   /// Utility rule: `exploration` and `min_sigma` as given; thresholds searched (quantiles of
   /// the utilities seen, absolute and relative, σ weighting on and off, "never descend"), each
