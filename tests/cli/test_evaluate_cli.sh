@@ -40,7 +40,8 @@ echo "ok: adaptive front margin on dubai-tile-6 (road) = $margin"
 want="field,strategy,decision,image,sigma,action,gsd_cm,images,extra_time_s,forecast_delta_sigma,forecast_delta_miou,"
 want+="forecast_delta_miou_std,forecast_relabelled_interest,forecast_field_gain,forecast_front_margin,observed_sigma_sub,"
 want+="observed_relabelled,observed_relabelled_interest,realised_region_delta_miou,realised_field_gain,flown,"
-want+="observed_top_input,observed_fine_input,realised_delta_tp,realised_delta_fp,realised_delta_fn"
+want+="observed_top_input,observed_fine_input,realised_delta_tp,realised_delta_fp,realised_delta_fn,forecast_curve_rise,"
+want+="forecast_end_s"
 [ "$(head -1 "$work/e/decisions.csv")" = "$want" ] || fail "decisions.csv header: $(head -1 "$work/e/decisions.csv")"
 # Every realised descent's pixel counts: present, whole numbers, and a class's true positives and
 # false negatives (its pixels, whatever the map says) moving by opposite amounts.
