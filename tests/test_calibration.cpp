@@ -542,7 +542,58 @@ TEST_CASE("calibration: gain ratios, realised over forecast field gain per desce
   CHECK(detail::fold_gain_ratios({}).empty());
 }
 
-TEST_CASE("calibration: gain ratios measured on the folds where asked for, and kept in the model") {
+TEST_CASE("calibration: margin biases, realised less forecast margin per second of descent, shrunk towards 0") {
+  // Flight 0 over a field whose lawnmowers rise 0.5 -> 0.7 from 100 to 200 s: a descent to
+  // 1 cm/px of 50 s ending at 150 s, forecast 0.02 - 0.05, realised 0.08 - 0.1 (error +0.01); one
+  // to 2 cm/px of 10 s ending past the curve (flat there), forecast 0.01 - 0.002, realised 0
+  // (-0.008). Flight 1, 0.3 -> 0.4 from 50 to 150 s: to 1 cm/px, 30 s ending at 100 s, forecast
+  // 0.01 - 0.01, realised 0.05 - 0.03 (+0.02); one without a predicted rise (left out).
+  std::vector<AdaptiveResult> flights(2);
+  const auto descend = [&](std::size_t j, double gsd, double seconds, double end, double gain, double rise,
+                           double realised) {
+    DecisionRecord rec;
+    rec.candidates = {Candidate{gsd, 5.0, 1, seconds}};
+    rec.decision.descend = true;
+    rec.decision.gsd_cm = gsd;
+    CandidateScore score;
+    score.predicted_field_gain = gain;
+    score.predicted_curve_rise = rise;
+    score.predicted_end_s = end;
+    rec.decision.scores = {score};
+    RealisedDescent r;
+    r.decision = flights[j].decisions.size();
+    r.field_gain = realised;
+    flights[j].decisions.push_back(rec);
+    flights[j].realised.push_back(r);
+  };
+  descend(0, 1.0, 50.0, 150.0, 0.02, 0.05, 0.08);
+  descend(0, 2.0, 10.0, 250.0, 0.01, 0.002, 0.0);
+  descend(1, 1.0, 30.0, 100.0, 0.01, 0.01, 0.05);
+  descend(1, 1.0, 30.0, 100.0, 0.01, std::numeric_limits<double>::quiet_NaN(), 0.5);
+  const std::vector<CurvePoint> c0{{100.0, 0.5}, {200.0, 0.7}}, c1{{150.0, 0.4}, {50.0, 0.3}};
+  const std::vector<const std::vector<CurvePoint>*> curves{&c0, &c1};
+  const std::vector<MarginBias> all = detail::fold_margin_biases(flights, curves);
+  REQUIRE(all.size() == 2);
+  CHECK(all[0].gsd_cm == 1.0);
+  CHECK(all[0].per_s == doctest::Approx(0.03 / (80.0 + 80.0)));  // prior: 2 x mean 40 s at bias 0
+  CHECK(all[1].gsd_cm == 2.0);
+  CHECK(all[1].per_s == doctest::Approx(-0.008 / (10.0 + 20.0)));
+  // Each fold by the other's flight only.
+  const std::vector<MarginBias> without_1 = detail::fold_margin_biases(flights, curves, 1);
+  REQUIRE(without_1.size() == 2);
+  CHECK(without_1[0].per_s == doctest::Approx(0.01 / (50.0 + 100.0)));
+  const std::vector<MarginBias> without_0 = detail::fold_margin_biases(flights, curves, 0);
+  REQUIRE(without_0.size() == 1);
+  CHECK(without_0[0].gsd_cm == 1.0);
+  CHECK(without_0[0].per_s == doctest::Approx(0.02 / (30.0 + 60.0)));
+  // The gain ratios skip a flight the same way (flight 0's: 0.08 of 0.02, 0 of 0.01).
+  const std::vector<GainRatio> ratios_without_1 = detail::fold_gain_ratios(flights, 1);
+  REQUIRE(ratios_without_1.size() == 2);
+  CHECK(ratios_without_1[0].ratio == doctest::Approx((0.08 + 0.04) / (0.02 + 0.04)));
+  CHECK(ratios_without_1[1].ratio == doctest::Approx((0.0 + 0.02) / (0.01 + 0.02)));
+}
+
+TEST_CASE("calibration: gain ratios and margin biases measured on the folds where asked for, and kept in the model") {
   const std::vector<Field> fields = two_blob_fields();
   OracleSegmenter oracle(fields.front().num_classes());
   CalibrationOptions options = ranked_options();
@@ -552,30 +603,51 @@ TEST_CASE("calibration: gain ratios measured on the folds where asked for, and k
   };
   const CalibrationResult plain = calibrate(std::span<const Field>(fields), oracle, options);
   CHECK(params(plain).gain_ratios.empty());  // not asked for
+  CHECK(params(plain).margin_biases.empty());
   // The folds descend at z = 0, as the measuring flights fly them.
   const auto z0 = std::find_if(plain.trials.begin(), plain.trials.end(),
                                [](const RuleTrial& t) { return t.description == "front-aware z=0"; });
   REQUIRE(z0 != plain.trials.end());
   REQUIRE(z0->descents > 0);
   options.gain_ratios = true;
+  options.margin_biases = true;
+  // Measured by flying each field with the model of the others: one field is refused, and so is
+  // a rule without a forecast margin.
+  CHECK_THROWS_WITH_AS((void)calibrate(fields.front(), oracle, options),
+                       doctest::Contains("which needs at least two training fields; count (got 1)"),
+                       std::invalid_argument);
+  CalibrationOptions utility = options;
+  utility.rule = "utility";
+  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, utility),
+                       doctest::Contains("gain_ratios and margin_biases belong to the front-aware rule"),
+                       std::invalid_argument);
   const CalibrationResult measured = calibrate(std::span<const Field>(fields), oracle, options);
   const std::vector<GainRatio> ratios = params(measured).gain_ratios;
+  const std::vector<MarginBias> biases = params(measured).margin_biases;
   REQUIRE_FALSE(ratios.empty());
+  REQUIRE_FALSE(biases.empty());
   for (const GainRatio& r : ratios) {
     CHECK((r.gsd_cm == 1.0 || r.gsd_cm == 2.0));
     CHECK(r.ratio >= 0.0);
     CHECK(r.ratio <= 4.0);
   }
+  for (const MarginBias& b : biases) {
+    CHECK((b.gsd_cm == 1.0 || b.gsd_cm == 2.0));
+    CHECK(std::isfinite(b.per_s));
+  }
   t::TempDir tmp;
   make_decision_model(fields, oracle.name(), options, measured).save(tmp.path() / "model.yaml");
-  const std::vector<GainRatio> back =
-      std::get<FrontAwarePolicy>(DecisionModel::load(tmp.path() / "model.yaml").decision_function.rule())
-          .params()
-          .gain_ratios;
-  REQUIRE(back.size() == ratios.size());
-  for (std::size_t k = 0; k < back.size(); ++k) {
-    CHECK(back[k].gsd_cm == ratios[k].gsd_cm);
-    CHECK(back[k].ratio == doctest::Approx(ratios[k].ratio).epsilon(1e-9));
+  const FrontAwarePolicy::Params back =
+      std::get<FrontAwarePolicy>(DecisionModel::load(tmp.path() / "model.yaml").decision_function.rule()).params();
+  REQUIRE(back.gain_ratios.size() == ratios.size());
+  for (std::size_t k = 0; k < ratios.size(); ++k) {
+    CHECK(back.gain_ratios[k].gsd_cm == ratios[k].gsd_cm);
+    CHECK(back.gain_ratios[k].ratio == doctest::Approx(ratios[k].ratio).epsilon(1e-9));
+  }
+  REQUIRE(back.margin_biases.size() == biases.size());
+  for (std::size_t k = 0; k < biases.size(); ++k) {
+    CHECK(back.margin_biases[k].gsd_cm == biases[k].gsd_cm);
+    CHECK(back.margin_biases[k].per_s == doctest::Approx(biases[k].per_s).epsilon(1e-9));
   }
 }
 
@@ -667,6 +739,31 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
                          std::invalid_argument);
   }
   p.gain_ratios.clear();
+  // So are the margin biases (files without the keys: none); lists of two lengths are refused.
+  CHECK(rule_of(back).margin_biases.empty());
+  p.margin_biases = {{1.0, -0.0005}, {2.0, 0.00025}};
+  policy.set_params(p);
+  corrected.save(tmp.path() / "biases.yaml");
+  const std::vector<MarginBias> biases_back = rule_of(DecisionModel::load(tmp.path() / "biases.yaml")).margin_biases;
+  REQUIRE(biases_back.size() == 2);
+  CHECK(biases_back[0].gsd_cm == 1.0);
+  CHECK(biases_back[0].per_s == -0.0005);
+  CHECK(biases_back[1].gsd_cm == 2.0);
+  CHECK(biases_back[1].per_s == 0.00025);
+  {
+    std::stringstream biases_text;
+    biases_text << std::ifstream(tmp.path() / "biases.yaml").rdbuf();
+    std::string uneven = biases_text.str();
+    const auto line_at = uneven.find("  margin_bias_per_s: [");
+    REQUIRE(line_at != std::string::npos);
+    uneven.replace(line_at, uneven.find('\n', line_at) - line_at, "  margin_bias_per_s: [-0.0005]");
+    std::ofstream(tmp.path() / "uneven_biases.yaml") << uneven;
+    CHECK_THROWS_WITH_AS(
+        (void)DecisionModel::load(tmp.path() / "uneven_biases.yaml"),
+        doctest::Contains("'rule.margin_bias_per_s' needs as many values as 'rule.margin_bias_gsd_cm'"),
+        std::invalid_argument);
+  }
+  p.margin_biases.clear();
   p.top_level = TopLevelChoice::hull;
   policy.set_params(p);
   corrected.save(tmp.path() / "hull.yaml");

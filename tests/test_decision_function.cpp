@@ -475,6 +475,32 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     CHECK_THROWS_WITH_AS(FrontAwarePolicy(with_cells(1.0), reference, {.gain_ratios = {{0.0, 1.0}}}),
                          doctest::Contains("gain_ratios: a GSD must be finite and > 0"), std::invalid_argument);
   }
+  SUBCASE("margin biases measured on the folds add b·T to a descent's margin, its gain unchanged") {
+    // β = 1: the four cells forecast 0.071 against the curve's 0.124 over their 90 s, the two
+    // cells 0.036 against 0.069 over 50 s; neither descends.
+    FrontAwarePolicy plain(with_cells(1.0), reference, {});
+    const Decision d = plain.decide(s.region(0, 0.1));
+    REQUIRE_FALSE(d.descend);
+    // A bias of another GSD changes nothing.
+    FrontAwarePolicy other(with_cells(1.0), reference, {.margin_biases = {{2.0, 0.001}}});
+    CHECK_FALSE(other.decide(s.region(0, 0.1)).descend);
+    // +0.001 per second: +0.09 for the four cells (lower bound 0.037), +0.05 for the two (0.017).
+    FrontAwarePolicy raised(with_cells(1.0), reference, {.margin_biases = {{1.0, 0.001}}});
+    const Decision r = raised.decide(s.region(0, 0.1));
+    CHECK(r.descend);
+    CHECK(r.candidate == 1);
+    for (std::size_t k = 0; k < 2; ++k)
+      CHECK(r.scores[k].predicted_field_gain == doctest::Approx(d.scores[k].predicted_field_gain));
+    // β = 4 descends (0.29 against 0.124); −0.002 per second takes 0.18 and 0.10 off: no descent.
+    FrontAwarePolicy four(with_cells(4.0), reference, {});
+    REQUIRE(four.decide(s.region(0, 0.1)).descend);
+    FrontAwarePolicy lowered(with_cells(4.0), reference, {.margin_biases = {{1.0, -0.002}}});
+    CHECK_FALSE(lowered.decide(s.region(0, 0.1)).descend);
+    CHECK_THROWS_WITH_AS(FrontAwarePolicy(with_cells(1.0), reference, {.margin_biases = {{1.0, NAN}}}),
+                         doctest::Contains("margin_biases: a bias must be finite"), std::invalid_argument);
+    CHECK_THROWS_WITH_AS(FrontAwarePolicy(with_cells(1.0), reference, {.margin_biases = {{-1.0, 0.0}}}),
+                         doctest::Contains("margin_biases: a GSD must be finite and > 0"), std::invalid_argument);
+  }
   SUBCASE("against the field's own predicted curve, the forecasts' scale cancels") {
     // The training curve rises by 0.2 mIoU over 145 s: against it, a descent of twice the cells'
     // gain looks better than one of half of it. Against the curve the same model predicts for

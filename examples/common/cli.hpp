@@ -244,6 +244,7 @@ struct CalibrationCli {
   std::string curve = to_string(CurveSource::corrected);  // the programs' default, not the struct's
   std::vector<std::string> top_levels{"undominated"};
   bool gain_ratios = false;
+  bool margin_biases = false;
 
   void add_to(CLI::App& app) {
     options_ = {
@@ -308,6 +309,11 @@ struct CalibrationCli {
                      "front-aware rule, several training fields: scale each forecast of a descent by what "
                      "descents to its GSD realised of their forecast when the training fields were flown with "
                      "the model of the others (measured before the search; saved in the model)"),
+        app.add_flag("--margin-biases", margin_biases,
+                     "front-aware rule, several training fields: add to each descent's forecast margin what "
+                     "descents to its GSD ended above theirs per second when the training fields were flown "
+                     "with the model of the others (gain and lawnmower curve both; measured before the search; "
+                     "saved in the model)"),
         app.add_option("--sigma-prior", sigma_prior,
                        "front-aware rule with several training fields: the prior of the field's share of L "
                        "(sigma-hat): given (weight 0.25 fields, no spread), spread (its spread over the training "
@@ -338,6 +344,7 @@ struct CalibrationCli {
     options.adaptive.coverage = parse_descent_coverage(coverage);
     options.front_aware.curve = parse_curve_source(curve);
     options.gain_ratios = gain_ratios;
+    options.margin_biases = margin_biases;
     options.top_levels.clear();
     for (const auto& name : top_levels) options.top_levels.push_back(parse_top_level_choice(name));
     options.cell_inputs.clear();

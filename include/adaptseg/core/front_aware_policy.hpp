@@ -100,6 +100,15 @@ struct GainRatio {
   double ratio = 1.0;   ///< realised / forecast field gain, >= 0
 };
 
+/// How far descents to one GSD ended above their forecast margin, per second of descent, when
+/// the training fields were flown as new ground (FrontAwarePolicy::Params::margin_biases;
+/// calibrate() with CalibrationOptions::margin_biases measures it): the error of the gain and of
+/// the lawnmower curve's rise together, which is what decides whether a descent pays.
+struct MarginBias {
+  double gsd_cm = 0.0;  ///< the descent GSD [cm/px]
+  double per_s = 0.0;   ///< (realised − forecast margin) per second of the descent's extra time
+};
+
 /// A training field's fixed-altitude lawnmower curve by GSD: the front-aware rule's yardstick.
 struct ReferenceCurve {
   std::string field;             ///< the training field's name
@@ -154,8 +163,10 @@ struct ReferenceCurve {
 ///   (upper_envelope(): never falling) of each training field's predicted curve: mean ΔD̄ and
 ///   spread sd_D over the training fields; beyond the curve's last point its last segment goes
 ///   on (rising_curve_miou);
-/// - the descent is worth its time if its lower bound (ĝ − ΔD̄) − z·sqrt(Var ĝ + sd_D²) > 0
-///   (z = `confidence`, chosen on training fields; 0: the forecasts' means). The UAV descends
+/// - the descent is worth its time if its lower bound (ĝ − ΔD̄ + b·T) − z·sqrt(Var ĝ + sd_D²) > 0
+///   (z = `confidence`, chosen on training fields; 0: the forecasts' means; b the margin bias
+///   per second of a descent to the candidate's GSD, `margin_biases`, 0 unless calibrated with
+///   them). The UAV descends
 ///   to the candidate of largest lower bound, if σ >= `min_sigma`. Since ΔD̄ grows with T0, it
 ///   descends while descents beat flying lower everywhere, and stops when they no longer do.
 ///
@@ -191,6 +202,11 @@ class FrontAwarePolicy {
     /// of what descents to that GSD were forecast to gain (calibrate() with
     /// CalibrationOptions::gain_ratios). A GSD not listed: 1. Empty (the default): none.
     std::vector<GainRatio> gain_ratios{};
+    /// Per descent GSD, b: what descents to it ended above their forecast margin per second of
+    /// their extra time on the training fields, each flown with a model that never saw it
+    /// (calibrate() with CalibrationOptions::margin_biases); b·T is added to a candidate's
+    /// margin (ĝ − ΔD̄), its spread unchanged. A GSD not listed: 0. Empty (the default): none.
+    std::vector<MarginBias> margin_biases{};
 
     /// @throws std::invalid_argument naming the field.
     void validate() const {
@@ -210,6 +226,12 @@ class FrontAwarePolicy {
         detail::require(std::isfinite(r.ratio) && r.ratio >= 0.0,
                         "FrontAwarePolicy::Params::gain_ratios: a ratio must be finite and >= 0", r.ratio);
       }
+      for (const MarginBias& b : margin_biases) {
+        detail::require(std::isfinite(b.gsd_cm) && b.gsd_cm > 0.0,
+                        "FrontAwarePolicy::Params::margin_biases: a GSD must be finite and > 0", b.gsd_cm);
+        detail::require(std::isfinite(b.per_s), "FrontAwarePolicy::Params::margin_biases: a bias must be finite",
+                        b.per_s);
+      }
     }
 
     /// The factor on the forecast gain of a descent to `gsd_cm` (1 where none is listed).
@@ -217,6 +239,13 @@ class FrontAwarePolicy {
       for (const GainRatio& r : gain_ratios)
         if (std::abs(r.gsd_cm - gsd_cm) <= 1e-9 * gsd_cm) return r.ratio;
       return 1.0;
+    }
+
+    /// The margin bias per second of a descent to `gsd_cm` (0 where none is listed).
+    [[nodiscard]] double margin_bias(double gsd_cm) const noexcept {
+      for (const MarginBias& b : margin_biases)
+        if (std::abs(b.gsd_cm - gsd_cm) <= 1e-9 * gsd_cm) return b.per_s;
+      return 0.0;
     }
   };
 
@@ -371,7 +400,9 @@ class FrontAwarePolicy {
       const double n = static_cast<double>(curves.size());
       const double rise = rise_sum / n;
       const double rise_var = curves.size() > 1 ? std::max(0.0, (rise_sq - n * rise * rise) / (n - 1.0)) : 0.0;
-      const double lower = gain - rise - params_.confidence * std::sqrt(gain_var + rise_var);
+      // What descents to this GSD ended above their forecast margin on the training fields as new ground.
+      const double bias = params_.margin_bias(cand.gsd_cm) * cand.extra_time_s;
+      const double lower = gain - rise + bias - params_.confidence * std::sqrt(gain_var + rise_var);
       s.predicted_front_margin =
           mean_top_miou(c) + forecast_gain_ + gain - curve_level - mean_curve_miou(curves, t0 + cand.extra_time_s);
       s.predicted_curve_rise = rise;

@@ -46,11 +46,16 @@ namespace detail {
 /// calibrate()'s settings of the adaptive missions it flies: `options.adaptive` with the labels
 /// of interest filled from the first field, and the declared segmentation and planning times.
 /// @throws std::invalid_argument for no field, fields with other class sets than the first's,
-///         invalid options (check_calibration_options) or no label of interest.
+///         invalid options (check_calibration_options), gain ratios or margin biases asked of
+///         one field, or no label of interest.
 [[nodiscard]] inline AdaptiveOptions calibration_settings(std::span<const Field> fields,
                                                           const CalibrationOptions& options) {
   require(!fields.empty(), "calibrate: at least one training field is needed; count", fields.size());
   check_calibration_options(options);
+  require(fields.size() >= 2 || !(options.gain_ratios || options.margin_biases),
+          "calibrate: gain_ratios and margin_biases are measured by flying each training field with the model of "
+          "the others, which needs at least two training fields; count",
+          fields.size());
   const auto names = [](const Field& f) {
     std::vector<std::string> v;
     for (const auto& c : f.classes()) v.push_back(c.name);

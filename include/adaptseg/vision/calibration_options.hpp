@@ -108,6 +108,16 @@ struct CalibrationOptions {
   /// ground tell how the forecast's dependence on the descent GSD transfers to a field the model
   /// never saw (docs/method.md, "Gain ratios measured on the folds"). false (the default): none.
   bool gain_ratios = false;
+  /// Front-aware rule, several training fields: measure FrontAwarePolicy::Params::margin_biases
+  /// on the folds before the search, on the same flights as `gain_ratios` (those fly without
+  /// ratios). Per descent GSD, how far its descents ended above their forecast margin (realised
+  /// field gain less the real curve's rise over their seconds, against forecast gain less the
+  /// predicted rise), per second of descent, shrunk towards 0 by two descents' worth
+  /// (detail::fold_margin_biases): in the model, those of every fold's flight; in the search,
+  /// each fold's trials those of the other folds' flights. The error of the gain and of the
+  /// curve together, measured where the model never saw the field (docs/method.md, "Margin
+  /// biases measured on the folds"). false (the default): none.
+  bool margin_biases = false;
   /// Front-aware rule, σ̂'s prior (FrontAwarePolicy `sigma_prior_weight` k, `sigma_prior_sd` τ)
   /// with several training fields: `given` keeps `front_aware`'s; `spread` estimates τ on the
   /// training fields (estimate_sigma_prior) and keeps k; `estimated` estimates both. Each fold

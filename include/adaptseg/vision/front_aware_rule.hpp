@@ -47,14 +47,11 @@ struct FrontAwareRule {
     if (p.curve == CurveSource::corrected) e << YAML::Key << "curve_ratio" << YAML::Value << detail::flag_text(true);
     if (p.top_level != TopLevelChoice::undominated)
       e << YAML::Key << "top_level" << YAML::Value << to_string(p.top_level);
-    if (!p.gain_ratios.empty()) {
-      std::vector<double> g, r;
-      for (const GainRatio& x : p.gain_ratios) g.push_back(x.gsd_cm), r.push_back(x.ratio);
-      e << YAML::Key << "gain_ratio_gsd_cm" << YAML::Value;
-      emit_numbers(e, g);
-      e << YAML::Key << "gain_ratio" << YAML::Value;
-      emit_numbers(e, r);
-    }
+    std::vector<std::pair<double, double>> ratios, biases;
+    for (const GainRatio& x : p.gain_ratios) ratios.emplace_back(x.gsd_cm, x.ratio);
+    for (const MarginBias& x : p.margin_biases) biases.emplace_back(x.gsd_cm, x.per_s);
+    write_pairs(e, "gain_ratio_gsd_cm", "gain_ratio", ratios);
+    write_pairs(e, "margin_bias_gsd_cm", "margin_bias_per_s", biases);
     e << YAML::Key << "reference" << YAML::Value << YAML::BeginSeq;
     for (const auto& r : rule.reference()) {
       std::vector<double> g, m;
@@ -117,18 +114,50 @@ struct FrontAwareRule {
                              .sigma_prior_sd = rule.has("sigma_prior_sd") ? rule.number("sigma_prior_sd") : 0.0,
                              .curve = read_curve(rule),
                              .top_level = rule.has("top_level") ? read_top_level(rule) : TopLevelChoice::undominated,
-                             .gain_ratios = read_gain_ratios(rule)});
+                             .gain_ratios = read_gain_ratios(rule),
+                             .margin_biases = read_margin_biases(rule)});
+  }
+
+  /// Per descent GSD, what the folds measured (FrontAwarePolicy::Params `gain_ratios` and
+  /// `margin_biases`): keys `gsd_key` and `value_key`, two lists of one length; none: nothing
+  /// written (files without them keep their bytes).
+  static void write_pairs(YAML::Emitter& e, const char* gsd_key, const char* value_key,
+                          const std::vector<std::pair<double, double>>& pairs) {
+    if (pairs.empty()) return;
+    std::vector<double> g, v;
+    for (const auto& [gsd, value] : pairs) g.push_back(gsd), v.push_back(value);
+    e << YAML::Key << gsd_key << YAML::Value;
+    detail::emit_numbers(e, g);
+    e << YAML::Key << value_key << YAML::Value;
+    detail::emit_numbers(e, v);
+  }
+
+  /// What write_pairs wrote (absent both keys: none).
+  /// @throws std::invalid_argument naming the file and the keys for lists of two lengths.
+  [[nodiscard]] static std::vector<std::pair<double, double>> read_pairs(const detail::YamlReader& rule,
+                                                                         const char* gsd_key, const char* value_key) {
+    if (!rule.has(gsd_key) && !rule.has(value_key)) return {};
+    const auto g = rule.numbers(gsd_key);
+    const auto v = rule.numbers(value_key);
+    if (g.size() != v.size())
+      detail::yaml_error(rule.where(),
+                         std::string("'rule.") + value_key + "' needs as many values as 'rule." + gsd_key + "'");
+    std::vector<std::pair<double, double>> out;
+    for (std::size_t i = 0; i < g.size(); ++i) out.emplace_back(g[i], v[i]);
+    return out;
   }
 
   /// `rule.gain_ratio_gsd_cm` and `rule.gain_ratio` (absent: none).
   [[nodiscard]] static std::vector<GainRatio> read_gain_ratios(const detail::YamlReader& rule) {
-    if (!rule.has("gain_ratio_gsd_cm") && !rule.has("gain_ratio")) return {};
-    const auto g = rule.numbers("gain_ratio_gsd_cm");
-    const auto r = rule.numbers("gain_ratio");
-    if (g.size() != r.size())
-      detail::yaml_error(rule.where(), "'rule.gain_ratio' needs as many values as 'rule.gain_ratio_gsd_cm'");
     std::vector<GainRatio> out;
-    for (std::size_t i = 0; i < g.size(); ++i) out.push_back({g[i], r[i]});
+    for (const auto& [g, r] : read_pairs(rule, "gain_ratio_gsd_cm", "gain_ratio")) out.push_back({g, r});
+    return out;
+  }
+
+  /// `rule.margin_bias_gsd_cm` and `rule.margin_bias_per_s` (absent: none).
+  [[nodiscard]] static std::vector<MarginBias> read_margin_biases(const detail::YamlReader& rule) {
+    std::vector<MarginBias> out;
+    for (const auto& [g, b] : read_pairs(rule, "margin_bias_gsd_cm", "margin_bias_per_s")) out.push_back({g, b});
     return out;
   }
 

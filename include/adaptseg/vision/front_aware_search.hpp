@@ -5,7 +5,9 @@
 /// choice) tried on the training fields, each field flown with a model fitted without it, and
 /// σ̂'s prior estimated from their top-level images. docs/method.md, "The front-aware rule".
 
+#include <adaptseg/core/detail/interpolate.hpp>
 #include <adaptseg/core/front_aware_policy.hpp>
+#include <adaptseg/core/lawnmower_curve.hpp>
 #include <adaptseg/vision/adaptive_mission.hpp>
 #include <adaptseg/vision/calibration_options.hpp>
 #include <adaptseg/vision/detail/number_text.hpp>
@@ -259,31 +261,46 @@ inline std::vector<GainModel> pooled_fold_models(const RuleSearchInputs& in, std
   return models;
 }
 
+/// Every fold's flight but `skip`'s (none skipped: `kAllFolds`).
+inline constexpr std::size_t kAllFolds = static_cast<std::size_t>(-1);
+
+/// Calls `visit(descent, record, k, j)` for each realised descent of `flights` but those of flight
+/// `skip` whose rule forecast a finite field gain: its RealisedDescent, its DecisionRecord, the
+/// candidate chosen and the flight's index.
+template <class Visit>
+void for_each_forecast_descent(std::span<const AdaptiveResult> flights, std::size_t skip, Visit&& visit) {
+  for (std::size_t j = 0; j < flights.size(); ++j) {
+    if (j == skip) continue;
+    for (const RealisedDescent& d : flights[j].realised) {
+      const DecisionRecord& rec = flights[j].decisions[d.decision];
+      const std::size_t k = chosen_candidate(rec.decision, rec.candidates, "front-aware");
+      if (k >= rec.decision.scores.size() || !std::isfinite(rec.decision.scores[k].predicted_field_gain)) continue;
+      visit(d, rec, k, j);
+    }
+  }
+}
+
 /// Per descent GSD, realised / forecast field gain over the descents of `flights` (each an
-/// AdaptiveResult of a fold, simulated so that its descents' realised field gains are known):
-/// (Σ realised + 2·f̄) / (Σ forecast + 2·f̄), f̄ the mean forecast gain of the GSD's descents (two
-/// descents' worth of prior at ratio 1), kept in [0, 4]; in increasing GSD order. A GSD whose
-/// descents were forecast nothing positive in all is left out (ratio 1).
-inline std::vector<GainRatio> fold_gain_ratios(std::span<const AdaptiveResult> flights) {
+/// AdaptiveResult of a fold, simulated so that its descents' realised field gains are known),
+/// those of flight `skip` left out: (Σ realised + 2·f̄) / (Σ forecast + 2·f̄), f̄ the mean
+/// forecast gain of the GSD's descents (two descents' worth of prior at ratio 1), kept in [0, 4];
+/// in increasing GSD order. A GSD whose descents were forecast nothing positive in all is left
+/// out (ratio 1).
+inline std::vector<GainRatio> fold_gain_ratios(std::span<const AdaptiveResult> flights, std::size_t skip = kAllFolds) {
   struct Sums {
     double gsd_cm, forecast, realised;
     int n;
   };
   std::vector<Sums> sums;
-  for (const AdaptiveResult& r : flights)
-    for (const RealisedDescent& d : r.realised) {
-      const DecisionRecord& rec = r.decisions[d.decision];
-      const std::size_t k = chosen_candidate(rec.decision, rec.candidates, "front-aware");
-      if (k >= rec.decision.scores.size()) continue;
-      const double forecast = rec.decision.scores[k].predicted_field_gain;
-      if (!std::isfinite(forecast)) continue;
-      const double g = rec.candidates[k].gsd_cm;
-      auto it = std::find_if(sums.begin(), sums.end(), [&](const Sums& s) { return s.gsd_cm == g; });
-      if (it == sums.end()) it = sums.insert(sums.end(), {g, 0.0, 0.0, 0});
-      it->forecast += forecast;
-      it->realised += d.field_gain;
-      ++it->n;
-    }
+  for_each_forecast_descent(
+      flights, skip, [&](const RealisedDescent& d, const DecisionRecord& rec, std::size_t k, std::size_t) {
+        const double g = rec.candidates[k].gsd_cm;
+        auto it = std::find_if(sums.begin(), sums.end(), [&](const Sums& s) { return s.gsd_cm == g; });
+        if (it == sums.end()) it = sums.insert(sums.end(), {g, 0.0, 0.0, 0});
+        it->forecast += rec.decision.scores[k].predicted_field_gain;
+        it->realised += d.field_gain;
+        ++it->n;
+      });
   std::sort(sums.begin(), sums.end(), [](const Sums& a, const Sums& b) { return a.gsd_cm < b.gsd_cm; });
   std::vector<GainRatio> out;
   for (const Sums& s : sums) {
@@ -292,6 +309,73 @@ inline std::vector<GainRatio> fold_gain_ratios(std::span<const AdaptiveResult> f
     out.push_back({s.gsd_cm, std::clamp((s.realised + prior) / (s.forecast + prior), 0.0, 4.0)});
   }
   return out;
+}
+
+/// Per descent GSD, how far the descents of `flights` ended above their forecast margin per
+/// second of descent, those of flight `skip` left out. A descent's forecast margin is its
+/// forecast field gain less the predicted lawnmower curve's rise over its extra time
+/// (CandidateScore::predicted_field_gain − predicted_curve_rise); its realised margin, its
+/// realised field gain (RealisedDescent::field_gain) less the rise of its field's real curve
+/// (`curves[j]` of flight j: the upper envelope of its lawnmowers, as front_margin reads it)
+/// over the same seconds, ending at CandidateScore::predicted_end_s. Per GSD Σ(realised −
+/// forecast margin) / (Σ T + 2·T̄), T the descents' extra times (two descents' worth of prior at
+/// bias 0); in increasing GSD order. Descents without a predicted rise or end are left out.
+inline std::vector<MarginBias> fold_margin_biases(std::span<const AdaptiveResult> flights,
+                                                  std::span<const std::vector<CurvePoint>* const> curves,
+                                                  std::size_t skip = kAllFolds) {
+  struct Sums {
+    double gsd_cm, error, seconds;
+    int n;
+  };
+  std::vector<std::vector<CurvePoint>> envelopes;
+  for (const std::vector<CurvePoint>* c : curves) envelopes.push_back(upper_envelope(*c));
+  const auto real_miou = [&](std::size_t j, double t) {
+    return detail::interpolate_flat(envelopes[j], t, &CurvePoint::time_s, &CurvePoint::miou);
+  };
+  std::vector<Sums> sums;
+  for_each_forecast_descent(
+      flights, skip, [&](const RealisedDescent& d, const DecisionRecord& rec, std::size_t k, std::size_t j) {
+        const CandidateScore& s = rec.decision.scores[k];
+        const double seconds = rec.candidates[k].extra_time_s;
+        if (!std::isfinite(s.predicted_curve_rise) || !std::isfinite(s.predicted_end_s) || !(seconds > 0.0)) return;
+        const double forecast = s.predicted_field_gain - s.predicted_curve_rise;
+        const double realised =
+            d.field_gain - (real_miou(j, s.predicted_end_s) - real_miou(j, s.predicted_end_s - seconds));
+        const double g = rec.candidates[k].gsd_cm;
+        auto it = std::find_if(sums.begin(), sums.end(), [&](const Sums& x) { return x.gsd_cm == g; });
+        if (it == sums.end()) it = sums.insert(sums.end(), {g, 0.0, 0.0, 0});
+        it->error += realised - forecast;
+        it->seconds += seconds;
+        ++it->n;
+      });
+  std::sort(sums.begin(), sums.end(), [](const Sums& a, const Sums& b) { return a.gsd_cm < b.gsd_cm; });
+  std::vector<MarginBias> out;
+  for (const Sums& s : sums) out.push_back({s.gsd_cm, s.error / (s.seconds + 2.0 * s.seconds / s.n)});
+  return out;
+}
+
+/// The flights the gain ratios and margin biases are measured on: each training field flown
+/// with the model of the others, the first slope pooling and top-level choice, z = 0 (the most
+/// descents to learn from), no ratio or bias of its own.
+template <class Fly>
+std::vector<AdaptiveResult> measuring_flights(const RuleSearchInputs& in, std::span<const FrontAwareFold> folds,
+                                              const FrontAwareGrid& grid, const FrontAwarePolicy::Params& base,
+                                              Fly& fly) {
+  FrontAwarePolicy::Params first = base;
+  const std::vector<GainModel> models = pooled_fold_models(in, folds, grid, grid.poolings.front(), first);
+  first.confidence = 0.0;
+  first.top_level = grid.top_levels.front();
+  first.gain_ratios.clear();
+  first.margin_biases.clear();
+  std::vector<AdaptiveResult> flights;
+  for (std::size_t k = 0; k < folds.size(); ++k) {
+    FrontAwarePolicy::Params fold_params = first;
+    apply_sigma_prior(fold_params, folds[k].sigma_prior, in.options.sigma_prior);
+    FrontAwarePolicy policy(models[k], folds[k].reference, fold_params);
+    double margin = 0.0;
+    flights.push_back(fly(*folds[k].field, policy, *folds[k].curve, margin));
+  }
+  return flights;
 }
 
 /// The setting kept (an index into `trials` and `settings`, in the same order): per pooling and
@@ -340,30 +424,22 @@ template <class Fly>
   FrontAwarePolicy::Params base = options.front_aware;
   base.online = true;
   detail::apply_sigma_prior(base, estimate_sigma_prior(traces), options.sigma_prior);
-  // Per fold, the gain ratios its trials fly with: measured on the other folds' flights only, as
-  // its model was fitted without its field (the model's own: on every fold's flight).
+  // Per fold, the gain ratios and margin biases its trials fly with: measured on the other
+  // folds' flights only, as its model was fitted without its field (the model's own: on every
+  // fold's flight).
   std::vector<std::vector<GainRatio>> fold_ratios(folds.size(), base.gain_ratios);
-  if (options.gain_ratios && in.fields.size() >= 2) {
-    // What descents to each GSD realised of their forecast on the training fields flown as new
-    // ground: the first pooling and top level, z = 0 (the most descents to learn from).
-    FrontAwarePolicy::Params first = base;
-    const std::vector<GainModel> models = detail::pooled_fold_models(in, folds, grid, grid.poolings.front(), first);
-    first.confidence = 0.0;
-    first.top_level = grid.top_levels.front();
-    std::vector<AdaptiveResult> flights;
-    for (std::size_t k = 0; k < folds.size(); ++k) {
-      FrontAwarePolicy::Params fold_params = first;
-      detail::apply_sigma_prior(fold_params, folds[k].sigma_prior, options.sigma_prior);
-      FrontAwarePolicy policy(models[k], folds[k].reference, fold_params);
-      double margin = 0.0;
-      flights.push_back(fly(*folds[k].field, policy, *folds[k].curve, margin));
+  std::vector<std::vector<MarginBias>> fold_biases(folds.size(), base.margin_biases);
+  if ((options.gain_ratios || options.margin_biases) && in.fields.size() >= 2) {
+    const std::vector<AdaptiveResult> flights = detail::measuring_flights(in, folds, grid, base, fly);
+    std::vector<const std::vector<CurvePoint>*> curves;
+    for (const detail::FrontAwareFold& f : folds) curves.push_back(f.curve);
+    if (options.gain_ratios) {
+      base.gain_ratios = detail::fold_gain_ratios(flights);
+      for (std::size_t k = 0; k < folds.size(); ++k) fold_ratios[k] = detail::fold_gain_ratios(flights, k);
     }
-    base.gain_ratios = detail::fold_gain_ratios(flights);
-    for (std::size_t k = 0; k < folds.size(); ++k) {
-      std::vector<AdaptiveResult> others;
-      for (std::size_t j = 0; j < flights.size(); ++j)
-        if (j != k) others.push_back(flights[j]);
-      fold_ratios[k] = detail::fold_gain_ratios(others);
+    if (options.margin_biases) {
+      base.margin_biases = detail::fold_margin_biases(flights, curves);
+      for (std::size_t k = 0; k < folds.size(); ++k) fold_biases[k] = detail::fold_margin_biases(flights, curves, k);
     }
   }
   std::vector<RuleTrial> trials;
@@ -383,6 +459,7 @@ template <class Fly>
           FrontAwarePolicy::Params fold_params = p;  // σ̂'s prior: the fold's estimate replaces all fields'
           detail::apply_sigma_prior(fold_params, folds[k].sigma_prior, options.sigma_prior);
           fold_params.gain_ratios = fold_ratios[k];
+          fold_params.margin_biases = fold_biases[k];
           FrontAwarePolicy policy(models[k], folds[k].reference, fold_params);
           double margin = 0.0;
           const AdaptiveResult r = fly(*folds[k].field, policy, *folds[k].curve, margin);

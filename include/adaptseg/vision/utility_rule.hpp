@@ -71,6 +71,8 @@ struct UtilityRule {
   /// @throws std::invalid_argument if `threshold_steps` < 1.
   static void check_options(const CalibrationOptions& options) {
     detail::require(options.threshold_steps >= 1, "calibrate: threshold_steps must be >= 1", options.threshold_steps);
+    detail::require(!options.gain_ratios && !options.margin_biases,
+                    "calibrate: gain_ratios and margin_biases belong to the front-aware rule; rule", kName);
   }
 
   /// The calibration search (CalibrationOptions: `utility`, `threshold_steps`): `exploration`
