@@ -12,7 +12,9 @@
 #include <adaptseg/core/decision_function.hpp>
 #include <adaptseg/core/decision_inputs.hpp>
 #include <adaptseg/core/error.hpp>
+#include <adaptseg/core/field_estimates.hpp>
 #include <adaptseg/core/front_aware_policy.hpp>
+#include <adaptseg/core/front_aware_settings.hpp>
 #include <adaptseg/core/gain_model.hpp>
 #include <adaptseg/core/gaussian_process.hpp>
 #include <adaptseg/core/gp_kernel.hpp>

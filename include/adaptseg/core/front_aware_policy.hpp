@@ -9,6 +9,8 @@
 #include <adaptseg/core/detail/interpolate.hpp>
 #include <adaptseg/core/detail/named_rows.hpp>
 #include <adaptseg/core/error.hpp>
+#include <adaptseg/core/field_estimates.hpp>
+#include <adaptseg/core/front_aware_settings.hpp>
 #include <adaptseg/core/gain_model.hpp>
 #include <adaptseg/core/lawnmower_curve.hpp>
 
@@ -25,115 +27,6 @@
 #include <vector>
 
 namespace adaptseg {
-
-/// How the front-aware rule chooses the GSD of its top level among those it was calibrated for
-/// (FrontAwarePolicy::top_gsd; the lawnmower times are this field's, the accuracies the training
-/// fields' lawnmower curves at the same GSD, so no label of this field is read):
-/// - `undominated`: the one whose lawnmower falls least short of the faster lawnmowers, the
-///   shortfall taken on each training field's curve and averaged (the coarsest where they tie:
-///   where no lawnmower is faster, the nominal one);
-/// - `hull`: from there, a finer one while the predicted curve rises faster per second up to it
-///   than from it to any finer lawnmower: the top level at the first corner of the predicted
-///   curve's upper concave hull. A descent is judged against the curve's upper envelope, whose
-///   segments are the lawnmowers' rates; where the curve rises steeply to a GSD for little time
-///   (a finer lawnmower whose grid fits the field better) and flattens after it, descents from
-///   the coarser level must beat the steep segment, those from the corner only the flatter one.
-enum class TopLevelChoice { undominated, hull };
-
-/// Every top-level choice by name (`top_level` in the model file, `--top-level` of the programs).
-inline constexpr std::array<detail::NamedValue<TopLevelChoice>, 2> kTopLevelChoices{{
-    {TopLevelChoice::undominated, "undominated"},
-    {TopLevelChoice::hull, "hull"},
-}};
-
-/// The name of a top-level choice.
-[[nodiscard]] inline std::string to_string(TopLevelChoice r) {
-  return detail::name_of(kTopLevelChoices, r, "top-level choice");
-}
-
-/// Parses a top-level choice's name.
-/// @throws std::invalid_argument for anything but `undominated` or `hull`.
-[[nodiscard]] inline TopLevelChoice parse_top_level_choice(std::string_view name) {
-  return detail::value_named(kTopLevelChoices, name, "top-level choice");
-}
-
-/// The lawnmower curve a descent is compared with (FrontAwarePolicy::Params::curve, `--curve`):
-/// - `training`: the training fields' own curves (the lawnmowers' times this field's);
-/// - `field`: with a cell gain model, this field's curve as the model predicts it (what
-///   re-mapping the whole field at each lawnmower GSD would gain, from the field's mean input
-///   estimated from its top-level images so far). The field factor s and σ̂ then scale the
-///   descent's gain and the curve's rise alike;
-/// - `corrected`: that prediction corrected by what the training fields' real lawnmowers did.
-///   For each training field f and lawnmower GSD g, its real rise from the top GSD against the
-///   rise the cell gain model predicts for it, r_f = (D_f(g) − D_f(top)) / (β(top, g)·X_f / σ_f),
-///   clamped to [1/4, 4] (1 where f's X_f or σ_f is unknown or nothing is predicted), scales this
-///   field's predicted rise to g: one curve per training field, their mean the curve a descent
-///   is compared with and their spread the sd_D of the lower bound. Single cells re-mapped alone
-///   inside a coarse map, which the model is fitted on, predict a network's lawnmower poorly: it
-///   re-maps every cell with its neighbours (docs/results.md, "The field curve against the real
-///   ones").
-/// Without a cell gain model `field` and `corrected` read the training fields' curves.
-enum class CurveSource { training, field, corrected };
-
-/// Every curve source by name (`--curve` of the programs; the model file keeps the flags
-/// `field_curve` and `curve_ratio` of earlier versions, docs/data_format.md).
-inline constexpr std::array<detail::NamedValue<CurveSource>, 3> kCurveSources{{
-    {CurveSource::training, "training"},
-    {CurveSource::field, "field"},
-    {CurveSource::corrected, "corrected"},
-}};
-
-/// The name of a curve source.
-[[nodiscard]] inline std::string to_string(CurveSource c) { return detail::name_of(kCurveSources, c, "curve source"); }
-
-/// Parses a curve source's name.
-/// @throws std::invalid_argument for anything but `training`, `field` or `corrected`.
-[[nodiscard]] inline CurveSource parse_curve_source(std::string_view name) {
-  return detail::value_named(kCurveSources, name, "curve source");
-}
-
-/// How much of its forecast field gain a descent to one GSD realised when the training fields
-/// were flown as new ground (FrontAwarePolicy::Params::gain_ratios; calibrate() with
-/// CalibrationOptions::gain_ratios measures it).
-struct GainRatio {
-  double gsd_cm = 0.0;  ///< the descent GSD [cm/px]
-  double ratio = 1.0;   ///< realised / forecast field gain, >= 0
-};
-
-/// How far descents to one GSD ended above their forecast margin, per second of descent, when
-/// the training fields were flown as new ground (FrontAwarePolicy::Params::margin_biases;
-/// calibrate() with CalibrationOptions::margin_biases measures it): the error of the gain and of
-/// the lawnmower curve's rise together, which is what decides whether a descent pays.
-struct MarginBias {
-  double gsd_cm = 0.0;  ///< the descent GSD [cm/px]
-  double per_s = 0.0;   ///< (realised − forecast margin) per second of the descent's extra time
-};
-
-/// A training field's fixed-altitude lawnmower curve by GSD: the front-aware rule's yardstick.
-struct ReferenceCurve {
-  std::string field;             ///< the training field's name
-  std::vector<GsdPoint> points;  ///< field mIoU over L by lawnmower GSD
-  /// σ of the field's top-level map (its share of L as the UAV sees it); 0: unknown. The mean
-  /// over the reference curves is the prior of a new field's σ.
-  double field_sigma = 0.0;
-  /// The mean over the field's top-level images of the cell gain model's input (its value per
-  /// field pixel); 0: unknown (models without cells). The mean over the reference curves is the
-  /// prior of a new field's (CurveSource::field). At the nominal top-level GSD.
-  double field_input = 0.0;
-  /// The same mean at every top-level GSD the cell gain model was calibrated for (the nominal
-  /// one and finer ones the rule may choose, ChoosesTopLevel), as (GSD, input) pairs: a finer
-  /// top level's map has less wrong, so its input is smaller. Empty (models before it):
-  /// `field_input` at every top.
-  std::vector<std::pair<double, double>> top_inputs{};
-
-  /// The field's mean input at top-level GSD `top_gsd_cm`: its `top_inputs` entry, else
-  /// `field_input`.
-  [[nodiscard]] double input_at(double top_gsd_cm) const {
-    for (const auto& [g, x] : top_inputs)
-      if (detail::same_gsd(g, top_gsd_cm)) return x;
-    return field_input;
-  }
-};
 
 /// The front-aware rule over a GainModel; a DecisionPolicy.
 ///
@@ -276,6 +169,7 @@ class FrontAwarePolicy {
       }
     }
     if (with_sigma != reference_.size()) prior_sigma_ = 0.0;  // unknown for some: the running mean of σ
+    share_ = FieldShareEstimate(prior_sigma_);
     for (const auto& r : reference_) {
       detail::require(std::isfinite(r.field_input) && r.field_input >= 0.0,
                       "FrontAwarePolicy: reference curve '" + r.field + "' needs field_input >= 0", r.field_input);
@@ -289,6 +183,8 @@ class FrontAwarePolicy {
 
   [[nodiscard]] std::string name() const { return params_.online ? "adaptive" : "nonadaptive"; }
   [[nodiscard]] const Params& params() const noexcept { return params_; }
+  /// The prior spread of the field factor s (`scale_prior_sd`) takes effect at the next
+  /// begin_mission().
   /// @throws std::invalid_argument for invalid params.
   void set_params(const Params& p) {
     p.validate();
@@ -300,23 +196,15 @@ class FrontAwarePolicy {
   /// The model as given (what begin_mission restores).
   [[nodiscard]] const GainModel& initial_model() const noexcept { return initial_; }
   /// The field factor s: posterior mean and standard deviation so far in this mission.
-  [[nodiscard]] double field_scale() const noexcept { return scale_mean_; }
-  [[nodiscard]] double field_scale_sd() const noexcept { return std::sqrt(scale_var_); }
+  [[nodiscard]] double field_scale() const noexcept { return scale_.mean(); }
+  [[nodiscard]] double field_scale_sd() const noexcept { return scale_.sd(); }
 
   void begin_mission() {
     model_ = initial_;
-    sigma_sum_ = 0.0;
-    sigma_count_ = 0;
-    seen_share_ = 0.0;
-    seen_interest_ = 0.0;
-    seen_input_ = 0.0;
-    seen_input_share_ = 0.0;
+    share_.reset();
     forecast_gain_ = 0.0;
     chosen_.clear();
-    scale_mean_ = 1.0;
-    scale_var_ = params_.scale_prior_sd * params_.scale_prior_sd;
-    scale_precision_sum_ = 0.0;
-    scale_evidence_sum_ = 0.0;
+    scale_ = FieldScale(params_.scale_prior_sd);
   }
 
   /// @throws std::invalid_argument if the context has no lawnmower forecasts.
@@ -333,14 +221,7 @@ class FrontAwarePolicy {
       for (const auto& f : c.lawnmowers) curve.push_back({f.time_s, miou_at_gsd(r.points, f.gsd_cm)});
       curves.push_back(upper_envelope(std::move(curve)));
     }
-    sigma_sum_ += c.sigma;
-    ++sigma_count_;
-    seen_share_ += c.region_share;
-    seen_interest_ += c.region_share * c.sigma;
-    if (std::isfinite(c.region_input)) {
-      seen_input_ += c.region_share * c.region_input;
-      seen_input_share_ += c.region_share;
-    }
+    share_.add(c.sigma, c.region_share, c.region_input);
     const auto [weight, sigma_cv2] = gain_weight(c);
     const double t0 = c.elapsed_s + c.rest_s;
     // The predicted curve's mIoU relative to the top level's (curve not `training`) or absolute.
@@ -386,9 +267,9 @@ class FrontAwarePolicy {
       base_sd *= ratio;
       const double gain = scaled(base);
       const double gain_var =
-          scale_mean_ * scale_mean_ * base_sd * base_sd + scale_var_ * base * base + gain * gain * sigma_cv2;
+          scale_.mean() * scale_.mean() * base_sd * base_sd + scale_.var() * base * base + gain * gain * sigma_cv2;
       s.predicted_field_gain = gain;
-      if (std::isfinite(relabelled.mean)) s.predicted_relabelled = std::abs(scale_mean_) * relabelled.mean;
+      if (std::isfinite(relabelled.mean)) s.predicted_relabelled = std::abs(scale_.mean()) * relabelled.mean;
       s.utility = utility(gain, cand.extra_time_s);
       // The curve's rise over the descent's extra time, on every training field's curve.
       double rise_sum = 0.0, rise_sq = 0.0;
@@ -507,22 +388,14 @@ class FrontAwarePolicy {
       const double y = model_.cells()->proxy_gain(f.top_gsd_cm, f.sub_gsd_cm, out.top_input, out.fine_input);
       const double d = out.top_input - out.fine_input;
       const double var = f.proxy_var + p.proxy_slope_sd * p.proxy_slope_sd * d * d;
-      scale_precision_sum_ += f.gain * f.gain / var;
-      scale_evidence_sum_ += f.gain * y / var;
+      scale_.observe(f.gain, y, var, false);  // a finer look may be worse: s < 0, and the UAV stops
     } else {
       if (!std::isfinite(f.mean) || !model_.c_model()) return;
-      // Conjugate update of s in χ_obs = s·μ_C + ε, ε ~ N(0, sd_C²), prior s ~ N(1, ω²).
+      // χ_obs = s·μ_C + ε, ε ~ N(0, sd_C²); s >= 0 with C alone (a descent cannot relabel less
+      // than nothing; with a cell gain model a scene check may have found s < 0 before).
       const double noise = std::max(f.noisy_sd * f.noisy_sd, 1e-12);
-      scale_precision_sum_ += f.mean * f.mean / noise;
-      scale_evidence_sum_ += f.mean * out.relabelled.interest_share / noise;
+      scale_.observe(f.mean, out.relabelled.interest_share, noise, !model_.cells());
     }
-    const double prior_precision = 1.0 / (params_.scale_prior_sd * params_.scale_prior_sd);
-    const double precision = prior_precision + scale_precision_sum_;
-    // s >= 0 with C (a descent cannot relabel less than nothing); a scene check may find the
-    // finer look worse than the coarse one, s < 0: descending loses there, and the UAV stops.
-    scale_mean_ = (prior_precision + scale_evidence_sum_) / precision;
-    if (!model_.cells()) scale_mean_ = std::max(0.0, scale_mean_);
-    scale_var_ = 1.0 / precision;
   }
 
  private:
@@ -539,28 +412,15 @@ class FrontAwarePolicy {
     double sub_gsd_cm = 0.0;
   };
 
-  /// A forecast gain (of a descent, or of the field's curve) `base` before the field factor s,
-  /// times s. A gain the training fields saw (base >= 0) scales with s and turns into a loss
-  /// where the scene check found the finer look worse (s < 0); a loss the training fields saw
-  /// (base < 0: a descent GSD that lost there) stays a loss whatever s: |s|·base. Without it, a
-  /// field where descending loses would forecast a gain for exactly the descents the training
-  /// fields saw lose.
-  [[nodiscard]] double scaled(double base) const noexcept {
-    return base >= 0.0 ? scale_mean_ * base : std::abs(scale_mean_) * base;
-  }
+  /// A forecast gain `base` before the field factor s, times s (FieldScale::scaled).
+  [[nodiscard]] double scaled(double base) const noexcept { return scale_.scaled(base); }
 
-  /// X̂, the field's mean input per field pixel (CurveSource::field): the top-level regions
-  /// seen so far, the unseen part shrunk towards the training fields' mean at this top level
-  /// with σ̂'s weight k.
+  /// X̂, the field's mean input per field pixel (CurveSource::field): FieldShareEstimate::input
+  /// towards the training fields' mean input at this top level with σ̂'s weight k.
   [[nodiscard]] double field_input_estimate(const DecisionContext& c) const {
-    const double k = params_.sigma_prior_weight;
-    const double unseen = std::max(0.0, 1.0 - seen_input_share_);
     double prior_input = 0.0;  // the training fields' mean input at this top level (0: unknown)
     for (const auto& r : reference_) prior_input += r.input_at(c.top_gsd_cm) / static_cast<double>(reference_.size());
-    const double rest = prior_input > 0.0         ? (seen_input_ + k * prior_input) / (seen_input_share_ + k)
-                        : seen_input_share_ > 0.0 ? seen_input_ / seen_input_share_
-                                                  : 0.0;
-    return seen_input_ + unseen * rest;
+    return share_.input(prior_input, params_.sigma_prior_weight);
   }
 
   /// The lawnmower curve of this field as the cell gain model predicts it (CurveSource::field),
@@ -590,23 +450,9 @@ class FrontAwarePolicy {
     return std::clamp(real / predicted, 0.25, 4.0);
   }
 
-  /// a / σ̂: a relabelled share of the region, times η, as a field-level gain; and Var σ̂ / σ̂²
-  /// (see the class comment).
+  /// a / σ̂ and Var σ̂ / σ̂² (FieldShareEstimate::gain_weight, with σ̂'s k and τ).
   [[nodiscard]] std::pair<double, double> gain_weight(const DecisionContext& c) const {
-    double sigma = 0.0;
-    double sigma_var = 0.0;
-    if (prior_sigma_ > 0.0) {
-      const double k = params_.sigma_prior_weight;
-      const double rest = (seen_interest_ + k * prior_sigma_) / (seen_share_ + k);
-      const double unseen = std::max(0.0, 1.0 - seen_share_);
-      sigma = seen_interest_ + unseen * rest;
-      const double tau2 = params_.sigma_prior_sd * params_.sigma_prior_sd;
-      sigma_var = unseen * unseen * tau2 * k / (k + seen_share_) + unseen * k * tau2;
-    } else {
-      sigma = sigma_sum_ / static_cast<double>(sigma_count_);
-    }
-    if (!(sigma > 0.0)) return {0.0, 0.0};
-    return {c.region_share / sigma, sigma_var / (sigma * sigma)};
+    return share_.gain_weight(c.region_share, params_.sigma_prior_weight, params_.sigma_prior_sd);
   }
 
   /// mIoU of a predicted curve (sorted by time) at time t: linear between its points, flat
@@ -644,18 +490,10 @@ class FrontAwarePolicy {
   Params params_;
   double prior_sigma_ = 0.0;  ///< mean σ of the training fields (0: unknown)
   // Per mission (reset by begin_mission):
-  double sigma_sum_ = 0.0;  ///< σ of the top-level images so far
-  std::size_t sigma_count_ = 0;
-  double seen_share_ = 0.0;         ///< field share of the top-level regions seen so far
-  double seen_interest_ = 0.0;      ///< ... and Σ share · σ over them
-  double seen_input_ = 0.0;         ///< Σ share · the region's mean cell-model input (DecisionContext::region_input)
-  double seen_input_share_ = 0.0;   ///< ... the share of the field those regions cover
+  FieldShareEstimate share_;        ///< σ̂ and X̂ from the top-level images so far
+  FieldScale scale_;                ///< the field factor s
   double forecast_gain_ = 0.0;      ///< forecast field-level gain of the descents taken
   std::vector<Relabelled> chosen_;  ///< what each descent chosen was forecast to relabel (DescentOutcome::descent)
-  double scale_mean_ = 1.0;         ///< field factor s: posterior mean
-  double scale_var_ = 0.0;          ///< ... and variance
-  double scale_precision_sum_ = 0.0;
-  double scale_evidence_sum_ = 0.0;
 };
 
 static_assert(DecisionPolicy<FrontAwarePolicy>);

@@ -1,0 +1,128 @@
+#pragma once
+/// @file
+/// What the front-aware rule (front_aware_policy.hpp) is set with beside its gain model: how it
+/// chooses its top level, which lawnmower curve a descent is compared with, what the folds of its
+/// calibration measured per descent GSD, and the training fields' lawnmower curves.
+
+#include <adaptseg/core/detail/gsd.hpp>
+#include <adaptseg/core/detail/named_rows.hpp>
+#include <adaptseg/core/lawnmower_curve.hpp>
+
+#include <array>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace adaptseg {
+
+/// How the front-aware rule chooses the GSD of its top level among those it was calibrated for
+/// (FrontAwarePolicy::top_gsd; the lawnmower times are this field's, the accuracies the training
+/// fields' lawnmower curves at the same GSD, so no label of this field is read):
+/// - `undominated`: the one whose lawnmower falls least short of the faster lawnmowers, the
+///   shortfall taken on each training field's curve and averaged (the coarsest where they tie:
+///   where no lawnmower is faster, the nominal one);
+/// - `hull`: from there, a finer one while the predicted curve rises faster per second up to it
+///   than from it to any finer lawnmower: the top level at the first corner of the predicted
+///   curve's upper concave hull. A descent is judged against the curve's upper envelope, whose
+///   segments are the lawnmowers' rates; where the curve rises steeply to a GSD for little time
+///   (a finer lawnmower whose grid fits the field better) and flattens after it, descents from
+///   the coarser level must beat the steep segment, those from the corner only the flatter one.
+enum class TopLevelChoice { undominated, hull };
+
+/// Every top-level choice by name (`top_level` in the model file, `--top-level` of the programs).
+inline constexpr std::array<detail::NamedValue<TopLevelChoice>, 2> kTopLevelChoices{{
+    {TopLevelChoice::undominated, "undominated"},
+    {TopLevelChoice::hull, "hull"},
+}};
+
+/// The name of a top-level choice.
+[[nodiscard]] inline std::string to_string(TopLevelChoice r) {
+  return detail::name_of(kTopLevelChoices, r, "top-level choice");
+}
+
+/// Parses a top-level choice's name.
+/// @throws std::invalid_argument for anything but `undominated` or `hull`.
+[[nodiscard]] inline TopLevelChoice parse_top_level_choice(std::string_view name) {
+  return detail::value_named(kTopLevelChoices, name, "top-level choice");
+}
+
+/// The lawnmower curve a descent is compared with (FrontAwarePolicy::Params::curve, `--curve`):
+/// - `training`: the training fields' own curves (the lawnmowers' times this field's);
+/// - `field`: with a cell gain model, this field's curve as the model predicts it (what
+///   re-mapping the whole field at each lawnmower GSD would gain, from the field's mean input
+///   estimated from its top-level images so far). The field factor s and σ̂ then scale the
+///   descent's gain and the curve's rise alike;
+/// - `corrected`: that prediction corrected by what the training fields' real lawnmowers did.
+///   For each training field f and lawnmower GSD g, its real rise from the top GSD against the
+///   rise the cell gain model predicts for it, r_f = (D_f(g) − D_f(top)) / (β(top, g)·X_f / σ_f),
+///   clamped to [1/4, 4] (1 where f's X_f or σ_f is unknown or nothing is predicted), scales this
+///   field's predicted rise to g: one curve per training field, their mean the curve a descent
+///   is compared with and their spread the sd_D of the lower bound. Single cells re-mapped alone
+///   inside a coarse map, which the model is fitted on, predict a network's lawnmower poorly: it
+///   re-maps every cell with its neighbours (docs/results.md, "The field curve against the real
+///   ones").
+/// Without a cell gain model `field` and `corrected` read the training fields' curves.
+enum class CurveSource { training, field, corrected };
+
+/// Every curve source by name (`--curve` of the programs; the model file keeps the flags
+/// `field_curve` and `curve_ratio` of earlier versions, docs/data_format.md).
+inline constexpr std::array<detail::NamedValue<CurveSource>, 3> kCurveSources{{
+    {CurveSource::training, "training"},
+    {CurveSource::field, "field"},
+    {CurveSource::corrected, "corrected"},
+}};
+
+/// The name of a curve source.
+[[nodiscard]] inline std::string to_string(CurveSource c) { return detail::name_of(kCurveSources, c, "curve source"); }
+
+/// Parses a curve source's name.
+/// @throws std::invalid_argument for anything but `training`, `field` or `corrected`.
+[[nodiscard]] inline CurveSource parse_curve_source(std::string_view name) {
+  return detail::value_named(kCurveSources, name, "curve source");
+}
+
+/// How much of its forecast field gain a descent to one GSD realised when the training fields
+/// were flown as new ground (FrontAwarePolicy::Params::gain_ratios; calibrate() with
+/// CalibrationOptions::gain_ratios measures it).
+struct GainRatio {
+  double gsd_cm = 0.0;  ///< the descent GSD [cm/px]
+  double ratio = 1.0;   ///< realised / forecast field gain, >= 0
+};
+
+/// How far descents to one GSD ended above their forecast margin, per second of descent, when
+/// the training fields were flown as new ground (FrontAwarePolicy::Params::margin_biases;
+/// calibrate() with CalibrationOptions::margin_biases measures it): the error of the gain and of
+/// the lawnmower curve's rise together, which is what decides whether a descent pays.
+struct MarginBias {
+  double gsd_cm = 0.0;  ///< the descent GSD [cm/px]
+  double per_s = 0.0;   ///< (realised − forecast margin) per second of the descent's extra time
+};
+
+/// A training field's fixed-altitude lawnmower curve by GSD: the front-aware rule's yardstick.
+struct ReferenceCurve {
+  std::string field;             ///< the training field's name
+  std::vector<GsdPoint> points;  ///< field mIoU over L by lawnmower GSD
+  /// σ of the field's top-level map (its share of L as the UAV sees it); 0: unknown. The mean
+  /// over the reference curves is the prior of a new field's σ.
+  double field_sigma = 0.0;
+  /// The mean over the field's top-level images of the cell gain model's input (its value per
+  /// field pixel); 0: unknown (models without cells). The mean over the reference curves is the
+  /// prior of a new field's (CurveSource::field). At the nominal top-level GSD.
+  double field_input = 0.0;
+  /// The same mean at every top-level GSD the cell gain model was calibrated for (the nominal
+  /// one and finer ones the rule may choose, ChoosesTopLevel), as (GSD, input) pairs: a finer
+  /// top level's map has less wrong, so its input is smaller. Empty (models before it):
+  /// `field_input` at every top.
+  std::vector<std::pair<double, double>> top_inputs{};
+
+  /// The field's mean input at top-level GSD `top_gsd_cm`: its `top_inputs` entry, else
+  /// `field_input`.
+  [[nodiscard]] double input_at(double top_gsd_cm) const {
+    for (const auto& [g, x] : top_inputs)
+      if (detail::same_gsd(g, top_gsd_cm)) return x;
+    return field_input;
+  }
+};
+
+}  // namespace adaptseg
