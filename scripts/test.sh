@@ -3,7 +3,8 @@
 # warnings as errors, and a Debug build under AddressSanitizer + UndefinedBehaviorSanitizer
 # (every test and every example program compiled with them, so the programs' CLI tests run
 # sanitized too; the package, doxygen, snippet, header-alone and Python tests, which build or
-# run nothing sanitized, run in the Release build only).
+# run nothing sanitized, and docs:commands, which runs the programs on the CLI tests' paths again,
+# run in the Release build only).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/deps.sh test
