@@ -7,7 +7,6 @@
 #include <adaptseg/core/decision.hpp>
 #include <adaptseg/core/detail/gsd.hpp>
 #include <adaptseg/core/detail/interpolate.hpp>
-#include <adaptseg/core/detail/named_rows.hpp>
 #include <adaptseg/core/error.hpp>
 #include <adaptseg/core/field_estimates.hpp>
 #include <adaptseg/core/front_aware_settings.hpp>
@@ -15,14 +14,12 @@
 #include <adaptseg/core/lawnmower_curve.hpp>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
-#include <string_view>
 #include <utility>
 #include <vector>
 
