@@ -149,6 +149,7 @@ class FrontAwarePolicy {
                     "FrontAwarePolicy: the gain model needs C or a cell gain model (what a descent relabels); C",
                     "absent");
     std::size_t with_sigma = 0;
+    double prior_sigma = 0.0;  // the training fields' mean σ (0: unknown)
     detail::require(!reference_.empty(), "FrontAwarePolicy: at least one reference lawnmower curve is needed; count",
                     reference_.size());
     for (const auto& r : reference_) {
@@ -161,12 +162,12 @@ class FrontAwarePolicy {
       detail::require(std::isfinite(r.field_sigma) && r.field_sigma >= 0.0 && r.field_sigma <= 1.0,
                       "FrontAwarePolicy: reference curve '" + r.field + "' needs field_sigma in [0, 1]", r.field_sigma);
       if (r.field_sigma > 0.0) {
-        prior_sigma_ += r.field_sigma / static_cast<double>(reference_.size());
+        prior_sigma += r.field_sigma / static_cast<double>(reference_.size());
         ++with_sigma;
       }
     }
-    if (with_sigma != reference_.size()) prior_sigma_ = 0.0;  // unknown for some: the running mean of σ
-    share_ = FieldShareEstimate(prior_sigma_);
+    if (with_sigma != reference_.size()) prior_sigma = 0.0;  // unknown for some: the running mean of σ
+    share_ = FieldShareEstimate(prior_sigma);
     for (const auto& r : reference_) {
       detail::require(std::isfinite(r.field_input) && r.field_input >= 0.0,
                       "FrontAwarePolicy: reference curve '" + r.field + "' needs field_input >= 0", r.field_input);
@@ -454,9 +455,7 @@ class FrontAwarePolicy {
 
   /// mIoU of a predicted curve (sorted by time) at time t: linear between its points, flat
   /// beyond its ends, as front_margin reads the curve.
-  static double curve_miou(const std::vector<CurvePoint>& curve, double t) {
-    return detail::interpolate_flat(curve, t, &CurvePoint::time_s, &CurvePoint::miou);
-  }
+  static double curve_miou(const std::vector<CurvePoint>& curve, double t) { return miou_at_time(curve, t); }
 
   /// The curve a descent's gain is compared with: as curve_miou, but beyond the last point (a
   /// mission slower than the finest lawnmower) the last segment goes on if it rises (never
@@ -485,7 +484,6 @@ class FrontAwarePolicy {
   GainModel model_;
   std::vector<ReferenceCurve> reference_;
   Params params_;
-  double prior_sigma_ = 0.0;  ///< mean σ of the training fields (0: unknown)
   // Per mission (reset by begin_mission):
   FieldShareEstimate share_;        ///< σ̂ and X̂ from the top-level images so far
   FieldScale scale_;                ///< the field factor s

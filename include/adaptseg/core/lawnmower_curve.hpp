@@ -49,6 +49,13 @@ struct CurvePoint {
   return env;
 }
 
+/// mIoU of a curve sorted by time (a lawnmower curve or its upper_envelope()) at `time_s`:
+/// linear between its points, flat beyond its ends. How front_margin() reads the envelope.
+/// @throws std::invalid_argument for an empty curve.
+[[nodiscard]] inline double miou_at_time(const std::vector<CurvePoint>& curve, double time_s) {
+  return detail::interpolate_flat(curve, time_s, &CurvePoint::time_s, &CurvePoint::miou);
+}
+
 /// Front margin (paper §5, docs/method.md, "Decisions where the paper is silent, and departures"):
 /// `miou` minus the lawnmower curve's **upper envelope**
 /// (upper_envelope(): the best lawnmower at `time_s` or sooner) linearly interpolated at
@@ -60,7 +67,7 @@ struct CurvePoint {
 [[nodiscard]] inline double front_margin(std::vector<CurvePoint> curve, double time_s, double miou) {
   detail::require(std::isfinite(time_s) && std::isfinite(miou), "front_margin: time and mIoU must be finite", time_s);
   const std::vector<CurvePoint> env = upper_envelope(std::move(curve));
-  return miou - detail::interpolate_flat(env, time_s, &CurvePoint::time_s, &CurvePoint::miou);
+  return miou - miou_at_time(env, time_s);
 }
 
 /// The front margin against the curve itself (linear between its points, flat beyond its ends),
@@ -71,7 +78,7 @@ struct CurvePoint {
   detail::require(std::isfinite(time_s) && std::isfinite(miou), "curve_front_margin: time and mIoU must be finite",
                   time_s);
   std::sort(curve.begin(), curve.end(), [](const CurvePoint& a, const CurvePoint& b) { return a.time_s < b.time_s; });
-  return miou - detail::interpolate_flat(curve, time_s, &CurvePoint::time_s, &CurvePoint::miou);
+  return miou - miou_at_time(curve, time_s);
 }
 
 /// Field mIoU of a fixed-altitude lawnmower at one GSD (a training field's curve, indexed by

@@ -5,7 +5,6 @@
 /// choice) tried on the training fields, each field flown with a model fitted without it, and
 /// σ̂'s prior estimated from their top-level images. docs/method.md, "The front-aware rule".
 
-#include <adaptseg/core/detail/interpolate.hpp>
 #include <adaptseg/core/front_aware_policy.hpp>
 #include <adaptseg/core/lawnmower_curve.hpp>
 #include <adaptseg/vision/adaptive_mission.hpp>
@@ -329,9 +328,7 @@ inline std::vector<MarginBias> fold_margin_biases(std::span<const AdaptiveResult
   };
   std::vector<std::vector<CurvePoint>> envelopes;
   for (const std::vector<CurvePoint>* c : curves) envelopes.push_back(upper_envelope(*c));
-  const auto real_miou = [&](std::size_t j, double t) {
-    return detail::interpolate_flat(envelopes[j], t, &CurvePoint::time_s, &CurvePoint::miou);
-  };
+  const auto real_miou = [&](std::size_t j, double t) { return miou_at_time(envelopes[j], t); };
   std::vector<Sums> sums;
   for_each_forecast_descent(
       flights, skip, [&](const RealisedDescent& d, const DecisionRecord& rec, std::size_t k, std::size_t j) {
@@ -354,6 +351,17 @@ inline std::vector<MarginBias> fold_margin_biases(std::span<const AdaptiveResult
   return out;
 }
 
+/// One fold flown by `fly` with the front-aware rule over `model` and `params`, σ̂'s prior the
+/// fold's own estimate (estimated without its field) where one is asked for; `margin` its front
+/// margin.
+template <class Fly>
+AdaptiveResult fly_fold(const RuleSearchInputs& in, const FrontAwareFold& fold, const GainModel& model,
+                        FrontAwarePolicy::Params params, Fly& fly, double& margin) {
+  apply_sigma_prior(params, fold.sigma_prior, in.options.sigma_prior);
+  FrontAwarePolicy policy(model, fold.reference, params);
+  return fly(*fold.field, policy, *fold.curve, margin);
+}
+
 /// The flights the gain ratios and margin biases are measured on: each training field flown
 /// with the model of the others, the first slope pooling and top-level choice, z = 0 (the most
 /// descents to learn from), no ratio or bias of its own.
@@ -369,11 +377,8 @@ std::vector<AdaptiveResult> measuring_flights(const RuleSearchInputs& in, std::s
   first.margin_biases.clear();
   std::vector<AdaptiveResult> flights;
   for (std::size_t k = 0; k < folds.size(); ++k) {
-    FrontAwarePolicy::Params fold_params = first;
-    apply_sigma_prior(fold_params, folds[k].sigma_prior, in.options.sigma_prior);
-    FrontAwarePolicy policy(models[k], folds[k].reference, fold_params);
     double margin = 0.0;
-    flights.push_back(fly(*folds[k].field, policy, *folds[k].curve, margin));
+    flights.push_back(fly_fold(in, folds[k], models[k], first, fly, margin));
   }
   return flights;
 }
@@ -456,13 +461,11 @@ template <class Fly>
         t.description = detail::z_text(z, grid.poolings.size() > 1 ? &grid.poolings[pi] : nullptr,
                                        grid.top_levels.size() > 1 ? &grid.top_levels[ti] : nullptr);
         for (std::size_t k = 0; k < folds.size(); ++k) {
-          FrontAwarePolicy::Params fold_params = p;  // σ̂'s prior: the fold's estimate replaces all fields'
-          detail::apply_sigma_prior(fold_params, folds[k].sigma_prior, options.sigma_prior);
+          FrontAwarePolicy::Params fold_params = p;
           fold_params.gain_ratios = fold_ratios[k];
           fold_params.margin_biases = fold_biases[k];
-          FrontAwarePolicy policy(models[k], folds[k].reference, fold_params);
           double margin = 0.0;
-          const AdaptiveResult r = fly(*folds[k].field, policy, *folds[k].curve, margin);
+          const AdaptiveResult r = detail::fly_fold(in, folds[k], models[k], fold_params, fly, margin);
           detail::add_to_trial(t, r, margin);
         }
         trials.push_back(std::move(t));
