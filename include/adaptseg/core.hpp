@@ -26,5 +26,6 @@
 #include <adaptseg/core/map_fusion.hpp>
 #include <adaptseg/core/mission_options.hpp>
 #include <adaptseg/core/timing.hpp>
+#include <adaptseg/core/top_level.hpp>
 #include <adaptseg/core/utility_policy.hpp>
 #include <adaptseg/core/version.hpp>

@@ -6,12 +6,12 @@
 
 #include <adaptseg/core/decision.hpp>
 #include <adaptseg/core/detail/gsd.hpp>
-#include <adaptseg/core/detail/interpolate.hpp>
 #include <adaptseg/core/error.hpp>
 #include <adaptseg/core/field_estimates.hpp>
 #include <adaptseg/core/front_aware_settings.hpp>
 #include <adaptseg/core/gain_model.hpp>
 #include <adaptseg/core/lawnmower_curve.hpp>
+#include <adaptseg/core/top_level.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -52,7 +52,7 @@ namespace adaptseg {
 /// - the curve's rise ΔD over the descent's extra time, [T0, T0 + T], on the upper envelope
 ///   (upper_envelope(): never falling) of each training field's predicted curve: mean ΔD̄ and
 ///   spread sd_D over the training fields; beyond the curve's last point its last segment goes
-///   on (rising_curve_miou);
+///   on (rising_miou_at_time());
 /// - the descent is worth its time if its lower bound (ĝ − ΔD̄ + b·T) − z·sqrt(Var ĝ + sd_D²) > 0
 ///   (z = `confidence`, chosen on training fields; 0: the forecasts' means; b the margin bias
 ///   per second of a descent to the candidate's GSD, `margin_biases`, 0 unless calibrated with
@@ -110,18 +110,8 @@ class FrontAwarePolicy {
                       "FrontAwarePolicy::Params::sigma_prior_weight must be finite and > 0", sigma_prior_weight);
       detail::require(std::isfinite(sigma_prior_sd) && sigma_prior_sd >= 0.0 && sigma_prior_sd <= 1.0,
                       "FrontAwarePolicy::Params::sigma_prior_sd must be in [0, 1]", sigma_prior_sd);
-      for (const GainRatio& r : gain_ratios) {
-        detail::require(std::isfinite(r.gsd_cm) && r.gsd_cm > 0.0,
-                        "FrontAwarePolicy::Params::gain_ratios: a GSD must be finite and > 0", r.gsd_cm);
-        detail::require(std::isfinite(r.ratio) && r.ratio >= 0.0,
-                        "FrontAwarePolicy::Params::gain_ratios: a ratio must be finite and >= 0", r.ratio);
-      }
-      for (const MarginBias& b : margin_biases) {
-        detail::require(std::isfinite(b.gsd_cm) && b.gsd_cm > 0.0,
-                        "FrontAwarePolicy::Params::margin_biases: a GSD must be finite and > 0", b.gsd_cm);
-        detail::require(std::isfinite(b.per_s), "FrontAwarePolicy::Params::margin_biases: a bias must be finite",
-                        b.per_s);
-      }
+      for (const GainRatio& r : gain_ratios) r.validate();
+      for (const MarginBias& b : margin_biases) b.validate();
     }
 
     /// The factor on the forecast gain of a descent to `gsd_cm` (1 where none is listed).
@@ -148,19 +138,12 @@ class FrontAwarePolicy {
     detail::require(model_.c_model().has_value() || model_.cells().has_value(),
                     "FrontAwarePolicy: the gain model needs C or a cell gain model (what a descent relabels); C",
                     "absent");
-    std::size_t with_sigma = 0;
-    double prior_sigma = 0.0;  // the training fields' mean σ (0: unknown)
     detail::require(!reference_.empty(), "FrontAwarePolicy: at least one reference lawnmower curve is needed; count",
                     reference_.size());
+    std::size_t with_sigma = 0;
+    double prior_sigma = 0.0;  // the training fields' mean σ (0: unknown)
     for (const auto& r : reference_) {
-      detail::require(!r.points.empty(), "FrontAwarePolicy: reference curve '" + r.field + "' has no point; count",
-                      r.points.size());
-      for (const auto& p : r.points)
-        detail::require(std::isfinite(p.gsd_cm) && p.gsd_cm > 0.0 && std::isfinite(p.miou),
-                        "FrontAwarePolicy: reference curve '" + r.field + "' needs GSD > 0 and finite mIoU; GSD",
-                        p.gsd_cm);
-      detail::require(std::isfinite(r.field_sigma) && r.field_sigma >= 0.0 && r.field_sigma <= 1.0,
-                      "FrontAwarePolicy: reference curve '" + r.field + "' needs field_sigma in [0, 1]", r.field_sigma);
+      r.validate();
       if (r.field_sigma > 0.0) {
         prior_sigma += r.field_sigma / static_cast<double>(reference_.size());
         ++with_sigma;
@@ -168,14 +151,6 @@ class FrontAwarePolicy {
     }
     if (with_sigma != reference_.size()) prior_sigma = 0.0;  // unknown for some: the running mean of σ
     share_ = FieldShareEstimate(prior_sigma);
-    for (const auto& r : reference_) {
-      detail::require(std::isfinite(r.field_input) && r.field_input >= 0.0,
-                      "FrontAwarePolicy: reference curve '" + r.field + "' needs field_input >= 0", r.field_input);
-      for (const auto& [g, x] : r.top_inputs)
-        detail::require(
-            std::isfinite(g) && g > 0.0 && std::isfinite(x) && x >= 0.0,
-            "FrontAwarePolicy: reference curve '" + r.field + "' needs top_inputs of GSD > 0 and input >= 0; GSD", g);
-    }
     begin_mission();
   }
 
@@ -210,112 +185,35 @@ class FrontAwarePolicy {
     detail::require(!c.lawnmowers.empty(),
                     "FrontAwarePolicy::decide: the context needs the field's lawnmower forecasts; count",
                     c.lawnmowers.size());
-    // Each training field's lawnmower accuracy, placed at this field's lawnmower times: the
-    // upper envelope of that predicted curve (the best lawnmower at a time or sooner, as the
-    // front margin reads it), in time order (curve_miou and rising_curve_miou read it there).
-    std::vector<std::vector<CurvePoint>> curves;
-    for (const auto& r : reference_) {
-      std::vector<CurvePoint> curve;
-      for (const auto& f : c.lawnmowers) curve.push_back({f.time_s, miou_at_gsd(r.points, f.gsd_cm)});
-      curves.push_back(upper_envelope(std::move(curve)));
-    }
     share_.add(c.sigma, c.region_share, c.region_input);
     const auto [weight, sigma_cv2] = gain_weight(c);
-    const double t0 = c.elapsed_s + c.rest_s;
-    // The predicted curve's mIoU relative to the top level's (curve not `training`) or absolute.
-    double curve_level = 0.0;
-    if (params_.curve != CurveSource::training && model_.cells() && c.region_share > 0.0 && weight > 0.0) {
-      const double x = field_input_estimate(c);
-      curves.clear();
-      if (params_.curve == CurveSource::corrected)
-        for (const auto& r : reference_) curves.push_back(field_curve(c, x, weight / c.region_share, &r));
-      else
-        curves.push_back(field_curve(c, x, weight / c.region_share, nullptr));
-      curve_level = mean_top_miou(c);
-    }
-
+    const PredictedCurves curves = predicted_curves(c, weight);
     Decision d;
     std::optional<std::size_t> best_index;
     double best = 0.0;
-    std::vector<double> gains;
-    std::vector<Relabelled> forecasts;
+    std::vector<Assessment> assessed;
     for (std::size_t k = 0; k < c.candidates.size(); ++k) {
-      const Candidate& cand = c.candidates[k];
-      const double delta_h = c.top_altitude_m - cand.altitude_m;
-      const GainForecast f = model_.forecast(delta_h, c.sigma);
-      CandidateScore s = scored(cand, f);
-      // The descent's gain in shares of the region (its sd, and what it relabels): from its
-      // cells (DescentCoverage::ranked), else from C and η.
-      double base = 0.0, base_sd = 0.0;
-      Relabelled relabelled;
-      if (!cand.cells.empty() && model_.cells() && c.region_px > 0.0) {
-        const CellGainModel::Forecast cf = model_.cells()->forecast(c.top_gsd_cm, cand.gsd_cm, cand.cells, c.region_px);
-        base = cf.gain * weight;
-        base_sd = std::sqrt(cf.gain_var) * weight;
-        relabelled = {cf.relabelled, std::sqrt(cf.relabelled_var), cf.gain, cf.proxy_var, c.top_gsd_cm, cand.gsd_cm};
-      } else if (model_.c_model()) {
-        const double eta = model_.efficiency(delta_h);
-        base = f.relabelled * eta * weight;
-        base_sd = f.relabelled_std * eta * weight;
-        relabelled = {f.relabelled, f.relabelled_noisy_std, 0.0, 0.0, 0.0, 0.0};
-      }
-      // What descents to this GSD realised of their forecast on the training fields as new ground.
-      const double ratio = params_.gain_ratio(cand.gsd_cm);
-      base *= ratio;
-      base_sd *= ratio;
-      const double gain = scaled(base);
-      const double gain_var =
-          scale_.mean() * scale_.mean() * base_sd * base_sd + scale_.var() * base * base + gain * gain * sigma_cv2;
-      s.predicted_field_gain = gain;
-      if (std::isfinite(relabelled.mean)) s.predicted_relabelled = std::abs(scale_.mean()) * relabelled.mean;
-      s.utility = utility(gain, cand.extra_time_s);
-      // The curve's rise over the descent's extra time, on every training field's curve.
-      double rise_sum = 0.0, rise_sq = 0.0;
-      for (const auto& curve : curves) {
-        const double rise = rising_curve_miou(curve, t0 + cand.extra_time_s) - rising_curve_miou(curve, t0);
-        rise_sum += rise;
-        rise_sq += rise * rise;
-      }
-      const double n = static_cast<double>(curves.size());
-      const double rise = rise_sum / n;
-      const double rise_var = curves.size() > 1 ? std::max(0.0, (rise_sq - n * rise * rise) / (n - 1.0)) : 0.0;
-      // What descents to this GSD ended above their forecast margin on the training fields as new ground.
-      const double bias = params_.margin_bias(cand.gsd_cm) * cand.extra_time_s;
-      const double lower = gain - rise + bias - params_.confidence * std::sqrt(gain_var + rise_var);
-      s.predicted_front_margin =
-          mean_top_miou(c) + forecast_gain_ + gain - curve_level - mean_curve_miou(curves, t0 + cand.extra_time_s);
-      s.predicted_curve_rise = rise;
-      s.predicted_end_s = t0 + cand.extra_time_s;
-      if (gain > 0.0 && lower > best) {
-        best = lower;
+      assessed.push_back(assess(c, c.candidates[k], curves, weight, sigma_cv2));
+      if (assessed.back().gain > 0.0 && assessed.back().lower > best) {
+        best = assessed.back().lower;
         best_index = k;
       }
-      d.scores.push_back(s);
-      gains.push_back(gain);
-      forecasts.push_back(relabelled);
+      d.scores.push_back(assessed.back().score);
     }
     if (best_index && c.sigma >= params_.min_sigma) {
       d.descend = true;
       d.gsd_cm = c.candidates[*best_index].gsd_cm;
       d.candidate = *best_index;
-      forecast_gain_ += gains[*best_index];
-      chosen_.push_back(forecasts[*best_index]);
+      forecast_gain_ += assessed[*best_index].gain;
+      chosen_.push_back(assessed[*best_index].relabelled);
     }
     return d;
   }
 
   /// The GSD to fly the top level at (ChoosesTopLevel): of those the model can decide from (its
-  /// cell gain model's top-level GSDs, else the nominal one), the one whose lawnmower over the
-  /// area falls least short of the lawnmowers of `lawnmowers` as fast or faster: on each training
-  /// field's curve, the most any of them maps better (0 if none), averaged over the fields; the
-  /// coarsest where they tie. The margin a mission is judged by is exactly such a shortfall
-  /// against the curve's upper envelope, and it is taken field by field because the fields'
-  /// curves cross: a network on ground it never saw maps one field better at 12.5 cm/px than at
-  /// 15 and the next worse, so the shortfall of their mean curve can be 0 where flying the
-  /// coarser, slower lawnmower loses on some of them. With TopLevelChoice::hull,
-  /// then a finer one of them while the predicted curve rises faster per second up to it than
-  /// from it to any finer lawnmower of `lawnmowers`. Both the adaptive and the non-adaptive rule
-  /// choose so (nothing is learnt here).
+  /// cell gain model's top-level GSDs, else the nominal one), choose_top_gsd()'s with the
+  /// training fields' curves and `params().top_level`. Both the adaptive and the non-adaptive
+  /// rule choose so (nothing is learnt here).
   [[nodiscard]] double top_gsd(std::span<const LawnmowerForecast> lawnmowers, double nominal) const {
     std::vector<double> allowed;
     if (model_.cells())
@@ -324,48 +222,7 @@ class FrontAwarePolicy {
           if (detail::same_gsd(l.gsd_cm, g)) allowed.push_back(l.gsd_cm);
     if (std::find(allowed.begin(), allowed.end(), nominal) == allowed.end()) allowed.push_back(nominal);
     std::sort(allowed.begin(), allowed.end(), std::greater<>());
-    const auto predicted = [&](double g) {
-      double m = 0.0;
-      for (const auto& r : reference_) m += miou_at_gsd(r.points, g);
-      return m / static_cast<double>(reference_.size());
-    };
-    const auto time_of = [&](double g) {
-      for (const auto& l : lawnmowers)
-        if (l.gsd_cm == g) return l.time_s;
-      return std::numeric_limits<double>::infinity();  // the nominal top without a forecast: never dominated
-    };
-    // The mean over the training fields of how far a faster lawnmower beats g on each.
-    const auto shortfall = [&](double g) {
-      double sum = 0.0;
-      for (const auto& r : reference_) {
-        double worst = 0.0;
-        for (const auto& l : lawnmowers)
-          if (l.time_s <= time_of(g))
-            worst = std::max(worst, miou_at_gsd(r.points, l.gsd_cm) - miou_at_gsd(r.points, g));
-        sum += worst;
-      }
-      return sum / static_cast<double>(reference_.size());
-    };
-    double best = nominal, best_shortfall = std::numeric_limits<double>::infinity();
-    for (double g : allowed) {
-      const double v = shortfall(g);
-      if (v < best_shortfall - 1e-12) best = g, best_shortfall = v;
-    }
-    if (params_.top_level != TopLevelChoice::hull) return best;
-    for (double g : allowed) {  // coarse to fine
-      const double t0 = time_of(best), t1 = time_of(g);
-      if (!(g < best) || !std::isfinite(t1) || !std::isfinite(t0)) continue;
-      // The rise per second up to g, and the steepest from g to a finer, slower lawnmower.
-      const double rise = predicted(g) - predicted(best);
-      const double rate_to = t1 > t0 ? rise / (t1 - t0) : (rise > 0.0 ? std::numeric_limits<double>::infinity() : rise);
-      double rate_on = 0.0;
-      for (const auto& l : lawnmowers)
-        if (l.gsd_cm < g && l.time_s > t1)
-          rate_on = std::max(rate_on, (predicted(l.gsd_cm) - predicted(g)) / (l.time_s - t1));
-      if (!(rate_to > rate_on)) break;
-      best = g;
-    }
-    return best;
+    return choose_top_gsd(reference_, allowed, lawnmowers, nominal, params_.top_level);
   }
 
   /// After a descent: the paper's update of O and the field correction (no-op unless `online`).
@@ -410,6 +267,119 @@ class FrontAwarePolicy {
     double sub_gsd_cm = 0.0;
   };
 
+  /// The lawnmower curves a descent is compared with at one image, per training field (or one,
+  /// CurveSource::field), each in time order; `level` the mIoU they are relative to (the top
+  /// level's for the curves the cell gain model predicts, 0 for the training fields' own).
+  struct PredictedCurves {
+    std::vector<std::vector<CurvePoint>> curves;
+    double level = 0.0;
+    double t0 = 0.0;  ///< the mission's end if it descends no more: elapsed + rest of the top level
+  };
+
+  /// One candidate as the rule sees it: its score, its forecast field gain ĝ, the lower bound
+  /// of its margin, and what it is forecast to relabel (kept for observe() if it is chosen).
+  struct Assessment {
+    CandidateScore score;
+    double gain = 0.0;
+    double lower = 0.0;
+    Relabelled relabelled{};
+  };
+
+  /// The predicted curves (CurveSource): each training field's lawnmower accuracy placed at
+  /// this field's lawnmower times, the upper envelope of that predicted curve (the best
+  /// lawnmower at a time or sooner, as the front margin reads it); or, with a cell gain model
+  /// and a curve source other than `training`, this field's curve as predicted (field_curve),
+  /// `weight` = a / σ̂.
+  [[nodiscard]] PredictedCurves predicted_curves(const DecisionContext& c, double weight) const {
+    PredictedCurves p;
+    p.t0 = c.elapsed_s + c.rest_s;
+    if (params_.curve != CurveSource::training && model_.cells() && c.region_share > 0.0 && weight > 0.0) {
+      const double x = field_input_estimate(c);
+      if (params_.curve == CurveSource::corrected)
+        for (const auto& r : reference_) p.curves.push_back(field_curve(c, x, weight / c.region_share, &r));
+      else
+        p.curves.push_back(field_curve(c, x, weight / c.region_share, nullptr));
+      p.level = mean_top_miou(c);
+      return p;
+    }
+    for (const auto& r : reference_) {
+      std::vector<CurvePoint> curve;
+      for (const auto& f : c.lawnmowers) curve.push_back({f.time_s, miou_at_gsd(r.points, f.gsd_cm)});
+      p.curves.push_back(upper_envelope(std::move(curve)));
+    }
+    return p;
+  }
+
+  /// The descent's gain in shares of the region before the field factor s (mean, sd, and what
+  /// it relabels): from its cells (DescentCoverage::ranked), else from C and η; times the gain
+  /// ratio of its GSD (what descents to it realised of their forecast on the training fields as
+  /// new ground).
+  struct BaseGain {
+    double mean = 0.0, sd = 0.0;
+    Relabelled relabelled{};
+  };
+  [[nodiscard]] BaseGain base_gain(const DecisionContext& c, const Candidate& cand, const GainForecast& f,
+                                   double delta_h, double weight) const {
+    BaseGain b;
+    if (!cand.cells.empty() && model_.cells() && c.region_px > 0.0) {
+      const CellGainModel::Forecast cf = model_.cells()->forecast(c.top_gsd_cm, cand.gsd_cm, cand.cells, c.region_px);
+      b.mean = cf.gain * weight;
+      b.sd = std::sqrt(cf.gain_var) * weight;
+      b.relabelled = {cf.relabelled, std::sqrt(cf.relabelled_var), cf.gain, cf.proxy_var, c.top_gsd_cm, cand.gsd_cm};
+    } else if (model_.c_model()) {
+      const double eta = model_.efficiency(delta_h);
+      b.mean = f.relabelled * eta * weight;
+      b.sd = f.relabelled_std * eta * weight;
+      b.relabelled = {f.relabelled, f.relabelled_noisy_std, 0.0, 0.0, 0.0, 0.0};
+    }
+    const double ratio = params_.gain_ratio(cand.gsd_cm);
+    b.mean *= ratio;
+    b.sd *= ratio;
+    return b;
+  }
+
+  /// The curves' rise over a descent of `extra_s` from `t0`: mean ΔD̄ over the curves and its
+  /// variance sd_D² between them (0 with one curve).
+  static std::pair<double, double> curve_rise(const std::vector<std::vector<CurvePoint>>& curves, double t0,
+                                              double extra_s) {
+    double rise_sum = 0.0, rise_sq = 0.0;
+    for (const auto& curve : curves) {
+      const double rise = rising_miou_at_time(curve, t0 + extra_s) - rising_miou_at_time(curve, t0);
+      rise_sum += rise;
+      rise_sq += rise * rise;
+    }
+    const double n = static_cast<double>(curves.size());
+    const double rise = rise_sum / n;
+    return {rise, curves.size() > 1 ? std::max(0.0, (rise_sq - n * rise * rise) / (n - 1.0)) : 0.0};
+  }
+
+  /// One candidate's forecast gain ĝ and its variance, the curves' rise over its extra time and
+  /// the lower bound (ĝ − ΔD̄ + b·T) − z·sqrt(Var ĝ + sd_D²) (class comment).
+  [[nodiscard]] Assessment assess(const DecisionContext& c, const Candidate& cand, const PredictedCurves& p,
+                                  double weight, double sigma_cv2) const {
+    const double delta_h = c.top_altitude_m - cand.altitude_m;
+    const GainForecast f = model_.forecast(delta_h, c.sigma);
+    Assessment a;
+    a.score = scored(cand, f);
+    const BaseGain b = base_gain(c, cand, f, delta_h, weight);
+    a.gain = scaled(b.mean);
+    const double gain_var =
+        scale_.mean() * scale_.mean() * b.sd * b.sd + scale_.var() * b.mean * b.mean + a.gain * a.gain * sigma_cv2;
+    a.score.predicted_field_gain = a.gain;
+    if (std::isfinite(b.relabelled.mean)) a.score.predicted_relabelled = std::abs(scale_.mean()) * b.relabelled.mean;
+    a.score.utility = utility(a.gain, cand.extra_time_s);
+    const auto [rise, rise_var] = curve_rise(p.curves, p.t0, cand.extra_time_s);
+    // What descents to this GSD ended above their forecast margin on the training fields as new ground.
+    const double bias = params_.margin_bias(cand.gsd_cm) * cand.extra_time_s;
+    a.lower = a.gain - rise + bias - params_.confidence * std::sqrt(gain_var + rise_var);
+    a.score.predicted_front_margin =
+        mean_top_miou(c) + forecast_gain_ + a.gain - p.level - mean_curve_miou(p.curves, p.t0 + cand.extra_time_s);
+    a.score.predicted_curve_rise = rise;
+    a.score.predicted_end_s = p.t0 + cand.extra_time_s;
+    a.relabelled = b.relabelled;
+    return a;
+  }
+
   /// A forecast gain `base` before the field factor s, times s (FieldScale::scaled).
   [[nodiscard]] double scaled(double base) const noexcept { return scale_.scaled(base); }
 
@@ -432,20 +402,10 @@ class FrontAwarePolicy {
     for (const auto& l : c.lawnmowers) {
       if (l.gsd_cm > c.top_gsd_cm) continue;  // coarser than the top level: not what it compares with
       const double slope = l.gsd_cm < c.top_gsd_cm ? model_.cells()->at(c.top_gsd_cm, l.gsd_cm).gain_slope : 0.0;
-      const double ratio = corrected_by ? rise_ratio(*corrected_by, c.top_gsd_cm, l.gsd_cm, slope) : 1.0;
+      const double ratio = corrected_by ? corrected_rise_ratio(*corrected_by, c.top_gsd_cm, l.gsd_cm, slope) : 1.0;
       curve.push_back({l.time_s, scaled(slope * x * inv_sigma * ratio)});
     }
     return upper_envelope(std::move(curve));
-  }
-
-  /// CurveSource::corrected's r_f: training field `r`'s real lawnmower rise from GSD `top` to `g`
-  /// over the one the cell gain model predicts for it, slope·X_f / σ_f (X_f at `top`); clamped
-  /// to [1/4, 4]; 1 where nothing is predicted.
-  static double rise_ratio(const ReferenceCurve& r, double top, double g, double slope) {
-    const double predicted = r.field_sigma > 0.0 ? slope * r.input_at(top) / r.field_sigma : 0.0;
-    if (!(predicted > 0.0)) return 1.0;
-    const double real = miou_at_gsd(r.points, g) - miou_at_gsd(r.points, top);
-    return std::clamp(real / predicted, 0.25, 4.0);
   }
 
   /// a / σ̂ and Var σ̂ / σ̂² (FieldShareEstimate::gain_weight, with σ̂'s k and τ).
@@ -453,22 +413,10 @@ class FrontAwarePolicy {
     return share_.gain_weight(c.region_share, params_.sigma_prior_weight, params_.sigma_prior_sd);
   }
 
-  /// mIoU of a predicted curve (sorted by time) at time t: linear between its points, flat
-  /// beyond its ends, as front_margin reads the curve.
-  static double curve_miou(const std::vector<CurvePoint>& curve, double t) { return miou_at_time(curve, t); }
-
-  /// The curve a descent's gain is compared with: as curve_miou, but beyond the last point (a
-  /// mission slower than the finest lawnmower) the last segment goes on if it rises (never
-  /// below the last point: the finest lawnmower can always be flown), capped at 1. There a
-  /// descent must still beat what the finest lawnmowers bought per second; read flat, any
-  /// positive gain would beat it however long the descent.
-  static double rising_curve_miou(const std::vector<CurvePoint>& curve, double t) {
-    return std::min(1.0, detail::interpolate_extend(curve, t, &CurvePoint::time_s, &CurvePoint::miou));
-  }
-
+  /// The mean over `curves` of their mIoU at `t` (miou_at_time(): as the front margin reads them).
   static double mean_curve_miou(const std::vector<std::vector<CurvePoint>>& curves, double t) {
     double s = 0.0;
-    for (const auto& c : curves) s += curve_miou(c, t);
+    for (const auto& c : curves) s += miou_at_time(c, t);
     return s / static_cast<double>(curves.size());
   }
 

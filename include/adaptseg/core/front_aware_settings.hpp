@@ -6,9 +6,12 @@
 
 #include <adaptseg/core/detail/gsd.hpp>
 #include <adaptseg/core/detail/named_rows.hpp>
+#include <adaptseg/core/error.hpp>
 #include <adaptseg/core/lawnmower_curve.hpp>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -88,6 +91,14 @@ inline constexpr std::array<detail::NamedValue<CurveSource>, 3> kCurveSources{{
 struct GainRatio {
   double gsd_cm = 0.0;  ///< the descent GSD [cm/px]
   double ratio = 1.0;   ///< realised / forecast field gain, >= 0
+
+  /// @throws std::invalid_argument for a GSD <= 0 or a ratio < 0 or not finite.
+  void validate() const {
+    detail::require(std::isfinite(gsd_cm) && gsd_cm > 0.0,
+                    "FrontAwarePolicy::Params::gain_ratios: a GSD must be finite and > 0", gsd_cm);
+    detail::require(std::isfinite(ratio) && ratio >= 0.0,
+                    "FrontAwarePolicy::Params::gain_ratios: a ratio must be finite and >= 0", ratio);
+  }
 };
 
 /// How far descents to one GSD ended above their forecast margin, per second of descent, when
@@ -97,6 +108,13 @@ struct GainRatio {
 struct MarginBias {
   double gsd_cm = 0.0;  ///< the descent GSD [cm/px]
   double per_s = 0.0;   ///< (realised − forecast margin) per second of the descent's extra time
+
+  /// @throws std::invalid_argument for a GSD <= 0 or a bias that is not finite.
+  void validate() const {
+    detail::require(std::isfinite(gsd_cm) && gsd_cm > 0.0,
+                    "FrontAwarePolicy::Params::margin_biases: a GSD must be finite and > 0", gsd_cm);
+    detail::require(std::isfinite(per_s), "FrontAwarePolicy::Params::margin_biases: a bias must be finite", per_s);
+  }
 };
 
 /// A training field's fixed-altitude lawnmower curve by GSD: the front-aware rule's yardstick.
@@ -116,6 +134,23 @@ struct ReferenceCurve {
   /// `field_input` at every top.
   std::vector<std::pair<double, double>> top_inputs{};
 
+  /// @throws std::invalid_argument naming the field: no point, a point with a GSD <= 0 or a
+  ///         non-finite mIoU, `field_sigma` outside [0, 1], `field_input` < 0 or not finite, a
+  ///         `top_inputs` entry with a GSD <= 0 or an input < 0.
+  void validate() const {
+    const std::string curve = "reference curve '" + field + "'";
+    detail::require(!points.empty(), curve + " has no point; count", points.size());
+    for (const auto& p : points)
+      detail::require(std::isfinite(p.gsd_cm) && p.gsd_cm > 0.0 && std::isfinite(p.miou),
+                      curve + " needs GSD > 0 and finite mIoU; GSD", p.gsd_cm);
+    detail::require(std::isfinite(field_sigma) && field_sigma >= 0.0 && field_sigma <= 1.0,
+                    curve + " needs field_sigma in [0, 1]", field_sigma);
+    detail::require(std::isfinite(field_input) && field_input >= 0.0, curve + " needs field_input >= 0", field_input);
+    for (const auto& [g, x] : top_inputs)
+      detail::require(std::isfinite(g) && g > 0.0 && std::isfinite(x) && x >= 0.0,
+                      curve + " needs top_inputs of GSD > 0 and input >= 0; GSD", g);
+  }
+
   /// The field's mean input at top-level GSD `top_gsd_cm`: its `top_inputs` entry, else
   /// `field_input`.
   [[nodiscard]] double input_at(double top_gsd_cm) const {
@@ -124,5 +159,15 @@ struct ReferenceCurve {
     return field_input;
   }
 };
+
+/// CurveSource::corrected's r_f: training field `r`'s real lawnmower rise from GSD `top` to `g`
+/// over the one the cell gain model predicts for it, slope·X_f / σ_f (X_f at `top`, `slope` the
+/// model's β(top, g)); clamped to [1/4, 4]; 1 where nothing is predicted.
+[[nodiscard]] inline double corrected_rise_ratio(const ReferenceCurve& r, double top, double g, double slope) {
+  const double predicted = r.field_sigma > 0.0 ? slope * r.input_at(top) / r.field_sigma : 0.0;
+  if (!(predicted > 0.0)) return 1.0;
+  const double real = miou_at_gsd(r.points, g) - miou_at_gsd(r.points, top);
+  return std::clamp(real / predicted, 0.25, 4.0);
+}
 
 }  // namespace adaptseg

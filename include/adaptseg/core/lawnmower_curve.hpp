@@ -56,6 +56,16 @@ struct CurvePoint {
   return detail::interpolate_flat(curve, time_s, &CurvePoint::time_s, &CurvePoint::miou);
 }
 
+/// A curve's mIoU at `time_s` as a descent has to beat it (FrontAwarePolicy): as miou_at_time(),
+/// but beyond the last point (a mission slower than the finest lawnmower) the last segment goes
+/// on if it rises (never below the last point: the finest lawnmower can always be flown), capped
+/// at 1. There a descent must still beat what the finest lawnmowers bought per second; read
+/// flat, any positive gain would beat it however long the descent.
+/// @throws std::invalid_argument for an empty curve.
+[[nodiscard]] inline double rising_miou_at_time(const std::vector<CurvePoint>& curve, double time_s) {
+  return std::min(1.0, detail::interpolate_extend(curve, time_s, &CurvePoint::time_s, &CurvePoint::miou));
+}
+
 /// Front margin (paper §5, docs/method.md, "Decisions where the paper is silent, and departures"):
 /// `miou` minus the lawnmower curve's **upper envelope**
 /// (upper_envelope(): the best lawnmower at `time_s` or sooner) linearly interpolated at
