@@ -42,6 +42,22 @@
 #   (examples/tools/descent_table.py --curve, --hindsight --gsd 10). Last, the issue's targets
 #   (examples/tools/loto_targets.py; several configurations side by
 #   side: loto_targets.py --oracle out/results/oracle-default a=out/results/loto b=...).
+# loto-insample: a ceiling on what calibration can give the loto runs, not a deployment: each
+#   tile flown by the network that never saw it, as in loto, but calibrated on that tile alone,
+#   segmented by the same network: the rule's gain model fitted on the very field it flies, the
+#   lawnmower curve it compares descents with that field's own. Where a class's run stays at or
+#   below +0.001 here, no calibration of this rule's forecasts could lift it; what would have to
+#   change is the candidates (regions, GSDs, durations) or the network. CONFIG (default
+#   loto-insample) and EXTRA as for loto (no --gain-ratios or --margin-biases: one training
+#   field). About 15 minutes on 2 cores with the segmentation cache warm.
+# loto-swap: which half of a calibration transfers badly to new ground (a diagnosis, not a
+#   deployment): each loto run flown again at z = 0 with a model put together
+#   (examples/tools/compose_model.py) from its leave-one-tile-out model (LOTO_CONFIG, default
+#   loto-pooled-z0) and its model calibrated on the field itself (INSAMPLE_CONFIG, default
+#   loto-insample-pooled): the leave-one-tile-out gain model with the field's own reference
+#   (lawnmower curve, σ and input priors; config loto-swap-own-reference), the field's own gain
+#   model with the leave-one-tile-out reference (loto-swap-own-gain), and both the field's own
+#   (loto-swap-own-both). Needs both configurations; about 12 minutes on 2 cores.
 # loto-proxy: until the six leave-one-tile-out networks are trained, a stand-in for loto on the
 #   tiles that have a network of MobileNetV2 that never saw them: each tile with a bundled
 #   mobilenetv2-dubai-loto/tile-k flown by it, tiles 4 and 6 otherwise by mobilenetv2-dubai
@@ -148,9 +164,9 @@
 set -euo pipefail
 part=${1:-all}
 jobs=${2:-$(nproc 2>/dev/null || echo 2)}
-case "$part" in all | oracle | oracle-default | paper | network | loto | loto-proxy | new-ground-check | ensemble | ensemble-split | cells | curve-check | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | z-choice-network | \
+case "$part" in all | oracle | oracle-default | paper | network | loto | loto-insample | loto-swap | loto-proxy | new-ground-check | ensemble | ensemble-split | cells | curve-check | previous | network-held-out | sigma-prior | sigma-prior-fit | z-choice | z-choice-network | \
   cross-fit | network-variants | proxy-check | vertical-speed | all-tiles) ;;
-  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|loto|loto-proxy|new-ground-check|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed|all-tiles] [JOBS]" >&2
+  *) echo "usage: $0 [all|oracle|oracle-default|paper|network|loto|loto-insample|loto-swap|loto-proxy|new-ground-check|ensemble|ensemble-split|cells|curve-check|previous|network-held-out|sigma-prior|sigma-prior-fit|z-choice|z-choice-network|cross-fit|network-variants|proxy-check|vertical-speed|all-tiles] [JOBS]" >&2
     exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
@@ -432,19 +448,20 @@ if [ "$part" = ensemble-split ]; then
   exit 0
 fi
 
-if [ "$part" = loto ]; then
+if [ "$part" = loto ] || [ "$part" = loto-insample ]; then
   loto=${LOTO_NETWORKS:-examples/models/mobilenetv2-dubai-loto}
   crossed=()
   for k in 1 2 3 4 5 6; do
     [ -s "$loto/tile-$k/model.onnx" ] || { echo "no $loto/tile-$k: bash scripts/loto.sh recipe-cpu, then bundle" >&2; exit 1; }
     crossed+=(--calibration-network "$loto/tile-$k")
   done
-  config=${CONFIG:-loto} oracle=${ORACLE_CONFIG:-oracle-default}
+  config=${CONFIG:-$part} oracle=${ORACLE_CONFIG:-oracle-default}
   read -r -a extra <<<"${EXTRA:-}"
   rm -rf "${root:?}/$config"
   for cls in $classes; do
     for t in 1 2 3 4 5 6; do
       train_except "$t"
+      [ "$part" = loto-insample ] && train=(--train "$(dubai "$t")")
       run "$config" "mobilenetv2-loto-$cls-tile-$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
         --network "$loto/tile-$t" "${network[@]}" "${crossed[@]}" --no-plots "${extra[@]}"
     done
@@ -461,6 +478,39 @@ if [ "$part" = loto ]; then
   targets=("$config=$root/$config")
   [ -d "$root/$oracle" ] && targets=(--oracle "$root/$oracle" "${targets[@]}")
   /usr/bin/python3 examples/tools/loto_targets.py "${targets[@]}"
+  exit 0
+fi
+
+if [ "$part" = loto-swap ]; then
+  loto=${LOTO_NETWORKS:-examples/models/mobilenetv2-dubai-loto}
+  lofo=$root/${LOTO_CONFIG:-loto-pooled-z0} own=$root/${INSAMPLE_CONFIG:-loto-insample-pooled}
+  for d in "$lofo" "$own"; do
+    [ -d "$d" ] || { echo "no $d: bash $0 loto (CONFIG, EXTRA) and loto-insample first" >&2; exit 1; }
+  done
+  labels=("lofo=$lofo")
+  for mix in own-reference own-gain own-both; do
+    config=loto-swap-$mix
+    rm -rf "${root:?}/$config"
+    mkdir -p "$root/$config"
+    for cls in $classes; do
+      for t in 1 2 3 4 5 6; do
+        name=mobilenetv2-loto-$cls-tile-$t
+        case $mix in
+          own-reference) gain=$lofo/$name/model.yaml reference=$own/$name/model.yaml ;;
+          own-gain) gain=$own/$name/model.yaml reference=$lofo/$name/model.yaml ;;
+          own-both) gain=$own/$name/model.yaml reference=$own/$name/model.yaml ;;
+        esac
+        /usr/bin/python3 examples/tools/compose_model.py --gain "$gain" --reference "$reference" --confidence 0 \
+          --out "$root/$config/$name.model.yaml"
+        run "$config" "$name" --decision-model "$root/$config/$name.model.yaml" --test "$(dubai "$t")" \
+          --interest "$cls" --network "$loto/tile-$t" "${network[@]}" --no-plots
+      done
+    done
+    labels+=("$mix=$root/$config")
+  done
+  wait
+  check
+  /usr/bin/python3 examples/tools/loto_targets.py "${labels[@]}"
   exit 0
 fi
 
