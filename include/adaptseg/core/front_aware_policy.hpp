@@ -423,9 +423,7 @@ class FrontAwarePolicy {
   /// The training fields' mean lawnmower mIoU at the top GSD: where the forecast end point
   /// starts (reported as CandidateScore::predicted_front_margin only).
   [[nodiscard]] double mean_top_miou(const DecisionContext& c) const {
-    double s = 0.0;
-    for (const auto& r : reference_) s += miou_at_gsd(r.points, c.top_gsd_cm);
-    return s / static_cast<double>(reference_.size());
+    return detail::mean_reference_miou(reference_, c.top_gsd_cm);
   }
 
   GainModel initial_;
