@@ -19,6 +19,7 @@
 #include <span>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <utility>
 #include <variant>
@@ -713,6 +714,18 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
     CHECK(rule_of(DecisionModel::load(tmp.path() / "corrected.yaml")).curve == source);
   }
   p.curve = CurveSource::corrected;
+  // A copy of model file `from` with the rest of the line from the first `marker` on replaced by
+  // `replacement`, written to `to`.
+  const auto edited = [&](const char* from, std::string_view marker, std::string_view replacement, const char* to) {
+    std::stringstream in;
+    in << std::ifstream(tmp.path() / from).rdbuf();
+    std::string content = in.str();
+    const auto pos = content.find(marker);
+    REQUIRE(pos != std::string::npos);
+    content.replace(pos, content.find('\n', pos) - pos, replacement);
+    std::ofstream(tmp.path() / to) << content;
+    return tmp.path() / to;
+  };
   // So is the top-level rule (files without the key: undominated); a name it does not know is refused.
   CHECK(rule_of(back).top_level == TopLevelChoice::undominated);
   // So are the gain ratios (files without the keys: none); lists of two lengths are refused.
@@ -726,18 +739,10 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
   CHECK(read_back[0].ratio == 0.5);
   CHECK(read_back[1].gsd_cm == 2.0);
   CHECK(read_back[1].ratio == 1.25);
-  {
-    std::stringstream ratios_text;
-    ratios_text << std::ifstream(tmp.path() / "ratios.yaml").rdbuf();
-    std::string uneven = ratios_text.str();
-    const auto ratio_at = uneven.find("  gain_ratio: [0.5, 1.25]");
-    REQUIRE(ratio_at != std::string::npos);
-    uneven.replace(ratio_at, 25, "  gain_ratio: [0.5]");
-    std::ofstream(tmp.path() / "uneven.yaml") << uneven;
-    CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "uneven.yaml"),
-                         doctest::Contains("'rule.gain_ratio' needs as many values as 'rule.gain_ratio_gsd_cm'"),
-                         std::invalid_argument);
-  }
+  CHECK_THROWS_WITH_AS((void)DecisionModel::load(
+                           edited("ratios.yaml", "  gain_ratio: [0.5, 1.25]", "  gain_ratio: [0.5]", "uneven.yaml")),
+                       doctest::Contains("'rule.gain_ratio' needs as many values as 'rule.gain_ratio_gsd_cm'"),
+                       std::invalid_argument);
   p.gain_ratios.clear();
   // So are the margin biases (files without the keys: none); lists of two lengths are refused.
   CHECK(rule_of(back).margin_biases.empty());
@@ -750,32 +755,26 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
   CHECK(biases_back[0].per_s == -0.0005);
   CHECK(biases_back[1].gsd_cm == 2.0);
   CHECK(biases_back[1].per_s == 0.00025);
-  {
-    std::stringstream biases_text;
-    biases_text << std::ifstream(tmp.path() / "biases.yaml").rdbuf();
-    std::string uneven = biases_text.str();
-    const auto line_at = uneven.find("  margin_bias_per_s: [");
-    REQUIRE(line_at != std::string::npos);
-    uneven.replace(line_at, uneven.find('\n', line_at) - line_at, "  margin_bias_per_s: [-0.0005]");
-    std::ofstream(tmp.path() / "uneven_biases.yaml") << uneven;
-    CHECK_THROWS_WITH_AS(
-        (void)DecisionModel::load(tmp.path() / "uneven_biases.yaml"),
-        doctest::Contains("'rule.margin_bias_per_s' needs as many values as 'rule.margin_bias_gsd_cm'"),
-        std::invalid_argument);
-  }
+  CHECK_THROWS_WITH_AS((void)DecisionModel::load(edited("biases.yaml", "  margin_bias_per_s: [",
+                                                        "  margin_bias_per_s: [-0.0005]", "uneven_biases.yaml")),
+                       doctest::Contains("'rule.margin_bias_per_s' needs as many values as 'rule.margin_bias_gsd_cm'"),
+                       std::invalid_argument);
   p.margin_biases.clear();
+  // The curve agreement: kept (files without the key: 0, no check); outside [0, 1] refused.
+  CHECK(rule_of(back).curve_agreement == 0.0);
+  p.curve_agreement = 0.75;
+  policy.set_params(p);
+  corrected.save(tmp.path() / "agreement.yaml");
+  CHECK(rule_of(DecisionModel::load(tmp.path() / "agreement.yaml")).curve_agreement == 0.75);
+  CHECK_THROWS_WITH_AS((void)DecisionModel::load(edited("agreement.yaml", "curve_agreement: 0.75",
+                                                        "curve_agreement: 1.5", "wrong_agreement.yaml")),
+                       doctest::Contains("curve_agreement must be in [0, 1]"), std::invalid_argument);
+  p.curve_agreement = 0.0;
   p.top_level = TopLevelChoice::hull;
   policy.set_params(p);
   corrected.save(tmp.path() / "hull.yaml");
   CHECK(rule_of(DecisionModel::load(tmp.path() / "hull.yaml")).top_level == TopLevelChoice::hull);
-  std::stringstream hull_text;
-  hull_text << std::ifstream(tmp.path() / "hull.yaml").rdbuf();
-  std::string bad = hull_text.str();
-  const auto hull_at = bad.find("top_level: hull");
-  REQUIRE(hull_at != std::string::npos);
-  bad.replace(hull_at, 15, "top_level: hul");
-  std::ofstream(tmp.path() / "bad.yaml") << bad;
-  CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "bad.yaml"),
+  CHECK_THROWS_WITH_AS((void)DecisionModel::load(edited("hull.yaml", "top_level: hull", "top_level: hul", "bad.yaml")),
                        doctest::Contains("'rule.top_level' must be undominated or hull (got 'hul')"),
                        std::invalid_argument);
   // Fields of another class set are refused.

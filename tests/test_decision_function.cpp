@@ -501,6 +501,28 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     CHECK_THROWS_WITH_AS(FrontAwarePolicy(with_cells(1.0), reference, {.margin_biases = {{-1.0, 0.0}}}),
                          doctest::Contains("margin_biases: a GSD must be finite and > 0"), std::invalid_argument);
   }
+  SUBCASE("the curve agreement: no descent to a GSD whose lawnmower lost on too many training fields") {
+    // β = 4 descends to 1 cm/px against field a, whose lawnmower at 1 cm/px beat its 3 cm/px one.
+    CHECK(finer_lawnmower_share(reference, 3.0, 1.0) == 1.0);
+    FrontAwarePolicy sure(with_cells(4.0), reference, {.curve_agreement = 1.0});
+    CHECK(sure.decide(s.region(0, 0.1)).descend);
+    // Field b lost at 1 cm/px (its curve flat after the top level: the same forecast still beats
+    // the mean rise); half the fields gained.
+    std::vector<ReferenceCurve> two = reference;
+    two.push_back({"b", {{1.0, 0.70}, {3.0, 0.75}}, 0.2, 0.05});
+    CHECK(finer_lawnmower_share(two, 3.0, 1.0) == 0.5);
+    CHECK(finer_lawnmower_share({}, 3.0, 1.0) == 0.0);
+    for (const double q : {0.0, 0.5}) {
+      FrontAwarePolicy p(with_cells(4.0), two, {.curve_agreement = q});
+      CHECK(p.decide(s.region(0, 0.1)).descend);
+    }
+    FrontAwarePolicy strict(with_cells(4.0), two, {.curve_agreement = 0.75});
+    const Decision d = strict.decide(s.region(0, 0.1));
+    CHECK_FALSE(d.descend);
+    CHECK(d.scores.size() == 2);  // still assessed, and reported
+    CHECK_THROWS_WITH_AS(FrontAwarePolicy(with_cells(1.0), reference, {.curve_agreement = 1.5}),
+                         doctest::Contains("curve_agreement must be in [0, 1]"), std::invalid_argument);
+  }
   SUBCASE("against the field's own predicted curve, the forecasts' scale cancels") {
     // The training curve rises by 0.2 mIoU over 145 s: against it, a descent of twice the cells'
     // gain looks better than one of half of it. Against the curve the same model predicts for

@@ -245,6 +245,7 @@ struct CalibrationCli {
   std::vector<std::string> top_levels{"undominated"};
   bool gain_ratios = false;
   bool margin_biases = false;
+  double curve_agreement = 0.0;
 
   void add_to(CLI::App& app) {
     options_ = {
@@ -314,6 +315,12 @@ struct CalibrationCli {
                      "descents to its GSD ended above theirs per second when the training fields were flown "
                      "with the model of the others (gain and lawnmower curve both; measured before the search; "
                      "saved in the model)"),
+        app.add_option("--curve-agreement", curve_agreement,
+                       "front-aware rule: descend to a GSD only where the lawnmower at it mapped better than the "
+                       "top level's on at least this share of the training fields (0: no such check; saved in "
+                       "the model)")
+            ->check(CLI::Range(0.0, 1.0))
+            ->capture_default_str(),
         app.add_option("--sigma-prior", sigma_prior,
                        "front-aware rule with several training fields: the prior of the field's share of L "
                        "(sigma-hat): given (weight 0.25 fields, no spread), spread (its spread over the training "
@@ -345,6 +352,7 @@ struct CalibrationCli {
     options.front_aware.curve = parse_curve_source(curve);
     options.gain_ratios = gain_ratios;
     options.margin_biases = margin_biases;
+    options.front_aware.curve_agreement = curve_agreement;
     options.top_levels.clear();
     for (const auto& name : top_levels) options.top_levels.push_back(parse_top_level_choice(name));
     options.cell_inputs.clear();

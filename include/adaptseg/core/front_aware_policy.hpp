@@ -59,6 +59,9 @@ namespace adaptseg {
 ///   them). The UAV descends
 ///   to the candidate of largest lower bound, if σ >= `min_sigma`. Since ΔD̄ grows with T0, it
 ///   descends while descents beat flying lower everywhere, and stops when they no longer do.
+///   With `curve_agreement` q > 0, only to a GSD g whose lawnmower mapped better than the top
+///   level's on at least a share q of the training fields (finer_lawnmower_share(): where
+///   flying finer lost on the fields, the cells' forecast of a gain is not trusted).
 ///
 /// Field correction (`online`; beyond the paper, §3.2.3's idea applied to what is observable):
 /// a descent's relabelled share χ (Relabelling::interest_share, the region's field pixels whose
@@ -70,8 +73,7 @@ namespace adaptseg {
 /// ĝ and the UAV stops earlier; descents that change more raise it; each observation narrows
 /// Var(s), so the lower bound rises as evidence accrues. Also the paper's update of O.
 /// `online = false` (non-adaptive) keeps s = 1, Var(s) = ω² and O as initialised. The rule
-/// needs C or a cell gain model (every calibrated model has C; models of adaptseg 0.1, which
-/// forecast the gain from I alone, are no longer read since 0.2.0).
+/// needs C or a cell gain model (every calibrated model has C).
 class FrontAwarePolicy {
  public:
   /// Behaviour; validated by the constructor.
@@ -82,20 +84,19 @@ class FrontAwarePolicy {
     double scale_prior_sd = 0.5;       ///< ω > 0, prior spread of the field factor s
     double sigma_prior_weight = 0.25;  ///< k > 0: weight of the training fields' σ in σ̂ [fields]
     double sigma_prior_sd = 0.0;       ///< τ >= 0: spread of a field's σ about the training fields' mean
+    double curve_agreement = 0.0;      ///< q in [0, 1]: see class comment; 0: no such check
     /// The lawnmower curve a descent is compared with (CurveSource; `corrected` is the
     /// programs' default, this struct's the training fields' curves).
     CurveSource curve = CurveSource::training;
     /// How top_gsd() chooses the top level (TopLevelChoice).
     TopLevelChoice top_level = TopLevelChoice::undominated;
-    /// Per descent GSD, the factor on a candidate's forecast field gain (its mean and its
-    /// spread): what the training fields, each flown with a model that never saw it, realised
-    /// of what descents to that GSD were forecast to gain (calibrate() with
-    /// CalibrationOptions::gain_ratios). A GSD not listed: 1. Empty (the default): none.
+    /// Per descent GSD, the factor on a candidate's forecast field gain (mean and spread): what
+    /// descents to it realised of their forecast on the training fields, each flown with a model
+    /// that never saw it (CalibrationOptions::gain_ratios). Not listed: 1. Empty: none.
     std::vector<GainRatio> gain_ratios{};
-    /// Per descent GSD, b: what descents to it ended above their forecast margin per second of
-    /// their extra time on the training fields, each flown with a model that never saw it
-    /// (calibrate() with CalibrationOptions::margin_biases); b·T is added to a candidate's
-    /// margin (ĝ − ΔD̄), its spread unchanged. A GSD not listed: 0. Empty (the default): none.
+    /// Per descent GSD, b: what descents to it ended above their forecast margin per second on
+    /// the training fields flown so (CalibrationOptions::margin_biases); b·T is added to a
+    /// candidate's margin (ĝ − ΔD̄), its spread unchanged. Not listed: 0. Empty: none.
     std::vector<MarginBias> margin_biases{};
 
     /// @throws std::invalid_argument naming the field.
@@ -110,6 +111,8 @@ class FrontAwarePolicy {
                       "FrontAwarePolicy::Params::sigma_prior_weight must be finite and > 0", sigma_prior_weight);
       detail::require(std::isfinite(sigma_prior_sd) && sigma_prior_sd >= 0.0 && sigma_prior_sd <= 1.0,
                       "FrontAwarePolicy::Params::sigma_prior_sd must be in [0, 1]", sigma_prior_sd);
+      detail::require(std::isfinite(curve_agreement) && curve_agreement >= 0.0 && curve_agreement <= 1.0,
+                      "FrontAwarePolicy::Params::curve_agreement must be in [0, 1]", curve_agreement);
       for (const GainRatio& r : gain_ratios) r.validate();
       for (const MarginBias& b : margin_biases) b.validate();
     }
@@ -156,8 +159,7 @@ class FrontAwarePolicy {
 
   [[nodiscard]] std::string name() const { return params_.online ? "adaptive" : "nonadaptive"; }
   [[nodiscard]] const Params& params() const noexcept { return params_; }
-  /// The prior spread of the field factor s (`scale_prior_sd`) takes effect at the next
-  /// begin_mission().
+  /// The prior spread of s (`scale_prior_sd`) takes effect at the next begin_mission().
   /// @throws std::invalid_argument for invalid params.
   void set_params(const Params& p) {
     p.validate();
@@ -194,7 +196,7 @@ class FrontAwarePolicy {
     std::vector<Assessment> assessed;
     for (std::size_t k = 0; k < c.candidates.size(); ++k) {
       assessed.push_back(assess(c, c.candidates[k], curves, weight, sigma_cv2));
-      if (assessed.back().gain > 0.0 && assessed.back().lower > best) {
+      if (assessed.back().gain > 0.0 && assessed.back().lower > best && agreed(c.top_gsd_cm, c.candidates[k].gsd_cm)) {
         best = assessed.back().lower;
         best_index = k;
       }
@@ -378,6 +380,11 @@ class FrontAwarePolicy {
     a.score.predicted_end_s = p.t0 + cand.extra_time_s;
     a.relabelled = b.relabelled;
     return a;
+  }
+
+  /// Whether a descent to `gsd` may be taken from top level `top` (Params::curve_agreement).
+  [[nodiscard]] bool agreed(double top, double gsd) const {
+    return params_.curve_agreement <= 0.0 || finer_lawnmower_share(reference_, top, gsd) >= params_.curve_agreement;
   }
 
   /// A forecast gain `base` before the field factor s, times s (FieldScale::scaled).

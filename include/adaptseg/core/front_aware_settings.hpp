@@ -12,6 +12,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -168,6 +170,15 @@ struct ReferenceCurve {
   if (!(predicted > 0.0)) return 1.0;
   const double real = miou_at_gsd(r.points, g) - miou_at_gsd(r.points, top);
   return std::clamp(real / predicted, 0.25, 4.0);
+}
+
+/// The share of the training fields in `reference` whose lawnmower at GSD `g` mapped better than
+/// theirs at the top level `top` (FrontAwarePolicy::Params `curve_agreement`); 0 without any.
+[[nodiscard]] inline double finer_lawnmower_share(std::span<const ReferenceCurve> reference, double top, double g) {
+  std::size_t finer = 0;
+  for (const auto& r : reference)
+    if (miou_at_gsd(r.points, g) > miou_at_gsd(r.points, top)) ++finer;
+  return reference.empty() ? 0.0 : static_cast<double>(finer) / static_cast<double>(reference.size());
 }
 
 }  // namespace adaptseg

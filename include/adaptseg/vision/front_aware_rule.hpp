@@ -47,6 +47,7 @@ struct FrontAwareRule {
     if (p.curve == CurveSource::corrected) e << YAML::Key << "curve_ratio" << YAML::Value << detail::flag_text(true);
     if (p.top_level != TopLevelChoice::undominated)
       e << YAML::Key << "top_level" << YAML::Value << to_string(p.top_level);
+    if (p.curve_agreement > 0.0) e << YAML::Key << "curve_agreement" << YAML::Value << num(p.curve_agreement);
     std::vector<std::pair<double, double>> ratios, biases;
     for (const GainRatio& x : p.gain_ratios) ratios.emplace_back(x.gsd_cm, x.ratio);
     for (const MarginBias& x : p.margin_biases) biases.emplace_back(x.gsd_cm, x.per_s);
@@ -112,6 +113,7 @@ struct FrontAwareRule {
                              .scale_prior_sd = rule.number("scale_prior_sd"),
                              .sigma_prior_weight = rule.number("sigma_prior_weight"),
                              .sigma_prior_sd = rule.has("sigma_prior_sd") ? rule.number("sigma_prior_sd") : 0.0,
+                             .curve_agreement = rule.has("curve_agreement") ? rule.number("curve_agreement") : 0.0,
                              .curve = read_curve(rule),
                              .top_level = rule.has("top_level") ? read_top_level(rule) : TopLevelChoice::undominated,
                              .gain_ratios = read_gain_ratios(rule),
