@@ -168,6 +168,8 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (field_spec.empty()) throw std::invalid_argument("--field is required (the validation field to fit on)");
+    if (at && write)
+      throw std::invalid_argument("--at evaluates a given temperature; it cannot be combined with --write");
     const Field field = adaptseg::examples::load_field_spec(field_spec);
     adaptseg::examples::check_gsd_factors(bands, "--bands");
     const MissionOptions mo = common.resolve(field);
@@ -205,8 +207,6 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "band %.2f cm/px: %zu images, %zu pixels\n", f * field.gsd_cm(), plan.size(), px.size());
       per_band.push_back(std::move(px));
     }
-    if (at && write)
-      throw std::invalid_argument("--at evaluates a given temperature; it cannot be combined with --write");
     // T: the best of a logarithmic grid over [0.25, 8], refined by golden section.
     double best = 1.0, best_nll = nll(per_band, 1.0);
     for (double t = 0.25; !at && t <= 8.0001; t *= 1.1) {
