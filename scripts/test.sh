@@ -24,7 +24,7 @@ cmake --build build/release -j"$jobs"
 # (mavlink:*) in the sanitized phase below, with the same code built with the sanitizers; here
 # what builds or runs nothing sanitized (the package, doxygen, the snippets, the header-alone
 # check, lint, the Python tools, docs:commands, which runs the Release programs on the CLI tests'
-# paths). Run here too, the others cost this phase about 460 s of its 730 s of test time (2-core
+# paths). Run here too, the others cost this phase about 490 s of its 730 s of test time (2-core
 # VM). `ctest` in a build folder still runs every test.
 ctest --test-dir build/release --output-on-failure --no-tests=error -j"$jobs" \
   --exclude-regex '^(test_[a-z_]+|cli|mavlink):'
