@@ -150,7 +150,10 @@ int main(int argc, char** argv) {
     if (!cal.cell_input_scores.empty()) {
       std::printf(
           "decision inputs tried for ranking the cells (share of the achievable gain the best 20 %% of the "
-          "training fields' cells capture), the chosen one first:\n");
+          "training fields' cells capture%s), the chosen one first:\n",
+          options.cell_input_score == adaptseg::CellInputScore::transfer
+              ? ", where the model fitted on the other fields forecasts a gain"
+              : "");
       for (const auto& [input, score] : cal.cell_input_scores)
         std::printf("  %-16s %+.3f\n", adaptseg::to_string(input).c_str(), score);
       std::printf("%zu cell samples\n", cal.cell_samples.size());

@@ -1,4 +1,5 @@
 #include <adaptseg/core/cell_gain_model.hpp>
+#include <adaptseg/core/cell_input_scores.hpp>
 
 #include <doctest/doctest.h>
 
@@ -101,6 +102,43 @@ TEST_CASE("cell gain model: an input is scored by how much of each field's gain 
   CHECK(best == doctest::Approx(19.0 / 55.0));
   CHECK(worst == doctest::Approx(3.0 / 55.0));
   CHECK(std::isnan(cell_ranking_capture({}, DecisionInput::sigma)));
+}
+
+TEST_CASE(
+    "cell gain model: the transfer score counts a field's capture only where the others' slope forecasts a gain") {
+  // Fields 0 and 1: the gain grows with the input (captured 19 / 55 each, as above). Field 2: the
+  // input is ten times larger, its five largest cells lose 0.5 x, the others gain 0.05: its best
+  // 20 % capture (-0.5 - 0.45) / (5 * 0.05) = -3.8 of its achievable gain, and with it among the
+  // training fields the pooled slope is negative (it holds nearly all of Σ w x²).
+  const auto fields = [](bool losing) {
+    std::vector<CellSample> s;
+    for (std::size_t f = 0; f < 3; ++f)
+      for (int k = 0; k < 10; ++k) {
+        const bool loses = losing && f == 2;
+        const double x = (loses ? 0.1 : 0.01) * (k + 1);
+        const double nu = !loses ? 0.9 * x : k < 5 ? 0.05 : -0.5 * x;
+        s.push_back(cell(f, 15.0, 5.0, x, 1000.0, nu, 0.0));
+      }
+    return s;
+  };
+  const std::vector<CellSample> agree = fields(false), lose = fields(true);
+  const DecisionInput e = DecisionInput::expected_error;
+  // Where every field's slope is positive, the two scores are one.
+  CHECK(cell_transfer_capture(agree, e) == doctest::Approx(19.0 / 55.0));
+  CHECK(cell_transfer_capture(agree, e) == doctest::Approx(cell_ranking_capture(agree, e)));
+  // Fields 0 and 1 left out: the model of the others (with field 2) forecasts a loss, they count 0;
+  // field 2 left out: fields 0 and 1 forecast a gain, it counts its -3.8.
+  CHECK(cell_ranking_capture(lose, e) == doctest::Approx((2.0 * 19.0 / 55.0 - 3.8) / 3.0));
+  CHECK(cell_transfer_capture(lose, e) == doctest::Approx(-3.8 / 3.0));
+  CHECK(cell_input_score(CellInputScore::transfer, lose, e) == cell_transfer_capture(lose, e));
+  CHECK(cell_input_score(CellInputScore::ranking, lose, e) == cell_ranking_capture(lose, e));
+  // One field: no other to fit on, the ranking score.
+  const std::vector<CellSample> one(lose.begin() + 20, lose.end());
+  CHECK(cell_transfer_capture(one, e) == doctest::Approx(-3.8));
+  CHECK(std::isnan(cell_transfer_capture({}, e)));
+  CHECK(parse_cell_input_score("transfer") == CellInputScore::transfer);
+  CHECK(to_string(CellInputScore::ranking) == "ranking");
+  CHECK_THROWS_AS((void)parse_cell_input_score("capture"), std::invalid_argument);
 }
 
 TEST_CASE("cell gain model: the scene check's proxy slope, and how far it differs between the training fields") {

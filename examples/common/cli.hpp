@@ -240,6 +240,7 @@ struct CalibrationCli {
   std::string sigma_prior = to_string(CalibrationOptions::kDefaultSigmaPrior);
   std::optional<double> segmentation_time_s;
   std::vector<std::string> cell_inputs;
+  std::string cell_input_score = to_string(CellInputScore::ranking);
   std::vector<std::string> slope_poolings{"cells", "fields"};
   std::string curve = to_string(CurveSource::corrected);  // the programs' default, not the struct's
   std::vector<std::string> top_levels{"undominated"};
@@ -269,6 +270,12 @@ struct CalibrationCli {
                        "the one that ranks the training fields' cells best is saved in the model)")
             ->delimiter(',')
             ->check(CLI::IsMember(detail::names_of(kDecisionInputs))),
+        app.add_option("--cell-input-score", cell_input_score,
+                       "coverage ranked: how the input is chosen, by the share of each training field's achievable "
+                       "gain its best cells capture (ranking), or the same counted only where the cell gain model "
+                       "fitted on the other training fields forecasts a gain (transfer)")
+            ->check(CLI::IsMember(detail::names_of(kCellInputScores)))
+            ->capture_default_str(),
         app.add_option("--slope-pooling", slope_poolings,
                        "coverage ranked, several training fields: how the cell gain model's slopes may pool the "
                        "fields, tried with every confidence level on the training fields, comma-separated: cells "
@@ -357,6 +364,7 @@ struct CalibrationCli {
     for (const auto& name : top_levels) options.top_levels.push_back(parse_top_level_choice(name));
     options.cell_inputs.clear();
     for (const auto& name : cell_inputs) options.cell_inputs.push_back(parse_decision_input(name));
+    options.cell_input_score = parse_cell_input_score(cell_input_score);
     options.slope_poolings.clear();
     for (const auto& name : slope_poolings) options.slope_poolings.push_back(parse_slope_pooling(name));
     options.fit.gain_inputs = gain_inputs == "delta-sigma-height" ? GainModel::GainInputs::delta_sigma_and_height

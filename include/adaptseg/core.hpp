@@ -8,6 +8,7 @@
 #include <adaptseg/core/camera.hpp>
 #include <adaptseg/core/camera_presets.hpp>
 #include <adaptseg/core/cell_gain_model.hpp>
+#include <adaptseg/core/cell_input_scores.hpp>
 #include <adaptseg/core/decision.hpp>
 #include <adaptseg/core/decision_function.hpp>
 #include <adaptseg/core/decision_inputs.hpp>

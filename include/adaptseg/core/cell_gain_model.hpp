@@ -2,8 +2,8 @@
 /// @file
 /// What re-mapping chosen cells of a region gains, forecast from one decision input of the
 /// top-level image (beyond the paper; docs/method.md, "Cells that pay"): the cell gain model,
-/// fitted to calibration samples of single cells re-mapped alone, and the score its input is
-/// chosen by on the training fields.
+/// fitted to calibration samples of single cells re-mapped alone (the scores its input is chosen
+/// by on the training fields: cell_input_scores.hpp).
 
 #include <adaptseg/core/decision_inputs.hpp>
 #include <adaptseg/core/detail/gsd.hpp>
@@ -16,13 +16,10 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <limits>
-#include <numeric>
 #include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
-#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -415,39 +412,5 @@ class CellGainModel {
   SlopePooling pooling_ = SlopePooling::cells;
   std::vector<Point> points_;
 };
-
-/// How well an input ranks the cells of the training fields by what re-mapping them gains:
-/// on each field and pair of top-level and candidate GSD in turn, the share of the achievable positive field gain
-/// (Σ max(gain, 0)) that re-mapping the `share` of cells with the most input mass
-/// (CellInputs::mass) captures; the mean over the (field, GSD) pairs with a positive
-/// achievable gain. No fitting is involved (the cell gain model only rescales the ranking), so
-/// each field is scored without the others: a leave-one-field-out score. NaN without such a pair.
-[[nodiscard]] inline double cell_ranking_capture(std::span<const CellSample> samples, DecisionInput input,
-                                                 double share = 0.2) {
-  std::vector<std::tuple<std::size_t, double, double>> groups;  // (field, top GSD, GSD)
-  for (const CellSample& s : samples)
-    if (std::find(groups.begin(), groups.end(), std::tuple{s.field, s.top_gsd_cm, s.sub_gsd_cm}) == groups.end())
-      groups.emplace_back(s.field, s.top_gsd_cm, s.sub_gsd_cm);
-  double sum = 0.0;
-  int count = 0;
-  for (const auto& [field, top, gsd] : groups) {
-    std::vector<const CellSample*> cells;
-    double positive = 0.0;
-    for (const CellSample& s : samples)
-      if (s.field == field && s.top_gsd_cm == top && s.sub_gsd_cm == gsd) {
-        cells.push_back(&s);
-        positive += std::max(0.0, s.field_gain);
-      }
-    if (!(positive > 0.0)) continue;
-    std::stable_sort(cells.begin(), cells.end(),
-                     [&](const CellSample* a, const CellSample* b) { return a->top.mass(input) > b->top.mass(input); });
-    const auto n = static_cast<std::size_t>(std::lround(share * static_cast<double>(cells.size())));
-    double captured = 0.0;
-    for (std::size_t k = 0; k < n; ++k) captured += cells[k]->field_gain;
-    sum += captured / positive;
-    ++count;
-  }
-  return count > 0 ? sum / count : std::numeric_limits<double>::quiet_NaN();
-}
 
 }  // namespace adaptseg

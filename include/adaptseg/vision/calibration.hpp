@@ -5,6 +5,7 @@
 /// C samples, fit the gain model, and choose the decision rule's settings on the training
 /// fields only, by the front margin over each field's own lawnmower curve.
 
+#include <adaptseg/core/cell_input_scores.hpp>
 #include <adaptseg/core/decision_function.hpp>
 #include <adaptseg/core/detail/gsd.hpp>
 #include <adaptseg/core/linear_decision.hpp>
@@ -91,11 +92,12 @@ namespace detail {
 }
 
 /// The decision inputs `tried` (empty: the inputs about L) that the pooled training cells know,
-/// each with the share of the achievable gain its ranking captures (cell_ranking_capture), best
-/// first; ties keep the order tried, an input without a score comes last.
+/// each with its `score` (cell_input_score(): the share of the achievable gain its ranking
+/// captures), best first; ties keep the order tried, an input without a score comes last.
 /// @throws std::invalid_argument for no cell, or no input the backend gives.
 [[nodiscard]] inline std::vector<std::pair<DecisionInput, double>> score_cell_inputs(
-    const std::vector<CellSample>& cells, std::vector<DecisionInput> tried, const std::string& field) {
+    const std::vector<CellSample>& cells, std::vector<DecisionInput> tried, CellInputScore score,
+    const std::string& field) {
   require(!cells.empty(), "calibrate: the training fields gave no cell sample", field);
   if (tried.empty())
     tried = {DecisionInput::sigma, DecisionInput::boundary, DecisionInput::ambiguity, DecisionInput::expected_error,
@@ -106,13 +108,13 @@ namespace detail {
     // on every cell.
     const bool known =
         std::any_of(cells.begin(), cells.end(), [&](const CellSample& c) { return std::isfinite(c.top.value(i)); });
-    if (known) scores.emplace_back(i, cell_ranking_capture(cells, i));
+    if (known) scores.emplace_back(i, cell_input_score(score, cells, i));
   }
   require(!scores.empty(), "calibrate: no decision input to rank the cells by is known from this backend; inputs tried",
           tried.size());
-  const auto score = [](double v) { return std::isnan(v) ? -std::numeric_limits<double>::infinity() : v; };
+  const auto value = [](double v) { return std::isnan(v) ? -std::numeric_limits<double>::infinity() : v; };
   std::stable_sort(scores.begin(), scores.end(),
-                   [&](const auto& a, const auto& b) { return score(a.second) > score(b.second); });
+                   [&](const auto& a, const auto& b) { return value(a.second) > value(b.second); });
   return scores;
 }
 
@@ -215,7 +217,8 @@ template <SegmentationBackend Backend>
   // A coverage that ranks cells: the input that ranks the training fields' cells best.
   std::vector<std::pair<DecisionInput, double>> input_scores;
   if (ranked) {
-    input_scores = detail::score_cell_inputs(cell_samples, options.cell_inputs, fields.front().name());
+    input_scores =
+        detail::score_cell_inputs(cell_samples, options.cell_inputs, options.cell_input_score, fields.front().name());
     adaptive.cell_input = input_scores.front().first;
   }
   // The backend of a field the rule search flies: its own, or the single field's for its halves.

@@ -6,6 +6,7 @@
 /// (front_aware_rule.hpp, utility_rule.hpp).
 
 #include <adaptseg/core/cell_gain_model.hpp>
+#include <adaptseg/core/cell_input_scores.hpp>
 #include <adaptseg/core/decision_function.hpp>
 #include <adaptseg/core/detail/named_rows.hpp>
 #include <adaptseg/core/lawnmower_curve.hpp>
@@ -51,13 +52,16 @@ struct CalibrationOptions {
     return g;
   }
   /// DescentCoverage::ranked (`adaptive.coverage`): the decision inputs the cells may be ranked
-  /// and forecast by; the one whose ranking captures most of the training fields' achievable
-  /// gain is chosen (cell_ranking_capture(), each field scored on its own) and set as
-  /// `adaptive.cell_input`; those the backend does not give (probabilities from a labels-only
-  /// backend) are left out. Empty: the inputs about L (sigma, boundary, ambiguity,
+  /// and forecast by; the one of best `cell_input_score` on the training fields is chosen and
+  /// set as `adaptive.cell_input`; those the backend does not give (probabilities from a
+  /// labels-only backend) are left out. Empty: the inputs about L (sigma, boundary, ambiguity,
   /// expected_error, second_choice); the generic ones, blind to which errors matter for L, are
   /// tried only when named.
   std::vector<DecisionInput> cell_inputs{};
+  /// How the input is scored (CellInputScore): `ranking` (the default), how much of each
+  /// training field's achievable gain its best cells capture (cell_ranking_capture()); `transfer`,
+  /// the same where the model fitted without the field forecasts a gain (cell_transfer_capture()).
+  CellInputScore cell_input_score = CellInputScore::ranking;
   /// DescentCoverage::ranked: other top-level GSDs the cell gain model is calibrated for, so
   /// that a mission may fly its top level at one of them where the predicted lawnmower curve
   /// shows the model's top lawnmower dominated by a faster one on the field flown
