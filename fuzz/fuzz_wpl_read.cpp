@@ -2,7 +2,7 @@
 
 #include "fuzz_support.hpp"
 
-#include <adaptseg/geo/mission_export.hpp>
+#include <adaptseg/geo/wpl.hpp>
 
 #include <cstddef>
 #include <cstdint>

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Text helpers of the mission-file readers and writers (mission_export.hpp): errors that name
+/// Text helpers of the mission-file readers and writers (qgc_plan.hpp, wpl.hpp, geojson.hpp): errors that name
 /// the format and the offending member, JSON member access with those errors, and the WPL
 /// number reader (numbers are written by number_text.hpp's codec). Internal.
 
