@@ -4,7 +4,7 @@
 # on the left half, every strategy flown over the right half). Results and figures: out/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/deps.sh plots
+bash scripts/deps.sh demo
 source scripts/configure.sh
 configure_for demo build/release
 # Only the program the demo runs (the others: cmake --build build/release, docs/quickstart.md).

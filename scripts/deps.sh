@@ -9,8 +9,13 @@
 #   scripts/deps.sh bench   test + what the benchmarks compare against (scikit-learn, with
 #                           OpenBLAS as well as the reference BLAS)
 #   scripts/deps.sh plots   build + matplotlib for the evaluation figures
+#   scripts/deps.sh demo    what scripts/demo.sh builds and runs, and no more: the example
+#                           programs' libraries with OpenCV's four modules as their own packages
+#                           (no libopencv-dev, which brings every module; no GDAL), and matplotlib
 #   scripts/deps.sh fuzz    build + clang with libFuzzer (scripts/fuzz.sh)
 # As root it runs apt-get; otherwise it prints the command to run and fails if anything is missing.
+#   scripts/deps.sh SET --list   prints the set's packages, one per line, and installs nothing
+#                                (scripts/apt_footprint.sh counts what they bring on a bare system)
 set -euo pipefail
 
 # libopencv-dev: the only package that ships OpenCV's CMake config (OpenCVConfig.cmake).
@@ -19,16 +24,26 @@ set -euo pipefail
 build=(cmake g++ make pkg-config libeigen3-dev libopencv-dev doctest-dev liblbfgspp-dev
        libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libgeographiclib-dev libgdal-dev)
 python=(python3 python3-numpy python3-opencv python3-yaml python3-pil)
+# The demo: OpenCV's modules found without its CMake config (cmake/adaptsegFindOpenCV.cmake).
+demo=(cmake g++ make libeigen3-dev liblbfgspp-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
+      libgeographiclib-dev libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-dnn-dev
+      python3 python3-matplotlib)
 case "${1:-build}" in
   build) want=("${build[@]}") ;;
   test) want=("${build[@]}" "${python[@]}" gdal-bin doxygen pyflakes3 clang-format-14 clang-tidy-14) ;;
   docs) want=(doxygen) ;;
   bench) want=("${build[@]}" "${python[@]}" gdal-bin doxygen python3-sklearn python3-torch libopenblas0-pthread) ;;
   plots) want=("${build[@]}" "${python[@]}" python3-matplotlib) ;;
+  demo) want=("${demo[@]}") ;;
   # clang: the compiler; libclang-rt-14-dev: libFuzzer and the sanitizer runtimes for it.
   fuzz) want=("${build[@]}" clang libclang-rt-14-dev) ;;
-  *) echo "usage: $0 [build|test|docs|bench|plots|fuzz]" >&2; exit 2 ;;
+  *) echo "usage: $0 [build|test|docs|bench|plots|demo|fuzz]" >&2; exit 2 ;;
 esac
+
+if [ "${2:-}" = --list ]; then
+  printf '%s\n' "${want[@]}"
+  exit 0
+fi
 
 missing=()
 for p in "${want[@]}"; do

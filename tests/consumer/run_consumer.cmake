@@ -1,6 +1,8 @@
 # Installs the build tree into a scratch prefix, then configures, builds and runs the consumer
 # projects against it. Called by CTest with BUILD_DIR, SOURCE_DIR and WORK_DIR.
 #   - SOURCE_DIR: every component (vision, erfnet, geo; gdal where installed) asked for and used;
+#   - SOURCE_DIR again with OpenCV's CMake config replaced by one that finds nothing (the modules
+#     found by cmake/adaptsegFindOpenCV.cmake), the network component built and run;
 #   - SOURCE_DIR/core: the core alone with OpenCV, yaml-cpp, nlohmann_json and GeographicLib
 #     hidden (a GP fitted); asking for vision there must fail, naming OpenCV.
 
@@ -26,6 +28,19 @@ endif()
 foreach(exe IN LISTS exes)
   step("${exe}" "${WORK_DIR}/build/${exe}")
 endforeach()
+
+# Without OpenCV's CMake config (Debian's libopencv-core-dev, ... ship none; scripts/deps.sh demo
+# installs those): the package finds the modules by their headers and libraries.
+step("configuring the consumer without OpenCV's config" "${CMAKE_COMMAND}" -S "${SOURCE_DIR}"
+     -B "${WORK_DIR}/no-opencv-config" ${prefix} -DCMAKE_BUILD_TYPE=Release
+     "-DOpenCV_DIR=${SOURCE_DIR}/without_opencv_config")
+file(STRINGS "${WORK_DIR}/no-opencv-config/CMakeCache.txt" include_dir REGEX "^ADAPTSEG_OPENCV_INCLUDE_DIR:")
+if(NOT include_dir MATCHES "opencv4$")
+  message(FATAL_ERROR "without OpenCV's config the package did not find its headers itself: '${include_dir}'")
+endif()
+step("building the consumer without OpenCV's config" "${CMAKE_COMMAND}" --build "${WORK_DIR}/no-opencv-config"
+     --target consumer_erfnet)
+step("consumer_erfnet without OpenCV's config" "${WORK_DIR}/no-opencv-config/consumer_erfnet")
 
 set(hidden -DCMAKE_DISABLE_FIND_PACKAGE_OpenCV=ON -DCMAKE_DISABLE_FIND_PACKAGE_yaml-cpp=ON
            -DCMAKE_DISABLE_FIND_PACKAGE_nlohmann_json=ON -DCMAKE_DISABLE_FIND_PACKAGE_GeographicLib=ON)
