@@ -15,8 +15,8 @@ look was less sure, about as sure, or surer (drop_bins).
 
   proxy_table.py LABEL=CELLS.csv [LABEL=CELLS.csv ...]
 
-e.g. the fields a network was trained on against fields it never saw (docs/results.md, "After a
-descent").
+e.g. the fields a network was trained on against fields it never saw (docs/journal/2026-11-cells.md,
+"After a descent").
 """
 import csv
 import math
