@@ -6,4 +6,5 @@
 
 #include <adaptseg/erfnet/ensemble_segmenter.hpp>
 #include <adaptseg/erfnet/network_identity.hpp>
+#include <adaptseg/erfnet/onnx_model_info.hpp>
 #include <adaptseg/erfnet/onnx_segmenter.hpp>

@@ -17,6 +17,7 @@
 #include <adaptseg/vision/decision_rules.hpp>
 #include <adaptseg/vision/descent_coverage.hpp>
 #include <adaptseg/vision/field.hpp>
+#include <adaptseg/vision/field_geo.hpp>
 #include <adaptseg/vision/front_aware_rule.hpp>
 #include <adaptseg/vision/gp_io.hpp>
 #include <adaptseg/vision/grid_inputs.hpp>

@@ -7,22 +7,20 @@
 /// without OpenCV DNN pay nothing for it.
 ///
 /// A model is an ONNX file (fp32, input `1x3xHxW`, output `1xCx(H/s)x(W/s)` logits at output
-/// stride s) plus a metadata YAML written by `examples/tools/train_segnet.py`: class names in
-/// label-index order, input size, channel order, the per-channel normalisation
-/// `(v / 255 - mean) / std` and the output stride. Any network of that form runs here: the
-/// bundled models are an ERFNet (`examples/models/erfnet-dubai`, stride 1) and a MobileNetV2
+/// stride s) plus a metadata YAML (onnx_model_info.hpp: class names, input size, channel order,
+/// normalisation `(v / 255 - mean) / std`, output stride). Any network of that form runs here:
+/// the bundled models are an ERFNet (`examples/models/erfnet-dubai`, stride 1) and a MobileNetV2
 /// with a light decoder (`examples/models/mobilenetv2-dubai`, stride 4).
 
 #include <adaptseg/core/camera.hpp>
 #include <adaptseg/core/error.hpp>
-#include <adaptseg/vision/detail/yaml_io.hpp>
+#include <adaptseg/erfnet/onnx_model_info.hpp>
 #include <adaptseg/vision/field.hpp>
 #include <adaptseg/vision/segmentation_backend.hpp>
 
 #include <opencv2/core.hpp>
 #include <opencv2/dnn.hpp>
 #include <opencv2/imgproc.hpp>
-#include <yaml-cpp/yaml.h>
 
 #include <array>
 #include <cmath>
@@ -33,38 +31,6 @@
 #include <vector>
 
 namespace adaptseg {
-
-namespace detail {
-/// Class names as "[a, b, c]", for messages about class sets.
-inline std::string class_list(const std::vector<std::string>& classes) {
-  std::string s;
-  for (const auto& x : classes) s += (s.empty() ? "" : ", ") + x;
-  return "[" + s + "]";
-}
-}  // namespace detail
-
-/// What a model's metadata YAML (model.yaml) says; read by OnnxSegmenter. The keys below are
-/// read (`classes`, `input.{width, height, channel_order, mean, std}`, optional `output.stride`,
-/// `width`, `temperature`, `training.fields`); the others the export writes (the rest of
-/// training, validation, check ...) are provenance for people and are not read.
-struct OnnxModelInfo {
-  std::vector<std::string> classes;  ///< class names, label-index order
-  int input_width_px = 0;            ///< network input W [px] (multiple of 8)
-  int input_height_px = 0;           ///< network input H [px] (multiple of 8)
-  bool rgb_order = true;             ///< true: the network takes RGB; false: BGR
-  std::array<float, 3> mean{};       ///< per input channel, in the network's channel order, on v/255
-  std::array<float, 3> std{};        ///< per input channel, > 0
-  int output_stride = 1;             ///< logits are input / output_stride per side (`output.stride`, default 1)
-  double width_multiplier = 0.0;     ///< informational (ERFNet; 1.0 = the paper's 16/64/128 channels)
-  /// T > 0 of the probabilities softmax(logits / T) (`temperature`, default 1): fitted on the
-  /// network's validation data so that its confidence matches its accuracy
-  /// (examples/tools/eval_segnet.py --fit-temperature); labels do not depend on it.
-  double temperature = 1.0;
-  /// The fields the network was trained on, by name (`training.fields`, optional; empty: not
-  /// stated): a network maps them nearly as well from high up as from low down, so a decision
-  /// calibrated there learns that flying lower gains little (calibrate(), cross-fitting).
-  std::vector<std::string> training_fields;
-};
 
 /// Options of OnnxSegmenter, validated once by its constructor.
 struct OnnxParams {
@@ -144,7 +110,7 @@ class OnnxSegmenter {
   OnnxSegmenter(const std::filesystem::path& onnx_file, const std::filesystem::path& metadata_file, Params params = {})
       : params_(std::move(params)) {
     validate_params();
-    info_ = read_metadata(metadata_file);
+    info_ = read_onnx_model_info(metadata_file);
     check_classes(metadata_file);
     check_camera();
     load_network(onnx_file);
@@ -186,7 +152,9 @@ class OnnxSegmenter {
 
   /// The metadata YAML `file` as the constructor reads it, without loading the network.
   /// @throws std::invalid_argument as the constructor does for bad metadata.
-  [[nodiscard]] static OnnxModelInfo read_model_info(const std::filesystem::path& file) { return read_metadata(file); }
+  [[nodiscard]] static OnnxModelInfo read_model_info(const std::filesystem::path& file) {
+    return read_onnx_model_info(file);
+  }
   [[nodiscard]] int num_classes() const noexcept { return static_cast<int>(info_.classes.size()); }
   [[nodiscard]] const std::vector<std::string>& classes() const noexcept { return info_.classes; }
   /// The network's input size [px].
@@ -346,58 +314,6 @@ class OnnxSegmenter {
                     "OnnxParams: dnn_target is not available for dnn_backend " + std::to_string(params_.dnn_backend) +
                         " in this OpenCV build",
                     params_.dnn_target);
-  }
-
-  [[noreturn]] static void meta_error(const std::filesystem::path& file, const std::string& what) {
-    throw std::invalid_argument("OnnxSegmenter: " + file.string() + ": " + what);
-  }
-
-  static OnnxModelInfo read_metadata(const std::filesystem::path& file) {
-    if (!std::filesystem::is_regular_file(file))
-      throw std::invalid_argument("OnnxSegmenter: metadata file not found: " + file.string());
-    // The keys read below; the others (the rest of training, validation, check ...) are provenance.
-    const std::string where = "OnnxSegmenter: " + file.string();
-    const detail::YamlReader r(
-        detail::yaml_mapping(where, "network metadata", [&] { return YAML::LoadFile(file.string()); }), where);
-    OnnxModelInfo info;
-    info.classes = r.texts("classes");
-    if (info.classes.empty() || info.classes.size() > 255)
-      meta_error(file,
-                 "'classes' must be a list of 1 to 255 class names (got " + std::to_string(info.classes.size()) + ")");
-    const detail::YamlReader input = r.map("input");
-    info.input_width_px = static_cast<int>(input.integer("width", 8, 1 << 16));
-    info.input_height_px = static_cast<int>(input.integer("height", 8, 1 << 16));
-    if (info.input_width_px % 8 != 0 || info.input_height_px % 8 != 0)
-      meta_error(file, "input width and height must be positive multiples of 8 (got " +
-                           std::to_string(info.input_width_px) + "x" + std::to_string(info.input_height_px) + ")");
-    const std::string order = input.text("channel_order");
-    if (order != "RGB" && order != "BGR")
-      meta_error(file, "input.channel_order must be RGB or BGR (got '" + order + "')");
-    info.rgb_order = order == "RGB";
-    for (const char* key : {"mean", "std"}) {
-      const bool std_dev = std::string(key) == "std";
-      const std::vector<double> v = input.numbers(key);
-      if (v.size() != 3) meta_error(file, "'" + input.path(key) + "' must be a list of 3 numbers");
-      for (std::size_t k = 0; k < 3; ++k) {
-        if (std_dev && !(v[k] > 0.0))
-          meta_error(file, "input.std values must be > 0 (got " + std::to_string(v[k]) + ")");
-        (std_dev ? info.std : info.mean)[k] = static_cast<float>(v[k]);
-      }
-    }
-    if (r.has("output") && r.map("output").has("stride")) {
-      info.output_stride = static_cast<int>(r.map("output").integer("stride", 1, 32));
-      if (info.input_width_px % info.output_stride != 0 || info.input_height_px % info.output_stride != 0)
-        meta_error(file, "output.stride must divide the input width and height (got " +
-                             std::to_string(info.output_stride) + ")");
-    }
-    if (r.has("width")) info.width_multiplier = r.number("width");
-    if (r.has("temperature")) {
-      info.temperature = r.number("temperature");
-      if (info.temperature < 0.01 || info.temperature > 100.0)
-        meta_error(file, "temperature must be a number in [0.01, 100] (got " + std::to_string(info.temperature) + ")");
-    }
-    if (r.has("training") && r.map("training").has("fields")) info.training_fields = r.map("training").texts("fields");
-    return info;
   }
 
   void check_classes(const std::filesystem::path& file) const {
