@@ -142,7 +142,8 @@ cell_groups(std::span<const CellSample> samples) {
 /// The score `score` names.
 [[nodiscard]] inline double cell_input_score(CellInputScore score, std::span<const CellSample> samples,
                                              DecisionInput input) {
-  return score == CellInputScore::transfer ? cell_transfer_capture(samples, input) : cell_ranking_capture(samples, input);
+  return score == CellInputScore::transfer ? cell_transfer_capture(samples, input)
+                                           : cell_ranking_capture(samples, input);
 }
 
 }  // namespace adaptseg
