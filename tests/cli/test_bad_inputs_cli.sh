@@ -35,11 +35,14 @@ adaptseg_calibrate)
   expect_error "is not a region x0,y0,x1,y1 (fractions 0..1); write DIR:x0,y0,x1,y1" --train "$weedmap:0.5,0,1" \
     --out "$work/m.yaml"
   expect_error "field directory not found" --train "$work/none" --out "$work/m.yaml"
-  # A setting's choices are its table's names (decision inputs, slope poolings, top-level choices).
+  # A setting's choices are its table's names (decision inputs, input scores, slope poolings, top-level
+  # choices).
   expect_error "--cell-input: confusion not in {sigma,boundary,ambiguity,expected_error,second_choice," \
     --field "$weedmap" --out "$work/m.yaml" --cell-input sigma,confusion
   expect_error "--slope-pooling: field not in {cells,fields}" --field "$weedmap" \
     --out "$work/m.yaml" --slope-pooling field
+  expect_error "--cell-input-score: capture not in {ranking,transfer}" --field "$weedmap" \
+    --out "$work/m.yaml" --cell-input-score capture
   expect_error "--top-level: convex not in {undominated,hull}" --field "$weedmap" \
     --out "$work/m.yaml" --top-level convex
   expect_error "--top-level: convex not in {undominated,hull}" --field "$weedmap" \
