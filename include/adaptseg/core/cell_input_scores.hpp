@@ -111,9 +111,14 @@ cell_groups(std::span<const CellSample> samples) {
 /// on: cell_ranking_capture(). NaN without such a pair.
 [[nodiscard]] inline double cell_transfer_capture(std::span<const CellSample> samples, DecisionInput input,
                                                   SlopePooling pooling = SlopePooling::cells, double share = 0.2) {
+  // Each (field, GSD pair) group and its captured share once; each field's model once.
+  const auto groups = detail::cell_groups(samples);
   std::vector<std::size_t> fields;
-  for (const CellSample& s : samples)
-    if (std::find(fields.begin(), fields.end(), s.field) == fields.end()) fields.push_back(s.field);
+  std::vector<std::optional<double>> captured;
+  for (const auto& [key, cells] : groups) {
+    if (std::find(fields.begin(), fields.end(), std::get<0>(key)) == fields.end()) fields.push_back(std::get<0>(key));
+    captured.push_back(detail::captured_share(cells, input, share));
+  }
   if (fields.size() < 2) return cell_ranking_capture(samples, input, share);
   double sum = 0.0;
   int count = 0;
@@ -127,13 +132,11 @@ cell_groups(std::span<const CellSample> samples) {
         if (detail::same_gsd(p.top_gsd_cm, top) && detail::same_gsd(p.sub_gsd_cm, sub)) return p.gain_slope;
       return 0.0;
     };
-    for (const auto& [key, cells] : detail::cell_groups(samples)) {
-      const auto& [field, top, sub] = key;
-      if (field != held_out) continue;
-      if (const auto captured = detail::captured_share(cells, input, share)) {
-        if (slope(top, sub) > 0.0) sum += *captured;
-        ++count;
-      }
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      const auto& [field, top, sub] = groups[g].first;
+      if (field != held_out || !captured[g]) continue;
+      if (slope(top, sub) > 0.0) sum += *captured[g];
+      ++count;
     }
   }
   return count > 0 ? sum / count : std::numeric_limits<double>::quiet_NaN();
