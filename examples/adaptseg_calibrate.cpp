@@ -162,9 +162,15 @@ int main(int argc, char** argv) {
             "cell gain model of %s per pair of GSDs (gain slope beta; the scene check's proxy slope gamma "
             "and its spread between the training fields tau):\n",
             adaptseg::to_string(cells->input()).c_str());
-        for (const auto& p : cells->points())
-          std::printf("  %5.2f -> %5.2f cm/px  beta %+.3f  gamma %+.3f  tau %.3f\n", p.top_gsd_cm, p.sub_gsd_cm,
+        for (const auto& p : cells->points()) {
+          std::printf("  %5.2f -> %5.2f cm/px  beta %+.3f  gamma %+.3f  tau %.3f", p.top_gsd_cm, p.sub_gsd_cm,
                       p.gain_slope, p.proxy_slope, p.proxy_slope_sd);
+          if (p.entropy_slope != 0.0)  // field-entropy: beta at the reference entropy, and per unit of it
+            std::printf("  (at entropy %.3f; %+.3f per unit, entropy %.3f to %.3f: beta %+.3f to %+.3f)",
+                        p.entropy_reference, p.entropy_slope, p.entropy_low, p.entropy_high,
+                        p.gain_slope_at(p.entropy_low), p.gain_slope_at(p.entropy_high));
+          std::printf("\n");
+        }
       }
     }
     std::printf("%zu region samples; linear sigma range [%.4f, %.4f]; model -> %s\n", cal.samples.size(),

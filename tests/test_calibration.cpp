@@ -345,8 +345,27 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
       return tmp.path() / "pooling.yaml";
     };
     CHECK(DecisionModel::load(with("fields")).decision_function.model().cells()->pooling() == SlopePooling::fields);
+    // field-entropy needs β's line per point, and keeps it.
+    CHECK_THROWS_WITH_AS((void)DecisionModel::load(with("field-entropy")),
+                         doctest::Contains("missing key 'gain_model.cells.entropy_slope'"), std::invalid_argument);
+    {
+      std::string list = "[";
+      for (std::size_t k = 0; k < cells->points().size(); ++k) list += k ? ", 0.5" : "0.5";
+      list += "]";
+      std::string entropy = "    slope_pooling: field-entropy\n";
+      for (const char* key : {"entropy_slope", "entropy_reference", "entropy_low", "entropy_high"})
+        entropy += std::string("    ") + key + ": " + list + "\n";
+      t::write_file(tmp.path() / "entropy.yaml", text.substr(0, next) + entropy + text.substr(next));
+      const DecisionModel e = DecisionModel::load(tmp.path() / "entropy.yaml");
+      CHECK(e.decision_function.reads_field_entropy());
+      e.save(tmp.path() / "entropy-again.yaml");
+      const auto& again = *DecisionModel::load(tmp.path() / "entropy-again.yaml").decision_function.model().cells();
+      CHECK(again.pooling() == SlopePooling::field_entropy);
+      for (const auto& q : again.points()) CHECK((q.entropy_slope == 0.5 && q.entropy_high == 0.5));
+    }
     CHECK_THROWS_WITH_AS((void)DecisionModel::load(with("both")),
-                         doctest::Contains("slope_pooling' must be cells or fields"), std::invalid_argument);
+                         doctest::Contains("slope_pooling' must be cells, fields or field-entropy"),
+                         std::invalid_argument);
   }
   // Each training field's mean input at both top levels: the nominal one's is field_input, and
   // the finer top level's map has less wrong (the oracle's expected error is its share of

@@ -231,6 +231,61 @@ TEST_CASE(
   CHECK(parse_slope_pooling(to_string(SlopePooling::fields)) == SlopePooling::fields);
   CHECK(parse_slope_pooling(to_string(SlopePooling::cells)) == SlopePooling::cells);
   CHECK_THROWS_WITH_AS((void)parse_slope_pooling("field"),
-                       doctest::Contains("slope pooling must be 'cells' or 'fields', not 'field'"),
+                       doctest::Contains("slope pooling must be 'cells', 'fields' or 'field-entropy', not 'field'"),
                        std::invalid_argument);
+}
+
+TEST_CASE("cell gain model: the slope as a line in the field's mean top-level entropy (field-entropy)") {
+  // Four fields whose own slopes lie on b = -0.3 + u, u their mean entropy: the two surest
+  // fields lose by re-mapping (b = -0.1, 0), the two least sure gain (+0.2, +0.3).
+  const std::vector<double> entropy{0.2, 0.3, 0.5, 0.6};
+  std::vector<CellSample> s;
+  for (std::size_t f = 0; f < entropy.size(); ++f)
+    for (double x : {0.1, 0.2, 0.3}) {
+      CellSample c = cell(f, 15.0, 5.0, x, 1000.0, (-0.3 + entropy[f]) * x, 0.5 * x);
+      c.top.values[index_of(DecisionInput::entropy)] = entropy[f];
+      s.push_back(c);
+    }
+  const CellGainModel m = CellGainModel::fit(s, DecisionInput::expected_error, SlopePooling::field_entropy);
+  CHECK(m.pooling() == SlopePooling::field_entropy);
+  CHECK(m.reads_field_entropy());
+  const CellGainModel::Point& p = m.points().front();
+  // Exact lines: the fields weigh alike, the reference is their mean entropy, the line exact.
+  CHECK(p.entropy_reference == doctest::Approx(0.4));
+  CHECK(p.gain_slope == doctest::Approx(0.1));
+  CHECK(p.entropy_slope == doctest::Approx(1.0));
+  CHECK(p.entropy_low == doctest::Approx(0.2));
+  CHECK(p.entropy_high == doctest::Approx(0.6));
+  CHECK(p.gain_noise == doctest::Approx(0.0).epsilon(1e-9));
+  CHECK(m.entropy_reference(15.0) == doctest::Approx(0.4));
+  // What at() reads: β at the reference until the field's entropy is known; then on the line,
+  // clamped to the training fields' range; the sign follows the field.
+  CellGainModel flown = m;
+  CHECK(flown.at(15.0, 5.0).gain_slope == doctest::Approx(0.1));
+  flown.set_field_entropy(0.25);
+  CHECK(flown.at(15.0, 5.0).gain_slope == doctest::Approx(-0.05));
+  CellInputs one;
+  one.values.fill(NAN);
+  one.values[index_of(DecisionInput::expected_error)] = 0.2;
+  one.field_px = 1000.0;
+  CHECK(flown.cell_gain(15.0, 5.0, one) == doctest::Approx(-0.01));
+  flown.set_field_entropy(0.9);
+  CHECK(flown.at(15.0, 5.0).gain_slope == doctest::Approx(0.3));
+  flown.set_field_entropy(0.0);
+  CHECK(flown.at(15.0, 5.0).gain_slope == doctest::Approx(-0.1));
+  // The same cells pooled without the covariate: one slope for every field, +0.1.
+  CHECK(CellGainModel::fit(s, DecisionInput::expected_error, SlopePooling::fields).at(15.0, 5.0).gain_slope ==
+        doctest::Approx(0.1));
+  // Fewer than three fields with an entropy: no line, the fields' pooled slope.
+  const std::vector<CellSample> two(s.begin(), s.begin() + 6);
+  const CellGainModel flat = CellGainModel::fit(two, DecisionInput::expected_error, SlopePooling::field_entropy);
+  CHECK_FALSE(flat.reads_field_entropy());
+  CHECK(flat.at(15.0, 5.0).gain_slope ==
+        CellGainModel::fit(two, DecisionInput::expected_error, SlopePooling::fields).at(15.0, 5.0).gain_slope);
+  CHECK(parse_slope_pooling("field-entropy") == SlopePooling::field_entropy);
+  // A range upside down is refused.
+  CellGainModel::Point bad = p;
+  bad.entropy_low = 0.7;
+  CHECK_THROWS_AS(CellGainModel(DecisionInput::expected_error, {bad}, SlopePooling::field_entropy),
+                  std::invalid_argument);
 }

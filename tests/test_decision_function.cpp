@@ -501,6 +501,43 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     CHECK_THROWS_WITH_AS(FrontAwarePolicy(with_cells(1.0), reference, {.margin_biases = {{-1.0, 0.0}}}),
                          doctest::Contains("margin_biases: a GSD must be finite and > 0"), std::invalid_argument);
   }
+  SUBCASE("the slope read at the field's entropy (field-entropy): a field the network is sure of loses") {
+    // β = 4 at entropy 0.5, +10 per unit over the training fields' range 0.2 to 0.8: β = 1 on a
+    // field of entropy 0.2 (no descent, as with_cells(1.0)), 7 at 0.8, 4 while it is unknown.
+    const auto by_entropy = [] {
+      GainModel m = with_cells(4.0);
+      std::vector<CellGainModel::Point> points = m.cells()->points();
+      for (CellGainModel::Point& q : points) q.entropy_slope = 10.0, q.entropy_reference = 0.5, q.entropy_high = 0.8;
+      for (CellGainModel::Point& q : points) q.entropy_low = 0.2;
+      m.set_cells(CellGainModel(DecisionInput::expected_error, points, SlopePooling::field_entropy));
+      return m;
+    };
+    // Hardly any prior weight: the field's entropy is what its first image shows.
+    const FrontAwarePolicy::Params params{.sigma_prior_weight = 1e-6};
+    FrontAwarePolicy p(by_entropy(), reference, params);
+    CHECK(p.reads_field_entropy());
+    CHECK_FALSE(FrontAwarePolicy(with_cells(4.0), reference, params).reads_field_entropy());
+    CHECK(DecisionFunction(FrontAwarePolicy(by_entropy(), reference, params)).reads_field_entropy());
+    const Decision unknown = p.decide(s.region(0, 0.1));
+    FrontAwarePolicy four(with_cells(4.0), reference, params);
+    CHECK(unknown.descend);
+    CHECK(unknown.scores[1].predicted_field_gain ==
+          doctest::Approx(four.decide(s.region(0, 0.1)).scores[1].predicted_field_gain));
+    DecisionContext sure = s.region(0, 0.1);
+    sure.region_entropy = 0.2;
+    p.begin_mission();
+    const Decision d = p.decide(sure);
+    CHECK_FALSE(d.descend);
+    FrontAwarePolicy one(with_cells(1.0), reference, params);
+    CHECK(d.scores[1].predicted_field_gain ==
+          doctest::Approx(one.decide(s.region(0, 0.1)).scores[1].predicted_field_gain).epsilon(1e-4));
+    DecisionContext unsure = s.region(0, 0.1);
+    unsure.region_entropy = 0.95;  // beyond the training fields' range: read at its end, 0.8
+    p.begin_mission();
+    const Decision e = p.decide(unsure);
+    CHECK(e.descend);
+    CHECK(e.scores[1].predicted_field_gain == doctest::Approx(1.75 * unknown.scores[1].predicted_field_gain));
+  }
   SUBCASE("the curve agreement: no descent to a GSD whose lawnmower lost on too many training fields") {
     // β = 4 descends to 1 cm/px against field a, whose lawnmower at 1 cm/px beat its 3 cm/px one.
     CHECK(finer_lawnmower_share(reference, 3.0, 1.0) == 1.0);

@@ -280,8 +280,9 @@ struct CalibrationCli {
                        "coverage ranked, several training fields: how the cell gain model's slopes may pool the "
                        "fields, tried with every confidence level on the training fields, comma-separated: cells "
                        "(one fit over every field's cells) and fields (each field's own slope, pooled as random "
-                       "effects); cells is kept unless fields beats it on the folds beyond their noise (one standard "
-                       "error), and the one kept is saved in the model")
+                       "effects) and field-entropy (as fields, the slope a line in the field's mean top-level entropy, "
+                       "read in flight from the images so far); the first is kept unless another beats it on the "
+                       "folds beyond their noise (one standard error), and the one kept is saved in the model")
             ->delimiter(',')
             ->check(CLI::IsMember(detail::names_of(kSlopePoolings)))
             ->capture_default_str(),

@@ -39,10 +39,9 @@ def slopes(cells, inp, mean_px):
     return (wdg / wdd if wdd > 0 else math.nan, wxg / wxx if wxx > 0 else math.nan, wdd)
 
 
-def main():
-    if len(sys.argv) != 3:
-        sys.exit(__doc__)
-    path, inp = sys.argv[1], sys.argv[2]
+def cell_pairs(path, inp):
+    """The cell samples of `path` per pair of GSDs {(top, descent): rows}, and the fields' names
+    sorted; exits naming the file where it has no column top_<inp>."""
     with open(path, newline="") as f:
         rows = list(csv.DictReader(f))
     if rows and "top_" + inp not in rows[0]:
@@ -50,7 +49,14 @@ def main():
     pairs = defaultdict(list)
     for r in rows:
         pairs[(float(r["top_gsd_cm"]), float(r["sub_gsd_cm"]))].append(r)
-    fields = sorted({r["field"] for r in rows})
+    return pairs, sorted({r["field"] for r in rows})
+
+
+def main():
+    if len(sys.argv) != 3:
+        sys.exit(__doc__)
+    path, inp = sys.argv[1], sys.argv[2]
+    pairs, fields = cell_pairs(path, inp)
     print(f"{path}: input {inp}; per field: gamma_f / beta_f (share of the gamma fit's weight)")
     print("| top -> descent [cm/px] | beta | gamma | tau | " + " | ".join(fields) + " |")
     print("| --- | ---: | ---: | ---: | " + " | ".join("---:" for _ in fields) + " |")

@@ -6,6 +6,7 @@
 /// by on the training fields: cell_input_scores.hpp).
 
 #include <adaptseg/core/decision_inputs.hpp>
+#include <adaptseg/core/detail/field_slopes.hpp>
 #include <adaptseg/core/detail/gsd.hpp>
 #include <adaptseg/core/detail/interpolate.hpp>
 #include <adaptseg/core/detail/named_rows.hpp>
@@ -16,6 +17,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -32,14 +34,19 @@ namespace adaptseg {
 /// - `fields`: each field's own slope, pooled as random effects (DerSimonian and Laird 1986):
 ///   by the fields' precision where they agree within their cells' scatter, alike where they
 ///   disagree beyond it. A new field is one more field, not more cells of the training fields'.
+/// - `field-entropy`: as `fields`, with β a linear function of the field's mean top-level
+///   entropy (a random-effects meta-regression): how unsure the network is of the whole field,
+///   which on ground it never trained on marks how much a closer look gains. In flight the
+///   field's entropy is estimated from the top-level images so far (FrontAwarePolicy).
 /// Which one a model uses is a calibration choice (CalibrationOptions::slope_poolings, chosen
 /// with the confidence level z by leave-one-field-out); docs/method.md, "Cells that pay".
-enum class SlopePooling { cells, fields };
+enum class SlopePooling { cells, fields, field_entropy };
 
 /// Every pooling by name (`slope_pooling` in the model file, `--slope-pooling` of the programs).
-inline constexpr std::array<detail::NamedValue<SlopePooling>, 2> kSlopePoolings{{
+inline constexpr std::array<detail::NamedValue<SlopePooling>, 3> kSlopePoolings{{
     {SlopePooling::cells, "cells"},
     {SlopePooling::fields, "fields"},
+    {SlopePooling::field_entropy, "field-entropy"},
 }};
 
 /// The name of a pooling.
@@ -48,7 +55,7 @@ inline constexpr std::array<detail::NamedValue<SlopePooling>, 2> kSlopePoolings{
 }
 
 /// Parses a pooling's name.
-/// @throws std::invalid_argument for anything but `cells` or `fields`.
+/// @throws std::invalid_argument for anything but `cells`, `fields` or `field-entropy`.
 [[nodiscard]] inline SlopePooling parse_slope_pooling(std::string_view name) {
   return detail::value_named(kSlopePoolings, name, "slope pooling");
 }
@@ -144,6 +151,19 @@ class CellGainModel {
     double proxy_slope = 0.0;     ///< γ: gain per unit of the input the finer look removes
     double proxy_noise = 0.0;     ///< κ_p >= 0
     double proxy_slope_sd = 0.0;  ///< τ_γ >= 0: the spread of γ between the training fields
+    /// SlopePooling::field_entropy (0 otherwise): β changes by `entropy_slope` per unit of the
+    /// field's mean top-level entropy u from β at u = `entropy_reference`, u clamped to the
+    /// training fields' range [`entropy_low`, `entropy_high`].
+    double entropy_slope = 0.0;
+    double entropy_reference = 0.0;
+    double entropy_low = 0.0;
+    double entropy_high = 0.0;
+
+    /// β on a field of mean top-level entropy `u` (NaN: unknown, β at the reference).
+    [[nodiscard]] double gain_slope_at(double u) const noexcept {
+      if (!std::isfinite(u) || entropy_slope == 0.0) return gain_slope;
+      return gain_slope + entropy_slope * (std::clamp(u, entropy_low, entropy_high) - entropy_reference);
+    }
   };
 
   /// A forecast for a set of cells, in shares of the region's field pixels.
@@ -175,8 +195,13 @@ class CellGainModel {
       detail::require(std::isfinite(p.gain_slope) && std::isfinite(p.relabel_slope) && std::isfinite(p.gain_noise) &&
                           std::isfinite(p.relabel_noise) && p.gain_noise >= 0.0 && p.relabel_noise >= 0.0 &&
                           std::isfinite(p.proxy_slope) && std::isfinite(p.proxy_noise) && p.proxy_noise >= 0.0 &&
-                          std::isfinite(p.proxy_slope_sd) && p.proxy_slope_sd >= 0.0,
-                      "CellGainModel: slopes must be finite and noises finite and >= 0; at descent GSD", p.sub_gsd_cm);
+                          std::isfinite(p.proxy_slope_sd) && p.proxy_slope_sd >= 0.0 &&
+                          std::isfinite(p.entropy_slope) && std::isfinite(p.entropy_reference) &&
+                          std::isfinite(p.entropy_low) && std::isfinite(p.entropy_high) &&
+                          p.entropy_low <= p.entropy_high,
+                      "CellGainModel: slopes must be finite, noises finite and >= 0 and the entropy range ordered; "
+                      "at descent GSD",
+                      p.sub_gsd_cm);
     }
   }
 
@@ -208,31 +233,44 @@ class CellGainModel {
       double px = 0.0;
       for (const CellSample* c : g.cells) px += c->top.field_px;
       const double mean_px = px > 0.0 ? px / static_cast<double>(g.cells.size()) : 1.0;
-      // Per training field, the sums of its own fits of β and α (pooled by field_slope).
-      PerField gain_sums, relabel_sums;
+      // Per training field, the sums of its own fits of β and α (pooled by field_slope) and its
+      // mean top-level entropy (field_entropy).
+      detail::PerField gain_sums, relabel_sums;
       double wx = 0.0;
       for (const CellSample* c : g.cells) {
         const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
         // `cells`: every cell in one field's sums, one fit.
-        const std::size_t field = pooling == SlopePooling::fields ? c->field : 0;
-        sums_of(gain_sums, field).add(w, x, c->normalized_gain());
-        sums_of(relabel_sums, field).add(w, x, c->relabelled);
+        const std::size_t field = pooling != SlopePooling::cells ? c->field : 0;
+        detail::sums_of(gain_sums, field).add(w, x, c->normalized_gain());
+        detail::sums_of(gain_sums, field).add_covariate(c->top.field_px, c->top.value(DecisionInput::entropy));
+        detail::sums_of(relabel_sums, field).add(w, x, c->relabelled);
         wx += w * x;
       }
-      Point p{g.top, g.sub, field_slope(gain_sums), 0.0, field_slope(relabel_sums), 0.0, 0.0, 0.0};
+      Point p{g.top, g.sub, detail::field_slope(gain_sums), 0.0, detail::field_slope(relabel_sums), 0.0, 0.0, 0.0};
+      if (pooling == SlopePooling::field_entropy) {
+        const detail::PooledSlope b = detail::field_slope_by_covariate(gain_sums);
+        p.gain_slope = b.at_reference;
+        p.entropy_slope = b.per_unit;
+        p.entropy_reference = b.reference;
+        p.entropy_low = b.low;
+        p.entropy_high = b.high;
+      }
       double eg = 0.0, er = 0.0, wdd = 0.0, wdg = 0.0;
-      PerField proxy_sums;  // per training field, the proxy's own fit of ν on d = x − x' (τ_γ)
+      detail::PerField proxy_sums;  // per training field, the proxy's own fit of ν on d = x − x' (τ_γ)
       bool proxy = true;
       for (const CellSample* c : g.cells) {
         const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
-        eg += w * std::pow(c->normalized_gain() - p.gain_slope * x, 2);
+        // β on the cell's own field (its entropy's, with field_entropy).
+        const double beta =
+            p.entropy_slope != 0.0 ? p.gain_slope_at(detail::sums_of(gain_sums, c->field).covariate()) : p.gain_slope;
+        eg += w * std::pow(c->normalized_gain() - beta * x, 2);
         er += w * std::pow(c->relabelled - p.relabel_slope * x, 2);
         const double xf = c->fine.value(input);
         proxy = proxy && std::isfinite(c->top.value(input)) && std::isfinite(xf);
         if (!proxy) continue;
         wdd += w * (x - xf) * (x - xf);
         wdg += w * (x - xf) * c->normalized_gain();
-        sums_of(proxy_sums, c->field).add(w, x - xf, c->normalized_gain());
+        detail::sums_of(proxy_sums, c->field).add(w, x - xf, c->normalized_gain());
       }
       p.gain_noise = wx > 0.0 ? eg / wx : 0.0;
       p.relabel_noise = wx > 0.0 ? er / wx : 0.0;
@@ -244,7 +282,7 @@ class CellGainModel {
           ep += w * std::pow(p.proxy_slope * (x - c->fine.value(input)) - p.gain_slope * x, 2);
         }
         p.proxy_noise = ep / wx;
-        p.proxy_slope_sd = field_slope_spread(proxy_sums, p.proxy_slope);
+        p.proxy_slope_sd = detail::field_slope_spread(proxy_sums, p.proxy_slope);
       }
       points.push_back(p);
     }
@@ -285,13 +323,14 @@ class CellGainModel {
 
   /// The model for a pair of GSDs (see the class comment).
   [[nodiscard]] Point at(double top_gsd_cm, double sub_gsd_cm) const {
-    // The calibrated top-level GSD nearest `top_gsd_cm`, and its points.
-    double top = points_.front().top_gsd_cm;
-    for (const Point& p : points_)
-      if (std::abs(p.top_gsd_cm - top_gsd_cm) < std::abs(top - top_gsd_cm)) top = p.top_gsd_cm;
+    // The calibrated top-level GSD nearest `top_gsd_cm`, and its points (β at the field's entropy).
+    const double top = nearest_top(top_gsd_cm);
     std::vector<Point> row;
     for (const Point& p : points_)
-      if (p.top_gsd_cm == top) row.push_back(p);
+      if (p.top_gsd_cm == top) {
+        row.push_back(p);
+        row.back().gain_slope = p.gain_slope_at(field_entropy_);
+      }
     Point out{top_gsd_cm, sub_gsd_cm, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
     out.gain_slope = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::gain_slope);
     out.gain_noise = detail::interpolate_flat(row, sub_gsd_cm, &Point::sub_gsd_cm, &Point::gain_noise);
@@ -311,6 +350,25 @@ class CellGainModel {
     return out;
   }
 
+  /// The flown field's mean top-level entropy (SlopePooling::field_entropy: what at() reads β
+  /// at; NaN, the default: unknown, β at each point's reference).
+  void set_field_entropy(double u) noexcept { field_entropy_ = u; }
+  [[nodiscard]] double field_entropy() const noexcept { return field_entropy_; }
+  /// Whether β depends on the field's entropy (some point has an entropy slope).
+  [[nodiscard]] bool reads_field_entropy() const noexcept {
+    return std::any_of(points_.begin(), points_.end(), [](const Point& p) { return p.entropy_slope != 0.0; });
+  }
+  /// The training fields' mean top-level entropy at the calibrated top level nearest
+  /// `top_gsd_cm` (the mean of its points' references; 0 without an entropy slope).
+  [[nodiscard]] double entropy_reference(double top_gsd_cm) const {
+    const double top = nearest_top(top_gsd_cm);
+    double sum = 0.0;
+    std::size_t n = 0;
+    for (const Point& p : points_)
+      if (p.top_gsd_cm == top && p.entropy_slope != 0.0) sum += p.entropy_reference, ++n;
+    return n > 0 ? sum / static_cast<double>(n) : 0.0;
+  }
+
   [[nodiscard]] DecisionInput input() const noexcept { return input_; }
   /// How the slopes were pooled over the training fields (what fit was told; saved in the model file).
   [[nodiscard]] SlopePooling pooling() const noexcept { return pooling_; }
@@ -319,88 +377,12 @@ class CellGainModel {
  private:
   [[nodiscard]] double x_of(const CellInputs& c) const noexcept { return value_of(c, input_); }
 
-  /// One training field's sums for the slope through the origin of y on x (weights w).
-  struct FieldSlopeSums {
-    double xy = 0.0, xx = 0.0, yy = 0.0;
-    std::size_t n = 0;
-    void add(double w, double x, double y) {
-      xy += w * x * y;
-      xx += w * x * x;
-      yy += w * y * y;
-      ++n;
-    }
-  };
-
-  /// Each training field's sums (field index, sums), in the order the fields first occur.
-  using PerField = std::vector<std::pair<std::size_t, FieldSlopeSums>>;
-
-  /// The sums of `field` in `fields`, added (zero) if it has none yet.
-  static FieldSlopeSums& sums_of(PerField& fields, std::size_t field) {
-    auto it = std::find_if(fields.begin(), fields.end(), [&](const auto& f) { return f.first == field; });
-    if (it == fields.end()) it = fields.insert(fields.end(), {field, FieldSlopeSums{}});
-    return it->second;
-  }
-
-  /// β or α of one pair of GSDs from each training field's sums (see the class comment): each
-  /// field's own slope b_f = Σ w·x·y / Σ w·x² and its variance v_f = s_f² / Σ w·x² (s_f² the
-  /// field's residual variance), pooled as random effects (DerSimonian and Laird 1986): τ², the
-  /// spread of the true slopes between fields, by the method of moments from Cochran's Q about
-  /// the precision-weighted mean; then the mean of the b_f weighted by 1 / (v_f + τ²). Fields
-  /// that agree within their cells' scatter weigh by their precision (near the fit pooled over
-  /// the cells); fields that disagree weigh alike (near the mean of their slopes). A field of
-  /// fewer than two cells, or whose cells hold no input, does not count; without any field that
-  /// counts, the fit pooled over the cells (also the result for one field's sums: its own fit).
-  static double field_slope(const PerField& fields) {
-    if (fields.size() == 1) {  // one field's (or SlopePooling::cells: all cells') own fit
-      const FieldSlopeSums& f = fields.front().second;
-      return f.xx > 0.0 ? f.xy / f.xx : 0.0;
-    }
-    std::vector<std::pair<double, double>> slopes;  // (b_f, v_f)
-    double xy = 0.0, xx = 0.0;
-    for (const auto& [field, f] : fields) {
-      xy += f.xy;
-      xx += f.xx;
-      if (!(f.xx > 0.0) || f.n < 2) continue;
-      const double b = f.xy / f.xx;
-      const double rss = std::max(0.0, f.yy - b * f.xy);
-      // A field whose line fits its cells exactly (the oracle at the field's GSD) still has a
-      // finite weight.
-      slopes.emplace_back(b, std::max(rss / static_cast<double>(f.n - 1), 1e-12) / f.xx);
-    }
-    if (slopes.empty()) return xx > 0.0 ? xy / xx : 0.0;
-    double sw = 0.0, sww = 0.0, swb = 0.0;
-    for (const auto& [b, v] : slopes) {
-      sw += 1.0 / v;
-      sww += 1.0 / (v * v);
-      swb += b / v;
-    }
-    const double fixed = swb / sw;
-    double q = 0.0;
-    for (const auto& [b, v] : slopes) q += (b - fixed) * (b - fixed) / v;
-    const double c = sw - sww / sw;
-    const double tau2 = c > 0.0 ? std::max(0.0, (q - static_cast<double>(slopes.size() - 1)) / c) : 0.0;
-    double num = 0.0, den = 0.0;
-    for (const auto& [b, v] : slopes) {
-      num += b / (v + tau2);
-      den += 1.0 / (v + tau2);
-    }
-    return num / den;
-  }
-
-  /// τ_γ of one pair of GSDs (see the class comment): the proxy's slope fitted on each training
-  /// field's cells alone, γ_f = Σ w·d·ν / Σ w·d² (from `fields`, the sums fit() collects of ν on
-  /// d = x − x'), and their spread about
-  /// the pooled `slope`, Σ_f (γ_f − γ)² / (n − 1) over the n fields whose finer looks changed the
-  /// input; |γ| where n < 2.
-  static double field_slope_spread(const PerField& fields, double slope) {
-    double sq = 0.0;
-    std::size_t n = 0;
-    for (const auto& [field, sums] : fields)
-      if (sums.xx > 0.0) {
-        sq += std::pow(sums.xy / sums.xx - slope, 2);
-        ++n;
-      }
-    return n >= 2 ? std::sqrt(sq / static_cast<double>(n - 1)) : std::abs(slope);
+  /// The calibrated top-level GSD nearest `top_gsd_cm`.
+  [[nodiscard]] double nearest_top(double top_gsd_cm) const noexcept {
+    double top = points_.front().top_gsd_cm;
+    for (const Point& p : points_)
+      if (std::abs(p.top_gsd_cm - top_gsd_cm) < std::abs(top - top_gsd_cm)) top = p.top_gsd_cm;
+    return top;
   }
 
   static double value_of(const CellInputs& c, DecisionInput input) noexcept {
@@ -411,6 +393,7 @@ class CellGainModel {
   DecisionInput input_;
   SlopePooling pooling_ = SlopePooling::cells;
   std::vector<Point> points_;
+  double field_entropy_ = std::numeric_limits<double>::quiet_NaN();  ///< set_field_entropy()
 };
 
 }  // namespace adaptseg

@@ -93,6 +93,10 @@ struct DecisionContext {
   /// DescentCoverage::ranked: the ranking decision input's value over the region's field pixels,
   /// as the top-level image saw them (NaN otherwise).
   double region_input = std::numeric_limits<double>::quiet_NaN();
+  /// The region's mean normalised entropy of the class probabilities in the top-level image
+  /// (DecisionInput::entropy), where the policy reads the field's entropy (ReadsFieldEntropy;
+  /// NaN otherwise).
+  double region_entropy = std::numeric_limits<double>::quiet_NaN();
   std::span<const LawnmowerForecast> lawnmowers{};  ///< this field's lawnmowers at the top and candidate GSDs
 };
 
@@ -191,6 +195,13 @@ concept DecisionPolicy = requires(P& policy, const DecisionContext& context, con
 template <typename P>
 concept ChoosesTopLevel = requires(P& policy, std::span<const LawnmowerForecast> lawnmowers, double nominal) {
   { policy.top_gsd(lawnmowers, nominal) } -> std::convertible_to<double>;
+};
+
+/// A policy whose forecasts read the field's mean top-level entropy (DecisionContext::
+/// region_entropy): the planner computes it only for such a policy, and only where it says so.
+template <class P>
+concept ReadsFieldEntropy = requires(const P& policy) {
+  { policy.reads_field_entropy() } -> std::convertible_to<bool>;
 };
 
 /// The index of the candidate a descending `decision` names: `decision.candidate` if that

@@ -57,6 +57,18 @@ class DecisionFunction {
         rule_);
   }
 
+  /// Whether the rule reads the field's mean top-level entropy (ReadsFieldEntropy).
+  [[nodiscard]] bool reads_field_entropy() const {
+    return std::visit(
+        [](const auto& r) {
+          if constexpr (requires { r.reads_field_entropy(); })
+            return r.reads_field_entropy();
+          else
+            return false;
+        },
+        rule_);
+  }
+
   /// Whether the rule learns in flight ("adaptive") or not ("non-adaptive").
   [[nodiscard]] bool online() const {
     return std::visit([](const auto& r) { return r.params().online; }, rule_);
@@ -85,5 +97,6 @@ class DecisionFunction {
 
 static_assert(DecisionPolicy<DecisionFunction>);
 static_assert(ChoosesTopLevel<DecisionFunction>);
+static_assert(ReadsFieldEntropy<DecisionFunction>);
 
 }  // namespace adaptseg

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <utility>
 
 namespace adaptseg {
@@ -28,9 +29,14 @@ class FieldShareEstimate {
   /// Forgets every image (a new mission); keeps the prior.
   void reset() noexcept { *this = FieldShareEstimate(prior_sigma_); }
 
-  /// One top-level image: its σ, its region's share of the field and the region's mean input
-  /// (NaN: unknown, left out of X̂).
-  void add(double sigma, double region_share, double region_input) noexcept {
+  /// One top-level image: its σ, its region's share of the field, the region's mean input (NaN:
+  /// unknown, left out of X̂) and its mean entropy (NaN: unknown, left out of entropy()).
+  void add(double sigma, double region_share, double region_input,
+           double region_entropy = std::numeric_limits<double>::quiet_NaN()) noexcept {
+    if (std::isfinite(region_entropy)) {
+      seen_entropy_ += region_share * region_entropy;
+      seen_entropy_share_ += region_share;
+    }
     sigma_sum_ += sigma;
     ++sigma_count_;
     seen_share_ += region_share;
@@ -59,6 +65,12 @@ class FieldShareEstimate {
     return {region_share / sigma, sigma_var / (sigma * sigma)};
   }
 
+  /// The field's mean top-level entropy: the seen regions' mean shrunk towards `prior` (the
+  /// training fields' mean) with weight k, as the unseen part of X̂ is; `prior` with none seen.
+  [[nodiscard]] double entropy(double prior, double k) const noexcept {
+    return (seen_entropy_ + k * prior) / (seen_entropy_share_ + k);
+  }
+
   /// X̂: the regions seen so far, the unseen part at their mean shrunk towards `prior_input`
   /// (the training fields' mean input; 0: unknown, the seen mean alone) with weight k.
   [[nodiscard]] double input(double prior_input, double k) const noexcept {
@@ -70,13 +82,15 @@ class FieldShareEstimate {
   }
 
  private:
-  double prior_sigma_ = 0.0;       ///< mean σ of the training fields (0: unknown)
-  double sigma_sum_ = 0.0;         ///< σ of the top-level images so far
-  std::size_t sigma_count_ = 0;    ///< ... and their number
-  double seen_share_ = 0.0;        ///< field share of the top-level regions seen so far
-  double seen_interest_ = 0.0;     ///< ... and Σ share · σ over them
-  double seen_input_ = 0.0;        ///< Σ share · the region's mean input, where known
-  double seen_input_share_ = 0.0;  ///< ... the share of the field those regions cover
+  double prior_sigma_ = 0.0;         ///< mean σ of the training fields (0: unknown)
+  double sigma_sum_ = 0.0;           ///< σ of the top-level images so far
+  std::size_t sigma_count_ = 0;      ///< ... and their number
+  double seen_share_ = 0.0;          ///< field share of the top-level regions seen so far
+  double seen_interest_ = 0.0;       ///< ... and Σ share · σ over them
+  double seen_input_ = 0.0;          ///< Σ share · the region's mean input, where known
+  double seen_input_share_ = 0.0;    ///< ... the share of the field those regions cover
+  double seen_entropy_ = 0.0;        ///< Σ share · the region's mean entropy, where known
+  double seen_entropy_share_ = 0.0;  ///< ... the share of the field those regions cover
 };
 
 /// The field factor s: how much more (s > 1) or less than forecast this field's descents

@@ -116,20 +116,6 @@ class FrontAwarePolicy {
       for (const GainRatio& r : gain_ratios) r.validate();
       for (const MarginBias& b : margin_biases) b.validate();
     }
-
-    /// The factor on the forecast gain of a descent to `gsd_cm` (1 where none is listed).
-    [[nodiscard]] double gain_ratio(double gsd_cm) const noexcept {
-      for (const GainRatio& r : gain_ratios)
-        if (std::abs(r.gsd_cm - gsd_cm) <= 1e-9 * gsd_cm) return r.ratio;
-      return 1.0;
-    }
-
-    /// The margin bias per second of a descent to `gsd_cm` (0 where none is listed).
-    [[nodiscard]] double margin_bias(double gsd_cm) const noexcept {
-      for (const MarginBias& b : margin_biases)
-        if (std::abs(b.gsd_cm - gsd_cm) <= 1e-9 * gsd_cm) return b.per_s;
-      return 0.0;
-    }
   };
 
   /// @throws std::invalid_argument for invalid params, a model without C and without a cell gain
@@ -187,7 +173,10 @@ class FrontAwarePolicy {
     detail::require(!c.lawnmowers.empty(),
                     "FrontAwarePolicy::decide: the context needs the field's lawnmower forecasts; count",
                     c.lawnmowers.size());
-    share_.add(c.sigma, c.region_share, c.region_input);
+    share_.add(c.sigma, c.region_share, c.region_input, c.region_entropy);
+    if (reads_field_entropy())
+      model_.set_field_entropy(
+          share_.entropy(model_.cells()->entropy_reference(c.top_gsd_cm), params_.sigma_prior_weight));
     const auto [weight, sigma_cv2] = gain_weight(c);
     const PredictedCurves curves = predicted_curves(c, weight);
     Decision d;
@@ -226,6 +215,9 @@ class FrontAwarePolicy {
     std::sort(allowed.begin(), allowed.end(), std::greater<>());
     return choose_top_gsd(reference_, allowed, lawnmowers, nominal, params_.top_level);
   }
+
+  /// Whether β reads the field's entropy (a cell gain model pooled by SlopePooling::field_entropy).
+  [[nodiscard]] bool reads_field_entropy() const { return model_.cells() && model_.cells()->reads_field_entropy(); }
 
   /// After a descent: the paper's update of O and the field correction (no-op unless `online`).
   void observe(const DescentOutcome& out) {
@@ -334,7 +326,7 @@ class FrontAwarePolicy {
       b.sd = f.relabelled_std * eta * weight;
       b.relabelled = {f.relabelled, f.relabelled_noisy_std, 0.0, 0.0, 0.0, 0.0};
     }
-    const double ratio = params_.gain_ratio(cand.gsd_cm);
+    const double ratio = gain_ratio_at(params_.gain_ratios, cand.gsd_cm);
     b.mean *= ratio;
     b.sd *= ratio;
     return b;
@@ -372,7 +364,7 @@ class FrontAwarePolicy {
     a.score.utility = utility(a.gain, cand.extra_time_s);
     const auto [rise, rise_var] = curve_rise(p.curves, p.t0, cand.extra_time_s);
     // What descents to this GSD ended above their forecast margin on the training fields as new ground.
-    const double bias = params_.margin_bias(cand.gsd_cm) * cand.extra_time_s;
+    const double bias = margin_bias_at(params_.margin_biases, cand.gsd_cm) * cand.extra_time_s;
     a.lower = a.gain - rise + bias - params_.confidence * std::sqrt(gain_var + rise_var);
     a.score.predicted_front_margin =
         mean_top_miou(c) + forecast_gain_ + a.gain - p.level - mean_curve_miou(p.curves, p.t0 + cand.extra_time_s);
@@ -446,5 +438,6 @@ class FrontAwarePolicy {
 
 static_assert(DecisionPolicy<FrontAwarePolicy>);
 static_assert(ChoosesTopLevel<FrontAwarePolicy>);
+static_assert(ReadsFieldEntropy<FrontAwarePolicy>);
 
 }  // namespace adaptseg

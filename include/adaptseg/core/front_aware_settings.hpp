@@ -119,6 +119,20 @@ struct MarginBias {
   }
 };
 
+/// The factor on the forecast gain of a descent to `gsd_cm` in `ratios` (1 where none is listed).
+[[nodiscard]] inline double gain_ratio_at(std::span<const GainRatio> ratios, double gsd_cm) noexcept {
+  for (const GainRatio& r : ratios)
+    if (std::abs(r.gsd_cm - gsd_cm) <= 1e-9 * gsd_cm) return r.ratio;
+  return 1.0;
+}
+
+/// The margin bias per second of a descent to `gsd_cm` in `biases` (0 where none is listed).
+[[nodiscard]] inline double margin_bias_at(std::span<const MarginBias> biases, double gsd_cm) noexcept {
+  for (const MarginBias& b : biases)
+    if (std::abs(b.gsd_cm - gsd_cm) <= 1e-9 * gsd_cm) return b.per_s;
+  return 0.0;
+}
+
 /// A training field's fixed-altitude lawnmower curve by GSD: the front-aware rule's yardstick.
 struct ReferenceCurve {
   std::string field;             ///< the training field's name

@@ -269,6 +269,11 @@ class GainModel {
   /// The cell gain model (DescentCoverage::ranked), absent unless calibration set one.
   [[nodiscard]] const std::optional<CellGainModel>& cells() const noexcept { return cells_; }
   void set_cells(std::optional<CellGainModel> cells) { cells_ = std::move(cells); }
+  /// The flown field's mean top-level entropy for the cell gain model (CellGainModel::
+  /// set_field_entropy; nothing without one).
+  void set_field_entropy(double u) noexcept {
+    if (cells_) cells_->set_field_entropy(u);
+  }
   /// @throws std::invalid_argument for a negative value.
   void set_refit_every(int k) {
     detail::require(k >= 0, "GainModel::set_refit_every: refit_every must be >= 0", k);

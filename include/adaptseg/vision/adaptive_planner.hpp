@@ -623,9 +623,21 @@ class AdaptivePlanner {
   [[nodiscard]] const GridInputs* region_inputs(std::size_t i, const Image& image, const Segmentation& segmentation) {
     const cv::Rect region = region_rect(i);
     if (!coverage_.ranks_cells || region.area() == 0) return nullptr;
-    region_inputs_.assign(image, segmentation, options_.mission.interest, area_.ignore_label, region,
-                          std::array{options_.cell_input});
+    if (reads_field_entropy())
+      region_inputs_.assign(image, segmentation, options_.mission.interest, area_.ignore_label, region,
+                            std::array{options_.cell_input, DecisionInput::entropy});
+    else
+      region_inputs_.assign(image, segmentation, options_.mission.interest, area_.ignore_label, region,
+                            std::array{options_.cell_input});
     return &region_inputs_;
+  }
+
+  /// Whether the policy reads the field's mean top-level entropy (ReadsFieldEntropy).
+  [[nodiscard]] bool reads_field_entropy() const {
+    if constexpr (ReadsFieldEntropy<Policy>)
+      return policy_.reads_field_entropy();
+    else
+      return false;
   }
 
   /// Every descent the decision at top-level waypoint i may choose from, per candidate GSD:
@@ -742,8 +754,9 @@ class AdaptivePlanner {
     ctx.region_px = static_cast<double>(valid_pixels(top_[i].footprint));
     if (inputs) {
       const cv::Rect region = region_rect(i);
-      ctx.region_input = inputs->cell(area_.valid_mask(region), cv::Rect(0, 0, region.width, region.height))
-                             .value(options_.cell_input);
+      const CellInputs whole = inputs->cell(area_.valid_mask(region), cv::Rect(0, 0, region.width, region.height));
+      ctx.region_input = whole.value(options_.cell_input);
+      if (reads_field_entropy()) ctx.region_entropy = whole.value(DecisionInput::entropy);
     }
     ctx.lawnmowers = forecasts;
     rec.decision = policy_.decide(ctx);

@@ -59,6 +59,15 @@ inline constexpr std::array<std::pair<const char*, double CellGainModel::Point::
     {"proxy_slope_sd", &CellGainModel::Point::proxy_slope_sd},
 }};
 
+/// The keys of β's dependence on the field's entropy (SlopePooling::field_entropy), written and
+/// required with that pooling only.
+inline constexpr std::array<std::pair<const char*, double CellGainModel::Point::*>, 4> kCellEntropyKeys{{
+    {"entropy_slope", &CellGainModel::Point::entropy_slope},
+    {"entropy_reference", &CellGainModel::Point::entropy_reference},
+    {"entropy_low", &CellGainModel::Point::entropy_low},
+    {"entropy_high", &CellGainModel::Point::entropy_high},
+}};
+
 /// A calibrated decision model and its provenance.
 struct DecisionModel {
   std::vector<std::string> calibration_fields;  ///< names of the training fields (with regions)
@@ -203,12 +212,16 @@ struct DecisionModel {
       e << YAML::Key << "input" << YAML::Value << to_string(cells->input());
       if (cells->pooling() != SlopePooling::cells)
         e << YAML::Key << "slope_pooling" << YAML::Value << to_string(cells->pooling());
-      for (const auto& [key, member] : kCellPointKeys) {
-        std::vector<double> v;
-        for (const auto& p : cells->points()) v.push_back(p.*member);
-        e << YAML::Key << key << YAML::Value;
-        emit_numbers(e, v);
-      }
+      const auto emit_points = [&](const auto& keys) {
+        for (const auto& [key, member] : keys) {
+          std::vector<double> v;
+          for (const auto& p : cells->points()) v.push_back(p.*member);
+          e << YAML::Key << key << YAML::Value;
+          emit_numbers(e, v);
+        }
+      };
+      emit_points(kCellPointKeys);
+      if (cells->pooling() == SlopePooling::field_entropy) emit_points(kCellEntropyKeys);
       e << YAML::EndMap;
     }
     e << YAML::EndMap;
@@ -332,10 +345,20 @@ struct DecisionModel {
         try {
           pooling = parse_slope_pooling(name);
         } catch (const std::invalid_argument&) {
-          detail::yaml_error(r.where(),
-                             "'gain_model.cells.slope_pooling' must be cells or fields (got '" + name + "')");
+          detail::yaml_error(
+              r.where(),
+              "'gain_model.cells.slope_pooling' must be cells, fields or field-entropy (got '" + name + "')");
         }
       }
+      if (pooling == SlopePooling::field_entropy)
+        for (const auto& [key, member] : kCellEntropyKeys) {
+          const auto v = c.numbers(key);
+          if (v.size() != points.size())
+            detail::yaml_error(r.where(),
+                               "'gain_model.cells' with slope_pooling field-entropy needs one entropy_slope, "
+                               "entropy_reference, entropy_low and entropy_high value per point");
+          for (std::size_t j = 0; j < v.size(); ++j) points[j].*member = v[j];
+        }
       model.set_cells(CellGainModel(input, std::move(points), pooling));
     }
     const auto rule = r.map("rule");
