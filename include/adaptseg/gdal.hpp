@@ -8,6 +8,7 @@
 #include <adaptseg/gdal/elevation_model.hpp>
 #include <adaptseg/gdal/exif_position.hpp>
 #include <adaptseg/gdal/gdal_io.hpp>
+#include <adaptseg/gdal/map_geotiff.hpp>
 #include <adaptseg/gdal/site_picture.hpp>
 #include <adaptseg/gdal/site_plan.hpp>
 #include <adaptseg/gdal/survey_site.hpp>
