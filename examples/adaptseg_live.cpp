@@ -52,6 +52,8 @@
 #include <adaptseg/vision/adaptive_planner.hpp>
 #ifdef ADAPTSEG_HAVE_GDAL
 #include <adaptseg/gdal/exif_position.hpp>
+#include <adaptseg/gdal/site_fence.hpp>
+#include <adaptseg/gdal/site_lawnmower.hpp>
 #include <adaptseg/gdal/survey_site.hpp>
 #endif
 

@@ -4,6 +4,8 @@
 #include <adaptseg/gdal/elevation_model.hpp>
 #include <adaptseg/gdal/exif_position.hpp>
 #include <adaptseg/gdal/gdal_io.hpp>
+#include <adaptseg/gdal/site_fence.hpp>
+#include <adaptseg/gdal/site_lawnmower.hpp>
 #include <adaptseg/gdal/site_plan.hpp>
 #include <adaptseg/gdal/survey_site.hpp>
 

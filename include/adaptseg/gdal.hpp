@@ -9,6 +9,8 @@
 #include <adaptseg/gdal/exif_position.hpp>
 #include <adaptseg/gdal/gdal_io.hpp>
 #include <adaptseg/gdal/map_geotiff.hpp>
+#include <adaptseg/gdal/site_fence.hpp>
+#include <adaptseg/gdal/site_lawnmower.hpp>
 #include <adaptseg/gdal/site_picture.hpp>
 #include <adaptseg/gdal/site_plan.hpp>
 #include <adaptseg/gdal/survey_site.hpp>

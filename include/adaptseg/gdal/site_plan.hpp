@@ -23,6 +23,8 @@
 #include <adaptseg/core/error.hpp>
 #include <adaptseg/core/timing.hpp>
 #include <adaptseg/gdal/elevation_model.hpp>
+#include <adaptseg/gdal/site_fence.hpp>
+#include <adaptseg/gdal/site_lawnmower.hpp>
 #include <adaptseg/gdal/survey_site.hpp>
 #include <adaptseg/geo/fence_route.hpp>
 #include <adaptseg/geo/georeference.hpp>
