@@ -66,7 +66,8 @@ class FieldShareEstimate {
   }
 
   /// The field's mean top-level entropy: the seen regions' mean shrunk towards `prior` (the
-  /// training fields' mean) with weight k, as the unseen part of X̂ is; `prior` with none seen.
+  /// training fields' mean) with weight k, as X̂'s unseen part is; `prior` with none seen. Unlike
+  /// X̂ the seen part is not taken as known: a field seen whole keeps k / (1 + k) of the prior.
   [[nodiscard]] double entropy(double prior, double k) const noexcept {
     return (seen_entropy_ + k * prior) / (seen_entropy_share_ + k);
   }
