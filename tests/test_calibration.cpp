@@ -359,7 +359,8 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
       const DecisionModel e = DecisionModel::load(tmp.path() / "entropy.yaml");
       CHECK(e.decision_function.reads_field_entropy());
       e.save(tmp.path() / "entropy-again.yaml");
-      const auto& again = *DecisionModel::load(tmp.path() / "entropy-again.yaml").decision_function.model().cells();
+      const DecisionModel loaded = DecisionModel::load(tmp.path() / "entropy-again.yaml");
+      const CellGainModel& again = *loaded.decision_function.model().cells();
       CHECK(again.pooling() == SlopePooling::field_entropy);
       for (const auto& q : again.points()) CHECK((q.entropy_slope == 0.5 && q.entropy_high == 0.5));
     }

@@ -39,7 +39,7 @@ adaptseg_calibrate)
   # choices).
   expect_error "--cell-input: confusion not in {sigma,boundary,ambiguity,expected_error,second_choice," \
     --field "$weedmap" --out "$work/m.yaml" --cell-input sigma,confusion
-  expect_error "--slope-pooling: field not in {cells,fields}" --field "$weedmap" \
+  expect_error "--slope-pooling: field not in {cells,fields,field-entropy}" --field "$weedmap" \
     --out "$work/m.yaml" --slope-pooling field
   expect_error "--cell-input-score: capture not in {ranking,transfer}" --field "$weedmap" \
     --out "$work/m.yaml" --cell-input-score capture
