@@ -14,7 +14,7 @@ do on new ground), clamped to their range of u; and how many forecasts have the 
 import math
 import sys
 
-from proxy_slopes import cell_pairs  # the same tool folder
+from proxy_slopes import cell_pairs, normalized_gain  # the same tool folder
 
 
 def own_slope(cells, inp, mean_px):
@@ -22,8 +22,7 @@ def own_slope(cells, inp, mean_px):
     for c in cells:
         x = float(c["top_" + inp])
         w = float(c["field_px"]) / mean_px
-        share = float(c["field_share"])
-        nu = float(c["field_gain"]) * float(c["field_sigma"]) / share if share > 0 else 0.0
+        nu = normalized_gain(c)
         wxx += w * x * x
         wxg += w * x * nu
         u = float(c["top_entropy"])

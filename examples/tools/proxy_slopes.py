@@ -21,6 +21,13 @@ import sys
 from collections import defaultdict
 
 
+def normalized_gain(c):
+    """A cell sample's field gain per unit of its field share and of the field's sigma
+    (CellSample::normalized_gain)."""
+    share = float(c["field_share"])
+    return float(c["field_gain"]) * float(c["field_sigma"]) / share if share > 0 else 0.0
+
+
 def slopes(cells, inp, mean_px):
     """(gamma, beta, weight) of `cells`: least squares through the origin of the normalised gain
     on the input's drop and on the input, each cell weighted by its field pixels over `mean_px`;
@@ -30,8 +37,7 @@ def slopes(cells, inp, mean_px):
         x = float(c["top_" + inp])
         d = x - float(c["fine_" + inp])
         w = float(c["field_px"]) / mean_px
-        share = float(c["field_share"])
-        nu = float(c["field_gain"]) * float(c["field_sigma"]) / share if share > 0 else 0.0
+        nu = normalized_gain(c)
         wdd += w * d * d
         wdg += w * d * nu
         wxx += w * x * x

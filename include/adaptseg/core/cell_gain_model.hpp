@@ -241,8 +241,9 @@ class CellGainModel {
         const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
         // `cells`: every cell in one field's sums, one fit.
         const std::size_t field = pooling != SlopePooling::cells ? c->field : 0;
-        detail::sums_of(gain_sums, field).add(w, x, c->normalized_gain());
-        detail::sums_of(gain_sums, field).add_covariate(c->top.field_px, c->top.value(DecisionInput::entropy));
+        detail::FieldSlopeSums& gain = detail::sums_of(gain_sums, field);
+        gain.add(w, x, c->normalized_gain());
+        gain.add_covariate(c->top.field_px, c->top.value(DecisionInput::entropy));
         detail::sums_of(relabel_sums, field).add(w, x, c->relabelled);
         wx += w * x;
       }
