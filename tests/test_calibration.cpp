@@ -236,17 +236,20 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
   const auto& cells = cal.decision_function.model().cells();
   REQUIRE(cells.has_value());
   CHECK(cells->input() == cal.cell_input_scores.front().first);
-  // Each z tried with the slopes pooled over the cells and over the fields; the chosen one
-  // first, the best mean margin of its pooling, and the model's cell gain model pooled as it says.
-  REQUIRE(cal.trials.size() == 2 * options.confidences.size());
+  // Each z tried with each default pooling (the field's entropy, the cells, the fields); the
+  // chosen one first, the best mean margin of its pooling, and the model's cell gain model
+  // pooled as it says.
+  REQUIRE(options.slope_poolings.size() == 3);
+  REQUIRE(cal.trials.size() == options.slope_poolings.size() * options.confidences.size());
   const std::string chosen = " slopes=" + to_string(cells->pooling());
   CHECK(cal.trials.front().description.ends_with(chosen));
-  int by_fields = 0;
-  for (const auto& trial : cal.trials) {
-    if (trial.description.ends_with(chosen)) CHECK(trial.front_margin <= cal.trials.front().front_margin);
-    by_fields += trial.description.ends_with(" slopes=fields");
+  for (const SlopePooling pooling : options.slope_poolings) {
+    int tried = 0;
+    for (const auto& trial : cal.trials) tried += trial.description.ends_with(" slopes=" + to_string(pooling));
+    CHECK(tried == static_cast<int>(options.confidences.size()));
   }
-  CHECK(by_fields == static_cast<int>(options.confidences.size()));
+  for (const auto& trial : cal.trials)
+    if (trial.description.ends_with(chosen)) CHECK(trial.front_margin <= cal.trials.front().front_margin);
   const CellGainModel refit = CellGainModel::fit(cal.cell_samples, cells->input(), cells->pooling());
   for (std::size_t k = 0; k < cells->points().size(); ++k)
     CHECK(refit.points()[k].gain_slope == cells->points()[k].gain_slope);
@@ -326,13 +329,17 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
   }
   const DecisionModel before = DecisionModel::load(tmp.path() / "old.yaml");
   for (const auto& p : before.decision_function.model().cells()->points()) CHECK(p.proxy_slope_sd == 0.0);
-  // The pooling: kept where it is `fields`, absent (cells, as files before it) otherwise; any
-  // other value refused naming the key.
+  // The pooling: kept where it is not `cells`, absent (cells, as files before it) otherwise;
+  // any other value refused naming the key.
   CHECK(back_cells.pooling() == cells->pooling());
   {
-    std::string text = t::read_file(tmp.path() / "model.yaml");
-    const auto line = text.find("    slope_pooling: fields\n");
-    if (line != std::string::npos) text.erase(line, std::string("    slope_pooling: fields\n").size());
+    // The model without its pooling (whichever the folds chose) and the field-entropy lines.
+    std::string text;
+    {
+      std::istringstream in(t::read_file(tmp.path() / "model.yaml"));
+      for (std::string line; std::getline(in, line);)
+        if (!line.starts_with("    slope_pooling: ") && !line.starts_with("    entropy_")) text += line + "\n";
+    }
     const auto input = text.find("    input: ");
     REQUIRE(input != std::string::npos);
     const auto next = text.find('\n', input) + 1;
