@@ -97,7 +97,7 @@ struct CalibrationOptions {
   /// field's own slope either way). The default tries field_entropy first: on new ground it
   /// beat the others on the leave-one-tile-out folds (docs/results.md); where the fields' mean
   /// entropies do not spread (the oracle's are all 0) or fewer than three fields count, it is
-  /// the fields pooling.
+  /// the fields pooling under another name and is not tried (detail::distinct_poolings).
   std::vector<SlopePooling> slope_poolings{SlopePooling::field_entropy, SlopePooling::cells, SlopePooling::fields};
   /// Front-aware rule, DescentCoverage::ranked: the top-level choices tried (TopLevelChoice;
   /// each replaces `front_aware.top_level`), each with every pooling and z; the first is kept
