@@ -454,7 +454,7 @@ TEST_CASE("calibration: field-entropy is tried only where the training fields' e
   };
   const std::vector<SlopePooling> all{SlopePooling::field_entropy, SlopePooling::cells, SlopePooling::fields};
   CHECK(detail::distinct_poolings(all, fields_at({0.2, 0.4, 0.6}), DecisionInput::expected_error) == all);
-  // The same entropy on every field (the oracle's, 0), or two fields: no line, left out.
+  // The same entropy on every field, or two fields: no line, left out.
   const std::vector<SlopePooling> rest{SlopePooling::cells, SlopePooling::fields};
   CHECK(detail::distinct_poolings(all, fields_at({0.0, 0.0, 0.0}), DecisionInput::expected_error) == rest);
   CHECK(detail::distinct_poolings(all, fields_at({0.2, 0.6}), DecisionInput::expected_error) == rest);

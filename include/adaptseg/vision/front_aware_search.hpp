@@ -146,9 +146,9 @@ struct FrontAwareGrid {
 
 /// The slope poolings of `poolings` that are not another under a second name: `field-entropy`
 /// is left out where its line is flat at every pair of GSDs on the training fields' cells
-/// `cells` (fewer than three fields count, or their mean entropies do not spread, as the
-/// oracle's, all 0), where it is `fields`; the order of the others then decides which is kept
-/// first. None is left out of a list of one.
+/// `cells` (fewer than three fields count, or their mean entropies do not spread), where it is
+/// `fields`; the order of the others then decides which is kept first. None is left out of a
+/// list of one.
 inline std::vector<SlopePooling> distinct_poolings(std::vector<SlopePooling> poolings,
                                                    std::span<const std::vector<CellSample>> cells,
                                                    DecisionInput input) {
