@@ -227,6 +227,7 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
   const std::vector<Field> fields = two_blob_fields();
   OracleSegmenter oracle(fields.front().num_classes());
   CalibrationOptions options = ranked_options();
+  options.slope_poolings = {SlopePooling::field_entropy, SlopePooling::cells, SlopePooling::fields};
   const CalibrationResult cal = calibrate(std::span<const Field>(fields), oracle, options);
   REQUIRE_FALSE(cal.cell_samples.empty());
   // Every input about L is known from the oracle (it gives probabilities) and scored; the
@@ -236,14 +237,13 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
   const auto& cells = cal.decision_function.model().cells();
   REQUIRE(cells.has_value());
   CHECK(cells->input() == cal.cell_input_scores.front().first);
-  // Each z tried with each default pooling (the field's entropy, the cells, the fields); the
-  // chosen one first, the best mean margin of its pooling, and the model's cell gain model
-  // pooled as it says.
-  REQUIRE(options.slope_poolings.size() == 3);
-  REQUIRE(cal.trials.size() == options.slope_poolings.size() * options.confidences.size());
+  // Each z tried with each pooling asked for but the field's entropy, which two fields cannot
+  // make a line of (it would be `fields`): the cells, the fields; the chosen one first, the best
+  // mean margin of its pooling, and the model's cell gain model pooled as it says.
+  REQUIRE(cal.trials.size() == 2 * options.confidences.size());
   const std::string chosen = " slopes=" + to_string(cells->pooling());
   CHECK(cal.trials.front().description.ends_with(chosen));
-  for (const SlopePooling pooling : options.slope_poolings) {
+  for (const SlopePooling pooling : {SlopePooling::cells, SlopePooling::fields}) {
     int tried = 0;
     for (const auto& trial : cal.trials) tried += trial.description.ends_with(" slopes=" + to_string(pooling));
     CHECK(tried == static_cast<int>(options.confidences.size()));
@@ -429,6 +429,40 @@ TEST_CASE("calibration: with coverage 'ranked' every cell is a sample, and the i
   }
 }
 
+TEST_CASE("calibration: field-entropy is tried only where the training fields' entropies make a line") {
+  // Fields of one cell per x at 15 -> 5 cm/px each, gaining about b_f x with b_f on a line in
+  // the field's mean entropy u_f.
+  const auto fields_at = [](const std::vector<double>& entropy) {
+    std::vector<std::vector<CellSample>> cells(entropy.size());
+    for (std::size_t f = 0; f < entropy.size(); ++f)
+      for (double x : {0.1, 0.2, 0.3}) {
+        CellSample c;
+        c.field = f;
+        c.top_gsd_cm = 15.0;
+        c.sub_gsd_cm = 5.0;
+        c.top.values.fill(NAN);
+        c.top.values[index_of(DecisionInput::expected_error)] = x;
+        c.top.values[index_of(DecisionInput::entropy)] = entropy[f];
+        c.top.field_px = 1000.0;
+        c.field_sigma = 0.1;
+        c.field_share = 1e-3;
+        c.field_gain = (-0.3 + entropy[f] + 0.01 * x) * x * c.field_share / c.field_sigma;
+        c.relabelled = 0.5 * x;
+        cells[f].push_back(c);
+      }
+    return cells;
+  };
+  const std::vector<SlopePooling> all{SlopePooling::field_entropy, SlopePooling::cells, SlopePooling::fields};
+  CHECK(detail::distinct_poolings(all, fields_at({0.2, 0.4, 0.6}), DecisionInput::expected_error) == all);
+  // The same entropy on every field, or two fields: no line, left out.
+  const std::vector<SlopePooling> rest{SlopePooling::cells, SlopePooling::fields};
+  CHECK(detail::distinct_poolings(all, fields_at({0.0, 0.0, 0.0}), DecisionInput::expected_error) == rest);
+  CHECK(detail::distinct_poolings(all, fields_at({0.2, 0.6}), DecisionInput::expected_error) == rest);
+  // Asked for alone, it stays (it is the fields pooling there).
+  CHECK(detail::distinct_poolings({SlopePooling::field_entropy}, fields_at({0.0, 0.0, 0.0}),
+                                  DecisionInput::expected_error) ==
+        std::vector<SlopePooling>{SlopePooling::field_entropy});
+}
 TEST_CASE("calibration: another slope pooling replaces the first only where the folds prefer it beyond their noise") {
   const auto select = [](const std::vector<RuleTrial>& trials) {
     std::vector<const RuleTrial*> p;

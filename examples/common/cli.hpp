@@ -241,7 +241,7 @@ struct CalibrationCli {
   std::optional<double> segmentation_time_s;
   std::vector<std::string> cell_inputs;
   std::string cell_input_score = to_string(CellInputScore::ranking);
-  std::vector<std::string> slope_poolings{"field-entropy", "cells", "fields"};
+  std::vector<std::string> slope_poolings{"cells", "fields"};
   std::string curve = to_string(CurveSource::corrected);  // the programs' default, not the struct's
   std::vector<std::string> top_levels{"undominated"};
   bool gain_ratios = false;

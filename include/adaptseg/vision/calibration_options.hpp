@@ -94,11 +94,13 @@ struct CalibrationOptions {
   /// factor's prior spread estimated with it), each with its z of best mean front margin. The
   /// first pooling is kept unless another beats it on the folds by more than one standard error
   /// of their paired margins (detail::select_pooling). One training field: the first only (a
-  /// field's own slope either way). The default tries field_entropy first: on new ground it
-  /// beat the others on the leave-one-tile-out folds (docs/results.md); where the fields' mean
-  /// entropies do not spread (the oracle's are all 0) or fewer than three fields count, it is
-  /// the fields pooling.
-  std::vector<SlopePooling> slope_poolings{SlopePooling::field_entropy, SlopePooling::cells, SlopePooling::fields};
+  /// field's own slope either way). SlopePooling::field_entropy is not tried where the fields'
+  /// mean entropies do not spread or fewer than three fields count:
+  /// it is the fields pooling there under another name (detail::distinct_poolings). With
+  /// pooled maps (MapFusion::pooled) on new ground, `{field_entropy, cells, fields}` did best on
+  /// the leave-one-tile-out folds, and the deployment's decision models are calibrated with it;
+  /// with the default fusion it lost more there than `{cells, fields}` (docs/results.md).
+  std::vector<SlopePooling> slope_poolings{SlopePooling::cells, SlopePooling::fields};
   /// Front-aware rule, DescentCoverage::ranked: the top-level choices tried (TopLevelChoice;
   /// each replaces `front_aware.top_level`), each with every pooling and z; the first is kept
   /// unless another's best setting has a larger mean front margin on the folds. Without ranked

@@ -144,6 +144,23 @@ struct FrontAwareGrid {
   bool pools = false;   ///< ranked with several training fields
 };
 
+/// The slope poolings of `poolings` that are not another under a second name: `field-entropy`
+/// is left out where its line is flat at every pair of GSDs on the training fields' cells
+/// `cells` (fewer than three fields count, or their mean entropies do not spread), where it is
+/// `fields`; the order of the others then decides which is kept first. None is left out of a
+/// list of one.
+inline std::vector<SlopePooling> distinct_poolings(std::vector<SlopePooling> poolings,
+                                                   std::span<const std::vector<CellSample>> cells,
+                                                   DecisionInput input) {
+  const auto entropy = std::find(poolings.begin(), poolings.end(), SlopePooling::field_entropy);
+  if (entropy == poolings.end() || poolings.size() == 1) return poolings;
+  std::vector<CellSample> all;
+  for (const auto& c : cells) all.insert(all.end(), c.begin(), c.end());
+  if (all.empty() || !CellGainModel::fit(all, input, SlopePooling::field_entropy).reads_field_entropy())
+    poolings.erase(entropy);
+  return poolings;
+}
+
 /// One setting tried: its pooling and top level (indices into FrontAwareGrid), z, the
 /// parameters flown.
 struct FrontAwareSetting {
@@ -330,7 +347,9 @@ template <class Fly>
   detail::FrontAwareGrid grid;
   grid.ranked = descent_coverage_info(in.adaptive.coverage).ranks_cells;
   grid.pools = grid.ranked && in.fields.size() >= 2;
-  grid.poolings = grid.pools ? options.slope_poolings : std::vector<SlopePooling>{options.slope_poolings.front()};
+  grid.poolings = grid.ranked ? detail::distinct_poolings(options.slope_poolings, in.cells, in.adaptive.cell_input)
+                              : options.slope_poolings;
+  if (!grid.pools) grid.poolings.resize(1);
   grid.top_levels =
       options.top_levels.empty() ? std::vector<TopLevelChoice>{options.front_aware.top_level} : options.top_levels;
   if (!grid.ranked) grid.top_levels.resize(1);

@@ -1,0 +1,99 @@
+#pragma once
+/// @file
+/// What the adaptive planner (adaptive_planner.hpp) refuses: settings that cannot plan a
+/// mission, and images reported that do not fit the camera or the protocol.
+
+#include <adaptseg/core/camera.hpp>
+#include <adaptseg/core/error.hpp>
+#include <adaptseg/core/mission_options.hpp>
+#include <adaptseg/vision/adaptive_options.hpp>
+#include <adaptseg/vision/image.hpp>
+#include <adaptseg/vision/segmentation_backend.hpp>
+
+#include <opencv2/core.hpp>
+
+#include <cmath>
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace adaptseg::detail {
+
+/// The candidate GSDs a descent may fly over `area`'s map grid (those of `options` not finer
+/// than the map), after checking the settings that do not depend on the flight.
+/// @throws std::invalid_argument for fixed times that are negative or not finite, no labels of
+///         interest (or one that is not a class index), a top GSD finer than the map's,
+///         candidates that are not finer than the top (or none to descend to), a budget that is
+///         not positive.
+[[nodiscard]] inline std::vector<double> planner_candidates(const AdaptiveOptions& options, const SurveyArea& area) {
+  check_fixed_times(options.mission);
+  const auto& interest = options.mission.interest;
+  require(!interest.empty(), "AdaptivePlanner: no labels of interest (options.mission.interest)", 0);
+  for (int c : interest)
+    require(c >= 0 && c < area.num_classes,
+            "AdaptivePlanner: a label of interest is not a class index 0.." + std::to_string(area.num_classes - 1), c);
+  const double map_gsd = area.map_gsd_cm;
+  require(std::isfinite(options.top_gsd_cm) && options.top_gsd_cm >= map_gsd * (1.0 - 1e-9),
+          "AdaptivePlanner: top_gsd_cm must not be finer than the map's " + std::to_string(map_gsd) + " cm/px",
+          options.top_gsd_cm);
+  std::vector<double> candidates;
+  for (double g : options.candidate_gsd_cm) {
+    require(std::isfinite(g) && g > 0.0 && g < options.top_gsd_cm,
+            "AdaptivePlanner: candidate GSDs must be positive and finer than top_gsd_cm", g);
+    if (g >= map_gsd * (1.0 - 1e-9)) candidates.push_back(g);  // finer than the map: skip
+  }
+  // Without a candidate the planner could never descend: say so instead of flying a lawnmower.
+  require(!candidates.empty(),
+          "AdaptivePlanner: no candidate GSD to descend to (options.candidate_gsd_cm is empty or every one is finer "
+          "than the map's " +
+              std::to_string(map_gsd) +
+              " cm/px); DecisionModel::adaptive_options sets the candidates a model was calibrated for",
+          options.candidate_gsd_cm.size());
+  if (options.budget_s)
+    require(std::isfinite(*options.budget_s) && *options.budget_s > 0.0,
+            "AdaptivePlanner: budget_s must be finite and > 0", *options.budget_s);
+  return candidates;
+}
+
+/// Checks an image reported to the planner (AdaptivePlanner::report) before anything changes.
+/// @throws std::invalid_argument if no waypoint is `pending` (`handed_out` so far), for an image
+///         that is not of `camera`'s size or has no footprint or a yaw that is not finite, and
+///         an `elapsed_s` that is negative or not finite.
+inline void check_reported_image(const Image& image, const CameraModel& camera, bool pending, std::size_t handed_out,
+                                 std::optional<double> elapsed_s) {
+  require(pending,
+          "AdaptivePlanner::report: no waypoint is waiting for an image (call next() first; each waypoint takes "
+          "one image)",
+          handed_out);
+  require(image.width_px == camera.width_px() && image.height_px == camera.height_px(),
+          "AdaptivePlanner::report: the image must have the camera's size " + std::to_string(camera.width_px()) + "x" +
+              std::to_string(camera.height_px()),
+          std::to_string(image.width_px) + "x" + std::to_string(image.height_px));
+  require(image.bgr.empty() || image.bgr.size() == cv::Size(image.width_px, image.height_px),
+          "AdaptivePlanner::report: the image's rgb must be of its size",
+          std::to_string(image.bgr.cols) + "x" + std::to_string(image.bgr.rows));
+  require(image.footprint_px.width > 0 && image.footprint_px.height > 0 && image.gsd_cm > 0.0,
+          "AdaptivePlanner::report: the image has no footprint (make it with image_at())", image.gsd_cm);
+  require(std::isfinite(image.yaw_deg), "AdaptivePlanner::report: the image's yaw_deg must be finite", image.yaw_deg);
+  if (elapsed_s)
+    require(std::isfinite(*elapsed_s) && *elapsed_s >= 0.0,
+            "AdaptivePlanner::report: elapsed_s must be finite and >= 0", *elapsed_s);
+}
+
+/// Checks a segmentation reported with its image (AdaptivePlanner::report) and the time it took.
+/// @throws std::invalid_argument for labels that break the segmentation contract
+///         (check_segmentation()), probabilities or member votes that break theirs
+///         (check_probabilities()), and a `segmentation_s` that is negative or not finite.
+inline void check_reported_segmentation(const Segmentation& segmentation, const Image& image, int num_classes,
+                                        double segmentation_s) {
+  check_segmentation(segmentation.labels, image, num_classes, "AdaptivePlanner::report: the labels reported");
+  check_probabilities(segmentation.probabilities, segmentation.labels, image, num_classes,
+                      "AdaptivePlanner::report: the probabilities reported");
+  check_probabilities(segmentation.member_votes, segmentation.labels, image, num_classes,
+                      "AdaptivePlanner::report: the member votes reported");
+  require(std::isfinite(segmentation_s) && segmentation_s >= 0.0,
+          "AdaptivePlanner::report: segmentation_s must be finite and >= 0", segmentation_s);
+}
+
+}  // namespace adaptseg::detail

@@ -1,0 +1,109 @@
+#pragma once
+/// @file
+/// The adaptive planner's time account (AdaptivePlanner, adaptive_planner.hpp): the mission
+/// time so far, and what the budget reserves for each step still to come.
+
+#include <adaptseg/core/mission_options.hpp>
+
+#include <algorithm>
+#include <cstddef>
+#include <optional>
+#include <utility>
+
+namespace adaptseg::detail {
+
+/// Mission time as the adaptive planner counts it: flight by the timing model along the legs
+/// flown, segmentation per image and planning (measured, or fixed per image / waypoint by the
+/// MissionOptions), unless the caller reported its own clock with the last image; and the
+/// bound of a step's processing that the budget reserves for each step still to come.
+class PlannerClock {
+ public:
+  /// Fixed segmentation and planning times from `options` where it sets them (checked by
+  /// check_fixed_times()).
+  explicit PlannerClock(const MissionOptions& options)
+      : fixed_segmentation_s_(options.fixed_segmentation_time_s), fixed_planning_s_(options.fixed_planning_time_s) {}
+
+  /// A waypoint handed out: the fixed planning time per waypoint, where the options set one.
+  void waypoint_handed_out() {
+    if (fixed_planning_s_) planning_s_ += *fixed_planning_s_;
+  }
+
+  /// An image reported after the flight model's `leg_s` [s], segmented in `segmentation_s` [s]
+  /// (the fixed time instead where the options set one), with the mission time the caller
+  /// measured if it did (`reported_elapsed_s`, used instead of the own account from now on
+  /// until the next image). What the step cost beyond the leg (the mission clock's advance
+  /// since the last image: segmentation, the planner's own time, and whatever else the caller's
+  /// clock counted) feeds step_bound().
+  void image_reported(double leg_s, double segmentation_s, std::optional<double> reported_elapsed_s) {
+    reported_elapsed_s_ = reported_elapsed_s;
+    flight_s_ += leg_s;
+    const double seg = fixed_segmentation_s_.value_or(segmentation_s);
+    segmentation_s_ += seg;
+    slowest_segmentation_s_ = std::max(slowest_segmentation_s_, seg);
+    const double now = elapsed_s();
+    slowest_step_s_ = std::max(slowest_step_s_, std::max(0.0, now - elapsed_at_last_image_s_ - leg_s));
+    elapsed_at_last_image_s_ = now;
+    ++steps_;
+  }
+
+  /// Measured planner computation `s` [s]: charged as planning time unless the options fix it,
+  /// and kept for take_planning_s().
+  void charge_planning(double s) {
+    untaken_planning_s_ += s;
+    if (!fixed_planning_s_) planning_s_ += s;
+  }
+
+  /// Mission time so far [s]: what the caller reported with the last image if it did,
+  /// otherwise the own account (flight + segmentation + planning).
+  [[nodiscard]] double elapsed_s() const noexcept {
+    return reported_elapsed_s_.value_or(flight_s_ + segmentation_s_ + planning_s_);
+  }
+
+  /// Measured planner computation [s] since the last call.
+  [[nodiscard]] double take_planning_s() noexcept { return std::exchange(untaken_planning_s_, 0.0); }
+
+  /// What an image's segmentation is expected to take [s]: the fixed time, or 1.25 times the
+  /// slowest so far (0 before the first image).
+  [[nodiscard]] double segmentation_estimate() const {
+    return fixed_segmentation_s_.value_or(1.25 * slowest_segmentation_s_);
+  }
+  /// What a waypoint's planning is expected to take [s]: the fixed time, or 0.
+  [[nodiscard]] double planning_estimate() const { return fixed_planning_s_.value_or(0.0); }
+  /// Both [s]: what a forecast charges per image beyond its flight.
+  [[nodiscard]] double per_image_estimate() const { return segmentation_estimate() + planning_estimate(); }
+
+  /// Whether segmentation and planning times are both fixed (the budget then reserves exactly).
+  [[nodiscard]] bool times_fixed() const { return fixed_segmentation_s_.has_value() && fixed_planning_s_.has_value(); }
+
+  /// What the budget reserves for each step still to come beyond its flight [s]: with fixed
+  /// segmentation and planning times, their sum (exact); otherwise a bound learned from the
+  /// steps so far, each step's advance of the mission clock beyond the flight model's leg: the
+  /// largest of k steps times (k + 1) / k (for processing times spread uniformly up to some
+  /// limit, an unbiased estimate of the limit; generous while few steps are seen), and never
+  /// less than segmentation_estimate(). 0 before the first image.
+  [[nodiscard]] double step_bound() const {
+    if (times_fixed()) return per_image_estimate();
+    if (steps_ == 0) return segmentation_estimate();
+    const double k = static_cast<double>(steps_);
+    return std::max(segmentation_estimate(), slowest_step_s_ * (k + 1.0) / k);
+  }
+
+  /// What the budget reserves for the step in progress beyond the bounds of those to come [s]:
+  /// with measured times, one more bound (the decision being made is not yet charged).
+  [[nodiscard]] double this_step_reserve() const { return times_fixed() ? 0.0 : step_bound(); }
+
+ private:
+  std::optional<double> fixed_segmentation_s_;
+  std::optional<double> fixed_planning_s_;
+  double flight_s_ = 0.0;
+  double segmentation_s_ = 0.0;
+  double planning_s_ = 0.0;
+  double slowest_segmentation_s_ = 0.0;
+  double slowest_step_s_ = 0.0;           ///< the largest advance of the clock beyond a leg's flight [s]
+  double elapsed_at_last_image_s_ = 0.0;  ///< elapsed_s() when the last image was reported
+  std::size_t steps_ = 0;                 ///< images reported
+  double untaken_planning_s_ = 0.0;
+  std::optional<double> reported_elapsed_s_;
+};
+
+}  // namespace adaptseg::detail
