@@ -95,8 +95,8 @@ struct CalibrationOptions {
   /// first pooling is kept unless another beats it on the folds by more than one standard error
   /// of their paired margins (detail::select_pooling). One training field: the first only (a
   /// field's own slope either way). SlopePooling::field_entropy is not tried where the fields'
-  /// mean entropies do not spread or fewer than three fields count:
-  /// it is the fields pooling there under another name (detail::distinct_poolings). With
+  /// mean entropies do not spread or fewer than three fields count: it is the fields pooling
+  /// there under another name (detail::distinct_poolings). With
   /// pooled maps (MapFusion::pooled) on new ground, `{field_entropy, cells, fields}` did best on
   /// the leave-one-tile-out folds, and the deployment's decision models are calibrated with it;
   /// with the default fusion it lost more there than `{cells, fields}` (docs/results.md).
