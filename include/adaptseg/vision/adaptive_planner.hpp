@@ -604,10 +604,9 @@ class AdaptivePlanner {
   const DescentCoverageInfo& coverage_;  ///< options_.coverage's
   detail::PlannerClock clock_;           ///< the time account
   std::vector<double> candidates_;
-  double top_gsd_cm_ = 0.0;     ///< the GSD the top level is flown at
-  detail::PlannerRoute route_;  ///< the top-level lawnmower, its windows and their tours
-  /// A fixed-altitude lawnmower over the area (a front-aware policy's yardstick).
-  detail::LawnmowerCosts lawnmowers_;  ///< the area's lawnmowers at the candidate and top GSDs
+  double top_gsd_cm_ = 0.0;            ///< the GSD the top level is flown at
+  detail::PlannerRoute route_;         ///< the top-level lawnmower, its windows and their tours
+  detail::LawnmowerCosts lawnmowers_;  ///< the area's lawnmowers at the candidate and top GSDs (a yardstick)
 
   std::size_t top_next_ = 0;       ///< next top-level waypoint to hand out
   std::vector<Waypoint> sub_;      ///< the descent in progress, if any
