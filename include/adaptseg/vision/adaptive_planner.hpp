@@ -579,9 +579,7 @@ class AdaptivePlanner {
     out.sub_altitude_m = current_.altitude_m;
     out.descent = current_.ordinal;
     out.sigma_top = rec.sigma;
-    const cv::Rect region = region_rect(top_index);
-    const cv::Mat after = region.area() == 0 ? cv::Mat() : map_.labels()(region);
-    watch_.region_outcome(out, after, region.area() == 0 ? cv::Mat() : grid_.area().valid_mask(region),
+    watch_.region_outcome(out, map_.labels(), grid_.area().valid_mask, region_rect(top_index),
                           options_.mission.interest, map_.unknown_label());
     if (coverage_.ranks_cells)
       watch_.input_outcome(out, rec.candidates[chosen_candidate(rec.decision, rec.candidates, policy_.name())],

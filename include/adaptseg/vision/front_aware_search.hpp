@@ -144,6 +144,13 @@ struct FrontAwareGrid {
   bool pools = false;   ///< ranked with several training fields
 };
 
+/// Every training field's cell samples in one list, field after field.
+inline std::vector<CellSample> cells_of_every_field(std::span<const std::vector<CellSample>> cells) {
+  std::vector<CellSample> all;
+  for (const auto& c : cells) all.insert(all.end(), c.begin(), c.end());
+  return all;
+}
+
 /// The slope poolings of `poolings` that are not another under a second name: `field-entropy`
 /// is left out where its line is flat at every pair of GSDs on the training fields' cells
 /// `cells` (fewer than three fields count, or their mean entropies do not spread), where it is
@@ -154,8 +161,7 @@ inline std::vector<SlopePooling> distinct_poolings(std::vector<SlopePooling> poo
                                                    DecisionInput input) {
   const auto entropy = std::find(poolings.begin(), poolings.end(), SlopePooling::field_entropy);
   if (entropy == poolings.end() || poolings.size() == 1) return poolings;
-  std::vector<CellSample> all;
-  for (const auto& c : cells) all.insert(all.end(), c.begin(), c.end());
+  const std::vector<CellSample> all = cells_of_every_field(cells);
   if (all.empty() || !CellGainModel::fit(all, input, SlopePooling::field_entropy).reads_field_entropy())
     poolings.erase(entropy);
   return poolings;
@@ -408,9 +414,7 @@ template <class Fly>
   GainModel model = in.model;
   const SlopePooling pooling = grid.poolings[settings[best].pooling];
   if (grid.ranked && model.cells() && model.cells()->pooling() != pooling) {
-    std::vector<CellSample> all;
-    for (const auto& c : in.cells) all.insert(all.end(), c.begin(), c.end());
-    model.set_cells(CellGainModel::fit(all, in.adaptive.cell_input, pooling));
+    model.set_cells(CellGainModel::fit(detail::cells_of_every_field(in.cells), in.adaptive.cell_input, pooling));
   }
   return {DecisionFunction(FrontAwarePolicy(std::move(model), reference, settings[best].params)), std::move(trials)};
 }

@@ -39,13 +39,17 @@ class DescentWatch {
     fine_mass_ += c.mass(input);
   }
 
-  /// After the descent's last image: σ of the region at h' from the fused map `region_labels`
-  /// (an empty region: 0) and what the descent relabelled over the region's field
-  /// `region_field`, into `out`.
-  void region_outcome(DescentOutcome& out, const cv::Mat& region_labels, const cv::Mat& region_field,
+  /// After the descent's last image: σ of the `region` of the fused map `labels` at h' (an
+  /// empty region: 0) and what the descent relabelled over its field (`valid_mask`, the map
+  /// grid's), into `out`.
+  void region_outcome(DescentOutcome& out, const cv::Mat& labels, const cv::Mat& valid_mask, const cv::Rect& region,
                       std::span<const int> interest, int unknown_label) const {
-    out.sigma_sub = region_labels.empty() ? 0.0 : semantic_ratio(region_labels, interest, unknown_label);
-    if (!region_labels.empty()) out.relabelled = relabelling(before_, region_labels, region_field, interest);
+    if (region.area() == 0) {
+      out.sigma_sub = 0.0;
+      return;
+    }
+    out.sigma_sub = semantic_ratio(labels(region), interest, unknown_label);
+    out.relabelled = relabelling(before_, labels(region), valid_mask(region), interest);
   }
 
   /// Ranked cells: the ranking input's mass per field pixel of the region (`region_px`) over
