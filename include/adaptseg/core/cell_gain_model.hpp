@@ -211,82 +211,8 @@ class CellGainModel {
   [[nodiscard]] static CellGainModel fit(std::span<const CellSample> samples, DecisionInput input,
                                          SlopePooling pooling = SlopePooling::cells) {
     detail::require(!samples.empty(), "CellGainModel::fit: number of samples must be > 0", 0);
-    struct Group {
-      double top = 0.0, sub = 0.0;
-      std::vector<const CellSample*> cells;
-    };
-    std::vector<Group> groups;
-    for (const CellSample& s : samples) {
-      detail::require(std::isfinite(s.top_gsd_cm) && std::isfinite(s.sub_gsd_cm) && std::isfinite(s.field_gain) &&
-                          std::isfinite(s.relabelled) && std::isfinite(s.top.field_px) &&
-                          std::isfinite(s.field_share) && std::isfinite(s.field_sigma),
-                      "CellGainModel::fit: samples must be finite; field gain", s.field_gain);
-      std::size_t k = 0;
-      while (k < groups.size() &&
-             !(detail::same_gsd(groups[k].top, s.top_gsd_cm) && detail::same_gsd(groups[k].sub, s.sub_gsd_cm)))
-        ++k;
-      if (k == groups.size()) groups.push_back(Group{s.top_gsd_cm, s.sub_gsd_cm, {}});
-      groups[k].cells.push_back(&s);
-    }
     std::vector<Point> points;
-    for (const Group& g : groups) {
-      double px = 0.0;
-      for (const CellSample* c : g.cells) px += c->top.field_px;
-      const double mean_px = px > 0.0 ? px / static_cast<double>(g.cells.size()) : 1.0;
-      // Per training field, the sums of its own fits of β and α (pooled by field_slope) and its
-      // mean top-level entropy (field_entropy).
-      detail::PerField gain_sums, relabel_sums;
-      double wx = 0.0;
-      for (const CellSample* c : g.cells) {
-        const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
-        // `cells`: every cell in one field's sums, one fit.
-        const std::size_t field = pooling != SlopePooling::cells ? c->field : 0;
-        detail::FieldSlopeSums& gain = detail::sums_of(gain_sums, field);
-        gain.add(w, x, c->normalized_gain());
-        gain.add_covariate(c->top.field_px, c->top.value(DecisionInput::entropy));
-        detail::sums_of(relabel_sums, field).add(w, x, c->relabelled);
-        wx += w * x;
-      }
-      Point p{g.top, g.sub, detail::field_slope(gain_sums), 0.0, detail::field_slope(relabel_sums), 0.0, 0.0, 0.0};
-      if (pooling == SlopePooling::field_entropy) {
-        const detail::PooledSlope b = detail::field_slope_by_covariate(gain_sums);
-        p.gain_slope = b.at_reference;
-        p.entropy_slope = b.per_unit;
-        p.entropy_reference = b.reference;
-        p.entropy_low = b.low;
-        p.entropy_high = b.high;
-      }
-      double eg = 0.0, er = 0.0, wdd = 0.0, wdg = 0.0;
-      detail::PerField proxy_sums;  // per training field, the proxy's own fit of ν on d = x − x' (τ_γ)
-      bool proxy = true;
-      for (const CellSample* c : g.cells) {
-        const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
-        // β on the cell's own field (its entropy's, with field_entropy).
-        const double beta =
-            p.entropy_slope != 0.0 ? p.gain_slope_at(detail::sums_of(gain_sums, c->field).covariate()) : p.gain_slope;
-        eg += w * std::pow(c->normalized_gain() - beta * x, 2);
-        er += w * std::pow(c->relabelled - p.relabel_slope * x, 2);
-        const double xf = c->fine.value(input);
-        proxy = proxy && std::isfinite(c->top.value(input)) && std::isfinite(xf);
-        if (!proxy) continue;
-        wdd += w * (x - xf) * (x - xf);
-        wdg += w * (x - xf) * c->normalized_gain();
-        detail::sums_of(proxy_sums, c->field).add(w, x - xf, c->normalized_gain());
-      }
-      p.gain_noise = wx > 0.0 ? eg / wx : 0.0;
-      p.relabel_noise = wx > 0.0 ? er / wx : 0.0;
-      if (proxy && wdd > 0.0 && wx > 0.0) {
-        p.proxy_slope = wdg / wdd;
-        double ep = 0.0;
-        for (const CellSample* c : g.cells) {
-          const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
-          ep += w * std::pow(p.proxy_slope * (x - c->fine.value(input)) - p.gain_slope * x, 2);
-        }
-        p.proxy_noise = ep / wx;
-        p.proxy_slope_sd = detail::field_slope_spread(proxy_sums, p.proxy_slope);
-      }
-      points.push_back(p);
-    }
+    for (const GsdGroup& g : group_by_gsds(samples)) points.push_back(fit_group(g, input, pooling));
     std::sort(points.begin(), points.end(), [](const Point& a, const Point& b) {
       return a.top_gsd_cm < b.top_gsd_cm || (a.top_gsd_cm == b.top_gsd_cm && a.sub_gsd_cm < b.sub_gsd_cm);
     });
@@ -376,6 +302,98 @@ class CellGainModel {
   [[nodiscard]] const std::vector<Point>& points() const noexcept { return points_; }
 
  private:
+  /// The cells of one pair of GSDs (fit()).
+  struct GsdGroup {
+    double top = 0.0, sub = 0.0;
+    std::vector<const CellSample*> cells;
+  };
+
+  /// fit()'s samples grouped by their pair of GSDs, in the order each pair first occurs.
+  static std::vector<GsdGroup> group_by_gsds(std::span<const CellSample> samples) {
+    std::vector<GsdGroup> groups;
+    for (const CellSample& s : samples) {
+      detail::require(std::isfinite(s.top_gsd_cm) && std::isfinite(s.sub_gsd_cm) && std::isfinite(s.field_gain) &&
+                          std::isfinite(s.relabelled) && std::isfinite(s.top.field_px) &&
+                          std::isfinite(s.field_share) && std::isfinite(s.field_sigma),
+                      "CellGainModel::fit: samples must be finite; field gain", s.field_gain);
+      std::size_t k = 0;
+      while (k < groups.size() &&
+             !(detail::same_gsd(groups[k].top, s.top_gsd_cm) && detail::same_gsd(groups[k].sub, s.sub_gsd_cm)))
+        ++k;
+      if (k == groups.size()) groups.push_back(GsdGroup{s.top_gsd_cm, s.sub_gsd_cm, {}});
+      groups[k].cells.push_back(&s);
+    }
+    return groups;
+  }
+
+  /// fit()'s point of one pair of GSDs: the slopes β and α, pooled as `pooling` says, then the
+  /// noises about them and the scene check's proxy (fit_noises).
+  static Point fit_group(const GsdGroup& g, DecisionInput input, SlopePooling pooling) {
+    double px = 0.0;
+    for (const CellSample* c : g.cells) px += c->top.field_px;
+    const double mean_px = px > 0.0 ? px / static_cast<double>(g.cells.size()) : 1.0;
+    // Per training field, the sums of its own fits of β and α (pooled by field_slope) and its
+    // mean top-level entropy (field_entropy).
+    detail::PerField gain_sums, relabel_sums;
+    double wx = 0.0;
+    for (const CellSample* c : g.cells) {
+      const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
+      // `cells`: every cell in one field's sums, one fit.
+      const std::size_t field = pooling != SlopePooling::cells ? c->field : 0;
+      detail::FieldSlopeSums& gain = detail::sums_of(gain_sums, field);
+      gain.add(w, x, c->normalized_gain());
+      gain.add_covariate(c->top.field_px, c->top.value(DecisionInput::entropy));
+      detail::sums_of(relabel_sums, field).add(w, x, c->relabelled);
+      wx += w * x;
+    }
+    Point p{g.top, g.sub, detail::field_slope(gain_sums), 0.0, detail::field_slope(relabel_sums), 0.0, 0.0, 0.0};
+    if (pooling == SlopePooling::field_entropy) {
+      const detail::PooledSlope b = detail::field_slope_by_covariate(gain_sums);
+      p.gain_slope = b.at_reference;
+      p.entropy_slope = b.per_unit;
+      p.entropy_reference = b.reference;
+      p.entropy_low = b.low;
+      p.entropy_high = b.high;
+    }
+    fit_noises(g, input, mean_px, wx, gain_sums, p);
+    return p;
+  }
+
+  /// fit_group()'s noises κ about the slopes and, where every cell has its finer look's input,
+  /// the scene check's proxy γ (ν on d = x − x'), its noise and its spread between the fields.
+  static void fit_noises(const GsdGroup& g, DecisionInput input, double mean_px, double wx, detail::PerField& gain_sums,
+                         Point& p) {
+    double eg = 0.0, er = 0.0, wdd = 0.0, wdg = 0.0;
+    detail::PerField proxy_sums;  // per training field, the proxy's own fit of ν on d = x − x' (τ_γ)
+    bool proxy = true;
+    for (const CellSample* c : g.cells) {
+      const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
+      // β on the cell's own field (its entropy's, with field_entropy).
+      const double beta =
+          p.entropy_slope != 0.0 ? p.gain_slope_at(detail::sums_of(gain_sums, c->field).covariate()) : p.gain_slope;
+      eg += w * std::pow(c->normalized_gain() - beta * x, 2);
+      er += w * std::pow(c->relabelled - p.relabel_slope * x, 2);
+      const double xf = c->fine.value(input);
+      proxy = proxy && std::isfinite(c->top.value(input)) && std::isfinite(xf);
+      if (!proxy) continue;
+      wdd += w * (x - xf) * (x - xf);
+      wdg += w * (x - xf) * c->normalized_gain();
+      detail::sums_of(proxy_sums, c->field).add(w, x - xf, c->normalized_gain());
+    }
+    p.gain_noise = wx > 0.0 ? eg / wx : 0.0;
+    p.relabel_noise = wx > 0.0 ? er / wx : 0.0;
+    if (proxy && wdd > 0.0 && wx > 0.0) {
+      p.proxy_slope = wdg / wdd;
+      double ep = 0.0;
+      for (const CellSample* c : g.cells) {
+        const double x = value_of(c->top, input), w = c->top.field_px / mean_px;
+        ep += w * std::pow(p.proxy_slope * (x - c->fine.value(input)) - p.gain_slope * x, 2);
+      }
+      p.proxy_noise = ep / wx;
+      p.proxy_slope_sd = detail::field_slope_spread(proxy_sums, p.proxy_slope);
+    }
+  }
+
   [[nodiscard]] double x_of(const CellInputs& c) const noexcept { return value_of(c, input_); }
 
   /// The calibrated top-level GSD nearest `top_gsd_cm`.

@@ -93,6 +93,115 @@ using DecisionInputValues = std::array<double, kDecisionInputCount>;
 /// split on it (input `split`, EnsembleSegmentation::class_split).
 inline constexpr float kVoteShareTolerance = 1e-4f;
 
+namespace detail {
+
+/// pixel_input_rows()'s parts, chunk by chunk of kChunk pixels: what is wanted, the ensemble's
+/// split, the probability mass, the entropy and the two most likely classes, and the outputs.
+struct InputRows {
+  static constexpr std::size_t kChunk = 64;
+  static constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
+
+  /// One chunk's sums over the classes.
+  struct Chunk {
+    std::array<float, kChunk> sum{}, entropy{}, p_first{}, p_second{};
+    std::array<std::size_t, kChunk> first{}, second{};
+    std::array<float, kChunk> ambiguity{}, expected_error{}, second_choice{};
+  };
+
+  InputRows(std::span<const float* const> probabilities_, const std::array<bool, 256>& in_interest_,
+            const std::array<bool, kDecisionInputCount>& wanted_, const std::array<float*, kDecisionInputCount>& out_)
+      : probabilities(probabilities_),
+        in_interest(in_interest_),
+        wanted(wanted_),
+        out(out_),
+        classes(probabilities_.size()),
+        with_entropy(want(DecisionInput::entropy)),
+        ranked(want(DecisionInput::second_choice) || want(DecisionInput::low_confidence)),
+        from_probabilities(classes > 0 && (want(DecisionInput::ambiguity) || want(DecisionInput::expected_error) ||
+                                           ranked || with_entropy)) {}
+
+  [[nodiscard]] bool want(DecisionInput i) const { return wanted[index_of(i)] && out[index_of(i)] != nullptr; }
+
+  /// split: the members' vote shares on the classes of L strictly between none and all.
+  void split(std::span<const float* const> votes, std::size_t x0, std::size_t m) const {
+    std::array<float, kChunk> vote_sum{}, split_count{};
+    for (std::size_t c = 0; c < votes.size() && c < 256; ++c) {
+      const float* v = votes[c] + x0;
+      for (std::size_t x = 0; x < m; ++x) vote_sum[x] += v[x];
+      if (in_interest[c])
+        for (std::size_t x = 0; x < m; ++x)
+          split_count[x] += (v[x] > kVoteShareTolerance && v[x] < 1.0f - kVoteShareTolerance) ? 1.0f : 0.0f;
+    }
+    for (std::size_t x = 0; x < m; ++x)
+      out[index_of(DecisionInput::split)][x0 + x] = vote_sum[x] > 0.0f ? split_count[x] : kNan;  // no votes: unknown
+  }
+
+  /// Without probabilities: every input that needs them unknown.
+  void unknown(std::size_t x0, std::size_t m) const {
+    for (DecisionInput i : {DecisionInput::ambiguity, DecisionInput::expected_error, DecisionInput::second_choice,
+                            DecisionInput::low_confidence, DecisionInput::entropy})
+      if (want(i)) std::fill_n(out[index_of(i)] + x0, m, kNan);
+  }
+
+  /// The probability mass, the entropy, the two most likely classes (first, then second: of
+  /// classes 0 and 1 the larger first, ties to class 0; then each class c >= 2 in turn).
+  void rank(Chunk& k, std::size_t x0, std::size_t m) const {
+    if (ranked) {
+      for (std::size_t x = 0; x < m; ++x) {
+        const float a = probabilities[0][x0 + x], b = classes > 1 ? probabilities[1][x0 + x] : a;
+        const bool one = classes > 1 && b > a;
+        k.first[x] = one ? 1 : 0;
+        k.second[x] = classes > 1 ? (one ? 0 : 1) : 0;
+        k.p_first[x] = one ? b : a;
+        k.p_second[x] = one ? a : b;
+      }
+    }
+    for (std::size_t c = 0; c < classes; ++c) {
+      const float* p = probabilities[c] + x0;
+      for (std::size_t x = 0; x < m; ++x) k.sum[x] += p[x];
+      if (with_entropy)
+        for (std::size_t x = 0; x < m; ++x)
+          if (p[x] > 0.0f) k.entropy[x] -= p[x] * std::log(p[x]);
+      if (ranked && c >= 2)
+        for (std::size_t x = 0; x < m; ++x) {
+          if (p[x] > k.p_first[x]) {
+            k.second[x] = k.first[x], k.p_second[x] = k.p_first[x];
+            k.first[x] = c, k.p_first[x] = p[x];
+          } else if (p[x] > k.p_second[x]) {
+            k.second[x] = c, k.p_second[x] = p[x];
+          }
+        }
+    }
+  }
+
+  /// The inputs read from the probabilities; no probabilities at a pixel (no data): unknown.
+  void write(const Chunk& k, std::size_t x0, std::size_t m) const {
+    const float log_classes = classes > 1 ? std::log(static_cast<float>(classes)) : 1.0f;
+    for (std::size_t x = 0; x < m; ++x) {
+      const bool data = k.sum[x] > 0.0f;
+      if (want(DecisionInput::ambiguity))
+        out[index_of(DecisionInput::ambiguity)][x0 + x] = data ? k.ambiguity[x] : kNan;
+      if (want(DecisionInput::expected_error))
+        out[index_of(DecisionInput::expected_error)][x0 + x] = data ? k.expected_error[x] : kNan;
+      if (want(DecisionInput::second_choice))
+        out[index_of(DecisionInput::second_choice)][x0 + x] = data ? k.second_choice[x] : kNan;
+      if (want(DecisionInput::low_confidence))
+        out[index_of(DecisionInput::low_confidence)][x0 + x] = data ? (k.p_first[x] < 0.6f ? 1.0f : 0.0f) : kNan;
+      if (with_entropy)
+        out[index_of(DecisionInput::entropy)][x0 + x] = data ? (classes > 1 ? k.entropy[x] / log_classes : 0.0f) : kNan;
+    }
+  }
+
+  std::span<const float* const> probabilities;
+  const std::array<bool, 256>& in_interest;
+  const std::array<bool, kDecisionInputCount>& wanted;
+  const std::array<float*, kDecisionInputCount>& out;
+  std::size_t classes;
+  bool with_entropy, ranked, from_probabilities;
+};
+
+}  // namespace detail
+
 /// The per-pixel quantity behind every input, for `n` labelled pixels at once (one row of an
 /// image, say): `labels[x]` the label l of pixel x (a class index; anything outside 0..255 is no
 /// class), `probabilities[c][x]` the class probabilities (no planes for a labels-only backend:
@@ -108,98 +217,35 @@ inline void pixel_input_rows(std::size_t n, const Label* labels, std::span<const
                              std::span<const float* const> votes, const std::array<bool, 256>& in_interest,
                              const std::array<bool, kDecisionInputCount>& wanted,
                              const std::array<float*, kDecisionInputCount>& out) {
-  constexpr float nan = std::numeric_limits<float>::quiet_NaN();
-  constexpr std::size_t kChunk = 64;
-  const auto want = [&](DecisionInput i) { return wanted[index_of(i)] && out[index_of(i)] != nullptr; };
-  const std::size_t classes = probabilities.size();
-  const bool with_entropy = want(DecisionInput::entropy);
-  const bool ranked = want(DecisionInput::second_choice) || want(DecisionInput::low_confidence);
-  const bool from_probabilities =
-      classes > 0 && (want(DecisionInput::ambiguity) || want(DecisionInput::expected_error) || ranked || with_entropy);
-  for (std::size_t x0 = 0; x0 < n; x0 += kChunk) {
-    const std::size_t m = std::min(kChunk, n - x0);
+  const detail::InputRows rows{probabilities, in_interest, wanted, out};
+  for (std::size_t x0 = 0; x0 < n; x0 += detail::InputRows::kChunk) {
+    const std::size_t m = std::min(detail::InputRows::kChunk, n - x0);
     const Label* l = labels + x0;
     // σ's indicator (and boundary's: the same pixel quantity).
     for (DecisionInput i : {DecisionInput::sigma, DecisionInput::boundary})
-      if (want(i))
+      if (rows.want(i))
         for (std::size_t x = 0; x < m; ++x)
           out[index_of(i)][x0 + x] =
               l[x] >= 0 && l[x] < 256 && in_interest[static_cast<std::size_t>(l[x])] ? 1.0f : 0.0f;
-    // split: the members' vote shares on the classes of L strictly between none and all.
-    if (want(DecisionInput::split)) {
-      std::array<float, kChunk> vote_sum{}, split{};
-      for (std::size_t c = 0; c < votes.size() && c < 256; ++c) {
-        const float* v = votes[c] + x0;
-        for (std::size_t x = 0; x < m; ++x) vote_sum[x] += v[x];
-        if (in_interest[c])
-          for (std::size_t x = 0; x < m; ++x)
-            split[x] += (v[x] > kVoteShareTolerance && v[x] < 1.0f - kVoteShareTolerance) ? 1.0f : 0.0f;
-      }
-      for (std::size_t x = 0; x < m; ++x)
-        out[index_of(DecisionInput::split)][x0 + x] = vote_sum[x] > 0.0f ? split[x] : nan;  // no votes: unknown
-    }
-    if (!from_probabilities) {
-      for (DecisionInput i : {DecisionInput::ambiguity, DecisionInput::expected_error, DecisionInput::second_choice,
-                              DecisionInput::low_confidence, DecisionInput::entropy})
-        if (want(i)) std::fill_n(out[index_of(i)] + x0, m, nan);
+    if (rows.want(DecisionInput::split)) rows.split(votes, x0, m);
+    if (!rows.from_probabilities) {
+      rows.unknown(x0, m);
       continue;
     }
-    // The probability mass, the entropy, the two most likely classes (first, then second: of
-    // classes 0 and 1 the larger first, ties to class 0; then each class c >= 2 in turn).
-    std::array<float, kChunk> sum{}, entropy{}, p_first{}, p_second{};
-    std::array<std::size_t, kChunk> first{}, second{};
-    if (ranked) {
-      for (std::size_t x = 0; x < m; ++x) {
-        const float a = probabilities[0][x0 + x], b = classes > 1 ? probabilities[1][x0 + x] : a;
-        const bool one = classes > 1 && b > a;
-        first[x] = one ? 1 : 0;
-        second[x] = classes > 1 ? (one ? 0 : 1) : 0;
-        p_first[x] = one ? b : a;
-        p_second[x] = one ? a : b;
-      }
-    }
-    for (std::size_t c = 0; c < classes; ++c) {
-      const float* p = probabilities[c] + x0;
-      for (std::size_t x = 0; x < m; ++x) sum[x] += p[x];
-      if (with_entropy)
-        for (std::size_t x = 0; x < m; ++x)
-          if (p[x] > 0.0f) entropy[x] -= p[x] * std::log(p[x]);
-      if (ranked && c >= 2)
-        for (std::size_t x = 0; x < m; ++x) {
-          if (p[x] > p_first[x]) {
-            second[x] = first[x], p_second[x] = p_first[x];
-            first[x] = c, p_first[x] = p[x];
-          } else if (p[x] > p_second[x]) {
-            second[x] = c, p_second[x] = p[x];
-          }
-        }
-    }
-    std::array<float, kChunk> ambiguity{}, expected_error{}, second_choice{};
-    for (std::size_t c = 0; c < classes && c < 256; ++c) {
+    detail::InputRows::Chunk chunk;
+    rows.rank(chunk, x0, m);
+    for (std::size_t c = 0; c < rows.classes && c < 256; ++c) {
       if (!in_interest[c]) continue;
       const float* p = probabilities[c] + x0;
       for (std::size_t x = 0; x < m; ++x) {
-        ambiguity[x] += (p[x] > 0.2f && p[x] < 0.8f) ? 1.0f : 0.0f;
-        expected_error[x] += static_cast<std::size_t>(l[x]) == c ? 1.0f - p[x] : p[x];
+        chunk.ambiguity[x] += (p[x] > 0.2f && p[x] < 0.8f) ? 1.0f : 0.0f;
+        chunk.expected_error[x] += static_cast<std::size_t>(l[x]) == c ? 1.0f - p[x] : p[x];
       }
-      if (ranked)
+      if (rows.ranked)
         for (std::size_t x = 0; x < m; ++x)
-          second_choice[x] += (c == second[x] && c != first[x] && p[x] > 0.2f) ? 1.0f : 0.0f;
+          chunk.second_choice[x] += (c == chunk.second[x] && c != chunk.first[x] && p[x] > 0.2f) ? 1.0f : 0.0f;
     }
-    // No probabilities at a pixel (no data): every input that needs them unknown.
-    const float log_classes = classes > 1 ? std::log(static_cast<float>(classes)) : 1.0f;
-    for (std::size_t x = 0; x < m; ++x) {
-      const bool data = sum[x] > 0.0f;
-      if (want(DecisionInput::ambiguity)) out[index_of(DecisionInput::ambiguity)][x0 + x] = data ? ambiguity[x] : nan;
-      if (want(DecisionInput::expected_error))
-        out[index_of(DecisionInput::expected_error)][x0 + x] = data ? expected_error[x] : nan;
-      if (want(DecisionInput::second_choice))
-        out[index_of(DecisionInput::second_choice)][x0 + x] = data ? second_choice[x] : nan;
-      if (want(DecisionInput::low_confidence))
-        out[index_of(DecisionInput::low_confidence)][x0 + x] = data ? (p_first[x] < 0.6f ? 1.0f : 0.0f) : nan;
-      if (with_entropy)
-        out[index_of(DecisionInput::entropy)][x0 + x] = data ? (classes > 1 ? entropy[x] / log_classes : 0.0f) : nan;
-    }
+    rows.write(chunk, x0, m);
   }
 }
 

@@ -194,24 +194,7 @@ class GainModel {
     (void)o.fit(xo, yo, {.restarts = options.restarts, .seed = options.seed});
     (void)i.fit(xi, yi, {.restarts = options.restarts, .seed = options.seed + 1});
     (void)c.fit(xc, yr, {.restarts = options.restarts, .seed = options.seed + 2});
-    // η per descent height (samples of one candidate GSD share Δh up to rounding).
-    std::vector<EfficiencyPoint> efficiency;
-    std::vector<double> num, den;
-    for (const RegionSample& s : samples) {
-      std::size_t k = 0;
-      while (k < efficiency.size() && std::abs(efficiency[k].delta_h_m - s.delta_h_m) > 1e-6) ++k;
-      if (k == efficiency.size()) {
-        efficiency.push_back({s.delta_h_m, 0.0});
-        num.push_back(0.0);
-        den.push_back(0.0);
-      }
-      num[k] += s.normalized_field_gain() * s.relabelled.interest_share;
-      den[k] += s.relabelled.interest_share * s.relabelled.interest_share;
-    }
-    for (std::size_t k = 0; k < efficiency.size(); ++k)
-      efficiency[k].efficiency = den[k] > 0.0 ? std::max(0.0, num[k] / den[k]) : 0.0;
-    std::sort(efficiency.begin(), efficiency.end(),
-              [](const EfficiencyPoint& a, const EfficiencyPoint& b) { return a.delta_h_m < b.delta_h_m; });
+    std::vector<EfficiencyPoint> efficiency = fit_efficiency(samples);
     return GainModel(std::move(o), std::move(i), std::move(c), std::move(efficiency));
   }
 
@@ -283,6 +266,29 @@ class GainModel {
   [[nodiscard]] int updates() const noexcept { return updates_; }
 
  private:
+  /// fit()'s η per descent height (samples of one candidate GSD share Δh up to rounding): the
+  /// least-squares slope through the origin of the normalised field gain on χ, at least 0.
+  static std::vector<EfficiencyPoint> fit_efficiency(std::span<const RegionSample> samples) {
+    std::vector<EfficiencyPoint> efficiency;
+    std::vector<double> num, den;
+    for (const RegionSample& s : samples) {
+      std::size_t k = 0;
+      while (k < efficiency.size() && std::abs(efficiency[k].delta_h_m - s.delta_h_m) > 1e-6) ++k;
+      if (k == efficiency.size()) {
+        efficiency.push_back({s.delta_h_m, 0.0});
+        num.push_back(0.0);
+        den.push_back(0.0);
+      }
+      num[k] += s.normalized_field_gain() * s.relabelled.interest_share;
+      den[k] += s.relabelled.interest_share * s.relabelled.interest_share;
+    }
+    for (std::size_t k = 0; k < efficiency.size(); ++k)
+      efficiency[k].efficiency = den[k] > 0.0 ? std::max(0.0, num[k] / den[k]) : 0.0;
+    std::sort(efficiency.begin(), efficiency.end(),
+              [](const EfficiencyPoint& a, const EfficiencyPoint& b) { return a.delta_h_m < b.delta_h_m; });
+    return efficiency;
+  }
+
   /// σ(1 − σ) of σ clamped to [0, 1]: how much boundary of L a region can have.
   static double boundary(double sigma) {
     const double s = std::clamp(sigma, 0.0, 1.0);

@@ -305,6 +305,66 @@ inline FieldGeo field_geo_of(const RasterGrid& g, const std::filesystem::path& f
   return geo;
 }
 
+/// load_field's orthomosaic of the field `y` in `dir`: on the labels' grid `grid` and CRS,
+/// red, green and blue read as BGR. No data in it (a 4th band's alpha 0, as OpenDroneMap writes
+/// outside the flown area, or the bands' nodata values) is not the field: black there, as the
+/// simulator fills ground outside the orthomosaic (a network backend leaves it unlabelled), and
+/// the ignore label in `labels`, so that nothing is segmented, fused or scored there.
+[[nodiscard]] inline cv::Mat read_field_image(const std::filesystem::path& dir, const adaptseg::detail::FieldYaml& y,
+                                              const RasterGrid& grid, cv::Mat& labels) {
+  using adaptseg::detail::field_error;
+  const std::filesystem::path image_file = dir / *y.image_file;
+  const Dataset id = open(image_file);
+  if (!has_geotransform(*id))
+    field_error(y.yaml, "'" + *y.image_file + "' has no georeference but '" + y.labels_file + "' has one");
+  const RasterGrid ig = grid_of(*id, image_file);
+  OGRSpatialReference a, b;
+  a.importFromWkt(grid.crs_wkt.c_str());
+  b.importFromWkt(ig.crs_wkt.c_str());
+  const double tol = 1e-6 * grid.pixel_size_m();
+  bool same = ig.width_px == grid.width_px && ig.height_px == grid.height_px;
+  for (int i = 0; i < 6; ++i) same = same && std::abs(ig.geotransform[i] - grid.geotransform[i]) <= tol;
+  if (!same)
+    field_error(y.yaml, "'" + *y.image_file + "' and '" + y.labels_file + "' are not on the same grid (" +
+                            std::to_string(ig.width_px) + "x" + std::to_string(ig.height_px) + " px from (" +
+                            num(ig.geotransform[0]) + ", " + num(ig.geotransform[3]) + ") vs " +
+                            std::to_string(grid.width_px) + "x" + std::to_string(grid.height_px) + " px from (" +
+                            num(grid.geotransform[0]) + ", " + num(grid.geotransform[3]) +
+                            "); align them with gdalwarp -te -tr)");
+  if (!a.IsSame(&b)) field_error(y.yaml, "'" + *y.image_file + "' and '" + y.labels_file + "' differ in CRS");
+  if (id->GetRasterCount() < 3)
+    fail(image_file, std::to_string(id->GetRasterCount()) + " band(s): the image needs red, green, blue");
+  cv::Mat image = read_interleaved(*id, image_file, {3, 2, 1});  // BGR, as OpenCV
+  cv::Mat no_data(image.size(), CV_8UC1, cv::Scalar(0));
+  if (id->GetRasterCount() >= 4 && id->GetRasterBand(4)->GetColorInterpretation() == GCI_AlphaBand)
+    no_data = read_interleaved(*id, image_file, {4}) == 0;
+  const std::array<std::optional<int>, 3> nodata{nodata_byte(*id, 1, image_file), nodata_byte(*id, 2, image_file),
+                                                 nodata_byte(*id, 3, image_file)};
+  if (nodata[0] && nodata[1] && nodata[2]) {
+    cv::Mat is_nodata;
+    cv::inRange(image, cv::Scalar(*nodata[2], *nodata[1], *nodata[0]), cv::Scalar(*nodata[2], *nodata[1], *nodata[0]),
+                is_nodata);  // BGR order
+    no_data |= is_nodata;
+  }
+  image.setTo(cv::Scalar(0, 0, 0), no_data);
+  labels.setTo(cv::Scalar(y.ignore_label), no_data);
+  return image;
+}
+
+/// load_field's check of the field's `geo:` section against the raster's georeference `geo`:
+/// the section anchors the frame origin (0, 0), compared there (1 m, 0.1 degree of heading).
+inline void check_field_geo(const adaptseg::detail::FieldYaml& y, const FieldGeo& geo) {
+  const GeoPoint origin = GeoReference(geo).to_wgs84({0.0, 0.0, 0.0});
+  double s = 0, a1 = 0, a2 = 0;
+  GeographicLib::Geodesic::WGS84().Inverse(origin.latitude_deg, origin.longitude_deg, y.geo->latitude_deg,
+                                           y.geo->longitude_deg, s, a1, a2);
+  const double dh = std::remainder(y.geo->heading_deg - geo.heading_deg, 360.0);
+  if (s > 1.0 || std::abs(dh) > 0.1)
+    adaptseg::detail::field_error(y.yaml, "geo: disagrees with '" + y.labels_file + "' (field origin " + num(s) +
+                                              " m apart, heading " + num(dh) +
+                                              " degrees apart); omit geo: or correct it");
+}
+
 }  // namespace detail
 
 /// The grid of a raster file.
@@ -331,48 +391,7 @@ inline FieldGeo field_geo_of(const RasterGrid& g, const std::filesystem::path& f
   const RasterGrid grid = detail::grid_of(*ld, labels_file);
   cv::Mat labels = detail::read_labels(*ld, labels_file, y.classes, y.ignore_label);
   cv::Mat image;
-  if (y.image_file) {
-    const std::filesystem::path image_file = dir / *y.image_file;
-    const detail::Dataset id = detail::open(image_file);
-    if (!detail::has_geotransform(*id))
-      field_error(y.yaml, "'" + *y.image_file + "' has no georeference but '" + y.labels_file + "' has one");
-    const RasterGrid ig = detail::grid_of(*id, image_file);
-    OGRSpatialReference a, b;
-    a.importFromWkt(grid.crs_wkt.c_str());
-    b.importFromWkt(ig.crs_wkt.c_str());
-    const double tol = 1e-6 * grid.pixel_size_m();
-    bool same = ig.width_px == grid.width_px && ig.height_px == grid.height_px;
-    for (int i = 0; i < 6; ++i) same = same && std::abs(ig.geotransform[i] - grid.geotransform[i]) <= tol;
-    if (!same)
-      field_error(y.yaml, "'" + *y.image_file + "' and '" + y.labels_file + "' are not on the same grid (" +
-                              std::to_string(ig.width_px) + "x" + std::to_string(ig.height_px) + " px from (" +
-                              detail::num(ig.geotransform[0]) + ", " + detail::num(ig.geotransform[3]) + ") vs " +
-                              std::to_string(grid.width_px) + "x" + std::to_string(grid.height_px) + " px from (" +
-                              detail::num(grid.geotransform[0]) + ", " + detail::num(grid.geotransform[3]) +
-                              "); align them with gdalwarp -te -tr)");
-    if (!a.IsSame(&b)) field_error(y.yaml, "'" + *y.image_file + "' and '" + y.labels_file + "' differ in CRS");
-    if (id->GetRasterCount() < 3)
-      detail::fail(image_file, std::to_string(id->GetRasterCount()) + " band(s): the image needs red, green, blue");
-    image = detail::read_interleaved(*id, image_file, {3, 2, 1});  // BGR, as OpenCV
-    // No data in the orthomosaic (a 4th band's alpha 0, as OpenDroneMap writes outside the
-    // flown area, or the bands' nodata values): not the field. Black there, as the simulator
-    // fills ground outside the orthomosaic (a network backend leaves it unlabelled), and the
-    // ignore label, so that nothing is segmented, fused or scored there.
-    cv::Mat no_data(image.size(), CV_8UC1, cv::Scalar(0));
-    if (id->GetRasterCount() >= 4 && id->GetRasterBand(4)->GetColorInterpretation() == GCI_AlphaBand)
-      no_data = detail::read_interleaved(*id, image_file, {4}) == 0;
-    const std::array<std::optional<int>, 3> nodata{detail::nodata_byte(*id, 1, image_file),
-                                                   detail::nodata_byte(*id, 2, image_file),
-                                                   detail::nodata_byte(*id, 3, image_file)};
-    if (nodata[0] && nodata[1] && nodata[2]) {
-      cv::Mat is_nodata;
-      cv::inRange(image, cv::Scalar(*nodata[2], *nodata[1], *nodata[0]), cv::Scalar(*nodata[2], *nodata[1], *nodata[0]),
-                  is_nodata);  // BGR order
-      no_data |= is_nodata;
-    }
-    image.setTo(cv::Scalar(0, 0, 0), no_data);
-    labels.setTo(cv::Scalar(y.ignore_label), no_data);
-  }
+  if (y.image_file) image = detail::read_field_image(dir, y, grid, labels);
   const double gsd_cm = 100.0 * grid.pixel_size_m();
   if (y.gsd_cm && std::abs(*y.gsd_cm - gsd_cm) > 1e-6 * gsd_cm)
     field_error(y.yaml, "gsd_cm " + detail::num(*y.gsd_cm) + " disagrees with '" + y.labels_file +
@@ -384,17 +403,7 @@ inline FieldGeo field_geo_of(const RasterGrid& g, const std::filesystem::path& f
       field_error(y.yaml, e.what());
     }
   }();
-  if (y.geo) {
-    // The section anchors the frame origin (0, 0): compare it there.
-    const GeoPoint origin = GeoReference(geo).to_wgs84({0.0, 0.0, 0.0});
-    double s = 0, a1 = 0, a2 = 0;
-    GeographicLib::Geodesic::WGS84().Inverse(origin.latitude_deg, origin.longitude_deg, y.geo->latitude_deg,
-                                             y.geo->longitude_deg, s, a1, a2);
-    const double dh = std::remainder(y.geo->heading_deg - geo.heading_deg, 360.0);
-    if (s > 1.0 || std::abs(dh) > 0.1)
-      field_error(y.yaml, "geo: disagrees with '" + y.labels_file + "' (field origin " + detail::num(s) +
-                              " m apart, heading " + detail::num(dh) + " degrees apart); omit geo: or correct it");
-  }
+  if (y.geo) detail::check_field_geo(y, geo);
   adaptseg::detail::FieldYaml with_geo = y;
   with_geo.geo = geo;
   return adaptseg::detail::field_from_yaml(with_geo, gsd_cm, std::move(labels), std::move(image))

@@ -145,6 +145,243 @@ inline std::string where_text(const GeoPoint& g) {
 
 }  // namespace detail
 
+namespace detail {
+
+/// plan_site's height above the ground for the GSD; refused below the minimum altitude.
+inline double site_plan_height(const CameraModel& camera, const SitePlanOptions& options) {
+  const double height_m = camera.altitude_m(options.gsd_cm);
+  if (height_m < options.min_altitude_m)
+    throw std::invalid_argument("the survey would fly " + format_fixed(height_m, 2) + " m above the ground at " +
+                                format_fixed(options.gsd_cm, 2) + " cm/px, below the minimum altitude " +
+                                format_fixed(options.min_altitude_m, 1) + " m: with this camera fly at least " +
+                                format_fixed(std::ceil(camera.gsd_cm(options.min_altitude_m) * 100.0) / 100.0, 2) +
+                                " cm/px");
+  return height_m;
+}
+
+/// plan_site's take-off point given by the user: on the site, or refused with a hint why not
+/// (swapped coordinates, too far, off the outline). Sets the plan's home and the lawnmower's
+/// start.
+inline void place_given_home(const SurveySite& site, const GeoPoint& given, const GeoReference& frame, SitePlan& plan,
+                             SiteSurveyOptions& survey) {
+  plan.home_given = true;
+  plan.home = {given.latitude_deg, given.longitude_deg, site.geo.altitude_m};
+  const double from_centre = geodesic_distance_m(site.centre(), plan.home);
+  if (looks_swapped(site, plan.home, 1000.0))
+    throw std::invalid_argument("the take-off point " + where_text(plan.home) + " lies " +
+                                format_fixed(from_centre / 1000.0, 0) + " km from the site, whose centre is " +
+                                where_text(site.centre()) +
+                                "; swapped, it would lie on the site: are the site's latitude and longitude swapped "
+                                "(GeoJSON and KML list longitude first), or the take-off point's (LAT,LON)?");
+  if (from_centre > site.radius_m() + 10e3)
+    throw std::invalid_argument("the take-off point " + where_text(plan.home) + " lies " +
+                                format_fixed(from_centre / 1000.0, 1) + " km from the site, whose centre is " +
+                                where_text(site.centre()) + ": take off on the site");
+  plan.home_xy = frame.to_field(plan.home).head<2>();
+  if (!site.contains(plan.home_xy))
+    throw std::invalid_argument("the take-off point " + where_text(plan.home) + " lies " +
+                                format_fixed(site.distance_to_edge_m(plan.home_xy), 1) +
+                                " m off the site (outside its outline or in a hole): take off on the site, inside the "
+                                "geofence the plan carries");
+  survey.start_xy = plan.home_xy;
+}
+
+/// plan_site's terrain: the waypoints follow `dem`, refused where the DEM lies elsewhere (with
+/// the swapped-coordinates hint) or a waypoint flies below the minimum altitude.
+inline void follow_site_terrain(const SurveySite& site, const SitePlanOptions& options, const GeoReference& frame,
+                                const ElevationModel& dem, SitePlan& plan) {
+  if (!dem.elevation_m(plan.home.latitude_deg, plan.home.longitude_deg) &&
+      looks_swapped(site, dem.centre(), dem.radius_m()))
+    throw std::invalid_argument("the DEM '" + dem.file().string() + "' covers " +
+                                format_fixed(dem.radius_m() / 1000.0, 1) + " km around " + where_text(dem.centre()) +
+                                ", " + format_fixed(geodesic_distance_m(site.centre(), dem.centre()) / 1000.0, 0) +
+                                " km from the site, whose centre is " + where_text(site.centre()) +
+                                "; swapped, the site would lie on it: are the site's latitude and longitude swapped "
+                                "(GeoJSON and KML list longitude first)?");
+  std::vector<Waypoint>& path = plan.survey.waypoints;
+  plan.terrain = follow_terrain(path, frame, plan.home_xy, dem, plan.height_m);
+  for (std::size_t i = 0; i < path.size(); ++i)
+    if (plan.terrain->clearance_m[i] < options.min_altitude_m)
+      throw std::invalid_argument("waypoint " + std::to_string(i) + " flies " +
+                                  format_fixed(plan.terrain->clearance_m[i], 1) +
+                                  " m above the highest ground under its footprint (DEM), below the minimum altitude " +
+                                  format_fixed(options.min_altitude_m, 1) + " m: fly a coarser GSD");
+}
+
+/// plan_site's legs inside the geofence: the via points of every leg (between waypoints, from
+/// home, home), computed once each, and the times along them (every point a stop, the timing
+/// model's; holds at the waypoints only).
+class SiteLegs {
+ public:
+  SiteLegs(const SitePlan& plan, const FenceRouter& router, const TimingModel& timing, double margin)
+      : path_(plan.survey.waypoints),
+        home_xy_(plan.home_xy),
+        router_(router),
+        timing_(timing),
+        margin_(margin),
+        home3_(plan.home_xy.x(), plan.home_xy.y(), 0.0),
+        legs_(path_.size()),
+        out_vias_(path_.size()),
+        back_vias_(path_.size()) {
+    // Via points between waypoints i - 1 and i, z along the leg.
+    for (std::size_t i = 1; i < path_.size(); ++i) {
+      const Eigen::Vector3d a = path_[i - 1].position, b = path_[i].position;
+      const auto vias =
+          route2d(a.head<2>(), b.head<2>(), "from waypoint " + std::to_string(i - 1) + " to " + std::to_string(i));
+      double total = 0.0, run = 0.0;
+      Eigen::Vector2d prev = a.head<2>();
+      for (const auto& v : vias) total += (v - prev).norm(), prev = v;
+      total += (b.head<2>() - prev).norm();
+      prev = a.head<2>();
+      for (const auto& v : vias) {
+        run += (v - prev).norm(), prev = v;
+        legs_[i].emplace_back(v.x(), v.y(), a.z() + (b.z() - a.z()) * (total > 0.0 ? run / total : 0.0));
+      }
+    }
+  }
+
+  /// Via points from the waypoint before `i` to `i`.
+  [[nodiscard]] const std::vector<Eigen::Vector3d>& leg(std::size_t i) const { return legs_[i]; }
+  /// Via points from home to waypoint `i`, at its altitude.
+  [[nodiscard]] std::vector<Eigen::Vector3d> outbound(std::size_t i) {
+    if (!out_vias_[i])
+      out_vias_[i] =
+          route2d(home_xy_, path_[i].position.head<2>(), "from the take-off to waypoint " + std::to_string(i));
+    return at_z(*out_vias_[i], path_[i].position.z());
+  }
+  /// Via points from waypoint `i` home, at its altitude.
+  [[nodiscard]] std::vector<Eigen::Vector3d> back(std::size_t i) {
+    if (!back_vias_[i])
+      back_vias_[i] = route2d(path_[i].position.head<2>(), home_xy_, "from waypoint " + std::to_string(i) + " home");
+    return at_z(*back_vias_[i], path_[i].position.z());
+  }
+  /// Time from `from` through `vias` to `to`.
+  [[nodiscard]] double through(Eigen::Vector3d from, const std::vector<Eigen::Vector3d>& vias,
+                               const Eigen::Vector3d& to) const {
+    double t = 0.0;
+    for (const auto& v : vias) t += timing_.segment_time_s(from, v), from = v;
+    return t + timing_.segment_time_s(from, to);
+  }
+  /// Home on the ground.
+  [[nodiscard]] const Eigen::Vector3d& home() const { return home3_; }
+  /// Above home at `z`.
+  [[nodiscard]] Eigen::Vector3d above_home(double z) const { return {home3_.x(), home3_.y(), z}; }
+
+ private:
+  std::vector<Eigen::Vector2d> route2d(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                                       const std::string& what) const {
+    try {
+      return router_.route(a, b);
+    } catch (const std::invalid_argument&) {
+      throw std::invalid_argument("no route inside the geofence " + what + " keeps " + format_fixed(0.5 * margin_, 1) +
+                                  " m from its edges: the site is too narrow there for the inside margin");
+    }
+  }
+  static std::vector<Eigen::Vector3d> at_z(const std::vector<Eigen::Vector2d>& vias, double z) {
+    std::vector<Eigen::Vector3d> out;
+    for (const auto& v : vias) out.emplace_back(v.x(), v.y(), z);
+    return out;
+  }
+
+  const std::vector<Waypoint>& path_;
+  Eigen::Vector2d home_xy_;
+  const FenceRouter& router_;
+  const TimingModel& timing_;
+  double margin_;
+  Eigen::Vector3d home3_;
+  std::vector<std::vector<Eigen::Vector3d>> legs_;
+  std::vector<std::optional<std::vector<Eigen::Vector2d>>> out_vias_, back_vias_;
+};
+
+/// plan_site's sorties and their routes along `legs`, the flight and survey times.
+inline void route_sorties(const SitePlanOptions& options, const TimingModel& timing, SiteLegs& legs, SitePlan& plan) {
+  const std::vector<Waypoint>& path = plan.survey.waypoints;
+  plan.sorties = split_into_sorties(
+      path.size(), options.max_flight_s,
+      [&](std::size_t i) {
+        const double z = path[i].position.z();
+        return timing.segment_time_s(legs.home(), legs.above_home(z)) +
+               legs.through(legs.above_home(z), legs.outbound(i), path[i].position) + options.hold_s;
+      },
+      [&](std::size_t i) { return legs.through(path[i - 1].position, legs.leg(i), path[i].position) + options.hold_s; },
+      [&](std::size_t i) {
+        const double z = path[i].position.z();
+        return legs.through(path[i].position, legs.back(i), legs.above_home(z)) +
+               timing.segment_time_s(legs.above_home(z), legs.home());
+      });
+  for (const Sortie& s : plan.sorties) {
+    plan.flight_s += s.flight_s;
+    auto& route = plan.routes.emplace_back();
+    for (const auto& v : legs.outbound(s.first)) route.push_back({v, std::nullopt});
+    for (std::size_t i = s.first; i < s.end; ++i) {
+      if (i > s.first)
+        for (const auto& v : legs.leg(i)) route.push_back({v, std::nullopt});
+      route.push_back({path[i].position, i});
+    }
+    for (const auto& v : legs.back(s.end - 1)) route.push_back({v, std::nullopt});
+    for (const auto& p : route) plan.via_points += p.image ? 0 : 1;
+  }
+  plan.survey_s = options.hold_s * static_cast<double>(path.size());
+  for (std::size_t k = 1; k < path.size(); ++k)
+    plan.survey_s += timing.segment_time_s(path[k - 1].position, path[k].position);
+}
+
+/// plan_site's check of every leg a sortie flies over the DEM: up at home, along its route; the
+/// return is the autopilot's (at its RTL altitude: a warning).
+inline void check_leg_clearance(const SitePlanOptions& options, const GeoReference& frame, const ElevationModel& dem,
+                                const SiteLegs& legs, const SitePlan& plan) {
+  for (std::size_t k = 0; k < plan.sorties.size(); ++k) {
+    const auto& route = plan.routes[k];
+    std::vector<Eigen::Vector3d> legs3{legs.above_home(route.front().position.z())};
+    for (const auto& p : route) legs3.push_back(p.position);
+    std::size_t at = 0;
+    const double low = lowest_leg_clearance_m(legs3, frame, dem, plan.terrain->home_ground_m, 2.0, &at);
+    if (low < options.min_altitude_m) {
+      const auto name = [&](std::size_t r) {
+        return route[r].image ? "waypoint " + std::to_string(*route[r].image) : std::string("a via point");
+      };
+      throw std::invalid_argument(
+          (at == 0 ? "the leg from the take-off to " + name(0) : "the leg from " + name(at - 1) + " to " + name(at)) +
+          " passes " + format_fixed(low, 1) + " m above the ground (DEM), below the minimum altitude " +
+          format_fixed(options.min_altitude_m, 1) + " m: fly a coarser GSD");
+    }
+  }
+}
+
+/// What a person should read before flying the plan.
+inline std::vector<std::string> site_plan_warnings(const SurveySite& site, const SitePlanOptions& options,
+                                                   const SitePlan& plan) {
+  std::vector<std::string> warn;
+  const std::size_t waypoints = plan.survey.waypoints.size();
+  const double area = site.area_m2();
+  if (area < options.warn_min_area_m2 || area > options.warn_max_area_m2)
+    warn.push_back("the site's area is " + format_fixed(area, 0) + " m^2 (" + format_fixed(area / 1e4, 2) +
+                   " ha), outside " + format_fixed(options.warn_min_area_m2, 0) + " m^2 .. " +
+                   format_fixed(options.warn_max_area_m2 / 1e6, 0) +
+                   " km^2: is it the polygon you meant, in the units you meant?");
+  if (waypoints > options.warn_waypoints)
+    warn.push_back("the plan has " + std::to_string(waypoints) + " waypoints, more than " +
+                   std::to_string(options.warn_waypoints) + ": check the GSD (" + format_fixed(options.gsd_cm, 2) +
+                   " cm/px) against the site's " + format_fixed(area / 1e4, 1) + " ha");
+  if (plan.flight_s > options.warn_flight_s)
+    warn.push_back("the plan flies " + format_fixed(plan.flight_s / 3600.0, 1) + " h in " +
+                   std::to_string(plan.sorties.size()) + " sortie(s), more than " +
+                   format_fixed(options.warn_flight_s / 3600.0, 1) + " h");
+  if (!options.max_flight_s && plan.flight_s > options.warn_sortie_s)
+    warn.push_back("its one sortie flies " + format_fixed(plan.flight_s / 60.0, 0) + " min, longer than " +
+                   format_fixed(options.warn_sortie_s / 60.0, 0) +
+                   " min: split it into sorties that fit a battery (a flight-time limit)");
+  if (plan.terrain && plan.terrain->highest_rise_m > 0.0)
+    warn.push_back("the ground under the survey rises " + format_fixed(plan.terrain->highest_rise_m, 1) +
+                   " m above home: set the autopilot's return altitude (PX4 RTL_RETURN_ALT, ArduPilot RTL_ALT) above " +
+                   format_fixed(plan.terrain->highest_rise_m + options.min_altitude_m, 1) + " m");
+  if (geodesic_distance_m(site.centre(), GeoPoint{0.0, 0.0, 0.0}) < 10e3)
+    warn.push_back("the site lies at latitude and longitude (0, 0), in the Gulf of Guinea: are its coordinates unset?");
+  return warn;
+}
+
+}  // namespace detail
+
 /// The plan of `site` at `options.gsd_cm`, with the terrain of `dem` if given. In order:
 /// - the height the GSD flies at, refused below `min_altitude_m`;
 /// - the home point: `options.home` on the site (refused off it, with a hint where the site's
@@ -174,40 +411,9 @@ inline std::string where_text(const GeoPoint& g) {
   const TimingModel timing(options.timing);
   const GeoReference frame(site.geo);
   SitePlan plan;
-  plan.height_m = camera.altitude_m(options.gsd_cm);
-  if (plan.height_m < options.min_altitude_m)
-    throw std::invalid_argument(
-        "the survey would fly " + detail::format_fixed(plan.height_m, 2) + " m above the ground at " +
-        detail::format_fixed(options.gsd_cm, 2) + " cm/px, below the minimum altitude " +
-        detail::format_fixed(options.min_altitude_m, 1) + " m: with this camera fly at least " +
-        detail::format_fixed(std::ceil(camera.gsd_cm(options.min_altitude_m) * 100.0) / 100.0, 2) + " cm/px");
-
-  // Home on the site, or a hint why not.
+  plan.height_m = detail::site_plan_height(camera, options);
   SiteSurveyOptions survey = options.survey;
-  if (options.home) {
-    plan.home_given = true;
-    plan.home = {options.home->latitude_deg, options.home->longitude_deg, site.geo.altitude_m};
-    const double from_centre = geodesic_distance_m(site.centre(), plan.home);
-    if (looks_swapped(site, plan.home, 1000.0))
-      throw std::invalid_argument("the take-off point " + detail::where_text(plan.home) + " lies " +
-                                  detail::format_fixed(from_centre / 1000.0, 0) +
-                                  " km from the site, whose centre is " + detail::where_text(site.centre()) +
-                                  "; swapped, it would lie on the site: are the site's latitude and longitude swapped "
-                                  "(GeoJSON and KML list longitude first), or the take-off point's (LAT,LON)?");
-    if (from_centre > site.radius_m() + 10e3)
-      throw std::invalid_argument("the take-off point " + detail::where_text(plan.home) + " lies " +
-                                  detail::format_fixed(from_centre / 1000.0, 1) +
-                                  " km from the site, whose centre is " + detail::where_text(site.centre()) +
-                                  ": take off on the site");
-    plan.home_xy = frame.to_field(plan.home).head<2>();
-    if (!site.contains(plan.home_xy))
-      throw std::invalid_argument(
-          "the take-off point " + detail::where_text(plan.home) + " lies " +
-          detail::format_fixed(site.distance_to_edge_m(plan.home_xy), 1) +
-          " m off the site (outside its outline or in a hole): take off on the site, inside the "
-          "geofence the plan carries");
-    survey.start_xy = plan.home_xy;
-  }
+  if (options.home) detail::place_given_home(site, *options.home, frame, plan, survey);
   plan.survey = survey_site(site, camera, options.gsd_cm, survey);
   if (plan.survey.waypoints.empty())
     throw std::invalid_argument("no waypoint lies " + detail::format_fixed(survey.inside_margin_m, 1) +
@@ -217,26 +423,7 @@ inline std::string where_text(const GeoPoint& g) {
     plan.home = frame.to_wgs84(Eigen::Vector3d(plan.home_xy.x(), plan.home_xy.y(), 0.0));
     plan.home.altitude_m = site.geo.altitude_m;
   }
-
-  std::vector<Waypoint>& path = plan.survey.waypoints;
-  if (dem != nullptr) {
-    if (!dem->elevation_m(plan.home.latitude_deg, plan.home.longitude_deg) &&
-        looks_swapped(site, dem->centre(), dem->radius_m()))
-      throw std::invalid_argument("the DEM '" + dem->file().string() + "' covers " +
-                                  detail::format_fixed(dem->radius_m() / 1000.0, 1) + " km around " +
-                                  detail::where_text(dem->centre()) + ", " +
-                                  detail::format_fixed(geodesic_distance_m(site.centre(), dem->centre()) / 1000.0, 0) +
-                                  " km from the site, whose centre is " + detail::where_text(site.centre()) +
-                                  "; swapped, the site would lie on it: are the site's latitude and longitude swapped "
-                                  "(GeoJSON and KML list longitude first)?");
-    plan.terrain = follow_terrain(path, frame, plan.home_xy, *dem, plan.height_m);
-    for (std::size_t i = 0; i < path.size(); ++i)
-      if (plan.terrain->clearance_m[i] < options.min_altitude_m)
-        throw std::invalid_argument(
-            "waypoint " + std::to_string(i) + " flies " + detail::format_fixed(plan.terrain->clearance_m[i], 1) +
-            " m above the highest ground under its footprint (DEM), below the minimum altitude " +
-            detail::format_fixed(options.min_altitude_m, 1) + " m: fly a coarser GSD");
-  }
+  if (dem != nullptr) detail::follow_site_terrain(site, options, frame, *dem, plan);
 
   // The geofence (simplified by at most a quarter of the margin, so waypoints stay 3/4 of it
   // inside) and the router that keeps legs half the margin inside it.
@@ -248,138 +435,15 @@ inline std::string where_text(const GeoPoint& g) {
   if (!router.inside(plan.home_xy))
     throw std::invalid_argument(
         "the take-off point lies off the simplified geofence: take off farther inside the site");
+  const std::vector<Waypoint>& path = plan.survey.waypoints;
   for (std::size_t i = 0; i < path.size(); ++i)
     if (!router.inside(path[i].position.head<2>()))
       throw std::invalid_argument("waypoint " + std::to_string(i) +
                                   " lies off the simplified geofence: simplify the site's outline yourself");
-  const auto route2d = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const std::string& what) {
-    try {
-      return router.route(a, b);
-    } catch (const std::invalid_argument&) {
-      throw std::invalid_argument("no route inside the geofence " + what + " keeps " +
-                                  detail::format_fixed(0.5 * margin, 1) +
-                                  " m from its edges: the site is too narrow there for the inside margin");
-    }
-  };
-  // Via points between waypoints i - 1 and i (z along the leg); from home to i and i to home
-  // (at i's altitude), computed when a sortie needs them.
-  std::vector<std::vector<Eigen::Vector3d>> legs(path.size());
-  for (std::size_t i = 1; i < path.size(); ++i) {
-    const Eigen::Vector3d a = path[i - 1].position, b = path[i].position;
-    const auto vias =
-        route2d(a.head<2>(), b.head<2>(), "from waypoint " + std::to_string(i - 1) + " to " + std::to_string(i));
-    double total = 0.0, run = 0.0;
-    Eigen::Vector2d prev = a.head<2>();
-    for (const auto& v : vias) total += (v - prev).norm(), prev = v;
-    total += (b.head<2>() - prev).norm();
-    prev = a.head<2>();
-    for (const auto& v : vias) {
-      run += (v - prev).norm(), prev = v;
-      legs[i].emplace_back(v.x(), v.y(), a.z() + (b.z() - a.z()) * (total > 0.0 ? run / total : 0.0));
-    }
-  }
-  std::vector<std::optional<std::vector<Eigen::Vector2d>>> out_vias(path.size()), back_vias(path.size());
-  const auto outbound = [&](std::size_t i) -> const std::vector<Eigen::Vector2d>& {
-    if (!out_vias[i])
-      out_vias[i] =
-          route2d(plan.home_xy, path[i].position.head<2>(), "from the take-off to waypoint " + std::to_string(i));
-    return *out_vias[i];
-  };
-  const auto back = [&](std::size_t i) -> const std::vector<Eigen::Vector2d>& {
-    if (!back_vias[i])
-      back_vias[i] = route2d(path[i].position.head<2>(), plan.home_xy, "from waypoint " + std::to_string(i) + " home");
-    return *back_vias[i];
-  };
-  // Times along routes: every point a stop (the timing model's), holds at the waypoints only.
-  const auto through = [&](Eigen::Vector3d from, const std::vector<Eigen::Vector3d>& vias, const Eigen::Vector3d& to) {
-    double t = 0.0;
-    for (const auto& v : vias) t += timing.segment_time_s(from, v), from = v;
-    return t + timing.segment_time_s(from, to);
-  };
-  const auto at_z = [](const std::vector<Eigen::Vector2d>& vias, double z) {
-    std::vector<Eigen::Vector3d> out;
-    for (const auto& v : vias) out.emplace_back(v.x(), v.y(), z);
-    return out;
-  };
-  const Eigen::Vector3d home3(plan.home_xy.x(), plan.home_xy.y(), 0.0);
-  const auto above_home = [&](double z) { return Eigen::Vector3d(home3.x(), home3.y(), z); };
-  plan.sorties = split_into_sorties(
-      path.size(), options.max_flight_s,
-      [&](std::size_t i) {
-        const double z = path[i].position.z();
-        return timing.segment_time_s(home3, above_home(z)) +
-               through(above_home(z), at_z(outbound(i), z), path[i].position) + options.hold_s;
-      },
-      [&](std::size_t i) { return through(path[i - 1].position, legs[i], path[i].position) + options.hold_s; },
-      [&](std::size_t i) {
-        const double z = path[i].position.z();
-        return through(path[i].position, at_z(back(i), z), above_home(z)) + timing.segment_time_s(above_home(z), home3);
-      });
-  for (const Sortie& s : plan.sorties) {
-    plan.flight_s += s.flight_s;
-    auto& route = plan.routes.emplace_back();
-    for (const auto& v : at_z(outbound(s.first), path[s.first].position.z())) route.push_back({v, std::nullopt});
-    for (std::size_t i = s.first; i < s.end; ++i) {
-      if (i > s.first)
-        for (const auto& v : legs[i]) route.push_back({v, std::nullopt});
-      route.push_back({path[i].position, i});
-    }
-    for (const auto& v : at_z(back(s.end - 1), path[s.end - 1].position.z())) route.push_back({v, std::nullopt});
-    for (const auto& p : route) plan.via_points += p.image ? 0 : 1;
-  }
-  plan.survey_s = options.hold_s * static_cast<double>(path.size());
-  for (std::size_t k = 1; k < path.size(); ++k)
-    plan.survey_s += timing.segment_time_s(path[k - 1].position, path[k].position);
-
-  if (dem != nullptr) {
-    // Every leg a sortie flies over the DEM: up at home, along its route; the return is the
-    // autopilot's (at its RTL altitude: the warning below).
-    for (std::size_t k = 0; k < plan.sorties.size(); ++k) {
-      const auto& route = plan.routes[k];
-      std::vector<Eigen::Vector3d> legs3{above_home(route.front().position.z())};
-      for (const auto& p : route) legs3.push_back(p.position);
-      std::size_t at = 0;
-      const double low = lowest_leg_clearance_m(legs3, frame, *dem, plan.terrain->home_ground_m, 2.0, &at);
-      if (low < options.min_altitude_m) {
-        const auto name = [&](std::size_t r) {
-          return route[r].image ? "waypoint " + std::to_string(*route[r].image) : std::string("a via point");
-        };
-        throw std::invalid_argument(
-            (at == 0 ? "the leg from the take-off to " + name(0) : "the leg from " + name(at - 1) + " to " + name(at)) +
-            " passes " + detail::format_fixed(low, 1) + " m above the ground (DEM), below the minimum altitude " +
-            detail::format_fixed(options.min_altitude_m, 1) + " m: fly a coarser GSD");
-      }
-    }
-  }
-
-  // What a person should read before flying it.
-  auto& warn = plan.warnings;
-  const double area = site.area_m2();
-  if (area < options.warn_min_area_m2 || area > options.warn_max_area_m2)
-    warn.push_back("the site's area is " + detail::format_fixed(area, 0) + " m^2 (" +
-                   detail::format_fixed(area / 1e4, 2) + " ha), outside " +
-                   detail::format_fixed(options.warn_min_area_m2, 0) + " m^2 .. " +
-                   detail::format_fixed(options.warn_max_area_m2 / 1e6, 0) +
-                   " km^2: is it the polygon you meant, in the units you meant?");
-  if (path.size() > options.warn_waypoints)
-    warn.push_back("the plan has " + std::to_string(path.size()) + " waypoints, more than " +
-                   std::to_string(options.warn_waypoints) + ": check the GSD (" +
-                   detail::format_fixed(options.gsd_cm, 2) + " cm/px) against the site's " +
-                   detail::format_fixed(area / 1e4, 1) + " ha");
-  if (plan.flight_s > options.warn_flight_s)
-    warn.push_back("the plan flies " + detail::format_fixed(plan.flight_s / 3600.0, 1) + " h in " +
-                   std::to_string(plan.sorties.size()) + " sortie(s), more than " +
-                   detail::format_fixed(options.warn_flight_s / 3600.0, 1) + " h");
-  if (!options.max_flight_s && plan.flight_s > options.warn_sortie_s)
-    warn.push_back("its one sortie flies " + detail::format_fixed(plan.flight_s / 60.0, 0) + " min, longer than " +
-                   detail::format_fixed(options.warn_sortie_s / 60.0, 0) +
-                   " min: split it into sorties that fit a battery (a flight-time limit)");
-  if (plan.terrain && plan.terrain->highest_rise_m > 0.0)
-    warn.push_back("the ground under the survey rises " + detail::format_fixed(plan.terrain->highest_rise_m, 1) +
-                   " m above home: set the autopilot's return altitude (PX4 RTL_RETURN_ALT, ArduPilot RTL_ALT) above " +
-                   detail::format_fixed(plan.terrain->highest_rise_m + options.min_altitude_m, 1) + " m");
-  if (geodesic_distance_m(site.centre(), GeoPoint{0.0, 0.0, 0.0}) < 10e3)
-    warn.push_back("the site lies at latitude and longitude (0, 0), in the Gulf of Guinea: are its coordinates unset?");
+  detail::SiteLegs legs(plan, router, timing, margin);
+  detail::route_sorties(options, timing, legs, plan);
+  if (dem != nullptr) detail::check_leg_clearance(options, frame, *dem, legs, plan);
+  plan.warnings = detail::site_plan_warnings(site, options, plan);
   return plan;
 }
 

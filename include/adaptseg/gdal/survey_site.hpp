@@ -148,6 +148,24 @@ inline double enclosing_rectangle_angle(const std::vector<Eigen::Vector2d>& poin
   return std::atan2(longer.y, longer.x);
 }
 
+/// The mask of a site whose frame extends `width_m` x `height_m` at `map_gsd_cm`.
+/// @throws std::invalid_argument for more than 4e8 pixels, naming the coarsest GSD that fits.
+[[nodiscard]] inline cv::Size site_mask_size(double width_m, double height_m, double map_gsd_cm) {
+  const double px = 100.0 / map_gsd_cm;
+  const double cols_d = std::ceil(width_m * px - 1e-9), rows_d = std::ceil(height_m * px - 1e-9);
+  if (constexpr double kMaxPixels = 4e8; cols_d * rows_d > kMaxPixels) {
+    // The coarsest GSD, to a millimetre, whose mask fits.
+    const double fits_cm = std::ceil(map_gsd_cm * std::sqrt(cols_d * rows_d / kMaxPixels) * 10.0 + 1e-9) / 10.0;
+    throw std::invalid_argument("the site's mask at " + gdal::detail::num(map_gsd_cm) + " cm/px would be " +
+                                std::to_string(static_cast<long long>(cols_d)) + " x " +
+                                std::to_string(static_cast<long long>(rows_d)) + " = " +
+                                std::to_string(static_cast<long long>(cols_d * rows_d)) +
+                                " pixels, more than the 400000000 allowed: a map GSD of at least " +
+                                gdal::detail::num(fits_cm) + " cm/px fits (--map-gsd-cm)");
+  }
+  return {static_cast<int>(cols_d), static_cast<int>(rows_d)};
+}
+
 /// The site of `rings_enu` (east, north [m] about the tangent point `origin`; `holes[i]`: ring i
 /// is an inner ring): the frame along the enclosing rectangle's longer side, the mask
 /// rasterised at `map_gsd_cm`.
@@ -182,18 +200,8 @@ inline SurveySite site_from_rings(std::string name, const GeoPoint& origin, doub
   site.area.area = {0.0, 0.0, x1 - x0, y1 - y0};
   site.area.map_gsd_cm = map_gsd_cm;
   const double px = 100.0 / map_gsd_cm;
-  const double cols_d = std::ceil((x1 - x0) * px - 1e-9), rows_d = std::ceil((y1 - y0) * px - 1e-9);
-  if (constexpr double kMaxPixels = 4e8; cols_d * rows_d > kMaxPixels) {
-    // The coarsest GSD, to a millimetre, whose mask fits.
-    const double fits_cm = std::ceil(map_gsd_cm * std::sqrt(cols_d * rows_d / kMaxPixels) * 10.0 + 1e-9) / 10.0;
-    throw std::invalid_argument("the site's mask at " + gdal::detail::num(map_gsd_cm) + " cm/px would be " +
-                                std::to_string(static_cast<long long>(cols_d)) + " x " +
-                                std::to_string(static_cast<long long>(rows_d)) + " = " +
-                                std::to_string(static_cast<long long>(cols_d * rows_d)) +
-                                " pixels, more than the 400000000 allowed: a map GSD of at least " +
-                                gdal::detail::num(fits_cm) + " cm/px fits (--map-gsd-cm)");
-  }
-  const int cols = static_cast<int>(cols_d), rows = static_cast<int>(rows_d);
+  const cv::Size mask_size = site_mask_size(x1 - x0, y1 - y0, map_gsd_cm);
+  const int cols = mask_size.width, rows = mask_size.height;
   site.area.valid_mask = cv::Mat(rows, cols, CV_8UC1, cv::Scalar(0));
   // Each ring in the frame, and filled even-odd (an inner ring, a hole, stays out).
   for (std::size_t k = 0; k < rings_enu.size(); ++k) {
@@ -295,6 +303,48 @@ inline std::vector<std::vector<Eigen::Vector2d>> raster_outline(const std::files
   return rings;
 }
 
+/// Longitude, latitude of every ring of every Polygon and MultiPolygon of `layer`, in WGS84,
+/// into `rings`; which are holes into `holes`.
+/// @throws std::invalid_argument (prefixed `where`) for a CRS or a point that does not transform.
+inline void layer_rings(OGRLayer& layer, const std::string& where, std::vector<std::vector<Eigen::Vector2d>>& rings,
+                        std::vector<bool>& holes) {
+  OGRSpatialReference wgs84;
+  wgs84.SetWellKnownGeogCS("WGS84");
+  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  std::unique_ptr<OGRCoordinateTransformation, void (*)(OGRCoordinateTransformation*)> to_wgs84(
+      nullptr, [](OGRCoordinateTransformation* t) { OGRCoordinateTransformation::DestroyCT(t); });
+  if (const OGRSpatialReference* srs = layer.GetSpatialRef(); srs != nullptr && !srs->IsSame(&wgs84)) {
+    OGRSpatialReference src(*srs);
+    src.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    to_wgs84.reset(OGRCreateCoordinateTransformation(&src, &wgs84));
+    if (!to_wgs84) throw std::invalid_argument(where + ": its CRS has no transformation to WGS84");
+  }
+  const auto add_polygon = [&](const OGRPolygon& poly) {
+    for (int k = -1; k < poly.getNumInteriorRings(); ++k) {
+      const OGRLinearRing* ring = k < 0 ? poly.getExteriorRing() : poly.getInteriorRing(k);
+      if (ring == nullptr || ring->getNumPoints() < 3) continue;
+      std::vector<Eigen::Vector2d> r;
+      for (int i = 0; i < ring->getNumPoints(); ++i) {
+        double x = ring->getX(i), y = ring->getY(i);
+        if (to_wgs84 && !to_wgs84->Transform(1, &x, &y))
+          throw std::invalid_argument(where + ": a point does not transform to WGS84");
+        r.emplace_back(x, y);
+      }
+      rings.push_back(std::move(r));
+      holes.push_back(k >= 0);
+    }
+  };
+  layer.ResetReading();
+  for (OGRFeature* f; (f = layer.GetNextFeature()) != nullptr; OGRFeature::DestroyFeature(f)) {
+    const OGRGeometry* g = f->GetGeometryRef();
+    if (g == nullptr) continue;
+    const auto type = wkbFlatten(g->getGeometryType());
+    if (type == wkbPolygon) add_polygon(*g->toPolygon());
+    if (type == wkbMultiPolygon)
+      for (const OGRPolygon* p : *g->toMultiPolygon()) add_polygon(*p);
+  }
+}
+
 }  // namespace detail
 
 /// The site of an area file: the polygons of a vector file (GeoJSON, KML, Shapefile, ...: any
@@ -329,45 +379,9 @@ inline std::vector<std::vector<Eigen::Vector2d>> raster_outline(const std::files
                                    map_gsd_cm, altitude_m);
   }
   if (d->GetLayerCount() < 1) throw std::invalid_argument(where + ": no layer");
-  OGRLayer* layer = d->GetLayer(0);
-  OGRSpatialReference wgs84;
-  wgs84.SetWellKnownGeogCS("WGS84");
-  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  std::unique_ptr<OGRCoordinateTransformation, void (*)(OGRCoordinateTransformation*)> to_wgs84(
-      nullptr, [](OGRCoordinateTransformation* t) { OGRCoordinateTransformation::DestroyCT(t); });
-  if (const OGRSpatialReference* srs = layer->GetSpatialRef(); srs != nullptr && !srs->IsSame(&wgs84)) {
-    OGRSpatialReference src(*srs);
-    src.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    to_wgs84.reset(OGRCreateCoordinateTransformation(&src, &wgs84));
-    if (!to_wgs84) throw std::invalid_argument(where + ": its CRS has no transformation to WGS84");
-  }
-  // Longitude, latitude of every ring; which are holes.
   std::vector<std::vector<Eigen::Vector2d>> rings;
   std::vector<bool> holes;
-  const auto add_polygon = [&](const OGRPolygon& poly) {
-    for (int k = -1; k < poly.getNumInteriorRings(); ++k) {
-      const OGRLinearRing* ring = k < 0 ? poly.getExteriorRing() : poly.getInteriorRing(k);
-      if (ring == nullptr || ring->getNumPoints() < 3) continue;
-      std::vector<Eigen::Vector2d> r;
-      for (int i = 0; i < ring->getNumPoints(); ++i) {
-        double x = ring->getX(i), y = ring->getY(i);
-        if (to_wgs84 && !to_wgs84->Transform(1, &x, &y))
-          throw std::invalid_argument(where + ": a point does not transform to WGS84");
-        r.emplace_back(x, y);
-      }
-      rings.push_back(std::move(r));
-      holes.push_back(k >= 0);
-    }
-  };
-  layer->ResetReading();
-  for (OGRFeature* f; (f = layer->GetNextFeature()) != nullptr; OGRFeature::DestroyFeature(f)) {
-    const OGRGeometry* g = f->GetGeometryRef();
-    if (g == nullptr) continue;
-    const auto type = wkbFlatten(g->getGeometryType());
-    if (type == wkbPolygon) add_polygon(*g->toPolygon());
-    if (type == wkbMultiPolygon)
-      for (const OGRPolygon* p : *g->toMultiPolygon()) add_polygon(*p);
-  }
+  detail::layer_rings(*d->GetLayer(0), where, rings, holes);
   if (rings.empty())
     throw std::invalid_argument(where + ": no polygon in its first layer (an area is a Polygon or MultiPolygon)");
   return detail::site_from_wgs84(where, file.stem().string(), rings, holes, map_gsd_cm, altitude_m);

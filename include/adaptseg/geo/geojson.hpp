@@ -65,6 +65,29 @@ inline std::string write_geojson(const ExportPath& path) {
   return doc.dump(2) + "\n";
 }
 
+namespace detail {
+
+/// read_geojson's waypoint at `g` from a Point feature's `properties` (at `where`): its index
+/// and the waypoint.
+inline std::pair<long long, ExportWaypoint> geojson_waypoint(const nlohmann::json& props, const GeoPoint& g,
+                                                             const std::string& where) {
+  constexpr const char* kFmt = "GeoJSON";
+  const long long index = json_integer(json_member(props, "index", kFmt, where), 0, std::numeric_limits<int>::max(),
+                                       kFmt, where + ".index");
+  ExportWaypoint w;
+  w.latitude_deg = g.latitude_deg;
+  w.longitude_deg = g.longitude_deg;
+  w.level = static_cast<int>(json_integer(json_member(props, "level", kFmt, where), 0, std::numeric_limits<int>::max(),
+                                          kFmt, where + ".level"));
+  w.gsd_cm = json_number(json_member(props, "gsd_cm", kFmt, where), kFmt, where + ".gsd_cm");
+  w.relative_altitude_m =
+      json_number(json_member(props, "relative_altitude_m", kFmt, where), kFmt, where + ".relative_altitude_m");
+  w.via = props.contains("role") && props["role"] == "via";
+  return {index, w};
+}
+
+}  // namespace detail
+
 /// Reads what write_geojson() writes back into an ExportPath.
 /// @throws std::invalid_argument naming the offending member: not JSON, not a
 ///         FeatureCollection, a missing or mistyped member, not exactly one LineString, point
@@ -99,19 +122,8 @@ inline ExportPath read_geojson(std::string_view text) {
         line->push_back(detail::json_position(coords[k], kFmt, cwhere + "[" + std::to_string(k) + "]"));
     } else if (type == "Point") {
       const GeoPoint g = detail::json_position(coords, kFmt, cwhere);
-      const nlohmann::json& props = detail::json_member(f, "properties", kFmt, where);
       const std::string pwhere = where + ".properties";
-      const long long index = detail::json_integer(detail::json_member(props, "index", kFmt, pwhere), 0,
-                                                   std::numeric_limits<int>::max(), kFmt, pwhere + ".index");
-      ExportWaypoint w;
-      w.latitude_deg = g.latitude_deg;
-      w.longitude_deg = g.longitude_deg;
-      w.level = static_cast<int>(detail::json_integer(detail::json_member(props, "level", kFmt, pwhere), 0,
-                                                      std::numeric_limits<int>::max(), kFmt, pwhere + ".level"));
-      w.gsd_cm = detail::json_number(detail::json_member(props, "gsd_cm", kFmt, pwhere), kFmt, pwhere + ".gsd_cm");
-      w.relative_altitude_m = detail::json_number(detail::json_member(props, "relative_altitude_m", kFmt, pwhere), kFmt,
-                                                  pwhere + ".relative_altitude_m");
-      w.via = props.contains("role") && props["role"] == "via";
+      const auto [index, w] = detail::geojson_waypoint(detail::json_member(f, "properties", kFmt, where), g, pwhere);
       if (!points.emplace(index, std::make_pair(w, g)).second)
         detail::export_parse_error(kFmt, pwhere + ".index " + std::to_string(index) + " appears twice");
     } else {

@@ -43,6 +43,56 @@ inline std::string write_wpl(const ExportPath& path, const ExportOptions& option
   return out;
 }
 
+namespace detail {
+
+/// A line of a waypoint file split on runs of tabs, spaces and a trailing '\r'.
+[[nodiscard]] inline std::vector<std::string_view> wpl_fields(std::string_view line) {
+  std::vector<std::string_view> fields;
+  std::size_t i = 0;
+  const auto is_space = [](char c) { return c == '\t' || c == ' ' || c == '\r'; };
+  while (i < line.size()) {
+    while (i < line.size() && is_space(line[i])) ++i;
+    const std::size_t start = i;
+    while (i < line.size() && !is_space(line[i])) ++i;
+    if (i > start) fields.push_back(line.substr(start, i - start));
+  }
+  return fields;
+}
+
+/// The mission item of a waypoint file's line `at` of 12 `fields`, which must be number
+/// `want_seq`.
+/// @throws std::invalid_argument naming the line and field.
+[[nodiscard]] inline MissionItem wpl_item(const std::vector<std::string_view>& fields, std::size_t want_seq,
+                                          const std::string& at) {
+  constexpr const char* kFmt = "WPL";
+  long long ints[4];
+  static constexpr const char* kIntNames[] = {"seq", "current", "frame", "command"};
+  static constexpr long long kIntMax[] = {65535, 1, 255, 65535};
+  for (int k = 0; k < 4; ++k)
+    if (const auto v = parse_integer(fields[static_cast<std::size_t>(k)], 0, kIntMax[k]))
+      ints[k] = *v;
+    else
+      export_parse_error(kFmt, at + ": " + kIntNames[k] + " must be an integer in 0.." + std::to_string(kIntMax[k]) +
+                                   " (got '" + std::string(fields[static_cast<std::size_t>(k)]) + "')");
+  if (static_cast<std::size_t>(ints[0]) != want_seq)
+    export_parse_error(
+        kFmt, at + ": seq " + std::to_string(ints[0]) + " out of order (want " + std::to_string(want_seq) + ")");
+  MissionItem item;
+  item.frame = static_cast<int>(ints[2]);
+  item.command = static_cast<int>(ints[3]);
+  for (std::size_t k = 0; k < 7; ++k)
+    if (!wpl_parse(fields[4 + k], item.params[k]))
+      export_parse_error(kFmt, at + ": field " + std::to_string(5 + k) + " (param" + std::to_string(k + 1) +
+                                   ") is not a number: '" + std::string(fields[4 + k]) + "'");
+  if (fields[11] != "0" && fields[11] != "1")
+    export_parse_error(kFmt, at + ": autocontinue must be 0 or 1 (got '" + std::string(fields[11]) + "')");
+  item.autocontinue = fields[11] == "1";
+  check_item_position(item, kFmt, at);
+  return item;
+}
+
+}  // namespace detail
+
 /// Reads a MAVLink plain-text waypoint file (`QGC WPL 110`): line 0 is the home position,
 /// the rest the mission items. Fields may be separated by tabs or spaces; blank lines and a
 /// final newline are allowed; `\r\n` line ends and a UTF-8 byte-order mark are accepted.
@@ -62,16 +112,7 @@ inline MissionFile read_wpl(std::string_view text) {
     text.remove_prefix(nl == std::string_view::npos ? text.size() : nl + 1);
     ++line_no;
     const std::string at = "line " + std::to_string(line_no);
-    // Split on runs of tabs, spaces and a trailing '\r'.
-    std::vector<std::string_view> fields;
-    std::size_t i = 0;
-    const auto is_space = [](char c) { return c == '\t' || c == ' ' || c == '\r'; };
-    while (i < line.size()) {
-      while (i < line.size() && is_space(line[i])) ++i;
-      const std::size_t start = i;
-      while (i < line.size() && !is_space(line[i])) ++i;
-      if (i > start) fields.push_back(line.substr(start, i - start));
-    }
+    const std::vector<std::string_view> fields = detail::wpl_fields(line);
     if (!header) {
       if (fields.size() != 3 || fields[0] != "QGC" || fields[1] != "WPL" || fields[2] != "110")
         detail::export_parse_error(kFmt, at + ": the first line must be 'QGC WPL 110'");
@@ -84,31 +125,7 @@ inline MissionFile read_wpl(std::string_view text) {
                                            ": want 12 fields (seq current frame command p1..p4 lat lon alt "
                                            "autocontinue), got " +
                                            std::to_string(fields.size()));
-    long long ints[4];
-    static constexpr const char* kIntNames[] = {"seq", "current", "frame", "command"};
-    static constexpr long long kIntMax[] = {65535, 1, 255, 65535};
-    for (int k = 0; k < 4; ++k)
-      if (const auto v = detail::parse_integer(fields[static_cast<std::size_t>(k)], 0, kIntMax[k]))
-        ints[k] = *v;
-      else
-        detail::export_parse_error(kFmt, at + ": " + kIntNames[k] + " must be an integer in 0.." +
-                                             std::to_string(kIntMax[k]) + " (got '" +
-                                             std::string(fields[static_cast<std::size_t>(k)]) + "')");
-    const std::size_t want_seq = home ? out.items.size() + 1 : 0;
-    if (static_cast<std::size_t>(ints[0]) != want_seq)
-      detail::export_parse_error(
-          kFmt, at + ": seq " + std::to_string(ints[0]) + " out of order (want " + std::to_string(want_seq) + ")");
-    MissionItem item;
-    item.frame = static_cast<int>(ints[2]);
-    item.command = static_cast<int>(ints[3]);
-    for (std::size_t k = 0; k < 7; ++k)
-      if (!detail::wpl_parse(fields[4 + k], item.params[k]))
-        detail::export_parse_error(kFmt, at + ": field " + std::to_string(5 + k) + " (param" + std::to_string(k + 1) +
-                                             ") is not a number: '" + std::string(fields[4 + k]) + "'");
-    if (fields[11] != "0" && fields[11] != "1")
-      detail::export_parse_error(kFmt, at + ": autocontinue must be 0 or 1 (got '" + std::string(fields[11]) + "')");
-    item.autocontinue = fields[11] == "1";
-    detail::check_item_position(item, kFmt, at);
+    const MissionItem item = detail::wpl_item(fields, home ? out.items.size() + 1 : 0, at);
     if (!home) {
       if (!std::isfinite(item.params[4]) || !std::isfinite(item.params[5]) || !std::isfinite(item.params[6]))
         detail::export_parse_error(kFmt,

@@ -125,26 +125,7 @@ class Parser {
         continue;
       }
       if (payload_length > info->full_length) ++stats_.longer_payloads;
-      Frame frame;
-      frame.version = v2 ? ProtocolVersion::v2 : ProtocolVersion::v1;
-      frame.incompat_flags = incompat;
-      frame.compat_flags = v2 ? p[3] : 0;
-      frame.sequence = v2 ? p[4] : p[2];
-      frame.system_id = v2 ? p[5] : p[3];
-      frame.component_id = v2 ? p[6] : p[4];
-      frame.message_id = id;
-      frame.payload_length = static_cast<std::uint8_t>(payload_length);
-      std::copy_n(p + header_length, payload_length, frame.payload.begin());
-      frame.checksum = received;
-      if (is_signed) {
-        const std::uint8_t* s = p + checked_length + kChecksumLength;
-        FrameSignature sig;
-        sig.link_id = s[0];
-        for (std::size_t i = 6; i-- > 0;) sig.timestamp = (sig.timestamp << 8) | s[1 + i];
-        std::copy_n(s + 7, sig.signature.size(), sig.signature.begin());
-        frame.signature = sig;
-        ++stats_.signed_frames;
-      }
+      Frame frame = decode(p, v2, header_length, payload_length, id, received);
       if (!v2) ++stats_.mavlink1_frames;
       ++stats_.frames_ok;
       start_ += frame_length;
@@ -167,6 +148,34 @@ class Parser {
   }
 
  private:
+  /// The frame at `p`, checked (version `v2`, its header and payload lengths, message `id`, the
+  /// checksum `received`): its header fields, payload and signature.
+  [[nodiscard]] Frame decode(const std::uint8_t* p, bool v2, std::size_t header_length, std::size_t payload_length,
+                             std::uint32_t id, std::uint16_t received) {
+    const std::uint8_t incompat = v2 ? p[2] : 0;
+    Frame frame;
+    frame.version = v2 ? ProtocolVersion::v2 : ProtocolVersion::v1;
+    frame.incompat_flags = incompat;
+    frame.compat_flags = v2 ? p[3] : 0;
+    frame.sequence = v2 ? p[4] : p[2];
+    frame.system_id = v2 ? p[5] : p[3];
+    frame.component_id = v2 ? p[6] : p[4];
+    frame.message_id = id;
+    frame.payload_length = static_cast<std::uint8_t>(payload_length);
+    std::copy_n(p + header_length, payload_length, frame.payload.begin());
+    frame.checksum = received;
+    if ((incompat & kIncompatFlagSigned) != 0) {
+      const std::uint8_t* s = p + header_length + payload_length + kChecksumLength;
+      FrameSignature sig;
+      sig.link_id = s[0];
+      for (std::size_t i = 6; i-- > 0;) sig.timestamp = (sig.timestamp << 8) | s[1 + i];
+      std::copy_n(s + 7, sig.signature.size(), sig.signature.begin());
+      frame.signature = sig;
+      ++stats_.signed_frames;
+    }
+    return frame;
+  }
+
   void drop(std::size_t n) {
     start_ += n;
     stats_.dropped_bytes += n;

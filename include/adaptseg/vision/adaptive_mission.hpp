@@ -57,6 +57,64 @@ struct AdaptiveResult {
   }
 };
 
+namespace detail {
+
+/// A descent of run_adaptive_mission, to be scored at the end: its region's map before it and
+/// the map pixels its images covered.
+struct PendingDescent {
+  std::size_t decision;
+  cv::Rect region;
+  cv::Mat before;
+  cv::Rect covered;  ///< bounding box of the descent's footprints on the map
+  double gsd_cm;
+};
+
+/// What each descent gained, in decision order (a tour flies them in its own), against the
+/// ground truth: its region's mIoU before it and at the end, and the field's mIoU with the
+/// pixels it mapped last (covered by it and still holding its GSD in `map_gsd_cm`) against the
+/// same pixels from the top-level images alone (`top_only`).
+[[nodiscard]] inline std::vector<RealisedDescent> realised_descents(const Field& field,
+                                                                    std::vector<PendingDescent> descents,
+                                                                    const SemanticMap& top_only,
+                                                                    const cv::Mat& map_gsd_cm,
+                                                                    const MissionResult& mission) {
+  std::sort(descents.begin(), descents.end(),
+            [](const PendingDescent& a, const PendingDescent& b) { return a.decision < b.decision; });
+  const auto& interest = mission.interest;
+  const int n = field.num_classes();
+  const auto region_confusion = [&](const cv::Rect& region, const cv::Mat& labels) {
+    ConfusionMatrix cm(n);
+    cm.add(field.labels()(region), labels, field.ignore_label());
+    return cm;
+  };
+  const double final_miou = mission.miou_interest().value_or(0.0);
+  const cv::Mat& final_labels = mission.fused_labels;
+  std::vector<RealisedDescent> out;
+  for (const PendingDescent& d : descents) {
+    RealisedDescent r;
+    r.decision = d.decision;
+    std::tie(r.region_miou_before, r.region_miou_after) =
+        paired_miou(region_confusion(d.region, d.before), region_confusion(d.region, final_labels(d.region)), interest);
+    const cv::Mat owned = map_gsd_cm(d.covered) == static_cast<float>(d.gsd_cm);
+    cv::Mat reverted = final_labels(d.covered).clone();
+    top_only.labels()(d.covered).copyTo(reverted, owned);
+    const ConfusionMatrix with_it = region_confusion(d.covered, final_labels(d.covered));
+    const ConfusionMatrix without_it = region_confusion(d.covered, reverted);
+    ConfusionMatrix without = mission.confusion;
+    without -= with_it;
+    without += without_it;
+    r.field_gain = final_miou - without.miou(interest).value_or(0.0);
+    const PixelCounts a = with_it.counts(interest), b = without_it.counts(interest);
+    r.delta_tp = a.tp - b.tp;
+    r.delta_fp = a.fp - b.fp;
+    r.delta_fn = a.fn - b.fn;
+    out.push_back(r);
+  }
+  return out;
+}
+
+}  // namespace detail
+
 /// Runs the adaptive strategy with `policy` over `field` in simulation: AdaptivePlanner
 /// decides, a Mission flies (SimulatedSensor image, segmentation by `backend`, scoring, time
 /// accounting) and reports each image with the mission's elapsed time; the planner's fused
@@ -75,14 +133,7 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
   AdaptivePlanner<Backend, Policy> planner(SurveyArea::of(field), backend, policy, std::move(planner_options));
   // What each descent gained is scored at the end against the ground truth: its region's map
   // before it, the map pixels its images covered, and the top-level images alone.
-  struct Pending {
-    std::size_t decision;
-    cv::Rect region;
-    cv::Mat before;
-    cv::Rect covered;  ///< bounding box of the descent's footprints on the map
-    double gsd_cm;
-  };
-  std::vector<Pending> descents;
+  std::vector<detail::PendingDescent> descents;
   SemanticMap top_only(field.labels().size(), field.ignore_label(), options.mission.map_fusion);
   while (const auto w = planner.next()) {
     mission.charge_planning(planner.take_planning_s());
@@ -103,42 +154,11 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
     planner.report(visit.image, segmentation, visit.record->segmentation_s, mission.elapsed_s());
     if (w->level == 0) top_only.fuse(visit.image, segmentation);
   }
-  // In decision order (a tour flies them in its own).
-  std::sort(descents.begin(), descents.end(),
-            [](const Pending& a, const Pending& b) { return a.decision < b.decision; });
   // The last decision's measured time (a fixed planning time is charged per waypoint only).
   if (!mission.options().fixed_planning_time_s) mission.charge_planning(planner.take_planning_s());
   AdaptiveResult result{std::move(mission).finish(planner.map()), planner.decisions(), {}};
-  const auto& interest = result.mission.interest;
-  const int n = field.num_classes();
-  const auto region_confusion = [&](const cv::Rect& region, const cv::Mat& labels) {
-    ConfusionMatrix cm(n);
-    cm.add(field.labels()(region), labels, field.ignore_label());
-    return cm;
-  };
-  const double final_miou = result.mission.miou_interest().value_or(0.0);
-  const cv::Mat& final_labels = result.mission.fused_labels;
-  for (const Pending& d : descents) {
-    RealisedDescent r;
-    r.decision = d.decision;
-    std::tie(r.region_miou_before, r.region_miou_after) =
-        paired_miou(region_confusion(d.region, d.before), region_confusion(d.region, final_labels(d.region)), interest);
-    // The pixels this descent mapped last: covered by it and still holding its GSD.
-    const cv::Mat owned = planner.map().gsd_cm()(d.covered) == static_cast<float>(d.gsd_cm);
-    cv::Mat reverted = final_labels(d.covered).clone();
-    top_only.labels()(d.covered).copyTo(reverted, owned);
-    const ConfusionMatrix with_it = region_confusion(d.covered, final_labels(d.covered));
-    const ConfusionMatrix without_it = region_confusion(d.covered, reverted);
-    ConfusionMatrix without = result.mission.confusion;
-    without -= with_it;
-    without += without_it;
-    r.field_gain = final_miou - without.miou(interest).value_or(0.0);
-    const PixelCounts a = with_it.counts(interest), b = without_it.counts(interest);
-    r.delta_tp = a.tp - b.tp;
-    r.delta_fp = a.fp - b.fp;
-    r.delta_fn = a.fn - b.fn;
-    result.realised.push_back(r);
-  }
+  result.realised =
+      detail::realised_descents(field, std::move(descents), top_only, planner.map().gsd_cm(), result.mission);
   return result;
 }
 

@@ -153,6 +153,83 @@ inline void set_field_inputs(std::vector<ReferenceCurve>& reference,
   return linear;
 }
 
+/// Every training field's samples (collect_samples), pooled and per field; with a coverage
+/// that ranks cells, the cells also as seen from the alternative top levels
+/// (alternative_top_gsds), re-mapped at the candidates below them.
+struct TrainingSamples {
+  std::vector<RegionSample> samples;
+  std::vector<std::vector<RegionSample>> by_field;
+  std::vector<CellSample> cell_samples;
+  std::vector<std::vector<CellSample>> cells_by_field;
+};
+
+template <SegmentationBackend Backend>
+[[nodiscard]] TrainingSamples collect_training_samples(std::span<const Field> fields,
+                                                       std::span<Backend* const> backends, const CameraModel& camera,
+                                                       const AdaptiveOptions& adaptive,
+                                                       const CalibrationOptions& options) {
+  const std::vector<int>& interest = adaptive.mission.interest;
+  const bool ranked = descent_coverage_info(adaptive.coverage).ranks_cells;
+  const std::vector<double> alternative_tops = ranked ? alternative_top_gsds(options) : std::vector<double>{};
+  TrainingSamples t;
+  for (std::size_t k = 0; k < fields.size(); ++k) {
+    CalibrationSamples c =
+        collect_samples(fields[k], *backends[k], camera, adaptive.top_gsd_cm, adaptive.candidate_gsd_cm, interest,
+                        adaptive.coverage, k, adaptive.mission.map_fusion);
+    t.by_field.push_back(std::move(c.regions));
+    require(!t.by_field.back().empty(), "calibrate: the training field gave no region sample", fields[k].name());
+    t.samples.insert(t.samples.end(), t.by_field.back().begin(), t.by_field.back().end());
+    t.cells_by_field.push_back(std::move(c.cells));
+    for (double top : alternative_tops) {
+      std::vector<double> below;
+      for (double g : adaptive.candidate_gsd_cm)
+        if (g < top) below.push_back(g);
+      CalibrationSamples alt = collect_samples(fields[k], *backends[k], camera, top, below, interest, adaptive.coverage,
+                                               k, adaptive.mission.map_fusion);
+      t.cells_by_field.back().insert(t.cells_by_field.back().end(), alt.cells.begin(), alt.cells.end());
+    }
+    t.cell_samples.insert(t.cell_samples.end(), t.cells_by_field.back().begin(), t.cells_by_field.back().end());
+  }
+  return t;
+}
+
+/// The training fields' backends as the rule search flies them: a field's own, or the single
+/// field's for its halves; and a field's lawnmower curve at the lawnmower GSDs.
+template <SegmentationBackend Backend>
+struct TrainingBackends {
+  std::span<const Field> fields;
+  std::span<Backend* const> backends;
+  const std::vector<double>& lawnmower_gsd;
+  const MissionOptions& mission;
+
+  [[nodiscard]] Backend& of(const Field& f) const {
+    for (std::size_t k = 0; k < fields.size(); ++k)
+      if (&f == &fields[k]) return *backends[k];
+    require(fields.size() == 1, "calibrate: the rule search flew a field that is not a training field", f.name());
+    return *backends.front();
+  }
+  [[nodiscard]] std::vector<CurvePoint> curve(const Field& f) const {
+    std::vector<CurvePoint> c;
+    for (double g : lawnmower_gsd) {
+      const MissionResult r = run_lawnmower_mission(f, g, of(f), mission);
+      c.push_back({r.total_s(), r.miou_interest().value_or(0.0)});
+    }
+    return c;
+  }
+};
+
+/// A single training field's halves across its longer axis (the rule search flies the field
+/// and its halves); none for several fields.
+[[nodiscard]] inline std::vector<Field> single_field_halves(std::span<const Field> fields) {
+  std::vector<Field> halves;
+  if (fields.size() != 1) return halves;
+  const Field& f = fields.front();
+  const bool wide = f.width_px() >= f.height_px();
+  halves.push_back(f.sub_field(wide ? FieldRegion{0, 0, 0.5, 1} : FieldRegion{0, 0, 1, 0.5}));
+  halves.push_back(f.sub_field(wide ? FieldRegion{0.5, 0, 1, 1} : FieldRegion{0, 0.5, 1, 1}));
+  return halves;
+}
+
 }  // namespace detail
 
 /// Calibrates on the training `fields`, `backends[k]` segmenting `fields[k]`.
@@ -186,34 +263,13 @@ template <SegmentationBackend Backend>
   for (Backend* b : backends) detail::require(b != nullptr, "calibrate: a training field's backend is null", "nullptr");
   AdaptiveOptions adaptive = detail::calibration_settings(fields, options);
   const std::vector<double> lawnmower_gsd = options.lawnmower_gsds();
-  const std::vector<int>& interest = adaptive.mission.interest;
   const CameraModel camera(adaptive.mission.camera);
-
   const bool ranked = descent_coverage_info(adaptive.coverage).ranks_cells;
-  const std::vector<double> alternative_tops = ranked ? detail::alternative_top_gsds(options) : std::vector<double>{};
-  std::vector<RegionSample> samples;
-  std::vector<std::vector<RegionSample>> by_field;
-  std::vector<CellSample> cell_samples;
-  std::vector<std::vector<CellSample>> cells_by_field;
-  for (std::size_t k = 0; k < fields.size(); ++k) {
-    CalibrationSamples c =
-        collect_samples(fields[k], *backends[k], camera, adaptive.top_gsd_cm, adaptive.candidate_gsd_cm, interest,
-                        adaptive.coverage, k, adaptive.mission.map_fusion);
-    by_field.push_back(std::move(c.regions));
-    detail::require(!by_field.back().empty(), "calibrate: the training field gave no region sample", fields[k].name());
-    samples.insert(samples.end(), by_field.back().begin(), by_field.back().end());
-    cells_by_field.push_back(std::move(c.cells));
-    // The cells as seen from the alternative top levels, re-mapped at the candidates below them.
-    for (double top : alternative_tops) {
-      std::vector<double> below;
-      for (double g : adaptive.candidate_gsd_cm)
-        if (g < top) below.push_back(g);
-      CalibrationSamples alt = collect_samples(fields[k], *backends[k], camera, top, below, interest, adaptive.coverage,
-                                               k, adaptive.mission.map_fusion);
-      cells_by_field.back().insert(cells_by_field.back().end(), alt.cells.begin(), alt.cells.end());
-    }
-    cell_samples.insert(cell_samples.end(), cells_by_field.back().begin(), cells_by_field.back().end());
-  }
+  detail::TrainingSamples train = detail::collect_training_samples(fields, backends, camera, adaptive, options);
+  std::vector<RegionSample>& samples = train.samples;
+  const std::vector<std::vector<RegionSample>>& by_field = train.by_field;
+  std::vector<CellSample>& cell_samples = train.cell_samples;
+  const std::vector<std::vector<CellSample>>& cells_by_field = train.cells_by_field;
   // A coverage that ranks cells: the input that ranks the training fields' cells best.
   std::vector<std::pair<DecisionInput, double>> input_scores;
   if (ranked) {
@@ -221,26 +277,11 @@ template <SegmentationBackend Backend>
         detail::score_cell_inputs(cell_samples, options.cell_inputs, options.cell_input_score, fields.front().name());
     adaptive.cell_input = input_scores.front().first;
   }
-  // The backend of a field the rule search flies: its own, or the single field's for its halves.
-  const auto backend_of = [&](const Field& f) -> Backend& {
-    for (std::size_t k = 0; k < fields.size(); ++k)
-      if (&f == &fields[k]) return *backends[k];
-    detail::require(fields.size() == 1, "calibrate: the rule search flew a field that is not a training field",
-                    f.name());
-    return *backends.front();
-  };
-  const auto curve_of = [&](const Field& f) {
-    std::vector<CurvePoint> c;
-    for (double g : lawnmower_gsd) {
-      const MissionResult r = run_lawnmower_mission(f, g, backend_of(f), adaptive.mission);
-      c.push_back({r.total_s(), r.miou_interest().value_or(0.0)});
-    }
-    return c;
-  };
+  const detail::TrainingBackends<Backend> flights{fields, backends, lawnmower_gsd, adaptive.mission};
   std::vector<std::vector<CurvePoint>> curves;
   std::vector<ReferenceCurve> reference;
   for (std::size_t f = 0; f < fields.size(); ++f) {
-    curves.push_back(curve_of(fields[f]));
+    curves.push_back(flights.curve(fields[f]));
     ReferenceCurve r{fields[f].name(), {}, by_field[f].front().field_sigma};
     for (std::size_t k = 0; k < lawnmower_gsd.size(); ++k)
       r.points.push_back({lawnmower_gsd[k], curves.back()[k].miou});
@@ -255,21 +296,15 @@ template <SegmentationBackend Backend>
   }
 
   // Layouts of a single field: the field and its halves across the longer axis.
-  std::vector<Field> halves;
+  const std::vector<Field> halves = detail::single_field_halves(fields);
   std::vector<std::vector<CurvePoint>> half_curves;
-  if (fields.size() == 1) {
-    const Field& f = fields.front();
-    const bool wide = f.width_px() >= f.height_px();
-    halves.push_back(f.sub_field(wide ? FieldRegion{0, 0, 0.5, 1} : FieldRegion{0, 0, 1, 0.5}));
-    halves.push_back(f.sub_field(wide ? FieldRegion{0.5, 0, 1, 1} : FieldRegion{0, 0.5, 1, 1}));
-    for (const Field& h : halves) half_curves.push_back(curve_of(h));
-  }
+  for (const Field& h : halves) half_curves.push_back(flights.curve(h));
 
   // The rule's settings, chosen by its own search (decision_rules.hpp).
   const RuleSearchInputs inputs{options,     adaptive, fields,         curves, halves,
                                 half_curves, by_field, cells_by_field, model,  reference};
   const auto fly = [&](const Field& f, auto& policy, const std::vector<CurvePoint>& curve, double& margin) {
-    return detail::fly_scored(f, backend_of(f), policy, adaptive, curve, margin);
+    return detail::fly_scored(f, flights.of(f), policy, adaptive, curve, margin);
   };
   std::optional<RuleSearchResult> searched;
   for_each_rule([&]<class Rule>() {

@@ -150,88 +150,19 @@ struct DecisionModel {
   /// Writes the model as YAML (format 2).
   /// @throws std::runtime_error if the file cannot be written.
   void save(const std::filesystem::path& path) const {
-    using detail::emit_number;
-    using detail::emit_numbers;
-    const auto num = [](double v) { return detail::format_number(v); };
     YAML::Emitter e;
     e << YAML::BeginMap;
     e << YAML::Key << "format" << YAML::Value << "adaptseg.decision_model/2";
-    e << YAML::Key << "calibration" << YAML::Value << YAML::BeginMap;
-    e << YAML::Key << "fields" << YAML::Value << YAML::Flow << calibration_fields;
-    e << YAML::Key << "segmenter" << YAML::Value << segmenter;
-    if (!field_segmenters.empty())
-      e << YAML::Key << "field_segmenters" << YAML::Value << YAML::Flow << field_segmenters;
-    e << YAML::Key << "segmentation_time_s" << YAML::Value << num(calibration_segmentation_time_s);
-    e << YAML::Key << "samples" << YAML::Value << std::to_string(samples);
-    e << YAML::Key << "train_front_margin" << YAML::Value << num(train_front_margin);
-    e << YAML::EndMap;
-    e << YAML::Key << "classes" << YAML::Value << YAML::Flow << classes;
-    e << YAML::Key << "interest" << YAML::Value << YAML::Flow << interest;
-    e << YAML::Key << "camera" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "image_width_px"
-      << YAML::Value << std::to_string(camera.image_width_px) << YAML::Key << "image_height_px" << YAML::Value
-      << std::to_string(camera.image_height_px) << YAML::Key << "sensor_width_mm" << YAML::Value
-      << num(camera.sensor_width_mm) << YAML::Key << "focal_length_mm" << YAML::Value << num(camera.focal_length_mm)
-      << YAML::EndMap;
-    e << YAML::Key << "timing" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "max_speed_mps"
-      << YAML::Value << num(timing.max_speed_mps) << YAML::Key << "max_accel_mps2" << YAML::Value
-      << num(timing.max_accel_mps2);
-    // Written only when set, so that models of the isotropic model keep their bytes.
-    if (timing.max_vertical_speed_mps > 0.0)
-      e << YAML::Key << "max_vertical_speed_mps" << YAML::Value << num(timing.max_vertical_speed_mps);
-    e << YAML::EndMap;
-    e << YAML::Key << "top_gsd_cm" << YAML::Value << num(top_gsd_cm);
-    e << YAML::Key << "candidate_gsd_cm" << YAML::Value;
-    emit_numbers(e, candidate_gsd_cm);
-    e << YAML::Key << "descent_coverage" << YAML::Value << to_string(coverage);
-    // Written only when not the paper's, so that earlier models keep their bytes.
-    if (map_fusion != MapFusion::finest) e << YAML::Key << "map_fusion" << YAML::Value << to_string(map_fusion);
-    e << YAML::Key << "linear" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "sigma_low" << YAML::Value
-      << num(linear.sigma_low) << YAML::Key << "sigma_high" << YAML::Value << num(linear.sigma_high) << YAML::EndMap;
-    const GainModel& gm = decision_function.model();
-    e << YAML::Key << "gain_model" << YAML::Value << YAML::BeginMap;
-    e << YAML::Key << "gain_inputs" << YAML::Value
-      << (gm.gain_inputs() == GainModel::GainInputs::delta_sigma ? "delta-sigma" : "delta-sigma-height");
-    e << YAML::Key << "refit_every" << YAML::Value << std::to_string(gm.refit_every());
-    e << YAML::Key << "O" << YAML::Value;
-    detail::emit_gp(e, gm.o_model());
-    e << YAML::Key << "I" << YAML::Value;
-    detail::emit_gp(e, gm.i_model());
-    if (gm.c_model()) {
-      e << YAML::Key << "C" << YAML::Value;
-      detail::emit_gp(e, *gm.c_model());
-      std::vector<double> h, v;
-      for (const auto& p : gm.efficiency_points()) h.push_back(p.delta_h_m), v.push_back(p.efficiency);
-      e << YAML::Key << "efficiency" << YAML::Value << YAML::BeginMap << YAML::Key << "delta_h_m" << YAML::Value;
-      emit_numbers(e, h);
-      e << YAML::Key << "eta" << YAML::Value;
-      emit_numbers(e, v);
-      e << YAML::EndMap;
-    }
-    if (const auto& cells = gm.cells()) {
-      e << YAML::Key << "cells" << YAML::Value << YAML::BeginMap;
-      e << YAML::Key << "input" << YAML::Value << to_string(cells->input());
-      if (cells->pooling() != SlopePooling::cells)
-        e << YAML::Key << "slope_pooling" << YAML::Value << to_string(cells->pooling());
-      const auto emit_points = [&](const auto& keys) {
-        for (const auto& [key, member] : keys) {
-          std::vector<double> v;
-          for (const auto& p : cells->points()) v.push_back(p.*member);
-          e << YAML::Key << key << YAML::Value;
-          emit_numbers(e, v);
-        }
-      };
-      emit_points(kCellPointKeys);
-      if (cells->pooling() == SlopePooling::field_entropy) emit_points(kCellEntropyKeys);
-      e << YAML::EndMap;
-    }
-    e << YAML::EndMap;
+    emit_calibration(e);
+    emit_setup(e);
+    emit_gain_model(e);
     e << YAML::Key << "rule" << YAML::Value << YAML::BeginMap;
     std::visit(
         [&](const auto& rule) {
           using Rule = RuleFor<std::decay_t<decltype(rule)>>;
           e << YAML::Key << "kind" << YAML::Value << std::string(Rule::kName);
           e << YAML::Key << "online" << YAML::Value << detail::flag_text(rule.params().online);
-          e << YAML::Key << "min_sigma" << YAML::Value << num(rule.params().min_sigma);
+          e << YAML::Key << "min_sigma" << YAML::Value << detail::format_number(rule.params().min_sigma);
           Rule::write_keys(e, rule);
         },
         decision_function.rule());
@@ -275,6 +206,90 @@ struct DecisionModel {
     return s;
   }
 
+  /// save()'s calibration record.
+  void emit_calibration(YAML::Emitter& e) const {
+    const auto num = [](double v) { return detail::format_number(v); };
+    e << YAML::Key << "calibration" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "fields" << YAML::Value << YAML::Flow << calibration_fields;
+    e << YAML::Key << "segmenter" << YAML::Value << segmenter;
+    if (!field_segmenters.empty())
+      e << YAML::Key << "field_segmenters" << YAML::Value << YAML::Flow << field_segmenters;
+    e << YAML::Key << "segmentation_time_s" << YAML::Value << num(calibration_segmentation_time_s);
+    e << YAML::Key << "samples" << YAML::Value << std::to_string(samples);
+    e << YAML::Key << "train_front_margin" << YAML::Value << num(train_front_margin);
+    e << YAML::EndMap;
+  }
+
+  /// save()'s class set, camera, timing, GSDs, coverage, fusion and linear baseline (read_setup).
+  void emit_setup(YAML::Emitter& e) const {
+    const auto num = [](double v) { return detail::format_number(v); };
+    e << YAML::Key << "classes" << YAML::Value << YAML::Flow << classes;
+    e << YAML::Key << "interest" << YAML::Value << YAML::Flow << interest;
+    e << YAML::Key << "camera" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "image_width_px"
+      << YAML::Value << std::to_string(camera.image_width_px) << YAML::Key << "image_height_px" << YAML::Value
+      << std::to_string(camera.image_height_px) << YAML::Key << "sensor_width_mm" << YAML::Value
+      << num(camera.sensor_width_mm) << YAML::Key << "focal_length_mm" << YAML::Value << num(camera.focal_length_mm)
+      << YAML::EndMap;
+    e << YAML::Key << "timing" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "max_speed_mps"
+      << YAML::Value << num(timing.max_speed_mps) << YAML::Key << "max_accel_mps2" << YAML::Value
+      << num(timing.max_accel_mps2);
+    // Written only when set, so that models of the isotropic model keep their bytes.
+    if (timing.max_vertical_speed_mps > 0.0)
+      e << YAML::Key << "max_vertical_speed_mps" << YAML::Value << num(timing.max_vertical_speed_mps);
+    e << YAML::EndMap;
+    e << YAML::Key << "top_gsd_cm" << YAML::Value << num(top_gsd_cm);
+    e << YAML::Key << "candidate_gsd_cm" << YAML::Value;
+    detail::emit_numbers(e, candidate_gsd_cm);
+    e << YAML::Key << "descent_coverage" << YAML::Value << to_string(coverage);
+    // Written only when not the paper's, so that earlier models keep their bytes.
+    if (map_fusion != MapFusion::finest) e << YAML::Key << "map_fusion" << YAML::Value << to_string(map_fusion);
+    e << YAML::Key << "linear" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "sigma_low" << YAML::Value
+      << num(linear.sigma_low) << YAML::Key << "sigma_high" << YAML::Value << num(linear.sigma_high) << YAML::EndMap;
+  }
+
+  /// save()'s gain model: O, I, C and its efficiencies, the cell gain model.
+  void emit_gain_model(YAML::Emitter& e) const {
+    using detail::emit_numbers;
+    const GainModel& gm = decision_function.model();
+    e << YAML::Key << "gain_model" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "gain_inputs" << YAML::Value
+      << (gm.gain_inputs() == GainModel::GainInputs::delta_sigma ? "delta-sigma" : "delta-sigma-height");
+    e << YAML::Key << "refit_every" << YAML::Value << std::to_string(gm.refit_every());
+    e << YAML::Key << "O" << YAML::Value;
+    detail::emit_gp(e, gm.o_model());
+    e << YAML::Key << "I" << YAML::Value;
+    detail::emit_gp(e, gm.i_model());
+    if (gm.c_model()) {
+      e << YAML::Key << "C" << YAML::Value;
+      detail::emit_gp(e, *gm.c_model());
+      std::vector<double> h, v;
+      for (const auto& p : gm.efficiency_points()) h.push_back(p.delta_h_m), v.push_back(p.efficiency);
+      e << YAML::Key << "efficiency" << YAML::Value << YAML::BeginMap << YAML::Key << "delta_h_m" << YAML::Value;
+      emit_numbers(e, h);
+      e << YAML::Key << "eta" << YAML::Value;
+      emit_numbers(e, v);
+      e << YAML::EndMap;
+    }
+    if (const auto& cells = gm.cells()) {
+      e << YAML::Key << "cells" << YAML::Value << YAML::BeginMap;
+      e << YAML::Key << "input" << YAML::Value << to_string(cells->input());
+      if (cells->pooling() != SlopePooling::cells)
+        e << YAML::Key << "slope_pooling" << YAML::Value << to_string(cells->pooling());
+      const auto emit_points = [&](const auto& keys) {
+        for (const auto& [key, member] : keys) {
+          std::vector<double> v;
+          for (const auto& p : cells->points()) v.push_back(p.*member);
+          e << YAML::Key << key << YAML::Value;
+          emit_numbers(e, v);
+        }
+      };
+      emit_points(kCellPointKeys);
+      if (cells->pooling() == SlopePooling::field_entropy) emit_points(kCellEntropyKeys);
+      e << YAML::EndMap;
+    }
+    e << YAML::EndMap;
+  }
+
   /// The keys after the calibration record and the decision function (class set, camera,
   /// timing, GSDs, coverage, linear baseline), read into `m` (read_v2).
   static void read_setup(const detail::YamlReader& r, DecisionModel& m) {
@@ -298,10 +313,8 @@ struct DecisionModel {
     (void)LinearDecision(m.linear);
   }
 
-  // The reader reads keys in the order of the model's members: a file with several faults
-  // reports the first in that order.
-  static DecisionModel read_v2(const detail::YamlReader& r) {
-    const auto cal = r.map("calibration");
+  /// read_v2's gain model (`gain_model`: O, I, C and its efficiencies, the cells).
+  static GainModel read_gain_model(const detail::YamlReader& r) {
     const auto gm = r.map("gain_model");
     const std::string inputs = gm.text("gain_inputs");
     if (inputs != "delta-sigma" && inputs != "delta-sigma-height")
@@ -323,44 +336,53 @@ struct DecisionModel {
     GainModel model(gp("O", 2), gp("I", inputs == "delta-sigma" ? 1 : 2),
                     with_c ? std::optional(gp("C", 2)) : std::nullopt, std::move(efficiency),
                     static_cast<int>(gm.integer("refit_every", 0, 1'000'000'000)));
-    if (gm.has("cells")) {
-      const auto c = gm.map("cells");
-      const DecisionInput input = parse_decision_input(c.text("input"));
-      std::vector<CellGainModel::Point> points;
-      for (const auto& [key, member] : kCellPointKeys) {
-        if (member == &CellGainModel::Point::proxy_slope_sd && !c.has(key)) continue;
+    if (gm.has("cells")) model.set_cells(read_cells(r, gm.map("cells")));
+    return model;
+  }
+
+  /// read_gain_model's cell gain model (`gain_model.cells`).
+  static CellGainModel read_cells(const detail::YamlReader& r, const detail::YamlReader& c) {
+    const DecisionInput input = parse_decision_input(c.text("input"));
+    std::vector<CellGainModel::Point> points;
+    for (const auto& [key, member] : kCellPointKeys) {
+      if (member == &CellGainModel::Point::proxy_slope_sd && !c.has(key)) continue;
+      const auto v = c.numbers(key);
+      if (points.empty()) points.resize(v.size());
+      if (v.empty() || v.size() != points.size())
+        detail::yaml_error(r.where(),
+                           "'gain_model.cells' needs one top_gsd_cm, sub_gsd_cm, gain_slope, gain_noise, "
+                           "relabel_slope, relabel_noise, proxy_slope, proxy_noise and (optional) "
+                           "proxy_slope_sd value per point (>= 1 point)");
+      for (std::size_t j = 0; j < v.size(); ++j) points[j].*member = v[j];
+    }
+    // Absent (files of adaptseg before 2026-11-27, or pooled over the cells): cells.
+    SlopePooling pooling = SlopePooling::cells;
+    if (c.has("slope_pooling")) {
+      const std::string name = c.text("slope_pooling");
+      try {
+        pooling = parse_slope_pooling(name);
+      } catch (const std::invalid_argument&) {
+        detail::yaml_error(
+            r.where(), "'gain_model.cells.slope_pooling' must be cells, fields or field-entropy (got '" + name + "')");
+      }
+    }
+    if (pooling == SlopePooling::field_entropy)
+      for (const auto& [key, member] : kCellEntropyKeys) {
         const auto v = c.numbers(key);
-        if (points.empty()) points.resize(v.size());
-        if (v.empty() || v.size() != points.size())
+        if (v.size() != points.size())
           detail::yaml_error(r.where(),
-                             "'gain_model.cells' needs one top_gsd_cm, sub_gsd_cm, gain_slope, gain_noise, "
-                             "relabel_slope, relabel_noise, proxy_slope, proxy_noise and (optional) "
-                             "proxy_slope_sd value per point (>= 1 point)");
+                             "'gain_model.cells' with slope_pooling field-entropy needs one entropy_slope, "
+                             "entropy_reference, entropy_low and entropy_high value per point");
         for (std::size_t j = 0; j < v.size(); ++j) points[j].*member = v[j];
       }
-      // Absent (files of adaptseg before 2026-11-27, or pooled over the cells): cells.
-      SlopePooling pooling = SlopePooling::cells;
-      if (c.has("slope_pooling")) {
-        const std::string name = c.text("slope_pooling");
-        try {
-          pooling = parse_slope_pooling(name);
-        } catch (const std::invalid_argument&) {
-          detail::yaml_error(
-              r.where(),
-              "'gain_model.cells.slope_pooling' must be cells, fields or field-entropy (got '" + name + "')");
-        }
-      }
-      if (pooling == SlopePooling::field_entropy)
-        for (const auto& [key, member] : kCellEntropyKeys) {
-          const auto v = c.numbers(key);
-          if (v.size() != points.size())
-            detail::yaml_error(r.where(),
-                               "'gain_model.cells' with slope_pooling field-entropy needs one entropy_slope, "
-                               "entropy_reference, entropy_low and entropy_high value per point");
-          for (std::size_t j = 0; j < v.size(); ++j) points[j].*member = v[j];
-        }
-      model.set_cells(CellGainModel(input, std::move(points), pooling));
-    }
+    return CellGainModel(input, std::move(points), pooling);
+  }
+
+  // The reader reads keys in the order of the model's members: a file with several faults
+  // reports the first in that order.
+  static DecisionModel read_v2(const detail::YamlReader& r) {
+    const auto cal = r.map("calibration");
+    GainModel model = read_gain_model(r);
     const auto rule = r.map("rule");
     const std::string kind = rule.text("kind");
     const bool online = rule.flag("online");

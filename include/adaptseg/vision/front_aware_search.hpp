@@ -341,6 +341,53 @@ inline std::size_t choose_setting(std::span<const RuleTrial> trials, std::span<c
   return chosen;
 }
 
+/// The search's grid beyond z from the calibration options: the slope poolings (distinct ones,
+/// several only where the cell gain model pools several fields) and the top-level choices
+/// (several only with ranked cells).
+[[nodiscard]] inline FrontAwareGrid front_aware_grid(const RuleSearchInputs& in) {
+  const CalibrationOptions& options = in.options;
+  FrontAwareGrid grid;
+  grid.ranked = descent_coverage_info(in.adaptive.coverage).ranks_cells;
+  grid.pools = grid.ranked && in.fields.size() >= 2;
+  grid.poolings = grid.ranked ? distinct_poolings(options.slope_poolings, in.cells, in.adaptive.cell_input)
+                              : options.slope_poolings;
+  if (!grid.pools) grid.poolings.resize(1);
+  grid.top_levels =
+      options.top_levels.empty() ? std::vector<TopLevelChoice>{options.front_aware.top_level} : options.top_levels;
+  if (!grid.ranked) grid.top_levels.resize(1);
+  return grid;
+}
+
+/// Per fold, the gain ratios and margin biases its trials fly with.
+struct FoldCorrections {
+  std::vector<std::vector<GainRatio>> ratios;
+  std::vector<std::vector<MarginBias>> biases;
+};
+
+/// The gain ratios and margin biases of every fold, measured on the other folds' flights only,
+/// as its model was fitted without its field; the model's own (on every fold's flight) into
+/// `base`. Without `gain_ratios` and `margin_biases`, or with one field, `base`'s for every fold.
+template <class Fly>
+[[nodiscard]] FoldCorrections fold_corrections(const RuleSearchInputs& in, std::span<const FrontAwareFold> folds,
+                                               const FrontAwareGrid& grid, FrontAwarePolicy::Params& base, Fly& fly) {
+  const CalibrationOptions& options = in.options;
+  FoldCorrections c{std::vector<std::vector<GainRatio>>(folds.size(), base.gain_ratios),
+                    std::vector<std::vector<MarginBias>>(folds.size(), base.margin_biases)};
+  if (!(options.gain_ratios || options.margin_biases) || in.fields.size() < 2) return c;
+  const std::vector<AdaptiveResult> flights = measuring_flights(in, folds, grid, base, fly);
+  std::vector<const std::vector<CurvePoint>*> curves;
+  for (const FrontAwareFold& f : folds) curves.push_back(f.curve);
+  if (options.gain_ratios) {
+    base.gain_ratios = fold_gain_ratios(flights);
+    for (std::size_t k = 0; k < folds.size(); ++k) c.ratios[k] = fold_gain_ratios(flights, k);
+  }
+  if (options.margin_biases) {
+    base.margin_biases = fold_margin_biases(flights, curves);
+    for (std::size_t k = 0; k < folds.size(); ++k) c.biases[k] = fold_margin_biases(flights, curves, k);
+  }
+  return c;
+}
+
 }  // namespace detail
 
 /// The front-aware rule's calibration search (FrontAwareRule::search, which documents it):
@@ -350,38 +397,13 @@ template <class Fly>
 [[nodiscard]] RuleSearchResult search_front_aware(const RuleSearchInputs& in, Fly&& fly) {
   const CalibrationOptions& options = in.options;
   const std::vector<ReferenceCurve> reference(in.reference.begin(), in.reference.end());
-  detail::FrontAwareGrid grid;
-  grid.ranked = descent_coverage_info(in.adaptive.coverage).ranks_cells;
-  grid.pools = grid.ranked && in.fields.size() >= 2;
-  grid.poolings = grid.ranked ? detail::distinct_poolings(options.slope_poolings, in.cells, in.adaptive.cell_input)
-                              : options.slope_poolings;
-  if (!grid.pools) grid.poolings.resize(1);
-  grid.top_levels =
-      options.top_levels.empty() ? std::vector<TopLevelChoice>{options.front_aware.top_level} : options.top_levels;
-  if (!grid.ranked) grid.top_levels.resize(1);
+  const detail::FrontAwareGrid grid = detail::front_aware_grid(in);
   const std::vector<TopLevelTrace> traces = detail::top_level_traces(in, reference, fly);
   const std::vector<detail::FrontAwareFold> folds = detail::front_aware_folds(in, reference, traces, grid.ranked);
   FrontAwarePolicy::Params base = options.front_aware;
   base.online = true;
   detail::apply_sigma_prior(base, estimate_sigma_prior(traces), options.sigma_prior);
-  // Per fold, the gain ratios and margin biases its trials fly with: measured on the other
-  // folds' flights only, as its model was fitted without its field (the model's own: on every
-  // fold's flight).
-  std::vector<std::vector<GainRatio>> fold_ratios(folds.size(), base.gain_ratios);
-  std::vector<std::vector<MarginBias>> fold_biases(folds.size(), base.margin_biases);
-  if ((options.gain_ratios || options.margin_biases) && in.fields.size() >= 2) {
-    const std::vector<AdaptiveResult> flights = detail::measuring_flights(in, folds, grid, base, fly);
-    std::vector<const std::vector<CurvePoint>*> curves;
-    for (const detail::FrontAwareFold& f : folds) curves.push_back(f.curve);
-    if (options.gain_ratios) {
-      base.gain_ratios = detail::fold_gain_ratios(flights);
-      for (std::size_t k = 0; k < folds.size(); ++k) fold_ratios[k] = detail::fold_gain_ratios(flights, k);
-    }
-    if (options.margin_biases) {
-      base.margin_biases = detail::fold_margin_biases(flights, curves);
-      for (std::size_t k = 0; k < folds.size(); ++k) fold_biases[k] = detail::fold_margin_biases(flights, curves, k);
-    }
-  }
+  const detail::FoldCorrections corrections = detail::fold_corrections(in, folds, grid, base, fly);
   std::vector<RuleTrial> trials;
   std::vector<detail::FrontAwareSetting> settings;
   for (std::size_t pi = 0; pi < grid.poolings.size(); ++pi) {
@@ -397,8 +419,8 @@ template <class Fly>
                                        grid.top_levels.size() > 1 ? &grid.top_levels[ti] : nullptr);
         for (std::size_t k = 0; k < folds.size(); ++k) {
           FrontAwarePolicy::Params fold_params = p;
-          fold_params.gain_ratios = fold_ratios[k];
-          fold_params.margin_biases = fold_biases[k];
+          fold_params.gain_ratios = corrections.ratios[k];
+          fold_params.margin_biases = corrections.biases[k];
           double margin = 0.0;
           const AdaptiveResult r = detail::fly_fold(in, folds[k], models[k], fold_params, fly, margin);
           detail::add_to_trial(t, r, margin);

@@ -175,48 +175,18 @@ class GridInputs {
     std::vector<std::int64_t> column_field;              // ... and its field pixels per map column
     std::array<detail::ExactSum, kDecisionInputCount> sum{};
     std::array<std::int64_t, kDecisionInputCount> count{};
-    const std::vector<std::int64_t>& sigma = units_[index_of(DecisionInput::sigma)];
     // The cell's map rows / columns inside the footprint, in the footprint's frame: [a, b).
     const int y_first = std::max(r.y, fp_.y - rect_.y), x_first = std::max(r.x, fp_.x - rect_.x);
     const int a = x_first + rect_.x - fp_.x, b = std::min(r.x + r.width + rect_.x - fp_.x, fp_.width);
     if (b <= a) return detail::cell_means(sum, count, 0, wanted_);
-    const int first = col_of_[static_cast<std::size_t>(a)], last = col_of_[static_cast<std::size_t>(b - 1)];
-    const std::size_t stride = static_cast<std::size_t>(camera_.width) + 1;
     const bool all_field = cv::countNonZero(field(r)) == r.area();  // then so is every strip
     int y0 = y_first;
     for (const auto& [camera_row, rows] : row_runs) {
       const cv::Mat strip = field(cv::Rect(r.x, y0, r.width, static_cast<int>(rows)));
       const int in_strip = all_field ? strip.rows * strip.cols : cv::countNonZero(strip);
-      const std::size_t base = static_cast<std::size_t>(camera_row) * static_cast<std::size_t>(camera_.width);
-      std::array<std::int64_t, kDecisionInputCount> strip_sum{}, strip_count{};
-      // Camera pixel `cx` of this row read by `w` map pixels of the strip.
-      const auto add = [&](int cx, std::int64_t w) {
-        const std::size_t at = base + static_cast<std::size_t>(cx);
-        if (w == 0 || sigma[at] == kUnknown) return;
-        for (std::size_t k : wanted_list_) {
-          const std::int64_t v = units_[k][at];
-          if (v == kUnknown) continue;
-          strip_sum[k] += v * w;  // within 64 bits: rows_fit_
-          strip_count[k] += w;
-        }
-      };
+      StripSums st{static_cast<std::size_t>(camera_row) * static_cast<std::size_t>(camera_.width), {}, {}};
       if (in_strip == strip.rows * strip.cols && !prefix_sum_[index_of(DecisionInput::sigma)].empty()) {
-        // Field across the cell: the first and last camera columns as far as the cell reaches
-        // into them, those between from the row's prefix sums; then times the strip's rows.
-        if (first == last) {
-          add(first, b - a);
-        } else {
-          add(first, col_start_[static_cast<std::size_t>(first) + 1] - a);
-          add(last, b - col_start_[static_cast<std::size_t>(last)]);
-          const std::size_t row = static_cast<std::size_t>(camera_row) * stride;
-          for (std::size_t k : wanted_list_) {
-            strip_sum[k] += prefix_sum_[k][row + static_cast<std::size_t>(last)] -
-                            prefix_sum_[k][row + static_cast<std::size_t>(first) + 1];
-            strip_count[k] += prefix_count_[k][row + static_cast<std::size_t>(last)] -
-                              prefix_count_[k][row + static_cast<std::size_t>(first) + 1];
-          }
-        }
-        for (std::size_t k : wanted_list_) strip_sum[k] *= rows, strip_count[k] *= rows;
+        add_field_strip(st, camera_row, a, b, rows);
       } else if (in_strip > 0) {
         if (col_runs.empty()) col_runs = runs(col_of_, rect_.x - fp_.x, r.x, r.width);
         const bool full = in_strip == strip.rows * strip.cols;
@@ -236,17 +206,57 @@ class GridInputs {
             w = 0;
             for (int x = x0; x < x0 + static_cast<int>(cols); ++x) w += column_field[static_cast<std::size_t>(x)];
           }
-          add(camera_col, w);
+          add(st, camera_col, w);
           x0 += static_cast<int>(cols);
         }
       }
       y0 += static_cast<int>(rows);
       for (std::size_t k : wanted_list_) {
-        sum[k].add(strip_sum[k]);
-        count[k] += strip_count[k];
+        sum[k].add(st.sum[k]);
+        count[k] += st.count[k];
       }
     }
     return detail::cell_means(sum, count, count[index_of(DecisionInput::sigma)], wanted_);
+  }
+
+  /// One strip's sums in cell_by_camera_pixels(): the camera row's first pixel `base`, each
+  /// wanted input's units and known pixels.
+  struct StripSums {
+    std::size_t base = 0;
+    std::array<std::int64_t, kDecisionInputCount> sum{}, count{};
+  };
+
+  /// Camera pixel `cx` of the strip's row read by `w` map pixels of the strip.
+  void add(StripSums& st, int cx, std::int64_t w) const {
+    const std::size_t at = st.base + static_cast<std::size_t>(cx);
+    if (w == 0 || units_[index_of(DecisionInput::sigma)][at] == kUnknown) return;
+    for (std::size_t k : wanted_list_) {
+      const std::int64_t v = units_[k][at];
+      if (v == kUnknown) continue;
+      st.sum[k] += v * w;  // within 64 bits: rows_fit_
+      st.count[k] += w;
+    }
+  }
+
+  /// A strip of `rows` map rows reading camera row `camera_row`, field across the cell's
+  /// footprint columns [a, b): the first and last camera columns as far as the cell reaches
+  /// into them, those between from the row's prefix sums; then times the strip's rows.
+  void add_field_strip(StripSums& st, int camera_row, int a, int b, std::int64_t rows) const {
+    const int first = col_of_[static_cast<std::size_t>(a)], last = col_of_[static_cast<std::size_t>(b - 1)];
+    if (first == last) {
+      add(st, first, b - a);
+    } else {
+      add(st, first, col_start_[static_cast<std::size_t>(first) + 1] - a);
+      add(st, last, b - col_start_[static_cast<std::size_t>(last)]);
+      const std::size_t row = static_cast<std::size_t>(camera_row) * (static_cast<std::size_t>(camera_.width) + 1);
+      for (std::size_t k : wanted_list_) {
+        st.sum[k] += prefix_sum_[k][row + static_cast<std::size_t>(last)] -
+                     prefix_sum_[k][row + static_cast<std::size_t>(first) + 1];
+        st.count[k] += prefix_count_[k][row + static_cast<std::size_t>(last)] -
+                       prefix_count_[k][row + static_cast<std::size_t>(first) + 1];
+      }
+    }
+    for (std::size_t k : wanted_list_) st.sum[k] *= rows, st.count[k] *= rows;
   }
 
   /// Unturned: where each camera column's footprint columns start (col_start_), and per camera

@@ -31,6 +31,227 @@ struct CalibrationSamples {
   std::vector<CellSample> cells;
 };
 
+namespace detail {
+
+/// collect_samples() on one field: the top-level lawnmower flown once (its map and confusion are
+/// every sample's reference), then each top-level region (TopRegion) re-mapped at every
+/// candidate GSD, a RegionSample each and, with a coverage that ranks cells, a CellSample per
+/// cell of the sub-lawnmower.
+template <SegmentationBackend Backend>
+class SampleCollector {
+ public:
+  SampleCollector(const Field& field, Backend& backend, const CameraModel& camera, double top_gsd_cm,
+                  const std::vector<int>& interest, DescentCoverage coverage, std::size_t field_index, MapFusion fusion)
+      : field_(field),
+        backend_(backend),
+        camera_(camera),
+        top_gsd_cm_(top_gsd_cm),
+        interest_(interest),
+        covers_(descent_coverage_info(coverage)),
+        field_index_(field_index),
+        fusion_(fusion),
+        sensor_(field, camera),
+        planner_(camera),
+        n_(field.num_classes()),
+        ranked_(covers_.ranks_cells),
+        pooled_(fusion == MapFusion::pooled),
+        field_map_(field.labels().size(), field.ignore_label(), fusion),
+        field_cm_(n_),
+        field_px_total_(std::max(1, field.valid_pixels())),
+        grid_(0, 0, field.width_px(), field.height_px()) {
+    // The top-level lawnmower over the whole field: every sample's field terms are measured
+    // against its map.
+    tops_ = planner_.plan(field.area(), top_gsd_cm, {0.0, 0.0}, [&](const Area& a) { return keep(a); });
+    for (const auto& top : tops_) {
+      top_images_.push_back(sensor_.capture(top));
+      top_segmentations_.push_back(segment(top_images_.back()));
+      field_map_.fuse(top_images_.back(), top_segmentations_.back());
+    }
+    field_cm_.add(field.labels(), field_map_.labels(), field.ignore_label());
+    field_miou_ = field_cm_.miou(interest).value_or(0.0);
+    field_counts_ = field_cm_.counts(interest);
+    field_sigma_ = semantic_ratio(field_map_.labels(), interest, field.ignore_label());
+  }
+
+  /// Every sample of the field.
+  [[nodiscard]] CalibrationSamples collect(const std::vector<double>& candidate_gsd_cm) {
+    CalibrationSamples out;
+    for (std::size_t t = 0; t < tops_.size(); ++t) {
+      const TopRegion r = top_region(t);
+      for (double g : candidate_gsd_cm) {
+        if (g < field_.gsd_cm() * (1.0 - 1e-9)) continue;
+        descend(r, g, out);
+      }
+    }
+    return out;
+  }
+
+ private:
+  /// What the UAV knows of top-level region `t` when it plans the descent, and the field terms
+  /// without it.
+  struct TopRegion {
+    std::size_t index = 0;
+    cv::Rect region, inside;        ///< the footprint on the field's grid; its part on the grid
+    Image local;                    ///< the top-level image, pixel frame shifted to the region
+    SemanticMap map;                ///< its segmentation on the map grid
+    cv::Mat field_px;               ///< the region's field pixels: where relabelling is counted
+    ConfusionMatrix field_without;  ///< the field's confusion without this region's top-level map
+    std::vector<cv::Mat> planes;    ///< the decision inputs on the region's map grid (ranked only)
+    ConfusionMatrix cm;             ///< the top-level image's own confusion
+    double sigma = 0.0;             ///< its semantic ratio
+  };
+
+  [[nodiscard]] bool keep(const Area& a) const { return field_.has_valid(a); }
+
+  // With probabilities where the cells' inputs or a pooled map read them (SemanticMap::fuse
+  // refuses a pooled map a segmentation without them).
+  [[nodiscard]] Segmentation segment(const Image& image) {
+    return ranked_ || pooled_ ? segment_with_probabilities_checked(backend_, image, n_)
+                              : Segmentation{segment_checked(backend_, image, n_), {}};
+  }
+
+  [[nodiscard]] TopRegion top_region(std::size_t t) const {
+    const Image& top_image = top_images_[t];
+    const Segmentation& top_segmentation = top_segmentations_[t];
+    const cv::Rect region = top_image.footprint_px;
+    TopRegion r{t,
+                region,
+                region & grid_,
+                top_image,
+                SemanticMap(region.size(), field_.ignore_label(), fusion_),
+                cv::Mat(region.size(), CV_8UC1, cv::Scalar(0)),
+                field_cm_,
+                {},
+                image_confusion(top_image, top_segmentation.labels, n_),
+                semantic_ratio(top_segmentation.labels, interest_, top_image.ignore_label)};
+    r.local.footprint_px -= region.tl();
+    r.map.fuse(r.local, top_segmentation);
+    field_.valid_mask()(r.inside).copyTo(r.field_px(r.inside - region.tl()));
+    ConfusionMatrix here(n_);
+    here.add(field_.labels()(r.inside), field_map_.labels()(r.inside), field_.ignore_label());
+    r.field_without -= here;
+    if (ranked_)
+      r.planes = planes_on_grid(top_image, pixel_inputs(top_segmentation, interest_, field_.ignore_label()), region);
+    return r;
+  }
+
+  /// The region `r` re-mapped by a sub-lawnmower at `g`: its RegionSample and CellSamples.
+  void descend(const TopRegion& r, double g, CalibrationSamples& out) {
+    const Waypoint& top = tops_[r.index];
+    const auto keep_cell = [&](const Area& a) {
+      return keep(a) && (!covers_.flies || covers_.flies(r.map.labels(), field_.pixel_rect(a) - r.region.tl(),
+                                                         top_gsd_cm_, field_.gsd_cm(), interest_));
+    };
+    const auto sub = planner_.plan(top.footprint, g, Eigen::Vector2d(top.position.x(), top.position.y()), keep_cell);
+    if (sub.empty()) return;
+    // Fuse the sub-lawnmower into a map of the region alone (pixel frame shifted). Cells a
+    // coverage leaves out keep their top-level labels, as in the mission's map; a pooled map
+    // pools the finer images with the top-level one everywhere.
+    SemanticMap local(r.region.size(), field_.ignore_label(), fusion_);
+    if (covers_.flies || pooled_) local.fuse(r.local, top_segmentations_[r.index]);
+    // Ranked: each finer image's own decision inputs over its cell (the scene check's proxy).
+    std::vector<CellInputs> fine_inputs;
+    for (const auto& w : sub) {
+      Image img = sensor_.capture(w);
+      const Segmentation seg = segment(img);
+      img.footprint_px -= r.region.tl();
+      local.fuse(img, seg);
+      if (!ranked_) continue;
+      const cv::Rect cell = ((field_.pixel_rect(w.footprint) & r.inside) - r.region.tl()) &
+                            cv::Rect(0, 0, r.region.width, r.region.height);
+      if (cell.area() == 0) {
+        fine_inputs.emplace_back();
+        continue;
+      }
+      const auto planes = planes_on_grid(img, pixel_inputs(seg, interest_, field_.ignore_label()), cell);
+      fine_inputs.push_back(cell_inputs(planes, r.field_px(cell), cv::Rect(0, 0, cell.width, cell.height)));
+    }
+    ConfusionMatrix sub_cm(n_);
+    sub_cm.add(top_images_[r.index].ground_truth, local.labels(), field_.ignore_label());
+    // What the descent changed in the mission's map (where the sub-lawnmower wrote nothing,
+    // the map keeps the top-level labels): C's target.
+    cv::Mat after = r.map.labels().clone();
+    local.labels().copyTo(after, local.labels() != field_.ignore_label());
+    RegionSample s;
+    s.field = field_index_;
+    s.relabelled = relabelling(r.map.labels(), after, r.field_px, interest_);
+    s.region_share = cv::countNonZero(r.field_px) / field_px_total_;
+    s.field_sigma = field_sigma_;
+    ConfusionMatrix with = r.field_without;
+    with.add(field_.labels()(r.inside), after(r.inside - r.region.tl()), field_.ignore_label());
+    s.field_gain = with.miou(interest_).value_or(0.0) - field_miou_;
+    if (ranked_) cell_samples(r, g, sub, fine_inputs, after, out);
+    s.top_gsd_cm = top_gsd_cm_;
+    s.sub_gsd_cm = g;
+    s.delta_h_m = camera_.altitude_m(top_gsd_cm_) - camera_.altitude_m(g);
+    s.sigma_top = r.sigma;
+    s.sigma_sub = semantic_ratio(local.labels(), interest_, field_.ignore_label());
+    std::tie(s.miou_top, s.miou_sub) = paired_miou(r.cm, sub_cm, interest_);
+    out.regions.push_back(s);
+  }
+
+  /// Each cell of the sub-lawnmower `sub` re-mapped alone: the field's top-level map with the
+  /// cell's pixels from the finer images (`after`; the cells of one sub-lawnmower tile the region).
+  void cell_samples(const TopRegion& r, double g, const std::vector<Waypoint>& sub,
+                    const std::vector<CellInputs>& fine_inputs, const cv::Mat& after, CalibrationSamples& out) const {
+    for (std::size_t k = 0; k < sub.size(); ++k) {
+      const cv::Rect cell_in = field_.pixel_rect(sub[k].footprint) & r.inside;
+      if (cell_in.area() == 0) continue;
+      const cv::Rect cell = cell_in - r.region.tl();
+      CellSample c;
+      c.field = field_index_;
+      c.region = r.index;
+      c.top_gsd_cm = top_gsd_cm_;
+      c.sub_gsd_cm = g;
+      c.top = cell_inputs(r.planes, r.field_px, cell);
+      if (!(c.top.field_px > 0.0)) continue;
+      c.fine = fine_inputs[k];
+      c.field_share = c.top.field_px / field_px_total_;
+      c.field_sigma = field_sigma_;
+      c.relabelled = relabelling(r.map.labels()(cell), after(cell), r.field_px(cell), interest_).interest_share;
+      ConfusionMatrix cell_cm = field_cm_;
+      ConfusionMatrix before_cell(n_), after_cell(n_);
+      before_cell.add(field_.labels()(cell_in), field_map_.labels()(cell_in), field_.ignore_label());
+      after_cell.add(field_.labels()(cell_in), after(cell), field_.ignore_label());
+      cell_cm -= before_cell;
+      cell_cm += after_cell;
+      c.field_gain = cell_cm.miou(interest_).value_or(0.0) - field_miou_;
+      const PixelCounts now = after_cell.counts(interest_), was = before_cell.counts(interest_);
+      c.delta_tp = now.tp - was.tp;
+      c.delta_fp = now.fp - was.fp;
+      c.field_tp = field_counts_.tp;
+      c.field_fp = field_counts_.fp;
+      c.field_fn = field_counts_.fn;
+      out.cells.push_back(c);
+    }
+  }
+
+  const Field& field_;
+  Backend& backend_;
+  const CameraModel& camera_;
+  double top_gsd_cm_;
+  const std::vector<int>& interest_;
+  const DescentCoverageInfo& covers_;
+  std::size_t field_index_;
+  MapFusion fusion_;
+  SimulatedSensor sensor_;
+  LawnmowerPlanner planner_;
+  int n_;
+  bool ranked_, pooled_;
+  std::vector<Waypoint> tops_;
+  std::vector<Image> top_images_;
+  std::vector<Segmentation> top_segmentations_;
+  SemanticMap field_map_;
+  ConfusionMatrix field_cm_;
+  double field_miou_ = 0.0;
+  PixelCounts field_counts_{};
+  double field_sigma_ = 0.0;
+  double field_px_total_;
+  cv::Rect grid_;
+};
+
+}  // namespace detail
+
 /// Flies every top-level region of `field` at `top_gsd_cm` and at each of `candidate_gsd_cm`
 /// and returns one RegionSample per (region, candidate). Regions without a valid pixel are
 /// skipped; candidates finer than the field's GSD are skipped. `coverage`: what each
@@ -57,153 +278,8 @@ template <SegmentationBackend Backend>
   for (double g : candidate_gsd_cm)
     detail::require(std::isfinite(g) && g > 0.0 && g < top_gsd_cm,
                     "collect_region_samples: candidate GSDs must be finer than top_gsd_cm", g);
-  const SimulatedSensor sensor(field, camera);
-  const LawnmowerPlanner planner(camera);
-  const auto keep = [&](const Area& a) { return field.has_valid(a); };
-  const int n = field.num_classes();
-  // The top-level lawnmower over the whole field: every sample's field terms are measured
-  // against its map.
-  const DescentCoverageInfo& covers = descent_coverage_info(coverage);
-  const bool ranked = covers.ranks_cells;
-  const bool pooled = fusion == MapFusion::pooled;
-  // With probabilities where the cells' inputs or a pooled map read them (SemanticMap::fuse
-  // refuses a pooled map a segmentation without them).
-  const auto segment = [&](const Image& image) {
-    return ranked || pooled ? segment_with_probabilities_checked(backend, image, n)
-                            : Segmentation{segment_checked(backend, image, n), {}};
-  };
-  const auto tops = planner.plan(field.area(), top_gsd_cm, {0.0, 0.0}, keep);
-  std::vector<Image> top_images;
-  std::vector<Segmentation> top_segmentations;
-  SemanticMap field_map(field.labels().size(), field.ignore_label(), fusion);
-  for (const auto& top : tops) {
-    top_images.push_back(sensor.capture(top));
-    top_segmentations.push_back(segment(top_images.back()));
-    field_map.fuse(top_images.back(), top_segmentations.back());
-  }
-  ConfusionMatrix field_cm(n);
-  field_cm.add(field.labels(), field_map.labels(), field.ignore_label());
-  const double field_miou = field_cm.miou(interest).value_or(0.0);
-  const PixelCounts field_counts = field_cm.counts(interest);
-  const double field_sigma = semantic_ratio(field_map.labels(), interest, field.ignore_label());
-  const double field_px_total = std::max(1, field.valid_pixels());
-  const cv::Rect grid(0, 0, field.width_px(), field.height_px());
-  CalibrationSamples out;
-  for (std::size_t t = 0; t < tops.size(); ++t) {
-    const Waypoint& top = tops[t];
-    const Image& top_image = top_images[t];
-    const Segmentation& top_segmentation = top_segmentations[t];
-    const cv::Mat& top_labels = top_segmentation.labels;
-    const ConfusionMatrix top_cm = image_confusion(top_image, top_labels, n);
-    const double sigma_top = semantic_ratio(top_labels, interest, top_image.ignore_label);
-    const cv::Rect region = top_image.footprint_px;
-    // What the UAV knows when it plans the descent: the top-level segmentation on the map grid.
-    Image top_local = top_image;  // pixel frame shifted to the region
-    top_local.footprint_px -= region.tl();
-    SemanticMap top_map(region.size(), field.ignore_label(), fusion);
-    top_map.fuse(top_local, top_segmentation);
-    // The region's field pixels: where relabelling is counted.
-    cv::Mat field_px(region.size(), CV_8UC1, cv::Scalar(0));
-    const cv::Rect inside = region & grid;
-    field.valid_mask()(inside).copyTo(field_px(inside - region.tl()));
-    // The field's confusion without this region's top-level map, for the field gain.
-    ConfusionMatrix field_without_region = field_cm;
-    {
-      ConfusionMatrix here(n);
-      here.add(field.labels()(inside), field_map.labels()(inside), field.ignore_label());
-      field_without_region -= here;
-    }
-    const auto keep_cell = [&](const Area& a) {
-      return keep(a) && (!covers.flies || covers.flies(top_map.labels(), field.pixel_rect(a) - region.tl(), top_gsd_cm,
-                                                       field.gsd_cm(), interest));
-    };
-    // The decision inputs of the top-level image on the region's map grid (ranked only).
-    const std::vector<cv::Mat> top_planes =
-        ranked ? planes_on_grid(top_image, pixel_inputs(top_segmentations[t], interest, field.ignore_label()), region)
-               : std::vector<cv::Mat>{};
-    for (double g : candidate_gsd_cm) {
-      if (g < field.gsd_cm() * (1.0 - 1e-9)) continue;
-      // Fuse the sub-lawnmower into a map of the region alone (pixel frame shifted).
-      const auto sub = planner.plan(top.footprint, g, Eigen::Vector2d(top.position.x(), top.position.y()), keep_cell);
-      if (sub.empty()) continue;
-      SemanticMap local(region.size(), field.ignore_label(), fusion);
-      // Cells a coverage leaves out keep their top-level labels, as in the mission's map; a
-      // pooled map pools the finer images with the top-level one everywhere.
-      if (covers.flies || pooled) local.fuse(top_local, top_segmentation);
-      // Ranked: each finer image's own decision inputs over its cell (the scene check's proxy).
-      std::vector<CellInputs> fine_inputs;
-      for (const auto& w : sub) {
-        Image img = sensor.capture(w);
-        const Segmentation seg = segment(img);
-        img.footprint_px -= region.tl();
-        local.fuse(img, seg);
-        if (!ranked) continue;
-        const cv::Rect cell =
-            ((field.pixel_rect(w.footprint) & inside) - region.tl()) & cv::Rect(0, 0, region.width, region.height);
-        if (cell.area() == 0) {
-          fine_inputs.emplace_back();
-          continue;
-        }
-        const auto planes = planes_on_grid(img, pixel_inputs(seg, interest, field.ignore_label()), cell);
-        fine_inputs.push_back(cell_inputs(planes, field_px(cell), cv::Rect(0, 0, cell.width, cell.height)));
-      }
-      ConfusionMatrix sub_cm(n);
-      sub_cm.add(top_image.ground_truth, local.labels(), field.ignore_label());
-      // What the descent changed in the mission's map (where the sub-lawnmower wrote nothing,
-      // the map keeps the top-level labels): C's target.
-      cv::Mat after = top_map.labels().clone();
-      local.labels().copyTo(after, local.labels() != field.ignore_label());
-      RegionSample s;
-      s.field = field_index;
-      s.relabelled = relabelling(top_map.labels(), after, field_px, interest);
-      s.region_share = cv::countNonZero(field_px) / field_px_total;
-      s.field_sigma = field_sigma;
-      ConfusionMatrix with = field_without_region;
-      with.add(field.labels()(inside), after(inside - region.tl()), field.ignore_label());
-      s.field_gain = with.miou(interest).value_or(0.0) - field_miou;
-      // Each cell re-mapped alone: the field's top-level map with the cell's pixels from the
-      // finer images (the cells of one sub-lawnmower tile the region).
-      for (std::size_t k = 0; ranked && k < sub.size(); ++k) {
-        const Waypoint& w = sub[k];
-        const cv::Rect cell_in = field.pixel_rect(w.footprint) & inside;
-        if (cell_in.area() == 0) continue;
-        const cv::Rect cell = cell_in - region.tl();
-        CellSample c;
-        c.field = field_index;
-        c.region = t;
-        c.top_gsd_cm = top_gsd_cm;
-        c.sub_gsd_cm = g;
-        c.top = cell_inputs(top_planes, field_px, cell);
-        if (!(c.top.field_px > 0.0)) continue;
-        c.fine = fine_inputs[k];
-        c.field_share = c.top.field_px / field_px_total;
-        c.field_sigma = field_sigma;
-        c.relabelled = relabelling(top_map.labels()(cell), after(cell), field_px(cell), interest).interest_share;
-        ConfusionMatrix cell_cm = field_cm;
-        ConfusionMatrix before_cell(n), after_cell(n);
-        before_cell.add(field.labels()(cell_in), field_map.labels()(cell_in), field.ignore_label());
-        after_cell.add(field.labels()(cell_in), after(cell), field.ignore_label());
-        cell_cm -= before_cell;
-        cell_cm += after_cell;
-        c.field_gain = cell_cm.miou(interest).value_or(0.0) - field_miou;
-        const PixelCounts now = after_cell.counts(interest), was = before_cell.counts(interest);
-        c.delta_tp = now.tp - was.tp;
-        c.delta_fp = now.fp - was.fp;
-        c.field_tp = field_counts.tp;
-        c.field_fp = field_counts.fp;
-        c.field_fn = field_counts.fn;
-        out.cells.push_back(c);
-      }
-      s.top_gsd_cm = top_gsd_cm;
-      s.sub_gsd_cm = g;
-      s.delta_h_m = camera.altitude_m(top_gsd_cm) - camera.altitude_m(g);
-      s.sigma_top = sigma_top;
-      s.sigma_sub = semantic_ratio(local.labels(), interest, field.ignore_label());
-      std::tie(s.miou_top, s.miou_sub) = paired_miou(top_cm, sub_cm, interest);
-      out.regions.push_back(s);
-    }
-  }
-  return out;
+  return detail::SampleCollector<Backend>(field, backend, camera, top_gsd_cm, interest, coverage, field_index, fusion)
+      .collect(candidate_gsd_cm);
 }
 
 /// The region samples of collect_samples() (the paper's initialisation samples).

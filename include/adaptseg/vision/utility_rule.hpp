@@ -124,28 +124,8 @@ struct UtilityRule {
       std::vector<double> utilities;
       try_params(probe, &utilities);  // descends wherever the predicted gain is positive
       std::sort(utilities.begin(), utilities.end());
-      // Absolute thresholds: quantiles spread evenly, plus the top tail where only the best
-      // regions qualify.
-      std::vector<double> quantiles;
-      for (int k = 0; k < options.threshold_steps; ++k)
-        quantiles.push_back(static_cast<double>(k) / options.threshold_steps);
-      for (double q : {0.93, 0.96, 0.99}) quantiles.push_back(q);
-      for (double q : quantiles) {
-        if (utilities.empty()) break;
-        UtilityPolicy::Params p = probe;
-        p.min_utility = utilities[static_cast<std::size_t>(q * static_cast<double>(utilities.size() - 1))];
+      for (const UtilityPolicy::Params& p : thresholds(probe, utilities, options.threshold_steps))
         try_params(p, nullptr);
-      }
-      // Relative thresholds: a region's best utility over the mission's running mean.
-      for (int k = 0; k < options.threshold_steps; ++k) {
-        UtilityPolicy::Params p = probe;
-        p.relative_utility = true;
-        p.min_utility = 1.0 + 2.0 * static_cast<double>(k) / options.threshold_steps;
-        try_params(p, nullptr);
-      }
-      UtilityPolicy::Params never = probe;  // the top-level lawnmower alone
-      never.min_utility = std::numeric_limits<double>::max();
-      try_params(never, nullptr);
     }
     std::stable_sort(tried.begin(), tried.end(), [](const Tried& a, const Tried& b) {
       if (a.trial.worst_margin != b.trial.worst_margin) return a.trial.worst_margin > b.trial.worst_margin;
@@ -158,6 +138,35 @@ struct UtilityRule {
     const UtilityPolicy::Params best = tried.front().params;
     for (auto& c : tried) trials.push_back(std::move(c.trial));
     return {DecisionFunction(UtilityPolicy(in.model, best)), std::move(trials)};
+  }
+
+ private:
+  /// What search() tries after the probe `probe` (σ weighting on or off) saw `utilities`
+  /// (sorted): absolute thresholds, quantiles spread evenly plus the top tail where only the
+  /// best regions qualify (none without a utility); relative ones, a region's best utility over
+  /// the mission's running mean; "never descend", the top-level lawnmower alone.
+  [[nodiscard]] static std::vector<UtilityPolicy::Params> thresholds(const UtilityPolicy::Params& probe,
+                                                                     const std::vector<double>& utilities, int steps) {
+    std::vector<UtilityPolicy::Params> out;
+    std::vector<double> quantiles;
+    for (int k = 0; k < steps; ++k) quantiles.push_back(static_cast<double>(k) / steps);
+    for (double q : {0.93, 0.96, 0.99}) quantiles.push_back(q);
+    for (double q : quantiles) {
+      if (utilities.empty()) break;
+      UtilityPolicy::Params p = probe;
+      p.min_utility = utilities[static_cast<std::size_t>(q * static_cast<double>(utilities.size() - 1))];
+      out.push_back(p);
+    }
+    for (int k = 0; k < steps; ++k) {
+      UtilityPolicy::Params p = probe;
+      p.relative_utility = true;
+      p.min_utility = 1.0 + 2.0 * static_cast<double>(k) / steps;
+      out.push_back(p);
+    }
+    UtilityPolicy::Params never = probe;
+    never.min_utility = std::numeric_limits<double>::max();
+    out.push_back(never);
+    return out;
   }
 };
 

@@ -80,6 +80,61 @@ inline cv::Mat class_legend(const std::vector<ClassInfo>& classes, int width, co
   return out;
 }
 
+/// render_path's colours of altitude: viridis from the path's lowest waypoint to its highest.
+class AltitudeColours {
+ public:
+  explicit AltitudeColours(std::span<const Waypoint> path) {
+    if (!path.empty()) {
+      lo = hi = path.front().position.z();
+      for (const auto& w : path) {
+        lo = std::min(lo, w.position.z());
+        hi = std::max(hi, w.position.z());
+      }
+    }
+    cv::Mat ramp(1, 256, CV_8UC1);
+    for (int i = 0; i < 256; ++i) ramp.at<std::uint8_t>(0, i) = static_cast<std::uint8_t>(i);
+    cv::applyColorMap(ramp, ramp_bgr_, cv::COLORMAP_VIRIDIS);
+  }
+  [[nodiscard]] cv::Scalar operator()(double z) const {
+    const double t = hi > lo ? (z - lo) / (hi - lo) : 1.0;
+    const auto v = ramp_bgr_.at<cv::Vec3b>(0, static_cast<int>(std::lround(t * 255.0)));
+    return cv::Scalar(v[0], v[1], v[2]);
+  }
+  double lo = 0.0, hi = 1.0;  ///< the lowest and highest waypoint [m]
+
+ private:
+  cv::Mat ramp_bgr_;
+};
+
+/// render_path's side panel, `rows` high: the altitude colour bar (with GSD) and the class
+/// legend (colours faded by `fade`, as the map).
+[[nodiscard]] inline cv::Mat path_panel(int rows, std::span<const Waypoint> path, const AltitudeColours& colours,
+                                        const std::vector<ClassInfo>& classes, double fade) {
+  const int panel_w = 230;
+  const double z_lo = colours.lo, z_hi = colours.hi;
+  cv::Mat panel(rows, panel_w, CV_8UC3, cv::Scalar(255, 255, 255));
+  put_text(panel, "waypoint altitude", {10, 22}, 0.55);
+  const int bar_top = 40, bar_h = std::min(260, std::max(60, rows - 200));
+  for (int y = 0; y < bar_h; ++y) {
+    const double z = z_hi - (z_hi - z_lo) * y / std::max(1, bar_h - 1);
+    cv::line(panel, {10, bar_top + y}, {40, bar_top + y}, colours(z));
+  }
+  cv::rectangle(panel, cv::Rect(10, bar_top, 31, bar_h), cv::Scalar(0, 0, 0), 1);
+  const double gsd_per_m = path.empty() ? 0.0 : path.front().gsd_cm / path.front().position.z();
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "%.1f m (%.2f cm/px)", z_hi, z_hi * gsd_per_m);
+  put_text(panel, buf, {48, bar_top + 12}, 0.45);
+  std::snprintf(buf, sizeof buf, "%.1f m (%.2f cm/px)", z_lo, z_lo * gsd_per_m);
+  put_text(panel, buf, {48, bar_top + bar_h}, 0.45);
+  std::snprintf(buf, sizeof buf, "%zu waypoints", path.size());
+  put_text(panel, buf, {10, bar_top + bar_h + 28}, 0.5);
+  put_text(panel, "boxes: image footprints", {10, bar_top + bar_h + 50}, 0.45);
+  const cv::Mat legend = class_legend(classes, panel_w, "outside field", {255, 255, 255}, fade);
+  if (bar_top + bar_h + 60 + legend.rows <= panel.rows)
+    legend.copyTo(panel(cv::Rect(0, bar_top + bar_h + 60, panel_w, legend.rows)));
+  return panel;
+}
+
 }  // namespace detail
 
 /// Top view of `path` (in visiting order) over the field: the field's labels faded, the
@@ -104,27 +159,12 @@ inline cv::Mat class_legend(const std::vector<ClassInfo>& classes, int width, co
         cv::Point(static_cast<int>(std::lround(r.x * s)), static_cast<int>(std::lround(r.y * s))),
         cv::Point(static_cast<int>(std::lround(r.br().x * s)), static_cast<int>(std::lround(r.br().y * s))));
   };
-  double z_lo = 0.0, z_hi = 1.0;
-  if (!path.empty()) {
-    z_lo = z_hi = path.front().position.z();
-    for (const auto& w : path) {
-      z_lo = std::min(z_lo, w.position.z());
-      z_hi = std::max(z_hi, w.position.z());
-    }
-  }
+  const detail::AltitudeColours colours(path);
+  const auto color_of = [&](double z) { return colours(z); };
   const auto to_px = [&](const Eigen::Vector3d& p) {
     return cv::Point(
         static_cast<int>(std::lround((p.x() * 100.0 / field.gsd_cm() - canvas.x) * s)),
         static_cast<int>(std::lround((field.height_px() - p.y() * 100.0 / field.gsd_cm() - canvas.y) * s)));
-  };
-  cv::Mat ramp(1, 256, CV_8UC1);
-  for (int i = 0; i < 256; ++i) ramp.at<std::uint8_t>(0, i) = static_cast<std::uint8_t>(i);
-  cv::Mat ramp_bgr;
-  cv::applyColorMap(ramp, ramp_bgr, cv::COLORMAP_VIRIDIS);
-  const auto color_of = [&](double z) {
-    const double t = z_hi > z_lo ? (z - z_lo) / (z_hi - z_lo) : 1.0;
-    const auto v = ramp_bgr.at<cv::Vec3b>(0, static_cast<int>(std::lround(t * 255.0)));
-    return cv::Scalar(v[0], v[1], v[2]);
   };
   // Footprints: a dark outline under the altitude colour, visible on white and on any class colour.
   for (const auto& w : path) cv::rectangle(base, rect_px(w.footprint), cv::Scalar(40, 40, 40), 3);
@@ -138,28 +178,7 @@ inline cv::Mat class_legend(const std::vector<ClassInfo>& classes, int width, co
   }
   if (!path.empty()) detail::put_text(base, "start", to_px(path.front().position) + cv::Point(6, -6), 0.5);
 
-  // Side panel: altitude colour bar (with GSD) and class legend.
-  const int panel_w = 230;
-  cv::Mat panel(base.rows, panel_w, CV_8UC3, cv::Scalar(255, 255, 255));
-  detail::put_text(panel, "waypoint altitude", {10, 22}, 0.55);
-  const int bar_top = 40, bar_h = std::min(260, std::max(60, base.rows - 200));
-  for (int y = 0; y < bar_h; ++y) {
-    const double z = z_hi - (z_hi - z_lo) * y / std::max(1, bar_h - 1);
-    cv::line(panel, {10, bar_top + y}, {40, bar_top + y}, color_of(z));
-  }
-  cv::rectangle(panel, cv::Rect(10, bar_top, 31, bar_h), cv::Scalar(0, 0, 0), 1);
-  const double gsd_per_m = path.empty() ? 0.0 : path.front().gsd_cm / path.front().position.z();
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "%.1f m (%.2f cm/px)", z_hi, z_hi * gsd_per_m);
-  detail::put_text(panel, buf, {48, bar_top + 12}, 0.45);
-  std::snprintf(buf, sizeof buf, "%.1f m (%.2f cm/px)", z_lo, z_lo * gsd_per_m);
-  detail::put_text(panel, buf, {48, bar_top + bar_h}, 0.45);
-  std::snprintf(buf, sizeof buf, "%zu waypoints", path.size());
-  detail::put_text(panel, buf, {10, bar_top + bar_h + 28}, 0.5);
-  detail::put_text(panel, "boxes: image footprints", {10, bar_top + bar_h + 50}, 0.45);
-  const cv::Mat legend = detail::class_legend(field.classes(), panel_w, "outside field", {255, 255, 255}, kFade);
-  if (bar_top + bar_h + 60 + legend.rows <= panel.rows)
-    legend.copyTo(panel(cv::Rect(0, bar_top + bar_h + 60, panel_w, legend.rows)));
+  const cv::Mat panel = detail::path_panel(base.rows, path, colours, field.classes(), kFade);
   cv::Mat out;
   cv::hconcat(base, panel, out);
   return detail::with_title(out, title);

@@ -25,6 +25,41 @@ namespace adaptseg::detail {
 /// Fresh L-BFGS-B runs per start after a failed line search.
 inline constexpr int kGpMaxSolverRestarts = 20;
 
+/// One start of gp_multistart_minimize() from `theta`: the minimiser signals a failed line
+/// search (or a non-descent direction from its subspace minimisation) by an exception; like
+/// scipy's driver, restart from the best point seen with a fresh quasi-Newton memory while that
+/// still improves the objective. Fills `start`'s iterations and status.
+template <class Objective>
+void gp_minimize_start(Objective& objective, Eigen::VectorXd& theta, const Eigen::VectorXd& lower,
+                       const Eigen::VectorXd& upper, const GpFitOptions& fo, BoxMinimizerSettings& settings,
+                       GpStartSummary& start) {
+  int runs = 0;
+  while (true) {
+    const double before = objective.best_value;
+    settings.max_iterations = std::max(1, fo.max_iterations - start.iterations);
+    try {
+      start.iterations += minimize_in_box(objective, theta, lower, upper, settings);
+      start.status = start.iterations >= fo.max_iterations ? FitStatus::kMaxIterations : FitStatus::kConverged;
+      break;
+    } catch (const GpObjectiveAborted& aborted) {
+      try {
+        std::rethrow_exception(aborted.cause);
+      } catch (const NumericalError&) {
+        start.status = FitStatus::kNumericalFailure;
+      }
+      break;
+    } catch (const std::exception&) {
+      start.status = FitStatus::kLineSearchFailed;
+      ++start.iterations;
+    }
+    const bool improved = objective.best_value < before &&
+                          (!std::isfinite(before) ||
+                           before - objective.best_value > fo.relative_tolerance * std::max(1.0, std::abs(before)));
+    if (!improved || ++runs > kGpMaxSolverRestarts || start.iterations >= fo.max_iterations) break;
+    theta = objective.best_theta;
+  }
+}
+
 /// Runs the search and returns the best log hyperparameters found; fills `summary` (starts,
 /// evaluations, the chosen start and its status). `make_objective()` gives a fresh objective
 /// per start: callable as `double(const Eigen::VectorXd& theta, Eigen::VectorXd& grad)`
@@ -50,34 +85,7 @@ template <class MakeObjective>
     theta = theta.cwiseMax(lower).cwiseMin(upper);
     start.initial_log_parameters = theta;
     auto objective = make_objective();
-    // The minimiser signals a failed line search (or a non-descent direction from its
-    // subspace minimisation) by an exception. Like scipy's driver, restart from the best
-    // point seen with a fresh quasi-Newton memory while that still improves the objective.
-    int runs = 0;
-    while (true) {
-      const double before = objective.best_value;
-      settings.max_iterations = std::max(1, fo.max_iterations - start.iterations);
-      try {
-        start.iterations += minimize_in_box(objective, theta, lower, upper, settings);
-        start.status = start.iterations >= fo.max_iterations ? FitStatus::kMaxIterations : FitStatus::kConverged;
-        break;
-      } catch (const GpObjectiveAborted& aborted) {
-        try {
-          std::rethrow_exception(aborted.cause);
-        } catch (const NumericalError&) {
-          start.status = FitStatus::kNumericalFailure;
-        }
-        break;
-      } catch (const std::exception&) {
-        start.status = FitStatus::kLineSearchFailed;
-        ++start.iterations;
-      }
-      const bool improved = objective.best_value < before &&
-                            (!std::isfinite(before) ||
-                             before - objective.best_value > fo.relative_tolerance * std::max(1.0, std::abs(before)));
-      if (!improved || ++runs > kGpMaxSolverRestarts || start.iterations >= fo.max_iterations) break;
-      theta = objective.best_theta;
-    }
+    gp_minimize_start(objective, theta, lower, upper, fo, settings, start);
     start.evaluations = objective.evaluations;
     summary.evaluations += objective.evaluations;
     if (objective.evaluations > 0) {
