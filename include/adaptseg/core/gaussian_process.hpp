@@ -5,44 +5,31 @@
 /// updates by extending the Cholesky factor. A fitted model is saved and restored through its
 /// State (`state()`, `from_state`); the file format is in gp_io.hpp, not here.
 ///
-/// Self-contained: needs Eigen 3.4, LBFGSpp (header-only, reached only through
-/// detail/lbfgs.hpp) and adaptseg/core/error.hpp only. The kernel concept and the kernel are in
-/// gp_kernel.hpp, the options and results in gp_options.hpp, the vectorised loops in
-/// detail/gp_simd.hpp, the dense linear algebra in detail/gp_numerics.hpp, the multi-start
-/// hyperparameter search in detail/gp_optimize.hpp.
+/// Needs Eigen 3.4 and LBFGSpp (through detail/lbfgs.hpp) only. The kernels: gp_kernel.hpp;
+/// options and results: gp_options.hpp; vectorised loops: detail/gp_simd.hpp; dense algebra:
+/// detail/gp_numerics.hpp; the likelihood: detail/gp_likelihood.hpp; the multi-start search:
+/// detail/gp_optimize.hpp.
 /// Conventions follow scikit-learn's `GaussianProcessRegressor` with the kernel
 /// `ConstantKernel(sf2) * RBF(length_scale) + WhiteKernel(sn2)` and `alpha = 0`, so that
 /// results can be checked against it (see tests/tools/make_gp_fixtures.py).
 
+#include <adaptseg/core/detail/gp_likelihood.hpp>
 #include <adaptseg/core/detail/gp_numerics.hpp>
 #include <adaptseg/core/detail/gp_optimize.hpp>
+#include <adaptseg/core/detail/gp_simd.hpp>
 #include <adaptseg/core/error.hpp>
 #include <adaptseg/core/gp_kernel.hpp>
 #include <adaptseg/core/gp_options.hpp>
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 
 #include <algorithm>
 #include <cmath>
-#include <concepts>
-#include <cstddef>
-#include <cstdint>
-#include <cstring>
-#include <exception>
 #include <limits>
 #include <numbers>
-#include <sstream>
-#include <string>
-#include <string_view>
 #include <utility>
-#include <vector>
 
 namespace adaptseg {
-
-// ============================================================================================
-// GaussianProcess
-// ============================================================================================
 
 /// Exact GP regression, zero prior mean (paper eq:prior) on optionally normalised targets,
 /// covariance from a `Kernel` (paper eq:sqexp), posterior by eq:gp computed as Rasmussen &
@@ -115,7 +102,7 @@ class GaussianProcess {
   FitSummary fit(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y,
                  const FitOptions& fit_options = {}) {
     fit_options.validate();
-    check_training_data(x, y);
+    detail::gp_check_training_data(kernel_, x, y);
     store_data(x, y);
     compute_normalization();
     return fit_current(fit_options);
@@ -135,7 +122,7 @@ class GaussianProcess {
   /// factorises in O(n^3): the batch equivalent of a sequence of `add_observation`.
   /// @throws std::invalid_argument on bad input; NumericalError.
   void condition(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y) {
-    check_training_data(x, y);
+    detail::gp_check_training_data(kernel_, x, y);
     store_data(x, y);
     yn_.head(n_) = (y_.head(n_).array() - y_mean_) / y_std_;
     factorize();
@@ -144,19 +131,17 @@ class GaussianProcess {
   /// Sets new hyperparameters (no optimisation) and refactorises the current data.
   /// @throws std::invalid_argument if the kernel does not accept the data's dimension.
   void set_kernel(K kernel) {
-    if (n_ > 0) {
+    if (n_ > 0)
       detail::require(kernel.accepts_dimension(dimension_),
                       "GaussianProcess::set_kernel: kernel does not accept input dimension", dimension_);
-    }
     kernel_ = std::move(kernel);
     if (n_ > 0) factorize();
   }
 
-  /// Adds one observation in O(n^2) (one triangular solve) by extending the Cholesky factor;
-  /// hyperparameters and normalisation stay as they are. Afterwards `predict_mean` costs an
-  /// extra O(n^2) per call until the next `fit`/`refit`/`condition`/`set_kernel`. If the extended factor is not
-  /// positive definite (a nearly repeated input with tiny noise), falls back to an O(n^3) refactorisation with jitter
-  /// retries.
+  /// Adds one observation in O(n^2) by extending the Cholesky factor; hyperparameters and
+  /// normalisation stay. `predict_mean` then costs O(n^2) more per call until the next `fit`,
+  /// `refit`, `condition` or `set_kernel`. An extended factor that is not positive definite (a
+  /// nearly repeated input, tiny noise) falls back to an O(n^3) refactorisation with jitter.
   /// @param x input of dimension D (the data's, or any the kernel accepts if there is none).
   /// @param y target [output units].
   /// @throws std::invalid_argument on non-finite values or a wrong dimension; NumericalError.
@@ -241,7 +226,7 @@ class GaussianProcess {
   /// @throws std::invalid_argument on a wrong dimension or non-finite input.
   [[nodiscard]] Prediction predict(const Eigen::Ref<const Eigen::MatrixXd>& xq,
                                    PredictiveVariance kind = PredictiveVariance::kLatent) const {
-    check_query(xq);
+    detail::gp_check_query(kernel_, dimension_, xq);
     const detail::GpScopedFlushSubnormals flush;
     const Eigen::Index m = xq.rows();
     Prediction out{Eigen::VectorXd::Zero(m), kernel_.prior_variance(xq)};
@@ -270,7 +255,7 @@ class GaussianProcess {
   /// Posterior mean only, O(m n) (plus O(n^2) after `add_observation`, see there).
   /// @throws std::invalid_argument on a wrong dimension or non-finite input.
   [[nodiscard]] Eigen::VectorXd predict_mean(const Eigen::Ref<const Eigen::MatrixXd>& xq) const {
-    check_query(xq);
+    detail::gp_check_query(kernel_, dimension_, xq);
     Eigen::VectorXd mean = Eigen::VectorXd::Zero(xq.rows());
     if (n_ > 0) {
       const detail::GpScopedFlushSubnormals flush;
@@ -291,7 +276,7 @@ class GaussianProcess {
   /// @throws std::invalid_argument on a wrong dimension or non-finite input.
   [[nodiscard]] CovariancePrediction predict_covariance(const Eigen::Ref<const Eigen::MatrixXd>& xq,
                                                         PredictiveVariance kind = PredictiveVariance::kLatent) const {
-    check_query(xq);
+    detail::gp_check_query(kernel_, dimension_, xq);
     const detail::GpScopedFlushSubnormals flush;
     CovariancePrediction out{Eigen::VectorXd::Zero(xq.rows()), kernel_.cross_covariance(xq, xq)};
     if (n_ > 0) {
@@ -326,26 +311,20 @@ class GaussianProcess {
     detail::require(n_ > 0, "GaussianProcess::log_marginal_likelihood: number of training samples must be > 0", n_);
     K kernel = kernel_;
     kernel.set_log_parameters(theta);
-    Workspace work;
-    return evaluate(kernel, gradient, work);
+    detail::GpWorkspace work;
+    return training().log_likelihood(kernel, gradient, work);
   }
 
   // ---- accessors ----------------------------------------------------------------------------
 
   [[nodiscard]] const K& kernel() const { return kernel_; }
   [[nodiscard]] const Options& options() const { return options_; }
-  /// Number of training samples.
-  [[nodiscard]] Eigen::Index size() const { return n_; }
-  /// Input dimension D (0 before any data).
-  [[nodiscard]] Eigen::Index dimension() const { return dimension_; }
-  /// n x D training inputs.
-  [[nodiscard]] Eigen::MatrixXd training_inputs() const { return x_.topRows(n_); }
-  /// n training targets, original units.
-  [[nodiscard]] Eigen::VectorXd training_targets() const { return y_.head(n_); }
-  /// Frozen normalisation mean [output units] (0 without normalisation).
-  [[nodiscard]] double y_mean() const { return y_mean_; }
-  /// Frozen normalisation std [output units] (1 without normalisation).
-  [[nodiscard]] double y_std() const { return y_std_; }
+  [[nodiscard]] Eigen::Index size() const { return n_; }                            ///< training samples n
+  [[nodiscard]] Eigen::Index dimension() const { return dimension_; }               ///< D (0 before any data)
+  [[nodiscard]] Eigen::MatrixXd training_inputs() const { return x_.topRows(n_); }  ///< n x D
+  [[nodiscard]] Eigen::VectorXd training_targets() const { return y_.head(n_); }    ///< n, original units
+  [[nodiscard]] double y_mean() const { return y_mean_; }  ///< frozen normalisation mean (0 without normalize_y)
+  [[nodiscard]] double y_std() const { return y_std_; }    ///< frozen normalisation std (1 without normalize_y)
   /// Diagonal jitter in use (0 when the plain factorisation succeeded).
   [[nodiscard]] double jitter() const { return jitter_; }
 
@@ -388,27 +367,6 @@ class GaussianProcess {
   }
 
  private:
-  void check_training_data(const Eigen::Ref<const Eigen::MatrixXd>& x,
-                           const Eigen::Ref<const Eigen::VectorXd>& y) const {
-    detail::require(x.rows() >= 1, "GaussianProcess: number of training samples (rows of x) must be >= 1", x.rows());
-    detail::require(kernel_.accepts_dimension(x.cols()),
-                    "GaussianProcess: kernel does not accept the input dimension (columns of x)", x.cols());
-    detail::require(y.size() == x.rows(), "GaussianProcess: size of y must equal the rows of x, size", y.size());
-    detail::require(x.allFinite(), "GaussianProcess: x must be finite, rows", x.rows());
-    detail::require(y.allFinite(), "GaussianProcess: y must be finite, size", y.size());
-  }
-
-  void check_query(const Eigen::Ref<const Eigen::MatrixXd>& xq) const {
-    if (dimension_ > 0) {
-      detail::require(xq.cols() == dimension_, "GaussianProcess::predict: columns of the query must equal D",
-                      xq.cols());
-    } else {
-      detail::require(kernel_.accepts_dimension(xq.cols()),
-                      "GaussianProcess::predict: kernel does not accept the query dimension", xq.cols());
-    }
-    detail::require(xq.allFinite(), "GaussianProcess::predict: query inputs must be finite, rows", xq.rows());
-  }
-
   void store_data(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y) {
     n_ = 0;
     dimension_ = x.cols();
@@ -432,121 +390,16 @@ class GaussianProcess {
     yn_.head(n_) = (y_.head(n_).array() - y_mean_) / y_std_;
   }
 
-  /// Runs `factor()` (true on success); after a failure, `reset(jitter)` restores the matrix
-  /// with `jitter` added to its diagonal and `factor()` runs again, jitter
-  /// `initial_jitter * scale * 10^k`, k = 0..max_jitter_attempts-1. Returns the jitter used.
-  /// @throws NumericalError when the last attempt fails (n: the matrix size, for the message).
-  template <typename Reset, typename Factor>
-  double factor_with_jitter(Eigen::Index n, double scale, Reset&& reset, Factor&& factor) const {
-    double jitter = 0.0;
-    for (int attempt = 0;; ++attempt) {
-      if (attempt > 0) {
-        jitter = options_.initial_jitter * scale * std::pow(10.0, attempt - 1);
-        reset(jitter);
-      }
-      if (factor()) return jitter;
-      if (attempt >= options_.max_jitter_attempts) {
-        std::ostringstream os;
-        os << "GaussianProcess: covariance matrix (n = " << n << ") is not positive definite after "
-           << options_.max_jitter_attempts << " jitter retries (last jitter " << jitter
-           << "); inputs nearly repeated with too little noise, or hyperparameters out of range: "
-           << kernel_.log_parameters().transpose();
-        throw NumericalError(os.str());
-      }
-    }
-  }
-
-  /// Scratch of `evaluate`, kept across the evaluations of one optimiser run.
-  struct Workspace {
-    Eigen::MatrixXd a;   // K, then L, then K^-1 and the gradient weights (lower triangles)
-    Eigen::MatrixXd xt;  // (L^-1)^T
-  };
-
-  /// Columns n4 = 4 ceil(n / 4) and leading dimension (a multiple of kGpRowGroup) of the
-  /// padded matrices the dense kernels work on.
-  static Eigen::Index padded_columns(Eigen::Index n) { return (n + 3) / 4 * 4; }
-  static Eigen::Index padded_rows(Eigen::Index n) {
-    return (padded_columns(n) + detail::kGpRowGroup - 1) / detail::kGpRowGroup * detail::kGpRowGroup;
-  }
-
-  /// K_XX of the first n_ samples for `kernel` into the top-left of `a` (padded to
-  /// padded_columns(n_) with the identity; a.rows() a multiple of kGpRowGroup, >=
-  /// padded_rows(n_)), factorised in place (dispatched Cholesky up to
-  /// `detail::gp_dense_kernel_limit()`, Eigen's blocked LLT above) with jitter retries:
-  /// lower(a) = L. Returns the jitter. `fit` (through `evaluate`) and `factorize` share it, so
-  /// the optimiser and the final model agree to the last bit.
-  double factorize_into(const K& kernel, Eigen::MatrixXd& a) const {
-    const Eigen::Index n = n_;
-    const Eigen::Index n4 = padded_columns(n);
-    ADAPTSEG_ASSERT(a.rows() % detail::kGpRowGroup == 0 && a.rows() >= padded_rows(n) && a.cols() >= n4);
-    const auto x = x_.topRows(n);
-    const double noise = kernel.noise_variance();
-    const auto fill = [&](double jitter) {
-      a.leftCols(n4).setZero();
-      a.topLeftCorner(n, n) = kernel.cross_covariance(x, x);
-      a.diagonal().head(n).array() += noise + jitter;
-      a.diagonal().segment(n, n4 - n).setOnes();
-    };
-    fill(0.0);
-    const double scale = std::abs(a.diagonal().head(n).mean());
-    if (n <= detail::gp_dense_kernel_limit()) {
-      return factor_with_jitter(n, scale, fill, [&] { return detail::gp_cholesky(a.data(), n4, a.rows()); });
-    }
-    return factor_with_jitter(n, scale, fill, [&] {
-      auto l = a.topLeftCorner(n, n);
-      Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Lower> llt(l);
-      return llt.info() == Eigen::Success && l.diagonal().allFinite() && (l.diagonal().array() > 0.0).all();
-    });
-  }
-
-  /// LML (and gradient) of the normalised training targets for `kernel`. The dense work
-  /// (Cholesky, L^-1, K^-1 = L^-T L^-1: n^3 flops in all) runs in the dispatched kernels up to
-  /// `detail::gp_dense_kernel_limit()`, in Eigen above.
-  double evaluate(const K& kernel, Eigen::VectorXd* gradient, Workspace& ws) const {
-    const detail::GpScopedFlushSubnormals flush;
-    const Eigen::Index n = n_;
-    const Eigen::Index n4 = padded_columns(n);
-    const Eigen::Index ld = padded_rows(n);
-    const auto x = x_.topRows(n);
-    Eigen::MatrixXd& a = ws.a;
-    a.resize(ld, n4);
-    factorize_into(kernel, a);
-    const auto l = a.topLeftCorner(n, n);
-    const Eigen::VectorXd z = l.template triangularView<Eigen::Lower>().solve(yn_.head(n));
-    const Eigen::VectorXd alpha = l.template triangularView<Eigen::Lower>().transpose().solve(z);
-    const double lml = -0.5 * z.squaredNorm() - l.diagonal().array().log().sum() -
-                       0.5 * static_cast<double>(n) * std::log(2.0 * std::numbers::pi);
-    if (!std::isfinite(lml)) {
-      std::ostringstream os;
-      os << "GaussianProcess: log marginal likelihood is not finite at log hyperparameters "
-         << kernel.log_parameters().transpose();
-      throw NumericalError(os.str());
-    }
-    if (gradient != nullptr) {
-      auto w = a.topLeftCorner(n, n);
-      if (n <= detail::gp_dense_kernel_limit()) {
-        ws.xt.setZero(ld, n4);
-        detail::gp_invert_lower(a.data(), ws.xt.data(), n4, ld);
-        detail::gp_gram(ws.xt.data(), a.data(), n4, ld);  // lower(a) = K^-1
-      } else {
-        detail::gp_invert_lower_in_place(w);
-        detail::gp_lower_gram_in_place(w);
-      }
-      for (Eigen::Index j = 0; j < n; ++j) {
-        w.col(j).tail(n - j) = alpha.tail(n - j) * alpha(j) - w.col(j).tail(n - j);
-      }
-      *gradient = 0.5 * kernel.contract_gradient(x, w);
-    }
-    return lml;
-  }
+  /// The training data as the likelihood reads it (detail/gp_likelihood.hpp).
+  [[nodiscard]] detail::GpTraining<K> training() const { return {x_.topRows(n_), yn_.head(n_), options_, kernel_}; }
 
   /// Factorises K_XX of the current data and hyperparameters into l_, z_, alpha_.
   void factorize() {
     ADAPTSEG_ASSERT(n_ > 0);
     const detail::GpScopedFlushSubnormals flush;
     const Eigen::Index n = n_;
-    reserve(padded_rows(n));
-    jitter_ = factorize_into(kernel_, l_);
+    reserve(detail::gp_padded_rows(n));
+    jitter_ = training().factorize_into(kernel_, l_);
     const auto l = l_.topLeftCorner(n, n);
     z_.head(n) = l.template triangularView<Eigen::Lower>().solve(yn_.head(n));
     alpha_.head(n) = l.template triangularView<Eigen::Lower>().transpose().solve(z_.head(n));
@@ -564,37 +417,11 @@ class GaussianProcess {
     return summary;
   }
 
-  /// Objective of the bounded minimiser: -LML and its gradient; remembers the best point seen.
-  struct Objective {
-    const GaussianProcess* gp;
-    K kernel;
-    Workspace work;
-    Eigen::VectorXd best_theta;
-    double best_value = std::numeric_limits<double>::infinity();
-    int evaluations = 0;
-
-    double operator()(const Eigen::VectorXd& theta, Eigen::VectorXd& grad) {
-      try {
-        kernel.set_log_parameters(theta);
-        Eigen::VectorXd g;
-        const double lml = gp->evaluate(kernel, &g, work);
-        ++evaluations;
-        grad = -g;
-        if (-lml < best_value) {
-          best_value = -lml;
-          best_theta = theta;
-        }
-        return -lml;
-      } catch (...) {
-        throw detail::GpObjectiveAborted{std::current_exception()};
-      }
-    }
-  };
-
   void optimize(const FitOptions& fo, FitSummary& summary) {
     const Eigen::VectorXd theta = detail::gp_multistart_minimize(
-        kernel_.log_parameters(), kernel_.log_lower_bounds(), kernel_.log_upper_bounds(), fo, summary,
-        [this] { return Objective{this, kernel_, {}, {}, std::numeric_limits<double>::infinity(), 0}; });
+        kernel_.log_parameters(), kernel_.log_lower_bounds(), kernel_.log_upper_bounds(), fo, summary, [this] {
+          return detail::GpObjective<K>{training(), kernel_, {}, {}, std::numeric_limits<double>::infinity(), 0};
+        });
     kernel_.set_log_parameters(theta);
   }
 
