@@ -24,19 +24,15 @@
 /// Why guided reposition, not an uploaded mission: see the comment above VehicleLink::go_to.
 
 #include <adaptseg/mavlink/camera_image_captured.hpp>
-#include <adaptseg/mavlink/command_ack.hpp>
 #include <adaptseg/mavlink/command_int.hpp>
 #include <adaptseg/mavlink/command_long.hpp>
 #include <adaptseg/mavlink/detail/geodesy.hpp>
+#include <adaptseg/mavlink/detail/link_channel.hpp>
 #include <adaptseg/mavlink/enums.hpp>
-#include <adaptseg/mavlink/frame.hpp>
 #include <adaptseg/mavlink/global_position_int.hpp>
 #include <adaptseg/mavlink/gps_raw_int.hpp>
-#include <adaptseg/mavlink/heartbeat.hpp>
 #include <adaptseg/mavlink/link_error.hpp>
 #include <adaptseg/mavlink/link_options.hpp>
-#include <adaptseg/mavlink/message.hpp>
-#include <adaptseg/mavlink/parser.hpp>
 #include <adaptseg/mavlink/site_limits.hpp>
 #include <adaptseg/mavlink/status_text.hpp>
 #include <adaptseg/mavlink/transport.hpp>
@@ -44,30 +40,17 @@
 #include <adaptseg/mavlink/vehicle_state.hpp>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <functional>
 #include <limits>
 #include <optional>
-#include <span>
 #include <stdexcept>
 #include <string>
-#include <type_traits>
 #include <utility>
-#include <variant>
 #include <vector>
 
 namespace adaptseg::mavlink {
-
-/// The link's clock: seconds, monotonic, any origin. Tests give a fake one.
-using Clock = std::function<double()>;
-
-/// std::chrono::steady_clock in seconds: the default Clock.
-[[nodiscard]] inline double steady_clock_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 
 /// The live link to one autopilot over a ByteTransport, driven synchronously by its caller.
 ///
@@ -91,16 +74,10 @@ class VehicleLink {
   /// A link over `transport` that never sends the vehicle outside `limits`.
   /// @throws std::invalid_argument from LinkOptions::check().
   VehicleLink(AnyTransport transport, SiteLimits limits, LinkOptions options = {}, Clock clock = {})
-      : transport_(std::move(transport)),
-        limits_(std::move(limits)),
-        options_(std::move(options)),
-        clock_(clock ? std::move(clock) : Clock(&steady_clock_s)),
-        buffer_(kReceiveBufferSize) {
-    options_.check();
-  }
+      : channel_(std::move(transport), std::move(options), std::move(clock)), limits_(std::move(limits)) {}
 
   /// The link's clock [s]: deadlines for poll() are on it.
-  [[nodiscard]] double now() const { return clock_(); }
+  [[nodiscard]] double now() const { return channel_.now(); }
 
   /// Waits for the autopilot's HEARTBEAT (LinkOptions::heartbeat_timeout_s), asks for its
   /// GLOBAL_POSITION_INT and GPS_RAW_INT streams (SET_MESSAGE_INTERVAL, acknowledged), then
@@ -111,43 +88,44 @@ class VehicleLink {
   const VehicleInfo& connect() {
     const char* step = "connect";
     const double t0 = now();
-    next_heartbeat_s_ = t0;  // announce ourselves at once: some links talk only to who talks
-    if (!pump_until(
-            t0 + options_.heartbeat_timeout_s, [&] { return vehicle_.has_value(); }, step)) {
+    channel_.announce_at(t0);  // announce ourselves at once: some links talk only to who talks
+    if (!channel_.pump_until(
+            t0 + options().heartbeat_timeout_s, [&] { return seen().vehicle.has_value(); }, step)) {
       throw VehicleLinkError(LinkFailure::no_heartbeat, step,
-                             "no HEARTBEAT from an autopilot within " + num(options_.heartbeat_timeout_s) + " s on " +
-                                 transport_.description());
+                             "no HEARTBEAT from an autopilot within " + num(options().heartbeat_timeout_s) + " s on " +
+                                 channel_.description());
     }
-    request_interval(GlobalPositionInt::kId, options_.position_interval_s, step);
-    request_interval(GpsRawInt::kId, options_.gps_interval_s, step);
+    channel_.request_interval(GlobalPositionInt::kId, options().position_interval_s, step);
+    channel_.request_interval(GpsRawInt::kId, options().gps_interval_s, step);
     const double t1 = now();
     const auto ready = [&] {
-      return gps_ && gps_->fix_type >= gps_fix_type::k3dFix && position_ && position_->received_s >= fix_since_s_ &&
-             !(position_->lat_deg == 0.0 && position_->lon_deg == 0.0);
+      return seen().gps && seen().gps->fix_type >= gps_fix_type::k3dFix && seen().position &&
+             seen().position->received_s >= seen().fix_since_s &&
+             !(seen().position->lat_deg == 0.0 && seen().position->lon_deg == 0.0);
     };
-    if (!pump_until(t1 + options_.fix_timeout_s, ready, step)) {
+    if (!channel_.pump_until(t1 + options().fix_timeout_s, ready, step)) {
       std::string why;
-      if (!gps_) {
+      if (!seen().gps) {
         why = "no GPS_RAW_INT came (no GPS, or the stream request was ignored)";
-      } else if (gps_->fix_type < gps_fix_type::k3dFix) {
-        why = "GPS_RAW_INT says fix_type " + std::to_string(gps_->fix_type) + " (" + fix_name(gps_->fix_type) + "), " +
-              std::to_string(gps_->satellites) + " satellites";
+      } else if (seen().gps->fix_type < gps_fix_type::k3dFix) {
+        why = "GPS_RAW_INT says fix_type " + std::to_string(seen().gps->fix_type) + " (" +
+              fix_name(seen().gps->fix_type) + "), " + std::to_string(seen().gps->satellites) + " satellites";
       } else {
         why = "a 3-D fix but no valid GLOBAL_POSITION_INT after it";
       }
       throw VehicleLinkError(
           LinkFailure::no_gps_fix, step,
-          "no 3-D GPS fix within " + num(options_.fix_timeout_s) + " s: " + why + "; refusing to start without one");
+          "no 3-D GPS fix within " + num(options().fix_timeout_s) + " s: " + why + "; refusing to start without one");
     }
     connected_ = true;
-    return *vehicle_;
+    return *seen().vehicle;
   }
 
   /// Reads and dispatches what arrives, and sends our HEARTBEAT when due, until `deadline_s`
   /// (on now()'s clock). Call it while doing other work between operations.
   /// @throws LinkLost after connect() if the vehicle is silent for LinkOptions::link_timeout_s.
   void poll(double deadline_s) {
-    pump_until(
+    channel_.pump_until(
         deadline_s, [] { return false; }, "poll");
   }
 
@@ -157,19 +135,20 @@ class VehicleLink {
   /// The autopilot's latest HEARTBEAT.
   /// @throws std::logic_error before one was heard (call connect() first).
   [[nodiscard]] const VehicleInfo& vehicle() const {
-    if (!vehicle_) throw std::logic_error("VehicleLink::vehicle: no autopilot heard yet: call connect() first");
-    return *vehicle_;
+    if (!seen().vehicle) throw std::logic_error("VehicleLink::vehicle: no autopilot heard yet: call connect() first");
+    return *seen().vehicle;
   }
 
   /// The latest GLOBAL_POSITION_INT (check its received_s against now() for its age).
   /// @throws std::logic_error before one arrived (call connect() first).
   [[nodiscard]] const VehiclePosition& position() const {
-    if (!position_) throw std::logic_error("VehicleLink::position: no GLOBAL_POSITION_INT yet: call connect() first");
-    return *position_;
+    if (!seen().position)
+      throw std::logic_error("VehicleLink::position: no GLOBAL_POSITION_INT yet: call connect() first");
+    return *seen().position;
   }
 
   /// The latest GPS_RAW_INT, if one arrived.
-  [[nodiscard]] const std::optional<GpsStatus>& gps() const { return gps_; }
+  [[nodiscard]] const std::optional<GpsStatus>& gps() const { return seen().gps; }
 
   // Why guided reposition rather than an uploaded mission that is updated waypoint by
   // waypoint. The planner chooses each waypoint after the previous image, so the vehicle is
@@ -213,29 +192,30 @@ class VehicleLink {
       throw VehicleLinkError(LinkFailure::outside_site, step,
                              "refused to send the vehicle to " + to_string(target) + ": " + *why);
     }
-    refresh(step);
-    if (!vehicle_->armed()) {
+    channel_.refresh(step);
+    if (!seen().vehicle->armed()) {
       throw VehicleLinkError(LinkFailure::not_armed, step,
                              "the vehicle is disarmed: arm it and take off before the live loop sends targets");
     }
     check_mode(step);
     const VehiclePosition here = fresh_position(step);
-    if (vehicle_->firmware() == Firmware::ardupilot && !in_control_) enter_guided(step);
+    if (seen().vehicle->firmware() == Firmware::ardupilot && !in_control_) enter_guided(step);
     CommandInt cmd;
-    cmd.target_system = vehicle_->system_id;
-    cmd.target_component = vehicle_->component_id;
+    cmd.target_system = seen().vehicle->system_id;
+    cmd.target_component = seen().vehicle->component_id;
     cmd.frame = mav_frame::kGlobalInt;
     cmd.command = mav_cmd::kDoReposition;
-    cmd.param1 = static_cast<float>(options_.ground_speed_mps);
-    cmd.param2 = vehicle_->firmware() == Firmware::ardupilot ? 0.0F : 1.0F;  // MAV_DO_REPOSITION_FLAGS_CHANGE_MODE
+    cmd.param1 = static_cast<float>(options().ground_speed_mps);
+    cmd.param2 =
+        seen().vehicle->firmware() == Firmware::ardupilot ? 0.0F : 1.0F;  // MAV_DO_REPOSITION_FLAGS_CHANGE_MODE
     cmd.param3 = 0.0F;
     cmd.param4 = std::numeric_limits<float>::quiet_NaN();  // yaw: unchanged
     cmd.x = static_cast<std::int32_t>(std::lround(target.lat_deg * 1e7));
     cmd.y = static_cast<std::int32_t>(std::lround(target.lon_deg * 1e7));
     cmd.z = static_cast<float>(here.home_alt_msl_m() + target.rel_alt_m);
-    command(cmd, step);
+    channel_.command(cmd, step);
     in_control_ = true;
-    mode_settled_s_ = now() + options_.mode_timeout_s;
+    mode_settled_s_ = now() + options().mode_timeout_s;
   }
 
   /// Waits until the vehicle is within `criteria` of `target` (from GLOBAL_POSITION_INT:
@@ -248,7 +228,7 @@ class VehicleLink {
     const char* step = "wait_arrival";
     criteria.check();
     require_connected(step);
-    refresh(step);
+    channel_.refresh(step);
     const double t0 = now();
     double seen_s = -std::numeric_limits<double>::infinity();
     double best_m = std::numeric_limits<double>::infinity();
@@ -256,12 +236,12 @@ class VehicleLink {
     for (;;) {
       check_mode(step);
       const double t = now();
-      const bool fresh = pump_until(
-          std::min(t0 + criteria.timeout_s, t + options_.position_timeout_s),
-          [&] { return position_ && position_->received_s > seen_s; }, step);
+      const bool fresh = channel_.pump_until(
+          std::min(t0 + criteria.timeout_s, t + options().position_timeout_s),
+          [&] { return seen().position && seen().position->received_s > seen_s; }, step);
       const double t1 = now();
       if (fresh) {
-        const VehiclePosition& p = *position_;
+        const VehiclePosition& p = *seen().position;
         seen_s = p.received_s;
         const double h = detail::horizontal_distance_m(target.lat_deg, target.lon_deg, p.lat_deg, p.lon_deg);
         const double v = p.rel_alt_m - target.rel_alt_m;
@@ -281,15 +261,16 @@ class VehicleLink {
                                      num(criteria.horizontal_m) + " m horizontal, " + num(criteria.vertical_m) +
                                      " m vertical");
         }
-      } else if (!position_ || t1 - position_->received_s >= options_.position_timeout_s) {
+      } else if (!seen().position || t1 - seen().position->received_s >= options().position_timeout_s) {
         throw VehicleLinkError(LinkFailure::stale_position, step,
-                               "no GLOBAL_POSITION_INT for " + num(options_.position_timeout_s) +
+                               "no GLOBAL_POSITION_INT for " + num(options().position_timeout_s) +
                                    " s while the vehicle's other frames still come");
       }
       if (t1 - t0 >= criteria.timeout_s) {
-        const std::string left = position_ ? num(detail::horizontal_distance_m(target.lat_deg, target.lon_deg,
-                                                                               position_->lat_deg, position_->lon_deg))
-                                           : std::string("?");
+        const std::string left =
+            seen().position ? num(detail::horizontal_distance_m(target.lat_deg, target.lon_deg,
+                                                                seen().position->lat_deg, seen().position->lon_deg))
+                            : std::string("?");
         throw VehicleLinkError(LinkFailure::arrival_timeout, step,
                                "the vehicle did not reach " + to_string(target) + " within " + num(criteria.timeout_s) +
                                    " s (" + left + " m left horizontally)");
@@ -307,11 +288,11 @@ class VehicleLink {
   CameraCapture trigger_camera() {
     const char* step = "trigger_camera";
     require_connected(step);
-    refresh(step);
-    CommandLong cmd = command_long_to_vehicle();
-    cmd.command = options_.camera_command != 0                  ? options_.camera_command
-                  : vehicle_->firmware() == Firmware::ardupilot ? mav_cmd::kDoDigicamControl
-                                                                : mav_cmd::kImageStartCapture;
+    channel_.refresh(step);
+    CommandLong cmd = channel_.command_long_to_vehicle();
+    cmd.command = options().camera_command != 0                       ? options().camera_command
+                  : seen().vehicle->firmware() == Firmware::ardupilot ? mav_cmd::kDoDigicamControl
+                                                                      : mav_cmd::kImageStartCapture;
     if (cmd.command == mav_cmd::kImageStartCapture) {
       cmd.param1 = 0.0F;  // all cameras
       cmd.param2 = 0.0F;  // interval: none
@@ -320,15 +301,15 @@ class VehicleLink {
     } else {
       cmd.param5 = 1.0F;  // shoot
     }
-    images_.clear();
-    command(cmd, step);
-    if (options_.capture_wait_s > 0.0) {
-      pump_until(
-          now() + options_.capture_wait_s, [&] { return !images_.empty(); }, step);
+    channel_.inbox().images.clear();
+    channel_.command(cmd, step);
+    if (options().capture_wait_s > 0.0) {
+      channel_.pump_until(
+          now() + options().capture_wait_s, [&] { return !channel_.inbox().images.empty(); }, step);
     }
     CameraCapture out;
     out.command = cmd.command;
-    if (!images_.empty()) out.image = images_.back();
+    if (!channel_.inbox().images.empty()) out.image = channel_.inbox().images.back();
     return out;
   }
 
@@ -339,10 +320,10 @@ class VehicleLink {
   void return_to_launch() {
     const char* step = "return_to_launch";
     require_connected(step);
-    refresh(step);
-    CommandLong cmd = command_long_to_vehicle();
+    channel_.refresh(step);
+    CommandLong cmd = channel_.command_long_to_vehicle();
     cmd.command = mav_cmd::kNavReturnToLaunch;
-    command(cmd, step);
+    channel_.command(cmd, step);
     in_control_ = false;
   }
 
@@ -351,277 +332,65 @@ class VehicleLink {
   /// @throws LinkLost.
   bool wait_disarmed(double timeout_s) {
     require_connected("wait_disarmed");
-    return pump_until(
-        now() + timeout_s, [&] { return !vehicle_->armed(); }, "wait_disarmed");
+    return channel_.pump_until(
+        now() + timeout_s, [&] { return !seen().vehicle->armed(); }, "wait_disarmed");
   }
 
   /// The latest STATUSTEXT from the vehicle, if any (PreArm and failsafe messages).
-  [[nodiscard]] const std::optional<StatusText>& last_status_text() const { return last_status_text_; }
+  [[nodiscard]] const std::optional<StatusText>& last_status_text() const { return seen().status_text; }
 
   /// Counts of frames, commands and retries.
-  [[nodiscard]] LinkStats stats() const {
-    LinkStats s = stats_;
-    s.parse = parser_.stats();
-    return s;
-  }
+  [[nodiscard]] LinkStats stats() const { return channel_.stats(); }
 
-  [[nodiscard]] const SiteLimits& limits() const { return limits_; }                  ///< the site's limits
-  [[nodiscard]] const LinkOptions& options() const { return options_; }               ///< the settings
-  [[nodiscard]] std::string description() const { return transport_.description(); }  ///< the transport
+  [[nodiscard]] const SiteLimits& limits() const { return limits_; }                ///< the site's limits
+  [[nodiscard]] const LinkOptions& options() const { return channel_.options(); }   ///< the settings
+  [[nodiscard]] std::string description() const { return channel_.description(); }  ///< the transport
 
   /// Bytes read from the transport at a time: a UDP datagram of the largest size.
-  static constexpr std::size_t kReceiveBufferSize = 65536;
+  static constexpr std::size_t kReceiveBufferSize = detail::LinkChannel::kReceiveBufferSize;
 
  private:
-  // --- the loop: receive, dispatch, heartbeat, link loss ---
-
-  // Runs the link until done() or deadline_s; false if the deadline came first.
-  template <typename Done>
-  bool pump_until(double deadline_s, Done&& done, const char* step) {
-    for (;;) {
-      if (done()) return true;
-      const double t = now();
-      if (vehicle_ && t - last_vehicle_frame_s_ >= options_.link_timeout_s) {
-        if (drain(step) > 0) continue;  // frames that waited while the caller was busy
-        throw_link_lost(step, t);
-      }
-      if (t >= deadline_s) return false;
-      send_heartbeat_if_due(t);
-      double until = std::min(deadline_s, next_heartbeat_s_);
-      if (vehicle_) until = std::min(until, last_vehicle_frame_s_ + options_.link_timeout_s);
-      receive_once(std::max(0.0, until - t));
-    }
-  }
-
-  // Reads what waited while the caller was busy, then throws LinkLost if the vehicle has still
-  // been silent too long: every operation starts here, so that none sends to a lost link.
-  void refresh(const char* step) {
-    drain(step);
-    const double t = now();
-    if (vehicle_ && t - last_vehicle_frame_s_ >= options_.link_timeout_s) throw_link_lost(step, t);
-  }
-
-  [[noreturn]] void throw_link_lost(const char* step, double t) const {
-    throw LinkLost(step, "no frame from the vehicle (system " + std::to_string(vehicle_->system_id) + ") for " +
-                             num(t - last_vehicle_frame_s_) + " s on " + transport_.description() +
-                             ": the link is lost; the vehicle is left to its own failsafe");
-  }
-
-  // Reads what is waiting, without waiting; the bytes read.
-  std::size_t drain(const char*) {
-    std::size_t total = 0;
-    for (int i = 0; i < 100000; ++i) {
-      const std::size_t n = receive_once(0.0);
-      if (n == 0) break;
-      total += n;
-    }
-    return total;
-  }
-
-  std::size_t receive_once(double timeout_s) {
-    const std::size_t n = transport_.receive(buffer_, timeout_s);
-    if (n == 0) return 0;
-    parser_.feed(std::span<const std::uint8_t>(buffer_.data(), n));
-    while (const std::optional<Frame> frame = parser_.next()) dispatch(*frame);
-    return n;
-  }
-
-  void send_heartbeat_if_due(double t) {
-    if (t < next_heartbeat_s_) return;
-    Heartbeat hb;
-    hb.type = options_.heartbeat_type;
-    hb.autopilot = mav_autopilot::kInvalid;
-    hb.base_mode = 0;
-    hb.custom_mode = 0;
-    hb.system_status = mav_state::kActive;
-    send(hb);
-    ++stats_.heartbeats_sent;
-    next_heartbeat_s_ += options_.heartbeat_period_s;
-    if (next_heartbeat_s_ <= t) next_heartbeat_s_ = t + options_.heartbeat_period_s;
-  }
-
-  template <MessageType M>
-  void send(const M& msg) {
-    transport_.send(encode(msg, FrameHeader{sequence_++, options_.system_id, options_.component_id}));
-    ++stats_.frames_sent;
-  }
-
-  static bool is_autopilot(const Heartbeat& hb) {
-    return hb.autopilot != mav_autopilot::kInvalid && hb.type != mav_type::kGcs &&
-           hb.type != mav_type::kOnboardController && hb.type != mav_type::kCamera && hb.type != mav_type::kGimbal;
-  }
-
-  void dispatch(const Frame& frame) {
-    if (frame.system_id == options_.system_id && frame.component_id == options_.component_id) return;  // ours, echoed
-    const Message msg = decode(frame);
-    const double t = now();
-    if (!vehicle_) {
-      const auto* hb = std::get_if<Heartbeat>(&msg);
-      if (hb == nullptr || !is_autopilot(*hb)) return;
-      if (options_.vehicle_system_id != 0 && frame.system_id != options_.vehicle_system_id) return;
-      vehicle_ = VehicleInfo{};
-      vehicle_->system_id = frame.system_id;
-      vehicle_->component_id = frame.component_id;
-    }
-    if (frame.system_id != vehicle_->system_id) return;
-    last_vehicle_frame_s_ = t;
-    ++stats_.frames_received;
-    if (const auto* hb = std::get_if<Heartbeat>(&msg)) {
-      if (frame.component_id != vehicle_->component_id) return;  // a camera's, a gimbal's
-      vehicle_->autopilot = hb->autopilot;
-      vehicle_->type = hb->type;
-      vehicle_->base_mode = hb->base_mode;
-      vehicle_->custom_mode = hb->custom_mode;
-      vehicle_->system_status = hb->system_status;
-      vehicle_->received_s = t;
-    } else if (const auto* gp = std::get_if<GlobalPositionInt>(&msg)) {
-      VehiclePosition p;
-      p.lat_deg = gp->lat * 1e-7;
-      p.lon_deg = gp->lon * 1e-7;
-      p.alt_msl_m = gp->alt * 1e-3;
-      p.rel_alt_m = gp->relative_alt * 1e-3;
-      p.vn_mps = gp->vx * 1e-2;
-      p.ve_mps = gp->vy * 1e-2;
-      p.vd_mps = gp->vz * 1e-2;
-      if (gp->hdg != std::numeric_limits<std::uint16_t>::max()) p.heading_deg = gp->hdg * 1e-2;
-      p.time_boot_ms = gp->time_boot_ms;
-      p.received_s = t;
-      position_ = p;
-    } else if (const auto* gps = std::get_if<GpsRawInt>(&msg)) {
-      if (gps->fix_type >= gps_fix_type::k3dFix && (!gps_ || gps_->fix_type < gps_fix_type::k3dFix)) fix_since_s_ = t;
-      gps_ = GpsStatus{gps->fix_type, gps->satellites_visible, t};
-    } else if (const auto* ack = std::get_if<CommandAck>(&msg)) {
-      // The extension fields name the command's sender where the firmware fills them.
-      if ((ack->target_system == 0 || ack->target_system == options_.system_id) &&
-          (ack->target_component == 0 || ack->target_component == options_.component_id)) {
-        acks_.push_back(*ack);
-        ++stats_.acks_received;
-      }
-    } else if (const auto* image = std::get_if<CameraImageCaptured>(&msg)) {
-      images_.push_back(*image);
-    } else if (const auto* text = std::get_if<StatusText>(&msg)) {
-      last_status_text_ = *text;
-      last_status_text_s_ = t;
-    }
-  }
-
-  // --- commands ---
-
-  CommandLong command_long_to_vehicle() const {
-    CommandLong cmd;
-    cmd.target_system = vehicle_->system_id;
-    cmd.target_component = vehicle_->component_id;
-    return cmd;
-  }
-
-  std::optional<CommandAck> take_ack(std::uint16_t command) {
-    const auto it = std::find_if(acks_.begin(), acks_.end(), [&](const CommandAck& a) { return a.command == command; });
-    if (it == acks_.end()) return std::nullopt;
-    const CommandAck ack = *it;
-    acks_.erase(it);
-    return ack;
-  }
-
-  // Sends `cmd` until it is acknowledged; see the class comment for the rules.
-  template <typename Command>
-  CommandAck command(Command cmd, const char* step) {
-    const std::uint16_t id = cmd.command;
-    acks_.clear();
-    const double started_s = now();
-    bool temporarily_rejected = false;
-    for (int attempt = 1; attempt <= options_.command_attempts; ++attempt) {
-      if constexpr (std::is_same_v<Command, CommandLong>) {
-        cmd.confirmation = static_cast<std::uint8_t>(std::min(attempt - 1, 255));
-      }
-      send(cmd);
-      ++stats_.commands_sent;
-      if (attempt > 1) ++stats_.command_retries;
-      const double sent_s = now();
-      double deadline_s = sent_s + options_.ack_timeout_s;
-      for (;;) {
-        std::optional<CommandAck> ack;
-        if (!pump_until(
-                deadline_s, [&] { return (ack = take_ack(id)).has_value(); }, step))
-          break;
-        if (ack->result == mav_result::kAccepted) return *ack;
-        if (ack->result == mav_result::kInProgress) {  // a final answer follows
-          deadline_s = std::min(now() + options_.ack_timeout_s, sent_s + options_.in_progress_timeout_s);
-          continue;
-        }
-        if (ack->result == mav_result::kTemporarilyRejected) {  // try again once this attempt's time is up
-          temporarily_rejected = true;
-          pump_until(
-              deadline_s, [] { return false; }, step);
-          break;
-        }
-        throw VehicleLinkError(
-            LinkFailure::refused, step,
-            "the vehicle refused " + command_name(id) + ": " + result_name(ack->result) + vehicle_says(started_s));
-      }
-    }
-    if (temporarily_rejected) {
-      throw VehicleLinkError(LinkFailure::no_ack, step,
-                             command_name(id) + " was TEMPORARILY_REJECTED, " +
-                                 std::to_string(options_.command_attempts) + " attempts in " + num(now() - started_s) +
-                                 " s" + vehicle_says(started_s));
-    }
-    throw VehicleLinkError(LinkFailure::no_ack, step,
-                           "no COMMAND_ACK for " + command_name(id) + " after " +
-                               std::to_string(options_.command_attempts) + " attempts, " + num(options_.ack_timeout_s) +
-                               " s each");
-  }
-
-  // " (the vehicle says: ...)" for a warning or worse STATUSTEXT since `since_s`.
-  std::string vehicle_says(double since_s) const {
-    if (!last_status_text_ || last_status_text_s_ < since_s || last_status_text_->severity > mav_severity::kWarning) {
-      return {};
-    }
-    return " (the vehicle says: \"" + last_status_text_->text + "\")";
-  }
-
-  void request_interval(std::uint32_t message_id, double interval_s, const char* step) {
-    CommandLong cmd = command_long_to_vehicle();
-    cmd.command = mav_cmd::kSetMessageInterval;
-    cmd.param1 = static_cast<float>(message_id);
-    cmd.param2 = static_cast<float>(interval_s * 1e6);
-    command(cmd, step);
-  }
+  // What the vehicle has told the link.
+  [[nodiscard]] const detail::VehicleInbox& seen() const { return channel_.inbox(); }
 
   // Puts ArduPilot in GUIDED and waits for its HEARTBEAT to say so.
   void enter_guided(const char* step) {
     const std::optional<std::uint32_t> mode =
-        options_.ardupilot_guided_mode ? options_.ardupilot_guided_mode : ardupilot_guided_mode(vehicle_->type);
+        options().ardupilot_guided_mode ? options().ardupilot_guided_mode : ardupilot_guided_mode(seen().vehicle->type);
     if (!mode) {
       throw VehicleLinkError(LinkFailure::refused, step,
-                             "ArduPilot's GUIDED mode number for MAV_TYPE " + std::to_string(vehicle_->type) +
+                             "ArduPilot's GUIDED mode number for MAV_TYPE " + std::to_string(seen().vehicle->type) +
                                  " is unknown: set LinkOptions::ardupilot_guided_mode");
     }
-    if (vehicle_->custom_mode != *mode) {
-      CommandLong cmd = command_long_to_vehicle();
+    if (seen().vehicle->custom_mode != *mode) {
+      CommandLong cmd = channel_.command_long_to_vehicle();
       cmd.command = mav_cmd::kDoSetMode;
       cmd.param1 = static_cast<float>(mav_mode_flag::kCustomModeEnabled);
       cmd.param2 = static_cast<float>(*mode);
-      command(cmd, step);
+      channel_.command(cmd, step);
       const double t = now();
-      if (!pump_until(
-              t + options_.mode_timeout_s, [&] { return vehicle_->received_s > t && vehicle_->custom_mode == *mode; },
-              step)) {
-        throw VehicleLinkError(
-            LinkFailure::refused, step,
-            "the vehicle acknowledged DO_SET_MODE " + mode_name(Firmware::ardupilot, vehicle_->type, *mode) +
-                " but its HEARTBEAT still says " + vehicle_->mode() + " after " + num(options_.mode_timeout_s) + " s");
+      if (!channel_.pump_until(
+              t + options().mode_timeout_s,
+              [&] { return seen().vehicle->received_s > t && seen().vehicle->custom_mode == *mode; }, step)) {
+        throw VehicleLinkError(LinkFailure::refused, step,
+                               "the vehicle acknowledged DO_SET_MODE " +
+                                   mode_name(Firmware::ardupilot, seen().vehicle->type, *mode) +
+                                   " but its HEARTBEAT still says " + seen().vehicle->mode() + " after " +
+                                   num(options().mode_timeout_s) + " s");
       }
     }
     guided_mode_ = *mode;
   }
 
   // The mode a vehicle under our control must be in.
-  std::uint32_t expected_mode() const { return vehicle_->firmware() == Firmware::px4 ? px4_mode::kHold : guided_mode_; }
+  std::uint32_t expected_mode() const {
+    return seen().vehicle->firmware() == Firmware::px4 ? px4_mode::kHold : guided_mode_;
+  }
 
   // Throws mode_changed if the vehicle is returning or landing, or left the mode we put it in
   // (judged on a HEARTBEAT that came after the mode had time to show).
   void check_mode(const char* step) const {
-    const VehicleInfo& v = *vehicle_;
+    const VehicleInfo& v = *seen().vehicle;
     if (is_returning_or_landing(v.firmware(), v.type, v.custom_mode)) {
       throw VehicleLinkError(LinkFailure::mode_changed, step,
                              "the vehicle is in " + v.mode() +
@@ -637,11 +406,11 @@ class VehicleLink {
 
   // The latest position, read just now and younger than position_timeout_s.
   VehiclePosition fresh_position(const char* step) const {
-    if (!position_ || now() - position_->received_s >= options_.position_timeout_s) {
+    if (!seen().position || now() - seen().position->received_s >= options().position_timeout_s) {
       throw VehicleLinkError(LinkFailure::stale_position, step,
-                             "no GLOBAL_POSITION_INT in the last " + num(options_.position_timeout_s) + " s");
+                             "no GLOBAL_POSITION_INT in the last " + num(options().position_timeout_s) + " s");
     }
-    return *position_;
+    return *seen().position;
   }
 
   void require_connected(const char* step) const {
@@ -649,7 +418,7 @@ class VehicleLink {
   }
 
   // `x` to `decimals` digits after the point, for messages.
-  static std::string num(double x, int decimals = 1) { return detail::fixed_text(x, decimals); }
+  static std::string num(double x, int decimals = 1) { return detail::LinkChannel::num(x, decimals); }
 
   static std::string fix_name(std::uint8_t fix_type) {
     switch (fix_type) {
@@ -660,29 +429,13 @@ class VehicleLink {
     }
   }
 
-  AnyTransport transport_;
+  detail::LinkChannel channel_;
   SiteLimits limits_;
-  LinkOptions options_;
-  Clock clock_;
-  Parser parser_;
-  std::vector<std::uint8_t> buffer_;
-  std::uint8_t sequence_ = 0;
-  double next_heartbeat_s_ = -std::numeric_limits<double>::infinity();
-  double last_vehicle_frame_s_ = 0.0;
-  std::optional<VehicleInfo> vehicle_;
-  std::optional<VehiclePosition> position_;
-  std::optional<GpsStatus> gps_;
-  double fix_since_s_ = 0.0;
-  std::vector<CommandAck> acks_;
-  std::vector<CameraImageCaptured> images_;
-  std::optional<StatusText> last_status_text_;
-  double last_status_text_s_ = 0.0;
   bool connected_ = false;
   bool in_control_ = false;        // a go_to was accepted since connect() or the last RTL
   std::uint32_t guided_mode_ = 0;  // ArduPilot's GUIDED number, once set
   double mode_settled_s_ = 0.0;    // the mode a go_to asked for shows in HEARTBEATs after this
   std::uint32_t capture_sequence_ = 0;
-  LinkStats stats_;
 };
 
 }  // namespace adaptseg::mavlink
