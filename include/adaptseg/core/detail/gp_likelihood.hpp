@@ -172,8 +172,8 @@ template <class K>
 void gp_check_training_data(const K& kernel, const Eigen::Ref<const Eigen::MatrixXd>& x,
                             const Eigen::Ref<const Eigen::VectorXd>& y) {
   require(x.rows() >= 1, "GaussianProcess: number of training samples (rows of x) must be >= 1", x.rows());
-  require(kernel.accepts_dimension(x.cols()), "GaussianProcess: kernel does not accept the input dimension (columns of x)",
-          x.cols());
+  require(kernel.accepts_dimension(x.cols()),
+          "GaussianProcess: kernel does not accept the input dimension (columns of x)", x.cols());
   require(y.size() == x.rows(), "GaussianProcess: size of y must equal the rows of x, size", y.size());
   require(x.allFinite(), "GaussianProcess: x must be finite, rows", x.rows());
   require(y.allFinite(), "GaussianProcess: y must be finite, size", y.size());
