@@ -144,18 +144,19 @@ class LinkChannel {
       send(cmd);
       ++stats_.commands_sent;
       if (attempt > 1) ++stats_.command_retries;
-      if (const std::optional<mavlink::CommandAck> ack = await_ack(id, started_s, temporarily_rejected, step)) return *ack;
+      if (const std::optional<mavlink::CommandAck> ack = await_ack(id, started_s, temporarily_rejected, step))
+        return *ack;
     }
     if (temporarily_rejected) {
       throw mavlink::VehicleLinkError(mavlink::LinkFailure::no_ack, step,
-                             mavlink::command_name(id) + " was TEMPORARILY_REJECTED, " +
-                                 std::to_string(options_.command_attempts) + " attempts in " + num(now() - started_s) +
-                                 " s" + vehicle_says(started_s));
+                                      mavlink::command_name(id) + " was TEMPORARILY_REJECTED, " +
+                                          std::to_string(options_.command_attempts) + " attempts in " +
+                                          num(now() - started_s) + " s" + vehicle_says(started_s));
     }
     throw mavlink::VehicleLinkError(mavlink::LinkFailure::no_ack, step,
-                           "no COMMAND_ACK for " + mavlink::command_name(id) + " after " +
-                               std::to_string(options_.command_attempts) + " attempts, " + num(options_.ack_timeout_s) +
-                               " s each");
+                                    "no COMMAND_ACK for " + mavlink::command_name(id) + " after " +
+                                        std::to_string(options_.command_attempts) + " attempts, " +
+                                        num(options_.ack_timeout_s) + " s each");
   }
 
   /// SET_MESSAGE_INTERVAL for `message_id`, acknowledged.
@@ -169,7 +170,8 @@ class LinkChannel {
 
   /// " (the vehicle says: ...)" for a warning or worse STATUSTEXT since `since_s`.
   [[nodiscard]] std::string vehicle_says(double since_s) const {
-    if (!in_.status_text || in_.status_text_s < since_s || in_.status_text->severity > mavlink::mav_severity::kWarning) {
+    if (!in_.status_text || in_.status_text_s < since_s ||
+        in_.status_text->severity > mavlink::mav_severity::kWarning) {
       return {};
     }
     return " (the vehicle says: \"" + in_.status_text->text + "\")";
@@ -182,7 +184,7 @@ class LinkChannel {
   // One attempt of command(): waits out its acknowledgement. The ack if accepted; nullopt if
   // this attempt's time ran out (after a TEMPORARILY_REJECTED, `temporarily_rejected` set).
   std::optional<mavlink::CommandAck> await_ack(std::uint16_t id, double started_s, bool& temporarily_rejected,
-                                      const char* step) {
+                                               const char* step) {
     const double sent_s = now();
     double deadline_s = sent_s + options_.ack_timeout_s;
     for (;;) {
@@ -201,16 +203,16 @@ class LinkChannel {
             deadline_s, [] { return false; }, step);
         return std::nullopt;
       }
-      throw mavlink::VehicleLinkError(
-          mavlink::LinkFailure::refused, step,
-          "the vehicle refused " + mavlink::command_name(id) + ": " + mavlink::result_name(ack->result) + vehicle_says(started_s));
+      throw mavlink::VehicleLinkError(mavlink::LinkFailure::refused, step,
+                                      "the vehicle refused " + mavlink::command_name(id) + ": " +
+                                          mavlink::result_name(ack->result) + vehicle_says(started_s));
     }
   }
 
   [[noreturn]] void throw_link_lost(const char* step, double t) const {
-    throw mavlink::LinkLost(step, "no frame from the vehicle (system " + std::to_string(in_.vehicle->system_id) + ") for " +
-                             num(t - in_.last_frame_s) + " s on " + transport_.description() +
-                             ": the link is lost; the vehicle is left to its own failsafe");
+    throw mavlink::LinkLost(step, "no frame from the vehicle (system " + std::to_string(in_.vehicle->system_id) +
+                                      ") for " + num(t - in_.last_frame_s) + " s on " + transport_.description() +
+                                      ": the link is lost; the vehicle is left to its own failsafe");
   }
 
   // Reads what is waiting, without waiting; the bytes read.
@@ -254,7 +256,8 @@ class LinkChannel {
 
   static bool is_autopilot(const mavlink::Heartbeat& hb) {
     return hb.autopilot != mavlink::mav_autopilot::kInvalid && hb.type != mavlink::mav_type::kGcs &&
-           hb.type != mavlink::mav_type::kOnboardController && hb.type != mavlink::mav_type::kCamera && hb.type != mavlink::mav_type::kGimbal;
+           hb.type != mavlink::mav_type::kOnboardController && hb.type != mavlink::mav_type::kCamera &&
+           hb.type != mavlink::mav_type::kGimbal;
   }
 
   // Whether `frame` is the vehicle's: the first autopilot heard (mavlink::LinkOptions::vehicle_system_id,
@@ -289,7 +292,8 @@ class LinkChannel {
     } else if (const auto* gp = std::get_if<mavlink::GlobalPositionInt>(&msg)) {
       in_.position = position_of(*gp, t);
     } else if (const auto* gps = std::get_if<mavlink::GpsRawInt>(&msg)) {
-      if (gps->fix_type >= mavlink::gps_fix_type::k3dFix && (!in_.gps || in_.gps->fix_type < mavlink::gps_fix_type::k3dFix))
+      if (gps->fix_type >= mavlink::gps_fix_type::k3dFix &&
+          (!in_.gps || in_.gps->fix_type < mavlink::gps_fix_type::k3dFix))
         in_.fix_since_s = t;
       in_.gps = mavlink::GpsStatus{gps->fix_type, gps->satellites_visible, t};
     } else if (const auto* ack = std::get_if<mavlink::CommandAck>(&msg)) {
@@ -323,8 +327,8 @@ class LinkChannel {
   }
 
   std::optional<mavlink::CommandAck> take_ack(std::uint16_t command) {
-    const auto it =
-        std::find_if(in_.acks.begin(), in_.acks.end(), [&](const mavlink::CommandAck& a) { return a.command == command; });
+    const auto it = std::find_if(in_.acks.begin(), in_.acks.end(),
+                                 [&](const mavlink::CommandAck& a) { return a.command == command; });
     if (it == in_.acks.end()) return std::nullopt;
     const mavlink::CommandAck ack = *it;
     in_.acks.erase(it);
