@@ -577,15 +577,15 @@ int main(int argc, char** argv) {
                  "where the top-level grid is laid: corner (from the area's corner, the paper's grid) or centred "
                  "(on the area, every waypoint inside it: adaptseg_plan's); default centred with --area, else corner; "
                  "record and fly with the same")
-      ->check(CLI::IsMember({"corner", "centred"}));
+      ->check(CLI::IsMember(adaptseg::detail::names_of(adaptseg::kGridAnchors)));
   if (const auto code = adaptseg::examples::parse_command_line(app, argc, argv)) return *code;
   if (decision_model.empty()) return adaptseg::examples::command_line_error(app, "--decision-model is required");
   s.segmenter = segmenter;
   s.flight.trigger = trigger.empty() ? simulate_field.empty() : trigger == "autopilot";
   s.flight.pose_from_exif = image_pose == "exif";
-  const adaptseg::GridAnchor grid = grid_name == "centred" || (grid_name.empty() && !area_file.empty())
-                                        ? adaptseg::GridAnchor::centred
-                                        : adaptseg::GridAnchor::corner;
+  const adaptseg::GridAnchor grid = !grid_name.empty()   ? adaptseg::parse_grid_anchor(grid_name)
+                                    : !area_file.empty() ? adaptseg::GridAnchor::centred
+                                                         : adaptseg::GridAnchor::corner;
 
   try {
     const adaptseg::DecisionModel model = adaptseg::DecisionModel::load(decision_model);

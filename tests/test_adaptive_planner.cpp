@@ -178,6 +178,17 @@ TEST_CASE("descent coverages: each rule says which cells it flies and whether it
                        std::invalid_argument);
 }
 
+TEST_CASE("adaptive planner: grid anchors by name, as the programs' --grid reads them") {
+  for (const auto& row : kGridAnchors) {
+    CHECK(parse_grid_anchor(row.name) == row.value);
+    CHECK(std::string(to_string(row.value)) == row.name);
+  }
+  CHECK(parse_grid_anchor("centred") == GridAnchor::centred);
+  CHECK(std::string(to_string(GridAnchor::corner)) == "corner");
+  CHECK_THROWS_WITH_AS(static_cast<void>(parse_grid_anchor("centered")),
+                       "grid anchor must be 'corner' or 'centred', not 'centered'", std::invalid_argument);
+}
+
 TEST_CASE("adaptive planner: coverage 'ranked' offers the best k cells by their expected error, for every k") {
   // Two top-level regions of 3 x 3 sub-cells at 1 cm/px; in the first, a small crop patch in
   // the top-left cell and a larger one in the bottom-right cell, both with edges off the 3 cm/px

@@ -9,14 +9,17 @@
 #include <adaptseg/core/decision.hpp>
 #include <adaptseg/core/decision_inputs.hpp>
 #include <adaptseg/core/descent_schedule.hpp>
+#include <adaptseg/core/detail/named_rows.hpp>
 #include <adaptseg/core/lawnmower_planner.hpp>
 #include <adaptseg/core/mission_options.hpp>
 #include <adaptseg/vision/descent_coverage.hpp>
 
 #include <opencv2/core.hpp>
 
+#include <array>
 #include <cstddef>
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace adaptseg {
@@ -35,6 +38,21 @@ enum class GridAnchor {
   /// (its axes turned half a turn, or the origin moved) asks for the same waypoints on the ground.
   centred,
 };
+
+/// Every grid anchor and its name (the programs' `--grid`).
+inline constexpr std::array<detail::NamedValue<GridAnchor>, 2> kGridAnchors{{
+    {GridAnchor::corner, "corner"},
+    {GridAnchor::centred, "centred"},
+}};
+
+/// "corner" or "centred".
+[[nodiscard]] inline const char* to_string(GridAnchor a) { return detail::name_of(kGridAnchors, a, "grid anchor"); }
+
+/// Parses a grid anchor's name.
+/// @throws std::invalid_argument naming both for anything else.
+[[nodiscard]] inline GridAnchor parse_grid_anchor(const std::string& s) {
+  return detail::value_named(kGridAnchors, s, "grid anchor");
+}
 
 /// Settings of an adaptive mission.
 struct AdaptiveOptions {
