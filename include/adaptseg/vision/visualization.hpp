@@ -160,7 +160,6 @@ class AltitudeColours {
         cv::Point(static_cast<int>(std::lround(r.br().x * s)), static_cast<int>(std::lround(r.br().y * s))));
   };
   const detail::AltitudeColours colours(path);
-  const auto color_of = [&](double z) { return colours(z); };
   const auto to_px = [&](const Eigen::Vector3d& p) {
     return cv::Point(
         static_cast<int>(std::lround((p.x() * 100.0 / field.gsd_cm() - canvas.x) * s)),
@@ -168,13 +167,13 @@ class AltitudeColours {
   };
   // Footprints: a dark outline under the altitude colour, visible on white and on any class colour.
   for (const auto& w : path) cv::rectangle(base, rect_px(w.footprint), cv::Scalar(40, 40, 40), 3);
-  for (const auto& w : path) cv::rectangle(base, rect_px(w.footprint), color_of(w.position.z()), 1);
+  for (const auto& w : path) cv::rectangle(base, rect_px(w.footprint), colours(w.position.z()), 1);
   for (std::size_t i = 1; i < path.size(); ++i)
     cv::line(base, to_px(path[i - 1].position), to_px(path[i].position), cv::Scalar(60, 60, 60), 1, cv::LINE_AA);
   const int radius = std::max(2, static_cast<int>(std::lround(std::min(base.cols, base.rows) / 150.0)));
   for (const auto& w : path) {
     cv::circle(base, to_px(w.position), radius + 1, cv::Scalar(0, 0, 0), cv::FILLED, cv::LINE_AA);
-    cv::circle(base, to_px(w.position), radius, color_of(w.position.z()), cv::FILLED, cv::LINE_AA);
+    cv::circle(base, to_px(w.position), radius, colours(w.position.z()), cv::FILLED, cv::LINE_AA);
   }
   if (!path.empty()) detail::put_text(base, "start", to_px(path.front().position) + cv::Point(6, -6), 0.5);
 
