@@ -32,7 +32,10 @@
 #   never saw tile k (examples/models/mobilenetv2-dubai-loto/tile-k; scripts/loto.sh) flies tile
 #   k, its decision function calibrated on the other five tiles, each segmented by the network
 #   of the same recipe that never saw it (--calibration-network), as the deployment network's
-#   decision model is calibrated for a new site; 24 runs, measured segmentation times. Printed
+#   decision model is calibrated for a new site; 24 runs. Declared times as the oracle's (0.1 s per
+#   image, about MobileNetV2's median on the VM, the time calibration charges; 0 s per waypoint),
+#   so a loaded machine moves no decision (LOTO_TIMES=measured
+#   flies the measured times of the rows recorded before 2026-12-01). Printed
 #   beside the oracle's runs of the same folds (part oracle-default's Dubai runs, when there;
 #   ORACLE_CONFIG names another folder of them). Every network segments its own tile once into
 #   the segmentation cache. CONFIG (environment) names the folder (default loto), EXTRA adds
@@ -457,13 +460,15 @@ if [ "$part" = loto ] || [ "$part" = loto-insample ]; then
   done
   config=${CONFIG:-$part} oracle=${ORACLE_CONFIG:-oracle-default}
   read -r -a extra <<<"${EXTRA:-}"
+  times=("${fixed[@]}")
+  [ "${LOTO_TIMES:-declared}" = measured ] && times=()
   rm -rf "${root:?}/$config"
   for cls in $classes; do
     for t in 1 2 3 4 5 6; do
       train_except "$t"
       [ "$part" = loto-insample ] && train=(--train "$(dubai "$t")")
       run "$config" "mobilenetv2-loto-$cls-tile-$t" "${train[@]}" --test "$(dubai "$t")" --interest "$cls" \
-        --network "$loto/tile-$t" "${network[@]}" "${crossed[@]}" --no-plots "${extra[@]}"
+        --network "$loto/tile-$t" "${network[@]}" "${crossed[@]}" "${times[@]}" --no-plots "${extra[@]}"
     done
   done
   wait
@@ -503,7 +508,7 @@ if [ "$part" = loto-swap ]; then
         /usr/bin/python3 examples/tools/compose_model.py --gain "$gain" --reference "$reference" --confidence 0 \
           --out "$root/$config/$name.model.yaml"
         run "$config" "$name" --decision-model "$root/$config/$name.model.yaml" --test "$(dubai "$t")" \
-          --interest "$cls" --network "$loto/tile-$t" "${network[@]}" --no-plots
+          --interest "$cls" --network "$loto/tile-$t" "${network[@]}" "${fixed[@]}" --no-plots
       done
     done
     labels+=("$mix=$root/$config")
