@@ -56,17 +56,17 @@ Steps fly(const adaptseg::Field& field, Backend& backend, const adaptseg::Decisi
   DecisionFunction policy = model.decision_function;
   policy.set_online(strategy.online);
   Mission<Backend> mission(field, backend, ao.mission, std::string(strategy.name));
-  const bool probabilities = descent_coverage_info(ao.coverage).ranks_cells;
   Steps out;
   const auto t_start = std::chrono::steady_clock::now();
-  AdaptivePlanner<Backend, DecisionFunction> planner(SurveyArea::of(field), backend, policy, ao);
+  AdaptivePlanner<DecisionFunction> planner(SurveyArea::of(field), policy, ao);
   auto w = planner.next();
   out.setup.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count());
   while (w) {
-    auto visit = mission.visit_without_fusion(w->waypoint, w->level, probabilities);  // not timed
-    const Segmentation s{visit.labels, std::move(visit.probabilities), std::move(visit.member_votes)};
+    // Segmented and checked by the mission, not timed.
+    const auto visit = mission.visit(w->waypoint, w->level, planner.wants_probabilities());
     const auto t0 = std::chrono::steady_clock::now();
-    const PlannerStep step = planner.report(visit.image, s, visit.record->segmentation_s, mission.elapsed_s());
+    const PlannerStep step =
+        planner.report(visit.image, visit.segmentation, visit.record->segmentation_s, mission.elapsed_s());
     w = planner.next();
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     out.all.push_back(ms);

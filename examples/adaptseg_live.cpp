@@ -277,7 +277,7 @@ std::unique_ptr<ex::MavlinkVehicle> connect_vehicle(const Planner& planner, cons
 template <adaptseg::SegmentationBackend Backend, adaptseg::DecisionPolicy Policy>
 void fly(const ImageSetInfo& info, Backend& backend, Policy& policy, const adaptseg::AdaptiveOptions& options,
          const LiveSettings& s) {
-  adaptseg::AdaptivePlanner<Backend, Policy> planner(info.area, backend, policy, options);
+  adaptseg::AdaptivePlanner<Policy> planner(info.area, policy, options);
   // The GSD the top level is flown at: the model's, or the one its policy chose for this area.
   std::printf("%s: %zu top-level waypoints at %.2f cm/px", info.name.c_str(), planner.top_level().size(),
               planner.top_gsd_cm());
@@ -318,7 +318,8 @@ void fly(const ImageSetInfo& info, Backend& backend, Policy& policy, const adapt
       // The mission's real clock, from the first waypoint on: the budget learns each step's cost.
       const std::optional<double> elapsed = vehicle ? std::optional<double>(vehicle->elapsed_s()) : std::nullopt;
       const adaptseg::PlannerStep step =
-          vehicle ? vehicle->while_busy([&] { return planner.report(image, elapsed); }) : planner.report(image);
+          vehicle ? vehicle->while_busy([&] { return adaptseg::segment_and_report(planner, backend, image, elapsed); })
+                  : adaptseg::segment_and_report(planner, backend, image);
 
       const auto& p = w->waypoint.position;
       std::printf("[%3zu] %s x=%7.2f y=%7.2f z=%6.2f m  %s  sigma=%.4f", w->index, w->level == 0 ? "top" : "sub", p.x(),
@@ -595,9 +596,8 @@ int main(int argc, char** argv) {
       const std::vector<int> interest = field.class_indices(model.interest);
       model.check_compatible(field, interest);
       const adaptseg::AdaptiveOptions o = model_options(model, interest, grid);
-      adaptseg::OracleSegmenter oracle(field.num_classes());
       adaptseg::DecisionFunction df = model.decision_function;
-      const adaptseg::AdaptivePlanner planner(adaptseg::SurveyArea::of(field), oracle, df, o);
+      const adaptseg::AdaptivePlanner planner(adaptseg::SurveyArea::of(field), df, o);
       const auto waypoints = planner.reachable_waypoints();
       ex::write_image_set(images_dir, field, model, waypoints, record_yaw_deg, record_gnss);
       std::printf("%s: recorded %zu images (%zu top-level, %zu for the descents) -> %s\n", field.name().c_str(),

@@ -600,7 +600,7 @@ TEST_CASE("adaptive planner: bad options are refused") {
 // --- AdaptivePlanner driven step by step, as a UAV's companion computer would ---
 
 namespace {
-using Planner = AdaptivePlanner<OracleSegmenter, Scripted>;
+using Planner = AdaptivePlanner<Scripted>;
 
 AdaptiveOptions weedmap_options(const Field& f) {
   AdaptiveOptions o = options();
@@ -608,11 +608,13 @@ AdaptiveOptions weedmap_options(const Field& f) {
   return o;
 }
 
-// Flies `planner` with a simulated camera: next() -> capture -> report(), as a caller would.
+// Flies `planner` with a simulated camera: next() -> capture -> segment_and_report() with the
+// oracle, as a caller would.
 // With `report_elapsed`, the caller keeps the mission time itself (flight by the timing model,
 // the fixed per-image and per-waypoint times) and reports it with each image.
 std::vector<PlannerStep> fly(Planner& planner, const Field& f, bool report_elapsed = false) {
   const SimulatedSensor sensor(f, planner.camera());
+  OracleSegmenter oracle(f.num_classes());
   const auto& mo = planner.options().mission;
   std::vector<PlannerStep> steps;
   std::optional<Eigen::Vector3d> at;
@@ -621,8 +623,8 @@ std::vector<PlannerStep> fly(Planner& planner, const Field& f, bool report_elaps
     if (at) clock += planner.timing().segment_time_s(*at, w->waypoint.position);
     at = w->waypoint.position;
     clock += *mo.fixed_segmentation_time_s + *mo.fixed_planning_time_s;
-    steps.push_back(report_elapsed ? planner.report(sensor.capture(w->waypoint), clock)
-                                   : planner.report(sensor.capture(w->waypoint)));
+    steps.push_back(report_elapsed ? segment_and_report(planner, oracle, sensor.capture(w->waypoint), clock)
+                                   : segment_and_report(planner, oracle, sensor.capture(w->waypoint)));
   }
   return steps;
 }
@@ -643,7 +645,7 @@ TEST_CASE("AdaptivePlanner: stepping by hand over WeedMap gives run_adaptive_mis
     Scripted sim_policy{.gsd = 1.5, .which = {0, 2, 3, 5, 8, 9, 11}};
     const AdaptiveResult sim = run_adaptive_mission(f, oracle, sim_policy, o, "scripted");
     Scripted live_policy = Scripted{.gsd = 1.5, .which = {0, 2, 3, 5, 8, 9, 11}};
-    Planner planner(SurveyArea::of(f), oracle, live_policy, o);
+    Planner planner(SurveyArea::of(f), live_policy, o);
     const auto steps = fly(planner, f, report_elapsed);
 
     REQUIRE(sim.descents() >= 2);
@@ -699,7 +701,7 @@ TEST_CASE(
   const AdaptiveResult sim = run_adaptive_mission(f, oracle, sim_policy, o, "scripted");
   REQUIRE(sim.descents() >= 2);
   Scripted live_policy{.gsd = 1.5, .which = {0, 2, 3, 5}};
-  Planner planner(SurveyArea::of(f), oracle, live_policy, o);
+  Planner planner(SurveyArea::of(f), live_policy, o);
   CHECK(planner.map().fusion() == MapFusion::pooled);
   (void)fly(planner, f);
   CHECK(cv::countNonZero(planner.map().labels() != sim.mission.fused_labels) == 0);
@@ -711,7 +713,7 @@ TEST_CASE(
   // Labels without probabilities cannot be pooled: refused, the waypoint still pending.
   o.mission.map_fusion = MapFusion::pooled;
   Scripted never{.gsd = 0.5};
-  Planner live(SurveyArea::of(f), oracle, never, o);
+  Planner live(SurveyArea::of(f), never, o);
   const auto w = live.next();
   REQUIRE(w.has_value());
   const Image img = SimulatedSensor(f, live.camera()).capture(w->waypoint);
@@ -726,7 +728,7 @@ TEST_CASE("AdaptivePlanner: next() repeats the pending waypoint and is nullopt o
   const Field f = t::blob_field(1500, 1100, 1.0, 5, 40);
   OracleSegmenter oracle(f.num_classes());
   Scripted one{.gsd = 2.0, .which = {0}};
-  Planner planner(SurveyArea::of(f), oracle, one, weedmap_options(f));
+  Planner planner(SurveyArea::of(f), one, weedmap_options(f));
   CHECK_FALSE(planner.done());
   const auto a = planner.next();
   const auto b = planner.next();
@@ -757,35 +759,86 @@ TEST_CASE("AdaptivePlanner: report() refuses a missing, repeated or malformed im
   const Field f = t::blob_field(1500, 1100, 1.0, 5, 40);
   OracleSegmenter oracle(f.num_classes());
   Scripted never{.gsd = 0.5};
-  Planner planner(SurveyArea::of(f), oracle, never, weedmap_options(f));
+  Planner planner(SurveyArea::of(f), never, weedmap_options(f));
   const SimulatedSensor sensor(f, planner.camera());
   const Image first = sensor.capture(planner.top_level().front());
-  CHECK_THROWS_WITH_AS((void)planner.report(first), doctest::Contains("no waypoint is waiting for an image"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)segment_and_report(planner, oracle, first),
+                       doctest::Contains("no waypoint is waiting for an image"), std::invalid_argument);
   const auto w = planner.next();
   REQUIRE(w.has_value());
   Image small = first;
   small.width_px = 320;
-  CHECK_THROWS_WITH_AS((void)planner.report(small), doctest::Contains("the image must have the camera's size 480x360"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)segment_and_report(planner, oracle, small),
+                       doctest::Contains("the image must have the camera's size 480x360"), std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)planner.report(first, cv::Mat(10, 10, CV_8UC1), 0.1),
                        doctest::Contains("labels must have the image's size 480x360"), std::invalid_argument);
-  CHECK_THROWS_WITH_AS((void)planner.report(first, -1.0), doctest::Contains("elapsed_s"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)segment_and_report(planner, oracle, first, -1.0), doctest::Contains("elapsed_s"),
+                       std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)planner.image_at(w->waypoint.position, cv::Mat(10, 10, CV_8UC3)),
                        doctest::Contains("bgr must be CV_8UC3 of the camera's size"), std::invalid_argument);
   CHECK_THROWS_WITH_AS((void)planner.image_at(w->waypoint.position, {}, std::numeric_limits<double>::quiet_NaN()),
                        doctest::Contains("yaw_deg must be finite"), std::invalid_argument);
   Image lost = first;
   lost.yaw_deg = std::numeric_limits<double>::infinity();
-  CHECK_THROWS_WITH_AS((void)planner.report(lost), doctest::Contains("yaw_deg must be finite"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)segment_and_report(planner, oracle, lost), doctest::Contains("yaw_deg must be finite"),
+                       std::invalid_argument);
   // A refused report changes nothing: the waypoint is still pending.
   CHECK(planner.pending().has_value());
-  const PlannerStep step = planner.report(first);
+  const PlannerStep step = segment_and_report(planner, oracle, first);
   CHECK(step.waypoint.index == 0);
   REQUIRE(step.decision.has_value());
   CHECK_FALSE(step.decision->decision.descend);
-  CHECK_THROWS_WITH_AS((void)planner.report(first), doctest::Contains("each waypoint takes one image"),
+  CHECK_THROWS_WITH_AS((void)segment_and_report(planner, oracle, first),
+                       doctest::Contains("each waypoint takes one image"), std::invalid_argument);
+}
+
+namespace {
+/// The oracle, counting its calls.
+struct CountingOracle {
+  OracleSegmenter oracle;
+  int calls = 0;
+  std::string name() const { return "counting"; }
+  cv::Mat segment(const Image& image) {
+    ++calls;
+    return oracle.segment(image);
+  }
+};
+}  // namespace
+
+TEST_CASE("AdaptivePlanner: a segmentation crosses once, checked where it was made") {
+  const Field f = t::blob_field(1500, 1100, 1.0, 5, 40);
+  Scripted never{.gsd = 0.5};
+  Planner planner(SurveyArea::of(f), never, weedmap_options(f));
+  const SimulatedSensor sensor(f, planner.camera());
+  const Image first = sensor.capture(planner.top_level().front());
+  CountingOracle backend{OracleSegmenter(f.num_classes())};
+  // Refused before the backend runs: nothing is pending.
+  CHECK_THROWS_WITH_AS((void)segment_and_report(planner, backend, first),
+                       doctest::Contains("no waypoint is waiting for an image"), std::invalid_argument);
+  CHECK(backend.calls == 0);
+  REQUIRE(planner.next().has_value());
+  // A segmentation checked for another class set, or for an image of another size: refused.
+  const CheckedSegmentation other_classes = segment_and_check(backend, first, f.num_classes() + 1, false);
+  CHECK_THROWS_WITH_AS((void)planner.report(first, other_classes, 0.1),
+                       doctest::Contains("the segmentation was checked for another image size, ignore label or class "
+                                         "set"),
                        std::invalid_argument);
+  Image half = first;
+  half.width_px /= 2;
+  half.height_px /= 2;
+  const CheckedSegmentation smaller =
+      CheckedSegmentation::check(Segmentation{cv::Mat(half.height_px, half.width_px, CV_8UC1, cv::Scalar(0)), {}}, half,
+                                 f.num_classes(), SegmentationSource::backend("test"));
+  CHECK_THROWS_WITH_AS((void)planner.report(first, smaller, 0.1), doctest::Contains("checked for another image size"),
+                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS((void)planner.report(first, segment_and_check(backend, first, f.num_classes(), false), -0.1),
+                       doctest::Contains("segmentation_s must be finite and >= 0"), std::invalid_argument);
+  CHECK(planner.pending().has_value());
+  // The backend's, checked once by segment_and_report: fused, the waypoint flown.
+  const int before = backend.calls;
+  CHECK(segment_and_report(planner, backend, first).waypoint.index == 0);
+  CHECK(backend.calls == before + 1);
+  CHECK_FALSE(planner.pending().has_value());
 }
 
 TEST_CASE("AdaptivePlanner: the elapsed time the caller reports drives the budget") {
@@ -799,7 +852,7 @@ TEST_CASE("AdaptivePlanner: the elapsed time the caller reports drives the budge
   Scripted greedy{.gsd = 1.0};
   const AdaptiveResult sim = run_adaptive_mission(f, oracle, greedy, o, "greedy");
   Scripted greedy_live{.gsd = 1.0};
-  Planner planner(SurveyArea::of(f), oracle, greedy_live, o);
+  Planner planner(SurveyArea::of(f), greedy_live, o);
   (void)fly(planner, f, true);
   CHECK(planner.elapsed_s() == doctest::Approx(sim.mission.total_s()).epsilon(1e-12));
   CHECK(planner.elapsed_s() <= *o.budget_s + 1e-9);
@@ -807,9 +860,9 @@ TEST_CASE("AdaptivePlanner: the elapsed time the caller reports drives the budge
   CHECK(sim.descents() > 0);
   // A caller whose clock says the budget is spent gets no descent, whatever the policy wants.
   Scripted late{.gsd = 1.0};
-  Planner spent(SurveyArea::of(f), oracle, late, o);
+  Planner spent(SurveyArea::of(f), late, o);
   const SimulatedSensor sensor(f, spent.camera());
-  while (const auto w = spent.next()) (void)spent.report(sensor.capture(w->waypoint), *o.budget_s);
+  while (const auto w = spent.next()) (void)segment_and_report(spent, oracle, sensor.capture(w->waypoint), *o.budget_s);
   CHECK(spent.elapsed_s() == *o.budget_s);
   CHECK(spent.path().size() == spent.top_level().size());
   for (const auto& d : spent.decisions()) {
@@ -823,7 +876,7 @@ TEST_CASE("AdaptivePlanner: live images made from poses land where the simulator
   const Field f = Field::load(t::example_field("weedmap-000"));
   OracleSegmenter oracle(f.num_classes());
   Scripted never{.gsd = 0.5};
-  Planner planner(SurveyArea::of(f), oracle, never, weedmap_options(f));
+  Planner planner(SurveyArea::of(f), never, weedmap_options(f));
   const SimulatedSensor sensor(f, planner.camera());
   const auto reachable = planner.reachable_waypoints();
   CHECK(reachable.size() > planner.top_level().size() * 4);
@@ -840,9 +893,9 @@ TEST_CASE("AdaptivePlanner: GridAnchor::centred lays the top-level grid centred 
   OracleSegmenter oracle(f.num_classes());
   Scripted never{.gsd = 0.5};
   AdaptiveOptions o = weedmap_options(f);
-  const Planner corner(SurveyArea::of(f), oracle, never, o);
+  const Planner corner(SurveyArea::of(f), never, o);
   o.grid_anchor = GridAnchor::centred;
-  const Planner centred(SurveyArea::of(f), oracle, never, o);
+  const Planner centred(SurveyArea::of(f), never, o);
   REQUIRE(centred.top_level().size() == corner.top_level().size());
   const Area& a = f.area();
   double lo_x = a.x_max_m, hi_x = a.x_min_m, lo_y = a.y_max_m, hi_y = a.y_min_m;
@@ -872,7 +925,7 @@ TEST_CASE("AdaptivePlanner: a camera that does not hold the plan's heading is fu
   for (double yaw : {0.0, 180.0, 25.0}) {
     CAPTURE(yaw);
     Scripted policy = twice;
-    Planner planner(SurveyArea::of(f), oracle, policy, weedmap_options(f));
+    Planner planner(SurveyArea::of(f), policy, weedmap_options(f));
     const SimulatedSensor sensor(f, planner.camera());
     while (const auto w = planner.next()) {
       const Image sim = sensor.capture(w->waypoint, yaw);
@@ -880,7 +933,7 @@ TEST_CASE("AdaptivePlanner: a camera that does not hold the plan's heading is fu
       CHECK(live.yaw_deg == yaw);
       CHECK(live.footprint_px == sim.footprint_px);
       live.ground_truth = sim.ground_truth;
-      (void)planner.report(live);
+      (void)segment_and_report(planner, oracle, live);
     }
     CHECK(policy.observed == 2);
     maps[yaw] = planner.map().labels().clone();
@@ -899,15 +952,15 @@ TEST_CASE("AdaptivePlanner: a survey area without a mask covers the rectangle") 
   OracleSegmenter oracle(f.num_classes());
   Scripted never{.gsd = 0.5};
   SurveyArea area{.area = {0.0, 0.0, 15.0, 11.0}, .map_gsd_cm = 1.0, .num_classes = f.num_classes()};
-  Planner planner(area, oracle, never, weedmap_options(f));
+  Planner planner(area, never, weedmap_options(f));
   CHECK(planner.map().labels().size() == cv::Size(1500, 1100));
   CHECK(planner.valid_fraction(planner.top_level().front().footprint) == 1.0);
   CHECK(planner.top_level().size() == LawnmowerPlanner(CameraModel{}).plan(area.area, 3.0).size());
   AdaptiveOptions no_interest = options();
-  CHECK_THROWS_WITH_AS(Planner(area, oracle, never, no_interest), doctest::Contains("no labels of interest"),
+  CHECK_THROWS_WITH_AS(Planner(area, never, no_interest), doctest::Contains("no labels of interest"),
                        std::invalid_argument);
   area.area.x_min_m = -1.0;
-  CHECK_THROWS_WITH_AS(Planner(area, oracle, never, weedmap_options(f)), doctest::Contains("SurveyArea: area"),
+  CHECK_THROWS_WITH_AS(Planner(area, never, weedmap_options(f)), doctest::Contains("SurveyArea: area"),
                        std::invalid_argument);
 }
 
@@ -961,7 +1014,7 @@ TEST_CASE("AdaptivePlanner: the budget holds on a slow computer, images and deci
     const double budget = coverage_worst + (0.05 + 0.9 * (seed % 10) / 10.0) * (everything - coverage_worst);
     o.budget_s = budget;
     Scripted greedy{.gsd = 1.0};
-    AdaptivePlanner<OracleSegmenter, Scripted> planner(SurveyArea::of(f), oracle, greedy, o);
+    AdaptivePlanner<Scripted> planner(SurveyArea::of(f), greedy, o);
     const double clock = fly_on_callers_clock(planner, [&](const PlannedWaypoint& w, double& now) {
       const Image image = sensor.capture(w.waypoint);
       const double segmentation_s = slow(rng);
@@ -1016,7 +1069,7 @@ TEST_CASE("AdaptivePlanner: the budget holds on a vehicle's clock, whatever time
     const double budget = coverage_worst + (0.05 + 0.9 * (seed % 10) / 10.0) * (everything - coverage_worst);
     o.budget_s = budget;
     Scripted greedy{.gsd = 1.0};
-    AdaptivePlanner<OracleSegmenter, Scripted> planner(SurveyArea::of(f), oracle, greedy, o);
+    AdaptivePlanner<Scripted> planner(SurveyArea::of(f), greedy, o);
     const double clock = fly_on_callers_clock(planner, [&](const PlannedWaypoint& w, double& now) {
       now += settle(rng) + 0.1;
       const Image image = sensor.capture(w.waypoint);

@@ -541,7 +541,7 @@ TEST_CASE("robustness: ranked missions: class probabilities that break the contr
   CHECK_THROWS_WITH_AS((void)collect_samples(f, sum, CameraModel{}, 3.0, {1.0}, f.interest(), DescentCoverage::ranked),
                        Contains("sum to 1.5"), std::invalid_argument);
   // The caller's probabilities in report(image, segmentation, s): checked, nothing changes.
-  AdaptivePlanner planner(SurveyArea::of(f), sum, never, o);
+  AdaptivePlanner planner(SurveyArea::of(f), never, o);
   const auto w = planner.next();
   REQUIRE(w.has_value());
   const Image image = SimulatedSensor(f, planner.camera()).capture(w->waypoint);
@@ -583,11 +583,11 @@ TEST_CASE("robustness: live planner: labels outside the class set, from the back
   const Field f = weedmap_field();
   ContractBreaker backend{ContractBreaker::Fault::label};
   LinearDecision never({0.0, 1.0});
-  AdaptivePlanner planner(SurveyArea::of(f), backend, never, live_options(f));
+  AdaptivePlanner planner(SurveyArea::of(f), never, live_options(f));
   const auto w = planner.next();
   REQUIRE(w.has_value());
   const Image image = SimulatedSensor(f, planner.camera()).capture(w->waypoint);
-  CHECK_THROWS_WITH_AS((void)planner.report(image),
+  CHECK_THROWS_WITH_AS((void)segment_and_report(planner, backend, image),
                        Contains("segmentation backend 'breaker' broke the segmentation contract: label 7 at pixel "
                                 "(x 7, y 5)"),
                        std::invalid_argument);
@@ -603,17 +603,16 @@ TEST_CASE("robustness: live planner: labels outside the class set, from the back
 
 TEST_CASE("robustness: live planner: survey area without its class count") {
   const Field f = weedmap_field();
-  OracleSegmenter oracle(f.num_classes());
   LinearDecision never({0.0, 1.0});
   const AdaptiveOptions o = live_options(f);
   SurveyArea area = SurveyArea::of(f);
   area.num_classes = 0;
-  CHECK_THROWS_WITH_AS(AdaptivePlanner(area, oracle, never, o),
+  CHECK_THROWS_WITH_AS(AdaptivePlanner(area, never, o),
                        Contains("SurveyArea: num_classes must be the size of the backend's class set, 1..255"),
                        std::invalid_argument);
   area.num_classes = 1;  // interest is class 1 or 2 of the WeedMap crop: not a class any more
-  CHECK_THROWS_WITH_AS(AdaptivePlanner(area, oracle, never, o),
-                       Contains("a label of interest is not a class index 0..0"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(AdaptivePlanner(area, never, o), Contains("a label of interest is not a class index 0..0"),
+                       std::invalid_argument);
 }
 
 TEST_CASE("robustness: adaptive: top GSD finer than the field") {

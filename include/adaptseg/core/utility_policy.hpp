@@ -31,7 +31,7 @@ namespace adaptseg {
 ///
 /// @code
 /// adaptseg::UtilityPolicy policy(adaptseg::GainModel::fit(samples), {.min_utility = 1e-4});
-/// adaptseg::AdaptivePlanner planner(area, backend, policy, options);
+/// adaptseg::AdaptivePlanner planner(area, policy, options);
 /// @endcode
 class UtilityPolicy {
  public:

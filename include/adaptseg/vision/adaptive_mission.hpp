@@ -130,7 +130,7 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
   Mission<Backend> mission(field, backend, options.mission, std::move(strategy));
   AdaptiveOptions planner_options = options;
   planner_options.mission.interest = mission.interest();
-  AdaptivePlanner<Backend, Policy> planner(SurveyArea::of(field), backend, policy, std::move(planner_options));
+  AdaptivePlanner<Policy> planner(SurveyArea::of(field), policy, std::move(planner_options));
   // What each descent gained is scored at the end against the ground truth: its region's map
   // before it, the map pixels its images covered, and the top-level images alone.
   std::vector<detail::PendingDescent> descents;
@@ -146,13 +146,10 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
     }
     // With the backend's class probabilities where the decision reads them (a coverage that ranks
     // cells: the top-level images' decision inputs, a descent's scene check) or the map does
-    // (MapFusion::pooled).
-    const bool probabilities =
-        descent_coverage_info(options.coverage).ranks_cells || options.mission.map_fusion == MapFusion::pooled;
-    auto visit = mission.visit_without_fusion(w->waypoint, w->level, probabilities);
-    const Segmentation segmentation{visit.labels, std::move(visit.probabilities), std::move(visit.member_votes)};
-    planner.report(visit.image, segmentation, visit.record->segmentation_s, mission.elapsed_s());
-    if (w->level == 0) top_only.fuse(visit.image, segmentation);
+    // (MapFusion::pooled); checked once, by the mission, which ran the backend.
+    const auto visit = mission.visit(w->waypoint, w->level, planner.wants_probabilities());
+    planner.report(visit.image, visit.segmentation, visit.record->segmentation_s, mission.elapsed_s());
+    if (w->level == 0) top_only.fuse(visit.image, visit.segmentation.get());
   }
   // The last decision's measured time (a fixed planning time is charged per waypoint only).
   if (!mission.options().fixed_planning_time_s) mission.charge_planning(planner.take_planning_s());

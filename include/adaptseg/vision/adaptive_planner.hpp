@@ -18,6 +18,7 @@
 #include <adaptseg/core/mission_options.hpp>
 #include <adaptseg/core/timing.hpp>
 #include <adaptseg/vision/adaptive_options.hpp>
+#include <adaptseg/vision/detail/descent_costing.hpp>
 #include <adaptseg/vision/detail/descent_options.hpp>
 #include <adaptseg/vision/detail/descent_tour.hpp>
 #include <adaptseg/vision/detail/descent_watch.hpp>
@@ -53,8 +54,9 @@ namespace adaptseg {
 /// run_adaptive_mission.
 ///
 /// Protocol: `next()` gives the waypoint to fly to (nullopt when the mission is complete);
-/// the caller flies there, takes the image and calls `report()` with it, once. The planner
-/// segments it with the backend (or takes the caller's labels), fuses it into its map, and at
+/// the caller flies there, takes the image, segments it and calls `report()` with it and its
+/// segmentation, once (segment_and_report() with a backend). The planner checks the
+/// segmentation (once: CheckedSegmentation), fuses it into its map, and at
 /// a top-level waypoint i (GSD `top_gsd_cm`) decides: for each candidate GSD finer than the
 /// top and not finer than the map, it plans the sub-lawnmower over the region (starting in the
 /// corner nearest the UAV, cells without field skipped; with DescentCoverage::interest only the
@@ -71,18 +73,19 @@ namespace adaptseg {
 /// or, if it reports none, the planner's own account (flight by the timing model along the
 /// planned waypoints; segmentation and planning measured, or fixed per image / waypoint).
 ///
-/// Holds references to `backend` and `policy`, which must outlive the planner.
+/// Holds a reference to `policy`, which must outlive the planner. It holds no backend: what
+/// crosses into it is each image's segmentation, checked once.
 ///
 /// @code
-/// adaptseg::AdaptivePlanner planner(area, backend, policy, options);
+/// adaptseg::AdaptivePlanner planner(area, policy, options);
 /// while (const auto w = planner.next()) {
 ///   const cv::Mat bgr = fly_and_shoot(w->waypoint.position);         // the UAV's part
-///   const auto step = planner.report(planner.image_at(measured_pose(), bgr));
+///   const auto step = adaptseg::segment_and_report(planner, backend, planner.image_at(measured_pose(), bgr));
 ///   if (step.decision && step.decision->decision.descend) { /* a sub-lawnmower comes (next) */ }
 /// }
 /// const adaptseg::SemanticMap& map = planner.map();
 /// @endcode
-template <SegmentationBackend Backend, DecisionPolicy Policy>
+template <DecisionPolicy Policy>
 class AdaptivePlanner {
  public:
   /// Plans the top-level lawnmower over `area` (cells without field skipped).
@@ -91,11 +94,10 @@ class AdaptivePlanner {
   ///         finer than the map's, candidates that are not finer than the top (or none to
   ///         descend to), a budget that is not positive, or one too small for the top-level
   ///         coverage alone.
-  AdaptivePlanner(SurveyArea area, Backend& backend, Policy& policy, AdaptiveOptions options)
+  AdaptivePlanner(SurveyArea area, Policy& policy, AdaptiveOptions options)
       : grid_(std::move(area), CameraModel(options.mission.camera), options.grid_anchor),
         timing_(options.mission.timing),
         map_(grid_.size(), grid_.area().ignore_label, options.mission.map_fusion),
-        backend_(backend),
         policy_(policy),
         options_(std::move(options)),
         coverage_(descent_coverage_info(options_.coverage)),
@@ -167,31 +169,13 @@ class AdaptivePlanner {
     return p;
   }
 
-  /// Reports the image taken at the pending waypoint; the planner segments it with the backend
-  /// (the time it takes is the image's segmentation time) and goes on as the other overload.
-  /// @throws std::invalid_argument as the other overload, and whatever the backend throws.
-  PlannerStep report(const Image& image, std::optional<double> elapsed_s = std::nullopt) {
-    check_report(image, elapsed_s);
-    const auto t0 = std::chrono::steady_clock::now();
-    // With the backend's class probabilities where it gives them and the decision or the map reads
-    // them (a coverage that ranks cells: the cells' decision inputs at the top level,
-    // image_summary.hpp, and in a descent's images the scene check's; MapFusion::pooled);
-    // otherwise the labels alone.
-    Segmentation s = wants_probabilities()
-                         ? segment_with_probabilities_checked(backend_, image, grid_.area().num_classes)
-                         : Segmentation{segment_checked(backend_, image, grid_.area().num_classes), {}};
-    check_pooled(s, "the backend gives none");
-    const auto segmented = std::chrono::steady_clock::now();
-    const double segmentation_s = std::chrono::duration<double>(segmented - t0).count();  // as Mission measures it
-    return accept(image, s, segmentation_s, elapsed_s, segmented);
-  }
-
   /// Reports the image taken at the pending waypoint with its segmentation `labels`, which
   /// took `segmentation_s` [s] (ignored when the options fix a segmentation time). The image's
   /// pose (`position`, `footprint_px`, `yaw_deg`) is what gets fused: the waypoint's, or the
   /// one the UAV measured (see image_at()). `elapsed_s`: the mission time [s] the caller
   /// measured up to now (flight, segmentation, planning), used for the budget instead of the
   /// planner's own account. Nothing changes when it throws: the waypoint stays pending.
+  /// segment_and_report() segments the image with a backend and reports it.
   /// @throws std::invalid_argument if no waypoint is pending (next() not called, or its image
   ///         already reported), for an image that is not of the camera's size or has no
   ///         footprint or a yaw that is not finite, labels that break the segmentation
@@ -203,16 +187,45 @@ class AdaptivePlanner {
 
   /// As the labels overload, with the class probabilities behind the labels where the caller's
   /// segmentation gives them (Segmentation; the decision inputs that need them are unknown
-  /// without).
+  /// without), checked here (CheckedSegmentation::check()).
   /// @throws std::invalid_argument as the labels overload, and for probabilities (member votes)
   ///         that break their contract (check_probabilities()).
   PlannerStep report(const Image& image, const Segmentation& segmentation, double segmentation_s,
                      std::optional<double> elapsed_s = std::nullopt) {
+    check_report(image, elapsed_s);
+    return report(image, detail::check_reported_segmentation(segmentation, image, grid_.area().num_classes),
+                  segmentation_s, elapsed_s);
+  }
+
+  /// As the other overloads, for a segmentation checked where it was made (segment_and_check():
+  /// a backend's, checked once) for this image and the area's class set.
+  /// @throws std::invalid_argument as the labels overload, and for a segmentation checked for
+  ///         another image size, ignore label or class set.
+  PlannerStep report(const Image& image, const CheckedSegmentation& segmentation, double segmentation_s,
+                     std::optional<double> elapsed_s = std::nullopt) {
     const auto t0 = std::chrono::steady_clock::now();
     check_report(image, elapsed_s);
-    detail::check_reported_segmentation(segmentation, image, grid_.area().num_classes, segmentation_s);
-    check_pooled(segmentation, "none were reported");
-    return accept(image, segmentation, segmentation_s, elapsed_s, t0);
+    detail::require(segmentation.checked_for(image, grid_.area().num_classes),
+                    "AdaptivePlanner::report: the segmentation was checked for another image size, ignore label or "
+                    "class set",
+                    grid_.area().num_classes);
+    detail::check_segmentation_time(segmentation_s);
+    check_pooled(segmentation.get(), "none were reported");
+    return accept(image, segmentation.get(), segmentation_s, elapsed_s, t0);
+  }
+
+  /// Throws what report() throws before it reads the segmentation: nothing pending, an image
+  /// not of the camera's size, without footprint or with a yaw that is not finite, an elapsed
+  /// time that is negative or not finite (segment_and_report() asks before it segments).
+  void check_report(const Image& image, std::optional<double> elapsed_s) const {
+    detail::check_reported_image(image, grid_.camera(), pending_, path_.size(), elapsed_s);
+  }
+
+  /// Whether the planner reads the class probabilities behind each image's labels: for the
+  /// decision inputs of a coverage that ranks cells, and for a pooled map (which refuses labels
+  /// alone).
+  [[nodiscard]] bool wants_probabilities() const noexcept {
+    return coverage_.ranks_cells || map_.fusion() == MapFusion::pooled;
   }
 
   /// The Image of a camera frame `bgr` (CV_8UC3, B, G, R of the camera's size, or empty) taken at
@@ -352,7 +365,8 @@ class AdaptivePlanner {
 
     // A budget that can no longer afford the rest of the descent (the bound of a step, learned
     // since the descent was chosen, may have grown) ends it here.
-    if (p.level == 1 && sub_next_ < sub_.size() && options_.budget_s && !descent_rest_fits()) {
+    if (p.level == 1 && sub_next_ < sub_.size() && options_.budget_s &&
+        !costing().rest_fits(sub_, sub_next_, current_, top_next_)) {
       sub_.resize(sub_next_);
       cut_short_ = true;
     }
@@ -371,21 +385,11 @@ class AdaptivePlanner {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
 
-  /// Whether the planner needs the class probabilities behind each image's labels: for the
-  /// decision inputs of a coverage that ranks cells, and for a pooled map.
-  [[nodiscard]] bool wants_probabilities() const noexcept {
-    return coverage_.ranks_cells || map_.fusion() == MapFusion::pooled;
-  }
-
   /// @throws std::invalid_argument for a pooled map and a segmentation without probabilities.
   void check_pooled(const Segmentation& s, const char* why) const {
     detail::require(map_.fusion() == MapFusion::finest || !s.probabilities.empty(),
                     "AdaptivePlanner::report: map fusion 'pooled' needs the class probabilities behind the labels",
                     why);
-  }
-
-  void check_report(const Image& image, std::optional<double> elapsed_s) const {
-    detail::check_reported_image(image, grid_.camera(), pending_, path_.size(), elapsed_s);
   }
 
   /// The area's lawnmowers at the candidate and nominal top GSDs with their forecast times:
@@ -407,6 +411,11 @@ class AdaptivePlanner {
       region_inputs_.assign(image, segmentation, options_.mission.interest, grid_.area().ignore_label, region,
                             std::array{options_.cell_input});
     return &region_inputs_;
+  }
+
+  /// Descent costing (descent_costing.hpp) over the planner's route, clock and budget.
+  [[nodiscard]] detail::DescentCosting costing() const {
+    return {route_, timing_, clock_, grid_.camera(), options_.budget_s};
   }
 
   /// Whether the policy reads the field's mean top-level entropy (ReadsFieldEntropy).
@@ -436,76 +445,6 @@ class AdaptivePlanner {
     return out;
   }
 
-  /// A candidate's sub-lawnmower and its stop in the window's tour, beside DecisionRecord::candidates.
-  struct CostedPlan {
-    std::vector<Waypoint> plan;
-    TourStop stop;
-    TourInsertion insertion;  ///< where it goes into the tour (deferred only)
-  };
-
-  /// The candidates of the decision at top-level waypoint i (descent_options()) with their exact
-  /// extra times into `rec.candidates`, those the budget affords (`rec.budget_limited` where it
-  /// drops one), and their plans in the same order. `ahead`: what is left without descending.
-  std::vector<CostedPlan> cost_candidates(std::size_t i, const GridInputs* inputs,
-                                          const detail::PlannerRoute::Ahead& ahead, DecisionRecord& rec) const {
-    const double per_image = clock_.per_image_estimate();
-    // The budget reserves a bound of each step's processing instead of the estimate, and, where
-    // times are measured, one for what is left of this step (this decision, not yet charged).
-    const double bound = clock_.step_bound();
-    const double reserved = ahead.flight_s + ahead.images * bound + clock_.this_step_reserve();
-    const double elapsed = elapsed_s();
-    std::vector<CostedPlan> plans;
-    for (detail::DescentOption& option : descent_options(i, inputs)) {
-      std::vector<Waypoint>& sub = option.plan;
-      if (sub.empty()) continue;
-      const detail::PlannerRoute::Priced priced = route_.price(timing_, i, sub, ahead);
-      Candidate c;
-      c.deferred = priced.deferred;
-      c.gsd_cm = option.gsd_cm;
-      c.altitude_m = grid_.camera().altitude_m(option.gsd_cm);
-      c.images = static_cast<int>(sub.size());
-      c.extra_time_s = priced.flight_s + static_cast<double>(sub.size()) * per_image;
-      c.cells = std::move(option.cells);
-      // Descending replaces the direct leg to i+1: elapsed + extra + rest must fit, each image
-      // reserved at the bound.
-      if (options_.budget_s &&
-          elapsed + priced.flight_s + static_cast<double>(sub.size()) * bound + reserved > *options_.budget_s + 1e-9) {
-        rec.budget_limited = true;
-        continue;
-      }
-      rec.candidates.push_back(c);
-      plans.push_back({std::move(sub), priced.stop, priced.insertion});
-    }
-    return plans;
-  }
-
-  /// What the policy decides on at top-level waypoint i (DecisionContext): `rec`'s σ and
-  /// candidates, the mission so far and `rest_s` ahead, the region's share of the field and,
-  /// with ranked cells, its inputs (`inputs`), and `lawnmowers` (which must outlive its use).
-  [[nodiscard]] DecisionContext decision_context(std::size_t i, const DecisionRecord& rec, const GridInputs* inputs,
-                                                 double rest_s, std::span<const LawnmowerForecast> lawnmowers) const {
-    const Waypoint& top = route_.top()[i];
-    DecisionContext ctx;
-    ctx.sigma = rec.sigma;
-    ctx.valid_fraction = valid_fraction(top.footprint);
-    ctx.top_gsd_cm = top_gsd_cm_;
-    ctx.top_altitude_m = top.position.z();
-    ctx.candidates = rec.candidates;
-    ctx.elapsed_s = elapsed_s();
-    ctx.rest_s = rest_s;
-    ctx.region_share = grid_.valid_px() > 0 ? static_cast<double>(valid_pixels(top.footprint)) / grid_.valid_px() : 0.0;
-    ctx.region_px = static_cast<double>(valid_pixels(top.footprint));
-    if (inputs) {
-      const cv::Rect region = region_rect(i);
-      const CellInputs whole =
-          inputs->cell(grid_.area().valid_mask(region), cv::Rect(0, 0, region.width, region.height));
-      ctx.region_input = whole.value(options_.cell_input);
-      if (reads_field_entropy()) ctx.region_entropy = whole.value(DecisionInput::entropy);
-    }
-    ctx.lawnmowers = lawnmowers;
-    return ctx;
-  }
-
   /// The decision at top-level waypoint `p` (paper §3.2.2), its candidates with exact costs; a
   /// descent chosen comes next, or (deferred) goes into the window's tour.
   DecisionRecord decide(const PlannedWaypoint& p, double sigma, const Image& image, const Segmentation& segmentation) {
@@ -518,9 +457,11 @@ class AdaptivePlanner {
     const detail::PlannerRoute::Ahead ahead = route_.ahead(timing_, i);
     const double rest = ahead.flight_s + ahead.images * clock_.per_image_estimate();
     const GridInputs* inputs = region_inputs(i, image, segmentation);
-    std::vector<CostedPlan> plans = cost_candidates(i, inputs, ahead, rec);
+    std::vector<detail::CostedPlan> plans = costing().cost(descent_options(i, inputs), i, ahead, rec);
     const std::vector<LawnmowerForecast> forecasts = lawnmower_forecasts();
-    rec.decision = policy_.decide(decision_context(i, rec, inputs, rest, forecasts));
+    const detail::DecisionInputsAt at{route_.top()[i], region_rect(i), inputs, options_.cell_input,
+                                      reads_field_entropy()};
+    rec.decision = policy_.decide(detail::decision_context(grid_, at, top_gsd_cm_, rec, elapsed_s(), rest, forecasts));
     if (rec.decision.descend) {
       const std::size_t k = chosen_candidate(rec.decision, rec.candidates, policy_.name());
       detail::ChosenDescent chosen{
@@ -533,25 +474,6 @@ class AdaptivePlanner {
     }
     decisions_.push_back(rec);
     return rec;
-  }
-
-  /// Whether the budget still affords the rest of the descent in progress, from the image just
-  /// reported: its remaining images and flight, then what follows it (the next top-level
-  /// waypoint, or the rest of the tour being flown) and the rest of the mission, every image at
-  /// the step bound. Cutting it here flies straight on to what follows.
-  [[nodiscard]] bool descent_rest_fits() const {
-    const double bound = clock_.step_bound();
-    double inner = 0.0;  // from the image just reported through the descent's remaining waypoints
-    for (std::size_t k = sub_next_; k < sub_.size(); ++k)
-      inner += timing_.segment_time_s(sub_[k - 1].position, sub_[k].position);
-    const double more_images = static_cast<double>(sub_.size() - sub_next_);
-    // What follows: the rest of the tour being flown (none for a descent flown at once), its end,
-    // and the top level from there on.
-    const detail::PlannerRoute::AfterDescent after = route_.after_descent(timing_, current_, top_next_);
-    const double go_on =
-        inner + tour_flight_s(timing_, sub_.back().position, route_.tour().stops(), after.order, after.end);
-    const double mission_rest = after.flight_s + (more_images + after.images) * bound + clock_.this_step_reserve();
-    return elapsed_s() + go_on + mission_rest <= *options_.budget_s + 1e-9;
   }
 
   /// The descent chosen at a top-level waypoint: its waypoints come next.
@@ -596,7 +518,6 @@ class AdaptivePlanner {
   detail::SurveyGrid grid_;  ///< the area, its field and the camera's lawnmowers over it
   TimingModel timing_;
   SemanticMap map_;
-  Backend& backend_;
   Policy& policy_;
   AdaptiveOptions options_;
   const DescentCoverageInfo& coverage_;  ///< options_.coverage's
@@ -618,5 +539,23 @@ class AdaptivePlanner {
   std::vector<PlannedWaypoint> path_;
   std::vector<DecisionRecord> decisions_;
 };
+
+/// Segments `image` with `backend` and reports it to `planner` (AdaptivePlanner::report): the
+/// labels, with the backend's class probabilities where it gives them and the planner reads them
+/// (AdaptivePlanner::wants_probabilities()), checked once where they are made
+/// (segment_and_check()); the time the backend takes is the image's segmentation time. The
+/// backend does not run for an image report() would refuse before reading its segmentation.
+/// @throws std::invalid_argument as AdaptivePlanner::report (a pooled map and a labels-only
+///         backend included), and whatever the backend throws.
+template <SegmentationBackend Backend, DecisionPolicy Policy>
+PlannerStep segment_and_report(AdaptivePlanner<Policy>& planner, Backend& backend, const Image& image,
+                               std::optional<double> elapsed_s = std::nullopt) {
+  planner.check_report(image, elapsed_s);
+  const auto t0 = std::chrono::steady_clock::now();
+  const CheckedSegmentation s =
+      segment_and_check(backend, image, planner.area().num_classes, planner.wants_probabilities());
+  const double segmentation_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return planner.report(image, s, segmentation_s, elapsed_s);
+}
 
 }  // namespace adaptseg

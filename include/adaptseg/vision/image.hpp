@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace adaptseg {
@@ -241,5 +242,55 @@ inline void check_probabilities(const std::vector<cv::Mat>& probabilities, const
     }
   }
 }
+
+/// Who made a segmentation, as the contract checks name it in their messages: its labels, its
+/// probabilities and its member votes (e.g. "segmentation backend 'erfnet'" for the first two).
+struct SegmentationSource {
+  std::string labels;
+  std::string probabilities;
+  std::string member_votes;
+
+  /// A backend named `name`: "segmentation backend 'NAME'" (member votes: "... (member votes)").
+  [[nodiscard]] static SegmentationSource backend(std::string_view name) {
+    std::string who = "segmentation backend '" + std::string(name) + "'";
+    return {who, who, who + " (member votes)"};
+  }
+};
+
+/// A Segmentation checked against the contract (check_segmentation(), check_probabilities())
+/// for the image and class set it was made for: what crosses from the segmenter into the map and
+/// the planner, checked once where it is made (check(), segment_and_check()) and trusted after.
+/// Remembers what it was checked against, so that a reader can tell it was this image's.
+class CheckedSegmentation {
+ public:
+  /// Checks `segmentation` of `image` for a class set of `num_classes` classes.
+  /// @throws std::invalid_argument naming `source` as check_segmentation() and
+  ///         check_probabilities() do.
+  [[nodiscard]] static CheckedSegmentation check(Segmentation segmentation, const Image& image, int num_classes,
+                                                 const SegmentationSource& source) {
+    check_segmentation(segmentation.labels, image, num_classes, source.labels);
+    check_probabilities(segmentation.probabilities, segmentation.labels, image, num_classes, source.probabilities);
+    check_probabilities(segmentation.member_votes, segmentation.labels, image, num_classes, source.member_votes);
+    return CheckedSegmentation(std::move(segmentation), num_classes, image.ignore_label);
+  }
+
+  [[nodiscard]] const Segmentation& get() const noexcept { return segmentation_; }
+  [[nodiscard]] const cv::Mat& labels() const noexcept { return segmentation_.labels; }
+  /// The segmentation, moved out.
+  [[nodiscard]] Segmentation release() && { return std::move(segmentation_); }
+  /// Whether it was checked for an image of `image`'s size and ignore label, and `num_classes`.
+  [[nodiscard]] bool checked_for(const Image& image, int num_classes) const noexcept {
+    return num_classes_ == num_classes && ignore_label_ == image.ignore_label &&
+           segmentation_.labels.cols == image.width_px && segmentation_.labels.rows == image.height_px;
+  }
+
+ private:
+  CheckedSegmentation(Segmentation s, int num_classes, int ignore_label)
+      : segmentation_(std::move(s)), num_classes_(num_classes), ignore_label_(ignore_label) {}
+
+  Segmentation segmentation_;
+  int num_classes_;
+  int ignore_label_;
+};
 
 }  // namespace adaptseg

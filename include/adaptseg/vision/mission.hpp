@@ -53,9 +53,10 @@ struct MissionResult {
   [[nodiscard]] std::optional<double> miou_all() const { return confusion.miou_all(); }
 };
 
-/// Executes waypoints one by one for a planner: the data flow sensor -> segmenter ->
-/// map/metrics, and the time accounting (flight by the velocity-ramp model from the
-/// previous waypoint; segmentation and planning measured, or fixed per image/waypoint).
+/// Executes waypoints one by one for a planner: the data flow sensor -> segmenter -> metrics,
+/// and the time accounting (flight by the velocity-ramp model from the previous waypoint;
+/// segmentation and planning measured, or fixed per image/waypoint). The map is the planner's
+/// (run_lawnmower_mission's own, AdaptivePlanner's): the mission scores it at the end (finish()).
 /// The mission starts at its first waypoint: take-off and landing are equal for every
 /// strategy and are left out.
 ///
@@ -68,7 +69,6 @@ class Mission {
   Mission(const Field& field, Backend& backend, MissionOptions options, std::string strategy)
       : sensor_(field, CameraModel(options.camera)),
         timing_(options.timing),
-        map_(field.labels().size(), field.ignore_label(), options.map_fusion),
         backend_(backend),
         options_(std::move(options)) {
     detail::check_fixed_times(options_);
@@ -88,8 +88,6 @@ class Mission {
   [[nodiscard]] const TimingModel& timing() const noexcept { return timing_; }
   [[nodiscard]] const MissionOptions& options() const noexcept { return options_; }
   [[nodiscard]] const std::vector<int>& interest() const noexcept { return result_.interest; }
-  /// The map fused by visit() (visit_without_fusion() leaves it alone).
-  [[nodiscard]] const SemanticMap& map() const noexcept { return map_; }
   [[nodiscard]] const std::vector<WaypointRecord>& records() const noexcept { return result_.waypoints; }
   /// Time spent so far [s] (flight + segmentation + planning).
   [[nodiscard]] double elapsed_s() const noexcept { return result_.total_s(); }
@@ -99,58 +97,32 @@ class Mission {
     return result_.waypoints.back().waypoint.position;
   }
 
-  /// The outcome of one visit: the image, its segmentation and its record.
+  /// The outcome of one visit: the image, its segmentation (checked once, here) and its record.
   struct Visit {
     Image image;
-    cv::Mat labels;
+    /// The backend's labels and, if asked for and given (SegmentsWithProbabilities), its class
+    /// probabilities and an ensemble's member votes.
+    CheckedSegmentation segmentation;
     const WaypointRecord* record;
-    /// The backend's class probabilities, if asked for and given (SegmentsWithProbabilities).
-    std::vector<cv::Mat> probabilities{};
-    /// An ensemble's member votes, with the probabilities where it gives them
-    /// (Segmentation::member_votes).
-    std::vector<cv::Mat> member_votes{};
   };
 
-  /// Flies to `w`, takes and segments the image, fuses it into the map and records it.
-  Visit visit(const Waypoint& w, int level) {
-    if (map_.fusion() == MapFusion::finest) {
-      Visit v = visit_without_fusion(w, level);
-      map_.fuse(v.image, v.labels);
-      return v;
-    }
-    Visit v = visit_without_fusion(w, level, true);
-    detail::require(!v.probabilities.empty(),
-                    "Mission: map fusion 'pooled' needs a backend that gives class probabilities", result_.segmenter);
-    map_.fuse(v.image, Segmentation{v.labels, v.probabilities});
-    return v;
-  }
-
-  /// visit() without fusing the image into this mission's map, for a planner that keeps the
-  /// map itself (AdaptivePlanner); score that map with `finish(map)`. With `probabilities`, the
-  /// backend's class probabilities come with the labels where it gives them (checked, and
-  /// their computation counted in the segmentation time).
-  Visit visit_without_fusion(const Waypoint& w, int level, bool probabilities = false) {
+  /// Flies to `w`, takes the image, segments it (segment_and_check(); with `probabilities`,
+  /// the backend's class probabilities where it gives them, their computation counted in the
+  /// segmentation time) and records it. Fusing it into a map is the caller's.
+  Visit visit(const Waypoint& w, int level, bool probabilities = false) {
     if (const auto p = position()) result_.flight_s += timing_.segment_time_s(*p, w.position);
-    Visit v{sensor_.capture(w), cv::Mat(), nullptr};
+    Image image = sensor_.capture(w);
     const auto t0 = std::chrono::steady_clock::now();
-    if (probabilities) {
-      Segmentation s = segment_with_probabilities_checked(backend_, v.image, sensor_.field().num_classes());
-      v.labels = std::move(s.labels);
-      v.probabilities = std::move(s.probabilities);
-      v.member_votes = std::move(s.member_votes);
-    } else {
-      v.labels = backend_.segment(v.image);
-    }
+    CheckedSegmentation s = segment_and_check(backend_, image, sensor_.field().num_classes(), probabilities);
     const double measured = seconds_since(t0);
-    check_segmentation(v.labels, v.image, sensor_.field().num_classes(),
-                       "segmentation backend '" + result_.segmenter + "'");
+    const cv::Mat& labels = s.labels();
 
     WaypointRecord rec;
     rec.waypoint = w;
     rec.level = level;
-    rec.semantic_ratio = semantic_ratio(v.labels, result_.interest, v.image.ignore_label);
-    if (!v.image.ground_truth.empty()) {
-      const ConfusionMatrix cm = image_confusion(v.image, v.labels, field().num_classes());
+    rec.semantic_ratio = semantic_ratio(labels, result_.interest, image.ignore_label);
+    if (!image.ground_truth.empty()) {
+      const ConfusionMatrix cm = image_confusion(image, labels, field().num_classes());
       rec.image_miou_interest = cm.miou(result_.interest);
       rec.image_miou_all = cm.miou_all();
       rec.truth_ratio = cm.truth_share(result_.interest);
@@ -158,18 +130,14 @@ class Mission {
     rec.segmentation_s = options_.fixed_segmentation_time_s.value_or(measured);
     result_.segmentation_s += rec.segmentation_s;
     result_.waypoints.push_back(std::move(rec));
-    v.record = &result_.waypoints.back();
-    return v;
+    return Visit{std::move(image), std::move(s), &result_.waypoints.back()};
   }
 
   /// Charges planning time: `measured_s`, or the fixed per-waypoint time if one is set.
   void charge_planning(double measured_s) { result_.planning_s += options_.fixed_planning_time_s.value_or(measured_s); }
 
-  /// Scores the fused map against the field and returns the result. Call once, at the end.
-  MissionResult finish() && { return std::move(*this).finish(map_); }
-
-  /// Scores `map` (of the field's size, e.g. a planner's own map) as the mission's fused map.
-  /// Call once, at the end.
+  /// Scores `map` (of the field's size: the planner's map) as the mission's fused map and
+  /// returns the result. Call once, at the end.
   /// @throws std::invalid_argument if `map` differs in size from the field.
   MissionResult finish(const SemanticMap& map) && {
     detail::require(map.labels().size() == field().labels().size(),
@@ -188,7 +156,6 @@ class Mission {
  private:
   SimulatedSensor sensor_;
   TimingModel timing_;
-  SemanticMap map_;
   Backend& backend_;
   MissionOptions options_;
   MissionResult result_;
@@ -213,11 +180,16 @@ template <SegmentationBackend Backend>
   const auto plan = planner.plan(field.area(), gsd_cm, {0.0, 0.0}, [&](const Area& a) { return field.has_valid(a); });
   const double per_waypoint =
       plan.empty() ? 0.0 : Mission<Backend>::seconds_since(t0) / static_cast<double>(plan.size());
+  SemanticMap map(field.labels().size(), field.ignore_label(), options.map_fusion);
+  const bool pooled = options.map_fusion == MapFusion::pooled;
   for (const auto& w : plan) {
     mission.charge_planning(per_waypoint);
-    mission.visit(w, 0);
+    const auto v = mission.visit(w, 0, pooled);
+    detail::require(!pooled || !v.segmentation.get().probabilities.empty(),
+                    "Mission: map fusion 'pooled' needs a backend that gives class probabilities", backend.name());
+    map.fuse(v.image, v.segmentation.get());
   }
-  return std::move(mission).finish();
+  return std::move(mission).finish(map);
 }
 
 }  // namespace adaptseg

@@ -106,8 +106,7 @@ class SampleCollector {
   // With probabilities where the cells' inputs or a pooled map read them (SemanticMap::fuse
   // refuses a pooled map a segmentation without them).
   [[nodiscard]] Segmentation segment(const Image& image) {
-    return ranked_ || pooled_ ? segment_with_probabilities_checked(backend_, image, n_)
-                              : Segmentation{segment_checked(backend_, image, n_), {}};
+    return segment_and_check(backend_, image, n_, ranked_ || pooled_).release();
   }
 
   [[nodiscard]] TopRegion top_region(std::size_t t) const {

@@ -8,6 +8,7 @@
 
 #include <concepts>
 #include <string>
+#include <utility>
 
 namespace adaptseg {
 
@@ -58,10 +59,8 @@ concept SegmentsWithProbabilities = requires(B& backend, const Image& image) {
 };
 
 /// `backend.segment(image)`, checked against the contract (check_segmentation()) for a class
-/// set of `num_classes` classes; what AdaptivePlanner and calibration call when they run the
-/// backend themselves (segment_with_probabilities_checked() for a backend with probabilities).
-/// AdaptivePlanner::report (labels segmented outside the library) and Mission (which times
-/// the backend alone) call check_segmentation() themselves.
+/// set of `num_classes` classes: the labels alone, as a cv::Mat (segment_and_check() for a
+/// CheckedSegmentation, with the class probabilities where wanted).
 /// @throws std::invalid_argument naming the backend if its labels break the contract, and
 ///         whatever `segment` throws.
 template <SegmentationBackend B>
@@ -71,24 +70,33 @@ template <SegmentationBackend B>
   return labels;
 }
 
+/// `image` segmented by `backend` and checked (CheckedSegmentation) for a class set of
+/// `num_classes` classes: with `probabilities`, the labels and the class probabilities where the
+/// backend gives them (SegmentsWithProbabilities; a labels-only backend gives none); otherwise
+/// the labels alone. What the library calls where it runs a backend itself (Mission, calibration,
+/// segment_and_report()), so that a backend's segmentation is checked once, where it is made.
+/// @throws std::invalid_argument naming the backend if its output breaks the contract, and
+///         whatever the backend throws.
+template <SegmentationBackend B>
+[[nodiscard]] CheckedSegmentation segment_and_check(B& backend, const Image& image, int num_classes,
+                                                    bool probabilities) {
+  const SegmentationSource source = SegmentationSource::backend(backend.name());
+  if constexpr (SegmentsWithProbabilities<B>) {
+    if (probabilities)
+      return CheckedSegmentation::check(backend.segment_with_probabilities(image), image, num_classes, source);
+  }
+  return CheckedSegmentation::check(Segmentation{backend.segment(image), {}}, image, num_classes, source);
+}
+
 /// The labels and, where the backend gives them (SegmentsWithProbabilities), the class
 /// probabilities of `image`, both checked against the contract (check_segmentation(),
-/// check_probabilities()) for a class set of `num_classes` classes. A labels-only backend gives
-/// empty probabilities.
+/// check_probabilities()) for a class set of `num_classes` classes: segment_and_check() with
+/// probabilities, as a plain Segmentation. A labels-only backend gives empty probabilities.
 /// @throws std::invalid_argument naming the backend if its output breaks the contract, and
 ///         whatever the backend throws.
 template <SegmentationBackend B>
 [[nodiscard]] Segmentation segment_with_probabilities_checked(B& backend, const Image& image, int num_classes) {
-  if constexpr (SegmentsWithProbabilities<B>) {
-    Segmentation s = backend.segment_with_probabilities(image);
-    const std::string who = "segmentation backend '" + std::string(backend.name()) + "'";
-    check_segmentation(s.labels, image, num_classes, who);
-    check_probabilities(s.probabilities, s.labels, image, num_classes, who);
-    check_probabilities(s.member_votes, s.labels, image, num_classes, who + " (member votes)");
-    return s;
-  } else {
-    return {segment_checked(backend, image, num_classes), {}};
-  }
+  return segment_and_check(backend, image, num_classes, true).release();
 }
 
 }  // namespace adaptseg

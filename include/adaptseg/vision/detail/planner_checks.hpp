@@ -81,17 +81,21 @@ inline void check_reported_image(const Image& image, const CameraModel& camera, 
             "AdaptivePlanner::report: elapsed_s must be finite and >= 0", *elapsed_s);
 }
 
-/// Checks a segmentation reported with its image (AdaptivePlanner::report) and the time it took.
+/// Checks a segmentation reported with its image (AdaptivePlanner::report).
 /// @throws std::invalid_argument for labels that break the segmentation contract
 ///         (check_segmentation()), probabilities or member votes that break theirs
-///         (check_probabilities()), and a `segmentation_s` that is negative or not finite.
-inline void check_reported_segmentation(const Segmentation& segmentation, const Image& image, int num_classes,
-                                        double segmentation_s) {
-  check_segmentation(segmentation.labels, image, num_classes, "AdaptivePlanner::report: the labels reported");
-  check_probabilities(segmentation.probabilities, segmentation.labels, image, num_classes,
-                      "AdaptivePlanner::report: the probabilities reported");
-  check_probabilities(segmentation.member_votes, segmentation.labels, image, num_classes,
-                      "AdaptivePlanner::report: the member votes reported");
+///         (check_probabilities()).
+[[nodiscard]] inline CheckedSegmentation check_reported_segmentation(const Segmentation& segmentation,
+                                                                     const Image& image, int num_classes) {
+  return CheckedSegmentation::check(
+      segmentation, image, num_classes,
+      {"AdaptivePlanner::report: the labels reported", "AdaptivePlanner::report: the probabilities reported",
+       "AdaptivePlanner::report: the member votes reported"});
+}
+
+/// @throws std::invalid_argument for a segmentation time (AdaptivePlanner::report) that is
+///         negative or not finite.
+inline void check_segmentation_time(double segmentation_s) {
   require(std::isfinite(segmentation_s) && segmentation_s >= 0.0,
           "AdaptivePlanner::report: segmentation_s must be finite and >= 0", segmentation_s);
 }
