@@ -260,7 +260,7 @@ struct SegmentationSource {
 /// A Segmentation checked against the contract (check_segmentation(), check_probabilities())
 /// for the image and class set it was made for: what crosses from the segmenter into the map and
 /// the planner, checked once where it is made (check(), segment_and_check()) and trusted after.
-/// Remembers what it was checked against, so that a reader can tell it was this image's.
+/// Remembers the image size, ignore label and class count it was checked for (checked_for()).
 class CheckedSegmentation {
  public:
   /// Checks `segmentation` of `image` for a class set of `num_classes` classes.
