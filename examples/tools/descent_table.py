@@ -7,8 +7,10 @@ the realised field gain and the region's gain (realised_region_delta_miou, sign 
 helped), and what the descent changed in the field's map over L in pixels: true positives
 gained (ΔTP: misses corrected, net), false positives added (ΔFP; < 0: removed). A class's field
 IoU moves by about (ΔTP − IoU·ΔFP) / (TP + FP + FN): a false positive removed is worth IoU times
-a miss corrected, one added costs as much. Then, over all descents: how often the region's gain
-and the field's disagree in sign, and for those, whether the descent added false positives.
+a miss corrected, one added costs as much. And Δσ, what the UAV saw: the region's σ after the
+descent minus its top-level σ (observed_sigma_sub − sigma; a descent that writes the class where
+it is absent raises it far beyond the others). Then, over all descents: how often the region's
+gain and the field's disagree in sign, and for those, whether the descent added false positives.
 
 With --curve, per descent also the lawnmower curve it had to beat: the rise the rule predicted
 over the descent's extra time (forecast_curve_rise) against the rise of the field's real curve
@@ -158,16 +160,17 @@ def main(argv: list[str] | None = None) -> int:
         curve_table(rows, curves)
         return 0
     print("| run | decision | GSD [cm/px] | images | forecast field gain | realised field gain | region gain | "
-          "ΔTP [px] | ΔFP [px] |")
-    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+          "ΔTP [px] | ΔFP [px] | Δσ |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
     forecast, realised = [], []
     disagree = disagree_fp = 0
     for run, d in rows:
         fg, rg = number(d["forecast_field_gain"]), number(d["realised_field_gain"])
         region = -number(d["realised_region_delta_miou"])
         tp, fp = int(d["realised_delta_tp"]), int(d["realised_delta_fp"])
+        d_sigma = number(d.get("observed_sigma_sub", "")) - number(d.get("sigma", ""))
         print(f"| {run} | {d['decision']} | {number(d['gsd_cm']):g} | {d['images']} | {fg:+.4f} | {rg:+.4f} | "
-              f"{region:+.4f} | {tp:+d} | {fp:+d} |")
+              f"{region:+.4f} | {tp:+d} | {fp:+d} | {d_sigma:+.3f} |")
         if math.isfinite(fg) and math.isfinite(rg):
             forecast.append(fg)
             realised.append(rg)

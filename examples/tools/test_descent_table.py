@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
-"""Self-test of descent_table.py's --curve and --hindsight on a synthetic run (run by CTest;
-exit code != 0 on failure).
+"""Self-test of descent_table.py's plain table, --curve and --hindsight on a synthetic run (run by
+CTest; exit code != 0 on failure).
 
-One field whose lawnmowers map L at 0.50 in 100 s and 0.60 in 200 s (the real curve rises 0.001
-per second), flown from the first by a mission with two descents: one gains 0.02 in 10 s (it
-beats the curve), the other 0.001 in 20 s (it does not). In hindsight the first alone ends
-+0.0100 above the curve (0.52 at 110 s against 0.51), both together −0.0090; the first's real
-rise over its seconds is 0.0100, against a predicted 0.0040.
+Each descent's row: its gains, pixels and the change of its region's σ. One field whose
+lawnmowers map L at 0.50 in 100 s and 0.60 in 200 s (the real curve rises 0.001 per second),
+flown from the first by a mission with two descents: one gains 0.02 in 10 s (it beats the
+curve), the other 0.001 in 20 s (it does not). In hindsight the first alone ends +0.0100 above
+the curve (0.52 at 110 s against 0.51), both together −0.0090; the first's real rise over its
+seconds is 0.0100, against a predicted 0.0040.
 """
 import contextlib
 import io
@@ -23,10 +24,11 @@ f,lawnmower,10,0.60,200,0
 f,adaptive,15,0.521,130,-0.009
 """
 COLUMNS = ("field,strategy,decision,action,gsd_cm,images,extra_time_s,forecast_field_gain,realised_field_gain,"
-           "realised_region_delta_miou,realised_delta_tp,realised_delta_fp,forecast_curve_rise,forecast_end_s\n")
-DECISIONS = COLUMNS + """f,adaptive,0,descend,10,2,10,0.015,0.02,-0.05,100,-10,0.004,110
-f,adaptive,1,continue,,,,,,,,,,
-f,adaptive,2,descend,10,2,20,0.006,0.001,-0.01,5,3,0.005,130
+           "realised_region_delta_miou,realised_delta_tp,realised_delta_fp,forecast_curve_rise,forecast_end_s,"
+           "sigma,observed_sigma_sub\n")
+DECISIONS = COLUMNS + """f,adaptive,0,descend,10,2,10,0.015,0.02,-0.05,100,-10,0.004,110,0.10,0.12
+f,adaptive,1,continue,,,,,,,,,,,0.2,
+f,adaptive,2,descend,10,2,20,0.006,0.001,-0.01,5,3,0.005,130,0.30,0.25
 """
 
 
@@ -45,6 +47,14 @@ def main():
             f.write(RESULTS)
         with open(os.path.join(run, "decisions.csv"), "w") as f:
             f.write(DECISIONS)
+        # Each descent: gains, what it changed in pixels, and the region's σ after it minus before.
+        plain = table([run])
+        for want in ("| run | 0 | 10 | 2 | +0.0150 | +0.0200 | +0.0500 | +100 | -10 | +0.020 |",
+                     "| run | 2 | 10 | 2 | +0.0060 | +0.0010 | +0.0100 | +5 | +3 | -0.050 |"):
+            if want not in plain:
+                sys.exit(f"table: no row {want}:\n{plain}")
+        if "false positives added in 1 descents, misses corrected (ΔTP > 0) in 2" not in plain:
+            sys.exit(f"table summary:\n{plain}")
         hindsight = table(["--hindsight", run])
         if "| run | 2 | -0.0090 | 1 | +0.0100 |" not in hindsight:
             sys.exit(f"hindsight: the first descent alone should end +0.0100 above the curve:\n{hindsight}")
