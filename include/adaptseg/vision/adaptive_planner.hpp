@@ -192,9 +192,11 @@ class AdaptivePlanner {
   ///         that break their contract (check_probabilities()).
   PlannerStep report(const Image& image, const Segmentation& segmentation, double segmentation_s,
                      std::optional<double> elapsed_s = std::nullopt) {
+    const auto t0 = std::chrono::steady_clock::now();
     check_report(image, elapsed_s);
-    return report(image, detail::check_reported_segmentation(segmentation, image, grid_.area().num_classes),
-                  segmentation_s, elapsed_s);
+    const CheckedSegmentation checked =
+        detail::check_reported_segmentation(segmentation, image, grid_.area().num_classes);
+    return accept_checked(image, checked, segmentation_s, elapsed_s, t0);
   }
 
   /// As the other overloads, for a segmentation checked where it was made (segment_and_check():
@@ -209,9 +211,7 @@ class AdaptivePlanner {
                     "AdaptivePlanner::report: the segmentation was checked for another image size, ignore label or "
                     "class set",
                     grid_.area().num_classes);
-    detail::check_segmentation_time(segmentation_s);
-    check_pooled(segmentation.get(), "none were reported");
-    return accept(image, segmentation.get(), segmentation_s, elapsed_s, t0);
+    return accept_checked(image, segmentation, segmentation_s, elapsed_s, t0);
   }
 
   /// Throws what report() throws before it reads the segmentation: nothing pending, an image
@@ -338,6 +338,15 @@ class AdaptivePlanner {
   [[nodiscard]] double valid_fraction(const Area& a) const { return grid_.valid_fraction(a); }
 
  private:
+  /// The checks of a report that follow the segmentation's (its time, a pooled map's
+  /// probabilities), then accept(); both report() overloads of a segmentation end here.
+  PlannerStep accept_checked(const Image& image, const CheckedSegmentation& segmentation, double segmentation_s,
+                             std::optional<double> elapsed_s, std::chrono::steady_clock::time_point t0) {
+    detail::check_segmentation_time(segmentation_s);
+    check_pooled(segmentation.get(), "none were reported");
+    return accept(image, segmentation.get(), segmentation_s, elapsed_s, t0);
+  }
+
   /// A reported image and its checked labels: the time account, the fused map, and at a
   /// top-level waypoint the decision, after a descent's last image its outcome. The planner's
   /// processing since `t0` is charged as planning time.
