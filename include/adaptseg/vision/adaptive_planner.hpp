@@ -13,37 +13,29 @@
 
 #include <adaptseg/core/camera.hpp>
 #include <adaptseg/core/decision.hpp>
-#include <adaptseg/core/inspection_tour.hpp>
 #include <adaptseg/core/lawnmower_planner.hpp>
-#include <adaptseg/core/mission_options.hpp>
 #include <adaptseg/core/timing.hpp>
 #include <adaptseg/vision/adaptive_options.hpp>
 #include <adaptseg/vision/detail/descent_costing.hpp>
-#include <adaptseg/vision/detail/descent_options.hpp>
+#include <adaptseg/vision/detail/descent_in_progress.hpp>
 #include <adaptseg/vision/detail/descent_tour.hpp>
-#include <adaptseg/vision/detail/descent_watch.hpp>
 #include <adaptseg/vision/detail/planner_checks.hpp>
 #include <adaptseg/vision/detail/planner_clock.hpp>
 #include <adaptseg/vision/detail/planner_route.hpp>
+#include <adaptseg/vision/detail/region_summary.hpp>
 #include <adaptseg/vision/detail/survey_grid.hpp>
 #include <adaptseg/vision/grid_inputs.hpp>
-#include <adaptseg/vision/image_summary.hpp>
+#include <adaptseg/vision/image.hpp>
 #include <adaptseg/vision/metrics.hpp>
-#include <adaptseg/vision/segmentation_backend.hpp>
+#include <adaptseg/vision/segment_and_report.hpp>
 #include <adaptseg/vision/semantic_map.hpp>
 
 #include <opencv2/core.hpp>
 
 #include <Eigen/Core>
 
-#include <algorithm>
-#include <array>
 #include <chrono>
-#include <cmath>
 #include <optional>
-#include <span>
-#include <stdexcept>
-#include <string>
 #include <utility>
 #include <vector>
 
@@ -53,21 +45,17 @@ namespace adaptseg {
 /// the UAV and takes the images: a companion computer, or the simulation driver
 /// run_adaptive_mission.
 ///
-/// Protocol: `next()` gives the waypoint to fly to (nullopt when the mission is complete);
-/// the caller flies there, takes the image, segments it and calls `report()` with it and its
-/// segmentation, once (segment_and_report() with a backend). The planner checks the
-/// segmentation (once: CheckedSegmentation), fuses it into its map, and at
-/// a top-level waypoint i (GSD `top_gsd_cm`) decides: for each candidate GSD finer than the
-/// top and not finer than the map, it plans the sub-lawnmower over the region (starting in the
-/// corner nearest the UAV, cells without field skipped; with DescentCoverage::interest only the
-/// cells that show a label of interest, see descent_plan()) and computes its exact extra time: the
-/// flight i → sub-lawnmower → i+1 minus the flight i → i+1, plus the per-image segmentation
-/// and per-waypoint planning estimates. Candidates that would break the budget are dropped; the
-/// policy decides; a descent's waypoints come next (DescentSchedule::tour / row: next, or after
-/// the last top-level image of the survey / of the row, as one tour with the other deferred
-/// descents, as each was costed).
-/// After a descent's last image, the region's σ at h' and what it relabelled (from the fused
-/// map) go back to the policy (paper §3.2.3).
+/// Protocol: `next()` gives the waypoint to fly to (nullopt when the mission is complete); the
+/// caller flies there, takes the image and calls `report()` with it and its segmentation, once
+/// (segment_and_report() with a backend). The planner checks it (once: CheckedSegmentation),
+/// fuses it into its map and, at a top-level waypoint, decides: every descent over the region it
+/// may fly (per candidate GSD its sub-lawnmower, descent_plan(); with ranked cells its best cells,
+/// detail::RegionSummary) at its exact extra time (detail::DescentCosting: the detour minus the
+/// leg it replaces, plus the per-image and per-waypoint estimates); those that would break the
+/// budget are dropped and the policy chooses. A descent's waypoints come next, or
+/// (DescentSchedule::tour / row) after the last top-level image of the survey / row, as one tour
+/// with the other deferred descents. After its last image (detail::DescentInProgress) the
+/// region's σ at h' and what it relabelled (from the fused map) go back to the policy (§3.2.3).
 ///
 /// Time: the budget check uses the elapsed mission time the caller reports with each image,
 /// or, if it reports none, the planner's own account (flight by the timing model along the
@@ -113,29 +101,11 @@ class AdaptivePlanner {
     lawnmowers_ = detail::LawnmowerCosts(grid_, timing_, lawnmower_gsds);
     // The top level: the options' top GSD, or another of the lawnmower GSDs where the policy
     // chooses one (ChoosesTopLevel); descents go to the candidates finer than it.
-    top_gsd_cm_ = options_.top_gsd_cm;
-    if constexpr (ChoosesTopLevel<Policy>) {
-      const double g = policy_.top_gsd(lawnmower_forecasts(), options_.top_gsd_cm);
-      const bool known = lawnmowers_.has(g);
-      const bool below = std::any_of(candidates_.begin(), candidates_.end(), [&](double c) { return c < g; });
-      if (!known || !below)
-        throw std::logic_error("decision policy '" + std::string(policy_.name()) + "' chose the top-level GSD " +
-                               std::to_string(g) +
-                               " cm/px, which is not one of the lawnmower GSDs with a candidate "
-                               "below it");
-      top_gsd_cm_ = g;
-      std::erase_if(candidates_, [&](double c) { return c >= g; });
-    }
+    top_gsd_cm_ = detail::choose_top_gsd(policy_, lawnmowers_, lawnmower_forecasts(), options_.top_gsd_cm, candidates_);
     route_ = detail::PlannerRoute(grid_.lawnmower(top_gsd_cm_), descent_schedule_info(options_.schedule), timing_);
-    clock_.charge_planning(seconds_since(t0));
-    if (options_.budget_s) {
-      const double coverage =
-          route_.flight_after(0) + static_cast<double>(route_.top().size()) * clock_.per_image_estimate();
-      detail::require(coverage <= *options_.budget_s,
-                      "AdaptivePlanner: budget_s [s] is too small for the top-level coverage, which needs " +
-                          std::to_string(coverage) + " s",
-                      *options_.budget_s);
-    }
+    clock_.charge_planning(detail::seconds_since(t0));
+    detail::check_top_level_budget(options_.budget_s, route_.flight_after(0), route_.top().size(),
+                                   clock_.per_image_estimate());
   }
 
   /// The next waypoint to fly to and take an image at; the same one again while its image has
@@ -144,18 +114,14 @@ class AdaptivePlanner {
     if (pending_) return path_.back();
     // A tour starts once the last top-level waypoint of its window (the survey, or the row) is
     // flown; once flown, it is cleared for the next window's.
-    if (sub_next_ >= sub_.size() && !route_.tour().taken() && top_next_ > 0 &&
+    if (!descent_.has_next() && !route_.tour().taken() && top_next_ > 0 &&
         top_next_ - 1 == route_.window_last(top_next_ - 1))
       start_inspection();
-    if (sub_next_ >= sub_.size() && top_next_ < route_.top().size() && route_.tour().started() && route_.tour().taken())
+    if (!descent_.has_next() && top_next_ < route_.top().size() && route_.tour().started() && route_.tour().taken())
       route_.tour().clear();
     PlannedWaypoint p;
-    if (sub_next_ < sub_.size()) {
-      p.waypoint = sub_[sub_next_];
-      p.level = 1;
-      p.top_index = current_.top_index;
-      p.decision = current_.decision;
-      p.step = sub_next_++;
+    if (descent_.has_next()) {
+      descent_.hand_out(p);
     } else if (top_next_ < route_.top().size()) {
       p.waypoint = route_.top()[top_next_];
       p.top_index = top_next_++;
@@ -278,7 +244,7 @@ class AdaptivePlanner {
   /// The waypoints of the descent in progress, in visiting order: decided at the last
   /// top-level image, or (DescentSchedule::tour / row) the inspection being flown; empty when
   /// none is in progress or decided.
-  [[nodiscard]] const std::vector<Waypoint>& descent() const noexcept { return sub_; }
+  [[nodiscard]] const std::vector<Waypoint>& descent() const noexcept { return descent_.waypoints(); }
 
   /// The top-level lawnmower W^{h_max}.
   [[nodiscard]] const std::vector<Waypoint>& top_level() const noexcept { return route_.top(); }
@@ -302,7 +268,7 @@ class AdaptivePlanner {
 
   /// True once every waypoint has been handed out and reported.
   [[nodiscard]] bool done() const noexcept {
-    return !pending_ && sub_next_ >= sub_.size() && top_next_ >= route_.top().size() && route_.tour().taken();
+    return !pending_ && !descent_.has_next() && top_next_ >= route_.top().size() && route_.tour().taken();
   }
   /// The waypoint whose image is awaited, if any.
   [[nodiscard]] std::optional<PlannedWaypoint> pending() const {
@@ -343,7 +309,7 @@ class AdaptivePlanner {
   PlannerStep accept_checked(const Image& image, const CheckedSegmentation& segmentation, double segmentation_s,
                              std::optional<double> elapsed_s, std::chrono::steady_clock::time_point t0) {
     detail::check_segmentation_time(segmentation_s);
-    check_pooled(segmentation.get(), "none were reported");
+    detail::check_pooled(map_.fusion(), segmentation.get(), "none were reported");
     return accept(image, segmentation.get(), segmentation_s, elapsed_s, t0);
   }
 
@@ -358,47 +324,25 @@ class AdaptivePlanner {
     const double leg =
         p.index > 0 ? timing_.segment_time_s(path_[p.index - 1].waypoint.position, p.waypoint.position) : 0.0;
     clock_.image_reported(leg, segmentation_s, elapsed_s);
-    // A descent's first image: the region's map before the descent (what its outcome compares).
-    if (p.level == 1 && p.step == 0) {
-      watch_.begin(map_.labels()(region_rect(p.top_index)));
-    }
-    // Ranked cells: the finer image's own value of the ranking input over its cell (the scene check).
-    if (p.level == 1 && coverage_.ranks_cells) {
+    if (p.level == 1) {  // the region before the descent; with ranked cells, the scene check
       const cv::Rect region = region_rect(p.top_index);
-      const cv::Rect cell = pixel_rect(p.waypoint.footprint) & region;
-      if (cell.area() > 0)
-        watch_.add_fine_image(image, segmentation, options_.mission.interest, grid_.area().ignore_label, cell,
-                              grid_.area().valid_mask, options_.cell_input);
+      descent_.see(p.step, map_.labels()(region), image, segmentation,
+                   coverage_.ranks_cells ? std::optional(options_.cell_input) : std::nullopt,
+                   pixel_rect(p.waypoint.footprint) & region, options_.mission.interest, grid_.area().ignore_label,
+                   grid_.area().valid_mask);
     }
     map_.fuse(image, segmentation);
-
-    // A budget that can no longer afford the rest of the descent (the bound of a step, learned
-    // since the descent was chosen, may have grown) ends it here.
-    if (p.level == 1 && sub_next_ < sub_.size() && options_.budget_s &&
-        !costing().rest_fits(sub_, sub_next_, current_, top_next_)) {
-      sub_.resize(sub_next_);
-      cut_short_ = true;
-    }
+    // A budget that can no longer afford the rest of the descent ends it here.
+    if (p.level == 1) descent_.cut_short_unless_it_fits(costing(), top_next_);
     PlannerStep step;
     step.waypoint = p;
     step.sigma = semantic_ratio(labels, options_.mission.interest, image.ignore_label);
     if (p.level == 0)
       step.decision = decide(p, step.sigma, image, segmentation);
-    else if (sub_next_ == sub_.size())
+    else if (!descent_.has_next())
       step.outcome = finish_descent();
-    clock_.charge_planning(seconds_since(t0));
+    clock_.charge_planning(detail::seconds_since(t0));
     return step;
-  }
-
-  static double seconds_since(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  }
-
-  /// @throws std::invalid_argument for a pooled map and a segmentation without probabilities.
-  void check_pooled(const Segmentation& s, const char* why) const {
-    detail::require(map_.fusion() == MapFusion::finest || !s.probabilities.empty(),
-                    "AdaptivePlanner::report: map fusion 'pooled' needs the class probabilities behind the labels",
-                    why);
   }
 
   /// The area's lawnmowers at the candidate and nominal top GSDs with their forecast times:
@@ -407,51 +351,9 @@ class AdaptivePlanner {
     return lawnmowers_.forecasts(clock_.per_image_estimate());
   }
 
-  /// The decision input the cells are ranked by (`options().cell_input`) of the top-level image
-  /// of waypoint i (`image`, `segmentation`) over its region on the map grid (GridInputs, its
-  /// buffers kept from image to image); none unless the coverage ranks cells.
-  [[nodiscard]] const GridInputs* region_inputs(std::size_t i, const Image& image, const Segmentation& segmentation) {
-    const cv::Rect region = region_rect(i);
-    if (!coverage_.ranks_cells || region.area() == 0) return nullptr;
-    if (reads_field_entropy())
-      region_inputs_.assign(image, segmentation, options_.mission.interest, grid_.area().ignore_label, region,
-                            std::array{options_.cell_input, DecisionInput::entropy});
-    else
-      region_inputs_.assign(image, segmentation, options_.mission.interest, grid_.area().ignore_label, region,
-                            std::array{options_.cell_input});
-    return &region_inputs_;
-  }
-
   /// Descent costing (descent_costing.hpp) over the planner's route, clock and budget.
   [[nodiscard]] detail::DescentCosting costing() const {
     return {route_, timing_, clock_, grid_.camera(), options_.budget_s};
-  }
-
-  /// Whether the policy reads the field's mean top-level entropy (ReadsFieldEntropy).
-  [[nodiscard]] bool reads_field_entropy() const {
-    if constexpr (ReadsFieldEntropy<Policy>)
-      return policy_.reads_field_entropy();
-    else
-      return false;
-  }
-
-  /// Every descent the decision at top-level waypoint i may choose from, per candidate GSD:
-  /// descent_plan(), or for a coverage that ranks cells (DescentCoverage::ranked) its cells
-  /// ranked by their mass of `options().cell_input` in the region's inputs (`inputs`,
-  /// region_inputs(); detail::append_ranked_options).
-  [[nodiscard]] std::vector<detail::DescentOption> descent_options(std::size_t i, const GridInputs* inputs) const {
-    std::vector<detail::DescentOption> out;
-    if (!coverage_.ranks_cells) {
-      for (double g : candidates_) out.push_back({g, descent_plan(i, g), {}});
-      return out;
-    }
-    const cv::Rect region = region_rect(i);
-    if (region.area() == 0 || !inputs) return out;
-    const cv::Mat field = grid_.area().valid_mask(region);
-    const auto cell_rect = [&](const Area& a) { return (pixel_rect(a) & region) - region.tl(); };
-    for (double g : candidates_)
-      detail::append_ranked_options(out, g, descent_plan(i, g), *inputs, field, options_.cell_input, cell_rect);
-    return out;
   }
 
   /// The decision at top-level waypoint `p` (paper §3.2.2), its candidates with exact costs; a
@@ -465,11 +367,18 @@ class AdaptivePlanner {
     // the tour chosen so far: what it adds to the top-level legs).
     const detail::PlannerRoute::Ahead ahead = route_.ahead(timing_, i);
     const double rest = ahead.flight_s + ahead.images * clock_.per_image_estimate();
-    const GridInputs* inputs = region_inputs(i, image, segmentation);
-    std::vector<detail::CostedPlan> plans = costing().cost(descent_options(i, inputs), i, ahead, rec);
+    const cv::Rect region = region_rect(i);
+    const bool entropy = detail::reads_field_entropy(policy_);
+    const GridInputs* inputs = coverage_.ranks_cells
+                                   ? summary_.inputs(image, segmentation, region, options_.mission.interest,
+                                                     grid_.area().ignore_label, options_.cell_input, entropy)
+                                   : nullptr;
+    std::vector<detail::CostedPlan> plans = costing().cost(
+        detail::RegionSummary::options(grid_, region, candidates_, coverage_.ranks_cells, inputs, options_.cell_input,
+                                       [&](double g) { return descent_plan(i, g); }),
+        i, ahead, rec);
     const std::vector<LawnmowerForecast> forecasts = lawnmower_forecasts();
-    const detail::DecisionInputsAt at{route_.top()[i], region_rect(i), inputs, options_.cell_input,
-                                      reads_field_entropy()};
+    const detail::DecisionInputsAt at{route_.top()[i], region, inputs, options_.cell_input, entropy};
     rec.decision = policy_.decide(detail::decision_context(grid_, at, top_gsd_cm_, rec, elapsed_s(), rest, forecasts));
     if (rec.decision.descend) {
       const std::size_t k = chosen_candidate(rec.decision, rec.candidates, policy_.name());
@@ -479,17 +388,10 @@ class AdaptivePlanner {
       if (rec.candidates[k].deferred)
         route_.tour().add(std::move(chosen), plans[k].stop, plans[k].insertion.position);
       else
-        start_descent(std::move(chosen));
+        descent_.start(std::move(chosen));
     }
     decisions_.push_back(rec);
     return rec;
-  }
-
-  /// The descent chosen at a top-level waypoint: its waypoints come next.
-  void start_descent(detail::ChosenDescent d) {
-    sub_ = std::move(d.plan);
-    sub_next_ = 0;
-    current_ = std::move(d);
   }
 
   /// Tour: the next inspection of the tour comes next. Before the first, the tour is reordered
@@ -497,30 +399,27 @@ class AdaptivePlanner {
   void start_inspection() {
     const auto t0 = std::chrono::steady_clock::now();
     const std::size_t i = top_next_ - 1;  // the window's last top-level waypoint
-    start_descent(route_.tour().take_next(timing_, route_.tour_start(i), route_.tour_end(i)));
-    clock_.charge_planning(seconds_since(t0));
+    descent_.start(route_.tour().take_next(timing_, route_.tour_start(i), route_.tour_end(i)));
+    clock_.charge_planning(detail::seconds_since(t0));
   }
 
-  /// After a descent's last image: σ of the region at h' from the fused map, to the policy.
+  /// After a descent's last image: σ of the region at h' from the fused map and what the
+  /// descent relabelled (with ranked cells, the input over the cells flown), to the policy.
   DescentOutcome finish_descent() {
-    DecisionRecord& rec = decisions_[current_.decision];
-    const std::size_t top_index = current_.top_index;
-    DescentOutcome out;
-    out.top_altitude_m = route_.top()[top_index].position.z();
-    out.sub_altitude_m = current_.altitude_m;
-    out.descent = current_.ordinal;
-    out.sigma_top = rec.sigma;
-    watch_.region_outcome(out, map_.labels(), grid_.area().valid_mask, region_rect(top_index),
-                          options_.mission.interest, map_.unknown_label());
-    if (coverage_.ranks_cells)
-      watch_.input_outcome(out, rec.candidates[chosen_candidate(rec.decision, rec.candidates, policy_.name())],
-                           sub_.size(), static_cast<double>(valid_pixels(route_.top()[top_index].footprint)),
-                           options_.cell_input);
-    out.cut_short = std::exchange(cut_short_, false);
+    DecisionRecord& rec = decisions_[descent_.chosen().decision];
+    const Waypoint& top = route_.top()[descent_.chosen().top_index];
+    const detail::DescentRegion region{map_.labels(),
+                                       grid_.area().valid_mask,
+                                       region_rect(descent_.chosen().top_index),
+                                       static_cast<double>(valid_pixels(top.footprint)),
+                                       options_.mission.interest,
+                                       map_.unknown_label()};
+    const Candidate* chosen = coverage_.ranks_cells
+                                  ? &rec.candidates[chosen_candidate(rec.decision, rec.candidates, policy_.name())]
+                                  : nullptr;
+    const DescentOutcome out = descent_.finish(region, rec.sigma, top.position.z(), chosen, options_.cell_input);
     policy_.observe(out);
     rec.outcome = out;
-    sub_.clear();
-    sub_next_ = 0;
     return out;
   }
 
@@ -536,35 +435,13 @@ class AdaptivePlanner {
   detail::PlannerRoute route_;         ///< the top-level lawnmower, its windows and their tours
   detail::LawnmowerCosts lawnmowers_;  ///< the area's lawnmowers at the candidate and top GSDs (a yardstick)
 
-  std::size_t top_next_ = 0;       ///< next top-level waypoint to hand out
-  std::vector<Waypoint> sub_;      ///< the descent in progress, if any
-  std::size_t sub_next_ = 0;       ///< next waypoint of sub_ to hand out
-  detail::ChosenDescent current_;  ///< the descent in progress (its plan moved to sub_)
+  std::size_t top_next_ = 0;           ///< next top-level waypoint to hand out
+  detail::DescentInProgress descent_;  ///< the descent being flown, if any
   std::size_t descents_chosen_ = 0;
-  detail::DescentWatch watch_;  ///< the descent in progress over its region
-  bool cut_short_ = false;      ///< the budget ended the descent in progress early
-  GridInputs region_inputs_;    ///< the last top-level image's inputs (buffers reused)
-  bool pending_ = false;        ///< path_.back() awaits its image
+  detail::RegionSummary summary_;  ///< the last top-level image's region as the decision read it
+  bool pending_ = false;           ///< path_.back() awaits its image
   std::vector<PlannedWaypoint> path_;
   std::vector<DecisionRecord> decisions_;
 };
-
-/// Segments `image` with `backend` and reports it to `planner` (AdaptivePlanner::report): the
-/// labels, with the backend's class probabilities where it gives them and the planner reads them
-/// (AdaptivePlanner::wants_probabilities()), checked once where they are made
-/// (segment_and_check()); the time the backend takes is the image's segmentation time. The
-/// backend does not run for an image report() would refuse before reading its segmentation.
-/// @throws std::invalid_argument as AdaptivePlanner::report (a pooled map and a labels-only
-///         backend included), and whatever the backend throws.
-template <SegmentationBackend Backend, DecisionPolicy Policy>
-PlannerStep segment_and_report(AdaptivePlanner<Policy>& planner, Backend& backend, const Image& image,
-                               std::optional<double> elapsed_s = std::nullopt) {
-  planner.check_report(image, elapsed_s);
-  const auto t0 = std::chrono::steady_clock::now();
-  const CheckedSegmentation s =
-      segment_and_check(backend, image, planner.area().num_classes, planner.wants_probabilities());
-  const double segmentation_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return planner.report(image, s, segmentation_s, elapsed_s);
-}
 
 }  // namespace adaptseg

@@ -20,6 +20,25 @@
 
 namespace adaptseg::detail {
 
+/// @throws std::invalid_argument for a map fused by `fusion` 'pooled' and a segmentation `s`
+///         without class probabilities (`why` says so).
+inline void check_pooled(MapFusion fusion, const Segmentation& s, const char* why) {
+  require(fusion == MapFusion::finest || !s.probabilities.empty(),
+          "AdaptivePlanner::report: map fusion 'pooled' needs the class probabilities behind the labels", why);
+}
+
+/// @throws std::invalid_argument if `budget_s` is set and does not afford the top-level coverage
+///         alone: its flight `flight_s` and `images` images at `per_image_s` [s] each.
+inline void check_top_level_budget(std::optional<double> budget_s, double flight_s, std::size_t images,
+                                   double per_image_s) {
+  if (!budget_s) return;
+  const double coverage = flight_s + static_cast<double>(images) * per_image_s;
+  require(coverage <= *budget_s,
+          "AdaptivePlanner: budget_s [s] is too small for the top-level coverage, which needs " +
+              std::to_string(coverage) + " s",
+          *budget_s);
+}
+
 /// The candidate GSDs a descent may fly over `area`'s map grid (those of `options` not finer
 /// than the map), after checking the settings that do not depend on the flight.
 /// @throws std::invalid_argument for fixed times that are negative or not finite, no labels of

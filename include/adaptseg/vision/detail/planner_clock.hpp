@@ -6,11 +6,17 @@
 #include <adaptseg/core/mission_options.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cstddef>
 #include <optional>
 #include <utility>
 
 namespace adaptseg::detail {
+
+/// Seconds elapsed since `t0` on the steady clock (the planner's measured planning time).
+[[nodiscard]] inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
 /// Mission time as the adaptive planner counts it: flight by the timing model along the legs
 /// flown, segmentation per image and planning (measured, or fixed per image / waypoint by the

@@ -62,6 +62,29 @@ class LawnmowerCosts {
   std::vector<Cost> costs_;
 };
 
+/// The GSD the top level is flown at: `nominal` (AdaptiveOptions::top_gsd_cm), or where
+/// `policy` chooses one (ChoosesTopLevel) its choice among the area's `lawnmowers` (their
+/// forecast times `forecasts`); the `candidates` not finer than it are then dropped.
+/// @throws std::logic_error naming the policy if it chooses a GSD that is not one of the
+///         lawnmowers' or has no candidate below it.
+template <class Policy>
+[[nodiscard]] double choose_top_gsd(Policy& policy, const LawnmowerCosts& lawnmowers,
+                                    const std::vector<LawnmowerForecast>& forecasts, double nominal,
+                                    std::vector<double>& candidates) {
+  if constexpr (!ChoosesTopLevel<Policy>) {
+    return nominal;
+  } else {
+    const double g = policy.top_gsd(forecasts, nominal);
+    const bool below = std::any_of(candidates.begin(), candidates.end(), [&](double c) { return c < g; });
+    if (!lawnmowers.has(g) || !below)
+      throw std::logic_error("decision policy '" + std::string(policy.name()) + "' chose the top-level GSD " +
+                             std::to_string(g) +
+                             " cm/px, which is not one of the lawnmower GSDs with a candidate below it");
+    std::erase_if(candidates, [&](double c) { return c >= g; });
+    return g;
+  }
+}
+
 /// The top-level lawnmower W^{h_max} cut into the windows of a DescentSchedule, and the tour of
 /// the window being flown (DescentTour): the flight from each top-level waypoint on, where each
 /// window's tour starts and ends, and what a descent adds to the flight, flown at once or
