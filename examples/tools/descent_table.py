@@ -28,7 +28,13 @@ any that pay (selection) or none (the candidates themselves). Gains taken as add
 --gsd G also the margin of its descents to G cm/px alone, in the order flown: what the mission
 would have ended at had it descended to G only where it did.
 
-Usage: descent_table.py [--strategy adaptive] [--curve | --hindsight [--gsd G]] RUN_DIR [RUN_DIR ...]
+With --images, per image of a descent (per_image.csv): its σ (the share of L in its labels)
+against its region's top-level σ (the level-0 image before it), the jump between the two, and
+the ground truth's shares of the same two images (truth_sigma): what the UAV could see of a
+network that writes the class where it is absent at a finer GSD (a large jump the ground truth
+does not share), image by image, before the descent ends. Sorted by the jump, largest first.
+
+Usage: descent_table.py [--strategy adaptive] [--curve | --hindsight [--gsd G] | --images] RUN_DIR [RUN_DIR ...]
 """
 
 from __future__ import annotations
@@ -132,6 +138,36 @@ def hindsight_table(runs: list[str], rows: list[tuple[str, dict]], strategy: str
     print(f"{len(runs)} runs: {flown_above} above +0.001 as flown, {best_above} with their best descents only{alone}")
 
 
+def images_table(runs: list[str], strategy: str) -> None:
+    """Each descent image's σ against its region's top-level σ, and the ground truth's of both."""
+    rows = []
+    for run in runs:
+        with open(Path(run) / "per_image.csv", newline="") as f:
+            top: dict[tuple[str, str], dict] = {}
+            for r in csv.DictReader(f):
+                if r["strategy"] != strategy:
+                    continue
+                key = (r["field"], r["gsd_cm"])
+                if r["level"] == "0":
+                    top[key] = r
+                elif key in top:
+                    t = top[key]
+                    rows.append((number(r["sigma"]) - number(t["sigma"]), Path(run).name, r, t))
+    rows.sort(key=lambda x: -x[0] if math.isfinite(x[0]) else math.inf)
+    print("| run | image | GSD [cm/px] | σ | region's top-level σ | jump | truth σ | top-level truth σ |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for jump, run, r, t in rows:
+        print(f"| {run} | {r['image']} | {number(r['image_gsd_cm']):g} | {number(r['sigma']):.3f} | "
+              f"{number(t['sigma']):.3f} | {jump:+.3f} | {number(r['truth_sigma']):.3f} | "
+              f"{number(t['truth_sigma']):.3f} |")
+    print()
+    for bound in (0.1, 0.2, 0.3):
+        above = [(j, r, t) for j, _, r, t in rows if j > bound]
+        unshared = sum(number(r["truth_sigma"]) - number(t["truth_sigma"]) < j / 2 for j, r, t in above)
+        print(f"jump above {bound:.1f}: {len(above)} of {len(rows)} descent images, of which {unshared} with a "
+              f"ground-truth rise below half the jump")
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--strategy", default="adaptive")
@@ -140,8 +176,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--hindsight", action="store_true",
                     help="per run, the margin of its best descents only, chosen in hindsight")
     ap.add_argument("--gsd", type=float, help="with --hindsight: the margin of the descents to this GSD alone")
+    ap.add_argument("--images", action="store_true",
+                    help="each descent image's σ against its region's top-level σ, and the ground truth's")
     ap.add_argument("runs", nargs="+")
     args = ap.parse_args(argv)
+    if args.images:
+        images_table(args.runs, args.strategy)
+        return 0
     rows = []
     for run in args.runs:
         path = Path(run) / "decisions.csv"

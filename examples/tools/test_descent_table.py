@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Self-test of descent_table.py's plain table, --curve and --hindsight on a synthetic run (run by
-CTest; exit code != 0 on failure).
+"""Self-test of descent_table.py's plain table, --curve, --hindsight and --images on a synthetic
+run (run by CTest; exit code != 0 on failure).
 
 Each descent's row: its gains, pixels and the change of its region's σ. One field whose
 lawnmowers map L at 0.50 in 100 s and 0.60 in 200 s (the real curve rises 0.001 per second),
@@ -30,6 +30,16 @@ DECISIONS = COLUMNS + """f,adaptive,0,descend,10,2,10,0.015,0.02,-0.05,100,-10,0
 f,adaptive,1,continue,,,,,,,,,,,0.2,
 f,adaptive,2,descend,10,2,20,0.006,0.001,-0.01,5,3,0.005,130,0.30,0.25
 """
+# Per image: a top-level image (σ 0.10, truth 0.05), a descent of two images under it, one that
+# sees what the ground truth shows (σ 0.20, truth 0.16: jump +0.10) and one that writes the class
+# where it is absent (σ 0.60, truth 0.00: jump +0.50); the nonadaptive strategy's row is left out.
+PER_IMAGE = """field,strategy,gsd_cm,image,level,image_gsd_cm,sigma,image_miou_interest,image_miou_all,truth_sigma
+f,nonadaptive,15,0,0,15,0.9,0,0,0.9
+f,nonadaptive,15,1,1,10,0.1,0,0,0.9
+f,adaptive,15,0,0,15,0.10,0,0,0.05
+f,adaptive,15,1,1,10,0.20,0,0,0.16
+f,adaptive,15,2,1,10,0.60,0,0,0.00
+"""
 
 
 def table(args):
@@ -47,6 +57,8 @@ def main():
             f.write(RESULTS)
         with open(os.path.join(run, "decisions.csv"), "w") as f:
             f.write(DECISIONS)
+        with open(os.path.join(run, "per_image.csv"), "w") as f:
+            f.write(PER_IMAGE)
         # Each descent: gains, what it changed in pixels, and the region's σ after it minus before.
         plain = table([run])
         for want in ("| run | 0 | 10 | 2 | +0.0150 | +0.0200 | +0.0500 | +100 | -10 | +0.020 |",
@@ -73,6 +85,13 @@ def main():
             sys.exit(f"curve: no row {want}:\n{curve}")
         if "1 of 2 gained more than the real curve rose in their seconds" not in curve:
             sys.exit(f"curve summary:\n{curve}")
+        images = table(["--images", run])
+        rows = [line for line in images.splitlines() if line.startswith("| run |") and "σ" not in line]
+        if rows != ["| run | 2 | 10 | 0.600 | 0.100 | +0.500 | 0.000 | 0.050 |",
+                    "| run | 1 | 10 | 0.200 | 0.100 | +0.100 | 0.160 | 0.050 |"]:
+            sys.exit(f"images: the two descent images, largest jump first:\n{images}")
+        if "jump above 0.2: 1 of 2 descent images, of which 1 with a ground-truth rise below half the jump" not in images:
+            sys.exit(f"images summary:\n{images}")
     print("ok: descent_table.py sets each descent against the real curve and finds the best in hindsight")
 
 
