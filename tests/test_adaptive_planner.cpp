@@ -1,6 +1,7 @@
 #include "test_support.hpp"
 
 #include <adaptseg/core/front_aware_policy.hpp>
+#include <adaptseg/core/jump_guard.hpp>
 #include <adaptseg/vision/adaptive_mission.hpp>
 #include <adaptseg/vision/adaptive_planner.hpp>
 #include <adaptseg/vision/oracle_segmenter.hpp>
@@ -55,6 +56,55 @@ AdaptiveOptions options() {
   return o;
 }
 }  // namespace
+
+namespace {
+// Descends everywhere to `gsd` until its jump guard trips (bound: see JumpGuard).
+struct Guarded : Scripted {
+  JumpGuard guard;
+  Decision decide(const DecisionContext& c) { return guard.tripped() ? Decision{} : Scripted::decide(c); }
+  bool trusts_descent_image(double sigma_top, double sigma_image) { return guard.trusts(sigma_top, sigma_image); }
+  void begin_mission() {
+    Scripted::begin_mission();
+    guard.reset();
+  }
+};
+static_assert(GuardsDescentImages<Guarded>);
+}  // namespace
+
+TEST_CASE("adaptive planner: an image the policy's jump guard refuses is not fused and ends the descents") {
+  const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
+  OracleSegmenter oracle(f.num_classes());
+  // No bound: every descent as without a guard.
+  Guarded open{{.gsd = 1.0}, JumpGuard()};
+  const AdaptiveResult a = run_adaptive_mission(f, oracle, open, options(), "open");
+  CHECK(a.descents() == static_cast<int>(a.decisions.size()));
+  CHECK_FALSE(open.guard.tripped());
+  // A bound below any jump: the first descent image is refused, the descent ends there, no other
+  // follows, and the map is the top-level lawnmower's.
+  Guarded shut{{.gsd = 1.0}, JumpGuard(-2.0)};
+  AdaptiveOptions o = options();
+  o.mission.interest = f.interest();
+  AdaptivePlanner<Guarded> planner(SurveyArea::of(f), shut, o);
+  const SimulatedSensor sensor(f, planner.camera());
+  int level1 = 0, refused = 0, outcomes = 0;
+  while (const auto w = planner.next()) {
+    const PlannerStep step = segment_and_report(planner, oracle, sensor.capture(w->waypoint));
+    level1 += w->level;
+    refused += step.trusted ? 0 : 1;
+    if (step.outcome) {
+      ++outcomes;
+      CHECK(step.outcome->cut_short);
+      CHECK(step.outcome->relabelled.share == 0.0);  // nothing of the refused image was fused
+    }
+    CHECK(step.trusted == (w->level == 0));
+  }
+  CHECK(shut.guard.tripped());
+  CHECK(level1 == 1);
+  CHECK(refused == 1);
+  CHECK(outcomes == 1);
+  const MissionResult lawnmower = run_lawnmower_mission(f, 3.0, oracle, options().mission);
+  CHECK(cv::countNonZero(planner.map().labels() != lawnmower.fused_labels) == 0);
+}
 
 TEST_CASE("adaptive planner: never descending is the top-level lawnmower") {
   const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);

@@ -831,6 +831,13 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
                                                         "curve_agreement: 1.5", "wrong_agreement.yaml")),
                        doctest::Contains("curve_agreement must be in [0, 1]"), std::invalid_argument);
   p.curve_agreement = 0.0;
+  // The jump guard's bound: kept (files without the key: none, infinity).
+  CHECK(std::isinf(rule_of(back).jump_bound));
+  p.jump_bound = 0.25;
+  policy.set_params(p);
+  corrected.save(tmp.path() / "guard.yaml");
+  CHECK(rule_of(DecisionModel::load(tmp.path() / "guard.yaml")).jump_bound == 0.25);
+  p.jump_bound = std::numeric_limits<double>::infinity();
   p.top_level = TopLevelChoice::hull;
   policy.set_params(p);
   corrected.save(tmp.path() / "hull.yaml");

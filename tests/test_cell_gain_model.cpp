@@ -1,5 +1,6 @@
 #include <adaptseg/core/cell_gain_model.hpp>
 #include <adaptseg/core/cell_input_scores.hpp>
+#include <adaptseg/core/jump_guard.hpp>
 
 #include <doctest/doctest.h>
 
@@ -288,4 +289,40 @@ TEST_CASE("cell gain model: the slope as a line in the field's mean top-level en
   bad.entropy_low = 0.7;
   CHECK_THROWS_AS(CellGainModel(DecisionInput::expected_error, {bad}, SlopePooling::field_entropy),
                   std::invalid_argument);
+}
+
+namespace {
+// A re-mapped cell: its top-level σ, its finer image's σ and what re-mapping it gained the field.
+CellSample sigma_cell(double top, double fine, double gain) {
+  CellSample c;
+  c.top.field_px = 100.0;
+  c.top.values[index_of(DecisionInput::sigma)] = top;
+  c.fine.values[index_of(DecisionInput::sigma)] = fine;
+  c.field_gain = gain;
+  return c;
+}
+}  // namespace
+
+TEST_CASE("jump guard: the bound refuses the largest jumps that lost in total; one beyond it trips") {
+  // Jumps +0.6, +0.4, +0.3, +0.1, 0 (a cell without a finer σ counts for nothing); from the
+  // largest down the gains sum to -0.02, -0.015, -0.025 (the lowest), +0.005: the three largest
+  // are refused, the bound halfway between +0.3 and +0.1.
+  const std::vector<CellSample> cells{sigma_cell(0.1, 0.7, -0.02), sigma_cell(0.0, 0.4, 0.005),
+                                      sigma_cell(0.2, 0.5, -0.01), sigma_cell(0.3, 0.4, 0.03),
+                                      sigma_cell(0.5, 0.5, 0.01),  sigma_cell(0.5, std::nan(""), -1.0)};
+  CHECK(jump_bound(cells) == doctest::Approx(0.2));
+  // Where re-mapping never lost in total from the largest jump down, or too few cells: no guard.
+  CHECK(std::isinf(jump_bound(std::vector<CellSample>{sigma_cell(0.1, 0.7, 0.02), sigma_cell(0.0, 0.4, -0.01)})));
+  CHECK(std::isinf(jump_bound(std::vector<CellSample>{sigma_cell(0.1, 0.7, -0.02)})));
+  CHECK(std::isinf(jump_bound({})));
+  JumpGuard guard(0.4);
+  CHECK(guard.trusts(0.1, 0.45));
+  CHECK_FALSE(guard.tripped());
+  CHECK_FALSE(guard.trusts(0.1, 0.6));
+  CHECK(guard.tripped());
+  CHECK_FALSE(guard.trusts(0.1, 0.1));  // once tripped, for the rest of the mission
+  guard.reset();
+  CHECK(guard.trusts(0.1, 0.1));
+  CHECK(JumpGuard().trusts(0.0, 1.0));  // no bound: no guard
+  CHECK_THROWS_AS(JumpGuard(std::nan("")), std::invalid_argument);
 }

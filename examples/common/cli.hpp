@@ -246,6 +246,7 @@ struct CalibrationCli {
   std::vector<std::string> top_levels{"undominated"};
   bool gain_ratios = false;
   bool margin_biases = false;
+  bool jump_guard = false;
   double curve_agreement = 0.0;
 
   void add_to(CLI::App& app) {
@@ -318,6 +319,10 @@ struct CalibrationCli {
                      "front-aware rule, several training fields: scale each forecast of a descent by what "
                      "descents to its GSD realised of their forecast when the training fields were flown with "
                      "the model of the others (measured before the search; saved in the model)"),
+        app.add_flag("--jump-guard", jump_guard,
+                     "front-aware rule with ranked cells: descend no more after a descent image whose share of "
+                     "the labels of interest lies so far above the top-level map's over its cell that re-mapping "
+                     "such cells lost on the training fields (that image not fused; saved in the model)"),
         app.add_flag("--margin-biases", margin_biases,
                      "front-aware rule, several training fields: add to each descent's forecast margin what "
                      "descents to its GSD ended above theirs per second when the training fields were flown "
@@ -360,6 +365,7 @@ struct CalibrationCli {
     options.front_aware.curve = parse_curve_source(curve);
     options.gain_ratios = gain_ratios;
     options.margin_biases = margin_biases;
+    options.jump_guard = jump_guard;
     options.front_aware.curve_agreement = curve_agreement;
     options.top_levels.clear();
     for (const auto& name : top_levels) options.top_levels.push_back(parse_top_level_choice(name));

@@ -204,6 +204,14 @@ concept ReadsFieldEntropy = requires(const P& policy) {
   { policy.reads_field_entropy() } -> std::convertible_to<bool>;
 };
 
+/// A policy that may refuse a descent image (FrontAwarePolicy's jump guard, jump_guard.hpp):
+/// AdaptivePlanner asks it with the top-level map's σ over the image's cell and the image's σ
+/// before fusing each descent image; one refused is not fused and ends its descent.
+template <class P>
+concept GuardsDescentImages = requires(P& policy, double sigma_top, double sigma_image) {
+  { policy.trusts_descent_image(sigma_top, sigma_image) } -> std::convertible_to<bool>;
+};
+
 /// The index of the candidate a descending `decision` names: `decision.candidate` if that
 /// candidate has the decision's `gsd_cm`, else the first candidate of that GSD; checked.
 /// @throws std::logic_error naming `policy` if the decision descends to a GSD that is not one

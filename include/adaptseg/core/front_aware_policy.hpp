@@ -10,6 +10,7 @@
 #include <adaptseg/core/field_estimates.hpp>
 #include <adaptseg/core/front_aware_settings.hpp>
 #include <adaptseg/core/gain_model.hpp>
+#include <adaptseg/core/jump_guard.hpp>
 #include <adaptseg/core/lawnmower_curve.hpp>
 #include <adaptseg/core/top_level.hpp>
 
@@ -85,6 +86,9 @@ class FrontAwarePolicy {
     double sigma_prior_weight = 0.25;  ///< k > 0: weight of the training fields' σ in σ̂ [fields]
     double sigma_prior_sd = 0.0;       ///< τ >= 0: spread of a field's σ about the training fields' mean
     double curve_agreement = 0.0;      ///< q in [0, 1]: see class comment; 0: no such check
+    /// The jump guard's bound (JumpGuard; both rules; infinity: no guard): after a descent image
+    /// beyond it the UAV descends no more (trusts_descent_image()).
+    double jump_bound = std::numeric_limits<double>::infinity();
     /// The lawnmower curve a descent is compared with (CurveSource; `corrected` is the
     /// programs' default, this struct's the training fields' curves).
     CurveSource curve = CurveSource::training;
@@ -113,6 +117,7 @@ class FrontAwarePolicy {
                       "FrontAwarePolicy::Params::sigma_prior_sd must be in [0, 1]", sigma_prior_sd);
       detail::require(std::isfinite(curve_agreement) && curve_agreement >= 0.0 && curve_agreement <= 1.0,
                       "FrontAwarePolicy::Params::curve_agreement must be in [0, 1]", curve_agreement);
+      detail::require(!std::isnan(jump_bound), "FrontAwarePolicy::Params::jump_bound must not be NaN", jump_bound);
       for (const GainRatio& r : gain_ratios) r.validate();
       for (const MarginBias& b : margin_biases) b.validate();
     }
@@ -166,6 +171,7 @@ class FrontAwarePolicy {
     forecast_gain_ = 0.0;
     chosen_.clear();
     scale_ = FieldScale(params_.scale_prior_sd);
+    guard_ = JumpGuard(params_.jump_bound);
   }
 
   /// @throws std::invalid_argument if the context has no lawnmower forecasts.
@@ -191,7 +197,7 @@ class FrontAwarePolicy {
       }
       d.scores.push_back(assessed.back().score);
     }
-    if (best_index && c.sigma >= params_.min_sigma) {
+    if (best_index && c.sigma >= params_.min_sigma && !guard_.tripped()) {
       d.descend = true;
       d.gsd_cm = c.candidates[*best_index].gsd_cm;
       d.candidate = *best_index;
@@ -218,6 +224,10 @@ class FrontAwarePolicy {
 
   /// Whether β reads the field's entropy (a cell gain model pooled by SlopePooling::field_entropy).
   [[nodiscard]] bool reads_field_entropy() const { return model_.cells() && model_.cells()->reads_field_entropy(); }
+
+  /// Whether a descent image of σ `sigma_image` over a cell of top-level σ `sigma_top` is
+  /// trusted (GuardsDescentImages; the jump guard, Params::jump_bound).
+  bool trusts_descent_image(double sigma_top, double sigma_image) { return guard_.trusts(sigma_top, sigma_image); }
 
   /// After a descent: the paper's update of O and the field correction (no-op unless `online`).
   void observe(const DescentOutcome& out) {
@@ -293,7 +303,7 @@ class FrontAwarePolicy {
         for (const auto& r : reference_) p.curves.push_back(field_curve(c, x, weight / c.region_share, &r));
       else
         p.curves.push_back(field_curve(c, x, weight / c.region_share, nullptr));
-      p.level = mean_top_miou(c);
+      p.level = detail::mean_reference_miou(reference_, c.top_gsd_cm);
       return p;
     }
     for (const auto& r : reference_) {
@@ -366,8 +376,9 @@ class FrontAwarePolicy {
     // What descents to this GSD ended above their forecast margin on the training fields as new ground.
     const double bias = margin_bias_at(params_.margin_biases, cand.gsd_cm) * cand.extra_time_s;
     a.lower = a.gain - rise + bias - params_.confidence * std::sqrt(gain_var + rise_var);
-    a.score.predicted_front_margin =
-        mean_top_miou(c) + forecast_gain_ + a.gain - p.level - mean_curve_miou(p.curves, p.t0 + cand.extra_time_s);
+    // Reported only: from the training fields' mean lawnmower mIoU at the top GSD.
+    a.score.predicted_front_margin = detail::mean_reference_miou(reference_, c.top_gsd_cm) + forecast_gain_ + a.gain -
+                                     p.level - detail::mean_curve_miou(p.curves, p.t0 + cand.extra_time_s);
     a.score.predicted_curve_rise = rise;
     a.score.predicted_end_s = p.t0 + cand.extra_time_s;
     a.relabelled = b.relabelled;
@@ -412,19 +423,6 @@ class FrontAwarePolicy {
     return share_.gain_weight(c.region_share, params_.sigma_prior_weight, params_.sigma_prior_sd);
   }
 
-  /// The mean over `curves` of their mIoU at `t` (miou_at_time(): as the front margin reads them).
-  static double mean_curve_miou(const std::vector<std::vector<CurvePoint>>& curves, double t) {
-    double s = 0.0;
-    for (const auto& c : curves) s += miou_at_time(c, t);
-    return s / static_cast<double>(curves.size());
-  }
-
-  /// The training fields' mean lawnmower mIoU at the top GSD: where the forecast end point
-  /// starts (reported as CandidateScore::predicted_front_margin only).
-  [[nodiscard]] double mean_top_miou(const DecisionContext& c) const {
-    return detail::mean_reference_miou(reference_, c.top_gsd_cm);
-  }
-
   GainModel initial_;
   GainModel model_;
   std::vector<ReferenceCurve> reference_;
@@ -434,10 +432,12 @@ class FrontAwarePolicy {
   FieldScale scale_;                ///< the field factor s
   double forecast_gain_ = 0.0;      ///< forecast field-level gain of the descents taken
   std::vector<Relabelled> chosen_;  ///< what each descent chosen was forecast to relabel (DescentOutcome::descent)
+  JumpGuard guard_;                 ///< tripped by a descent image beyond Params::jump_bound
 };
 
 static_assert(DecisionPolicy<FrontAwarePolicy>);
 static_assert(ChoosesTopLevel<FrontAwarePolicy>);
 static_assert(ReadsFieldEntropy<FrontAwarePolicy>);
+static_assert(GuardsDescentImages<FrontAwarePolicy>);
 
 }  // namespace adaptseg

@@ -186,6 +186,15 @@ struct ReferenceCurve {
   return std::clamp(real / predicted, 0.25, 4.0);
 }
 
+namespace detail {
+/// The mean over `curves` of their mIoU at `t` (miou_at_time(): as the front margin reads them).
+[[nodiscard]] inline double mean_curve_miou(const std::vector<std::vector<CurvePoint>>& curves, double t) {
+  double s = 0.0;
+  for (const auto& c : curves) s += miou_at_time(c, t);
+  return s / static_cast<double>(curves.size());
+}
+}  // namespace detail
+
 /// The share of the training fields in `reference` whose lawnmower at GSD `g` mapped better than
 /// theirs at the top level `top` (FrontAwarePolicy::Params `curve_agreement`); 0 without any.
 [[nodiscard]] inline double finer_lawnmower_share(std::span<const ReferenceCurve> reference, double top, double g) {

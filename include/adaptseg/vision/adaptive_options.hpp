@@ -136,6 +136,9 @@ struct PlannedWaypoint {
 struct PlannerStep {
   PlannedWaypoint waypoint;  ///< the waypoint the image was reported for
   double sigma = 0.0;        ///< semantic ratio σ of the image's segmentation (paper Eq. `eq:vr`)
+  /// False for a descent image the policy did not trust (GuardsDescentImages): not fused into
+  /// the map, and its descent ended there.
+  bool trusted = true;
   /// At a top-level waypoint: the decision taken (descend or continue).
   std::optional<DecisionRecord> decision;
   /// After the last image of a descent: what the region showed, fed back to the policy.

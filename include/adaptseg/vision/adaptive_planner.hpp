@@ -324,19 +324,20 @@ class AdaptivePlanner {
     const double leg =
         p.index > 0 ? timing_.segment_time_s(path_[p.index - 1].waypoint.position, p.waypoint.position) : 0.0;
     clock_.image_reported(leg, segmentation_s, elapsed_s);
-    if (p.level == 1) {  // the region before the descent; with ranked cells, the scene check
-      const cv::Rect region = region_rect(p.top_index);
-      descent_.see(p.step, map_.labels()(region), image, segmentation,
-                   coverage_.ranks_cells ? std::optional(options_.cell_input) : std::nullopt,
-                   pixel_rect(p.waypoint.footprint) & region, options_.mission.interest, grid_.area().ignore_label,
-                   grid_.area().valid_mask);
-    }
-    map_.fuse(image, segmentation);
-    // A budget that can no longer afford the rest of the descent ends it here.
-    if (p.level == 1) descent_.cut_short_unless_it_fits(costing(), top_next_);
     PlannerStep step;
     step.waypoint = p;
     step.sigma = semantic_ratio(labels, options_.mission.interest, image.ignore_label);
+    if (p.level == 1) {  // the region before the descent, the policy's guard; with ranked cells, the scene check
+      const cv::Rect region = region_rect(p.top_index);
+      const cv::Rect cell = pixel_rect(p.waypoint.footprint) & region;
+      step.trusted = detail::trusts_descent_image(policy_, map_, cell, options_.mission.interest, step.sigma);
+      descent_.see(p.step, step.trusted, map_.labels()(region), image, segmentation,
+                   coverage_.ranks_cells ? std::optional(options_.cell_input) : std::nullopt, cell,
+                   options_.mission.interest, grid_.area().ignore_label, grid_.area().valid_mask);
+    }
+    if (step.trusted) map_.fuse(image, segmentation);
+    // A budget that can no longer afford the rest of the descent ends it here.
+    if (p.level == 1) descent_.cut_short_unless_it_fits(costing(), top_next_);
     if (p.level == 0)
       step.decision = decide(p, step.sigma, image, segmentation);
     else if (!descent_.has_next())

@@ -127,6 +127,12 @@ struct CalibrationOptions {
   /// curve together, measured where the model never saw the field (docs/method.md, "Margin
   /// biases measured on the folds"). false (the default): none.
   bool margin_biases = false;
+  /// Front-aware rule with ranked cells: the jump guard (FrontAwarePolicy::Params::jump_bound,
+  /// jump_guard.hpp), its bound learned on the training fields' cell samples (jump_bound(): the
+  /// jump of a finer image's σ over the cell's top-level σ above which re-mapping lost): in the
+  /// model, every field's cells; in the search, each fold's the other fields' only. false (the
+  /// default): no guard.
+  bool jump_guard = false;
   /// Front-aware rule, σ̂'s prior (FrontAwarePolicy `sigma_prior_weight` k, `sigma_prior_sd` τ)
   /// with several training fields: `given` keeps `front_aware`'s; `spread` estimates τ on the
   /// training fields (estimate_sigma_prior) and keeps k; `estimated` estimates both. Each fold

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -48,6 +49,7 @@ struct FrontAwareRule {
     if (p.top_level != TopLevelChoice::undominated)
       e << YAML::Key << "top_level" << YAML::Value << to_string(p.top_level);
     if (p.curve_agreement > 0.0) e << YAML::Key << "curve_agreement" << YAML::Value << num(p.curve_agreement);
+    if (std::isfinite(p.jump_bound)) e << YAML::Key << "jump_bound" << YAML::Value << num(p.jump_bound);
     std::vector<std::pair<double, double>> ratios, biases;
     for (const GainRatio& x : p.gain_ratios) ratios.emplace_back(x.gsd_cm, x.ratio);
     for (const MarginBias& x : p.margin_biases) biases.emplace_back(x.gsd_cm, x.per_s);
@@ -106,18 +108,20 @@ struct FrontAwareRule {
       }
       reference.push_back(std::move(curve));
     }
-    return FrontAwarePolicy(std::move(model), std::move(reference),
-                            {.min_sigma = min_sigma,
-                             .online = online,
-                             .confidence = rule.number("confidence"),
-                             .scale_prior_sd = rule.number("scale_prior_sd"),
-                             .sigma_prior_weight = rule.number("sigma_prior_weight"),
-                             .sigma_prior_sd = rule.has("sigma_prior_sd") ? rule.number("sigma_prior_sd") : 0.0,
-                             .curve_agreement = rule.has("curve_agreement") ? rule.number("curve_agreement") : 0.0,
-                             .curve = read_curve(rule),
-                             .top_level = rule.has("top_level") ? read_top_level(rule) : TopLevelChoice::undominated,
-                             .gain_ratios = read_gain_ratios(rule),
-                             .margin_biases = read_margin_biases(rule)});
+    return FrontAwarePolicy(
+        std::move(model), std::move(reference),
+        {.min_sigma = min_sigma,
+         .online = online,
+         .confidence = rule.number("confidence"),
+         .scale_prior_sd = rule.number("scale_prior_sd"),
+         .sigma_prior_weight = rule.number("sigma_prior_weight"),
+         .sigma_prior_sd = rule.has("sigma_prior_sd") ? rule.number("sigma_prior_sd") : 0.0,
+         .curve_agreement = rule.has("curve_agreement") ? rule.number("curve_agreement") : 0.0,
+         .jump_bound = rule.has("jump_bound") ? rule.number("jump_bound") : std::numeric_limits<double>::infinity(),
+         .curve = read_curve(rule),
+         .top_level = rule.has("top_level") ? read_top_level(rule) : TopLevelChoice::undominated,
+         .gain_ratios = read_gain_ratios(rule),
+         .margin_biases = read_margin_biases(rule)});
   }
 
   /// Per descent GSD, what the folds measured (FrontAwarePolicy::Params `gain_ratios` and

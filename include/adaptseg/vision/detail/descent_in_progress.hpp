@@ -12,6 +12,8 @@
 #include <adaptseg/vision/detail/descent_watch.hpp>
 #include <adaptseg/vision/grid_inputs.hpp>
 #include <adaptseg/vision/image.hpp>
+#include <adaptseg/vision/metrics.hpp>
+#include <adaptseg/vision/semantic_map.hpp>
 
 #include <opencv2/core.hpp>
 
@@ -34,6 +36,19 @@ struct DescentRegion {
   std::span<const int> interest;
   int unknown_label = 0;
 };
+
+/// Whether `policy` trusts a descent image of σ `sigma_image` (about `interest`) over `cell` of
+/// `map` before it is fused, whose σ there is the top-level one (GuardsDescentImages); a policy
+/// without a guard, or an empty cell, trusts every one.
+template <class Policy>
+[[nodiscard]] bool trusts_descent_image(Policy& policy, const SemanticMap& map, const cv::Rect& cell,
+                                        std::span<const int> interest, double sigma_image) {
+  if constexpr (GuardsDescentImages<Policy>)
+    return cell.area() == 0 ||
+           policy.trusts_descent_image(semantic_ratio(map.labels()(cell), interest, map.unknown_label()), sigma_image);
+  else
+    return true;
+}
 
 /// The descent in progress: the descent chosen at a top-level waypoint (or taken from the tour),
 /// its waypoints handed out in order, what its images do to its region (DescentWatch), and
@@ -64,15 +79,18 @@ class DescentInProgress {
   /// The descent chosen (its plan moved to waypoints()).
   [[nodiscard]] const ChosenDescent& chosen() const noexcept { return chosen_; }
 
-  /// One of its images (`image`, `segmentation`) is about to be fused at step `step`: the first
-  /// keeps its region's map before it (`region_labels`, what the outcome compares); with ranked
-  /// cells (`input` given) each adds its own mass of the input over its `cell` of the map grid
-  /// (the scene check; an empty cell adds nothing), whose field is `valid_mask(cell)`.
-  void see(std::size_t step, const cv::Mat& region_labels, const Image& image, const Segmentation& segmentation,
-           const std::optional<DecisionInput>& input, const cv::Rect& cell, std::span<const int> interest,
-           int ignore_label, const cv::Mat& valid_mask) {
+  /// One of its images (`image`, `segmentation`) is reported at step `step`, before it is fused:
+  /// the first keeps its region's map before it (`region_labels`, what the outcome compares); one
+  /// not `trusted` (the policy's guard) ends the descent there; with ranked cells (`input` given)
+  /// a trusted one adds its own mass of the input over its `cell` of the map grid (the scene
+  /// check; an empty cell adds nothing), whose field is `valid_mask(cell)`.
+  void see(std::size_t step, bool trusted, const cv::Mat& region_labels, const Image& image,
+           const Segmentation& segmentation, const std::optional<DecisionInput>& input, const cv::Rect& cell,
+           std::span<const int> interest, int ignore_label, const cv::Mat& valid_mask) {
     if (step == 0) watch_.begin(region_labels);
-    if (input && cell.area() > 0)
+    if (!trusted)
+      end_here();
+    else if (input && cell.area() > 0)
       watch_.add_fine_image(image, segmentation, interest, ignore_label, cell, valid_mask, *input);
   }
 
@@ -81,6 +99,11 @@ class DescentInProgress {
   /// grown; the next top-level waypoint `top_next`). A descent cut short flies straight on.
   void cut_short_unless_it_fits(const DescentCosting& costing, std::size_t top_next) {
     if (!has_next() || !costing.budget_s || costing.rest_fits(waypoints_, next_, chosen_, top_next)) return;
+    end_here();
+  }
+
+  /// Ends it after the waypoints handed out so far (DescentOutcome::cut_short).
+  void end_here() {
     waypoints_.resize(next_);
     cut_short_ = true;
   }
