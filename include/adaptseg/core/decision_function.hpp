@@ -69,6 +69,18 @@ class DecisionFunction {
         rule_);
   }
 
+  /// Whether the rule trusts a descent image (GuardsDescentImages; a rule without a guard: true).
+  bool trusts_descent_image(double sigma_top, double sigma_image) {
+    return std::visit(
+        [&](auto& r) {
+          if constexpr (requires { r.trusts_descent_image(sigma_top, sigma_image); })
+            return r.trusts_descent_image(sigma_top, sigma_image);
+          else
+            return true;
+        },
+        rule_);
+  }
+
   /// Whether the rule learns in flight ("adaptive") or not ("non-adaptive").
   [[nodiscard]] bool online() const {
     return std::visit([](const auto& r) { return r.params().online; }, rule_);
@@ -98,5 +110,6 @@ class DecisionFunction {
 static_assert(DecisionPolicy<DecisionFunction>);
 static_assert(ChoosesTopLevel<DecisionFunction>);
 static_assert(ReadsFieldEntropy<DecisionFunction>);
+static_assert(GuardsDescentImages<DecisionFunction>);
 
 }  // namespace adaptseg
