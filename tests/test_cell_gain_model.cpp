@@ -303,7 +303,7 @@ CellSample sigma_cell(double top, double fine, double gain) {
 }
 }  // namespace
 
-TEST_CASE("jump guard: the bound refuses the largest jumps that lost in total; one beyond it trips") {
+TEST_CASE("jump guard: the bound refuses the largest jumps that lost in total, and one beyond it trips") {
   // Jumps +0.6, +0.4, +0.3, +0.1, 0 (a cell without a finer σ counts for nothing); from the
   // largest down the gains sum to -0.02, -0.015, -0.025 (the lowest), +0.005: the three largest
   // are refused, the bound halfway between +0.3 and +0.1.
