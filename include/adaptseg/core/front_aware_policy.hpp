@@ -86,8 +86,8 @@ class FrontAwarePolicy {
     double sigma_prior_weight = 0.25;  ///< k > 0: weight of the training fields' σ in σ̂ [fields]
     double sigma_prior_sd = 0.0;       ///< τ >= 0: spread of a field's σ about the training fields' mean
     double curve_agreement = 0.0;      ///< q in [0, 1]: see class comment; 0: no such check
-    /// The jump guard's bound (JumpGuard; both rules; infinity: no guard): after a descent image
-    /// beyond it the UAV descends no more (trusts_descent_image()).
+    /// The jump guard's bound (JumpGuard; adaptive and non-adaptive alike; infinity: none):
+    /// after a descent image beyond it the UAV descends no more (trusts_descent_image()).
     double jump_bound = std::numeric_limits<double>::infinity();
     /// The lawnmower curve a descent is compared with (CurveSource; `corrected` is the
     /// programs' default, this struct's the training fields' curves).
