@@ -300,17 +300,22 @@ inline std::size_t choose_setting(std::span<const RuleTrial> trials, std::span<c
 struct FoldCorrections {
   std::vector<std::vector<GainRatio>> ratios;
   std::vector<std::vector<MarginBias>> biases;
+  std::vector<double> jump_bounds;  ///< the jump guard's (CalibrationOptions::jump_guard), else `base`'s
 };
 
 /// The gain ratios and margin biases of every fold, measured on the other folds' flights only,
 /// as its model was fitted without its field; the model's own (on every fold's flight) into
 /// `base`. Without `gain_ratios` and `margin_biases`, or with one field, `base`'s for every fold.
+/// With `jump_guard` and ranked cells, each fold's jump bound from the other fields' cells.
 template <class Fly>
 [[nodiscard]] FoldCorrections fold_corrections(const RuleSearchInputs& in, std::span<const FrontAwareFold> folds,
                                                const FrontAwareGrid& grid, FrontAwarePolicy::Params& base, Fly& fly) {
   const CalibrationOptions& options = in.options;
   FoldCorrections c{std::vector<std::vector<GainRatio>>(folds.size(), base.gain_ratios),
-                    std::vector<std::vector<MarginBias>>(folds.size(), base.margin_biases)};
+                    std::vector<std::vector<MarginBias>>(folds.size(), base.margin_biases),
+                    std::vector<double>(folds.size(), base.jump_bound)};
+  if (options.jump_guard && grid.ranked)
+    for (std::size_t k = 0; k < folds.size(); ++k) c.jump_bounds[k] = jump_bound(folds[k].cells);
   if (!(options.gain_ratios || options.margin_biases) || in.fields.size() < 2) return c;
   const std::vector<AdaptiveResult> flights = measuring_flights(in, folds, grid, base, fly);
   std::vector<const std::vector<CurvePoint>*> curves;
@@ -359,7 +364,7 @@ template <class Fly>
           FrontAwarePolicy::Params fold_params = p;
           fold_params.gain_ratios = corrections.ratios[k];
           fold_params.margin_biases = corrections.biases[k];
-          if (options.jump_guard && grid.ranked) fold_params.jump_bound = jump_bound(folds[k].cells);
+          fold_params.jump_bound = corrections.jump_bounds[k];
           double margin = 0.0;
           const AdaptiveResult r = detail::fly_fold(in, folds[k], models[k], fold_params, fly, margin);
           detail::add_to_trial(t, r, margin);

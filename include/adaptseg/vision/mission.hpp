@@ -8,6 +8,7 @@
 #include <adaptseg/core/lawnmower_planner.hpp>
 #include <adaptseg/core/mission_options.hpp>
 #include <adaptseg/core/timing.hpp>
+#include <adaptseg/vision/detail/planner_clock.hpp>
 #include <adaptseg/vision/field.hpp>
 #include <adaptseg/vision/metrics.hpp>
 #include <adaptseg/vision/segmentation_backend.hpp>
@@ -149,9 +150,7 @@ class Mission {
   }
 
   /// Seconds elapsed since `t0` on the steady clock.
-  static double seconds_since(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  }
+  static double seconds_since(std::chrono::steady_clock::time_point t0) { return detail::seconds_since(t0); }
 
  private:
   SimulatedSensor sensor_;
