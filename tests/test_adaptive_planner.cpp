@@ -1170,3 +1170,71 @@ TEST_CASE("run_adaptive_mission: a backend and a policy that sleep keep the budg
   CHECK(r.mission.total_s() <= *o.budget_s);
   CHECK(r.descents() >= 1);
 }
+
+TEST_CASE("AdaptivePlanner: a shared time account is charged the planner's planning and is the time it reads") {
+  // A caller that keeps the account (run_adaptive_mission: the Mission's) charges flight and
+  // segmentation; the planner charges its planning into it, per waypoint where the options fix
+  // it, and reads the mission time from it: nothing is handed from one account to another.
+  const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
+  OracleSegmenter oracle(f.num_classes());
+  AdaptiveOptions o = options();
+  o.top_gsd_cm = 6.0;
+  o.mission.fixed_segmentation_time_s = 0.1;
+  o.mission.fixed_planning_time_s = 0.25;
+  o.mission.interest = f.interest();
+  const SimulatedSensor sensor(f, CameraModel(o.mission.camera));
+  const TimingModel timing(o.mission.timing);
+  Scripted greedy{.gsd = 1.0};
+  TimeAccount shared{.flight_s = 7.0};  // the owner's: a take-off the planner knows nothing of
+  AdaptivePlanner<Scripted> planner(SurveyArea::of(f), greedy, o, &shared);
+  std::size_t handed_out = 0;
+  std::optional<Eigen::Vector3d> at;
+  while (const auto w = planner.next()) {
+    ++handed_out;
+    CHECK(shared.planning_s == doctest::Approx(0.25 * static_cast<double>(handed_out)));
+    if (at) shared.flight_s += timing.segment_time_s(*at, w->waypoint.position);
+    at = w->waypoint.position;
+    shared.segmentation_s += 0.1;
+    const Image image = sensor.capture(w->waypoint);
+    (void)planner.report(image, oracle.segment(image), 0.1);
+    CHECK(planner.elapsed_s() == shared.total_s());
+  }
+  CHECK(std::any_of(planner.decisions().begin(), planner.decisions().end(),
+                    [](const DecisionRecord& d) { return d.decision.descend; }));
+  CHECK(shared.segmentation_s == doctest::Approx(0.1 * static_cast<double>(handed_out)));
+  CHECK(shared.planning_s == doctest::Approx(0.25 * static_cast<double>(handed_out)));
+
+  // Measured planning: what the planner charges is what it hands a caller with its own account.
+  o.mission.fixed_planning_time_s.reset();
+  TimeAccount measured;
+  Scripted again{.gsd = 1.0};
+  AdaptivePlanner<Scripted> second(SurveyArea::of(f), again, o, &measured);
+  double taken = second.take_planning_s();
+  while (const auto w = second.next()) {
+    const Image image = sensor.capture(w->waypoint);
+    (void)second.report(image, oracle.segment(image), 0.1);
+    taken += second.take_planning_s();
+  }
+  CHECK(measured.planning_s > 0.0);
+  CHECK(measured.planning_s == doctest::Approx(taken));
+  CHECK(measured.flight_s == 0.0);  // the owner's to charge
+  CHECK(second.elapsed_s() == measured.total_s());
+}
+
+TEST_CASE("run_adaptive_mission: one time account, flight by the ramp model plus fixed times per image and waypoint") {
+  const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
+  OracleSegmenter oracle(f.num_classes());
+  AdaptiveOptions o = options();
+  o.top_gsd_cm = 6.0;
+  o.mission.fixed_segmentation_time_s = 0.1;
+  o.mission.fixed_planning_time_s = 0.25;
+  Scripted greedy{.gsd = 1.0};
+  const AdaptiveResult r = run_adaptive_mission(f, oracle, greedy, o, "greedy");
+  REQUIRE(r.descents() >= 1);
+  std::vector<Eigen::Vector3d> path;
+  for (const auto& w : r.mission.waypoints) path.push_back(w.waypoint.position);
+  const auto n = static_cast<double>(path.size());
+  CHECK(r.mission.flight_s == doctest::Approx(TimingModel(o.mission.timing).path_time_s(path)));
+  CHECK(r.mission.segmentation_s == doctest::Approx(0.1 * n));
+  CHECK(r.mission.planning_s == doctest::Approx(0.25 * n));  // once per waypoint, never twice
+}

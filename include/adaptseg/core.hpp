@@ -26,6 +26,7 @@
 #include <adaptseg/core/linear_decision.hpp>
 #include <adaptseg/core/map_fusion.hpp>
 #include <adaptseg/core/mission_options.hpp>
+#include <adaptseg/core/time_account.hpp>
 #include <adaptseg/core/timing.hpp>
 #include <adaptseg/core/top_level.hpp>
 #include <adaptseg/core/utility_policy.hpp>

@@ -116,9 +116,9 @@ struct PendingDescent {
 }  // namespace detail
 
 /// Runs the adaptive strategy with `policy` over `field` in simulation: AdaptivePlanner
-/// decides, a Mission flies (SimulatedSensor image, segmentation by `backend`, scoring, time
-/// accounting) and reports each image with the mission's elapsed time; the planner's fused
-/// map is the mission's map.
+/// decides, a Mission flies (SimulatedSensor image, segmentation by `backend`, scoring) and
+/// reports each image; the two share the mission's TimeAccount (the mission charges flight and
+/// segmentation, the planner its planning), and the planner's fused map is the mission's map.
 ///
 /// Holds references to `backend` and `policy` for the call's duration only.
 /// @throws std::invalid_argument for a top GSD finer than the field's, candidates that are not
@@ -130,13 +130,13 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
   Mission<Backend> mission(field, backend, options.mission, std::move(strategy));
   AdaptiveOptions planner_options = options;
   planner_options.mission.interest = mission.interest();
-  AdaptivePlanner<Policy> planner(SurveyArea::of(field), policy, std::move(planner_options));
+  // One time account: the mission charges flight and segmentation, the planner its planning.
+  AdaptivePlanner<Policy> planner(SurveyArea::of(field), policy, std::move(planner_options), &mission.time_account());
   // What each descent gained is scored at the end against the ground truth: its region's map
   // before it, the map pixels its images covered, and the top-level images alone.
   std::vector<detail::PendingDescent> descents;
   SemanticMap top_only(field.labels().size(), field.ignore_label(), options.mission.map_fusion);
   while (const auto w = planner.next()) {
-    mission.charge_planning(planner.take_planning_s());
     if (w->level == 1 && w->step == 0) {  // a descent starts: its region's map before it
       const cv::Rect region = planner.region_rect(w->top_index);
       cv::Rect covered;
@@ -148,11 +148,9 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
     // cells: the top-level images' decision inputs, a descent's scene check) or the map does
     // (MapFusion::pooled); checked once, by the mission, which ran the backend.
     const auto visit = mission.visit(w->waypoint, w->level, planner.wants_probabilities());
-    planner.report(visit.image, visit.segmentation, visit.record->segmentation_s, mission.elapsed_s());
+    planner.report(visit.image, visit.segmentation, visit.record->segmentation_s);
     if (w->level == 0) top_only.fuse(visit.image, visit.segmentation.get());
   }
-  // The last decision's measured time (a fixed planning time is charged per waypoint only).
-  if (!mission.options().fixed_planning_time_s) mission.charge_planning(planner.take_planning_s());
   AdaptiveResult result{std::move(mission).finish(planner.map()), planner.decisions(), {}};
   result.realised =
       detail::realised_descents(field, std::move(descents), top_only, planner.map().gsd_cm(), result.mission);

@@ -14,6 +14,7 @@
 #include <adaptseg/core/camera.hpp>
 #include <adaptseg/core/decision.hpp>
 #include <adaptseg/core/lawnmower_planner.hpp>
+#include <adaptseg/core/time_account.hpp>
 #include <adaptseg/core/timing.hpp>
 #include <adaptseg/vision/adaptive_options.hpp>
 #include <adaptseg/vision/detail/descent_costing.hpp>
@@ -58,8 +59,9 @@ namespace adaptseg {
 /// region's σ at h' and what it relabelled (from the fused map) go back to the policy (§3.2.3).
 ///
 /// Time: the budget check uses the elapsed mission time the caller reports with each image,
-/// or, if it reports none, the planner's own account (flight by the timing model along the
-/// planned waypoints; segmentation and planning measured, or fixed per image / waypoint).
+/// or, if it reports none, the time account: the planner's own (flight by the timing model
+/// along the planned waypoints; segmentation and planning measured, or fixed per image /
+/// waypoint), or one it shares with the caller (run_adaptive_mission: the Mission's).
 ///
 /// Holds a reference to `policy`, which must outlive the planner. It holds no backend: what
 /// crosses into it is each image's segmentation, checked once.
@@ -76,20 +78,22 @@ namespace adaptseg {
 template <DecisionPolicy Policy>
 class AdaptivePlanner {
  public:
-  /// Plans the top-level lawnmower over `area` (cells without field skipped).
+  /// Plans the top-level lawnmower over `area` (cells without field skipped). `shared`: a time
+  /// account to charge planning into and read the mission time from, whose owner charges
+  /// flight and segmentation (a Mission's; not null: it must outlive the planner).
   /// @throws std::invalid_argument for an invalid area (num_classes not set included), camera
   ///         or timing, no labels of interest (or one that is not a class index), a top GSD
   ///         finer than the map's, candidates that are not finer than the top (or none to
   ///         descend to), a budget that is not positive, or one too small for the top-level
   ///         coverage alone.
-  AdaptivePlanner(SurveyArea area, Policy& policy, AdaptiveOptions options)
+  AdaptivePlanner(SurveyArea area, Policy& policy, AdaptiveOptions options, TimeAccount* shared = nullptr)
       : grid_(std::move(area), CameraModel(options.mission.camera), options.grid_anchor),
         timing_(options.mission.timing),
         map_(grid_.size(), grid_.area().ignore_label, options.mission.map_fusion),
         policy_(policy),
         options_(std::move(options)),
         coverage_(descent_coverage_info(options_.coverage)),
-        clock_(options_.mission) {
+        clock_(options_.mission, shared) {
     const auto t0 = std::chrono::steady_clock::now();
     policy_.begin_mission();
     candidates_ = detail::planner_candidates(options_, grid_.area());
@@ -139,8 +143,8 @@ class AdaptivePlanner {
   /// took `segmentation_s` [s] (ignored when the options fix a segmentation time). The image's
   /// pose (`position`, `footprint_px`, `yaw_deg`) is what gets fused: the waypoint's, or the
   /// one the UAV measured (see image_at()). `elapsed_s`: the mission time [s] the caller
-  /// measured up to now (flight, segmentation, planning), used for the budget instead of the
-  /// planner's own account. Nothing changes when it throws: the waypoint stays pending.
+  /// measured up to now, used for the budget instead of the time account. Nothing changes
+  /// when it throws: the waypoint stays pending.
   /// segment_and_report() segments the image with a backend and reports it.
   /// @throws std::invalid_argument if no waypoint is pending (next() not called, or its image
   ///         already reported), for an image that is not of the camera's size or has no
@@ -187,9 +191,8 @@ class AdaptivePlanner {
     detail::check_reported_image(image, grid_.camera(), pending_, path_.size(), elapsed_s);
   }
 
-  /// Whether the planner reads the class probabilities behind each image's labels: for the
-  /// decision inputs of a coverage that ranks cells, and for a pooled map (which refuses labels
-  /// alone).
+  /// Whether the planner reads the class probabilities behind each image's labels: for the decision
+  /// inputs of a coverage that ranks cells, and for a pooled map (which refuses labels alone).
   [[nodiscard]] bool wants_probabilities() const noexcept {
     return coverage_.ranks_cells || map_.fusion() == MapFusion::pooled;
   }
@@ -234,8 +237,7 @@ class AdaptivePlanner {
     return grid_.sub_lawnmower(route_.top()[top_index], gsd_cm, keep_cell);
   }
 
-  /// The map pixels of top-level waypoint `top_index`'s region: its footprint, clipped to the
-  /// map grid.
+  /// The map pixels of top-level waypoint `top_index`'s region: its footprint, clipped to the map grid.
   /// @throws std::out_of_range for an index out of range.
   [[nodiscard]] cv::Rect region_rect(std::size_t top_index) const {
     return pixel_rect(route_.top().at(top_index).footprint) & grid_.rect();
@@ -248,8 +250,7 @@ class AdaptivePlanner {
 
   /// The top-level lawnmower W^{h_max}.
   [[nodiscard]] const std::vector<Waypoint>& top_level() const noexcept { return route_.top(); }
-  /// The GSD it is flown at [cm/px]: the options' top GSD, or the policy's choice
-  /// (ChoosesTopLevel).
+  /// The GSD it is flown at [cm/px]: the options' top GSD, or the policy's choice (ChoosesTopLevel).
   [[nodiscard]] double top_gsd_cm() const noexcept { return top_gsd_cm_; }
   /// The candidate GSDs a descent may fly [cm/px] (those not finer than the map, finer than
   /// the top level).
@@ -286,7 +287,7 @@ class AdaptivePlanner {
   [[nodiscard]] const AdaptiveOptions& options() const noexcept { return options_; }
 
   /// Mission time so far [s]: what the caller reported with the last image if it did,
-  /// otherwise the planner's own account (flight + segmentation + planning).
+  /// otherwise the time account's (flight + segmentation + planning).
   [[nodiscard]] double elapsed_s() const noexcept { return clock_.elapsed_s(); }
 
   /// Measured planner computation [s] since the last call (planning the top level, decisions,

@@ -7,6 +7,7 @@
 #include <adaptseg/core/camera.hpp>
 #include <adaptseg/core/lawnmower_planner.hpp>
 #include <adaptseg/core/mission_options.hpp>
+#include <adaptseg/core/time_account.hpp>
 #include <adaptseg/core/timing.hpp>
 #include <adaptseg/vision/detail/planner_clock.hpp>
 #include <adaptseg/vision/field.hpp>
@@ -91,7 +92,10 @@ class Mission {
   [[nodiscard]] const std::vector<int>& interest() const noexcept { return result_.interest; }
   [[nodiscard]] const std::vector<WaypointRecord>& records() const noexcept { return result_.waypoints; }
   /// Time spent so far [s] (flight + segmentation + planning).
-  [[nodiscard]] double elapsed_s() const noexcept { return result_.total_s(); }
+  [[nodiscard]] double elapsed_s() const noexcept { return time_.total_s(); }
+  /// The mission's time account: charged flight and segmentation by visit(), planning by
+  /// charge_planning() or by a planner that shares it (run_adaptive_mission).
+  [[nodiscard]] TimeAccount& time_account() noexcept { return time_; }
   /// Current position (the last waypoint visited), if any.
   [[nodiscard]] std::optional<Eigen::Vector3d> position() const {
     if (result_.waypoints.empty()) return std::nullopt;
@@ -111,11 +115,11 @@ class Mission {
   /// the backend's class probabilities where it gives them, their computation counted in the
   /// segmentation time) and records it. Fusing it into a map is the caller's.
   Visit visit(const Waypoint& w, int level, bool probabilities = false) {
-    if (const auto p = position()) result_.flight_s += timing_.segment_time_s(*p, w.position);
+    if (const auto p = position()) time_.flight_s += timing_.segment_time_s(*p, w.position);
     Image image = sensor_.capture(w);
     const auto t0 = std::chrono::steady_clock::now();
     CheckedSegmentation s = segment_and_check(backend_, image, sensor_.field().num_classes(), probabilities);
-    const double measured = seconds_since(t0);
+    const double measured = detail::seconds_since(t0);
     const cv::Mat& labels = s.labels();
 
     WaypointRecord rec;
@@ -129,13 +133,13 @@ class Mission {
       rec.truth_ratio = cm.truth_share(result_.interest);
     }
     rec.segmentation_s = options_.fixed_segmentation_time_s.value_or(measured);
-    result_.segmentation_s += rec.segmentation_s;
+    time_.segmentation_s += rec.segmentation_s;
     result_.waypoints.push_back(std::move(rec));
     return Visit{std::move(image), std::move(s), &result_.waypoints.back()};
   }
 
   /// Charges planning time: `measured_s`, or the fixed per-waypoint time if one is set.
-  void charge_planning(double measured_s) { result_.planning_s += options_.fixed_planning_time_s.value_or(measured_s); }
+  void charge_planning(double measured_s) { time_.planning_s += options_.fixed_planning_time_s.value_or(measured_s); }
 
   /// Scores `map` (of the field's size: the planner's map) as the mission's fused map and
   /// returns the result. Call once, at the end.
@@ -146,11 +150,11 @@ class Mission {
     result_.fused_labels = map.labels().clone();  // the map may go on changing
     result_.fused_gsd_cm = map.gsd_cm().clone();
     result_.confusion.add(field().labels(), map.labels(), field().ignore_label());
+    result_.flight_s = time_.flight_s;
+    result_.segmentation_s = time_.segmentation_s;
+    result_.planning_s = time_.planning_s;
     return std::move(result_);
   }
-
-  /// Seconds elapsed since `t0` on the steady clock.
-  static double seconds_since(std::chrono::steady_clock::time_point t0) { return detail::seconds_since(t0); }
 
  private:
   SimulatedSensor sensor_;
@@ -158,6 +162,7 @@ class Mission {
   Backend& backend_;
   MissionOptions options_;
   MissionResult result_;
+  TimeAccount time_;
 };
 
 /// The fixed-altitude lawnmower baseline (paper §5.2): the whole field at one GSD,
@@ -177,8 +182,7 @@ template <SegmentationBackend Backend>
   const auto t0 = std::chrono::steady_clock::now();
   const LawnmowerPlanner planner(mission.camera(), overlap);
   const auto plan = planner.plan(field.area(), gsd_cm, {0.0, 0.0}, [&](const Area& a) { return field.has_valid(a); });
-  const double per_waypoint =
-      plan.empty() ? 0.0 : Mission<Backend>::seconds_since(t0) / static_cast<double>(plan.size());
+  const double per_waypoint = plan.empty() ? 0.0 : detail::seconds_since(t0) / static_cast<double>(plan.size());
   SemanticMap map(field.labels().size(), field.ignore_label(), options.map_fusion);
   const bool pooled = options.map_fusion == MapFusion::pooled;
   for (const auto& w : plan) {

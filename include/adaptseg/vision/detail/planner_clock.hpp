@@ -4,6 +4,7 @@
 /// time so far, and what the budget reserves for each step still to come.
 
 #include <adaptseg/core/mission_options.hpp>
+#include <adaptseg/core/time_account.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -18,20 +19,25 @@ namespace adaptseg::detail {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// Mission time as the adaptive planner counts it: flight by the timing model along the legs
-/// flown, segmentation per image and planning (measured, or fixed per image / waypoint by the
-/// MissionOptions), unless the caller reported its own clock with the last image; and the
-/// bound of a step's processing that the budget reserves for each step still to come.
+/// Mission time as the adaptive planner counts it, in its own TimeAccount or in one it shares:
+/// flight by the timing model along the legs flown, segmentation per image and planning
+/// (measured, or fixed per image / waypoint by the MissionOptions), unless the caller reported
+/// its own clock with the last image; and the bound of a step's processing that the budget
+/// reserves for each step still to come. A shared account is charged flight and segmentation
+/// by its owner (the Mission that flies and segments), planning by the planner.
 class PlannerClock {
  public:
   /// Fixed segmentation and planning times from `options` where it sets them (checked by
-  /// check_fixed_times()).
-  explicit PlannerClock(const MissionOptions& options)
-      : fixed_segmentation_s_(options.fixed_segmentation_time_s), fixed_planning_s_(options.fixed_planning_time_s) {}
+  /// check_fixed_times()); the planner's own account, or `shared` (not null: it must outlive
+  /// the clock).
+  explicit PlannerClock(const MissionOptions& options, TimeAccount* shared = nullptr)
+      : fixed_segmentation_s_(options.fixed_segmentation_time_s),
+        fixed_planning_s_(options.fixed_planning_time_s),
+        shared_(shared) {}
 
   /// A waypoint handed out: the fixed planning time per waypoint, where the options set one.
   void waypoint_handed_out() {
-    if (fixed_planning_s_) planning_s_ += *fixed_planning_s_;
+    if (fixed_planning_s_) account().planning_s += *fixed_planning_s_;
   }
 
   /// An image reported after the flight model's `leg_s` [s], segmented in `segmentation_s` [s]
@@ -42,9 +48,8 @@ class PlannerClock {
   /// clock counted) feeds step_bound().
   void image_reported(double leg_s, double segmentation_s, std::optional<double> reported_elapsed_s) {
     reported_elapsed_s_ = reported_elapsed_s;
-    flight_s_ += leg_s;
     const double seg = fixed_segmentation_s_.value_or(segmentation_s);
-    segmentation_s_ += seg;
+    if (!shared_) own_.flight_s += leg_s, own_.segmentation_s += seg;
     slowest_segmentation_s_ = std::max(slowest_segmentation_s_, seg);
     const double now = elapsed_s();
     slowest_step_s_ = std::max(slowest_step_s_, std::max(0.0, now - elapsed_at_last_image_s_ - leg_s));
@@ -56,14 +61,12 @@ class PlannerClock {
   /// and kept for take_planning_s().
   void charge_planning(double s) {
     untaken_planning_s_ += s;
-    if (!fixed_planning_s_) planning_s_ += s;
+    if (!fixed_planning_s_) account().planning_s += s;
   }
 
   /// Mission time so far [s]: what the caller reported with the last image if it did,
-  /// otherwise the own account (flight + segmentation + planning).
-  [[nodiscard]] double elapsed_s() const noexcept {
-    return reported_elapsed_s_.value_or(flight_s_ + segmentation_s_ + planning_s_);
-  }
+  /// otherwise the account's (flight + segmentation + planning).
+  [[nodiscard]] double elapsed_s() const noexcept { return reported_elapsed_s_.value_or(account().total_s()); }
 
   /// Measured planner computation [s] since the last call.
   [[nodiscard]] double take_planning_s() noexcept { return std::exchange(untaken_planning_s_, 0.0); }
@@ -101,15 +104,17 @@ class PlannerClock {
  private:
   std::optional<double> fixed_segmentation_s_;
   std::optional<double> fixed_planning_s_;
-  double flight_s_ = 0.0;
-  double segmentation_s_ = 0.0;
-  double planning_s_ = 0.0;
+  TimeAccount own_;
+  TimeAccount* shared_ = nullptr;  ///< the account charged instead of own_, if any
   double slowest_segmentation_s_ = 0.0;
   double slowest_step_s_ = 0.0;           ///< the largest advance of the clock beyond a leg's flight [s]
   double elapsed_at_last_image_s_ = 0.0;  ///< elapsed_s() when the last image was reported
   std::size_t steps_ = 0;                 ///< images reported
   double untaken_planning_s_ = 0.0;
   std::optional<double> reported_elapsed_s_;
+
+  [[nodiscard]] TimeAccount& account() noexcept { return shared_ ? *shared_ : own_; }
+  [[nodiscard]] const TimeAccount& account() const noexcept { return shared_ ? *shared_ : own_; }
 };
 
 }  // namespace adaptseg::detail
