@@ -384,7 +384,7 @@ TEST_CASE(
   // new site flies them with this network, so each must name this network as it is now (its
   // weights and temperature) and each calibration tile's network of the same recipe that never
   // saw it; a retrained or re-tempered network makes them stale, and this says so. They pool
-  // their maps (docs/results.md, "Pooled maps and a second seed").
+  // their maps (docs/method.md, "Fusion").
   const fs::path models = fs::path(ADAPTSEG_EXAMPLES_DIR) / "models";
   const fs::path all = models / "mobilenetv2-dubai-all";
   for (const char* cls : {"building", "road", "vegetation", "water"}) {
