@@ -1029,6 +1029,19 @@ double fly_on_callers_clock(Planner& planner, Step&& step) {
   return clock;
 }
 
+/// The options of the tests on a clock below: `options()` over blob field `f` at a 6 cm/px top
+/// level, with the segmentation and planning times fixed at `segmentation_s` and `planning_s`
+/// (nullopt: measured).
+AdaptiveOptions clocked_options(const Field& f, std::optional<double> segmentation_s,
+                                std::optional<double> planning_s) {
+  AdaptiveOptions o = options();
+  o.top_gsd_cm = 6.0;
+  o.mission.fixed_segmentation_time_s = segmentation_s;
+  o.mission.fixed_planning_time_s = planning_s;
+  o.mission.interest = f.interest();
+  return o;
+}
+
 TEST_CASE("AdaptivePlanner: the budget holds on a slow computer, images and decisions slowed at random") {
   // A caller that keeps the mission clock itself (as a UAV's companion computer does): the flight
   // model's legs, then per image a segmentation of a random 0-300 ms and the planner slowed by
@@ -1037,11 +1050,7 @@ TEST_CASE("AdaptivePlanner: the budget holds on a slow computer, images and deci
   // the budgets that leave room still buy descents.
   const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
   OracleSegmenter oracle(f.num_classes());
-  AdaptiveOptions o = options();
-  o.top_gsd_cm = 6.0;
-  o.mission.fixed_segmentation_time_s.reset();
-  o.mission.fixed_planning_time_s.reset();
-  o.mission.interest = f.interest();
+  AdaptiveOptions o = clocked_options(f, std::nullopt, std::nullopt);
   const SimulatedSensor sensor(f, CameraModel(o.mission.camera));
   // The top level alone at the worst step (0.6 s per image), and with every descent at none.
   double coverage_worst = 0.0, everything = 0.0;
@@ -1097,11 +1106,7 @@ TEST_CASE("AdaptivePlanner: the budget holds on a vehicle's clock, whatever time
   // its budget.
   const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
   OracleSegmenter oracle(f.num_classes());
-  AdaptiveOptions o = options();
-  o.top_gsd_cm = 6.0;
-  o.mission.fixed_segmentation_time_s = 0.1;
-  o.mission.fixed_planning_time_s = 0.0;
-  o.mission.interest = f.interest();
+  AdaptiveOptions o = clocked_options(f, 0.1, 0.0);
   const SimulatedSensor sensor(f, CameraModel(o.mission.camera));
   double coverage_worst = 0.0, everything = 0.0;
   {
@@ -1156,10 +1161,7 @@ TEST_CASE("run_adaptive_mission: a backend and a policy that sleep keep the budg
     }
   };
   const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
-  AdaptiveOptions o = options();
-  o.top_gsd_cm = 6.0;
-  o.mission.fixed_segmentation_time_s.reset();
-  o.mission.fixed_planning_time_s.reset();
+  AdaptiveOptions o = clocked_options(f, std::nullopt, std::nullopt);
   SleepyOracle backend{OracleSegmenter(f.num_classes())};
   SleepyScripted never;
   never.gsd = 0.5;
@@ -1177,28 +1179,21 @@ TEST_CASE("AdaptivePlanner: a shared time account is charged the planner's plann
   // it, and reads the mission time from it: nothing is handed from one account to another.
   const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
   OracleSegmenter oracle(f.num_classes());
-  AdaptiveOptions o = options();
-  o.top_gsd_cm = 6.0;
-  o.mission.fixed_segmentation_time_s = 0.1;
-  o.mission.fixed_planning_time_s = 0.25;
-  o.mission.interest = f.interest();
+  AdaptiveOptions o = clocked_options(f, 0.1, 0.25);
   const SimulatedSensor sensor(f, CameraModel(o.mission.camera));
-  const TimingModel timing(o.mission.timing);
   Scripted greedy{.gsd = 1.0};
-  TimeAccount shared{.flight_s = 7.0};  // the owner's: a take-off the planner knows nothing of
+  TimeAccount shared;
   AdaptivePlanner<Scripted> planner(SurveyArea::of(f), greedy, o, &shared);
   std::size_t handed_out = 0;
-  std::optional<Eigen::Vector3d> at;
-  while (const auto w = planner.next()) {
+  (void)fly_on_callers_clock(planner, [&](const PlannedWaypoint& w, double& legs) {
     ++handed_out;
     CHECK(shared.planning_s == doctest::Approx(0.25 * static_cast<double>(handed_out)));
-    if (at) shared.flight_s += timing.segment_time_s(*at, w->waypoint.position);
-    at = w->waypoint.position;
+    shared.flight_s = 7.0 + legs;  // the owner's: a take-off the planner knows nothing of, and the legs
     shared.segmentation_s += 0.1;
-    const Image image = sensor.capture(w->waypoint);
+    const Image image = sensor.capture(w.waypoint);
     (void)planner.report(image, oracle.segment(image), 0.1);
     CHECK(planner.elapsed_s() == shared.total_s());
-  }
+  });
   CHECK(std::any_of(planner.decisions().begin(), planner.decisions().end(),
                     [](const DecisionRecord& d) { return d.decision.descend; }));
   CHECK(shared.segmentation_s == doctest::Approx(0.1 * static_cast<double>(handed_out)));
@@ -1224,10 +1219,7 @@ TEST_CASE("AdaptivePlanner: a shared time account is charged the planner's plann
 TEST_CASE("run_adaptive_mission: one time account, flight by the ramp model plus fixed times per image and waypoint") {
   const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
   OracleSegmenter oracle(f.num_classes());
-  AdaptiveOptions o = options();
-  o.top_gsd_cm = 6.0;
-  o.mission.fixed_segmentation_time_s = 0.1;
-  o.mission.fixed_planning_time_s = 0.25;
+  const AdaptiveOptions o = clocked_options(f, 0.1, 0.25);
   Scripted greedy{.gsd = 1.0};
   const AdaptiveResult r = run_adaptive_mission(f, oracle, greedy, o, "greedy");
   REQUIRE(r.descents() >= 1);
