@@ -158,11 +158,6 @@ void write_outputs(const Planner& planner, const ImageSetInfo& info, const std::
                    const nlohmann::json& vehicle, const std::optional<std::string>& stopped, const LiveSettings& s) {
   if (s.out.empty()) return;
   fs::create_directories(s.out);
-  int descents = 0, limited = 0;
-  for (const auto& d : planner.decisions()) {
-    descents += d.decision.descend ? 1 : 0;
-    limited += d.budget_limited ? 1 : 0;
-  }
   nlohmann::json j{{"field", info.name},
                    {"strategy", policy_name},
                    {"schedule", adaptseg::to_string(options.schedule)},
@@ -171,12 +166,9 @@ void write_outputs(const Planner& planner, const ImageSetInfo& info, const std::
                    {"top_gsd_cm", planner.top_gsd_cm()},
                    {"images", wps.size()},
                    {"time_s", {{"total", planner.elapsed_s()}}},
-                   {"decisions",
-                    {{"descend", descents},
-                     {"continue", static_cast<int>(planner.decisions().size()) - descents},
-                     {"budget_limited", limited}}},
                    {"waypoints", wps},
                    {"adaptseg_version", adaptseg::kVersion}};
+  ex::add_decisions(j, planner.decisions(), policy_name);
   if (options.budget_s) j["budget_s"] = *options.budget_s;
   if (!vehicle.is_null()) j["vehicle"] = vehicle;
   if (stopped) {
@@ -360,15 +352,10 @@ void fly(const ImageSetInfo& info, Backend& backend, Policy& policy, const adapt
           std::printf("  -> continue (%zu candidates%s)", step.decision->candidates.size(),
                       step.decision->budget_limited ? ", budget-limited" : "");
         }
-        wj["decision"] = {{"action", d.descend ? "descend" : "continue"},
-                          {"budget_limited", step.decision->budget_limited}};
-        if (d.descend) wj["decision"]["gsd_cm"] = d.gsd_cm;
       }
-      if (step.outcome) {
+      if (step.outcome)
         std::printf("  [descent done: sigma %.4f at %.1f m, %.4f at %.1f m]", step.outcome->sigma_top,
                     step.outcome->top_altitude_m, step.outcome->sigma_sub, step.outcome->sub_altitude_m);
-        wj["observed_sigma_sub"] = step.outcome->sigma_sub;
-      }
       std::printf("\n");
       std::fflush(stdout);
       wps.push_back(wj);

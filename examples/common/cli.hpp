@@ -389,6 +389,48 @@ inline nlohmann::json opt_json(const std::optional<double>& v) {
   return v && std::isfinite(*v) ? nlohmann::json(*v) : nlohmann::json(nullptr);
 }
 
+/// Adds a mission's decisions to its result.json document `j` (schema in docs/data_format.md):
+/// each under its top-level image in `j["waypoints"]` (`decision`: the action, σ, the candidates
+/// with their forecasts and, after a descent, the region's σ at the finer GSD), and their counts
+/// as `j["decisions"]`. The one writer of both adaptseg_mission's and adaptseg_live's. A decision
+/// whose image is not among `j["waypoints"]` (a live mission stopped on an error between the
+/// report and its record) is counted, not attached: what stops a mission must not stop its record.
+inline void add_decisions(nlohmann::json& j, const std::vector<DecisionRecord>& decisions, const std::string& policy) {
+  using nlohmann::json;
+  int descend = 0, limited = 0;
+  for (const auto& d : decisions) {
+    descend += d.decision.descend ? 1 : 0;
+    limited += d.budget_limited ? 1 : 0;
+    json dj{{"action", d.decision.descend ? "descend" : "continue"},
+            {"sigma", d.sigma},
+            {"budget_limited", d.budget_limited}};
+    if (d.decision.descend) {
+      dj["gsd_cm"] = d.decision.gsd_cm;
+      dj["candidate"] = chosen_candidate(d.decision, d.candidates, policy);
+    }
+    json cands = json::array();
+    for (std::size_t k = 0; k < d.candidates.size(); ++k) {
+      json cj{{"gsd_cm", d.candidates[k].gsd_cm},
+              {"images", d.candidates[k].images},
+              {"extra_time_s", d.candidates[k].extra_time_s}};
+      if (k < d.decision.scores.size()) {
+        const auto& sc = d.decision.scores[k];
+        cj["predicted_delta_sigma"] = sc.predicted_delta_sigma;
+        cj["predicted_delta_miou"] = sc.predicted_delta_miou;
+        cj["predicted_delta_miou_std"] = sc.predicted_delta_miou_std;
+        cj["utility"] = std::isfinite(sc.utility) ? json(sc.utility) : json(nullptr);
+        if (std::isfinite(sc.predicted_front_margin)) cj["predicted_front_margin"] = sc.predicted_front_margin;
+      }
+      cands.push_back(cj);
+    }
+    dj["candidates"] = cands;
+    if (d.outcome) dj["observed_sigma_sub"] = d.outcome->sigma_sub;
+    if (d.waypoint_index < j["waypoints"].size()) j["waypoints"][d.waypoint_index]["decision"] = dj;
+  }
+  j["decisions"] = {
+      {"descend", descend}, {"continue", static_cast<int>(decisions.size()) - descend}, {"budget_limited", limited}};
+}
+
 /// The result.json document of a mission (schema in docs/data_format.md).
 inline nlohmann::json result_json(const Field& field, const MissionResult& r, const MissionOptions& opt,
                                   const std::vector<DecisionRecord>* decisions = nullptr) {
@@ -427,40 +469,7 @@ inline nlohmann::json result_json(const Field& field, const MissionResult& r, co
                    {"segmentation_s", w.segmentation_s}});
   }
   j["waypoints"] = wps;
-  if (decisions) {
-    int descend = 0, limited = 0;
-    for (const auto& d : *decisions) {
-      descend += d.decision.descend ? 1 : 0;
-      limited += d.budget_limited ? 1 : 0;
-      json dj{{"action", d.decision.descend ? "descend" : "continue"},
-              {"sigma", d.sigma},
-              {"budget_limited", d.budget_limited}};
-      if (d.decision.descend) {
-        dj["gsd_cm"] = d.decision.gsd_cm;
-        dj["candidate"] = chosen_candidate(d.decision, d.candidates, "result_json");
-      }
-      json cands = json::array();
-      for (std::size_t k = 0; k < d.candidates.size(); ++k) {
-        json cj{{"gsd_cm", d.candidates[k].gsd_cm},
-                {"images", d.candidates[k].images},
-                {"extra_time_s", d.candidates[k].extra_time_s}};
-        if (k < d.decision.scores.size()) {
-          const auto& sc = d.decision.scores[k];
-          cj["predicted_delta_sigma"] = sc.predicted_delta_sigma;
-          cj["predicted_delta_miou"] = sc.predicted_delta_miou;
-          cj["predicted_delta_miou_std"] = sc.predicted_delta_miou_std;
-          cj["utility"] = std::isfinite(sc.utility) ? json(sc.utility) : json(nullptr);
-          if (std::isfinite(sc.predicted_front_margin)) cj["predicted_front_margin"] = sc.predicted_front_margin;
-        }
-        cands.push_back(cj);
-      }
-      dj["candidates"] = cands;
-      if (d.outcome) dj["observed_sigma_sub"] = d.outcome->sigma_sub;
-      j["waypoints"][d.waypoint_index]["decision"] = dj;
-    }
-    j["decisions"] = {
-        {"descend", descend}, {"continue", static_cast<int>(decisions->size()) - descend}, {"budget_limited", limited}};
-  }
+  if (decisions) add_decisions(j, *decisions, r.strategy);
   const auto& cam = opt.camera;
   j["camera"] = {{"image_width_px", cam.image_width_px},
                  {"image_height_px", cam.image_height_px},

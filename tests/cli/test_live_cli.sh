@@ -38,6 +38,16 @@ run linear-budget --strategy linear --budget-s 45
 import json, sys
 work = sys.argv[1]
 descents = 0
+
+def same(a, b):  # the same document, numbers to 1e-9
+    if isinstance(a, dict):
+        return isinstance(b, dict) and a.keys() == b.keys() and all(same(a[k], b[k]) for k in a)
+    if isinstance(a, list):
+        return isinstance(b, list) and len(a) == len(b) and all(same(x, y) for x, y in zip(a, b))
+    if isinstance(a, float) or isinstance(b, float):
+        return abs(a - b) < 1e-9
+    return a == b
+
 for strategy in ["adaptive", "row", "linear", "linear-budget"]:
     live = json.load(open(f"{work}/live-{strategy}/result.json"))
     sim = json.load(open(f"{work}/mission-{strategy}/result.json"))
@@ -47,9 +57,14 @@ for strategy in ["adaptive", "row", "linear", "linear-budget"]:
             assert abs(a[k] - b[k]) < 1e-9, (strategy, a, b)
         assert a["level"] == b["level"], (strategy, a, b)
         assert abs(a["semantic_ratio"] - b["semantic_ratio"]) < 1e-12, (strategy, a, b)
+        # One writer of decisions: the candidates, their forecasts and the descent's outcome alike.
+        assert ("decision" in a) == ("decision" in b), (strategy, a, b)
+        assert same(a.get("decision"), b.get("decision")), (strategy, a.get("decision"), b.get("decision"))
     assert live["decisions"] == sim["decisions"], (strategy, live["decisions"], sim["decisions"])
     assert abs(live["time_s"]["total"] - sim["time_s"]["total"]) < 1e-6, (strategy, live["time_s"], sim["time_s"])
     descents += live["decisions"]["descend"]
+    if live["decisions"]["descend"] > 0:
+        assert any("observed_sigma_sub" in w.get("decision", {}) for w in live["waypoints"]), strategy
     print(strategy, "images", live["images"], "decisions", live["decisions"])
 assert descents > 0, "no descent at all: the comparison would not cover sub-lawnmowers"
 limited = json.load(open(f"{work}/live-linear-budget/result.json"))
