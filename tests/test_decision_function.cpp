@@ -737,6 +737,13 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     CHECK(crossed.top_gsd(fits, 3.0) == 2.0);
     // Where 3 cm/px is the faster one, nothing faster beats it on either field: the nominal.
     CHECK(crossed.top_gsd(usual, 3.0) == 3.0);
+    // Curves on which 3 cm/px maps at least as well as 2 on every field: neither falls short on
+    // them, but where 2 cm/px is faster, 3 could on this field and 2 could not: the faster.
+    const std::vector<ReferenceCurve> coarse_as_good{{"a", {{1.0, 0.95}, {2.0, 0.70}, {3.0, 0.75}}, 0.2, 0.05},
+                                                     {"b", {{1.0, 0.95}, {2.0, 0.75}, {3.0, 0.75}}, 0.2, 0.05}};
+    const FrontAwarePolicy tied(with_cells(1.0), coarse_as_good, {});
+    CHECK(tied.top_gsd(fits, 3.0) == 2.0);
+    CHECK(tied.top_gsd(usual, 3.0) == 3.0);
   }
   SUBCASE("the top level at the predicted curve's first corner: hull") {
     // 3 -> 2 cm/px rises 0.10 in 20 s, 2 -> 1 as much in 125 s: the curve bends at 2.

@@ -25,8 +25,8 @@ namespace adaptseg {
 /// (FrontAwarePolicy::top_gsd; the lawnmower times are this field's, the accuracies the training
 /// fields' lawnmower curves at the same GSD, so no label of this field is read):
 /// - `undominated`: the one whose lawnmower falls least short of the faster lawnmowers, the
-///   shortfall taken on each training field's curve and averaged (the coarsest where they tie:
-///   where no lawnmower is faster, the nominal one);
+///   shortfall taken on each training field's curve and averaged (where they tie the fastest,
+///   then the coarsest: where no lawnmower is faster, the nominal one);
 /// - `hull`: from there, a finer one while the predicted curve rises faster per second up to it
 ///   than from it to any finer lawnmower: the top level at the first corner of the predicted
 ///   curve's upper concave hull. A descent is judged against the curve's upper envelope, whose

@@ -76,8 +76,10 @@ namespace detail {
 /// The GSD to fly the top level at, among `allowed` (sorted coarse to fine, each a GSD of
 /// `lawnmowers` or `nominal`): the one whose lawnmower over the area falls least short of the
 /// lawnmowers of `lawnmowers` as fast or faster, on each training field's curve of `reference`
-/// the most any of them maps better (0 if none), averaged over the fields; the coarsest where
-/// they tie (`nominal` where `allowed` is empty). The margin a mission is judged by is exactly
+/// the most any of them maps better (0 if none), averaged over the fields; where they tie the
+/// fastest, then the coarsest (`nominal` where `allowed` is empty): a slower top level that
+/// the training curves cannot tell from a faster one can still fall short on this field (its
+/// network may map the coarser GSD worse here), the fastest cannot. The margin a mission is judged by is exactly
 /// such a shortfall against the curve's upper envelope, and it is taken field by field because
 /// the fields' curves cross: a network on ground it never saw maps one field better at 12.5
 /// cm/px than at 15 and the next worse, so the shortfall of their mean curve can be 0 where
@@ -91,7 +93,10 @@ namespace detail {
   double best = nominal, best_shortfall = std::numeric_limits<double>::infinity();
   for (double g : allowed) {
     const double v = detail::top_level_shortfall(reference, lawnmowers, g);
-    if (v < best_shortfall - 1e-12) best = g, best_shortfall = v;
+    const bool tie = std::abs(v - best_shortfall) <= 1e-12;
+    if (v < best_shortfall - 1e-12 ||
+        (tie && detail::lawnmower_time(lawnmowers, g) < detail::lawnmower_time(lawnmowers, best)))
+      best = g, best_shortfall = v;
   }
   return choice == TopLevelChoice::hull ? detail::hull_top_gsd(reference, allowed, lawnmowers, best) : best;
 }
