@@ -79,8 +79,8 @@ namespace detail {
 /// the most any of them maps better (0 if none), averaged over the fields; where they tie the
 /// fastest, then the coarsest (`nominal` where `allowed` is empty): a slower top level that
 /// the training curves cannot tell from a faster one can still fall short on this field (its
-/// network may map the coarser GSD worse here), the fastest cannot. The margin a mission is judged by is exactly
-/// such a shortfall against the curve's upper envelope, and it is taken field by field because
+/// network may map the coarser GSD worse here), the fastest cannot. The margin a mission is
+/// judged by is exactly such a shortfall against the curve's upper envelope, and it is taken field by field because
 /// the fields' curves cross: a network on ground it never saw maps one field better at 12.5
 /// cm/px than at 15 and the next worse, so the shortfall of their mean curve can be 0 where
 /// flying the coarser, slower lawnmower loses on some of them. With TopLevelChoice::hull, then
