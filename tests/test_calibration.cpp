@@ -845,6 +845,17 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
   CHECK_THROWS_WITH_AS((void)DecisionModel::load(edited("hull.yaml", "top_level: hull", "top_level: hul", "bad.yaml")),
                        doctest::Contains("'rule.top_level' must be undominated or hull (got 'hul')"),
                        std::invalid_argument);
+  p.top_level = TopLevelChoice::undominated;
+  // The field factor's source: kept (files without the key: the scene check); unknown refused.
+  CHECK(rule_of(back).field_factor == FieldFactorSource::scene_check);
+  p.field_factor = FieldFactorSource::relabelled;
+  policy.set_params(p);
+  corrected.save(tmp.path() / "relabelled.yaml");
+  CHECK(rule_of(DecisionModel::load(tmp.path() / "relabelled.yaml")).field_factor == FieldFactorSource::relabelled);
+  CHECK_THROWS_WITH_AS((void)DecisionModel::load(edited("relabelled.yaml", "field_factor: relabelled",
+                                                        "field_factor: relabeled", "bad_factor.yaml")),
+                       doctest::Contains("'rule.field_factor' must be scene-check or relabelled (got 'relabeled')"),
+                       std::invalid_argument);
   // Fields of another class set are refused.
   const Field other("o", 1.0, a.labels(), {{"a", {0, 0, 0}}, {"b", {1, 1, 1}}, {"c", {2, 2, 2}}}, {1});
   const std::vector<Field> mixed{a, other};

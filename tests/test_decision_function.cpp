@@ -718,6 +718,56 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     blind.observe(cell_outcome(top, NAN));
     CHECK(blind.field_scale() == 1.0);
   }
+  SUBCASE("the relabelled share as the field factor: it scales the descent's gain, not the field's curve") {
+    // Against the field's own curve, after five regions that hold little input, the cells of the
+    // sixth are worth a descent (as above). They were forecast to relabel μ = α·Σ w·x of the
+    // region (α = 1: 0.05 or 0.1); they relabel twice that, and the finer images are as unsure as
+    // the top (a scene check that finds nothing).
+    const FrontAwarePolicy::Params relabelled{
+        .online = true, .curve = CurveSource::field, .field_factor = FieldFactorSource::relabelled};
+    FrontAwarePolicy adaptive(with_cells(1.0), reference, relabelled);
+    FrontAwarePolicy frozen(
+        with_cells(1.0), reference,
+        {.online = false, .curve = CurveSource::field, .field_factor = FieldFactorSource::relabelled});
+    FrontAwarePolicy scene(with_cells(1.0), reference, {.online = true, .curve = CurveSource::field});
+    const auto at = [&](int k) {
+      DecisionContext here = s.region(k, 0.1);
+      here.elapsed_s = 5.7 * (k + 1);
+      here.rest_s = 40.0 - here.elapsed_s;
+      return here;
+    };
+    for (FrontAwarePolicy* p : {&adaptive, &frozen, &scene}) {
+      for (int k = 0; k < 5; ++k) {
+        DecisionContext seen = s.region(0, 0.001);
+        seen.candidates = {};
+        REQUIRE_FALSE(p->decide(seen).descend);
+      }
+      const Decision d = p->decide(at(5));
+      REQUIRE(d.descend);
+      const double top = d.candidate == 0 ? 0.05 : 0.1;
+      DescentOutcome o = cell_outcome(top, top);
+      o.relabelled = {2.0 * top, 2.0 * top};
+      p->observe(o);
+    }
+    CHECK(adaptive.field_scale() == doctest::Approx(2.0).epsilon(0.01));
+    CHECK(frozen.field_scale() == 1.0);
+    CHECK(scene.field_scale() < 0.1);  // the scene check saw no change: no gain
+    const Decision twice = adaptive.decide(at(6));
+    const Decision once = frozen.decide(at(6));
+    const Decision none = scene.decide(at(6));
+    CHECK(twice.descend);
+    for (std::size_t k = 0; k < 2; ++k) {
+      CHECK(twice.scores[k].predicted_field_gain ==
+            doctest::Approx(adaptive.field_scale() * once.scores[k].predicted_field_gain));
+      // The field's curve as the model predicts it, whatever s: the same rise as the frozen twin's.
+      CHECK(twice.scores[k].predicted_curve_rise == doctest::Approx(once.scores[k].predicted_curve_rise));
+      CHECK(once.scores[k].predicted_curve_rise > 0.0);
+      // With the scene check s scales the curve's rise too.
+      CHECK(none.scores[k].predicted_curve_rise < 0.1 * once.scores[k].predicted_curve_rise);
+    }
+    CHECK(parse_field_factor_source(to_string(FieldFactorSource::relabelled)) == FieldFactorSource::relabelled);
+    CHECK_THROWS_AS((void)parse_field_factor_source("relabeled"), std::invalid_argument);
+  }
   SUBCASE("the top level: the coarsest calibrated GSD whose lawnmower nothing faster beats") {
     FrontAwarePolicy p(with_cells(1.0), {{"a", {{1.0, 0.95}, {2.0, 0.85}, {3.0, 0.75}}, 0.2, 0.05}}, {});
     // 2 cm/px is faster than 3 over this area (its grid fits it better) and maps better.

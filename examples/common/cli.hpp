@@ -244,6 +244,7 @@ struct CalibrationCli {
   std::vector<std::string> slope_poolings{"cells", "fields"};
   std::string curve = to_string(CurveSource::corrected);  // the programs' default, not the struct's
   std::vector<std::string> top_levels{"undominated"};
+  std::string field_factor = to_string(FieldFactorSource::scene_check);
   bool gain_ratios = false;
   bool margin_biases = false;
   bool jump_guard = false;
@@ -293,6 +294,13 @@ struct CalibrationCli {
                        "the top-level images (field), or that prediction scaled per training field by its real "
                        "lawnmowers' rise against the predicted one (corrected)")
             ->check(CLI::IsMember(detail::names_of(kCurveSources)))
+            ->capture_default_str(),
+        app.add_option("--field-factor", field_factor,
+                       "front-aware rule with --coverage ranked: what the field factor (how much more or less "
+                       "than forecast a closer look gains on this field) learns from in flight, each descent's "
+                       "scene check, scaling the gain and the field's curve alike (scene-check), or its "
+                       "relabelled share against the forecast one, scaling the gain only (relabelled)")
+            ->check(CLI::IsMember(detail::names_of(kFieldFactorSources)))
             ->capture_default_str(),
         app.add_option("--top-level", top_levels,
                        "front-aware rule with --coverage ranked: how the top-level GSD is chosen among those "
@@ -363,6 +371,7 @@ struct CalibrationCli {
     options.sigma_prior = parse_sigma_prior_source(sigma_prior);
     options.adaptive.coverage = parse_descent_coverage(coverage);
     options.front_aware.curve = parse_curve_source(curve);
+    options.front_aware.field_factor = parse_field_factor_source(field_factor);
     options.gain_ratios = gain_ratios;
     options.margin_biases = margin_biases;
     options.jump_guard = jump_guard;

@@ -72,9 +72,9 @@ namespace adaptseg {
 /// factor on the gains, the gain being paid by the relabelled pixels. After each descent s's
 /// posterior is updated (conjugate Gaussian): descents that change less than forecast lower
 /// ĝ and the UAV stops earlier; descents that change more raise it; each observation narrows
-/// Var(s), so the lower bound rises as evidence accrues. Also the paper's update of O.
-/// `online = false` (non-adaptive) keeps s = 1, Var(s) = ω² and O as initialised. The rule
-/// needs C or a cell gain model (every calibrated model has C).
+/// Var(s), so the lower bound rises as evidence accrues (with a cell gain model, s learns from
+/// the scene check unless `field_factor` says otherwise: FieldFactorSource). Also the paper's
+/// update of O. `online = false` (non-adaptive) keeps s = 1, Var(s) = ω² and O as initialised.
 class FrontAwarePolicy {
  public:
   /// Behaviour; validated by the constructor.
@@ -94,6 +94,8 @@ class FrontAwarePolicy {
     CurveSource curve = CurveSource::training;
     /// How top_gsd() chooses the top level (TopLevelChoice).
     TopLevelChoice top_level = TopLevelChoice::undominated;
+    /// What the field factor s learns from and scales (FieldFactorSource).
+    FieldFactorSource field_factor = FieldFactorSource::scene_check;
     /// Per descent GSD, the factor on a candidate's forecast field gain (mean and spread): what
     /// descents to it realised of their forecast on the training fields, each flown with a model
     /// that never saw it (CalibrationOptions::gain_ratios). Not listed: 1. Empty: none.
@@ -235,7 +237,11 @@ class FrontAwarePolicy {
     model_.update(out);
     if (out.descent >= chosen_.size()) return;
     const Relabelled& f = chosen_[out.descent];
-    if (model_.cells() && f.sub_gsd_cm > 0.0) {
+    if (model_.cells() && f.sub_gsd_cm > 0.0 && params_.field_factor == FieldFactorSource::relabelled) {
+      // χ_obs = s·μ + ε, μ the cell gain model's relabelled share, ε ~ N(0, its spread of one descent).
+      if (std::isfinite(f.mean) && f.mean > 0.0)
+        scale_.observe(f.mean, out.relabelled.interest_share, std::max(f.noisy_sd * f.noisy_sd, 1e-12), true);
+    } else if (model_.cells() && f.sub_gsd_cm > 0.0) {
       // The scene check (cell gain model): the descent's gain as the finer look estimates it,
       // y = γ·d = s·μ + ε, d = top − fine input, ε ~ N(0, κ_p·Σ w²x + τ_γ²·d²), μ the forecast
       // before s (τ_γ: how far the proxy's slope differs between the training fields). Without
@@ -403,7 +409,7 @@ class FrontAwarePolicy {
 
   /// The lawnmower curve of this field as the cell gain model predicts it (CurveSource::field),
   /// relative to the top level's mIoU: at each lawnmower GSD g finer than the top level,
-  /// s·β(top, g)·X̂·(1 / σ̂) (s applied by scaled()), `x` = X̂ (field_input_estimate),
+  /// s·β(top, g)·X̂·(1 / σ̂) (s by scaled(); none with FieldFactorSource::relabelled), `x` = X̂,
   /// `inv_sigma` = 1 / σ̂; 0 at the top level; its upper envelope. With a training field
   /// `corrected_by`, each rise times that field's real / predicted rise (CurveSource::corrected).
   [[nodiscard]] std::vector<CurvePoint> field_curve(const DecisionContext& c, double x, double inv_sigma,
@@ -413,7 +419,8 @@ class FrontAwarePolicy {
       if (l.gsd_cm > c.top_gsd_cm) continue;  // coarser than the top level: not what it compares with
       const double slope = l.gsd_cm < c.top_gsd_cm ? model_.cells()->at(c.top_gsd_cm, l.gsd_cm).gain_slope : 0.0;
       const double ratio = corrected_by ? corrected_rise_ratio(*corrected_by, c.top_gsd_cm, l.gsd_cm, slope) : 1.0;
-      curve.push_back({l.time_s, scaled(slope * x * inv_sigma * ratio)});
+      const double rise = slope * x * inv_sigma * ratio;
+      curve.push_back({l.time_s, params_.field_factor == FieldFactorSource::relabelled ? rise : scaled(rise)});
     }
     return upper_envelope(std::move(curve));
   }

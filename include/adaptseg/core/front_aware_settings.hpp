@@ -87,6 +87,39 @@ inline constexpr std::array<detail::NamedValue<CurveSource>, 3> kCurveSources{{
   return detail::value_named(kCurveSources, name, "curve source");
 }
 
+/// What the front-aware rule's field factor s (FieldScale: how much more or less than forecast
+/// a closer look gains on this field) learns from, and what it scales
+/// (FrontAwarePolicy::Params::field_factor, `field_factor` in the model file, `--field-factor`):
+/// - `scene-check`: with a cell gain model, from each descent's scene check (the finer images'
+///   input against the top-level one's; CellGainModel::proxy_gain); it scales the descent's
+///   forecast gain and, with the field's own curve, the curve's rise alike (at z = 0 it then
+///   changes a decision only by its sign). Without a cell gain model, from χ as below;
+/// - `relabelled`: from each descent's relabelled share of its region with L involved (χ,
+///   observable without ground truth) against the cell gain model's forecast of it; it scales
+///   the descent's forecast gain only, and the predicted curve keeps the training fields'
+///   anchor. On the leave-one-tile-out runs a field's gain per unit of input and its relabelled
+///   share per unit of input move together for building (docs/journal/2026-12-loto.md,
+///   "2026-12-01 (nineteenth session)"), while this field's real lawnmower rise did not follow
+///   the descents' gains.
+enum class FieldFactorSource { scene_check, relabelled };
+
+/// Every field-factor source by name.
+inline constexpr std::array<detail::NamedValue<FieldFactorSource>, 2> kFieldFactorSources{{
+    {FieldFactorSource::scene_check, "scene-check"},
+    {FieldFactorSource::relabelled, "relabelled"},
+}};
+
+/// The name of a field-factor source.
+[[nodiscard]] inline std::string to_string(FieldFactorSource f) {
+  return detail::name_of(kFieldFactorSources, f, "field-factor source");
+}
+
+/// Parses a field-factor source's name.
+/// @throws std::invalid_argument for anything but `scene-check` or `relabelled`.
+[[nodiscard]] inline FieldFactorSource parse_field_factor_source(std::string_view name) {
+  return detail::value_named(kFieldFactorSources, name, "field-factor source");
+}
+
 /// How much of its forecast field gain a descent to one GSD realised when the training fields
 /// were flown as new ground (FrontAwarePolicy::Params::gain_ratios; calibrate() with
 /// CalibrationOptions::gain_ratios measures it).

@@ -50,6 +50,8 @@ struct FrontAwareRule {
       e << YAML::Key << "top_level" << YAML::Value << to_string(p.top_level);
     if (p.curve_agreement > 0.0) e << YAML::Key << "curve_agreement" << YAML::Value << num(p.curve_agreement);
     if (std::isfinite(p.jump_bound)) e << YAML::Key << "jump_bound" << YAML::Value << num(p.jump_bound);
+    if (p.field_factor != FieldFactorSource::scene_check)
+      e << YAML::Key << "field_factor" << YAML::Value << to_string(p.field_factor);
     std::vector<std::pair<double, double>> ratios, biases;
     for (const GainRatio& x : p.gain_ratios) ratios.emplace_back(x.gsd_cm, x.ratio);
     for (const MarginBias& x : p.margin_biases) biases.emplace_back(x.gsd_cm, x.per_s);
@@ -120,6 +122,7 @@ struct FrontAwareRule {
          .jump_bound = rule.has("jump_bound") ? rule.number("jump_bound") : std::numeric_limits<double>::infinity(),
          .curve = read_curve(rule),
          .top_level = rule.has("top_level") ? read_top_level(rule) : TopLevelChoice::undominated,
+         .field_factor = rule.has("field_factor") ? read_field_factor(rule) : FieldFactorSource::scene_check,
          .gain_ratios = read_gain_ratios(rule),
          .margin_biases = read_margin_biases(rule)});
   }
@@ -181,6 +184,16 @@ struct FrontAwareRule {
       return parse_top_level_choice(name);
     } catch (const std::invalid_argument&) {
       detail::yaml_error(rule.where(), "'rule.top_level' must be undominated or hull (got '" + name + "')");
+    }
+  }
+
+  /// `rule.field_factor`, naming the file where it is not a FieldFactorSource.
+  [[nodiscard]] static FieldFactorSource read_field_factor(const detail::YamlReader& rule) {
+    const std::string name = rule.text("field_factor");
+    try {
+      return parse_field_factor_source(name);
+    } catch (const std::invalid_argument&) {
+      detail::yaml_error(rule.where(), "'rule.field_factor' must be scene-check or relabelled (got '" + name + "')");
     }
   }
 
