@@ -220,8 +220,8 @@ int main(int argc, char** argv) {
                                                                   [](const auto& d) { return d.decision.descend; }))
                                  : 0;
         results << csv(field.name()) << ',' << row.strategy << ',' << fmt(row.gsd, 3) << ',' << csv(m.miou_interest())
-                << ',' << csv(m.miou_all()) << ',' << fmt(m.total_s(), 3) << ',' << fmt(m.flight_s, 3) << ','
-                << fmt(m.segmentation_s, 4) << ',' << fmt(m.planning_s, 4) << ',' << m.waypoints.size() << ','
+                << ',' << csv(m.miou_all()) << ',' << fmt(m.total_s(), 3) << ',' << fmt(m.time.flight_s, 3) << ','
+                << fmt(m.time.segmentation_s, 4) << ',' << fmt(m.time.planning_s, 4) << ',' << m.waypoints.size() << ','
                 << fmt(margin, 6) << ',' << descents << ',' << altitude_changes(m) << ',' << fmt(curve_margin, 6)
                 << '\n';
         for (std::size_t k = 0; k < m.waypoints.size(); ++k) {

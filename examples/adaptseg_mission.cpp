@@ -106,8 +106,9 @@ int main(int argc, char** argv) {
     std::printf(
         "%s: %s images=%zu time=%.1f s (flight %.1f, segmentation %.2f, planning %.4f) "
         "mIoU interest=%.4f all=%.4f -> %s\n",
-        field.name().c_str(), what.c_str(), result.waypoints.size(), result.total_s(), result.flight_s,
-        result.segmentation_s, result.planning_s, mi.value_or(NAN), ma.value_or(NAN), out_dir.string().c_str());
+        field.name().c_str(), what.c_str(), result.waypoints.size(), result.total_s(), result.time.flight_s,
+        result.time.segmentation_s, result.time.planning_s, mi.value_or(NAN), ma.value_or(NAN),
+        out_dir.string().c_str());
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "adaptseg_mission: error: %s\n", e.what());

@@ -53,10 +53,10 @@ TEST_CASE("mission: time is flight by the ramp model plus fixed segmentation and
   std::vector<Eigen::Vector3d> pts;
   for (const auto& w : r.waypoints) pts.push_back(w.waypoint.position);
   REQUIRE(pts.size() == 4);  // 12 x 9 m field, 9.6 x 7.2 m footprints: 2 x 2
-  CHECK(r.flight_s == doctest::Approx(TimingModel(o.timing).path_time_s(pts)));
-  CHECK(r.segmentation_s == doctest::Approx(0.4));
-  CHECK(r.planning_s == doctest::Approx(1.0));
-  CHECK(r.total_s() == doctest::Approx(r.flight_s + 0.4 + 1.0));
+  CHECK(r.time.flight_s == doctest::Approx(TimingModel(o.timing).path_time_s(pts)));
+  CHECK(r.time.segmentation_s == doctest::Approx(0.4));
+  CHECK(r.time.planning_s == doctest::Approx(1.0));
+  CHECK(r.total_s() == doctest::Approx(r.time.flight_s + 0.4 + 1.0));
   for (const auto& w : r.waypoints) {
     CHECK(w.level == 0);
     CHECK(w.image_miou_all.has_value());

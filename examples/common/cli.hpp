@@ -458,8 +458,10 @@ inline nlohmann::json result_json(const Field& field, const MissionResult& r, co
     per_class[field.classes()[static_cast<std::size_t>(c)].name] = opt_json(r.confusion.iou(c));
   j["iou_per_class"] = per_class;
   j["images"] = r.waypoints.size();
-  j["time_s"] = {
-      {"total", r.total_s()}, {"flight", r.flight_s}, {"segmentation", r.segmentation_s}, {"planning", r.planning_s}};
+  j["time_s"] = {{"total", r.total_s()},
+                 {"flight", r.time.flight_s},
+                 {"segmentation", r.time.segmentation_s},
+                 {"planning", r.time.planning_s}};
   // Coverage: share of valid field pixels that received a label.
   const cv::Mat observed = (r.fused_labels != field.ignore_label()) & field.valid_mask();
   const int valid = field.valid_pixels();

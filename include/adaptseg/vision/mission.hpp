@@ -46,11 +46,10 @@ struct MissionResult {
   cv::Mat fused_labels;                   ///< SemanticMap::labels() at the end
   cv::Mat fused_gsd_cm;                   ///< SemanticMap::gsd_cm() at the end (+inf: unobserved)
   ConfusionMatrix confusion{1};           ///< fused map vs the field's ground truth
-  double flight_s = 0.0;
-  double segmentation_s = 0.0;
-  double planning_s = 0.0;
+  TimeAccount time;                       ///< the mission's time: flight, segmentation, planning
 
-  [[nodiscard]] double total_s() const noexcept { return flight_s + segmentation_s + planning_s; }
+  /// The mission's time, time.total_s() [s].
+  [[nodiscard]] double total_s() const noexcept { return time.total_s(); }
   [[nodiscard]] std::optional<double> miou_interest() const { return confusion.miou(interest); }
   [[nodiscard]] std::optional<double> miou_all() const { return confusion.miou_all(); }
 };
@@ -150,9 +149,7 @@ class Mission {
     result_.fused_labels = map.labels().clone();  // the map may go on changing
     result_.fused_gsd_cm = map.gsd_cm().clone();
     result_.confusion.add(field().labels(), map.labels(), field().ignore_label());
-    result_.flight_s = time_.flight_s;
-    result_.segmentation_s = time_.segmentation_s;
-    result_.planning_s = time_.planning_s;
+    result_.time = time_;
     return std::move(result_);
   }
 
