@@ -98,9 +98,9 @@ inline constexpr std::array<detail::NamedValue<CurveSource>, 3> kCurveSources{{
 ///   observable without ground truth) against the cell gain model's forecast of it; it scales
 ///   the descent's forecast gain only, and the predicted curve keeps the training fields'
 ///   anchor. On the leave-one-tile-out runs a field's gain per unit of input and its relabelled
-///   share per unit of input move together for building (docs/journal/2026-12-loto.md,
-///   "2026-12-01 (nineteenth session)"), while this field's real lawnmower rise did not follow
-///   the descents' gains.
+///   share per unit of input move together for building, while the field's real lawnmower rise
+///   did not follow the descents' gains (docs/method.md, "The field factor from what a descent
+///   relabelled", with what it measured).
 enum class FieldFactorSource { scene_check, relabelled };
 
 /// Every field-factor source by name.
