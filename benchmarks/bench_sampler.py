@@ -1,6 +1,6 @@
 #!/usr/bin/python3
-"""Training-batch throughput: the device sampler (examples/tools/device_sampler.py, what
-`train_segnet.py --sampler device` uses) side by side with another implementation of the same
+"""Training-batch throughput: the device sampler (adaptseg_tools.device_sampler, what
+`adaptseg_tools.train_segnet --sampler device` uses) side by side with another implementation of the same
 class (--baseline FILE, e.g. an earlier device_sampler.py taken from git) and with the CPU
 sampler (one process), on the same batches of the bundled training tiles.
 
@@ -10,7 +10,7 @@ reported, with crops per second. Batches of the ERFNet recipe (480x360 camera, 3
 and of the MobileNetV2 recipe (300x300 crops fed at 320x320) by default.
 
 Usage:
-  /usr/bin/python3 benchmarks/bench_sampler.py [--device cuda] [--batch 32] [--batches 5]
+  PYTHONPATH=python /usr/bin/python3 benchmarks/bench_sampler.py [--device cuda] [--batch 32] [--batches 5]
       [--rounds 3] [--baseline OLD_device_sampler.py] [--no-cpu] [--json FILE]
 """
 
@@ -20,17 +20,16 @@ import argparse
 import importlib.util
 import json
 import statistics
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 import torch
 
+from adaptseg_tools import device_sampler
+from adaptseg_tools import train_segnet as ts
+
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "examples" / "tools"))
-import device_sampler  # noqa: E402
-import train_segnet as ts  # noqa: E402
 
 
 def load_module(path: Path):

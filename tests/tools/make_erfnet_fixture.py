@@ -14,14 +14,13 @@ camera size), and PyTorch's output on it, computed from examples/models/erfnet-d
 
 tests/test_erfnet_segmenter.cpp compares OnnxSegmenter's output with these.
 
-Usage: /usr/bin/python3 tests/tools/make_erfnet_fixture.py [--model-dir DIR] [--field DIR]
+Usage: PYTHONPATH=python /usr/bin/python3 tests/tools/make_erfnet_fixture.py [--model-dir DIR] [--field DIR]
 """
 
 from __future__ import annotations
 
 import argparse
 import datetime
-import sys
 from pathlib import Path
 
 import cv2
@@ -30,8 +29,7 @@ import torch
 import yaml
 
 REPO = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(REPO / "examples" / "tools"))
-import train_segnet as te  # noqa: E402
+from adaptseg_tools import train_segnet as te
 
 # The sub-field of the test field on which tests/test_erfnet_segmenter.cpp checks the mIoU at
 # the finest GSD (fractions x0, y0, x1, y1; Field::sub_field). Kept small: 8 images.
