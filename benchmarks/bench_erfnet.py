@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from adaptseg_tools import train_segnet as te
+from adaptseg_tools.training.models import load_exported
 from bench_common import cpu_model
 
 REPO = Path(__file__).resolve().parents[1]
@@ -94,7 +94,7 @@ def main():
     args = ap.parse_args()
 
     model_dir = Path(args.model_dir)
-    model, _, meta = te.load_exported(model_dir)
+    model, _, meta = load_exported(model_dir)
     h, w = meta["input"]["height"], meta["input"]["width"]
     camera = meta["training"]["camera"]
     x = torch.from_numpy(np.random.default_rng(0).standard_normal((1, 3, h, w)).astype(np.float32))

@@ -27,7 +27,9 @@ import numpy as np
 import torch
 
 from adaptseg_tools import device_sampler
-from adaptseg_tools import train_segnet as ts
+from adaptseg_tools.training.fields import load_field
+from adaptseg_tools.training.network_path import NetSpec
+from adaptseg_tools.training.samples import Sampler
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -52,14 +54,14 @@ def main(argv=None):
     args = ap.parse_args(argv)
     torch.set_num_threads(args.threads)
     device = torch.device(args.device)
-    fields = [ts.load_field(REPO / "examples" / "data" / f"dubai-tile-{k}") for k in (1, 2, 3, 5)]
+    fields = [load_field(REPO / "examples" / "data" / f"dubai-tile-{k}") for k in (1, 2, 3, 5)]
     mean, std = np.array([0.47, 0.47, 0.47]), np.array([0.34, 0.33, 0.35])
-    recipes = {"erfnet (352 crops)": (ts.NetSpec("erfnet", (480, 360), (480, 360), 1, mean, std), 352),
-               "mobilenetv2 (300 crops)": (ts.NetSpec("mobilenetv2", (480, 360), (512, 384), 4, mean, std), 300)}
+    recipes = {"erfnet (352 crops)": (NetSpec("erfnet", (480, 360), (480, 360), 1, mean, std), 352),
+               "mobilenetv2 (300 crops)": (NetSpec("mobilenetv2", (480, 360), (512, 384), 4, mean, std), 300)}
     sync = torch.cuda.synchronize if device.type == "cuda" else (lambda: None)
     rows = []
     for recipe, (spec, crop) in recipes.items():
-        cpu = ts.Sampler(fields, spec, crop, 1.0, 3.0, "altitude", seed=0)
+        cpu = Sampler(fields, spec, crop, 1.0, 3.0, "altitude", seed=0)
         impls = {"device sampler": device_sampler.DeviceSampler(cpu, device).batch}
         if args.baseline:
             impls["baseline " + args.baseline.name] = load_module(args.baseline).DeviceSampler(cpu, device).batch

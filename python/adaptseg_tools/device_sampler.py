@@ -1,7 +1,7 @@
 """Training batches made on the training device (train_segnet.py --sampler device).
 
-The CPU sampler (train_segnet.Sampler, augmentation `altitude`) spends about 20 ms of one core
-per crop cutting the camera footprint out of the orthomosaic and resampling it as adaptseg's
+The CPU sampler (training.samples.Sampler, augmentation `altitude`) spends about 20 ms of one
+core per crop cutting the camera footprint out of the orthomosaic and resampling it as adaptseg's
 SimulatedSensor does; on a GPU that, not the network, sets the pace (examples/models/erfnet-dubai
 README: 133-220 crops/s with 7-14 workers). This sampler does the same on the device, for whole
 batches:
@@ -49,7 +49,7 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 
-IGNORE = 255
+from .fieldio import IGNORE
 
 
 def area_weights(axes: torch.Tensor, n: int, tmax: int) -> torch.Tensor:
@@ -148,8 +148,8 @@ class Photometric(NamedTuple):
 
 class DeviceSampler:
     """Batches of augmentation `altitude` made on `device` (see the module's docstring).
-    `cpu_sampler`: the train_segnet.Sampler whose fields, network spec, crop, GSD range and seed
-    this one shares (and whose footprint() draws the geometry)."""
+    `cpu_sampler`: the training.samples.Sampler whose fields, network spec, crop, GSD range and
+    seed this one shares (and whose footprint() draws the geometry)."""
 
     def __init__(self, cpu_sampler, device):
         self.cpu = cpu_sampler
@@ -174,9 +174,9 @@ class DeviceSampler:
         cw, ch = self.spec.camera_wh
         return min(self.cpu.crop, cw), min(self.cpu.crop, ch)
 
-    # -- the draws of one sample (its generator, in train_segnet.Sampler's order) ---------------
+    # -- the draws of one sample (its generator, in training.samples.Sampler's order) -------
     def draw_geometry(self, rng) -> Geometry:
-        """The geometric draws of train_segnet.Sampler.altitude_camera: quarter-turn yaw,
+        """The geometric draws of training.samples.Sampler.altitude_camera: quarter-turn yaw,
         footprint (field, GSD factor, position), mirror, crop position."""
         cw, ch = self.spec.camera_wh
         k = int(rng.integers(0, 4))
@@ -189,7 +189,7 @@ class DeviceSampler:
 
     @staticmethod
     def draw_photometric(rng) -> Photometric:
-        """The draws of train_segnet.photometric, in its order."""
+        """The draws of training.samples.photometric, in its order."""
         sat, con, bri = float(rng.uniform(0.7, 1.3)), float(rng.uniform(0.75, 1.25)), float(rng.uniform(-20, 20))
         wb = rng.uniform(0.92, 1.08, 3)
         gamma = float(rng.uniform(0.8, 1.25))
@@ -279,7 +279,7 @@ class DeviceSampler:
         return cam, target
 
     def photometric_batch(self, cam, draws):
-        """train_segnet.photometric on a B x 3 x H x W float BGR batch in 0..255, sample b with
+        """training.samples.photometric on a B x 3 x H x W float BGR batch in 0..255, sample b with
         the parameters draws[b]."""
         B, dev = cam.shape[0], cam.device
 
@@ -343,7 +343,7 @@ class DeviceSampler:
         cam = self.photometric_batch(cam, [self.draw_photometric(r) for r in rngs])
         cam = torch.where(black, torch.zeros_like(cam), cam)
         nw, nh = self.cpu.network_size(cam.shape[3], cam.shape[2])
-        if (nw, nh) != (cam.shape[3], cam.shape[2]):  # train_segnet.to_network_size
+        if (nw, nh) != (cam.shape[3], cam.shape[2]):  # training.network_path.to_network_size
             mode = "area" if nw < cam.shape[3] else "bilinear"
             cam = F.interpolate(cam, size=(nh, nw), mode=mode, **({} if mode == "area" else {"align_corners": False}))
             cam = torch.round(cam).clamp(0, 255)
@@ -356,13 +356,13 @@ class DeviceSampler:
 
     # -- one sample (the checks of test_device_sampler.py) ---------------------------------------
     def camera(self, rng):
-        """train_segnet.Sampler.altitude_camera on the device: camera crop (3 x h x w float,
+        """training.samples.Sampler.altitude_camera on the device: camera crop (3 x h x w float,
         rounded to 8 bits, BGR) and oracle target (h x w long) of one sample."""
         cam, target = self.cameras([self.draw_geometry(rng)])
         return cam[0], target[0]
 
     def photometric(self, cam, rng):
-        """train_segnet.photometric's augmentation on a 3 x H x W float BGR image in 0..255."""
+        """training.samples.photometric's augmentation on a 3 x H x W float BGR image in 0..255."""
         return self.photometric_batch(cam[None], [self.draw_photometric(rng)])[0]
 
     def sample(self, step: int, index: int):

@@ -36,7 +36,11 @@ import torch
 import yaml
 
 from . import REPO
-from . import train_segnet as te
+from .fieldio import IGNORE
+from .training.fields import capture, lawnmower_rects, load_field
+from .training.models import load_exported
+from .training.network_path import logits_to, to_network_size, to_tensor
+from .training.validation import confusion, miou
 
 
 def member_probabilities(model, spec, meta, bgr: np.ndarray, mirror: bool = False) -> np.ndarray:
@@ -45,9 +49,9 @@ def member_probabilities(model, spec, meta, bgr: np.ndarray, mirror: bool = Fals
     if mirror:
         back = member_probabilities(model, spec, meta, np.ascontiguousarray(bgr[:, ::-1]))[:, :, ::-1]
         return 0.5 * (member_probabilities(model, spec, meta, bgr) + back)
-    x = torch.from_numpy(te.to_tensor(te.to_network_size(bgr, spec.input_wh), spec.mean, spec.std))[None]
+    x = torch.from_numpy(to_tensor(to_network_size(bgr, spec.input_wh), spec.mean, spec.std))[None]
     with torch.no_grad():
-        logits = te.logits_to(model(x).float(), bgr.shape[:2])[0]
+        logits = logits_to(model(x).float(), bgr.shape[:2])[0]
     t = float(meta.get("temperature", 1.0))
     return torch.softmax(logits / t, dim=0).numpy()
 
@@ -105,7 +109,7 @@ def main():
     nets = {}
     for name, d in member_dirs.items():
         model_dir, mirror = member_dir(d)
-        model, spec, meta = te.load_exported(model_dir)
+        model, spec, meta = load_exported(model_dir)
         nets[name] = (model, spec, meta, mirror)
     classes = next(iter(nets.values()))[2]["classes"]
     for name, (_, _, meta, _) in nets.items():
@@ -121,7 +125,7 @@ def main():
     results = {}
     seconds = {n: 0.0 for n in member_dirs}
     for fdir in args.fields.split(","):
-        field = te.load_field(Path(fdir))
+        field = load_field(Path(fdir))
         if field.classes != classes:
             raise SystemExit(f"{fdir}: classes {field.classes} differ from the members' {classes}")
         results[field.name] = {}
@@ -129,9 +133,9 @@ def main():
             gsd = field.gsd_cm * fac
             cms = {r: np.zeros((nc, nc + 1), np.int64) for r in rows}
             n_img = 0
-            for (c0, r0, fw, fh) in te.lawnmower_rects(field, gsd, cam_wh):
-                rgb, _, gt = te.capture(field, c0, r0, fw, fh, cam_wh)
-                if (gt != te.IGNORE).sum() == 0:
+            for (c0, r0, fw, fh) in lawnmower_rects(field, gsd, cam_wh):
+                rgb, _, gt = capture(field, c0, r0, fw, fh, cam_wh)
+                if (gt != IGNORE).sum() == 0:
                     continue
                 probs = {}
                 for name, (model, spec, meta, mirror) in nets.items():
@@ -144,10 +148,10 @@ def main():
                     labels[ens] = (sum(wt * probs[n] for n, wt in mem) / w).argmax(0)
                 for r in rows:
                     up = cv2.resize(labels[r].astype(np.uint8), (fw, fh), interpolation=cv2.INTER_NEAREST_EXACT)
-                    cms[r] += te.confusion(gt, up, nc)
+                    cms[r] += confusion(gt, up, nc)
                 n_img += 1
             results[field.name][fac] = {"gsd_cm": gsd, "images": n_img,
-                                        **{r: dict(zip(("miou", "iou"), te.miou(cms[r]))) for r in rows}}
+                                        **{r: dict(zip(("miou", "iou"), miou(cms[r]))) for r in rows}}
         print(f"{field.name}: done", file=sys.stderr, flush=True)
 
     header = [f"{f} {b['gsd_cm']:.0f} cm/px" for f, fr in results.items() for b in fr.values()]

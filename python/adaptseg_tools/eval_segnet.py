@@ -33,24 +33,27 @@ import numpy as np
 import torch
 
 from . import REPO
-from . import train_segnet as te
+from .fieldio import IGNORE
+from .training.fields import FieldData, load_field
+from .training.models import load_exported
+from .training.validation import evaluate, miou
 
 
-def evaluate_field(model, spec, field: te.FieldData, bands, min_share: float):
-    """train_segnet.evaluate's field-level numbers per band, and per class the IoU of each image
-    whose valid ground is at least `min_share` that class."""
+def evaluate_field(model, spec, field: FieldData, bands, min_share: float):
+    """training.validation.evaluate's field-level numbers per band, and per class the IoU of each
+    image whose valid ground is at least `min_share` that class."""
     nc = len(field.classes)
     per_image = {fac: [[] for _ in range(nc)] for fac in bands}
 
     def on_image(fac, gt, image_cm):
-        valid = gt != te.IGNORE
+        valid = gt != IGNORE
         counts = np.bincount(gt[valid].astype(np.int64), minlength=nc)
-        _, iou = te.miou(image_cm)
+        _, iou = miou(image_cm)
         for c in range(nc):
             if counts[c] >= min_share * valid.sum():
                 per_image[fac][c].append(iou[c])
 
-    bands_result = te.evaluate(model, field, bands, spec, on_image=on_image)
+    bands_result = evaluate(model, field, bands, spec, on_image=on_image)
     return {fac: {"gsd_cm": r["gsd_cm"], "images": r["images"], "miou": r["miou_ortho"], "iou": r["iou_ortho"],
                   "per_image_iou_mean": [float(np.mean(v)) if v else None for v in per_image[fac]],
                   "per_image_count": [len(v) for v in per_image[fac]]}
@@ -74,11 +77,11 @@ def main():
     torch.set_num_threads(args.threads)
     cv2.setNumThreads(1)
 
-    model, spec, meta = te.load_exported(Path(args.model_dir))
+    model, spec, meta = load_exported(Path(args.model_dir))
     bands = [float(v) for v in args.bands.split(",")]
     results = {}
     for fdir in args.fields.split(","):
-        field = te.load_field(Path(fdir))
+        field = load_field(Path(fdir))
         if field.classes != meta["classes"]:
             raise SystemExit(f"{fdir}: classes {field.classes} differ from the model's {meta['classes']}")
         role = ("training" if Path(fdir).name in meta["training"]["fields"] else

@@ -33,7 +33,9 @@ import torch
 import yaml
 
 from . import REPO
-from . import train_segnet as te
+from .fieldio import IGNORE
+from .training.fields import FieldData, capture, lawnmower_rects, load_field
+from .training.network_path import logits_to, to_network_size, to_tensor
 FLOOR = 1.0 / 256.0  # SemanticMap::kPooledFloor
 TOP = 3.0            # the top level's GSD factor (15 cm/px on the 5 cm/px Dubai tiles)
 INTEREST = ("building", "road", "vegetation", "water")
@@ -54,19 +56,19 @@ class OnnxNetwork:
 
     def probabilities(self, bgr: np.ndarray) -> np.ndarray:
         """C x H x W class probabilities of a camera image."""
-        x = te.to_tensor(te.to_network_size(bgr, self.input_wh), self.mean, self.std)[None]
+        x = to_tensor(to_network_size(bgr, self.input_wh), self.mean, self.std)[None]
         self.net.setInput(x)
-        logits = te.logits_to(torch.from_numpy(self.net.forward().copy()), bgr.shape[:2])[0]
+        logits = logits_to(torch.from_numpy(self.net.forward().copy()), bgr.shape[:2])[0]
         return torch.softmax(logits / self.temperature, dim=0).numpy()
 
 
-def lawnmower_map(network: OnnxNetwork, field: te.FieldData, factor: float) -> np.ndarray:
+def lawnmower_map(network: OnnxNetwork, field: FieldData, factor: float) -> np.ndarray:
     """C x H x W probabilities on the orthomosaic grid of a whole-field lawnmower (nearest
     neighbour, later images over earlier; 0 where no image looked)."""
     h, w = field.labels.shape
     out = np.zeros((len(network.classes), h, w), np.float32)
-    for (c0, r0, fw, fh) in te.lawnmower_rects(field, field.gsd_cm * factor, network.camera_wh):
-        rgb, _, _ = te.capture(field, c0, r0, fw, fh, network.camera_wh)
+    for (c0, r0, fw, fh) in lawnmower_rects(field, field.gsd_cm * factor, network.camera_wh):
+        rgb, _, _ = capture(field, c0, r0, fw, fh, network.camera_wh)
         p = network.probabilities(rgb)
         x0, y0, x1, y1 = max(c0, 0), max(r0, 0), min(c0 + fw, w), min(r0 + fh, h)
         if x1 <= x0 or y1 <= y0:
@@ -78,7 +80,7 @@ def lawnmower_map(network: OnnxNetwork, field: te.FieldData, factor: float) -> n
 
 
 def iou(pred: np.ndarray, truth: np.ndarray, c: int) -> float:
-    valid = truth != te.IGNORE
+    valid = truth != IGNORE
     p, t = (pred == c) & valid, (truth == c) & valid
     union = (p | t).sum()
     return float((p & t).sum() / union) if union else float("nan")
@@ -96,7 +98,7 @@ def main():
     rows = []
     for k in (int(v) for v in args.tiles.split(",")):
         network = OnnxNetwork(Path(args.networks) / f"tile-{k}")
-        field = te.load_field(REPO / "examples" / "data" / f"dubai-tile-{k}")
+        field = load_field(REPO / "examples" / "data" / f"dubai-tile-{k}")
         top = lawnmower_map(network, field, TOP)
         for factor in fines:
             fine = lawnmower_map(network, field, factor)

@@ -38,7 +38,10 @@ import numpy as np  # noqa: E402
 import torch  # noqa: E402
 
 from adaptseg_tools import device_sampler as ds  # noqa: E402
-from adaptseg_tools import train_segnet as ts  # noqa: E402
+from adaptseg_tools.fieldio import IGNORE  # noqa: E402
+from adaptseg_tools.training.fields import FieldData, load_field  # noqa: E402
+from adaptseg_tools.training.network_path import NetSpec  # noqa: E402
+from adaptseg_tools.training.samples import Sampler, photometric  # noqa: E402
 
 EXAMPLES = Path(__file__).resolve().parent.parent.parent / "examples"
 
@@ -51,9 +54,9 @@ def main(argv=None):
     torch.set_num_threads(2)
     cv2.setNumThreads(1)
     data = EXAMPLES / "data"
-    fields = [ts.load_field(data / f"dubai-tile-{k}") for k in (1, 2, 3, 5)]
-    spec = ts.NetSpec("erfnet", (480, 360), (480, 360), 1, np.array([0.47, 0.47, 0.47]), np.array([0.34, 0.33, 0.35]))
-    cpu = ts.Sampler(fields, spec, 352, 1.0, 3.0, "altitude", seed=7)
+    fields = [load_field(data / f"dubai-tile-{k}") for k in (1, 2, 3, 5)]
+    spec = NetSpec("erfnet", (480, 360), (480, 360), 1, np.array([0.47, 0.47, 0.47]), np.array([0.34, 0.33, 0.35]))
+    cpu = Sampler(fields, spec, 352, 1.0, 3.0, "altitude", seed=7)
     dev = ds.DeviceSampler(cpu, args.device)
     failures = []
 
@@ -102,7 +105,7 @@ def main(argv=None):
 
     # Crops wider than the camera is high (420 x 360) come out of a batch transposed and padded
     # where the yaw turned them: the same crops as the CPU sampler's, in one batch of 12.
-    wide = ds.DeviceSampler(ts.Sampler(fields, spec, 420, 1.0, 3.0, "altitude", seed=7), args.device)
+    wide = ds.DeviceSampler(Sampler(fields, spec, 420, 1.0, 3.0, "altitude", seed=7), args.device)
     cams, targets = wide.cameras([wide.draw_geometry(np.random.default_rng((7, 2, i))) for i in range(12)])
     wmax, wagree = 0.0, []
     for i in range(12):
@@ -128,7 +131,7 @@ def main(argv=None):
             probe.uniform(0.3, 1.2)
         if probe.random() < 0.3:  # noise: the two samplers draw it differently
             continue
-        a = ts.photometric(a_img.copy(), np.random.default_rng((9, i))).astype(np.float32)
+        a = photometric(a_img.copy(), np.random.default_rng((9, i))).astype(np.float32)
         b = dev.photometric(torch.from_numpy(a_img.astype(np.float32)).permute(2, 0, 1).to(dev.device),
                             np.random.default_rng((9, i)))
         b = b.permute(1, 2, 0).cpu().numpy()
@@ -171,20 +174,20 @@ def main(argv=None):
 
     # 6. Redraws: a field labelled only in its top-left 400 x 300 pixels.
     f0 = fields[0]
-    labels = np.full_like(f0.labels, ts.IGNORE)
+    labels = np.full_like(f0.labels, IGNORE)
     labels[:300, :400] = f0.labels[:300, :400]
-    sparse = ts.FieldData("sparse", f0.gsd_cm, labels, f0.image, f0.classes, f0.ignore)
-    cpu6 = ts.Sampler([sparse], spec, 352, 1.0, 3.0, "altitude", seed=11)
+    sparse = FieldData("sparse", f0.gsd_cm, labels, f0.image, f0.classes, f0.ignore)
+    cpu6 = Sampler([sparse], spec, 352, 1.0, 3.0, "altitude", seed=11)
     dev6 = ds.DeviceSampler(cpu6, args.device)
     redrawn = 0
     for j in range(8):
         rng = np.random.default_rng((11, 0, j))
-        while (cpu6.altitude_camera(rng)[1] != ts.IGNORE).mean() < 0.05:
+        while (cpu6.altitude_camera(rng)[1] != IGNORE).mean() < 0.05:
             redrawn += 1
     _, y6 = dev6.batch(0, 8)
     c6 = np.stack([cpu6.sample(0, j)[1] for j in range(8)])
     agree6 = float((y6.cpu().numpy() == c6).mean())
-    labelled6 = float((y6 != ts.IGNORE).float().mean((1, 2)).min())
+    labelled6 = float((y6 != IGNORE).float().mean((1, 2)).min())
     check(redrawn >= 8 and agree6 >= 0.995 and labelled6 >= 0.05,
           f"redraws: {redrawn} over 8 samples; targets agree with the CPU sampler's on {100 * agree6:.2f} %, "
           f"every crop >= 5 % labelled ({100 * labelled6:.1f} % the least)")
