@@ -14,7 +14,7 @@ FLOPs; BN, ReLU, pooling and additions are not counted, they are < 1 % of the to
 achieved GFLOP/s.
 
 Usage:
-  /usr/bin/python3 benchmarks/bench_erfnet.py --bench-bin BUILD/benchmarks/bench_erfnet \\
+  PYTHONPATH=python /usr/bin/python3 benchmarks/bench_erfnet.py --bench-bin BUILD/benchmarks/bench_erfnet \\
       [--model-dir examples/models/erfnet-dubai] [--threads 1,2] [--rounds 3] [--iters 10]
 """
 
@@ -25,17 +25,16 @@ import json
 import os
 import statistics
 import subprocess
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 import torch
 
+from adaptseg_tools.training.models import load_exported
+from bench_common import cpu_model
+
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "examples" / "tools"))
-import train_segnet as te  # noqa: E402
-from bench_common import cpu_model  # noqa: E402
 
 
 def conv_flops(model: torch.nn.Module, x: torch.Tensor) -> tuple[int, list]:
@@ -95,7 +94,7 @@ def main():
     args = ap.parse_args()
 
     model_dir = Path(args.model_dir)
-    model, _, meta = te.load_exported(model_dir)
+    model, _, meta = load_exported(model_dir)
     h, w = meta["input"]["height"], meta["input"]["width"]
     camera = meta["training"]["camera"]
     x = torch.from_numpy(np.random.default_rng(0).standard_normal((1, 3, h, w)).astype(np.float32))

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
-"""Training-batch throughput: the device sampler (examples/tools/device_sampler.py, what
-`train_segnet.py --sampler device` uses) side by side with another implementation of the same
+"""Training-batch throughput: the device sampler (adaptseg_tools.device_sampler, what
+`adaptseg_tools.train_segnet --sampler device` uses) side by side with another implementation of the same
 class (--baseline FILE, e.g. an earlier device_sampler.py taken from git) and with the CPU
 sampler (one process), on the same batches of the bundled training tiles.
 
@@ -10,7 +10,7 @@ reported, with crops per second. Batches of the ERFNet recipe (480x360 camera, 3
 and of the MobileNetV2 recipe (300x300 crops fed at 320x320) by default.
 
 Usage:
-  /usr/bin/python3 benchmarks/bench_sampler.py [--device cuda] [--batch 32] [--batches 5]
+  PYTHONPATH=python /usr/bin/python3 benchmarks/bench_sampler.py [--device cuda] [--batch 32] [--batches 5]
       [--rounds 3] [--baseline OLD_device_sampler.py] [--no-cpu] [--json FILE]
 """
 
@@ -20,17 +20,18 @@ import argparse
 import importlib.util
 import json
 import statistics
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 import torch
 
+from adaptseg_tools import device_sampler
+from adaptseg_tools.training.fields import load_field
+from adaptseg_tools.training.network_path import NetSpec
+from adaptseg_tools.training.samples import Sampler
+
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "examples" / "tools"))
-import device_sampler  # noqa: E402
-import train_segnet as ts  # noqa: E402
 
 
 def load_module(path: Path):
@@ -53,14 +54,14 @@ def main(argv=None):
     args = ap.parse_args(argv)
     torch.set_num_threads(args.threads)
     device = torch.device(args.device)
-    fields = [ts.load_field(REPO / "examples" / "data" / f"dubai-tile-{k}") for k in (1, 2, 3, 5)]
+    fields = [load_field(REPO / "examples" / "data" / f"dubai-tile-{k}") for k in (1, 2, 3, 5)]
     mean, std = np.array([0.47, 0.47, 0.47]), np.array([0.34, 0.33, 0.35])
-    recipes = {"erfnet (352 crops)": (ts.NetSpec("erfnet", (480, 360), (480, 360), 1, mean, std), 352),
-               "mobilenetv2 (300 crops)": (ts.NetSpec("mobilenetv2", (480, 360), (512, 384), 4, mean, std), 300)}
+    recipes = {"erfnet (352 crops)": (NetSpec("erfnet", (480, 360), (480, 360), 1, mean, std), 352),
+               "mobilenetv2 (300 crops)": (NetSpec("mobilenetv2", (480, 360), (512, 384), 4, mean, std), 300)}
     sync = torch.cuda.synchronize if device.type == "cuda" else (lambda: None)
     rows = []
     for recipe, (spec, crop) in recipes.items():
-        cpu = ts.Sampler(fields, spec, crop, 1.0, 3.0, "altitude", seed=0)
+        cpu = Sampler(fields, spec, crop, 1.0, 3.0, "altitude", seed=0)
         impls = {"device sampler": device_sampler.DeviceSampler(cpu, device).batch}
         if args.baseline:
             impls["baseline " + args.baseline.name] = load_module(args.baseline).DeviceSampler(cpu, device).batch

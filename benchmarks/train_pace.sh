@@ -4,8 +4,9 @@
 #
 #   bash benchmarks/train_pace.sh SERIAL_SAMPLER.py ENCODER_WEIGHTS.pt
 #
-# SERIAL_SAMPLER.py: an earlier examples/tools/device_sampler.py to compare with (e.g.
-# `git show 9b046a1:examples/tools/device_sampler.py`), swapped in for the module's DeviceSampler;
+# SERIAL_SAMPLER.py: an earlier python/adaptseg_tools/device_sampler.py to compare with (e.g.
+# `git show 9b046a1:examples/tools/device_sampler.py`, from before the tools were a package),
+# swapped in for the module's DeviceSampler;
 # ENCODER_WEIGHTS.pt: MobileNetV2's ImageNet encoder (`bash scripts/loto.sh weights` writes
 # .device/mnv2_enc.pt). Five runs, each alone: MobileNetV2 (300 steps) with the serial sampler,
 # the batched one made when the step asks (--prefetch 0) and made ahead (--prefetch 2); ERFNet
@@ -13,6 +14,8 @@
 # table is over the train_log.csv rows after the warm-up. About 4 minutes on an H200.
 set -uo pipefail
 cd "$(dirname "$0")/.."
+# The Python tools run from the source tree (python/README.md).
+export PYTHONPATH="$PWD/python${PYTHONPATH:+:$PYTHONPATH}"
 serial=${1:?earlier device_sampler.py}
 enc=${2:?MobileNetV2 encoder weights}
 export PYTHONUNBUFFERED=1
@@ -21,8 +24,7 @@ py=${PYTHON:-$(python3 -c 'import torch, cv2' 2>/dev/null && echo python3 || ech
 work=$(mktemp -d)
 cat >"$work/run.py" <<'PY'
 import importlib.util, sys
-sys.path.insert(0, "examples/tools")
-import device_sampler, train_segnet
+from adaptseg_tools import device_sampler, train_segnet
 if sys.argv[1] != "batched":
     spec = importlib.util.spec_from_file_location("serial_sampler", sys.argv[1])
     mod = importlib.util.module_from_spec(spec)

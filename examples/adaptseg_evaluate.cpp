@@ -39,7 +39,7 @@ int altitude_changes(const adaptseg::MissionResult& m) {
 
 /// A field's name as a folder name: "weedmap-rededge-000[0.5,0,1,1]" (a region of a field)
 /// -> "weedmap-rededge-000_region_0.5-0-1-1"; other characters than letters, digits, '-' and
-/// '.' -> '_'. examples/tools/plot_evaluation.py's slug() is the same function.
+/// '.' -> '_'. python/adaptseg_tools/plot_evaluation.py's slug() is the same function.
 std::string slug(const std::string& s) {
   std::string out;
   for (char c : s) {
@@ -268,7 +268,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "[%6.1f s] wrote %s/results.csv, per_image.csv, decisions.csv and per-mission results\n",
                  elapsed(), out_dir.string().c_str());
     if (!no_plots) {
-      const std::string cmd = "/usr/bin/python3 '" + std::string(ADAPTSEG_PLOT_SCRIPT) + "' '" + out_dir.string() + "'";
+      // The package from the source tree, ahead of any PYTHONPATH of the caller's.
+      const std::string cmd = "PYTHONPATH='" + std::string(ADAPTSEG_PYTHON_TOOLS_DIR) +
+                              "'${PYTHONPATH:+:$PYTHONPATH} /usr/bin/python3 -m adaptseg_tools.plot_evaluation '" +
+                              out_dir.string() + "'";
       if (std::system(cmd.c_str()) != 0)
         std::fprintf(stderr, "adaptseg_evaluate: warning: plotting failed; run: %s\n", cmd.c_str());
     }

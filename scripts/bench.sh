@@ -6,6 +6,8 @@
 #   Results: docs/benchmarks.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# The Python tools run from the source tree (python/README.md).
+export PYTHONPATH="$PWD/python${PYTHONPATH:+:$PYTHONPATH}"
 bash scripts/deps.sh bench
 source scripts/configure.sh
 configure_for bench build/release

@@ -2,7 +2,7 @@
 # Leave-one-tile-out estimate of the deployment MobileNetV2's accuracy on new ground: six
 # trainings of examples/models/mobilenetv2-dubai-all's recipe, each on five of the
 # six bundled Dubai tiles, each scored on the tile it never saw (field mIoU of whole-field
-# lawnmowers at 5, 10 and 15 cm/px, examples/tools/eval_ensemble.py).
+# lawnmowers at 5, 10 and 15 cm/px, adaptseg_tools.eval_ensemble).
 #
 #   bash scripts/loto.sh weights
 #       here (npm and node needed): the ImageNet encoder weights into .device/mnv2_enc.pt, the
@@ -67,6 +67,8 @@
 #       it shares the cores). The calibration networks of `scripts/results.sh cross-fit`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# The Python tools run from the source tree (python/README.md).
+export PYTHONPATH="$PWD/python${PYTHONPATH:+:$PYTHONPATH}"
 # The interpreter with PyTorch: a device machine's plain python3, else Debian's (this machine's).
 py=${PYTHON:-$(python3 -c 'import torch, cv2' 2>/dev/null && echo python3 || echo /usr/bin/python3)}
 tiles_all=(1 2 3 4 5 6)
@@ -84,7 +86,7 @@ case "${1:-}" in
 weights)
   mkdir -p .device
   grep -qx '/.device/' .git/info/exclude 2>/dev/null || echo '/.device/' >>.git/info/exclude
-  "$py" examples/tools/mobilenet_v2.py --out .device/mnv2_enc.pt
+  "$py" -m adaptseg_tools.mobilenet_v2 --out .device/mnv2_enc.pt
   ;;
 train)
   minutes=${2:?minutes}
@@ -105,7 +107,7 @@ train)
   work=$(mktemp -d)
   pids=()
   for k in "${tiles[@]}"; do
-    "$py" examples/tools/train_segnet.py --arch mobilenetv2 --encoder-weights .device/mnv2_enc.pt \
+    "$py" -m adaptseg_tools.train_segnet --arch mobilenetv2 --encoder-weights .device/mnv2_enc.pt \
       --frozen-blocks 4 --no-image-pooling --lr 1e-3 --weight-decay 0.01 --ema 0.998 --augment altitude --seed "${LOTO_SEED:-0}" \
       --sampler "$sampler" --prefetch "${PREFETCH:-2}" --device "$device" --train-fields "$(train_fields "$k")" --val-field "dubai-tile-$k" \
       --test-field none --threads 1 --val-every 0 --ckpt-every 100 --log-every 50 --no-export \
@@ -130,7 +132,7 @@ eval)
     work=$wroot/work-$k
     mkdir -p "$work"
     cp "$ckpt" "$work/checkpoint.pt"
-    "$py" examples/tools/train_segnet.py --arch mobilenetv2 --work-dir "$work" --model-dir "$wroot/model-$k" \
+    "$py" -m adaptseg_tools.train_segnet --arch mobilenetv2 --work-dir "$work" --model-dir "$wroot/model-$k" \
       --export-only --train-fields "$(train_fields "$k")" --val-field "dubai-tile-$k" --test-field none \
       >"$wroot/export-$k.log" 2>&1 || { echo "export of $ckpt failed: $wroot/export-$k.log" >&2; exit 1; }
     # The device call's training logs beside the network, as recipe-cpu leaves them.
@@ -139,7 +141,7 @@ eval)
       tar xzf "$dir/loto-logs.tar.gz" -O "./loto-$k.log" >"$wroot/train-$k.log"
     fi
     echo "== held out dubai-tile-$k (trained on $(train_fields "$k"))"
-    "$py" examples/tools/eval_ensemble.py --members "loto$k=$wroot/model-$k" \
+    "$py" -m adaptseg_tools.eval_ensemble --members "loto$k=$wroot/model-$k" \
       --fields "examples/data/dubai-tile-$k" --bands 1,2,3 --json "$wroot/eval-$k.json"
   done
   # The estimate: each held-out tile's field mIoU per GSD, their mean, and per class.
@@ -173,7 +175,7 @@ recipe-cpu)
     if [ ! -s "$work/done" ]; then
       resume=()
       [ -s "$work/checkpoint.pt" ] && resume=(--resume)
-      "$py" examples/tools/train_segnet.py --arch mobilenetv2 --encoder-weights .device/mnv2_enc.pt \
+      "$py" -m adaptseg_tools.train_segnet --arch mobilenetv2 --encoder-weights .device/mnv2_enc.pt \
         --frozen-blocks 4 --no-image-pooling --lr 1e-3 --weight-decay 0.01 --ema 0.998 --augment altitude --seed "${LOTO_SEED:-0}" \
         --sampler cpu --device cpu --workers 1 --threads "${LOTO_THREADS:-2}" --train-fields "$(train_fields "$k")" \
         --val-field "dubai-tile-$k" --test-field none --val-every 0 --ckpt-every 100 --log-every 50 --no-export \
@@ -181,10 +183,10 @@ recipe-cpu)
         "${resume[@]}" >>"$wroot/train-$k.log" 2>&1 || { echo "training $k failed: $wroot/train-$k.log" >&2; exit 1; }
       date -u +%FT%TZ >"$work/done"
     fi
-    "$py" examples/tools/train_segnet.py --arch mobilenetv2 --work-dir "$work" --model-dir "$wroot/model-$k" \
+    "$py" -m adaptseg_tools.train_segnet --arch mobilenetv2 --work-dir "$work" --model-dir "$wroot/model-$k" \
       --export-only --train-fields "$(train_fields "$k")" --val-field "dubai-tile-$k" --test-field none \
       >"$wroot/export-$k.log" 2>&1 || { echo "export of tile $k failed: $wroot/export-$k.log" >&2; exit 1; }
-    "$py" examples/tools/eval_ensemble.py --members "loto$k=$wroot/model-$k" \
+    "$py" -m adaptseg_tools.eval_ensemble --members "loto$k=$wroot/model-$k" \
       --fields "examples/data/dubai-tile-$k" --bands 1,2,3 --json "$wroot/eval-$k.json"
   done
   ;;
@@ -257,7 +259,7 @@ cpu)
   shift 2
   [ -s .device/mnv2_enc.pt ] || { echo "no .device/mnv2_enc.pt: run 'bash $0 weights' here first" >&2; exit 2; }
   mkdir -p out/loto-cpu
-  "$py" examples/tools/train_segnet.py --arch mobilenetv2 --encoder-weights .device/mnv2_enc.pt \
+  "$py" -m adaptseg_tools.train_segnet --arch mobilenetv2 --encoder-weights .device/mnv2_enc.pt \
     --work-dir "out/loto-cpu/work-$k" --model-dir "out/loto-cpu/model-$k" \
     --steps 2000 --crop 300 --frozen-blocks 4 --no-image-pooling --lr 1e-3 --warmup 100 \
     --weight-decay 0.01 --val-every 0 --ckpt-every 100 --threads 2 --ema 0.998 --seed 0 \

@@ -21,7 +21,7 @@
 #   never trained on (4 and 6), each initialised on the five other tiles (the networks' training
 #   tiles 1, 2, 3, 5 and the other unseen tile), as a user calibrates on every labelled field
 #   they have; then every backend's missions against every backend's lawnmower curve
-#   (examples/tools/backend_compare.py: which gives the better map per second). About 26 minutes
+#   (adaptseg_tools.backend_compare: which gives the better map per second). About 26 minutes
 #   on 2 cores for the two networks and 26 more for the ensemble (its calibration segments every
 #   image with both networks once, into the cache); NETS="..." (environment) flies a subset and
 #   keeps the other networks' runs.
@@ -42,8 +42,8 @@
 #   flags to every run: CONFIG=loto-hull EXTRA="--top-level hull" ORACLE_CONFIG=oracle-hull.
 #   LOTO_NETWORKS names another folder of tile-1 ... tile-6 networks (another seed, say).
 #   Then every descent against the real curve and each run's best descents in hindsight
-#   (examples/tools/descent_table.py --curve, --hindsight --gsd 10). Last, the issue's targets
-#   (examples/tools/loto_targets.py; several configurations side by
+#   (adaptseg_tools.descent_table --curve, --hindsight --gsd 10). Last, the issue's targets
+#   (adaptseg_tools.loto_targets; several configurations side by
 #   side: loto_targets.py --oracle out/results/oracle-default a=out/results/loto b=...).
 # loto-insample: a ceiling on what calibration can give the loto runs, not a deployment: each
 #   tile flown by the network that never saw it, as in loto, but calibrated on that tile alone,
@@ -55,7 +55,7 @@
 #   field). About 15 minutes on 2 cores with the segmentation cache warm.
 # loto-swap: which half of a calibration transfers badly to new ground (a diagnosis, not a
 #   deployment): each loto run flown again at z = 0 with a model put together
-#   (examples/tools/compose_model.py) from its leave-one-tile-out model (LOTO_CONFIG, default
+#   (adaptseg_tools.compose_model) from its leave-one-tile-out model (LOTO_CONFIG, default
 #   loto-pooled-z0) and its model calibrated on the field itself (INSAMPLE_CONFIG, default
 #   loto-insample-pooled): the leave-one-tile-out gain model with the field's own reference
 #   (lawnmower curve, σ and input priors; config loto-swap-own-reference), the field's own gain
@@ -78,7 +78,7 @@
 #   with 2 jobs beside a training (segmentations cached in out/results/segmentation-cache).
 #   TILES="1 2 3 4 6" LOTO_TILES="1 2 3 4" keeps flying these five once tile 5's network is bundled.
 # new-ground-check: what a network's behaviour on new ground lets the decision forecast, on the
-#   stand-in's tiles (examples/tools/new_ground_check.py): each tile's cell samples, segmented by
+#   stand-in's tiles (adaptseg_tools.new_ground_check): each tile's cell samples, segmented by
 #   the network that flies it in loto-proxy (adaptseg_calibrate --cell-samples-csv, into
 #   new-ground-check/), each field's descents forecast from the other fields' cells (the cell gain
 #   model's normalised gain against the field's own exchange rate of false positives), and the
@@ -86,7 +86,7 @@
 #   predicted. Needs loto-proxy (CONFIG names another run of it); about 4 minutes on 2 cores.
 # ensemble: field mIoU of the bundled networks and of their ensemble (examples/models/ensemble-dubai)
 #   on the same whole-field lawnmowers of tiles 4 and 6 at 5, 10 and 15 cm/px
-#   (examples/tools/eval_ensemble.py, PyTorch on the exported weights), each network also with
+#   (adaptseg_tools.eval_ensemble, PyTorch on the exported weights), each network also with
 #   test-time mirror, and the ensembles with MobileNetV2 mirrored (examples/models/
 #   ensemble-dubai-mirror) and with both members mirrored; about 5 minutes on 2 cores.
 # ensemble-split: the ensemble's runs of part network again, calibration also offered the decision
@@ -95,11 +95,11 @@
 # cells: per network, tile it never trained on (4, 6) and class, how each decision input ranks the
 #   5 cm/px cells of every 15 cm/px region by the realised gain of re-mapping each alone, and how
 #   much of the achievable gain the input of the network run's model captures with 20 % of the
-#   cells (adaptseg_cell_study, examples/tools/cell_study_table.py). Needs network; about 12
+#   cells (adaptseg_cell_study, adaptseg_tools.cell_study_table). Needs network; about 12
 #   minutes on 2 cores for the three backends (NETS as for network).
 # curve-check: the field curve's predicted rise from the top level to each lawnmower GSD against
 #   the training fields' real curves, from the models oracle-default and network saved
-#   (examples/tools/curve_check_table.py; seconds, nothing flown).
+#   (adaptseg_tools.curve_check_table; seconds, nothing flown).
 # previous: the oracle and network sweeps flown with the defaults before 2026-11-26's ranked
 #   cells (--coverage interest --curve training), side by side with the defaults' runs. Needs
 #   oracle-default and network; about 30 minutes on 2 cores.
@@ -122,9 +122,9 @@
 #   from the top-level image to the finer one over the re-mapped cells) tracks what re-mapping
 #   them gained, on the tiles each network (NETS, default erfnet-dubai mobilenetv2-dubai) was
 #   trained on (1, 2, 3, 5) and on those it never saw (4, 6): adaptseg_cell_study --csv at 12.5,
-#   10 and 5 cm/px, then examples/tools/proxy_table.py; and, from the same cells, how well the
+#   10 and 5 cm/px, then adaptseg_tools.proxy_table; and, from the same cells, how well the
 #   cell gain model's slope fitted on five tiles forecasts the sixth's best cells, and each
-#   tile's own slope (examples/tools/slope_transfer.py). Independent of the other parts; about
+#   tile's own slope (adaptseg_tools.slope_transfer). Independent of the other parts; about
 #   20 minutes on 2 cores for the two networks. NETS=ensemble-dubai adds the ensemble's tables
 #   (with its members' split among the inputs) and keeps the other networks'.
 # sigma-prior: the previous defaults' runs (part previous) flown again with the models
@@ -161,7 +161,7 @@
 #   (default mobilenetv2-dubai): the training folds of the z choice (each tile flown with the
 #   model fitted on the other five) with the cell gain model's slopes pooled over the cells and
 #   over the fields, each alone (--slope-pooling), and which the default, trying both, keeps
-#   (examples/tools/fold_table.py). Nothing flown beyond the folds; about 15 minutes on 2 cores
+#   (adaptseg_tools.fold_table). Nothing flown beyond the folds; about 15 minutes on 2 cores
 #   for the oracle and MobileNetV2.
 # Outputs: out/results/<configuration>/<run>/ (adaptseg_evaluate's files); prints the tables.
 set -euo pipefail
@@ -173,6 +173,8 @@ case "$part" in all | oracle | oracle-default | paper | network | loto | loto-in
     exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
+# The Python tools run from the source tree (python/README.md).
+export PYTHONPATH="$PWD/python${PYTHONPATH:+:$PYTHONPATH}"
 bash scripts/deps.sh plots
 source scripts/configure.sh
 configure_for results build/release >/dev/null
@@ -271,7 +273,7 @@ if [ "$part" = sigma-prior ]; then
   wait
   check
   for k in 0.01 1; do labels+=("sigma-prior-$k=$(ls -d "$root/oracle-sigma-prior-$k"/*/ | sed 's:/$::' | paste -sd, -)"); done
-  /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
+  /usr/bin/python3 -m adaptseg_tools.sweep_table "${labels[@]}"
   exit 0
 fi
 
@@ -333,7 +335,7 @@ if [ "$part" = z-choice ] || [ "$part" = z-choice-network ]; then
     done
   fi
   wait
-  /usr/bin/python3 examples/tools/z_choice_table.py "$out"
+  /usr/bin/python3 -m adaptseg_tools.z_choice_table "$out"
   exit 0
 fi
 
@@ -348,7 +350,7 @@ if [ "$part" = sigma-prior-fit ]; then
   wait
   check
   for mode in spread estimated; do labels+=("$mode=$(ls -d "$root/oracle-sigma-prior-$mode"/*/ | sed 's:/$::' | paste -sd, -)"); done
-  /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
+  /usr/bin/python3 -m adaptseg_tools.sweep_table "${labels[@]}"
   exit 0
 fi
 
@@ -358,7 +360,7 @@ if [ "$part" = vertical-speed ]; then
   sweep "$config" "${fixed[@]}" --vertical-speed 1 --no-plots
   wait
   check
-  /usr/bin/python3 examples/tools/sweep_table.py "vertical 1 m/s=$(ls -d "$root/$config"/*/ | sed 's:/$::' | paste -sd, -)"
+  /usr/bin/python3 -m adaptseg_tools.sweep_table "vertical 1 m/s=$(ls -d "$root/$config"/*/ | sed 's:/$::' | paste -sd, -)"
   exit 0
 fi
 
@@ -383,11 +385,11 @@ if [ "$part" = previous ]; then
   wait
   check
   runs() { ls -d "$root/$1"/*/ | sed 's:/$::' | paste -sd, -; }
-  /usr/bin/python3 examples/tools/sweep_table.py "defaults=$(runs oracle-default)" "previous=$(runs oracle-previous)"
+  /usr/bin/python3 -m adaptseg_tools.sweep_table "defaults=$(runs oracle-default)" "previous=$(runs oracle-previous)"
   for net in erfnet-dubai mobilenetv2-dubai; do
     echo
     echo "## $net"
-    /usr/bin/python3 examples/tools/sweep_table.py "$net=$(ls -d "$root/network/$net"-*/ | sed 's:/$::' | paste -sd, -)" \
+    /usr/bin/python3 -m adaptseg_tools.sweep_table "$net=$(ls -d "$root/network/$net"-*/ | sed 's:/$::' | paste -sd, -)" \
       "previous=$(ls -d "$root/network-previous/$net"-*/ | sed 's:/$::' | paste -sd, -)"
   done
   exit 0
@@ -396,7 +398,7 @@ fi
 if [ "$part" = curve-check ]; then
   [ -d "$root/oracle-default" ] && [ -d "$root/network" ] || { echo "run 'bash $0 oracle-default' and 'network' first" >&2; exit 1; }
   runs() { ls -d "$@" | sed 's:/$::' | paste -sd, -; }
-  /usr/bin/python3 examples/tools/curve_check_table.py "oracle=$(runs "$root"/oracle-default/dubai-*/)" \
+  /usr/bin/python3 -m adaptseg_tools.curve_check_table "oracle=$(runs "$root"/oracle-default/dubai-*/)" \
     "mobilenetv2-dubai=$(runs "$root"/network/mobilenetv2-dubai-*/)" "erfnet-dubai=$(runs "$root"/network/erfnet-dubai-*/)"
   exit 0
 fi
@@ -418,14 +420,14 @@ if [ "$part" = cells ]; then
     done
     echo
     echo "## $net: capture of the achievable gain by the best 20 % of cells (mean over tiles 4, 6 and the four classes)"
-    cat "$out/$net"-*.md | /usr/bin/python3 examples/tools/cell_study_table.py
+    cat "$out/$net"-*.md | /usr/bin/python3 -m adaptseg_tools.cell_study_table
   done
   exit 0
 fi
 
 if [ "$part" = ensemble ]; then
   mkdir -p "$root/ensemble"
-  /usr/bin/python3 examples/tools/eval_ensemble.py --threads "$jobs" --bands 1,2,3 \
+  /usr/bin/python3 -m adaptseg_tools.eval_ensemble --threads "$jobs" --bands 1,2,3 \
     --members mobilenetv2-dubai=examples/models/mobilenetv2-dubai,erfnet-dubai=examples/models/erfnet-dubai,mobilenetv2-dubai-mirror=examples/models/mobilenetv2-dubai@mirror,erfnet-dubai-mirror=examples/models/erfnet-dubai@mirror \
     --ensembles ensemble-dubai=examples/models/ensemble-dubai,ensemble-dubai-mirror=examples/models/ensemble-dubai-mirror,both-mirrored=mobilenetv2-dubai-mirror+erfnet-dubai-mirror \
     --json "$root/ensemble/ensemble.json"
@@ -446,7 +448,7 @@ if [ "$part" = ensemble-split ]; then
   done
   wait
   check
-  /usr/bin/python3 examples/tools/sweep_table.py \
+  /usr/bin/python3 -m adaptseg_tools.sweep_table \
     "ensemble-dubai=$(dir_list "$root/network/ensemble-dubai"-*/)" "with-split=$(dir_list "$root/$config"/*/)"
   exit 0
 fi
@@ -475,14 +477,14 @@ if [ "$part" = loto ] || [ "$part" = loto-insample ]; then
   check
   labels=("$config=$(dir_list "$root/$config"/*/)")
   [ -d "$root/$oracle" ] && labels+=("oracle=$(dir_list "$root/$oracle"/dubai-*/)")
-  /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
-  /usr/bin/python3 examples/tools/descent_table.py "$root/$config"/*/
+  /usr/bin/python3 -m adaptseg_tools.sweep_table "${labels[@]}"
+  /usr/bin/python3 -m adaptseg_tools.descent_table "$root/$config"/*/
   # Each descent against the real curve, and each run's best descents in hindsight.
-  /usr/bin/python3 examples/tools/descent_table.py --curve "$root/$config"/*/
-  /usr/bin/python3 examples/tools/descent_table.py --hindsight --gsd 10 "$root/$config"/*/
+  /usr/bin/python3 -m adaptseg_tools.descent_table --curve "$root/$config"/*/
+  /usr/bin/python3 -m adaptseg_tools.descent_table --hindsight --gsd 10 "$root/$config"/*/
   targets=("$config=$root/$config")
   [ -d "$root/$oracle" ] && targets=(--oracle "$root/$oracle" "${targets[@]}")
-  /usr/bin/python3 examples/tools/loto_targets.py "${targets[@]}"
+  /usr/bin/python3 -m adaptseg_tools.loto_targets "${targets[@]}"
   exit 0
 fi
 
@@ -505,7 +507,7 @@ if [ "$part" = loto-swap ]; then
           own-gain) gain=$own/$name/model.yaml reference=$lofo/$name/model.yaml ;;
           own-both) gain=$own/$name/model.yaml reference=$own/$name/model.yaml ;;
         esac
-        /usr/bin/python3 examples/tools/compose_model.py --gain "$gain" --reference "$reference" --confidence 0 \
+        /usr/bin/python3 -m adaptseg_tools.compose_model --gain "$gain" --reference "$reference" --confidence 0 \
           --out "$root/$config/$name.model.yaml"
         run "$config" "$name" --decision-model "$root/$config/$name.model.yaml" --test "$(dubai "$t")" \
           --interest "$cls" --network "$loto/tile-$t" "${network[@]}" "${fixed[@]}" --no-plots
@@ -515,7 +517,7 @@ if [ "$part" = loto-swap ]; then
   done
   wait
   check
-  /usr/bin/python3 examples/tools/loto_targets.py "${labels[@]}"
+  /usr/bin/python3 -m adaptseg_tools.loto_targets "${labels[@]}"
   exit 0
 fi
 
@@ -559,8 +561,8 @@ if [ "$part" = loto-proxy ]; then
   done
   wait
   check
-  /usr/bin/python3 examples/tools/sweep_table.py "$config=$(dir_list "$root/$config"/*/)"
-  /usr/bin/python3 examples/tools/descent_table.py "$root/$config"/*/
+  /usr/bin/python3 -m adaptseg_tools.sweep_table "$config=$(dir_list "$root/$config"/*/)"
+  /usr/bin/python3 -m adaptseg_tools.descent_table "$root/$config"/*/
   exit 0
 fi
 
@@ -581,7 +583,7 @@ if [ "$part" = new-ground-check ]; then
     throttle
   done
   wait
-  /usr/bin/python3 examples/tools/new_ground_check.py "$root/new-ground-check" "$root/$config"
+  /usr/bin/python3 -m adaptseg_tools.new_ground_check "$root/new-ground-check" "$root/$config"
   exit 0
 fi
 
@@ -616,7 +618,7 @@ if [ "$part" = cross-fit ]; then
   check
   same=()
   [ -d "$root/$fields" ] && same=("same-network=$(dir_list "$root/$fields"/*/)")
-  /usr/bin/python3 examples/tools/sweep_table.py "five-tiles=$(dir_list "$root/network/mobilenetv2-dubai"-*/)" \
+  /usr/bin/python3 -m adaptseg_tools.sweep_table "five-tiles=$(dir_list "$root/network/mobilenetv2-dubai"-*/)" \
     "${same[@]}" "cross-fit=$(dir_list "$root/$crossfit"/*/)"
   exit 0
 fi
@@ -637,7 +639,7 @@ if [ "$part" = network-held-out ]; then
   check
   labels=()
   for net in ${NETS:-erfnet-dubai}; do labels+=("$net-held-out=$(dir_list "$root/$(held_out_config "$net")"/*/)"); done
-  /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
+  /usr/bin/python3 -m adaptseg_tools.sweep_table "${labels[@]}"
   exit 0
 fi
 
@@ -662,7 +664,7 @@ if [ "$part" = all-tiles ]; then
   for f in "$out"/*.txt; do
     [ -s "${f%.txt}.yaml" ] || { echo "FAILED: $f" >&2; exit 1; }
   done
-  /usr/bin/python3 examples/tools/fold_table.py --order cells,fields "$out"
+  /usr/bin/python3 -m adaptseg_tools.fold_table --order cells,fields "$out"
   exit 0
 fi
 
@@ -687,7 +689,7 @@ if [ "$part" = proxy-check ]; then
     for set in trained-on never-seen; do
       [ -s "$out/$net-$set.csv" ] || { echo "FAILED: $net $set (see $out/$net-$set.log)" >&2; exit 1; }
     done
-    /usr/bin/python3 examples/tools/proxy_table.py "$net, tiles it was trained on=$out/$net-trained-on.csv" \
+    /usr/bin/python3 -m adaptseg_tools.proxy_table "$net, tiles it was trained on=$out/$net-trained-on.csv" \
       "$net, tiles it never saw=$out/$net-never-seen.csv"
   done
   # The cell gain model's slope fitted on five tiles against the sixth's best cells: pooled over
@@ -695,7 +697,7 @@ if [ "$part" = proxy-check ]; then
   # effects; and each tile's own slope and mean input at the top (--field-slopes).
   transfer=()
   for net in ${NETS:-erfnet-dubai mobilenetv2-dubai}; do transfer+=("$out/$net-trained-on.csv" "$out/$net-never-seen.csv"); done
-  /usr/bin/python3 examples/tools/slope_transfer.py --field-slopes "${transfer[@]}"
+  /usr/bin/python3 -m adaptseg_tools.slope_transfer --field-slopes "${transfer[@]}"
   exit 0
 fi
 
@@ -726,7 +728,7 @@ if [ "$part" = network-variants ]; then
     labels+=("$net-five-tiles=$(dir_list "$root/network/$net"-*/)")
     for variant in top10 expected-error; do labels+=("$net-$variant=$(dir_list "$root/network-$variant/$net"-*/)"); done
   done
-  /usr/bin/python3 examples/tools/sweep_table.py "${labels[@]}"
+  /usr/bin/python3 -m adaptseg_tools.sweep_table "${labels[@]}"
   exit 0
 fi
 
@@ -748,14 +750,14 @@ if [ "$part" != network ]; then
   check
   runs() { ls -d "$root/$1"/*/ | sed 's:/$::' | paste -sd, -; }
   if [ "$part" = oracle-default ]; then
-    /usr/bin/python3 examples/tools/sweep_table.py "defaults=$(runs "${configs[0]}")"
-    /usr/bin/python3 examples/tools/per_image_table.py "$root/${configs[0]}/weedmap-train-left" \
+    /usr/bin/python3 -m adaptseg_tools.sweep_table "defaults=$(runs "${configs[0]}")"
+    /usr/bin/python3 -m adaptseg_tools.per_image_table "$root/${configs[0]}/weedmap-train-left" \
       "$root/${configs[0]}/weedmap-train-right"
   elif [ "$part" = paper ]; then
-    /usr/bin/python3 examples/tools/sweep_table.py "defaults=$(runs oracle-default)" "paper=$(runs oracle-paper)"
+    /usr/bin/python3 -m adaptseg_tools.sweep_table "defaults=$(runs oracle-default)" "paper=$(runs oracle-paper)"
   else
-    /usr/bin/python3 examples/tools/sweep_table.py "defaults=$(runs oracle-default)" "paper=$(runs oracle-paper)"
-    /usr/bin/python3 examples/tools/per_image_table.py "$root/oracle-default/weedmap-train-left" \
+    /usr/bin/python3 -m adaptseg_tools.sweep_table "defaults=$(runs oracle-default)" "paper=$(runs oracle-paper)"
+    /usr/bin/python3 -m adaptseg_tools.per_image_table "$root/oracle-default/weedmap-train-left" \
       "$root/oracle-default/weedmap-train-right"
   fi
 fi
@@ -776,12 +778,12 @@ if [ "$part" = all ] || [ "$part" = network ]; then
   for net in $nets; do
     echo
     echo "## $net"
-    /usr/bin/python3 examples/tools/sweep_table.py "$net=$(ls -d "$root/network/$net"-*/ | sed 's:/$::' | paste -sd, -)"
-    /usr/bin/python3 examples/tools/per_image_table.py "$root/network/$net-vegetation-fly6" \
+    /usr/bin/python3 -m adaptseg_tools.sweep_table "$net=$(ls -d "$root/network/$net"-*/ | sed 's:/$::' | paste -sd, -)"
+    /usr/bin/python3 -m adaptseg_tools.per_image_table "$root/network/$net-vegetation-fly6" \
       "$root/network/$net-vegetation-fly4"
   done
   # Map per second across backends: every backend's missions against every backend's curve.
   echo
   echo "## The backends against each other"
-  /usr/bin/python3 examples/tools/backend_compare.py "$root/network" mobilenetv2-dubai erfnet-dubai ensemble-dubai
+  /usr/bin/python3 -m adaptseg_tools.backend_compare "$root/network" mobilenetv2-dubai erfnet-dubai ensemble-dubai
 fi

@@ -472,7 +472,7 @@ TEST_CASE(
   // 15 then 5 cm/px, over the tile. With the paper's fusion the map is the 5 cm/px one; pooled,
   // the 15 cm/px images keep the pixels where they were sure and the closer look was not.
   // Measured (2026-11-29), finest -> pooled: building 0.576 -> 0.583, road 0.309 -> 0.356,
-  // vegetation 0.715 -> 0.725, water 0.748 -> 0.762, as examples/tools/fusion_study.py --tiles 6
+  // vegetation 0.715 -> 0.725, water 0.748 -> 0.762, as adaptseg_tools.fusion_study --tiles 6
   // measures them in Python.
   const Field f = Field::load(t::example_field(kTestField));
   const CameraModel camera;

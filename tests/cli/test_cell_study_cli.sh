@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Black-box test of adaptseg_cell_study, examples/tools/cell_study_table.py and proxy_table.py on the bundled
+# Black-box test of adaptseg_cell_study, adaptseg_tools.cell_study_table and proxy_table on the bundled
 # WeedMap field with the oracle: every decision input ranks the cells, the oracle's purity ranks
 # them as well as the truth allows (rank correlation near 1 for σ), and an input the backend
 # cannot give (the ensemble members' split, from a single backend) is unknown (nan), not ranked
@@ -7,6 +7,8 @@
 #   test_cell_study_cli.sh CELL_STUDY_BINARY EXAMPLES_DIR [PYTHON]
 set -uo pipefail
 study=$1 examples=$2 python=${3:-}
+# The Python tools run from the source tree (python/README.md).
+export PYTHONPATH="$examples/../python${PYTHONPATH:+:$PYTHONPATH}"
 source "$(dirname "$0")/cli_common.sh"
 "$study" --field "$examples/data/weedmap-000:0,0,0.5,1" --top-gsd 3 --gsd 1 --segmenter oracle \
   --csv "$work/cells.csv" >"$work/table.md" 2>"$work/log" || fail "cell study failed: $(tail -3 "$work/log")"
@@ -22,7 +24,7 @@ echo "ok: σ ranks the oracle's cells, split is unknown from one backend"
 head -1 "$work/cells.csv" | grep -q '^field,class,region,gsd_cm,field_px,field_share,field_sigma,relabelled,gain,top_sigma,' ||
   fail "cells.csv header: $(head -1 "$work/cells.csv")"
 if [ -n "$python" ]; then
-  "$python" "$examples/tools/cell_study_table.py" <"$work/table.md" >"$work/summary.md" || fail "cell_study_table.py failed"
+  "$python" -m adaptseg_tools.cell_study_table <"$work/table.md" >"$work/summary.md" || fail "cell_study_table.py failed"
   grep -q '^| sigma | +' "$work/summary.md" || fail "no sigma row: $(cat "$work/summary.md")"
   ! grep -q '^| split |' "$work/summary.md" || fail "the unknown input split has a row: $(cat "$work/summary.md")"
   echo "ok: the table lists the inputs the backend gives, and only those"
@@ -31,7 +33,7 @@ if [ -n "$python" ]; then
     "$work/cells.csv" || fail "cells.csv rows differ from its header in columns: $(sed -n 2p "$work/cells.csv")"
   # proxy_table.py: the oracle's finer look at the field's GSD is exact, so the drop of its
   # expected error over a cell is the top level's error there, which the cell's gain follows.
-  "$python" "$examples/tools/proxy_table.py" "oracle=$work/cells.csv" >"$work/proxy.md" || fail "proxy_table.py failed"
+  "$python" -m adaptseg_tools.proxy_table "oracle=$work/cells.csv" >"$work/proxy.md" || fail "proxy_table.py failed"
   awk -F'|' 'NR == 1 || !/^\| (crop|weed|all classes) \|/ { next } { n++; if (!($8 + 0 > 0.9)) bad++ }
     END { exit !(n == 3 && bad == 0) }' "$work/proxy.md" ||
     fail "want 3 rows with the expected error's drop ranking the gain (rho > 0.9): $(cat "$work/proxy.md")"
@@ -43,7 +45,7 @@ if [ -n "$python" ]; then
   "$study" --field "$examples/data/weedmap-000:0,0,0.5,1" --field "$examples/data/weedmap-000:0.5,0,1,1" \
     --top-gsd 3 --gsd 1 --segmenter oracle --csv "$work/halves.csv" >/dev/null 2>"$work/log" ||
     fail "cell study of two fields failed: $(tail -3 "$work/log")"
-  "$python" "$examples/tools/slope_transfer.py" --field-slopes "$work/halves.csv" >"$work/slopes.md" ||
+  "$python" -m adaptseg_tools.slope_transfer --field-slopes "$work/halves.csv" >"$work/slopes.md" ||
     fail "slope_transfer.py failed"
   grep -E '^\| halves \((crop|weed)\) \| expected_error \| 0 -> 1 \| \+0\.[0-9]+ \| \+0\.[0-9]+ \|$' "$work/slopes.md" |
     wc -l | grep -qx 2 || fail "want both classes' own slopes on expected_error positive on both fields: $(cat "$work/slopes.md")"

@@ -6,6 +6,8 @@
 #   test_mission_cli.sh MISSION_BINARY EXAMPLES_DIR PYTHON CASE [CALIBRATE_BINARY]
 set -uo pipefail
 mission=$1 examples=$2 python=$3 case=$4 calibrate=${5:-}
+# The Python tools run from the source tree (python/README.md).
+export PYTHONPATH="$examples/../python${PYTHONPATH:+:$PYTHONPATH}"
 source "$(dirname "$0")/cli_common.sh"
 field="$examples/data/weedmap-000"
 
@@ -282,7 +284,7 @@ determinism)
   # slope and its spread between the fields that the calibration printed (CellGainModel::fit).
   input=$(sed -n 's/^cell gain model of \([a-z_]*\) per pair.*/\1/p' "$work/a/calibrate.log")
   [ -n "$input" ] || fail "the calibration printed no cell gain model"
-  "$python" "$examples/tools/proxy_slopes.py" "$work/a/cells.csv" "$input" >"$work/slopes.md" ||
+  "$python" -m adaptseg_tools.proxy_slopes "$work/a/cells.csv" "$input" >"$work/slopes.md" ||
     fail "proxy_slopes.py failed"
   "$python" - "$work/a/calibrate.log" "$work/slopes.md" <<'EOF' || fail "proxy_slopes.py disagrees with the calibration"
 import re, sys

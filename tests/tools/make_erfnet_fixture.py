@@ -14,14 +14,13 @@ camera size), and PyTorch's output on it, computed from examples/models/erfnet-d
 
 tests/test_erfnet_segmenter.cpp compares OnnxSegmenter's output with these.
 
-Usage: /usr/bin/python3 tests/tools/make_erfnet_fixture.py [--model-dir DIR] [--field DIR]
+Usage: PYTHONPATH=python /usr/bin/python3 tests/tools/make_erfnet_fixture.py [--model-dir DIR] [--field DIR]
 """
 
 from __future__ import annotations
 
 import argparse
 import datetime
-import sys
 from pathlib import Path
 
 import cv2
@@ -30,20 +29,23 @@ import torch
 import yaml
 
 REPO = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(REPO / "examples" / "tools"))
-import train_segnet as te  # noqa: E402
+from adaptseg_tools.fieldio import IGNORE
+from adaptseg_tools.training.fields import FieldData, capture, lawnmower_rects, load_field, lround
+from adaptseg_tools.training.models import load_exported
+from adaptseg_tools.training.network_path import logits_to, to_network_size, to_tensor
+from adaptseg_tools.training.validation import evaluate
 
 # The sub-field of the test field on which tests/test_erfnet_segmenter.cpp checks the mIoU at
 # the finest GSD (fractions x0, y0, x1, y1; Field::sub_field). Kept small: 8 images.
 TEST_REGION = (0.0, 0.0, 0.37, 0.57)
 
 
-def sub_field(f: te.FieldData, region) -> te.FieldData:
+def sub_field(f: FieldData, region) -> FieldData:
     H, W = f.labels.shape
     x0, y0, x1, y1 = region
-    c0, c1 = te.lround(x0 * W), te.lround(x1 * W)
-    r0, r1 = te.lround(y0 * H), te.lround(y1 * H)
-    return te.FieldData(f.name + str(list(region)), f.gsd_cm, f.labels[r0:r1, c0:c1].copy(),
+    c0, c1 = lround(x0 * W), lround(x1 * W)
+    r0, r1 = lround(y0 * H), lround(y1 * H)
+    return FieldData(f.name + str(list(region)), f.gsd_cm, f.labels[r0:r1, c0:c1].copy(),
                         f.image[r0:r1, c0:c1].copy(), f.classes, f.ignore)
 
 
@@ -60,8 +62,8 @@ def main():
     cv2.setNumThreads(1)
 
     model_dir = Path(args.model_dir)
-    model, spec, meta = te.load_exported(model_dir)
-    field = te.load_field(Path(args.field))
+    model, spec, meta = load_exported(model_dir)
+    field = load_field(Path(args.field))
     if field.classes != meta["classes"]:
         raise SystemExit(f"classes differ: field {field.classes} vs model {meta['classes']}")
     nc = len(meta["classes"])
@@ -73,14 +75,14 @@ def main():
     # --- the fixture image: the lawnmower image (inside the orthomosaic, no black pixel) with
     # the most classes, ties to the larger share of the rarest class present.
     best = None
-    for i, (c0, r0, fw, fh) in enumerate(te.lawnmower_rects(field, field.gsd_cm * args.gsd_factor, cam)):
+    for i, (c0, r0, fw, fh) in enumerate(lawnmower_rects(field, field.gsd_cm * args.gsd_factor, cam)):
         H, W = field.labels.shape
         if c0 < 0 or r0 < 0 or c0 + fw > W or r0 + fh > H:
             continue
-        rgb, target, _ = te.capture(field, c0, r0, fw, fh, cam)
+        rgb, target, _ = capture(field, c0, r0, fw, fh, cam)
         if (rgb == 0).all(axis=2).any():
             continue
-        counts = np.bincount(target[target != te.IGNORE], minlength=nc)
+        counts = np.bincount(target[target != IGNORE], minlength=nc)
         present = counts[counts > 0]
         key = (len(present), present.min() / counts.sum())
         if best is None or key > best[0]:
@@ -89,17 +91,17 @@ def main():
         raise SystemExit("no lawnmower image lies fully inside the field")
     _, index, rect, rgb = best
     # What the backend computes: the network on its input size, logits resampled to the camera's.
-    x = torch.from_numpy(te.to_tensor(te.to_network_size(rgb, spec.input_wh), spec.mean, spec.std))[None]
+    x = torch.from_numpy(to_tensor(to_network_size(rgb, spec.input_wh), spec.mean, spec.std))[None]
     with torch.no_grad():
         net_logits = model(x)
-        logits = te.logits_to(net_logits, (cam[1], cam[0]))[0].numpy().astype(np.float32)
+        logits = logits_to(net_logits, (cam[1], cam[0]))[0].numpy().astype(np.float32)
     labels = logits.argmax(0).astype(np.uint8)
 
     net = cv2.dnn.readNetFromONNX(str(model_dir / "model.onnx"))
     net.setInput(x.numpy())
     cv_net_logits = net.forward()
     cv_diff = float(np.abs(cv_net_logits - net_logits.numpy()).max())
-    cv_logits = te.logits_to(torch.from_numpy(cv_net_logits), (cam[1], cam[0]))[0].numpy()
+    cv_logits = logits_to(torch.from_numpy(cv_net_logits), (cam[1], cam[0]))[0].numpy()
     cv_agree = float((cv_logits.argmax(0) == labels).mean())
     margin = np.sort(logits, axis=0)
     min_margin = float((margin[-1] - margin[-2]).min())
@@ -113,9 +115,9 @@ def main():
 
     # --- test-field metrics with PyTorch (= OpenCV DNN up to ~1e-5 in the logits)
     bands = [float(v) for v in args.bands.split(",")]
-    full = te.evaluate(model, field, bands, spec)
+    full = evaluate(model, field, bands, spec)
     region = sub_field(field, TEST_REGION)
-    test_region = te.evaluate(model, region, [1.0], spec)[1.0]
+    test_region = evaluate(model, region, [1.0], spec)[1.0]
 
     fixture = {
         "description": "ERFNet backend fixture: one camera image of the held-out test field and "

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// A network's metadata file (model.yaml beside its ONNX export, written by
-/// `examples/tools/train_segnet.py`): what OnnxSegmenter reads of it (`OnnxModelInfo`) and the
+/// `python/adaptseg_tools/train_segnet.py`): what OnnxSegmenter reads of it (`OnnxModelInfo`) and the
 /// reader, which checks it without loading the network (docs/data_format.md). CMake target
 /// adaptseg::erfnet (yaml-cpp only; no OpenCV DNN).
 
@@ -42,7 +42,7 @@ struct OnnxModelInfo {
   double width_multiplier = 0.0;     ///< informational (ERFNet; 1.0 = the paper's 16/64/128 channels)
   /// T > 0 of the probabilities softmax(logits / T) (`temperature`, default 1): fitted on the
   /// network's validation data so that its confidence matches its accuracy
-  /// (examples/tools/eval_segnet.py --fit-temperature); labels do not depend on it.
+  /// (adaptseg_fit_temperature, examples/tools/fit_temperature.cpp); labels do not depend on it.
   double temperature = 1.0;
   /// The fields the network was trained on, by name (`training.fields`, optional; empty: not
   /// stated): a network maps them nearly as well from high up as from low down, so a decision

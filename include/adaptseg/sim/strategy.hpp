@@ -90,7 +90,7 @@ static_assert(kStrategyTable[0].policy == StrategyPolicy::lawnmower, "the lawnmo
 }
 
 /// The table as CSV (`name,policy,schedule,online,label`), which a comparison writes beside its
-/// results for the figures (examples/tools/plot_evaluation.py).
+/// results for the figures (python/adaptseg_tools/plot_evaluation.py).
 [[nodiscard]] inline std::string strategies_csv() {
   std::string out = "name,policy,schedule,online,label\n";
   for (const auto& s : kStrategyTable)

@@ -1,0 +1,229 @@
+"""Every descent of the adaptive strategy in adaptseg_evaluate runs, its forecast against what it
+did to the field's map: why a region's gain and the field's disagree.
+
+Per descent (decisions.csv of each run directory): the GSD and images, the forecast field gain,
+the realised field gain and the region's gain (realised_region_delta_miou, sign turned: > 0
+helped), and what the descent changed in the field's map over L in pixels: true positives
+gained (ΔTP: misses corrected, net), false positives added (ΔFP; < 0: removed). A class's field
+IoU moves by about (ΔTP − IoU·ΔFP) / (TP + FP + FN): a false positive removed is worth IoU times
+a miss corrected, one added costs as much. And Δσ, what the UAV saw: the region's σ after the
+descent minus its top-level σ (observed_sigma_sub − sigma; a descent that writes the class where
+it is absent raises it far beyond the others). Then, over all descents: how often the region's
+gain and the field's disagree in sign, and for those, whether the descent added false positives.
+
+With --curve, per descent also the lawnmower curve it had to beat: the rise the rule predicted
+over the descent's extra time (forecast_curve_rise) against the rise of the field's real curve
+(results.csv's lawnmowers, upper envelope, linear between points, flat beyond the last, as the
+front margin reads it) over the same seconds, ending at the forecast end (forecast_end_s), and
+each descent's margin, forecast (forecast gain − predicted rise) and realised (realised gain −
+real rise). Where the rule predicts the rise too steep it keeps descents that would have paid;
+too flat, it takes descents that the curve outruns.
+
+With --hindsight, per run: what the mission would have ended at had it flown only its best
+descents, known in hindsight. Its descents sorted by realised gain per second, the prefix whose
+top-level lawnmower (results.csv: the lawnmower at the mission's top GSD) plus their realised
+gains and extra times ends highest above the real curve: whether the descents a rule took hold
+any that pay (selection) or none (the candidates themselves). Gains taken as additive. With
+--gsd G also the margin of its descents to G cm/px alone, in the order flown: what the mission
+would have ended at had it descended to G only where it did.
+
+With --images, per image of a descent (per_image.csv): its σ (the share of L in its labels)
+against its region's top-level σ (the level-0 image before it), the jump between the two, and
+the ground truth's shares of the same two images (truth_sigma): what the UAV could see of a
+network that writes the class where it is absent at a finer GSD (a large jump the ground truth
+does not share), image by image, before the descent ends. Sorted by the jump, largest first.
+
+Usage: descent_table.py [--strategy adaptive] [--curve | --hindsight [--gsd G] | --images] RUN_DIR [RUN_DIR ...]
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+from pathlib import Path
+
+from .lawnmower_envelope import envelope_at, upper_envelope
+
+
+def number(text: str) -> float:
+    return float(text) if text not in ("", None) else math.nan
+
+
+def correlation(x: list[float], y: list[float]) -> float:
+    n = len(x)
+    if n < 3:
+        return math.nan
+    mx, my = sum(x) / n, sum(y) / n
+    sxy = sum((a - mx) * (b - my) for a, b in zip(x, y))
+    sx = math.sqrt(sum((a - mx) ** 2 for a in x))
+    sy = math.sqrt(sum((b - my) ** 2 for b in y))
+    return sxy / (sx * sy) if sx > 0 and sy > 0 else math.nan
+
+
+def real_curves(run: Path) -> dict[str, list[tuple[float, float]]]:
+    """Per field, the upper envelope of the run's lawnmowers (results.csv)."""
+    points: dict[str, list[tuple[float, float]]] = {}
+    with open(run / "results.csv", newline="") as f:
+        for r in csv.DictReader(f):
+            if r["strategy"] == "lawnmower":
+                points.setdefault(r["field"], []).append((float(r["time_total"]), float(r["miou_interest"])))
+    return {field: upper_envelope(p) for field, p in points.items()}
+
+
+def curve_table(rows: list[tuple[str, dict]], curves: dict[tuple[str, str], list]) -> None:
+    print("| run | decision | GSD [cm/px] | extra time [s] | forecast end [s] | forecast gain | predicted rise | "
+          "real rise | forecast margin | realised margin |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    predicted, real, paid, without = [], [], 0, 0
+    for run, d in rows:
+        if d.get("forecast_curve_rise", "") in ("", None) or d.get("forecast_end_s", "") in ("", None):
+            without += 1  # the utility rule, or a file written before 2026-11-30
+            continue
+        env = curves[(run, d["field"])]
+        end, extra = number(d["forecast_end_s"]), number(d["extra_time_s"])
+        rise, real_rise = number(d["forecast_curve_rise"]), envelope_at(env, end) - envelope_at(env, end - extra)
+        fg, rg = number(d["forecast_field_gain"]), number(d["realised_field_gain"])
+        print(f"| {run} | {d['decision']} | {number(d['gsd_cm']):g} | {extra:.1f} | {end:.1f} | {fg:+.4f} | "
+              f"{rise:+.4f} | {real_rise:+.4f} | {fg - rise:+.4f} | {rg - real_rise:+.4f} |")
+        predicted.append(rise)
+        real.append(real_rise)
+        paid += rg > real_rise
+    print()
+    if without:
+        print(f"{without} descents left out: no forecast_curve_rise / forecast_end_s (the utility rule predicts "
+              "no curve; adaptseg_evaluate writes them since 2026-11-30)")
+    if predicted:
+        print(f"{len(predicted)} descents: predicted rise {sum(predicted):+.4f} in all against the real curve's "
+              f"{sum(real):+.4f} (correlation {correlation(predicted, real):+.2f}); {paid} of {len(predicted)} "
+              f"gained more than the real curve rose in their seconds")
+
+
+def hindsight_table(runs: list[str], rows: list[tuple[str, dict]], strategy: str, gsd: float | None) -> None:
+    only = f" | descents to {gsd:g} cm/px alone: margin" if gsd is not None else ""
+    print("| run | descents | margin flown | best prefix: descents | its margin" + only + " |")
+    print("| --- | ---: | ---: | ---: | ---: |" + (" ---: |" if gsd is not None else ""))
+    flown_above = best_above = only_above = 0
+    for run in runs:
+        path = Path(run)
+        with open(path / "results.csv", newline="") as f:
+            results = list(csv.DictReader(f))
+        for field, env in real_curves(path).items():
+            mission = next(r for r in results if r["field"] == field and r["strategy"] == strategy)
+            top = next(r for r in results if r["field"] == field and r["strategy"] == "lawnmower"
+                       and abs(float(r["gsd_cm"]) - float(mission["gsd_cm"])) < 1e-6)
+            t, m = float(top["time_total"]), float(top["miou_interest"])
+            flown_descents = [d for name, d in rows if name == path.name and d["field"] == field]
+            descents = sorted(((number(d["realised_field_gain"]), number(d["extra_time_s"])) for d in flown_descents),
+                              key=lambda gt: -gt[0] / max(gt[1], 1e-9))
+            cell = ""
+            if gsd is not None:
+                kept = [d for d in flown_descents if abs(number(d["gsd_cm"]) - gsd) < 1e-6]
+                t_only = t + sum(number(d["extra_time_s"]) for d in kept)
+                m_only = m + sum(number(d["realised_field_gain"]) for d in kept) - envelope_at(env, t_only)
+                only_above += m_only > 0.001
+                cell = f" {m_only:+.4f} |"
+            best, best_k = m - envelope_at(env, t), 0
+            for k, (g, dt) in enumerate(descents, start=1):
+                t, m = t + dt, m + g
+                if m - envelope_at(env, t) > best:
+                    best, best_k = m - envelope_at(env, t), k
+            flown = float(mission["front_margin"])
+            flown_above += flown > 0.001
+            best_above += best > 0.001
+            print(f"| {path.name} | {len(descents)} | {flown:+.4f} | {best_k} | {best:+.4f} |{cell}")
+    print()
+    alone = f", {only_above} with their descents to {gsd:g} cm/px alone" if gsd is not None else ""
+    print(f"{len(runs)} runs: {flown_above} above +0.001 as flown, {best_above} with their best descents only{alone}")
+
+
+def images_table(runs: list[str], strategy: str) -> None:
+    """Each descent image's σ against its region's top-level σ, and the ground truth's of both."""
+    rows = []
+    for run in runs:
+        with open(Path(run) / "per_image.csv", newline="") as f:
+            top: dict[tuple[str, str], dict] = {}
+            for r in csv.DictReader(f):
+                if r["strategy"] != strategy:
+                    continue
+                key = (r["field"], r["gsd_cm"])
+                if r["level"] == "0":
+                    top[key] = r
+                elif key in top:
+                    t = top[key]
+                    rows.append((number(r["sigma"]) - number(t["sigma"]), Path(run).name, r, t))
+    rows.sort(key=lambda x: -x[0] if math.isfinite(x[0]) else math.inf)
+    print("| run | image | GSD [cm/px] | σ | region's top-level σ | jump | truth σ | top-level truth σ |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for jump, run, r, t in rows:
+        print(f"| {run} | {r['image']} | {number(r['image_gsd_cm']):g} | {number(r['sigma']):.3f} | "
+              f"{number(t['sigma']):.3f} | {jump:+.3f} | {number(r['truth_sigma']):.3f} | "
+              f"{number(t['truth_sigma']):.3f} |")
+    print()
+    for bound in (0.1, 0.2, 0.3):
+        above = [(j, r, t) for j, _, r, t in rows if j > bound]
+        unshared = sum(number(r["truth_sigma"]) - number(t["truth_sigma"]) < j / 2 for j, r, t in above)
+        print(f"jump above {bound:.1f}: {len(above)} of {len(rows)} descent images, of which {unshared} with a "
+              f"ground-truth rise below half the jump")
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--strategy", default="adaptive")
+    ap.add_argument("--curve", action="store_true",
+                    help="each descent against the lawnmower curve: the predicted rise and the real one")
+    ap.add_argument("--hindsight", action="store_true",
+                    help="per run, the margin of its best descents only, chosen in hindsight")
+    ap.add_argument("--gsd", type=float, help="with --hindsight: the margin of the descents to this GSD alone")
+    ap.add_argument("--images", action="store_true",
+                    help="each descent image's σ against its region's top-level σ, and the ground truth's")
+    ap.add_argument("runs", nargs="+")
+    args = ap.parse_args(argv)
+    if args.images:
+        images_table(args.runs, args.strategy)
+        return 0
+    rows = []
+    for run in args.runs:
+        path = Path(run) / "decisions.csv"
+        with open(path, newline="") as f:
+            for d in csv.DictReader(f):
+                if d["strategy"] != args.strategy or d["action"] != "descend":
+                    continue
+                if "realised_delta_tp" not in d:
+                    raise SystemExit(f"{path}: no realised_delta_tp column (written by adaptseg_evaluate since 2026-11-29)")
+                rows.append((Path(run).name, d))
+    if args.hindsight:
+        hindsight_table(args.runs, rows, args.strategy, args.gsd)
+        return 0
+    if args.curve:
+        curves = {(Path(run).name, field): env for run in args.runs for field, env in real_curves(Path(run)).items()}
+        curve_table(rows, curves)
+        return 0
+    print("| run | decision | GSD [cm/px] | images | forecast field gain | realised field gain | region gain | "
+          "ΔTP [px] | ΔFP [px] | Δσ |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    forecast, realised = [], []
+    disagree = disagree_fp = 0
+    for run, d in rows:
+        fg, rg = number(d["forecast_field_gain"]), number(d["realised_field_gain"])
+        region = -number(d["realised_region_delta_miou"])
+        tp, fp = int(d["realised_delta_tp"]), int(d["realised_delta_fp"])
+        d_sigma = number(d.get("observed_sigma_sub", "")) - number(d.get("sigma", ""))
+        print(f"| {run} | {d['decision']} | {number(d['gsd_cm']):g} | {d['images']} | {fg:+.4f} | {rg:+.4f} | "
+              f"{region:+.4f} | {tp:+d} | {fp:+d} | {d_sigma:+.3f} |")
+        if math.isfinite(fg) and math.isfinite(rg):
+            forecast.append(fg)
+            realised.append(rg)
+        if math.isfinite(region) and math.isfinite(rg) and (region > 0) != (rg > 0):
+            disagree += 1
+            disagree_fp += fp > 0
+    print()
+    print(f"{len(rows)} descents; forecast and realised field gain correlate at {correlation(forecast, realised):+.2f}; "
+          f"the region's gain and the field's disagree in sign in {disagree}, of which {disagree_fp} added false "
+          f"positives; false positives added in {sum(int(d['realised_delta_fp']) > 0 for _, d in rows)} descents, "
+          f"misses corrected (ΔTP > 0) in {sum(int(d['realised_delta_tp']) > 0 for _, d in rows)}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,77 @@
+"""Each training field's own slope against its mean top-level entropy, and the slope the
+field-entropy pooling forecasts for each field left out (docs/method.md, "Cells that pay").
+
+Reads the cell samples that `adaptseg_calibrate --cell-samples-csv` writes and prints, per pair
+of GSDs, each field's own slope b_f of the normalised gain on INPUT (least squares through the
+origin, cells weighted by their field pixels) with its mean top-level entropy u_f, then, for each
+field, the slope forecast from the other fields' line b = a + c*u (weighted least squares, equal
+weights: the random-effects fit where the fields disagree beyond their cells' scatter, as they
+do on new ground), clamped to their range of u; and how many forecasts have the field's own sign.
+
+  entropy_slopes.py CELLS.csv INPUT
+"""
+import math
+import sys
+
+from .proxy_slopes import cell_pairs, normalized_gain
+
+
+def own_slope(cells, inp, mean_px):
+    wxx = wxg = pu = px = 0.0
+    for c in cells:
+        x = float(c["top_" + inp])
+        w = float(c["field_px"]) / mean_px
+        nu = normalized_gain(c)
+        wxx += w * x * x
+        wxg += w * x * nu
+        u = float(c["top_entropy"])
+        if math.isfinite(u):
+            pu += float(c["field_px"]) * u
+            px += float(c["field_px"])
+    return (wxg / wxx if wxx > 0 else math.nan, pu / px if px > 0 else math.nan)
+
+
+def line_forecast(points, u):
+    """b at u of the least-squares line through `points` (u_f, b_f), u clamped to their range."""
+    n = len(points)
+    mu = sum(p[0] for p in points) / n
+    mb = sum(p[1] for p in points) / n
+    suu = sum((p[0] - mu) ** 2 for p in points)
+    c = sum((p[0] - mu) * (p[1] - mb) for p in points) / suu if suu > 0 else 0.0
+    lo, hi = min(p[0] for p in points), max(p[0] for p in points)
+    return mb + c * (min(max(u, lo), hi) - mu)
+
+
+def main():
+    if len(sys.argv) != 3:
+        sys.exit(__doc__)
+    path, inp = sys.argv[1], sys.argv[2]
+    pairs, fields = cell_pairs(path, inp)
+    if any("top_entropy" not in cells[0] for cells in pairs.values()):
+        sys.exit(f"{path}: no column top_entropy")
+    print(f"{path}: input {inp}; per field: own slope b_f @ mean entropy u_f -> forecast from the others")
+    print("| top -> descent [cm/px] | signs right | " + " | ".join(fields) + " |")
+    print("| --- | ---: | " + " | ".join("---" for _ in fields) + " |")
+    for key in sorted(pairs):
+        cells = pairs[key]
+        mean_px = sum(float(c["field_px"]) for c in cells) / len(cells)
+        own = {n: own_slope([c for c in cells if c["field"] == n], inp, mean_px) for n in fields}
+        known = [n for n in fields if all(math.isfinite(v) for v in own[n])]
+        cols, right, counted = [], 0, 0
+        for n in fields:
+            if n not in known:
+                cols.append("-")
+                continue
+            others = [own[m][::-1] for m in known if m != n]
+            if len(others) < 2:
+                cols.append(f"{own[n][0]:+.3f} @ {own[n][1]:.2f}")
+                continue
+            f = line_forecast(others, own[n][1])
+            counted += 1
+            right += (f > 0) == (own[n][0] > 0)
+            cols.append(f"{own[n][0]:+.3f} @ {own[n][1]:.2f} -> {f:+.3f}")
+        print(f"| {key[0]:g} -> {key[1]:g} | {right} of {counted} | " + " | ".join(cols) + " |")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,173 @@
+"""Field mIoU of several networks and of their ensembles, side by side, on the same images.
+
+Every band is a whole-field lawnmower at that GSD (footprints as adaptseg's LawnmowerPlanner
+places them, images rendered as its SimulatedSensor renders them, as in eval_segnet.py). Each
+member runs on the path of the C++ backend (resampled to its input size, logits back to the
+camera size) in PyTorch on the weights its model.onnx was exported from; its probabilities are
+softmax(logits / T) with the temperature of its model.yaml (1 where it has none). An ensemble's
+labels are the argmax of its members' weighted mean probabilities (ties to the lower class), as
+adaptseg::EnsembleSegmenter gives them. Labels are scored against the orthomosaic labels at
+orthomosaic resolution; field mIoU over the classes present in truth or prediction.
+
+Members are named NAME=MODEL_DIR, or NAME=MODEL_DIR@mirror for the network with test-time mirror
+(ErfnetParams::test_time_mirror: the mean of its probabilities over the image and its left-right
+mirror); an ensemble is NAME=MEMBER+MEMBER[+...] (equal weights) or an ensemble directory
+(ensemble.yaml, its members resolved relative to it, each matched to the member of that
+directory and mirror setting).
+
+Usage:
+  PYTHONPATH=python /usr/bin/python3 -m adaptseg_tools.eval_ensemble \\
+      --members mnv2=examples/models/mobilenetv2-dubai,erf=examples/models/erfnet-dubai \\
+      --ensembles both=mnv2+erf [--fields F1,F2] [--bands 1,3] [--json out.json]
+  (a mirrored member: mnv2m=examples/models/mobilenetv2-dubai@mirror)
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import cv2
+import numpy as np
+import torch
+import yaml
+
+from . import REPO
+from .fieldio import IGNORE
+from .training.fields import capture, lawnmower_rects, load_field
+from .training.models import load_exported
+from .training.network_path import logits_to, to_network_size, to_tensor
+from .training.validation import confusion, miou
+
+
+def member_probabilities(model, spec, meta, bgr: np.ndarray, mirror: bool = False) -> np.ndarray:
+    """C x H x W probabilities of a camera image, the C++ backend's path; with `mirror` the mean
+    of those of the image and of its left-right mirror (flipped back)."""
+    if mirror:
+        back = member_probabilities(model, spec, meta, np.ascontiguousarray(bgr[:, ::-1]))[:, :, ::-1]
+        return 0.5 * (member_probabilities(model, spec, meta, bgr) + back)
+    x = torch.from_numpy(to_tensor(to_network_size(bgr, spec.input_wh), spec.mean, spec.std))[None]
+    with torch.no_grad():
+        logits = logits_to(model(x).float(), bgr.shape[:2])[0]
+    t = float(meta.get("temperature", 1.0))
+    return torch.softmax(logits / t, dim=0).numpy()
+
+
+def member_dir(value: str) -> tuple[Path, bool]:
+    """NAME=VALUE's model directory (resolved) and whether it is mirrored (VALUE ends in @mirror)."""
+    mirror = value.endswith("@mirror")
+    return Path(value[:-len("@mirror")] if mirror else value).resolve(), mirror
+
+
+def parse_pairs(text: str) -> dict[str, str]:
+    out = {}
+    for item in filter(None, text.split(",")):
+        name, _, value = item.partition("=")
+        if not value:
+            raise SystemExit(f"'{item}': expected NAME=VALUE")
+        out[name] = value
+    return out
+
+
+def ensemble_members(spec: str, members: dict) -> list[tuple[str, float]]:
+    """[(member name, weight)] of NAME+NAME or of an ensemble directory's ensemble.yaml."""
+    path = Path(spec)
+    if (path / "ensemble.yaml").is_file():
+        doc = yaml.safe_load((path / "ensemble.yaml").read_text())
+        out = []
+        for m in doc["members"]:
+            want = ((path / m["model"]).resolve(), bool(m.get("mirror", False)))
+            name = next((k for k, v in members.items() if member_dir(v) == want), None)
+            if name is None:
+                raise SystemExit(f"{spec}: member {m['model']}{'@mirror' if want[1] else ''} is not among --members")
+            out.append((name, float(m.get("weight", 1.0))))
+        return out
+    names = spec.split("+")
+    for n in names:
+        if n not in members:
+            raise SystemExit(f"ensemble '{spec}': unknown member '{n}'")
+    return [(n, 1.0) for n in names]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--members", required=True, help="NAME=MODEL_DIR,...")
+    ap.add_argument("--ensembles", default="", help="NAME=M1+M2[+...] or NAME=ENSEMBLE_DIR, ...")
+    ap.add_argument("--fields", default=",".join(str(REPO / "examples" / "data" / f"dubai-tile-{k}") for k in (4, 6)))
+    ap.add_argument("--bands", default="1,3", help="GSD factors of the fields' GSD")
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--json")
+    args = ap.parse_args()
+    torch.set_num_threads(args.threads)
+    cv2.setNumThreads(1)
+
+    member_dirs = parse_pairs(args.members)
+    ensembles = {name: ensemble_members(spec, member_dirs) for name, spec in parse_pairs(args.ensembles).items()}
+    nets = {}
+    for name, d in member_dirs.items():
+        model_dir, mirror = member_dir(d)
+        model, spec, meta = load_exported(model_dir)
+        nets[name] = (model, spec, meta, mirror)
+    classes = next(iter(nets.values()))[2]["classes"]
+    for name, (_, _, meta, _) in nets.items():
+        if meta["classes"] != classes:
+            raise SystemExit(f"member {name}: classes {meta['classes']} differ from {classes}")
+    cams = {tuple(s.camera_wh) for _, s, _, _ in nets.values()}
+    if len(cams) != 1:
+        raise SystemExit(f"members trained for different cameras: {sorted(cams)}")
+    cam_wh = cams.pop()
+    nc = len(classes)
+    bands = [float(v) for v in args.bands.split(",")]
+    rows = list(member_dirs) + list(ensembles)
+    results = {}
+    seconds = {n: 0.0 for n in member_dirs}
+    for fdir in args.fields.split(","):
+        field = load_field(Path(fdir))
+        if field.classes != classes:
+            raise SystemExit(f"{fdir}: classes {field.classes} differ from the members' {classes}")
+        results[field.name] = {}
+        for fac in bands:
+            gsd = field.gsd_cm * fac
+            cms = {r: np.zeros((nc, nc + 1), np.int64) for r in rows}
+            n_img = 0
+            for (c0, r0, fw, fh) in lawnmower_rects(field, gsd, cam_wh):
+                rgb, _, gt = capture(field, c0, r0, fw, fh, cam_wh)
+                if (gt != IGNORE).sum() == 0:
+                    continue
+                probs = {}
+                for name, (model, spec, meta, mirror) in nets.items():
+                    t0 = time.perf_counter()
+                    probs[name] = member_probabilities(model, spec, meta, rgb, mirror)
+                    seconds[name] += time.perf_counter() - t0
+                labels = {n: p.argmax(0) for n, p in probs.items()}
+                for ens, mem in ensembles.items():
+                    w = sum(wt for _, wt in mem)
+                    labels[ens] = (sum(wt * probs[n] for n, wt in mem) / w).argmax(0)
+                for r in rows:
+                    up = cv2.resize(labels[r].astype(np.uint8), (fw, fh), interpolation=cv2.INTER_NEAREST_EXACT)
+                    cms[r] += confusion(gt, up, nc)
+                n_img += 1
+            results[field.name][fac] = {"gsd_cm": gsd, "images": n_img,
+                                        **{r: dict(zip(("miou", "iou"), miou(cms[r]))) for r in rows}}
+        print(f"{field.name}: done", file=sys.stderr, flush=True)
+
+    header = [f"{f} {b['gsd_cm']:.0f} cm/px" for f, fr in results.items() for b in fr.values()]
+    print("| network | " + " | ".join(header) + " |")
+    print("| --- | " + " | ".join("---:" for _ in header) + " |")
+    for r in rows:
+        label = r if r in member_dirs else f"{r} ({' + '.join(n for n, _ in ensembles[r])})"
+        print(f"| {label} | " + " | ".join(f"{b[r]['miou']:.3f}" for fr in results.values() for b in fr.values()) + " |")
+    print("\nPyTorch time per image and member (this machine, "
+          f"{args.threads} threads): " + ", ".join(f"{n} {1000 * s / max(1, sum(b['images'] for fr in results.values() for b in fr.values())):.0f} ms"
+                                                  for n, s in seconds.items()))
+    if args.json:
+        Path(args.json).write_text(json.dumps({"classes": classes, "members": member_dirs,
+                                               "ensembles": {k: v for k, v in ensembles.items()},
+                                               "fields": results}, indent=2) + "\n")
+
+
+if __name__ == "__main__":
+    main()

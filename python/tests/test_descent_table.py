@@ -1,0 +1,98 @@
+#!/usr/bin/env python3
+"""Self-test of descent_table.py's plain table, --curve, --hindsight and --images on a synthetic
+run (run by CTest; exit code != 0 on failure).
+
+Each descent's row: its gains, pixels and the change of its region's σ. One field whose
+lawnmowers map L at 0.50 in 100 s and 0.60 in 200 s (the real curve rises 0.001 per second),
+flown from the first by a mission with two descents: one gains 0.02 in 10 s (it beats the
+curve), the other 0.001 in 20 s (it does not). In hindsight the first alone ends +0.0100 above
+the curve (0.52 at 110 s against 0.51), both together −0.0090; the first's real rise over its
+seconds is 0.0100, against a predicted 0.0040.
+"""
+import contextlib
+import io
+import os
+import sys
+import tempfile
+
+from adaptseg_tools import descent_table
+
+RESULTS = """field,strategy,gsd_cm,miou_interest,time_total,front_margin
+f,lawnmower,15,0.50,100,0
+f,lawnmower,10,0.60,200,0
+f,adaptive,15,0.521,130,-0.009
+"""
+COLUMNS = ("field,strategy,decision,action,gsd_cm,images,extra_time_s,forecast_field_gain,realised_field_gain,"
+           "realised_region_delta_miou,realised_delta_tp,realised_delta_fp,forecast_curve_rise,forecast_end_s,"
+           "sigma,observed_sigma_sub\n")
+DECISIONS = COLUMNS + """f,adaptive,0,descend,10,2,10,0.015,0.02,-0.05,100,-10,0.004,110,0.10,0.12
+f,adaptive,1,continue,,,,,,,,,,,0.2,
+f,adaptive,2,descend,10,2,20,0.006,0.001,-0.01,5,3,0.005,130,0.30,0.25
+"""
+# Per image: a top-level image (σ 0.10, truth 0.05), a descent of two images under it, one that
+# sees what the ground truth shows (σ 0.20, truth 0.16: jump +0.10) and one that writes the class
+# where it is absent (σ 0.60, truth 0.00: jump +0.50); the nonadaptive strategy's row is left out.
+PER_IMAGE = """field,strategy,gsd_cm,image,level,image_gsd_cm,sigma,image_miou_interest,image_miou_all,truth_sigma
+f,nonadaptive,15,0,0,15,0.9,0,0,0.9
+f,nonadaptive,15,1,1,10,0.1,0,0,0.9
+f,adaptive,15,0,0,15,0.10,0,0,0.05
+f,adaptive,15,1,1,10,0.20,0,0,0.16
+f,adaptive,15,2,1,10,0.60,0,0,0.00
+"""
+
+
+def table(args):
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        descent_table.main(args)
+    return out.getvalue()
+
+
+def main():
+    with tempfile.TemporaryDirectory() as tmp:
+        run = os.path.join(tmp, "run")
+        os.makedirs(run)
+        with open(os.path.join(run, "results.csv"), "w") as f:
+            f.write(RESULTS)
+        with open(os.path.join(run, "decisions.csv"), "w") as f:
+            f.write(DECISIONS)
+        with open(os.path.join(run, "per_image.csv"), "w") as f:
+            f.write(PER_IMAGE)
+        # Each descent: gains, what it changed in pixels, and the region's σ after it minus before.
+        plain = table([run])
+        for want in ("| run | 0 | 10 | 2 | +0.0150 | +0.0200 | +0.0500 | +100 | -10 | +0.020 |",
+                     "| run | 2 | 10 | 2 | +0.0060 | +0.0010 | +0.0100 | +5 | +3 | -0.050 |"):
+            if want not in plain:
+                sys.exit(f"table: no row {want}:\n{plain}")
+        if "false positives added in 1 descents, misses corrected (ΔTP > 0) in 2" not in plain:
+            sys.exit(f"table summary:\n{plain}")
+        hindsight = table(["--hindsight", run])
+        if "| run | 2 | -0.0090 | 1 | +0.0100 |" not in hindsight:
+            sys.exit(f"hindsight: the first descent alone should end +0.0100 above the curve:\n{hindsight}")
+        if "1 runs: 0 above +0.001 as flown, 1 with their best descents only" not in hindsight:
+            sys.exit(f"hindsight summary:\n{hindsight}")
+        # Both descents are to 10 cm/px: alone they end where the mission did.
+        alone = table(["--hindsight", "--gsd", "10", run])
+        if "| run | 2 | -0.0090 | 1 | +0.0100 | -0.0090 |" not in alone:
+            sys.exit(f"hindsight --gsd 10: the descents to 10 cm/px alone should end at -0.0090:\n{alone}")
+        if "| run | 2 | -0.0090 | 1 | +0.0100 | +0.0000 |" not in table(["--hindsight", "--gsd", "5", run]):
+            sys.exit("hindsight --gsd 5: no descent to 5 cm/px should leave the top-level lawnmower, margin 0")
+        curve = table(["--curve", run])
+        # decision, GSD, extra time, end, forecast gain, predicted rise, real rise, margins
+        want = "| run | 0 | 10 | 10.0 | 110.0 | +0.0150 | +0.0040 | +0.0100 | +0.0110 | +0.0100 |"
+        if want not in curve:
+            sys.exit(f"curve: no row {want}:\n{curve}")
+        if "1 of 2 gained more than the real curve rose in their seconds" not in curve:
+            sys.exit(f"curve summary:\n{curve}")
+        images = table(["--images", run])
+        rows = [line for line in images.splitlines() if line.startswith("| run |") and "σ" not in line]
+        if rows != ["| run | 2 | 10 | 0.600 | 0.100 | +0.500 | 0.000 | 0.050 |",
+                    "| run | 1 | 10 | 0.200 | 0.100 | +0.100 | 0.160 | 0.050 |"]:
+            sys.exit(f"images: the two descent images, largest jump first:\n{images}")
+        if "jump above 0.2: 1 of 2 descent images, of which 1 with a ground-truth rise below half the jump" not in images:
+            sys.exit(f"images summary:\n{images}")
+    print("ok: descent_table.py sets each descent against the real curve and finds the best in hindsight")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,48 @@
+#!/usr/bin/env python3
+"""Self-test of jump_table.py on a synthetic cell-samples CSV (run by CTest; exit code != 0 on
+failure): two fields, the bound learned with each left out as the library's jump_bound() learns
+it (tests/test_cell_gain_model.cpp checks the same rule in C++).
+
+Field a: cells jumping +0.6 (gain -0.02), +0.4 (+0.005), +0.3 (-0.01), +0.1 (+0.03); field b: one
+cell, 0.0 (+0.01). With b left out: from the largest jump down the sums are -0.02, -0.015, -0.025
+(the lowest): three refused, the bound halfway between +0.3 and +0.1, 0.200. With a left out: one
+cell, no guard.
+"""
+import contextlib
+import io
+import os
+import sys
+import tempfile
+
+from adaptseg_tools import jump_table
+
+CELLS = """field,region,sub_gsd_cm,field_px,field_gain,delta_fp,top_sigma,fine_sigma
+a,0,5,100,-0.02,500,0.1,0.7
+a,0,5,100,0.005,10,0.0,0.4
+a,1,5,100,-0.01,300,0.2,0.5
+a,1,5,100,0.03,-40,0.3,0.4
+b,0,5,100,0.01,0,0.5,0.5
+b,0,5,100,-1.0,0,0.5,
+"""
+
+
+def main():
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "cells.csv")
+        with open(path, "w") as f:
+            f.write(CELLS)
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            rc = jump_table.main([path])
+        text = out.getvalue()
+        if rc != 0:
+            sys.exit(f"exit code {rc}:\n{text}")
+        for want in ("| a | 4 | +0.600 |", "| b | 0.200 | 3 | -0.0250 |", "| a | inf | 0 | +0.0000 |",
+                     "| (0.3, inf] | 2 | -0.0150 | 1 | 2 |"):
+            if want not in text:
+                sys.exit(f"no row {want}:\n{text}")
+    print("ok: jump_table.py learns the jump guard's bound with each field left out")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,74 @@
+#!/usr/bin/env python3
+"""Self-test of loto_targets.py on synthetic runs (run by CTest; exit code != 0 on failure).
+
+Four runs of a configuration and the oracle's of the same folds, named as scripts/results.sh
+names them, with margins chosen so that every target's count is known: two runs above +0.001,
+one below max(non-adaptive, 0) - 0.002, three descents whose forecasts and realised gains are
+proportional (correlation +1), and the oracle above 0 in two of the three runs where some
+strategy beats the curve.
+"""
+import contextlib
+import io
+import os
+import sys
+import tempfile
+
+from adaptseg_tools import loto_targets
+
+RESULTS = "strategy,field,front_margin,descents,time_total,altitude_changes\n"
+DECISIONS = "strategy,action,forecast_field_gain,realised_field_gain\n"
+
+
+def write_run(root, name, adaptive, nonadaptive, descents=()):
+    d = os.path.join(root, name)
+    os.makedirs(d)
+    field = "dubai-tile-" + name.rsplit("-", 1)[1]
+    with open(os.path.join(d, "results.csv"), "w") as f:
+        f.write(RESULTS)
+        f.write(f"lawnmower,{field},0,0,100,0\n")
+        f.write(f"adaptive,{field},{adaptive},{len(descents)},120,{2 * len(descents)}\n")
+        f.write(f"nonadaptive,{field},{nonadaptive},0,100,0\n")
+    with open(os.path.join(d, "decisions.csv"), "w") as f:
+        f.write(DECISIONS)
+        for forecast, realised in descents:
+            f.write(f"adaptive,descend,{forecast},{realised}\n")
+        f.write("adaptive,stay,,\n")
+
+
+def main():
+    with tempfile.TemporaryDirectory() as tmp:
+        loto, oracle = os.path.join(tmp, "loto"), os.path.join(tmp, "oracle")
+        write_run(loto, "mobilenetv2-loto-building-tile-1", 0.004, 0.0, [(0.01, 0.02), (0.02, 0.04)])
+        write_run(loto, "mobilenetv2-loto-road-tile-1", 0.0015, 0.0, [(0.03, 0.06)])
+        write_run(loto, "mobilenetv2-loto-water-tile-2", -0.003, -0.0005)  # below max(-0.0005, 0) - 0.002
+        write_run(loto, "mobilenetv2-loto-water-tile-3", 0.0007, 0.0)
+        write_run(oracle, "dubai-building-tile-1", 0.01, 0.01)
+        write_run(oracle, "dubai-road-tile-1", -0.001, -0.001)  # beatable (loto's +0.0015), oracle not > 0
+        write_run(oracle, "dubai-water-tile-2", 0.0, 0.0)  # nobody beats the curve here
+        write_run(oracle, "dubai-water-tile-3", 0.002, 0.002)
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            loto_targets.main(["--oracle", oracle, f"base={loto}"])
+        lines = out.getvalue().splitlines()
+        summary = [c.strip() for c in lines[2].strip("|").split("|")]
+        # runs, > +0.001, median, mean, below, descents, correlation, oracle where beatable
+        want = ["base", "4", "2", "+0.0011", "+0.0008", "1", "3", "+1.00", "2 of 3"]
+        if summary != want:
+            sys.exit(f"summary {summary}, want {want}\n{out.getvalue()}")
+        if "| water | 2 | -0.0030 (0) | +0.0000 (0) |" not in lines:
+            sys.exit(f"no per-run row for water on tile 2:\n{out.getvalue()}")
+        # A folder without runs named ...-CLASS-tile-K is refused, naming it.
+        empty = os.path.join(tmp, "empty")
+        os.makedirs(empty)
+        try:
+            loto_targets.main([f"x={empty}"])
+        except SystemExit as e:
+            if "no runs named" not in str(e):
+                sys.exit(f"unexpected refusal: {e}")
+        else:
+            sys.exit("an empty folder was not refused")
+    print("ok: loto_targets.py counts every target")
+
+
+if __name__ == "__main__":
+    main()
