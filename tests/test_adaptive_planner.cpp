@@ -1226,7 +1226,7 @@ TEST_CASE("run_adaptive_mission: one time account, flight by the ramp model plus
   std::vector<Eigen::Vector3d> path;
   for (const auto& w : r.mission.waypoints) path.push_back(w.waypoint.position);
   const auto n = static_cast<double>(path.size());
-  CHECK(r.mission.flight_s == doctest::Approx(TimingModel(o.mission.timing).path_time_s(path)));
-  CHECK(r.mission.segmentation_s == doctest::Approx(0.1 * n));
-  CHECK(r.mission.planning_s == doctest::Approx(0.25 * n));  // once per waypoint, never twice
+  CHECK(r.mission.time.flight_s == doctest::Approx(TimingModel(o.mission.timing).path_time_s(path)));
+  CHECK(r.mission.time.segmentation_s == doctest::Approx(0.1 * n));
+  CHECK(r.mission.time.planning_s == doctest::Approx(0.25 * n));  // once per waypoint, never twice
 }
