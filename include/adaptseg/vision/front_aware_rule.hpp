@@ -15,6 +15,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -121,8 +122,10 @@ struct FrontAwareRule {
          .curve_agreement = rule.has("curve_agreement") ? rule.number("curve_agreement") : 0.0,
          .jump_bound = rule.has("jump_bound") ? rule.number("jump_bound") : std::numeric_limits<double>::infinity(),
          .curve = read_curve(rule),
-         .top_level = rule.has("top_level") ? read_top_level(rule) : TopLevelChoice::undominated,
-         .field_factor = rule.has("field_factor") ? read_field_factor(rule) : FieldFactorSource::scene_check,
+         .top_level =
+             rule.has("top_level") ? read_named(rule, "top_level", kTopLevelChoices) : TopLevelChoice::undominated,
+         .field_factor = rule.has("field_factor") ? read_named(rule, "field_factor", kFieldFactorSources)
+                                                  : FieldFactorSource::scene_check,
          .gain_ratios = read_gain_ratios(rule),
          .margin_biases = read_margin_biases(rule)});
   }
@@ -177,24 +180,19 @@ struct FrontAwareRule {
     return rule.has("curve_ratio") && rule.flag("curve_ratio") ? CurveSource::corrected : CurveSource::field;
   }
 
-  /// `rule.top_level`, naming the file where it is not a TopLevelChoice.
-  [[nodiscard]] static TopLevelChoice read_top_level(const detail::YamlReader& rule) {
-    const std::string name = rule.text("top_level");
-    try {
-      return parse_top_level_choice(name);
-    } catch (const std::invalid_argument&) {
-      detail::yaml_error(rule.where(), "'rule.top_level' must be undominated or hull (got '" + name + "')");
+  /// The value under `key` of `rule`, one of `table`'s names (a TopLevelChoice, a
+  /// FieldFactorSource); elsewhere an error naming the file and the names it may be.
+  template <typename Enum, std::size_t N>
+  [[nodiscard]] static Enum read_named(const detail::YamlReader& rule, const char* key,
+                                       const std::array<detail::NamedValue<Enum>, N>& table) {
+    const std::string name = rule.text(key);
+    std::string allowed;
+    for (std::size_t k = 0; k < N; ++k) {
+      if (k > 0) allowed += k + 1 == N ? " or " : ", ";
+      allowed += table[k].name;
+      if (name == table[k].name) return table[k].value;
     }
-  }
-
-  /// `rule.field_factor`, naming the file where it is not a FieldFactorSource.
-  [[nodiscard]] static FieldFactorSource read_field_factor(const detail::YamlReader& rule) {
-    const std::string name = rule.text("field_factor");
-    try {
-      return parse_field_factor_source(name);
-    } catch (const std::invalid_argument&) {
-      detail::yaml_error(rule.where(), "'rule.field_factor' must be scene-check or relabelled (got '" + name + "')");
-    }
+    detail::yaml_error(rule.where(), "'rule." + std::string(key) + "' must be " + allowed + " (got '" + name + "')");
   }
 
   /// Refuses options its search cannot use (before calibrate() samples anything).
