@@ -98,6 +98,14 @@ struct CellSample {
   }
 };
 
+/// Every training field's cell samples in one list, field after field (calibration keeps them
+/// per field: CalibrationResult::cell_samples, the cell gain model's fit, the folds' pooling).
+[[nodiscard]] inline std::vector<CellSample> cells_of_every_field(std::span<const std::vector<CellSample>> cells) {
+  std::vector<CellSample> all;
+  for (const auto& c : cells) all.insert(all.end(), c.begin(), c.end());
+  return all;
+}
+
 /// The cell gain model: per pair of top-level and descent GSD, how much of a cell's input x (a
 /// decision input of the top-level image, e.g. its expected error about L) a re-mapping turns
 /// into gain, and into relabelled pixels.

@@ -153,13 +153,13 @@ inline void set_field_inputs(std::vector<ReferenceCurve>& reference,
   return linear;
 }
 
-/// Every training field's samples (collect_samples), pooled and per field; with a coverage
-/// that ranks cells, the cells also as seen from the alternative top levels
-/// (alternative_top_gsds), re-mapped at the candidates below them.
+/// Every training field's samples (collect_samples): the regions pooled and per field, the cells
+/// per field (cells_of_every_field pools them); with a coverage that ranks cells, the cells also
+/// as seen from the alternative top levels (alternative_top_gsds), re-mapped at the candidates
+/// below them.
 struct TrainingSamples {
   std::vector<RegionSample> samples;
   std::vector<std::vector<RegionSample>> by_field;
-  std::vector<CellSample> cell_samples;
   std::vector<std::vector<CellSample>> cells_by_field;
 };
 
@@ -188,7 +188,6 @@ template <SegmentationBackend Backend>
                                                k, adaptive.mission.map_fusion);
       t.cells_by_field.back().insert(t.cells_by_field.back().end(), alt.cells.begin(), alt.cells.end());
     }
-    t.cell_samples.insert(t.cell_samples.end(), t.cells_by_field.back().begin(), t.cells_by_field.back().end());
   }
   return t;
 }
@@ -268,8 +267,8 @@ template <SegmentationBackend Backend>
   detail::TrainingSamples train = detail::collect_training_samples(fields, backends, camera, adaptive, options);
   std::vector<RegionSample>& samples = train.samples;
   const std::vector<std::vector<RegionSample>>& by_field = train.by_field;
-  std::vector<CellSample>& cell_samples = train.cell_samples;
   const std::vector<std::vector<CellSample>>& cells_by_field = train.cells_by_field;
+  std::vector<CellSample> cell_samples = cells_of_every_field(cells_by_field);
   // A coverage that ranks cells: the input that ranks the training fields' cells best.
   std::vector<std::pair<DecisionInput, double>> input_scores;
   if (ranked) {

@@ -82,13 +82,6 @@ struct FrontAwareGrid {
   bool pools = false;   ///< ranked with several training fields
 };
 
-/// Every training field's cell samples in one list, field after field.
-inline std::vector<CellSample> cells_of_every_field(std::span<const std::vector<CellSample>> cells) {
-  std::vector<CellSample> all;
-  for (const auto& c : cells) all.insert(all.end(), c.begin(), c.end());
-  return all;
-}
-
 /// The slope poolings of `poolings` that are not another under a second name: `field-entropy`
 /// is left out where its line is flat at every pair of GSDs on the training fields' cells
 /// `cells` (fewer than three fields count, or their mean entropies do not spread), where it is
@@ -380,10 +373,10 @@ template <class Fly>
   GainModel model = in.model;
   const SlopePooling pooling = grid.poolings[settings[best].pooling];
   if (grid.ranked && model.cells() && model.cells()->pooling() != pooling) {
-    model.set_cells(CellGainModel::fit(detail::cells_of_every_field(in.cells), in.adaptive.cell_input, pooling));
+    model.set_cells(CellGainModel::fit(cells_of_every_field(in.cells), in.adaptive.cell_input, pooling));
   }
   FrontAwarePolicy::Params params = settings[best].params;
-  if (options.jump_guard && grid.ranked) params.jump_bound = jump_bound(detail::cells_of_every_field(in.cells));
+  if (options.jump_guard && grid.ranked) params.jump_bound = jump_bound(cells_of_every_field(in.cells));
   return {DecisionFunction(FrontAwarePolicy(std::move(model), reference, params)), std::move(trials)};
 }
 
