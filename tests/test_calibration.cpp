@@ -524,6 +524,31 @@ TEST_CASE(
                        doctest::Contains("top_levels names a choice twice"), std::invalid_argument);
 }
 
+TEST_CASE(
+    "calibration: the relabel transfer b measured on the training fields' cells, asked with the relabelled factor") {
+  std::vector<Field> fields = two_blob_fields();
+  fields.push_back(t::blob_field(1200, 1100, 1.0, 7, 15));
+  OracleSegmenter oracle(fields.front().num_classes());
+  CalibrationOptions options = ranked_options();
+  options.slope_poolings = {SlopePooling::cells};
+  options.relabel_transfer = true;
+  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
+                       doctest::Contains("needs the field factor 'relabelled'"), std::invalid_argument);
+  options.front_aware.field_factor = FieldFactorSource::relabelled;
+  const CalibrationResult cal = calibrate(std::span<const Field>(fields), oracle, options);
+  const FrontAwarePolicy& rule = std::get<FrontAwarePolicy>(cal.decision_function.rule());
+  // The model's b: every field's cells, with the input the cells are ranked by.
+  const double b = relabel_transfer(cal.cell_samples, rule.model().cells()->input());
+  CHECK(b < 1.0);  // measured (on these blob fields the oracle relabels most where it gains least: 0)
+  CHECK(rule.params().relabel_transfer == b);
+  CHECK(rule.params().field_factor == FieldFactorSource::relabelled);
+  // Not asked: the given b.
+  options.relabel_transfer = false;
+  CHECK(std::get<FrontAwarePolicy>(calibrate(std::span<const Field>(fields), oracle, options).decision_function.rule())
+            .params()
+            .relabel_transfer == 1.0);
+}
+
 TEST_CASE("calibration: the setting kept, per top level its pooling's best z, then the best top level") {
   using adaptseg::detail::FrontAwareSetting;
   adaptseg::detail::FrontAwareGrid grid;
@@ -856,6 +881,17 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
                                                         "field_factor: relabeled", "bad_factor.yaml")),
                        doctest::Contains("'rule.field_factor' must be scene-check or relabelled (got 'relabeled')"),
                        std::invalid_argument);
+  // b, how far the gain follows the relabelled factor: kept where not 1 (absent: 1); out of
+  // [0, 1] refused.
+  CHECK(rule_of(back).relabel_transfer == 1.0);
+  p.relabel_transfer = 0.375;
+  policy.set_params(p);
+  corrected.save(tmp.path() / "transfer.yaml");
+  CHECK(rule_of(DecisionModel::load(tmp.path() / "transfer.yaml")).relabel_transfer == 0.375);
+  CHECK_THROWS_WITH_AS((void)DecisionModel::load(edited("transfer.yaml", "relabel_transfer: 0.375",
+                                                        "relabel_transfer: 1.5", "bad_transfer.yaml")),
+                       doctest::Contains("relabel_transfer must be in [0, 1]"), std::invalid_argument);
+  p.relabel_transfer = 1.0;
   // Fields of another class set are refused.
   const Field other("o", 1.0, a.labels(), {{"a", {0, 0, 0}}, {"b", {1, 1, 1}}, {"c", {2, 2, 2}}}, {1});
   const std::vector<Field> mixed{a, other};

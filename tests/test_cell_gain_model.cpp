@@ -1,6 +1,7 @@
 #include <adaptseg/core/cell_gain_model.hpp>
 #include <adaptseg/core/cell_input_scores.hpp>
 #include <adaptseg/core/jump_guard.hpp>
+#include <adaptseg/core/relabel_transfer.hpp>
 
 #include <doctest/doctest.h>
 
@@ -325,4 +326,29 @@ TEST_CASE("jump guard: the bound refuses the largest jumps that lost in total, a
   CHECK(guard.trusts(0.1, 0.1));
   CHECK(JumpGuard().trusts(0.0, 1.0));  // no bound: no guard
   CHECK_THROWS_AS(JumpGuard(std::nan("")), std::invalid_argument);
+}
+
+TEST_CASE("relabel transfer: how far a field's gain factor moved with its relabelled factor on the training fields") {
+  // Four fields at one pair of GSDs, two cells each; field f gains g_f·x and relabels r_f·x.
+  const auto fields = [](std::vector<std::pair<double, double>> gr) {
+    std::vector<CellSample> s;
+    for (std::size_t f = 0; f < gr.size(); ++f)
+      for (double x : {0.02, 0.05}) s.push_back(cell(f, 15.0, 5.0, x, 1000.0, gr[f].first * x, gr[f].second * x));
+    return s;
+  };
+  const auto b = [](const std::vector<CellSample>& s) { return relabel_transfer(s, DecisionInput::expected_error); };
+  // Gain and relabelled share in proportion on every field: the gain follows s whole.
+  CHECK(b(fields({{0.1, 0.5}, {0.2, 1.0}, {0.3, 1.5}, {0.4, 2.0}})) == doctest::Approx(1.0));
+  // The gain's ratios half as far from 1 as the relabelled share's (pooled slopes 0.25 and 1.25;
+  // ratios 0.8/0.6, 0.9/0.8, 1.1/1.2, 1.2/1.4).
+  CHECK(b(fields({{0.2, 0.75}, {0.225, 1.0}, {0.275, 1.5}, {0.3, 1.75}})) == doctest::Approx(0.5));
+  // The field that relabels most gains least (a class whose closer looks write it where it is
+  // absent): nothing carried over.
+  CHECK(b(fields({{0.4, 0.5}, {0.3, 1.0}, {0.2, 1.5}, {0.1, 2.0}})) == 0.0);
+  // More than in proportion: clamped to s itself.
+  CHECK(b(fields({{0.05, 0.5}, {0.1, 1.0}, {0.4, 1.5}, {0.45, 2.0}})) == 1.0);
+  // Too few fields, or no spread of the relabelled share: nothing measured, 1.
+  CHECK(b(fields({{0.4, 0.5}, {0.1, 2.0}})) == 1.0);
+  CHECK(b(fields({{0.4, 1.0}, {0.1, 1.0}, {0.2, 1.0}})) == 1.0);
+  CHECK(b({}) == 1.0);
 }

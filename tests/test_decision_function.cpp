@@ -768,6 +768,52 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     CHECK(parse_field_factor_source(to_string(FieldFactorSource::relabelled)) == FieldFactorSource::relabelled);
     CHECK_THROWS_AS((void)parse_field_factor_source("relabeled"), std::invalid_argument);
   }
+  SUBCASE("the relabelled share carried to the gain by b: 1 + b·(s − 1), s itself at b = 1, nothing at b = 0") {
+    // As above: a descent relabels twice its forecast share, s → 2; the gain follows by b.
+    const auto run = [&](double b) {
+      FrontAwarePolicy p(with_cells(1.0), reference,
+                         {.online = true,
+                          .curve = CurveSource::field,
+                          .field_factor = FieldFactorSource::relabelled,
+                          .relabel_transfer = b});
+      for (int k = 0; k < 5; ++k) {
+        DecisionContext seen = s.region(0, 0.001);
+        seen.candidates = {};
+        REQUIRE_FALSE(p.decide(seen).descend);
+      }
+      DecisionContext first = s.region(5, 0.1);
+      first.elapsed_s = 5.7 * 6;
+      first.rest_s = 40.0 - first.elapsed_s;
+      const Decision d = p.decide(first);
+      REQUIRE(d.descend);
+      const double top = d.candidate == 0 ? 0.05 : 0.1;
+      DescentOutcome o = cell_outcome(top, top);
+      o.relabelled = {2.0 * top, 2.0 * top};
+      p.observe(o);
+      DecisionContext next = s.region(6, 0.1);
+      next.elapsed_s = 5.7 * 7;
+      next.rest_s = 40.0 - next.elapsed_s;
+      return std::pair{p.field_scale(), p.decide(next)};
+    };
+    const auto [s1, whole] = run(1.0);
+    const auto [s0, none] = run(0.0);
+    const auto [sh, half] = run(0.5);
+    // s learns from the relabelled share alike whatever b: b says only how far the gain follows.
+    CHECK(s1 == doctest::Approx(2.0).epsilon(0.01));
+    CHECK(s0 == s1);
+    CHECK(sh == s1);
+    for (std::size_t k = 0; k < 2; ++k) {
+      const double base = none.scores[k].predicted_field_gain;  // b = 0: the gain as forecast
+      REQUIRE(base > 0.0);
+      CHECK(whole.scores[k].predicted_field_gain == doctest::Approx(s1 * base));
+      CHECK(half.scores[k].predicted_field_gain == doctest::Approx((1.0 + 0.5 * (s1 - 1.0)) * base));
+      // The relabelled share is forecast with s itself, whatever b.
+      CHECK(none.scores[k].predicted_relabelled == doctest::Approx(whole.scores[k].predicted_relabelled));
+    }
+    FrontAwarePolicy::Params bad{.field_factor = FieldFactorSource::relabelled, .relabel_transfer = 1.5};
+    CHECK_THROWS_WITH_AS(bad.validate(), doctest::Contains("relabel_transfer must be in [0, 1]"),
+                         std::invalid_argument);
+  }
   SUBCASE("the top level: the coarsest calibrated GSD whose lawnmower nothing faster beats") {
     FrontAwarePolicy p(with_cells(1.0), {{"a", {{1.0, 0.95}, {2.0, 0.85}, {3.0, 0.75}}, 0.2, 0.05}}, {});
     // 2 cm/px is faster than 3 over this area (its grid fits it better) and maps better.

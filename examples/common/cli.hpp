@@ -248,6 +248,7 @@ struct CalibrationCli {
   bool gain_ratios = false;
   bool margin_biases = false;
   bool jump_guard = false;
+  bool relabel_transfer = false;
   double curve_agreement = 0.0;
 
   void add_to(CLI::App& app) {
@@ -331,6 +332,10 @@ struct CalibrationCli {
                      "front-aware rule with ranked cells: descend no more after a descent image whose share of "
                      "the labels of interest lies so far above the top-level map's over its cell that re-mapping "
                      "such cells lost on the training fields (that image not fused; saved in the model)"),
+        app.add_flag("--relabel-transfer", relabel_transfer,
+                     "front-aware rule with --field-factor relabelled: scale a descent's gain by the field "
+                     "factor learnt from the relabelled share only as far as a field's gain moved with its "
+                     "relabelled share on the training fields' cells (measured; saved in the model)"),
         app.add_flag("--margin-biases", margin_biases,
                      "front-aware rule, several training fields: add to each descent's forecast margin what "
                      "descents to its GSD ended above theirs per second when the training fields were flown "
@@ -375,6 +380,7 @@ struct CalibrationCli {
     options.gain_ratios = gain_ratios;
     options.margin_biases = margin_biases;
     options.jump_guard = jump_guard;
+    options.relabel_transfer = relabel_transfer;
     options.front_aware.curve_agreement = curve_agreement;
     options.top_levels.clear();
     for (const auto& name : top_levels) options.top_levels.push_back(parse_top_level_choice(name));

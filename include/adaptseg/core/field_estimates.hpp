@@ -94,6 +94,20 @@ class FieldShareEstimate {
   double seen_entropy_share_ = 0.0;  ///< ... the share of the field those regions cover
 };
 
+/// A field factor's estimate: the mean and variance of its posterior (FieldScale).
+struct FactorEstimate {
+  double mean = 1.0;
+  double var = 0.0;
+
+  /// A forecast gain (of a descent, or of the field's curve) `base` before the factor, times the
+  /// factor. A gain the training fields saw (base >= 0) scales with it and turns into a loss
+  /// where a scene check found the finer look worse (mean < 0); a loss the training fields saw
+  /// (base < 0: a descent GSD that lost there) stays a loss whatever the factor: |mean|·base.
+  /// Without it, a field where descending loses would forecast a gain for exactly the descents
+  /// the training fields saw lose.
+  [[nodiscard]] double scaled(double base) const noexcept { return base >= 0.0 ? mean * base : std::abs(mean) * base; }
+};
+
 /// The field factor s: how much more (s > 1) or less than forecast this field's descents
 /// relabel. Prior N(1, ω²); each observation y = s·μ + ε, ε ~ N(0, noise), updates its posterior
 /// (conjugate Gaussian): precision 1/ω² + Σ μ²/noise, mean (1/ω² + Σ μ·y/noise) / precision.
@@ -118,13 +132,18 @@ class FieldScale {
     var_ = 1.0 / precision;
   }
 
-  /// A forecast gain (of a descent, or of the field's curve) `base` before s, times s. A gain
-  /// the training fields saw (base >= 0) scales with s and turns into a loss where a scene check
-  /// found the finer look worse (s < 0); a loss the training fields saw (base < 0: a descent GSD
-  /// that lost there) stays a loss whatever s: |s|·base. Without it, a field where descending
-  /// loses would forecast a gain for exactly the descents the training fields saw lose.
-  [[nodiscard]] double scaled(double base) const noexcept {
-    return base >= 0.0 ? mean_ * base : std::abs(mean_) * base;
+  /// s's estimate now.
+  [[nodiscard]] FactorEstimate estimate() const noexcept { return {mean_, var_}; }
+
+  /// A forecast gain `base` before s, times s (FactorEstimate::scaled).
+  [[nodiscard]] double scaled(double base) const noexcept { return estimate().scaled(base); }
+
+  /// The estimate of a second factor that moves b times as far from 1 as s does, s' = 1 + b·(s − 1)
+  /// (FrontAwarePolicy::Params::relabel_transfer): mean 1 + b·(mean − 1), variance b²·Var(s);
+  /// b = 1: s's own.
+  [[nodiscard]] FactorEstimate transferred(double b) const noexcept {
+    if (b == 1.0) return estimate();
+    return {1.0 + b * (mean_ - 1.0), b * b * var_};
   }
 
  private:

@@ -77,53 +77,8 @@ namespace adaptseg {
 /// update of O. `online = false` (non-adaptive) keeps s = 1, Var(s) = ω² and O as initialised.
 class FrontAwarePolicy {
  public:
-  /// Behaviour; validated by the constructor.
-  struct Params {
-    double min_sigma = 0.0;            ///< σ below which the UAV never descends
-    bool online = true;                ///< field correction and O's update (false: non-adaptive)
-    double confidence = 0.0;           ///< z >= 0 of the lower bound (see class comment)
-    double scale_prior_sd = 0.5;       ///< ω > 0, prior spread of the field factor s
-    double sigma_prior_weight = 0.25;  ///< k > 0: weight of the training fields' σ in σ̂ [fields]
-    double sigma_prior_sd = 0.0;       ///< τ >= 0: spread of a field's σ about the training fields' mean
-    double curve_agreement = 0.0;      ///< q in [0, 1]: see class comment; 0: no such check
-    /// The jump guard's bound (JumpGuard; adaptive and non-adaptive alike; infinity: none):
-    /// after a descent image beyond it the UAV descends no more (trusts_descent_image()).
-    double jump_bound = std::numeric_limits<double>::infinity();
-    /// The lawnmower curve a descent is compared with (CurveSource; `corrected` is the
-    /// programs' default, this struct's the training fields' curves).
-    CurveSource curve = CurveSource::training;
-    /// How top_gsd() chooses the top level (TopLevelChoice).
-    TopLevelChoice top_level = TopLevelChoice::undominated;
-    /// What the field factor s learns from and scales (FieldFactorSource).
-    FieldFactorSource field_factor = FieldFactorSource::scene_check;
-    /// Per descent GSD, the factor on a candidate's forecast field gain (mean and spread): what
-    /// descents to it realised of their forecast on the training fields, each flown with a model
-    /// that never saw it (CalibrationOptions::gain_ratios). Not listed: 1. Empty: none.
-    std::vector<GainRatio> gain_ratios{};
-    /// Per descent GSD, b: what descents to it ended above their forecast margin per second on
-    /// the training fields flown so (CalibrationOptions::margin_biases); b·T is added to a
-    /// candidate's margin (ĝ − ΔD̄), its spread unchanged. Not listed: 0. Empty: none.
-    std::vector<MarginBias> margin_biases{};
-
-    /// @throws std::invalid_argument naming the field.
-    void validate() const {
-      detail::require(std::isfinite(min_sigma) && min_sigma >= 0.0 && min_sigma <= 1.0,
-                      "FrontAwarePolicy::Params::min_sigma must be in [0, 1]", min_sigma);
-      detail::require(std::isfinite(confidence) && confidence >= 0.0,
-                      "FrontAwarePolicy::Params::confidence must be finite and >= 0", confidence);
-      detail::require(std::isfinite(scale_prior_sd) && scale_prior_sd > 0.0,
-                      "FrontAwarePolicy::Params::scale_prior_sd must be finite and > 0", scale_prior_sd);
-      detail::require(std::isfinite(sigma_prior_weight) && sigma_prior_weight > 0.0,
-                      "FrontAwarePolicy::Params::sigma_prior_weight must be finite and > 0", sigma_prior_weight);
-      detail::require(std::isfinite(sigma_prior_sd) && sigma_prior_sd >= 0.0 && sigma_prior_sd <= 1.0,
-                      "FrontAwarePolicy::Params::sigma_prior_sd must be in [0, 1]", sigma_prior_sd);
-      detail::require(std::isfinite(curve_agreement) && curve_agreement >= 0.0 && curve_agreement <= 1.0,
-                      "FrontAwarePolicy::Params::curve_agreement must be in [0, 1]", curve_agreement);
-      detail::require(!std::isnan(jump_bound), "FrontAwarePolicy::Params::jump_bound must not be NaN", jump_bound);
-      for (const GainRatio& r : gain_ratios) r.validate();
-      for (const MarginBias& b : margin_biases) b.validate();
-    }
-  };
+  /// Behaviour (FrontAwareParams); validated by the constructor.
+  using Params = FrontAwareParams;
 
   /// @throws std::invalid_argument for invalid params, a model without C and without a cell gain
   ///         model, no reference curve, a curve without points, or a point with a GSD <= 0 or
@@ -372,9 +327,9 @@ class FrontAwarePolicy {
     Assessment a;
     a.score = scored(cand, f);
     const BaseGain b = base_gain(c, cand, f, delta_h, weight);
-    a.gain = scaled(b.mean);
-    const double gain_var =
-        scale_.mean() * scale_.mean() * b.sd * b.sd + scale_.var() * b.mean * b.mean + a.gain * a.gain * sigma_cv2;
+    const FactorEstimate s = gain_factor();
+    a.gain = s.scaled(b.mean);
+    const double gain_var = s.mean * s.mean * b.sd * b.sd + s.var * b.mean * b.mean + a.gain * a.gain * sigma_cv2;
     a.score.predicted_field_gain = a.gain;
     if (std::isfinite(b.relabelled.mean)) a.score.predicted_relabelled = std::abs(scale_.mean()) * b.relabelled.mean;
     a.score.utility = utility(a.gain, cand.extra_time_s);
@@ -398,6 +353,13 @@ class FrontAwarePolicy {
 
   /// A forecast gain `base` before the field factor s, times s (FieldScale::scaled).
   [[nodiscard]] double scaled(double base) const noexcept { return scale_.scaled(base); }
+
+  /// The factor a descent's forecast gain is scaled by: s, or with s learnt from the relabelled
+  /// share, 1 + b·(s − 1) (Params::relabel_transfer b; FieldScale::transferred).
+  [[nodiscard]] FactorEstimate gain_factor() const noexcept {
+    return params_.field_factor == FieldFactorSource::relabelled ? scale_.transferred(params_.relabel_transfer)
+                                                                 : scale_.estimate();
+  }
 
   /// X̂, the field's mean input per field pixel (CurveSource::field): FieldShareEstimate::input
   /// towards the training fields' mean input at this top level with σ̂'s weight k.

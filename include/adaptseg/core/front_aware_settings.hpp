@@ -13,6 +13,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <span>
 #include <string>
 #include <string_view>
@@ -100,7 +101,8 @@ inline constexpr std::array<detail::NamedValue<CurveSource>, 3> kCurveSources{{
 ///   anchor. On the leave-one-tile-out runs a field's gain per unit of input and its relabelled
 ///   share per unit of input move together for building, while the field's real lawnmower rise
 ///   did not follow the descents' gains (docs/method.md, "The field factor from what a descent
-///   relabelled", with what it measured).
+///   relabelled", with what it measured); how far the gain follows s is
+///   FrontAwareParams::relabel_transfer (1: whole).
 enum class FieldFactorSource { scene_check, relabelled };
 
 /// Every field-factor source by name.
@@ -227,6 +229,61 @@ namespace detail {
   return s / static_cast<double>(curves.size());
 }
 }  // namespace detail
+
+/// The front-aware rule's behaviour (FrontAwarePolicy::Params; the class comment there says what
+/// each setting does); validated by FrontAwarePolicy's constructor.
+struct FrontAwareParams {
+  double min_sigma = 0.0;            ///< σ below which the UAV never descends
+  bool online = true;                ///< field correction and O's update (false: non-adaptive)
+  double confidence = 0.0;           ///< z >= 0 of the lower bound
+  double scale_prior_sd = 0.5;       ///< ω > 0, prior spread of the field factor s
+  double sigma_prior_weight = 0.25;  ///< k > 0: weight of the training fields' σ in σ̂ [fields]
+  double sigma_prior_sd = 0.0;       ///< τ >= 0: spread of a field's σ about the training fields' mean
+  double curve_agreement = 0.0;      ///< q in [0, 1]; 0: no such check
+  /// The jump guard's bound (JumpGuard; adaptive and non-adaptive alike; infinity: none):
+  /// after a descent image beyond it the UAV descends no more (trusts_descent_image()).
+  double jump_bound = std::numeric_limits<double>::infinity();
+  /// The lawnmower curve a descent is compared with (CurveSource; `corrected` is the
+  /// programs' default, this struct's the training fields' curves).
+  CurveSource curve = CurveSource::training;
+  /// How top_gsd() chooses the top level (TopLevelChoice).
+  TopLevelChoice top_level = TopLevelChoice::undominated;
+  /// What the field factor s learns from and scales (FieldFactorSource).
+  FieldFactorSource field_factor = FieldFactorSource::scene_check;
+  /// b in [0, 1], with `field_factor` relabelled: the descent's gain is scaled by 1 + b·(s − 1),
+  /// s learnt from the relabelled share, b how far a field's gain factor moved with its
+  /// relabelled factor on the training fields (relabel_transfer(); 1: by s itself, 0: not at all).
+  double relabel_transfer = 1.0;
+  /// Per descent GSD, the factor on a candidate's forecast field gain (mean and spread): what
+  /// descents to it realised of their forecast on the training fields, each flown with a model
+  /// that never saw it (CalibrationOptions::gain_ratios). Not listed: 1. Empty: none.
+  std::vector<GainRatio> gain_ratios{};
+  /// Per descent GSD, b: what descents to it ended above their forecast margin per second on
+  /// the training fields flown so (CalibrationOptions::margin_biases); b·T is added to a
+  /// candidate's margin (ĝ − ΔD̄), its spread unchanged. Not listed: 0. Empty: none.
+  std::vector<MarginBias> margin_biases{};
+
+  /// @throws std::invalid_argument naming the field.
+  void validate() const {
+    detail::require(std::isfinite(min_sigma) && min_sigma >= 0.0 && min_sigma <= 1.0,
+                    "FrontAwarePolicy::Params::min_sigma must be in [0, 1]", min_sigma);
+    detail::require(std::isfinite(confidence) && confidence >= 0.0,
+                    "FrontAwarePolicy::Params::confidence must be finite and >= 0", confidence);
+    detail::require(std::isfinite(scale_prior_sd) && scale_prior_sd > 0.0,
+                    "FrontAwarePolicy::Params::scale_prior_sd must be finite and > 0", scale_prior_sd);
+    detail::require(std::isfinite(sigma_prior_weight) && sigma_prior_weight > 0.0,
+                    "FrontAwarePolicy::Params::sigma_prior_weight must be finite and > 0", sigma_prior_weight);
+    detail::require(std::isfinite(sigma_prior_sd) && sigma_prior_sd >= 0.0 && sigma_prior_sd <= 1.0,
+                    "FrontAwarePolicy::Params::sigma_prior_sd must be in [0, 1]", sigma_prior_sd);
+    detail::require(std::isfinite(curve_agreement) && curve_agreement >= 0.0 && curve_agreement <= 1.0,
+                    "FrontAwarePolicy::Params::curve_agreement must be in [0, 1]", curve_agreement);
+    detail::require(!std::isnan(jump_bound), "FrontAwarePolicy::Params::jump_bound must not be NaN", jump_bound);
+    detail::require(std::isfinite(relabel_transfer) && relabel_transfer >= 0.0 && relabel_transfer <= 1.0,
+                    "FrontAwarePolicy::Params::relabel_transfer must be in [0, 1]", relabel_transfer);
+    for (const GainRatio& r : gain_ratios) r.validate();
+    for (const MarginBias& b : margin_biases) b.validate();
+  }
+};
 
 /// The share of the training fields in `reference` whose lawnmower at GSD `g` mapped better than
 /// theirs at the top level `top` (FrontAwarePolicy::Params `curve_agreement`); 0 without any.

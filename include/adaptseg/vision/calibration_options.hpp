@@ -133,6 +133,12 @@ struct CalibrationOptions {
   /// model, every field's cells; in the search, each fold's the other fields' only. false (the
   /// default): no guard.
   bool jump_guard = false;
+  /// Front-aware rule with ranked cells and FrontAwarePolicy::Params::field_factor relabelled:
+  /// measure Params::relabel_transfer b on the training fields' cell samples
+  /// (relabel_transfer(): how far a field's gain factor moved with its relabelled factor), in
+  /// the model every field's cells, in the search each fold's the other fields' only. false
+  /// (the default): `front_aware`'s b (1: s scales the gain whole).
+  bool relabel_transfer = false;
   /// Front-aware rule, σ̂'s prior (FrontAwarePolicy `sigma_prior_weight` k, `sigma_prior_sd` τ)
   /// with several training fields: `given` keeps `front_aware`'s; `spread` estimates τ on the
   /// training fields (estimate_sigma_prior) and keeps k; `estimated` estimates both. Each fold

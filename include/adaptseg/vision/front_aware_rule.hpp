@@ -53,6 +53,7 @@ struct FrontAwareRule {
     if (std::isfinite(p.jump_bound)) e << YAML::Key << "jump_bound" << YAML::Value << num(p.jump_bound);
     if (p.field_factor != FieldFactorSource::scene_check)
       e << YAML::Key << "field_factor" << YAML::Value << to_string(p.field_factor);
+    if (p.relabel_transfer != 1.0) e << YAML::Key << "relabel_transfer" << YAML::Value << num(p.relabel_transfer);
     std::vector<std::pair<double, double>> ratios, biases;
     for (const GainRatio& x : p.gain_ratios) ratios.emplace_back(x.gsd_cm, x.ratio);
     for (const MarginBias& x : p.margin_biases) biases.emplace_back(x.gsd_cm, x.per_s);
@@ -126,6 +127,7 @@ struct FrontAwareRule {
              rule.has("top_level") ? read_named(rule, "top_level", kTopLevelChoices) : TopLevelChoice::undominated,
          .field_factor = rule.has("field_factor") ? read_named(rule, "field_factor", kFieldFactorSources)
                                                   : FieldFactorSource::scene_check,
+         .relabel_transfer = rule.has("relabel_transfer") ? rule.number("relabel_transfer") : 1.0,
          .gain_ratios = read_gain_ratios(rule),
          .margin_biases = read_margin_biases(rule)});
   }
@@ -196,8 +198,9 @@ struct FrontAwareRule {
   }
 
   /// Refuses options its search cannot use (before calibrate() samples anything).
-  /// @throws std::invalid_argument if `confidences` or `slope_poolings` is empty, or
-  ///         `slope_poolings` or `top_levels` names a value twice.
+  /// @throws std::invalid_argument if `confidences` or `slope_poolings` is empty,
+  ///         `slope_poolings` or `top_levels` names a value twice, or `relabel_transfer` is asked
+  ///         without the relabelled field factor.
   static void check_options(const CalibrationOptions& options) {
     detail::require(!options.confidences.empty(), "calibrate: confidences must not be empty", 0);
     detail::require(!options.slope_poolings.empty(), "calibrate: slope_poolings must not be empty", 0);
@@ -209,6 +212,10 @@ struct FrontAwareRule {
       for (std::size_t j = 0; j < k; ++j)
         detail::require(options.top_levels[j] != options.top_levels[k],
                         "calibrate: top_levels names a choice twice:", to_string(options.top_levels[k]));
+    detail::require(!options.relabel_transfer || options.front_aware.field_factor == FieldFactorSource::relabelled,
+                    "calibrate: relabel_transfer (how far the gain follows the relabelled share) needs the field "
+                    "factor 'relabelled'; the field factor",
+                    to_string(options.front_aware.field_factor));
   }
 
   /// The calibration search (CalibrationOptions: `front_aware`, `confidences`,
