@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Self-test of compose_model.py on the bundled deployment network's decision models (run by
 CTest; exit code != 0 on failure): the reference of one model in the other's place, z where
-asked, everything else the gain model's; models of different labels of interest, or of another
-rule, refused with exit code 2 and one line.
+asked, everything else the gain model's; without a reference, one setting of the model's own
+rule changed; models of different labels of interest, or of another rule, and values out of
+bounds refused with exit code 2 and one line.
 """
 import contextlib
 import io
@@ -48,7 +49,16 @@ def main():
         assert compose_model.main(["--gain", road, "--reference", other_path, "--out", out]) == 0
         assert load(out)["rule"]["confidence"] == gain["rule"]["confidence"]
 
-        # Refused: another label of interest, another rule, a negative z.
+        # Without --reference the model keeps its own: one setting of its rule changed (z, or the
+        # weight of σ̂'s prior), everything else as it was.
+        for flag, setting, value in (("--confidence", "confidence", 1.5), ("--sigma-prior-weight", "sigma_prior_weight", 0.01)):
+            assert compose_model.main(["--gain", road, flag, str(value), "--out", out]) == 0
+            edited = load(out)
+            assert edited["rule"][setting] == value and gain["rule"][setting] != value
+            edited["rule"][setting] = gain["rule"][setting]
+            assert edited == gain, setting
+
+        # Refused: another label of interest, another rule, a negative z, a weight of 0.
         utility = load(road)
         utility["rule"] = {"kind": "utility"}
         utility_path = os.path.join(tmp, "utility.yaml")
@@ -58,6 +68,8 @@ def main():
             (["--gain", road, "--reference", building], "different classes or labels of interest"),
             (["--gain", utility_path, "--reference", road], "--gain: not a front-aware decision model"),
             (["--gain", road, "--reference", road, "--confidence", "-1"], "--confidence must be >= 0"),
+            (["--gain", road, "--sigma-prior-weight", "0"], "--sigma-prior-weight must be > 0"),
+            (["--gain", utility_path, "--confidence", "1"], "--gain: not a front-aware decision model"),
         ]:
             err = io.StringIO()
             with contextlib.redirect_stderr(err):
