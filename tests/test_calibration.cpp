@@ -542,6 +542,14 @@ TEST_CASE(
   CHECK(b < 1.0);  // measured (on these blob fields the oracle relabels most where it gains least: 0)
   CHECK(rule.params().relabel_transfer == b);
   CHECK(rule.params().field_factor == FieldFactorSource::relabelled);
+  // τ_r likewise, when asked.
+  options.relabel_region_spread = true;
+  const CalibrationResult spread = calibrate(std::span<const Field>(fields), oracle, options);
+  const FrontAwarePolicy& with_spread = std::get<FrontAwarePolicy>(spread.decision_function.rule());
+  const double tau = relabel_region_sd(spread.cell_samples, with_spread.model().cells()->input());
+  CHECK(tau > 0.0);
+  CHECK(with_spread.params().relabel_region_sd == tau);
+  options.relabel_region_spread = false;
   // Not asked: the given b.
   options.relabel_transfer = false;
   CHECK(std::get<FrontAwarePolicy>(calibrate(std::span<const Field>(fields), oracle, options).decision_function.rule())
@@ -892,6 +900,13 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
                                                         "relabel_transfer: 1.5", "bad_transfer.yaml")),
                        doctest::Contains("relabel_transfer must be in [0, 1]"), std::invalid_argument);
   p.relabel_transfer = 1.0;
+  // τ_r likewise (absent: 0).
+  CHECK(rule_of(back).relabel_region_sd == 0.0);
+  p.relabel_region_sd = 0.25;
+  policy.set_params(p);
+  corrected.save(tmp.path() / "region_sd.yaml");
+  CHECK(rule_of(DecisionModel::load(tmp.path() / "region_sd.yaml")).relabel_region_sd == 0.25);
+  p.relabel_region_sd = 0.0;
   // Fields of another class set are refused.
   const Field other("o", 1.0, a.labels(), {{"a", {0, 0, 0}}, {"b", {1, 1, 1}}, {"c", {2, 2, 2}}}, {1});
   const std::vector<Field> mixed{a, other};

@@ -5,6 +5,7 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -351,4 +352,31 @@ TEST_CASE("relabel transfer: how far a field's gain factor moved with its relabe
   CHECK(b(fields({{0.4, 0.5}, {0.1, 2.0}})) == 1.0);
   CHECK(b(fields({{0.4, 1.0}, {0.1, 1.0}, {0.2, 1.0}})) == 1.0);
   CHECK(b({}) == 1.0);
+}
+
+TEST_CASE("relabel region spread: how far a region's relabelled share strays from its field's, about the forecast") {
+  // Two fields, two regions each, every cell x = 0.1: the pooled slope α = 1, each region forecast
+  // 0.1. Field 0's regions relabel 0.05 and 0.15 (ρ 0.5 and 1.5), field 1's 0.1 and 0.1: within
+  // the fields Σ (ρ − ρ̄)² = 0.5 over 2 degrees of freedom, τ_r = 0.5.
+  std::vector<CellSample> s;
+  const auto add = [&](std::size_t field, std::size_t region, double chi) {
+    for (int k = 0; k < 3; ++k) {
+      CellSample c = cell(field, 15.0, 5.0, 0.1, 1000.0, 0.01, chi);
+      c.region = region;
+      s.push_back(c);
+    }
+  };
+  add(0, 0, 0.05);
+  add(0, 1, 0.15);
+  add(1, 0, 0.1);
+  add(1, 1, 0.1);
+  CHECK(relabel_region_sd(s, DecisionInput::expected_error) == doctest::Approx(0.5));
+  // A field's own level is taken out, the ratios are to the pooled forecast: field 1 relabelling
+  // 0.2 in both regions raises α to 1.5, field 0's ratios become 1/3 and 1, τ_r = 1/3.
+  for (CellSample& c : s)
+    if (c.field == 1) c.relabelled = 0.2;
+  CHECK(relabel_region_sd(s, DecisionInput::expected_error) == doctest::Approx(1.0 / 3.0));
+  // One region per field: nothing to measure.
+  s.erase(std::remove_if(s.begin(), s.end(), [](const CellSample& c) { return c.region == 1; }), s.end());
+  CHECK(relabel_region_sd(s, DecisionInput::expected_error) == 0.0);
 }

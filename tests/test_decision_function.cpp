@@ -770,12 +770,13 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
   }
   SUBCASE("the relabelled share carried to the gain by b: 1 + b·(s − 1), s itself at b = 1, nothing at b = 0") {
     // As above: a descent relabels twice its forecast share, s → 2; the gain follows by b.
-    const auto run = [&](double b) {
+    const auto run = [&](double b, double region_sd = 0.0) {
       FrontAwarePolicy p(with_cells(1.0), reference,
                          {.online = true,
                           .curve = CurveSource::field,
                           .field_factor = FieldFactorSource::relabelled,
-                          .relabel_transfer = b});
+                          .relabel_transfer = b,
+                          .relabel_region_sd = region_sd});
       for (int k = 0; k < 5; ++k) {
         DecisionContext seen = s.region(0, 0.001);
         seen.candidates = {};
@@ -812,6 +813,15 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     }
     FrontAwarePolicy::Params bad{.field_factor = FieldFactorSource::relabelled, .relabel_transfer = 1.5};
     CHECK_THROWS_WITH_AS(bad.validate(), doctest::Contains("relabel_transfer must be in [0, 1]"),
+                         std::invalid_argument);
+    // A region's own spread τ_r = 1 beside the cells' (nearly none): one descent that relabels
+    // twice its forecast says s ≈ (1/ω² + 2) / (1/ω² + 1) = 6 / 5 with ω = 0.5, not 2.
+    const auto [s_region, region_decision] = run(1.0, 1.0);
+    CHECK(s_region == doctest::Approx(1.2).epsilon(0.01));
+    CHECK(region_decision.scores[0].predicted_field_gain ==
+          doctest::Approx(s_region * none.scores[0].predicted_field_gain));
+    bad = {.field_factor = FieldFactorSource::relabelled, .relabel_region_sd = -0.1};
+    CHECK_THROWS_WITH_AS(bad.validate(), doctest::Contains("relabel_region_sd must be finite and >= 0"),
                          std::invalid_argument);
   }
   SUBCASE("the top level: the coarsest calibrated GSD whose lawnmower nothing faster beats") {

@@ -249,6 +249,7 @@ struct CalibrationCli {
   bool margin_biases = false;
   bool jump_guard = false;
   bool relabel_transfer = false;
+  bool relabel_region_spread = false;
   double curve_agreement = 0.0;
 
   void add_to(CLI::App& app) {
@@ -336,6 +337,11 @@ struct CalibrationCli {
                      "front-aware rule with --field-factor relabelled: scale a descent's gain by the field "
                      "factor learnt from the relabelled share only as far as a field's gain moved with its "
                      "relabelled share on the training fields' cells (measured; saved in the model)"),
+        app.add_flag("--relabel-region-spread", relabel_region_spread,
+                     "front-aware rule with --field-factor relabelled: count how far one region's relabelled "
+                     "share strayed from its field's on the training fields' cells as noise of each descent's "
+                     "observation, so that one region does not carry the field factor with it (measured; saved "
+                     "in the model)"),
         app.add_flag("--margin-biases", margin_biases,
                      "front-aware rule, several training fields: add to each descent's forecast margin what "
                      "descents to its GSD ended above theirs per second when the training fields were flown "
@@ -381,6 +387,7 @@ struct CalibrationCli {
     options.margin_biases = margin_biases;
     options.jump_guard = jump_guard;
     options.relabel_transfer = relabel_transfer;
+    options.relabel_region_spread = relabel_region_spread;
     options.front_aware.curve_agreement = curve_agreement;
     options.top_levels.clear();
     for (const auto& name : top_levels) options.top_levels.push_back(parse_top_level_choice(name));

@@ -33,7 +33,13 @@ the ground truth's shares of the same two images (truth_sigma): what the UAV cou
 network that writes the class where it is absent at a finer GSD (a large jump the ground truth
 does not share), image by image, before the descent ends. Sorted by the jump, largest first.
 
-Usage: descent_table.py [--strategy adaptive] [--curve | --hindsight [--gsd G] | --images] RUN_DIR [RUN_DIR ...]
+With --relabelled, per run its descents' relabelled share against its forecast (observed /
+forecast_relabelled_interest) beside their realised field gain against its forecast; then the
+variance of the logarithm of the first ratio within the runs (about each run's mean, n − 1 per
+run) and over all: how far one descent's relabelled share says what its field's does
+(docs/method.md, "The field factor from what a descent relabelled").
+
+Usage: descent_table.py [--strategy adaptive] [--curve | --hindsight [--gsd G] | --images | --relabelled] RUN_DIR [RUN_DIR ...]
 """
 
 from __future__ import annotations
@@ -167,6 +173,36 @@ def images_table(runs: list[str], strategy: str) -> None:
               f"ground-truth rise below half the jump")
 
 
+def relabelled_table(rows: list[tuple[str, dict]]) -> None:
+    """Per run, each descent's relabelled share and field gain against their forecasts; the
+    spread of the first's logarithm within the runs and over all."""
+    by_run: dict[str, list[tuple[float, float]]] = {}
+    for run, d in rows:
+        fc, ob = number(d["forecast_relabelled_interest"]), number(d["observed_relabelled_interest"])
+        fg, rg = number(d["forecast_field_gain"]), number(d["realised_field_gain"])
+        by_run.setdefault(run, []).append((ob / fc if fc > 0 else math.nan, rg / fg if fg > 0 else math.nan))
+    print("| run | relabelled / forecast, realised / forecast gain, per descent |")
+    print("| --- | --- |")
+    logs: list[tuple[str, float]] = []
+    for run, pairs in sorted(by_run.items()):
+        print(f"| {run} | {', '.join(f'{a:.2f} / {b:.2f}' for a, b in pairs)} |")
+        logs += [(run, math.log(a)) for a, _ in pairs if a > 0]
+    if len(logs) < 2:
+        return
+    mean = sum(x for _, x in logs) / len(logs)
+    total = sum((x - mean) ** 2 for _, x in logs) / (len(logs) - 1)
+    within = dof = 0.0
+    for run in by_run:
+        xs = [x for r, x in logs if r == run]
+        if len(xs) >= 2:
+            m = sum(xs) / len(xs)
+            within += sum((x - m) ** 2 for x in xs)
+            dof += len(xs) - 1
+    print()
+    print(f"{len(logs)} descents: variance of log(relabelled / forecast) {total:.3f} over all, "
+          f"{within / dof if dof else math.nan:.3f} within the runs ({dof:g} degrees of freedom)")
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--strategy", default="adaptive")
@@ -177,6 +213,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--gsd", type=float, help="with --hindsight: the margin of the descents to this GSD alone")
     ap.add_argument("--images", action="store_true",
                     help="each descent image's σ against its region's top-level σ, and the ground truth's")
+    ap.add_argument("--relabelled", action="store_true",
+                    help="each descent's relabelled share against its forecast, and its spread within the runs")
     ap.add_argument("runs", nargs="+")
     args = ap.parse_args(argv)
     if args.images:
@@ -192,6 +230,9 @@ def main(argv: list[str] | None = None) -> int:
                 if "realised_delta_tp" not in d:
                     raise SystemExit(f"{path}: no realised_delta_tp column (written by adaptseg_evaluate since 2026-11-29)")
                 rows.append((Path(run).name, d))
+    if args.relabelled:
+        relabelled_table(rows)
+        return 0
     if args.hindsight:
         hindsight_table(args.runs, rows, args.strategy, args.gsd)
         return 0

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Self-test of descent_table.py's plain table, --curve, --hindsight and --images on a synthetic
+"""Self-test of descent_table.py's plain table, --curve, --hindsight, --images and --relabelled on a synthetic
 run (run by CTest; exit code != 0 on failure).
 
 Each descent's row: its gains, pixels and the change of its region's σ. One field whose
@@ -7,7 +7,8 @@ lawnmowers map L at 0.50 in 100 s and 0.60 in 200 s (the real curve rises 0.001 
 flown from the first by a mission with two descents: one gains 0.02 in 10 s (it beats the
 curve), the other 0.001 in 20 s (it does not). In hindsight the first alone ends +0.0100 above
 the curve (0.52 at 110 s against 0.51), both together −0.0090; the first's real rise over its
-seconds is 0.0100, against a predicted 0.0040.
+seconds is 0.0100, against a predicted 0.0040. The first relabels twice its forecast share, the
+second half of it: log ratios ±0.693, variance 0.961 within the run.
 """
 import contextlib
 import io
@@ -24,10 +25,10 @@ f,adaptive,15,0.521,130,-0.009
 """
 COLUMNS = ("field,strategy,decision,action,gsd_cm,images,extra_time_s,forecast_field_gain,realised_field_gain,"
            "realised_region_delta_miou,realised_delta_tp,realised_delta_fp,forecast_curve_rise,forecast_end_s,"
-           "sigma,observed_sigma_sub\n")
-DECISIONS = COLUMNS + """f,adaptive,0,descend,10,2,10,0.015,0.02,-0.05,100,-10,0.004,110,0.10,0.12
-f,adaptive,1,continue,,,,,,,,,,,0.2,
-f,adaptive,2,descend,10,2,20,0.006,0.001,-0.01,5,3,0.005,130,0.30,0.25
+           "sigma,observed_sigma_sub,forecast_relabelled_interest,observed_relabelled_interest\n")
+DECISIONS = COLUMNS + """f,adaptive,0,descend,10,2,10,0.015,0.02,-0.05,100,-10,0.004,110,0.10,0.12,0.1,0.2
+f,adaptive,1,continue,,,,,,,,,,,0.2,,,
+f,adaptive,2,descend,10,2,20,0.006,0.001,-0.01,5,3,0.005,130,0.30,0.25,0.1,0.05
 """
 # Per image: a top-level image (σ 0.10, truth 0.05), a descent of two images under it, one that
 # sees what the ground truth shows (σ 0.20, truth 0.16: jump +0.10) and one that writes the class
@@ -91,6 +92,11 @@ def main():
             sys.exit(f"images: the two descent images, largest jump first:\n{images}")
         if "jump above 0.2: 1 of 2 descent images, of which 1 with a ground-truth rise below half the jump" not in images:
             sys.exit(f"images summary:\n{images}")
+        relabelled = table(["--relabelled", run])
+        if "| run | 2.00 / 1.33, 0.50 / 0.17 |" not in relabelled:
+            sys.exit(f"relabelled: the run's two ratios:\n{relabelled}")
+        if "2 descents: variance of log(relabelled / forecast) 0.961 over all, 0.961 within the runs" not in relabelled:
+            sys.exit(f"relabelled summary:\n{relabelled}")
     print("ok: descent_table.py sets each descent against the real curve and finds the best in hindsight")
 
 

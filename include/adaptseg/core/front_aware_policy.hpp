@@ -193,9 +193,13 @@ class FrontAwarePolicy {
     if (out.descent >= chosen_.size()) return;
     const Relabelled& f = chosen_[out.descent];
     if (model_.cells() && f.sub_gsd_cm > 0.0 && params_.field_factor == FieldFactorSource::relabelled) {
-      // χ_obs = s·μ + ε, μ the cell gain model's relabelled share, ε ~ N(0, its spread of one descent).
-      if (std::isfinite(f.mean) && f.mean > 0.0)
-        scale_.observe(f.mean, out.relabelled.interest_share, std::max(f.noisy_sd * f.noisy_sd, 1e-12), true);
+      // χ_obs = s·μ + ε, μ the cell gain model's relabelled share, ε ~ N(0, its spread of one
+      // descent and the region's own, (τ_r·μ)²).
+      if (std::isfinite(f.mean) && f.mean > 0.0) {
+        const double region = params_.relabel_region_sd * f.mean;
+        scale_.observe(f.mean, out.relabelled.interest_share,
+                       std::max(f.noisy_sd * f.noisy_sd, 1e-12) + region * region, true);
+      }
     } else if (model_.cells() && f.sub_gsd_cm > 0.0) {
       // The scene check (cell gain model): the descent's gain as the finer look estimates it,
       // y = γ·d = s·μ + ε, d = top − fine input, ε ~ N(0, κ_p·Σ w²x + τ_γ²·d²), μ the forecast

@@ -254,6 +254,11 @@ struct FrontAwareParams {
   /// s learnt from the relabelled share, b how far a field's gain factor moved with its
   /// relabelled factor on the training fields (relabel_transfer(); 1: by s itself, 0: not at all).
   double relabel_transfer = 1.0;
+  /// τ_r >= 0, with `field_factor` relabelled: how far one region's relabelled share strays from
+  /// its field's factor, relative to the forecast (relabel_region_sd()); each descent's χ then
+  /// tells s with the variance (τ_r·μ)² beside its cells' own spread, so that one region that
+  /// relabels more or less than its field does not carry s with it. 0: the cells' spread alone.
+  double relabel_region_sd = 0.0;
   /// Per descent GSD, the factor on a candidate's forecast field gain (mean and spread): what
   /// descents to it realised of their forecast on the training fields, each flown with a model
   /// that never saw it (CalibrationOptions::gain_ratios). Not listed: 1. Empty: none.
@@ -280,6 +285,8 @@ struct FrontAwareParams {
     detail::require(!std::isnan(jump_bound), "FrontAwarePolicy::Params::jump_bound must not be NaN", jump_bound);
     detail::require(std::isfinite(relabel_transfer) && relabel_transfer >= 0.0 && relabel_transfer <= 1.0,
                     "FrontAwarePolicy::Params::relabel_transfer must be in [0, 1]", relabel_transfer);
+    detail::require(std::isfinite(relabel_region_sd) && relabel_region_sd >= 0.0,
+                    "FrontAwarePolicy::Params::relabel_region_sd must be finite and >= 0", relabel_region_sd);
     for (const GainRatio& r : gain_ratios) r.validate();
     for (const MarginBias& b : margin_biases) b.validate();
   }

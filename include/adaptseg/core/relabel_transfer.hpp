@@ -1,7 +1,9 @@
 #pragma once
 /// @file
-/// How far a field's gain factor moves with its relabelled factor (beyond the paper;
-/// docs/method.md, "The field factor from what a descent relabelled"). In flight the relabelled
+/// What one descent's relabelled share says about the field (beyond the paper; docs/method.md,
+/// "The field factor from what a descent relabelled"): how far a field's gain factor moves with
+/// its relabelled factor, and how far one region's relabelled share strays from its field's
+/// factor. In flight the relabelled
 /// share χ of each descent is observable and tells the field factor s of what descents relabel
 /// (FieldFactorSource::relabelled); whether the gain follows is a property of the class and the
 /// network that calibration can measure on its training fields' cells: a field whose cells
@@ -13,6 +15,7 @@
 #include <adaptseg/core/detail/gsd.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <span>
@@ -68,6 +71,79 @@ namespace adaptseg {
   }
   if (!(den > 0.0)) return 1.0;
   return std::clamp(num / den, 0.0, 1.0);
+}
+
+namespace detail {
+/// One field's regions at one pair of GSDs, as relabel_region_sd() reads them: Σ ρ, Σ ρ², n.
+struct RegionRatios {
+  double top = 0.0, sub = 0.0;
+  std::size_t field = 0;
+  double sum = 0.0, sum_sq = 0.0;
+  std::size_t n = 0;
+};
+
+/// Per pair of GSDs and field, the ratios ρ of its regions' relabelled shares to their forecast
+/// (relabel_region_sd()).
+inline std::vector<RegionRatios> region_ratios(std::span<const CellSample> cells, DecisionInput input) {
+  struct Region {
+    double top = 0.0, sub = 0.0;
+    std::size_t field = 0, region = 0;
+    double px = 0.0, px_x = 0.0, px_chi = 0.0;
+  };
+  std::vector<Region> regions;
+  std::vector<std::pair<const CellSample*, std::array<double, 2>>> slopes;  // (a cell of the pair, Σ w·x², Σ w·x·χ)
+  const auto same = [](double top, double sub, const CellSample& c) {
+    return same_gsd(top, c.top_gsd_cm) && same_gsd(sub, c.sub_gsd_cm);
+  };
+  for (const CellSample& c : cells) {
+    const double x = c.top.value(input), w = c.top.field_px;
+    if (!std::isfinite(x) || !(x >= 0.0) || !(w > 0.0)) continue;
+    auto s = std::find_if(slopes.begin(), slopes.end(),
+                          [&](const auto& q) { return same(q.first->top_gsd_cm, q.first->sub_gsd_cm, c); });
+    if (s == slopes.end()) s = slopes.insert(slopes.end(), {&c, {0.0, 0.0}});
+    s->second[0] += w * x * x;
+    s->second[1] += w * x * c.relabelled;
+    auto r = std::find_if(regions.begin(), regions.end(), [&](const Region& q) {
+      return same(q.top, q.sub, c) && q.field == c.field && q.region == c.region;
+    });
+    if (r == regions.end()) r = regions.insert(regions.end(), Region{c.top_gsd_cm, c.sub_gsd_cm, c.field, c.region});
+    r->px += w, r->px_x += w * x, r->px_chi += w * c.relabelled;
+  }
+  std::vector<RegionRatios> groups;
+  for (const Region& r : regions) {
+    const auto& s = *std::find_if(slopes.begin(), slopes.end(), [&](const auto& q) {
+      return same_gsd(q.first->top_gsd_cm, r.top) && same_gsd(q.first->sub_gsd_cm, r.sub);
+    });
+    const double forecast = (s.second[0] > 0.0 ? s.second[1] / s.second[0] : 0.0) * r.px_x / r.px;
+    if (!(forecast > 0.0)) continue;
+    const double rho = (r.px_chi / r.px) / forecast;
+    auto g = std::find_if(groups.begin(), groups.end(), [&](const RegionRatios& q) {
+      return same_gsd(q.top, r.top) && same_gsd(q.sub, r.sub) && q.field == r.field;
+    });
+    if (g == groups.end()) g = groups.insert(groups.end(), RegionRatios{r.top, r.sub, r.field});
+    g->sum += rho, g->sum_sq += rho * rho, ++g->n;
+  }
+  return groups;
+}
+}  // namespace detail
+
+/// τ_r >= 0 (FrontAwarePolicy::Params::relabel_region_sd) from calibration's cell samples
+/// `cells`, their input `input`: how far one region's relabelled share strays from what its
+/// field's factor says, relative to the forecast. Per pair of GSDs, α the slope through the
+/// origin of the relabelled share on the input over every field's cells (as relabel_transfer());
+/// per field and region, the ratio ρ of its cells' relabelled share (Σ px·χ / Σ px) to the
+/// forecast α·Σ px·x / Σ px; τ_r² the variance of ρ about its field's mean, pooled over the fields
+/// and pairs with n − 1 degrees of freedom each. The cells' own spread (what the cell gain model's
+/// κ_χ gives one descent) is not taken out: a region's cells share its ground. No field with two
+/// regions that forecast a share: 0.
+[[nodiscard]] inline double relabel_region_sd(std::span<const CellSample> cells, DecisionInput input) {
+  double ss = 0.0, dof = 0.0;
+  for (const detail::RegionRatios& g : detail::region_ratios(cells, input)) {
+    if (g.n < 2) continue;
+    ss += std::max(0.0, g.sum_sq - g.sum * g.sum / static_cast<double>(g.n));
+    dof += static_cast<double>(g.n - 1);
+  }
+  return dof > 0.0 ? std::sqrt(ss / dof) : 0.0;
 }
 
 }  // namespace adaptseg

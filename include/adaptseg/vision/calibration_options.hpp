@@ -139,6 +139,11 @@ struct CalibrationOptions {
   /// the model every field's cells, in the search each fold's the other fields' only. false
   /// (the default): `front_aware`'s b (1: s scales the gain whole).
   bool relabel_transfer = false;
+  /// Front-aware rule with ranked cells and the relabelled field factor: measure
+  /// FrontAwarePolicy::Params::relabel_region_sd τ_r on the training fields' cell samples
+  /// (relabel_region_sd()), in the model every field's cells, in the search each fold's the
+  /// other fields' only. false (the default): `front_aware`'s τ_r (0).
+  bool relabel_region_spread = false;
   /// Front-aware rule, σ̂'s prior (FrontAwarePolicy `sigma_prior_weight` k, `sigma_prior_sd` τ)
   /// with several training fields: `given` keeps `front_aware`'s; `spread` estimates τ on the
   /// training fields (estimate_sigma_prior) and keeps k; `estimated` estimates both. Each fold
