@@ -525,36 +525,37 @@ TEST_CASE(
 }
 
 TEST_CASE(
-    "calibration: the relabel transfer b measured on the training fields' cells, asked with the relabelled factor") {
+    "calibration: the relabel transfer b and region spread τ_r measured on the training fields' cells, with the "
+    "relabelled factor") {
   std::vector<Field> fields = two_blob_fields();
   fields.push_back(t::blob_field(1200, 1100, 1.0, 7, 15));
   OracleSegmenter oracle(fields.front().num_classes());
   CalibrationOptions options = ranked_options();
   options.slope_poolings = {SlopePooling::cells};
   options.relabel_transfer = true;
+  // Refused up front without the relabelled factor, each.
   CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
-                       doctest::Contains("needs the field factor 'relabelled'"), std::invalid_argument);
+                       doctest::Contains("relabel_transfer (how far the gain follows the relabelled share) needs the "
+                                         "field factor 'relabelled'"),
+                       std::invalid_argument);
+  options.relabel_transfer = false;
+  options.relabel_region_spread = true;
+  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
+                       doctest::Contains("relabel_region_spread"), std::invalid_argument);
+  options.relabel_transfer = true;
   options.front_aware.field_factor = FieldFactorSource::relabelled;
   const CalibrationResult cal = calibrate(std::span<const Field>(fields), oracle, options);
   const FrontAwarePolicy& rule = std::get<FrontAwarePolicy>(cal.decision_function.rule());
-  // The model's b: every field's cells, with the input the cells are ranked by.
-  const double b = relabel_transfer(cal.cell_samples, rule.model().cells()->input());
+  // The model's b and τ_r: every field's cells, with the input the cells are ranked by (not
+  // asked, each stays as given: 1 and 0, as every other calibration here shows).
+  const DecisionInput input = rule.model().cells()->input();
+  const double b = relabel_transfer(cal.cell_samples, input);
   CHECK(b < 1.0);  // measured (on these blob fields the oracle relabels most where it gains least: 0)
   CHECK(rule.params().relabel_transfer == b);
-  CHECK(rule.params().field_factor == FieldFactorSource::relabelled);
-  // τ_r likewise, when asked.
-  options.relabel_region_spread = true;
-  const CalibrationResult spread = calibrate(std::span<const Field>(fields), oracle, options);
-  const FrontAwarePolicy& with_spread = std::get<FrontAwarePolicy>(spread.decision_function.rule());
-  const double tau = relabel_region_sd(spread.cell_samples, with_spread.model().cells()->input());
+  const double tau = relabel_region_sd(cal.cell_samples, input);
   CHECK(tau > 0.0);
-  CHECK(with_spread.params().relabel_region_sd == tau);
-  options.relabel_region_spread = false;
-  // Not asked: the given b.
-  options.relabel_transfer = false;
-  CHECK(std::get<FrontAwarePolicy>(calibrate(std::span<const Field>(fields), oracle, options).decision_function.rule())
-            .params()
-            .relabel_transfer == 1.0);
+  CHECK(rule.params().relabel_region_sd == tau);
+  CHECK(rule.params().field_factor == FieldFactorSource::relabelled);
 }
 
 TEST_CASE("calibration: the setting kept, per top level its pooling's best z, then the best top level") {
