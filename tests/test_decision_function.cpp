@@ -811,6 +811,18 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
       // The relabelled share is forecast with s itself, whatever b.
       CHECK(none.scores[k].predicted_relabelled == doctest::Approx(whole.scores[k].predicted_relabelled));
     }
+    // The factor on the gain: b·(what s learnt) and, for the rest of its spread between fields,
+    // the prior ω² (b = 0: nothing learnt, the prior whole, not a certainty).
+    FieldScale learnt(0.5);
+    learnt.observe(1.0, 2.0, 0.01, true);
+    const FactorEstimate own = learnt.transferred(1.0), half_way = learnt.transferred(0.5),
+                         prior = learnt.transferred(0.0);
+    CHECK(own.mean == learnt.mean());
+    CHECK(own.var == learnt.var());
+    CHECK(half_way.mean == doctest::Approx(1.0 + 0.5 * (learnt.mean() - 1.0)));
+    CHECK(half_way.var == doctest::Approx(0.25 * learnt.var() + 0.75 * 0.25));
+    CHECK(prior.mean == 1.0);
+    CHECK(prior.var == doctest::Approx(0.25));
     FrontAwarePolicy::Params bad{.field_factor = FieldFactorSource::relabelled, .relabel_transfer = 1.5};
     CHECK_THROWS_WITH_AS(bad.validate(), doctest::Contains("relabel_transfer must be in [0, 1]"),
                          std::invalid_argument);

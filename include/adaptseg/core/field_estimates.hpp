@@ -138,12 +138,14 @@ class FieldScale {
   /// A forecast gain `base` before s, times s (FactorEstimate::scaled).
   [[nodiscard]] double scaled(double base) const noexcept { return estimate().scaled(base); }
 
-  /// The estimate of a second factor that moves b times as far from 1 as s does, s' = 1 + b·(s − 1)
-  /// (FrontAwarePolicy::Params::relabel_transfer): mean 1 + b·(mean − 1), variance b²·Var(s);
-  /// b = 1: s's own.
+  /// The estimate of a second factor s' of the same prior N(1, ω²) that moves b times as far from
+  /// 1 as s does, s' = 1 + b·(s − 1) + e (FrontAwarePolicy::Params::relabel_transfer), e the part
+  /// of its spread between fields that s does not explain, Var e = (1 − b²)·ω²: mean
+  /// 1 + b·(mean − 1), variance b²·Var(s) + (1 − b²)·ω². b = 1: s's own; b = 0: the prior, however
+  /// much s has learnt.
   [[nodiscard]] FactorEstimate transferred(double b) const noexcept {
     if (b == 1.0) return estimate();
-    return {1.0 + b * (mean_ - 1.0), b * b * var_};
+    return {1.0 + b * (mean_ - 1.0), b * b * var_ + (1.0 - b * b) * prior_sd_ * prior_sd_};
   }
 
  private:
