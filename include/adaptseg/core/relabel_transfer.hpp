@@ -12,6 +12,7 @@
 
 #include <adaptseg/core/cell_gain_model.hpp>
 #include <adaptseg/core/decision_inputs.hpp>
+#include <adaptseg/core/detail/field_slopes.hpp>
 #include <adaptseg/core/detail/gsd.hpp>
 
 #include <algorithm>
@@ -33,12 +34,10 @@ namespace adaptseg {
 /// Σ (r_α − 1)(r_β − 1) / Σ (r_α − 1)², clamped to [0, 1]. Fewer than three fields with cells
 /// that hold the input, or no spread of r_α: 1 (s scales the gain whole, nothing measured).
 [[nodiscard]] inline double relabel_transfer(std::span<const CellSample> cells, DecisionInput input) {
-  struct Sums {
-    double xx = 0.0, xg = 0.0, xr = 0.0;
-  };
+  // Per pair of GSDs, each field's sums of the gain's and the relabelled share's fits.
   struct Pair {
     double top = 0.0, sub = 0.0;
-    std::vector<std::pair<std::size_t, Sums>> fields;
+    detail::PerField gain, relabel;
   };
   std::vector<Pair> pairs;
   std::vector<std::size_t> fields_seen;
@@ -48,23 +47,22 @@ namespace adaptseg {
     auto p = std::find_if(pairs.begin(), pairs.end(), [&](const Pair& q) {
       return detail::same_gsd(q.top, c.top_gsd_cm) && detail::same_gsd(q.sub, c.sub_gsd_cm);
     });
-    if (p == pairs.end()) p = pairs.insert(pairs.end(), Pair{c.top_gsd_cm, c.sub_gsd_cm, {}});
-    auto f = std::find_if(p->fields.begin(), p->fields.end(), [&](const auto& e) { return e.first == c.field; });
-    if (f == p->fields.end()) f = p->fields.insert(p->fields.end(), {c.field, Sums{}});
-    f->second.xx += w * x * x;
-    f->second.xg += w * x * c.normalized_gain();
-    f->second.xr += w * x * c.relabelled;
+    if (p == pairs.end()) p = pairs.insert(pairs.end(), Pair{c.top_gsd_cm, c.sub_gsd_cm, {}, {}});
+    detail::sums_of(p->gain, c.field).add(w, x, c.normalized_gain());
+    detail::sums_of(p->relabel, c.field).add(w, x, c.relabelled);
     if (std::find(fields_seen.begin(), fields_seen.end(), c.field) == fields_seen.end()) fields_seen.push_back(c.field);
   }
   if (fields_seen.size() < 3) return 1.0;
   double num = 0.0, den = 0.0;
   for (const Pair& p : pairs) {
-    Sums all;
-    for (const auto& [field, s] : p.fields) all.xx += s.xx, all.xg += s.xg, all.xr += s.xr;
-    const double beta = all.xg / all.xx, alpha = all.xr / all.xx;
+    double xx = 0.0, xg = 0.0, xr = 0.0;
+    for (std::size_t k = 0; k < p.gain.size(); ++k)
+      xx += p.gain[k].second.xx, xg += p.gain[k].second.xy, xr += p.relabel[k].second.xy;
+    const double beta = xg / xx, alpha = xr / xx;
     if (!(beta > 0.0) || !(alpha > 0.0)) continue;
-    for (const auto& [field, s] : p.fields) {
-      const double rb = s.xg / s.xx / beta - 1.0, ra = s.xr / s.xx / alpha - 1.0;
+    for (std::size_t k = 0; k < p.gain.size(); ++k) {
+      const detail::FieldSlopeSums &g = p.gain[k].second, &r = p.relabel[k].second;
+      const double rb = g.xy / g.xx / beta - 1.0, ra = r.xy / r.xx / alpha - 1.0;
       num += ra * rb;
       den += ra * ra;
     }
