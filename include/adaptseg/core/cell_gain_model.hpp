@@ -106,6 +106,28 @@ struct CellSample {
   return all;
 }
 
+namespace detail {
+/// The cell samples of one pair of top-level and descent GSDs.
+struct GsdGroup {
+  double top = 0.0, sub = 0.0;
+  std::vector<const CellSample*> cells;
+};
+
+/// `samples` grouped by their pair of GSDs (detail::same_gsd), in the order each pair first occurs:
+/// what CellGainModel::fit, relabel_transfer() and relabel_region_sd() each fit per pair.
+inline std::vector<GsdGroup> group_by_gsds(std::span<const CellSample> samples) {
+  std::vector<GsdGroup> groups;
+  for (const CellSample& s : samples) {
+    auto g = std::find_if(groups.begin(), groups.end(), [&](const GsdGroup& q) {
+      return same_gsd(q.top, s.top_gsd_cm) && same_gsd(q.sub, s.sub_gsd_cm);
+    });
+    if (g == groups.end()) g = groups.insert(groups.end(), GsdGroup{s.top_gsd_cm, s.sub_gsd_cm, {}});
+    g->cells.push_back(&s);
+  }
+  return groups;
+}
+}  // namespace detail
+
 /// The cell gain model: per pair of top-level and descent GSD, how much of a cell's input x (a
 /// decision input of the top-level image, e.g. its expected error about L) a re-mapping turns
 /// into gain, and into relabelled pixels.
@@ -219,8 +241,13 @@ class CellGainModel {
   [[nodiscard]] static CellGainModel fit(std::span<const CellSample> samples, DecisionInput input,
                                          SlopePooling pooling = SlopePooling::cells) {
     detail::require(!samples.empty(), "CellGainModel::fit: number of samples must be > 0", 0);
+    for (const CellSample& s : samples)
+      detail::require(std::isfinite(s.top_gsd_cm) && std::isfinite(s.sub_gsd_cm) && std::isfinite(s.field_gain) &&
+                          std::isfinite(s.relabelled) && std::isfinite(s.top.field_px) &&
+                          std::isfinite(s.field_share) && std::isfinite(s.field_sigma),
+                      "CellGainModel::fit: samples must be finite; field gain", s.field_gain);
     std::vector<Point> points;
-    for (const GsdGroup& g : group_by_gsds(samples)) points.push_back(fit_group(g, input, pooling));
+    for (const detail::GsdGroup& g : detail::group_by_gsds(samples)) points.push_back(fit_group(g, input, pooling));
     std::sort(points.begin(), points.end(), [](const Point& a, const Point& b) {
       return a.top_gsd_cm < b.top_gsd_cm || (a.top_gsd_cm == b.top_gsd_cm && a.sub_gsd_cm < b.sub_gsd_cm);
     });
@@ -310,33 +337,9 @@ class CellGainModel {
   [[nodiscard]] const std::vector<Point>& points() const noexcept { return points_; }
 
  private:
-  /// The cells of one pair of GSDs (fit()).
-  struct GsdGroup {
-    double top = 0.0, sub = 0.0;
-    std::vector<const CellSample*> cells;
-  };
-
-  /// fit()'s samples grouped by their pair of GSDs, in the order each pair first occurs.
-  static std::vector<GsdGroup> group_by_gsds(std::span<const CellSample> samples) {
-    std::vector<GsdGroup> groups;
-    for (const CellSample& s : samples) {
-      detail::require(std::isfinite(s.top_gsd_cm) && std::isfinite(s.sub_gsd_cm) && std::isfinite(s.field_gain) &&
-                          std::isfinite(s.relabelled) && std::isfinite(s.top.field_px) &&
-                          std::isfinite(s.field_share) && std::isfinite(s.field_sigma),
-                      "CellGainModel::fit: samples must be finite; field gain", s.field_gain);
-      std::size_t k = 0;
-      while (k < groups.size() &&
-             !(detail::same_gsd(groups[k].top, s.top_gsd_cm) && detail::same_gsd(groups[k].sub, s.sub_gsd_cm)))
-        ++k;
-      if (k == groups.size()) groups.push_back(GsdGroup{s.top_gsd_cm, s.sub_gsd_cm, {}});
-      groups[k].cells.push_back(&s);
-    }
-    return groups;
-  }
-
   /// fit()'s point of one pair of GSDs: the slopes β and α, pooled as `pooling` says, then the
   /// noises about them and the scene check's proxy (fit_noises).
-  static Point fit_group(const GsdGroup& g, DecisionInput input, SlopePooling pooling) {
+  static Point fit_group(const detail::GsdGroup& g, DecisionInput input, SlopePooling pooling) {
     double px = 0.0;
     for (const CellSample* c : g.cells) px += c->top.field_px;
     const double mean_px = px > 0.0 ? px / static_cast<double>(g.cells.size()) : 1.0;
@@ -369,8 +372,8 @@ class CellGainModel {
 
   /// fit_group()'s noises κ about the slopes and, where every cell has its finer look's input,
   /// the scene check's proxy γ (ν on d = x − x'), its noise and its spread between the fields.
-  static void fit_noises(const GsdGroup& g, DecisionInput input, double mean_px, double wx, detail::PerField& gain_sums,
-                         Point& p) {
+  static void fit_noises(const detail::GsdGroup& g, DecisionInput input, double mean_px, double wx,
+                         detail::PerField& gain_sums, Point& p) {
     double eg = 0.0, er = 0.0, wdd = 0.0, wdg = 0.0;
     detail::PerField proxy_sums;  // per training field, the proxy's own fit of ν on d = x − x' (τ_γ)
     bool proxy = true;

@@ -16,11 +16,9 @@
 #include <adaptseg/core/detail/gsd.hpp>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstddef>
 #include <span>
-#include <utility>
 #include <vector>
 
 namespace adaptseg {
@@ -36,21 +34,20 @@ namespace adaptseg {
 [[nodiscard]] inline double relabel_transfer(std::span<const CellSample> cells, DecisionInput input) {
   // Per pair of GSDs, each field's sums of the gain's and the relabelled share's fits.
   struct Pair {
-    double top = 0.0, sub = 0.0;
     detail::PerField gain, relabel;
   };
   std::vector<Pair> pairs;
   std::vector<std::size_t> fields_seen;
-  for (const CellSample& c : cells) {
-    const double x = c.top.value(input), w = c.top.field_px;
-    if (!std::isfinite(x) || !(x > 0.0) || !(w > 0.0)) continue;
-    auto p = std::find_if(pairs.begin(), pairs.end(), [&](const Pair& q) {
-      return detail::same_gsd(q.top, c.top_gsd_cm) && detail::same_gsd(q.sub, c.sub_gsd_cm);
-    });
-    if (p == pairs.end()) p = pairs.insert(pairs.end(), Pair{c.top_gsd_cm, c.sub_gsd_cm, {}, {}});
-    detail::sums_of(p->gain, c.field).add(w, x, c.normalized_gain());
-    detail::sums_of(p->relabel, c.field).add(w, x, c.relabelled);
-    if (std::find(fields_seen.begin(), fields_seen.end(), c.field) == fields_seen.end()) fields_seen.push_back(c.field);
+  for (const detail::GsdGroup& g : detail::group_by_gsds(cells)) {
+    Pair& p = pairs.emplace_back();
+    for (const CellSample* c : g.cells) {
+      const double x = c->top.value(input), w = c->top.field_px;
+      if (!std::isfinite(x) || !(x > 0.0) || !(w > 0.0)) continue;
+      detail::sums_of(p.gain, c->field).add(w, x, c->normalized_gain());
+      detail::sums_of(p.relabel, c->field).add(w, x, c->relabelled);
+      if (std::find(fields_seen.begin(), fields_seen.end(), c->field) == fields_seen.end())
+        fields_seen.push_back(c->field);
+    }
   }
   if (fields_seen.size() < 3) return 1.0;
   double num = 0.0, den = 0.0;
@@ -84,42 +81,33 @@ struct RegionRatios {
 /// (relabel_region_sd()).
 inline std::vector<RegionRatios> region_ratios(std::span<const CellSample> cells, DecisionInput input) {
   struct Region {
-    double top = 0.0, sub = 0.0;
     std::size_t field = 0, region = 0;
     double px = 0.0, px_x = 0.0, px_chi = 0.0;
   };
-  std::vector<Region> regions;
-  std::vector<std::pair<const CellSample*, std::array<double, 2>>> slopes;  // (a cell of the pair, Σ w·x², Σ w·x·χ)
-  const auto same = [](double top, double sub, const CellSample& c) {
-    return same_gsd(top, c.top_gsd_cm) && same_gsd(sub, c.sub_gsd_cm);
-  };
-  for (const CellSample& c : cells) {
-    const double x = c.top.value(input), w = c.top.field_px;
-    if (!std::isfinite(x) || !(x >= 0.0) || !(w > 0.0)) continue;
-    auto s = std::find_if(slopes.begin(), slopes.end(),
-                          [&](const auto& q) { return same(q.first->top_gsd_cm, q.first->sub_gsd_cm, c); });
-    if (s == slopes.end()) s = slopes.insert(slopes.end(), {&c, {0.0, 0.0}});
-    s->second[0] += w * x * x;
-    s->second[1] += w * x * c.relabelled;
-    auto r = std::find_if(regions.begin(), regions.end(), [&](const Region& q) {
-      return same(q.top, q.sub, c) && q.field == c.field && q.region == c.region;
-    });
-    if (r == regions.end()) r = regions.insert(regions.end(), Region{c.top_gsd_cm, c.sub_gsd_cm, c.field, c.region});
-    r->px += w, r->px_x += w * x, r->px_chi += w * c.relabelled;
-  }
   std::vector<RegionRatios> groups;
-  for (const Region& r : regions) {
-    const auto& s = *std::find_if(slopes.begin(), slopes.end(), [&](const auto& q) {
-      return same_gsd(q.first->top_gsd_cm, r.top) && same_gsd(q.first->sub_gsd_cm, r.sub);
-    });
-    const double forecast = (s.second[0] > 0.0 ? s.second[1] / s.second[0] : 0.0) * r.px_x / r.px;
-    if (!(forecast > 0.0)) continue;
-    const double rho = (r.px_chi / r.px) / forecast;
-    auto g = std::find_if(groups.begin(), groups.end(), [&](const RegionRatios& q) {
-      return same_gsd(q.top, r.top) && same_gsd(q.sub, r.sub) && q.field == r.field;
-    });
-    if (g == groups.end()) g = groups.insert(groups.end(), RegionRatios{r.top, r.sub, r.field});
-    g->sum += rho, g->sum_sq += rho * rho, ++g->n;
+  for (const GsdGroup& g : group_by_gsds(cells)) {
+    double xx = 0.0, xchi = 0.0;  // the pair's slope of χ on x through the origin, over every field
+    std::vector<Region> regions;
+    for (const CellSample* c : g.cells) {
+      const double x = c->top.value(input), w = c->top.field_px;
+      if (!std::isfinite(x) || !(x >= 0.0) || !(w > 0.0)) continue;
+      xx += w * x * x, xchi += w * x * c->relabelled;
+      auto r = std::find_if(regions.begin(), regions.end(),
+                            [&](const Region& q) { return q.field == c->field && q.region == c->region; });
+      if (r == regions.end()) r = regions.insert(regions.end(), Region{c->field, c->region});
+      r->px += w, r->px_x += w * x, r->px_chi += w * c->relabelled;
+    }
+    const double alpha = xx > 0.0 ? xchi / xx : 0.0;
+    for (const Region& r : regions) {
+      const double forecast = alpha * r.px_x / r.px;
+      if (!(forecast > 0.0)) continue;
+      const double rho = (r.px_chi / r.px) / forecast;
+      auto f = std::find_if(groups.begin(), groups.end(), [&](const RegionRatios& q) {
+        return same_gsd(q.top, g.top) && same_gsd(q.sub, g.sub) && q.field == r.field;
+      });
+      if (f == groups.end()) f = groups.insert(groups.end(), RegionRatios{g.top, g.sub, r.field});
+      f->sum += rho, f->sum_sq += rho * rho, ++f->n;
+    }
   }
   return groups;
 }
