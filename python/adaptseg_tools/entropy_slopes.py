@@ -8,12 +8,20 @@ field, the slope forecast from the other fields' line b = a + c*u (weighted leas
 weights: the random-effects fit where the fields disagree beyond their cells' scatter, as they
 do on new ground), clamped to their range of u; and how many forecasts have the field's own sign.
 
-  entropy_slopes.py CELLS.csv INPUT
+  entropy_slopes.py CELLS.csv INPUT [--covariates]
+
+--covariates: instead, per pair of GSDs, how well each field-level quantity the UAV has before it
+descends (the field's pixel-weighted mean of every top-level input, top_<name>, and its sigma)
+orders the fields' own slopes: the Spearman rank correlation over the fields, and how many fields
+the line in it fitted on the others forecasts with their own sign (as the entropy line above). Six
+fields tell a covariate from chance poorly: one that orders the slopes at every pair of GSDs, with
+one sign, is what a design could use.
 """
 import math
 import sys
 
 from .proxy_slopes import cell_pairs, normalized_gain
+from .proxy_table import spearman
 
 
 def own_slope(cells, inp, mean_px):
@@ -42,11 +50,65 @@ def line_forecast(points, u):
     return mb + c * (min(max(u, lo), hi) - mu)
 
 
-def main():
-    if len(sys.argv) != 3:
+def field_covariates(cells):
+    """{name: pixel-weighted mean over `cells`} of every top-level input, and the field's sigma."""
+    px = sum(float(c["field_px"]) for c in cells)
+    out = {}
+    for col in cells[0]:
+        if not col.startswith("top_") or col == "top_gsd_cm":
+            continue
+        vals = [(float(c["field_px"]), float(c[col])) for c in cells]
+        if all(math.isfinite(v) for _, v in vals):
+            out[col[4:]] = sum(w * v for w, v in vals) / px
+    out["field_sigma"] = float(cells[0]["field_sigma"])
+    return out
+
+
+def covariates(pairs, fields, inp):
+    """Prints, per pair of GSDs, each covariate's rank correlation with the fields' own slopes and
+    its leave-one-field-out sign count."""
+    names = None
+    rows = []
+    for key in sorted(pairs):
+        cells = pairs[key]
+        mean_px = sum(float(c["field_px"]) for c in cells) / len(cells)
+        per = {n: [c for c in cells if c["field"] == n] for n in fields}
+        per = {n: cs for n, cs in per.items() if cs}
+        slope = {n: own_slope(cs, inp, mean_px)[0] for n, cs in per.items()}
+        known = [n for n in per if math.isfinite(slope[n])]
+        if len(known) < 3:
+            continue
+        cov = {n: field_covariates(per[n]) for n in known}
+        if names is None:
+            names = [c for c in cov[known[0]] if all(c in cov[n] for n in known)]
+        cols = []
+        for name in names:
+            b = [slope[n] for n in known]
+            u = [cov[n][name] for n in known]
+            right = sum((line_forecast([(cov[m][name], slope[m]) for m in known if m != n], cov[n][name]) > 0) ==
+                        (slope[n] > 0) for n in known)
+            rho = spearman(u, b)
+            cols.append(f"{rho:+.2f} ({right}/{len(known)})" if math.isfinite(rho) else f"no spread ({right}/{len(known)})")
+        rows.append(f"| {key[0]:g} -> {key[1]:g} | " + " | ".join(cols) + " |")
+    if names is None:
+        sys.exit("no pair of GSDs with three fields whose slope is known")
+    print(f"input {inp}: per covariate, rank correlation with the fields' own slopes (signs right, leave one field out)")
+    print("| top -> descent [cm/px] | " + " | ".join(names) + " |")
+    print("| --- | " + " | ".join("---:" for _ in names) + " |")
+    print("\n".join(rows))
+
+
+def main(argv=None):
+    argv = sys.argv[1:] if argv is None else argv
+    flags = [a for a in argv if a.startswith("--")]
+    args = [a for a in argv if not a.startswith("--")]
+    if len(args) != 2 or any(f != "--covariates" for f in flags):
         sys.exit(__doc__)
-    path, inp = sys.argv[1], sys.argv[2]
+    path, inp = args
     pairs, fields = cell_pairs(path, inp)
+    if flags:
+        covariates(pairs, fields, inp)
+        return 0
     if any("top_entropy" not in cells[0] for cells in pairs.values()):
         sys.exit(f"{path}: no column top_entropy")
     print(f"{path}: input {inp}; per field: own slope b_f @ mean entropy u_f -> forecast from the others")
@@ -71,6 +133,7 @@ def main():
             right += (f > 0) == (own[n][0] > 0)
             cols.append(f"{own[n][0]:+.3f} @ {own[n][1]:.2f} -> {f:+.3f}")
         print(f"| {key[0]:g} -> {key[1]:g} | {right} of {counted} | " + " | ".join(cols) + " |")
+    return 0
 
 
 if __name__ == "__main__":
