@@ -12,7 +12,7 @@ configure_for() {
   local -a opts=(-DCMAKE_BUILD_TYPE=Release -DADAPTSEG_SANITIZE=OFF -DADAPTSEG_BUILD_EXAMPLES=ON)
   case "$purpose" in
     demo | results) ;;
-    test) opts+=(-DADAPTSEG_BUILD_TESTS=ON -DADAPTSEG_BUILD_BENCHMARKS=ON -DADAPTSEG_WARNINGS_AS_ERRORS=ON) ;;
+    test) opts+=(-DADAPTSEG_BUILD_TESTS=ON -DADAPTSEG_TEST_SUITES=ON -DADAPTSEG_BUILD_BENCHMARKS=ON -DADAPTSEG_WARNINGS_AS_ERRORS=ON) ;;
     bench) opts+=(-DADAPTSEG_BUILD_BENCHMARKS=ON) ;;
     *) echo "configure_for: unknown purpose '$purpose'" >&2; return 2 ;;
   esac

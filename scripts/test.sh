@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, and runs the whole test suite twice: a Release build with
-# warnings as errors, and a Debug build under AddressSanitizer + UndefinedBehaviorSanitizer
+# Installs what is missing, builds, and runs the whole test suite in two builds: a Release build
+# with warnings as errors (the library, the example programs and benchmarks; the doctest suites
+# are not compiled there), and a Debug build under AddressSanitizer + UndefinedBehaviorSanitizer
 # (every test and every example program compiled with them). Each test runs in one phase: the
 # doctest suites, the programs' CLI tests and the MAVLink peers sanitized; the package, doxygen,
 # snippet, header-alone, lint and Python tests, which build or run nothing sanitized, and
@@ -17,17 +18,20 @@ if command -v npm >/dev/null; then
 fi
 
 source scripts/configure.sh
-configure_for test build/release
+# Without the doctest suites and the MAVLink test programs (ADAPTSEG_TEST_SUITES=OFF): this phase
+# runs none of them, the sanitized one below builds and runs them.
+configure_for test build/release -DADAPTSEG_TEST_SUITES=OFF
 cmake --build build/release -j"$jobs"
 # --no-tests=error: a phase that found no test fails instead of passing. Each test runs once: the
-# doctest suites (test_*:), the example programs' CLI tests (cli:*) and the MAVLink peers
-# (mavlink:*) in the sanitized phase below, with the same code built with the sanitizers; here
-# what builds or runs nothing sanitized (the package, doxygen, the snippets, the header-alone
-# check, lint, the Python tools, docs:commands, which runs the Release programs on the CLI tests'
-# paths). Run here too, the others cost this phase about 490 s of its 730 s of test time (2-core
-# VM). `ctest` in a build folder still runs every test.
+# doctest suites (test_*:) and tests:discovered, the example programs' CLI tests (cli:*) and the
+# MAVLink peers (mavlink:*) in the sanitized phase below, with the same code built with the
+# sanitizers; here what builds or runs nothing sanitized (the package, doxygen, the snippets, the
+# header-alone check, lint, the Python tools, docs:commands, which runs the Release programs on
+# the CLI tests' paths). Run here too, the others cost this phase about 490 s of its 730 s of test
+# time (2-core VM). `ctest` in a build folder runs every test it has (build/release after this
+# script: all but the suites).
 ctest --test-dir build/release --output-on-failure --no-tests=error -j"$jobs" \
-  --exclude-regex '^(test_[a-z_]+|cli|mavlink):'
+  --exclude-regex '^(cli|mavlink):'
 
 # -g1: line tables only, enough for file:line in sanitizer stack traces; full -g cost the
 # sanitized build ~12 % more compile time (test_decision_function: 100 s against 88 s).
@@ -35,7 +39,7 @@ ctest --test-dir build/release --output-on-failure --no-tests=error -j"$jobs" \
 # and 82 s at -O1 and 74 s and 189 s at -O0 (2-core VM, one at a time); most of the phase is
 # compiling.
 cmake -S . -B build/asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS="-Og" -DCMAKE_CXX_FLAGS_DEBUG="-g1" \
-      -DADAPTSEG_WARNINGS_AS_ERRORS=ON -DADAPTSEG_SANITIZE=ON -DADAPTSEG_BUILD_TESTS=ON -DADAPTSEG_BUILD_BENCHMARKS=OFF \
+      -DADAPTSEG_WARNINGS_AS_ERRORS=ON -DADAPTSEG_SANITIZE=ON -DADAPTSEG_BUILD_TESTS=ON -DADAPTSEG_TEST_SUITES=ON -DADAPTSEG_BUILD_BENCHMARKS=OFF \
       -DADAPTSEG_BUILD_EXAMPLES=ON
 cmake --build build/asan -j"$jobs"
 # intercept_tls_get_addr=0: GCC 12's LeakSanitizer can take a dynamic TLS block of glibc 2.36 for an
