@@ -10,11 +10,11 @@ the curve (0.52 at 110 s against 0.51), both together −0.0090; the first's rea
 seconds is 0.0100, against a predicted 0.0040. The first relabels twice its forecast share, the
 second half of it: log ratios ±0.693, variance 0.961 within the run.
 """
-import contextlib
-import io
 import os
 import sys
 import tempfile
+
+from tool_output import printed
 
 from adaptseg_tools import descent_table
 
@@ -43,10 +43,7 @@ f,adaptive,15,2,1,10,0.60,0,0,0.00
 
 
 def table(args):
-    out = io.StringIO()
-    with contextlib.redirect_stdout(out):
-        descent_table.main(args)
-    return out.getvalue()
+    return printed(descent_table.main, args)[1]
 
 
 def main():

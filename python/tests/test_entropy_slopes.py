@@ -10,11 +10,7 @@ entropy lies below the others' range (read at 0.4: +1), with the wrong one: 3 of
 field's sigma do not spread: no correlation, and the mean of the others' slopes forecast for
 each, right but for a.
 """
-import contextlib
-import io
-import os
-import sys
-import tempfile
+from tool_output import check_on_csv
 
 from adaptseg_tools import entropy_slopes
 
@@ -27,19 +23,9 @@ d,0,15,10,100,1,1,5,1,0.8
 
 
 def main():
-    with tempfile.TemporaryDirectory() as tmp:
-        path = os.path.join(tmp, "cells.csv")
-        with open(path, "w") as f:
-            f.write(CELLS)
-        out = io.StringIO()
-        with contextlib.redirect_stdout(out):
-            rc = entropy_slopes.main([path, "sigma", "--covariates"])
-        text = out.getvalue()
-        if rc != 0:
-            sys.exit(f"exit code {rc}:\n{text}")
-        want = "| 15 -> 10 | no spread (3/4) | +1.00 (3/4) | no spread (3/4) |"
-        if "| top -> descent [cm/px] | sigma | entropy | field_sigma |" not in text or want not in text:
-            sys.exit(f"no row {want}:\n{text}")
+    check_on_csv(entropy_slopes.main, CELLS, ["sigma", "--covariates"],
+                 ("| top -> descent [cm/px] | sigma | entropy | field_sigma |",
+                  "| 15 -> 10 | no spread (3/4) | +1.00 (3/4) | no spread (3/4) |"))
     print("ok: entropy_slopes.py --covariates ranks the fields' slopes by each field-level covariate")
 
 

@@ -7,11 +7,11 @@ one below max(non-adaptive, 0) - 0.002, three descents whose forecasts and reali
 proportional (correlation +1), and the oracle above 0 in two of the three runs where some
 strategy beats the curve.
 """
-import contextlib
-import io
 import os
 import sys
 import tempfile
+
+from tool_output import printed
 
 from adaptseg_tools import loto_targets
 
@@ -46,17 +46,15 @@ def main():
         write_run(oracle, "dubai-road-tile-1", -0.001, -0.001)  # beatable (loto's +0.0015), oracle not > 0
         write_run(oracle, "dubai-water-tile-2", 0.0, 0.0)  # nobody beats the curve here
         write_run(oracle, "dubai-water-tile-3", 0.002, 0.002)
-        out = io.StringIO()
-        with contextlib.redirect_stdout(out):
-            loto_targets.main(["--oracle", oracle, f"base={loto}"])
-        lines = out.getvalue().splitlines()
+        text = printed(loto_targets.main, ["--oracle", oracle, f"base={loto}"])[1]
+        lines = text.splitlines()
         summary = [c.strip() for c in lines[2].strip("|").split("|")]
         # runs, > +0.001, median, mean, below, descents, correlation, oracle where beatable
         want = ["base", "4", "2", "+0.0011", "+0.0008", "1", "3", "+1.00", "2 of 3"]
         if summary != want:
-            sys.exit(f"summary {summary}, want {want}\n{out.getvalue()}")
+            sys.exit(f"summary {summary}, want {want}\n{text}")
         if "| water | 2 | -0.0030 (0) | +0.0000 (0) |" not in lines:
-            sys.exit(f"no per-run row for water on tile 2:\n{out.getvalue()}")
+            sys.exit(f"no per-run row for water on tile 2:\n{text}")
         # A folder without runs named ...-CLASS-tile-K is refused, naming it.
         empty = os.path.join(tmp, "empty")
         os.makedirs(empty)

@@ -1,0 +1,31 @@
+"""Shared by the Python tools' self-tests (python/tests/test_*.py, run by CTest as scripts, so
+this folder is on the import path): a tool's main() run in-process and what it printed."""
+import contextlib
+import io
+import os
+import sys
+import tempfile
+
+
+def printed(main, argv):
+    """(return value, standard output) of `main(argv)`."""
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        rc = main(argv)
+    return rc, out.getvalue()
+
+
+def check_on_csv(main, csv_text, args, rows):
+    """Writes `csv_text` to a temporary cells.csv, runs `main([path, *args])`, and exits naming
+    the first of `rows` its output lacks (or its exit code, if not 0); returns the output."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "cells.csv")
+        with open(path, "w") as f:
+            f.write(csv_text)
+        rc, text = printed(main, [path, *args])
+    if rc != 0:
+        sys.exit(f"exit code {rc}:\n{text}")
+    for want in rows:
+        if want not in text:
+            sys.exit(f"no row {want}:\n{text}")
+    return text
