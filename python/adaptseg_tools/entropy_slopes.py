@@ -50,6 +50,14 @@ def line_forecast(points, u):
     return mb + c * (min(max(u, lo), hi) - mu)
 
 
+def left_out_forecasts(points):
+    """{field: the slope the line through the other fields' (u, b) forecasts at its u} for every
+    field of `points` ({field: (u, b)}), where the others are two at least."""
+    if len(points) < 3:
+        return {}
+    return {n: line_forecast([points[m] for m in points if m != n], points[n][0]) for n in points}
+
+
 def field_covariates(cells):
     """{name: pixel-weighted mean over `cells`} of every top-level input, and the field's sigma."""
     px = sum(float(c["field_px"]) for c in cells)
@@ -82,11 +90,14 @@ def covariates(pairs, fields, inp):
         if names is None:
             names = [c for c in cov[known[0]] if all(c in cov[n] for n in known)]
         cols = []
+        b = [slope[n] for n in known]
         for name in names:
-            b = [slope[n] for n in known]
+            if any(name not in cov[n] for n in known):
+                cols.append("-")  # not finite on every field at this pair of GSDs
+                continue
             u = [cov[n][name] for n in known]
-            right = sum((line_forecast([(cov[m][name], slope[m]) for m in known if m != n], cov[n][name]) > 0) ==
-                        (slope[n] > 0) for n in known)
+            forecasts = left_out_forecasts({n: (cov[n][name], slope[n]) for n in known})
+            right = sum((f > 0) == (slope[n] > 0) for n, f in forecasts.items())
             rho = spearman(u, b)
             cols.append(f"{rho:+.2f} ({right}/{len(known)})" if math.isfinite(rho) else f"no spread ({right}/{len(known)})")
         rows.append(f"| {key[0]:g} -> {key[1]:g} | " + " | ".join(cols) + " |")
@@ -119,16 +130,16 @@ def main(argv=None):
         mean_px = sum(float(c["field_px"]) for c in cells) / len(cells)
         own = {n: own_slope([c for c in cells if c["field"] == n], inp, mean_px) for n in fields}
         known = [n for n in fields if all(math.isfinite(v) for v in own[n])]
+        forecasts = left_out_forecasts({n: own[n][::-1] for n in known})
         cols, right, counted = [], 0, 0
         for n in fields:
             if n not in known:
                 cols.append("-")
                 continue
-            others = [own[m][::-1] for m in known if m != n]
-            if len(others) < 2:
+            if n not in forecasts:
                 cols.append(f"{own[n][0]:+.3f} @ {own[n][1]:.2f}")
                 continue
-            f = line_forecast(others, own[n][1])
+            f = forecasts[n]
             counted += 1
             right += (f > 0) == (own[n][0] > 0)
             cols.append(f"{own[n][0]:+.3f} @ {own[n][1]:.2f} -> {f:+.3f}")
