@@ -525,8 +525,8 @@ TEST_CASE(
 }
 
 TEST_CASE(
-    "calibration: the relabel transfer b and region spread τ_r measured on the training fields' cells, with the "
-    "relabelled factor") {
+    "calibration: the relabel transfer b, region spread τ_r and field spread ω_χ measured on the training fields' "
+    "cells, with the relabelled factor") {
   std::vector<Field> fields = two_blob_fields();
   fields.push_back(t::blob_field(1200, 1100, 1.0, 7, 15));
   OracleSegmenter oracle(fields.front().num_classes());
@@ -542,6 +542,11 @@ TEST_CASE(
   options.relabel_region_spread = true;
   CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
                        doctest::Contains("relabel_region_spread"), std::invalid_argument);
+  options.relabel_region_spread = false;
+  options.relabel_field_spread = true;
+  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
+                       doctest::Contains("relabel_field_spread"), std::invalid_argument);
+  options.relabel_region_spread = true;
   options.relabel_transfer = true;
   options.front_aware.field_factor = FieldFactorSource::relabelled;
   const CalibrationResult cal = calibrate(std::span<const Field>(fields), oracle, options);
@@ -555,6 +560,9 @@ TEST_CASE(
   const double tau = relabel_region_sd(cal.cell_samples, input);
   CHECK(tau > 0.0);
   CHECK(rule.params().relabel_region_sd == tau);
+  const double omega_chi = relabel_field_sd(cal.cell_samples, input);
+  CHECK(omega_chi >= 0.1);
+  CHECK(rule.params().relabel_field_sd == omega_chi);
   CHECK(rule.params().field_factor == FieldFactorSource::relabelled);
 }
 
@@ -901,13 +909,16 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
                                                         "relabel_transfer: 1.5", "bad_transfer.yaml")),
                        doctest::Contains("relabel_transfer must be in [0, 1]"), std::invalid_argument);
   p.relabel_transfer = 1.0;
-  // τ_r likewise (absent: 0).
-  CHECK(rule_of(back).relabel_region_sd == 0.0);
-  p.relabel_region_sd = 0.25;
-  policy.set_params(p);
-  corrected.save(tmp.path() / "region_sd.yaml");
-  CHECK(rule_of(DecisionModel::load(tmp.path() / "region_sd.yaml")).relabel_region_sd == 0.25);
-  p.relabel_region_sd = 0.0;
+  // τ_r and ω_χ likewise: kept where above 0 (absent: 0).
+  for (double FrontAwarePolicy::Params::*spread :
+       {&FrontAwarePolicy::Params::relabel_region_sd, &FrontAwarePolicy::Params::relabel_field_sd}) {
+    CHECK(rule_of(back).*spread == 0.0);
+    p.*spread = 0.25;
+    policy.set_params(p);
+    corrected.save(tmp.path() / "spread.yaml");
+    CHECK(rule_of(DecisionModel::load(tmp.path() / "spread.yaml")).*spread == 0.25);
+    p.*spread = 0.0;
+  }
   // Fields of another class set are refused.
   const Field other("o", 1.0, a.labels(), {{"a", {0, 0, 0}}, {"b", {1, 1, 1}}, {"c", {2, 2, 2}}}, {1});
   const std::vector<Field> mixed{a, other};

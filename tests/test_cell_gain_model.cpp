@@ -380,3 +380,30 @@ TEST_CASE("relabel region spread: how far a region's relabelled share strays fro
   s.erase(std::remove_if(s.begin(), s.end(), [](const CellSample& c) { return c.region == 1; }), s.end());
   CHECK(relabel_region_sd(s, DecisionInput::expected_error) == 0.0);
 }
+
+TEST_CASE("relabel field spread: how far the fields' relabelled factors stray from 1, each against the others' slope") {
+  // Fields relabelling r_f·x with the same cells (x 0.02 and 0.05, 1000 px): the others' slope is
+  // the mean of their r, field f's factor r_f / that. r = 1, 2, 3: factors 1/2.5, 2/2, 3/1.5 =
+  // 0.4, 1, 2; ω_χ² = (0.36 + 0 + 1) / 3.
+  const auto fields = [](std::vector<double> r, double sub = 5.0) {
+    std::vector<CellSample> s;
+    for (std::size_t f = 0; f < r.size(); ++f)
+      for (double x : {0.02, 0.05}) s.push_back(cell(f, 15.0, sub, x, 1000.0, 0.1 * x, r[f] * x));
+    return s;
+  };
+  const auto omega = [](const std::vector<CellSample>& s) {
+    return relabel_field_sd(s, DecisionInput::expected_error);
+  };
+  CHECK(omega(fields({1.0, 2.0, 3.0})) == doctest::Approx(std::sqrt(1.36 / 3.0)));
+  // A field's factor is over every pair of GSDs it has cells at: the same fields at a second
+  // pair, where they relabel alike, pull each factor halfway to 1 (Σ μ·χ / Σ μ² over both).
+  std::vector<CellSample> two = fields({1.0, 2.0, 3.0});
+  for (const CellSample& c : fields({2.0, 2.0, 2.0}, 10.0)) two.push_back(c);
+  // Field 0: (2.5·1 + 2·2) / (2.5² + 2²) = 6.5 / 10.25; field 1: 1; field 2: (1.5·3 + 2·2) / (1.5² + 2²).
+  const double s0 = 6.5 / 10.25, s2 = 8.5 / 6.25;
+  CHECK(omega(two) == doctest::Approx(std::sqrt((std::pow(s0 - 1.0, 2) + std::pow(s2 - 1.0, 2)) / 3.0)));
+  // Fields alike: at least ω's floor, 0.1. One field, or none: 0 (s keeps ω).
+  CHECK(omega(fields({2.0, 2.0, 2.0})) == 0.1);
+  CHECK(omega(fields({2.0})) == 0.0);
+  CHECK(omega({}) == 0.0);
+}

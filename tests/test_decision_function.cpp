@@ -770,13 +770,14 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
   }
   SUBCASE("the relabelled share carried to the gain by b: 1 + b·(s − 1), s itself at b = 1, nothing at b = 0") {
     // As above: a descent relabels twice its forecast share, s → 2; the gain follows by b.
-    const auto run = [&](double b, double region_sd = 0.0) {
+    const auto run = [&](double b, double region_sd = 0.0, double field_sd = 0.0) {
       FrontAwarePolicy p(with_cells(1.0), reference,
                          {.online = true,
                           .curve = CurveSource::field,
                           .field_factor = FieldFactorSource::relabelled,
                           .relabel_transfer = b,
-                          .relabel_region_sd = region_sd});
+                          .relabel_region_sd = region_sd,
+                          .relabel_field_sd = field_sd});
       for (int k = 0; k < 5; ++k) {
         DecisionContext seen = s.region(0, 0.001);
         seen.candidates = {};
@@ -834,6 +835,26 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
           doctest::Approx(s_region * none.scores[0].predicted_field_gain));
     bad = {.field_factor = FieldFactorSource::relabelled, .relabel_region_sd = -0.1};
     CHECK_THROWS_WITH_AS(bad.validate(), doctest::Contains("relabel_region_sd must be finite and >= 0"),
+                         std::invalid_argument);
+    // s's own prior spread ω_χ = 0.25 (the fields' relabelled shares strayed less than their gains,
+    // ω = 0.5): the same descent says s ≈ (1/ω_χ² + 2) / (1/ω_χ² + 1) = 18 / 17; the gain's factor
+    // is s with the rest of ω's spread beside it (FieldScale::transferred).
+    const auto [s_field, field_decision] = run(1.0, 1.0, 0.25);
+    CHECK(s_field == doctest::Approx(18.0 / 17.0).epsilon(0.01));
+    CHECK(field_decision.scores[0].predicted_field_gain ==
+          doctest::Approx(s_field * none.scores[0].predicted_field_gain));
+    FieldScale narrow(0.25);
+    CHECK(narrow.transferred(0.5, 0.5).var == doctest::Approx(0.25));  // before any descent: ω², whatever ω_χ
+    narrow.observe(1.0, 2.0, 0.01, true);
+    const FactorEstimate gain = narrow.transferred(1.0, 0.5);
+    CHECK(gain.mean == narrow.mean());
+    CHECK(gain.var == doctest::Approx(narrow.var() + 0.25 - 0.0625));
+    // s cannot explain more of the gain's spread than there is: b capped at ω / ω_χ = 0.4.
+    const FactorEstimate capped = narrow.transferred(1.0, 0.1);
+    CHECK(capped.mean == doctest::Approx(1.0 + 0.4 * (narrow.mean() - 1.0)));
+    CHECK(capped.var == doctest::Approx(0.16 * narrow.var()));
+    bad = {.field_factor = FieldFactorSource::relabelled, .relabel_field_sd = -0.1};
+    CHECK_THROWS_WITH_AS(bad.validate(), doctest::Contains("relabel_field_sd must be finite and >= 0"),
                          std::invalid_argument);
   }
   SUBCASE("the top level: the coarsest calibrated GSD whose lawnmower nothing faster beats") {

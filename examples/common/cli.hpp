@@ -250,6 +250,7 @@ struct CalibrationCli {
   bool jump_guard = false;
   bool relabel_transfer = false;
   bool relabel_region_spread = false;
+  bool relabel_field_spread = false;
   double curve_agreement = 0.0;
 
   void add_to(CLI::App& app) {
@@ -342,6 +343,10 @@ struct CalibrationCli {
                      "share strayed from its field's on the training fields' cells as noise of each descent's "
                      "observation, so that one region does not carry the field factor with it (measured; saved "
                      "in the model)"),
+        app.add_flag("--relabel-field-spread", relabel_field_spread,
+                     "front-aware rule with --field-factor relabelled: the field factor's prior spread from how "
+                     "far the training fields' relabelled shares strayed from the forecast on their cells, not "
+                     "from how far their gains did (measured; saved in the model)"),
         app.add_flag("--margin-biases", margin_biases,
                      "front-aware rule, several training fields: add to each descent's forecast margin what "
                      "descents to its GSD ended above theirs per second when the training fields were flown "
@@ -388,6 +393,7 @@ struct CalibrationCli {
     options.jump_guard = jump_guard;
     options.relabel_transfer = relabel_transfer;
     options.relabel_region_spread = relabel_region_spread;
+    options.relabel_field_spread = relabel_field_spread;
     options.front_aware.curve_agreement = curve_agreement;
     options.top_levels.clear();
     for (const auto& name : top_levels) options.top_levels.push_back(parse_top_level_choice(name));

@@ -148,6 +148,17 @@ class FieldScale {
     return {1.0 + b * (mean_ - 1.0), b * b * var_ + (1.0 - b * b) * prior_sd_ * prior_sd_};
   }
 
+  /// As transferred(b), with the second factor's own prior spread ω' (`gain_sd`) told apart from
+  /// s's ω (FrontAwarePolicy::Params::relabel_field_sd): s' = 1 + c·(s − 1) + e, c = min(b, ω'/ω)
+  /// (s cannot explain more of s''s spread between fields than there is), Var e = ω'² − c²·ω²,
+  /// the part that c·s does not explain: mean 1 + c·(mean − 1), variance c²·Var(s) + ω'² − c²·ω²,
+  /// ω'² before any observation, whatever ω.
+  [[nodiscard]] FactorEstimate transferred(double b, double gain_sd) const noexcept {
+    const double c = std::min(b, gain_sd / prior_sd_);
+    const double mean = c == 1.0 ? mean_ : 1.0 + c * (mean_ - 1.0);
+    return {mean, c * c * var_ + std::max(0.0, gain_sd * gain_sd - c * c * prior_sd_ * prior_sd_)};
+  }
+
  private:
   double prior_sd_ = 0.5;
   double mean_ = 1.0;

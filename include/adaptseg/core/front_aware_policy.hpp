@@ -73,7 +73,8 @@ namespace adaptseg {
 /// posterior is updated (conjugate Gaussian): descents that change less than forecast lower
 /// ĝ and the UAV stops earlier; descents that change more raise it; each observation narrows
 /// Var(s), so the lower bound rises as evidence accrues (with a cell gain model, s learns from
-/// the scene check unless `field_factor` says otherwise: FieldFactorSource). Also the paper's
+/// the scene check unless `field_factor` says otherwise: FieldFactorSource; learnt from the
+/// relabelled share, s's prior spread may be its own, `relabel_field_sd`). Also the paper's
 /// update of O. `online = false` (non-adaptive) keeps s = 1, Var(s) = ω² and O as initialised.
 class FrontAwarePolicy {
  public:
@@ -127,7 +128,7 @@ class FrontAwarePolicy {
     share_.reset();
     forecast_gain_ = 0.0;
     chosen_.clear();
-    scale_ = FieldScale(params_.scale_prior_sd);
+    scale_ = FieldScale(relabel_field_spread() ? params_.relabel_field_sd : params_.scale_prior_sd);
     guard_ = JumpGuard(params_.jump_bound);
   }
 
@@ -359,10 +360,17 @@ class FrontAwarePolicy {
   [[nodiscard]] double scaled(double base) const noexcept { return scale_.scaled(base); }
 
   /// The factor a descent's forecast gain is scaled by: s, or with s learnt from the relabelled
-  /// share, 1 + b·(s − 1) (Params::relabel_transfer b; FieldScale::transferred).
+  /// share, 1 + b·(s − 1) (Params::relabel_transfer b; FieldScale::transferred), with the gain's
+  /// own prior spread ω where s has its own (Params::relabel_field_sd).
   [[nodiscard]] FactorEstimate gain_factor() const noexcept {
-    return params_.field_factor == FieldFactorSource::relabelled ? scale_.transferred(params_.relabel_transfer)
-                                                                 : scale_.estimate();
+    if (params_.field_factor != FieldFactorSource::relabelled) return scale_.estimate();
+    return relabel_field_spread() ? scale_.transferred(params_.relabel_transfer, params_.scale_prior_sd)
+                                  : scale_.transferred(params_.relabel_transfer);
+  }
+
+  /// Whether s, learnt from the relabelled share, has a prior spread of its own (ω_χ).
+  [[nodiscard]] bool relabel_field_spread() const noexcept {
+    return params_.field_factor == FieldFactorSource::relabelled && params_.relabel_field_sd > 0.0;
   }
 
   /// X̂, the field's mean input per field pixel (CurveSource::field): FieldShareEstimate::input

@@ -259,6 +259,11 @@ struct FrontAwareParams {
   /// tells s with the variance (τ_r·μ)² beside its cells' own spread, so that one region that
   /// relabels more or less than its field does not carry s with it. 0: the cells' spread alone.
   double relabel_region_sd = 0.0;
+  /// ω_χ >= 0, with `field_factor` relabelled: the prior spread of s, how far a field's
+  /// relabelled share strays from the forecast between the training fields (relabel_field_sd());
+  /// the gain's factor keeps its own prior spread ω (`scale_prior_sd`), of which s explains
+  /// b·ω_χ (FieldScale::transferred). 0: s's prior spread is ω.
+  double relabel_field_sd = 0.0;
   /// Per descent GSD, the factor on a candidate's forecast field gain (mean and spread): what
   /// descents to it realised of their forecast on the training fields, each flown with a model
   /// that never saw it (CalibrationOptions::gain_ratios). Not listed: 1. Empty: none.
@@ -287,6 +292,8 @@ struct FrontAwareParams {
                     "FrontAwarePolicy::Params::relabel_transfer must be in [0, 1]", relabel_transfer);
     detail::require(std::isfinite(relabel_region_sd) && relabel_region_sd >= 0.0,
                     "FrontAwarePolicy::Params::relabel_region_sd must be finite and >= 0", relabel_region_sd);
+    detail::require(std::isfinite(relabel_field_sd) && relabel_field_sd >= 0.0,
+                    "FrontAwarePolicy::Params::relabel_field_sd must be finite and >= 0", relabel_field_sd);
     for (const GainRatio& r : gain_ratios) r.validate();
     for (const MarginBias& b : margin_biases) b.validate();
   }

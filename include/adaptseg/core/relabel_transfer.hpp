@@ -3,7 +3,7 @@
 /// What one descent's relabelled share says about the field (beyond the paper; docs/method.md,
 /// "The field factor from what a descent relabelled"): how far a field's gain factor moves with
 /// its relabelled factor, and how far one region's relabelled share strays from its field's
-/// factor. In flight the relabelled
+/// factor, and how far the fields' relabelled factors stray from 1. In flight the relabelled
 /// share χ of each descent is observable and tells the field factor s of what descents relabel
 /// (FieldFactorSource::relabelled); whether the gain follows is a property of the class and the
 /// network that calibration can measure on its training fields' cells: a field whose cells
@@ -13,7 +13,6 @@
 #include <adaptseg/core/cell_gain_model.hpp>
 #include <adaptseg/core/decision_inputs.hpp>
 #include <adaptseg/core/detail/field_slopes.hpp>
-#include <adaptseg/core/detail/gsd.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -98,16 +97,16 @@ inline std::vector<RegionRatios> region_ratios(std::span<const CellSample> cells
       r->px += w, r->px_x += w * x, r->px_chi += w * c->relabelled;
     }
     const double alpha = xx > 0.0 ? xchi / xx : 0.0;
+    std::vector<RegionRatios> of_pair;  // this pair's fields
     for (const Region& r : regions) {
       const double forecast = alpha * r.px_x / r.px;
       if (!(forecast > 0.0)) continue;
       const double rho = (r.px_chi / r.px) / forecast;
-      auto f = std::find_if(groups.begin(), groups.end(), [&](const RegionRatios& q) {
-        return same_gsd(q.top, g.top) && same_gsd(q.sub, g.sub) && q.field == r.field;
-      });
-      if (f == groups.end()) f = groups.insert(groups.end(), RegionRatios{g.top, g.sub, r.field});
+      auto f = std::find_if(of_pair.begin(), of_pair.end(), [&](const RegionRatios& q) { return q.field == r.field; });
+      if (f == of_pair.end()) f = of_pair.insert(of_pair.end(), RegionRatios{g.top, g.sub, r.field});
       f->sum += rho, f->sum_sq += rho * rho, ++f->n;
     }
+    groups.insert(groups.end(), of_pair.begin(), of_pair.end());
   }
   return groups;
 }
@@ -130,6 +129,46 @@ inline std::vector<RegionRatios> region_ratios(std::span<const CellSample> cells
     dof += static_cast<double>(g.n - 1);
   }
   return dof > 0.0 ? std::sqrt(ss / dof) : 0.0;
+}
+
+/// ω_χ (FrontAwarePolicy::Params::relabel_field_sd) from calibration's cell samples `cells`,
+/// their input `input`: how far a field's relabelled factor strays from 1 between the training
+/// fields, measured as the field factor's prior spread ω is (pooled_fold_models()). Per field f,
+/// its factor s_f is the least-squares scale of the forecast relabelled shares onto its cells'
+/// own, Σ (μ·w)(χ·w) / Σ (μ·w)² over its cells at every pair of GSDs, μ = α₋f·x with α₋f the
+/// pair's slope through the origin of χ on the input over the other fields' cells (Σ w·x·χ /
+/// Σ w·x², w the cell's field pixels), so that no field is forecast by a slope it made; ω_χ² is
+/// the mean of (s_f − 1)² over the fields, ω_χ at least 0.1 (ω's floor). Fewer than two fields
+/// with cells that hold the input: 0 (s keeps ω).
+[[nodiscard]] inline double relabel_field_sd(std::span<const CellSample> cells, DecisionInput input) {
+  detail::PerField scales;  // per field over every pair: xy = Σ (μ·w)(χ·w), xx = Σ (μ·w)²
+  for (const detail::GsdGroup& g : detail::group_by_gsds(cells)) {
+    // This pair's sums per field, weighted by w (the slope's) and by w² (the scale's).
+    detail::PerField slope, scale;
+    for (const CellSample* c : g.cells) {
+      const double x = c->top.value(input), w = c->top.field_px;
+      if (!std::isfinite(x) || !(x >= 0.0) || !(w > 0.0) || !std::isfinite(c->relabelled)) continue;
+      detail::sums_of(slope, c->field).add(w, x, c->relabelled);
+      detail::sums_of(scale, c->field).add(w * w, x, c->relabelled);
+    }
+    double xx = 0.0, xchi = 0.0;
+    for (const auto& f : slope) xx += f.second.xx, xchi += f.second.xy;
+    for (std::size_t k = 0; k < slope.size(); ++k) {  // `scale` holds the same fields in the same order
+      const detail::FieldSlopeSums &own = slope[k].second, &sq = scale[k].second;
+      if (!(xx - own.xx > 0.0)) continue;
+      const double alpha = (xchi - own.xy) / (xx - own.xx);  // the other fields' slope
+      detail::FieldSlopeSums& f = detail::sums_of(scales, slope[k].first);
+      f.xy += alpha * sq.xy, f.xx += alpha * alpha * sq.xx;
+    }
+  }
+  double ss = 0.0;
+  std::size_t n = 0;
+  for (const auto& f : scales) {
+    if (!(f.second.xx > 0.0)) continue;
+    ss += std::pow(f.second.xy / f.second.xx - 1.0, 2);
+    ++n;
+  }
+  return n >= 2 ? std::max(0.1, std::sqrt(ss / static_cast<double>(n))) : 0.0;
 }
 
 }  // namespace adaptseg

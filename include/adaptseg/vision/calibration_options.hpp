@@ -144,6 +144,12 @@ struct CalibrationOptions {
   /// (relabel_region_sd()), in the model every field's cells, in the search each fold's the
   /// other fields' only. false (the default): `front_aware`'s τ_r (0).
   bool relabel_region_spread = false;
+  /// Front-aware rule with ranked cells and the relabelled field factor: measure
+  /// FrontAwarePolicy::Params::relabel_field_sd ω_χ, s's own prior spread, on the training fields'
+  /// cell samples (relabel_field_sd()), in the model every field's cells, in the search each
+  /// fold's the other fields' only. false (the default): `front_aware`'s ω_χ (0: s's prior spread
+  /// is ω).
+  bool relabel_field_spread = false;
   /// Front-aware rule, σ̂'s prior (FrontAwarePolicy `sigma_prior_weight` k, `sigma_prior_sd` τ)
   /// with several training fields: `given` keeps `front_aware`'s; `spread` estimates τ on the
   /// training fields (estimate_sigma_prior) and keeps k; `estimated` estimates both. Each fold

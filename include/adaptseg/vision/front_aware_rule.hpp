@@ -55,6 +55,7 @@ struct FrontAwareRule {
       e << YAML::Key << "field_factor" << YAML::Value << to_string(p.field_factor);
     if (p.relabel_transfer != 1.0) e << YAML::Key << "relabel_transfer" << YAML::Value << num(p.relabel_transfer);
     if (p.relabel_region_sd > 0.0) e << YAML::Key << "relabel_region_sd" << YAML::Value << num(p.relabel_region_sd);
+    if (p.relabel_field_sd > 0.0) e << YAML::Key << "relabel_field_sd" << YAML::Value << num(p.relabel_field_sd);
     std::vector<std::pair<double, double>> ratios, biases;
     for (const GainRatio& x : p.gain_ratios) ratios.emplace_back(x.gsd_cm, x.ratio);
     for (const MarginBias& x : p.margin_biases) biases.emplace_back(x.gsd_cm, x.per_s);
@@ -130,6 +131,7 @@ struct FrontAwareRule {
                                                   : FieldFactorSource::scene_check,
          .relabel_transfer = rule.has("relabel_transfer") ? rule.number("relabel_transfer") : 1.0,
          .relabel_region_sd = rule.has("relabel_region_sd") ? rule.number("relabel_region_sd") : 0.0,
+         .relabel_field_sd = rule.has("relabel_field_sd") ? rule.number("relabel_field_sd") : 0.0,
          .gain_ratios = read_gain_ratios(rule),
          .margin_biases = read_margin_biases(rule)});
   }
@@ -201,8 +203,9 @@ struct FrontAwareRule {
 
   /// Refuses options its search cannot use (before calibrate() samples anything).
   /// @throws std::invalid_argument if `confidences` or `slope_poolings` is empty,
-  ///         `slope_poolings` or `top_levels` names a value twice, or `relabel_transfer` or
-  ///         `relabel_region_spread` is asked without the relabelled field factor.
+  ///         `slope_poolings` or `top_levels` names a value twice, or `relabel_transfer`,
+  ///         `relabel_region_spread` or `relabel_field_spread` is asked without the relabelled
+  ///         field factor.
   static void check_options(const CalibrationOptions& options) {
     detail::require(!options.confidences.empty(), "calibrate: confidences must not be empty", 0);
     detail::require(!options.slope_poolings.empty(), "calibrate: slope_poolings must not be empty", 0);
@@ -220,6 +223,10 @@ struct FrontAwareRule {
                     to_string(options.front_aware.field_factor));
     detail::require(!options.relabel_region_spread || options.front_aware.field_factor == FieldFactorSource::relabelled,
                     "calibrate: relabel_region_spread (how far a region's relabelled share strays from its field's) "
+                    "needs the field factor 'relabelled'; the field factor",
+                    to_string(options.front_aware.field_factor));
+    detail::require(!options.relabel_field_spread || options.front_aware.field_factor == FieldFactorSource::relabelled,
+                    "calibrate: relabel_field_spread (how far the fields' relabelled shares stray from the forecast) "
                     "needs the field factor 'relabelled'; the field factor",
                     to_string(options.front_aware.field_factor));
   }

@@ -297,13 +297,14 @@ struct FoldCorrections {
   std::vector<double> jump_bounds;         ///< the jump guard's (CalibrationOptions::jump_guard), else `base`'s
   std::vector<double> relabel_transfers;   ///< b (CalibrationOptions::relabel_transfer), else `base`'s
   std::vector<double> relabel_region_sds;  ///< τ_r (CalibrationOptions::relabel_region_spread), else `base`'s
+  std::vector<double> relabel_field_sds;   ///< ω_χ (CalibrationOptions::relabel_field_spread), else `base`'s
 };
 
 /// The gain ratios and margin biases of every fold, measured on the other folds' flights only,
 /// as its model was fitted without its field; the model's own (on every fold's flight) into
 /// `base`. Without `gain_ratios` and `margin_biases`, or with one field, `base`'s for every fold.
 /// With `jump_guard` and ranked cells, each fold's jump bound from the other fields' cells; with
-/// `relabel_transfer` and `relabel_region_spread`, its b and τ_r so.
+/// `relabel_transfer`, `relabel_region_spread` and `relabel_field_spread`, its b, τ_r and ω_χ so.
 template <class Fly>
 [[nodiscard]] FoldCorrections fold_corrections(const RuleSearchInputs& in, std::span<const FrontAwareFold> folds,
                                                const FrontAwareGrid& grid, FrontAwarePolicy::Params& base, Fly& fly) {
@@ -312,7 +313,8 @@ template <class Fly>
                     std::vector<std::vector<MarginBias>>(folds.size(), base.margin_biases),
                     std::vector<double>(folds.size(), base.jump_bound),
                     std::vector<double>(folds.size(), base.relabel_transfer),
-                    std::vector<double>(folds.size(), base.relabel_region_sd)};
+                    std::vector<double>(folds.size(), base.relabel_region_sd),
+                    std::vector<double>(folds.size(), base.relabel_field_sd)};
   if (options.jump_guard && grid.ranked)
     for (std::size_t k = 0; k < folds.size(); ++k) c.jump_bounds[k] = jump_bound(folds[k].cells);
   if (options.relabel_transfer && grid.ranked)
@@ -321,6 +323,9 @@ template <class Fly>
   if (options.relabel_region_spread && grid.ranked)
     for (std::size_t k = 0; k < folds.size(); ++k)
       c.relabel_region_sds[k] = relabel_region_sd(folds[k].cells, in.adaptive.cell_input);
+  if (options.relabel_field_spread && grid.ranked)
+    for (std::size_t k = 0; k < folds.size(); ++k)
+      c.relabel_field_sds[k] = relabel_field_sd(folds[k].cells, in.adaptive.cell_input);
   if (!(options.gain_ratios || options.margin_biases) || in.fields.size() < 2) return c;
   const std::vector<AdaptiveResult> flights = measuring_flights(in, folds, grid, base, fly);
   std::vector<const std::vector<CurvePoint>*> curves;
@@ -372,6 +377,7 @@ template <class Fly>
           fold_params.jump_bound = corrections.jump_bounds[k];
           fold_params.relabel_transfer = corrections.relabel_transfers[k];
           fold_params.relabel_region_sd = corrections.relabel_region_sds[k];
+          fold_params.relabel_field_sd = corrections.relabel_field_sds[k];
           double margin = 0.0;
           const AdaptiveResult r = detail::fly_fold(in, folds[k], models[k], fold_params, fly, margin);
           detail::add_to_trial(t, r, margin);
@@ -395,6 +401,8 @@ template <class Fly>
     params.relabel_transfer = relabel_transfer(cells_of_every_field(in.cells), in.adaptive.cell_input);
   if (options.relabel_region_spread && grid.ranked)
     params.relabel_region_sd = relabel_region_sd(cells_of_every_field(in.cells), in.adaptive.cell_input);
+  if (options.relabel_field_spread && grid.ranked)
+    params.relabel_field_sd = relabel_field_sd(cells_of_every_field(in.cells), in.adaptive.cell_input);
   return {DecisionFunction(FrontAwarePolicy(std::move(model), reference, params)), std::move(trials)};
 }
 
