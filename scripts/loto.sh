@@ -57,6 +57,11 @@
 #       examples/models/mobilenetv2-dubai-loto) and sets the deployment network's temperature
 #       only from the default folder; decision reads LOTO_BUNDLE and writes into LOTO_WORK unless
 #       it is the default. scripts/results.sh loto flies such a folder with LOTO_NETWORKS.
+#   bash scripts/loto.sh mirror [DEST]
+#       here: DEST/tile-<k>/ensemble.yaml (default out/loto-mirror) for k = 1..6, each network of
+#       LOTO_BUNDLE under test-time mirror (an ensemble of one member, mirror: true: its
+#       probabilities the mean over the image and its left-right mirror, its temperature as
+#       bundled; two passes per image). Flown with LOTO_NETWORKS=DEST bash scripts/results.sh loto.
 #   bash scripts/loto.sh cpu TILE [--resume]
 #       here, no accelerator: one training of examples/models/mobilenetv2-dubai's CPU recipe
 #       (2000 steps of 8 crops) on the five tiles but TILE, exported to out/loto-cpu/model-TILE
@@ -270,8 +275,20 @@ cpu)
   build/release/examples/adaptseg_fit_temperature --network "out/loto-cpu/model-$k" \
     --field "examples/data/dubai-tile-$k" --threads 2 --write
   ;;
+mirror)
+  to=${2:-out/loto-mirror}
+  for k in "${tiles_all[@]}"; do
+    [ -s "$dest/tile-$k/model.onnx" ] || { echo "no $dest/tile-$k/model.onnx: run 'bash $0 bundle' first" >&2; exit 2; }
+    mkdir -p "$to/tile-$k"
+    # Members are found relative to ensemble.yaml.
+    member=$(realpath --relative-to="$to/tile-$k" "$dest/tile-$k")
+    printf '%s\n' "description: $dest/tile-$k under test-time mirror (its probabilities the mean over the image and its left-right mirror)" \
+      "members:" "  - model: $member" "    mirror: true" >"$to/tile-$k/ensemble.yaml"
+  done
+  echo "wrote $to/tile-{1..6}/ensemble.yaml"
+  ;;
 *)
-  sed -n '2,64p' "$0" >&2
+  sed -n '2,72p' "$0" >&2
   exit 2
   ;;
 esac
