@@ -48,6 +48,7 @@ class PlannerClock {
   /// clock counted) feeds step_bound().
   void image_reported(double leg_s, double segmentation_s, std::optional<double> reported_elapsed_s) {
     reported_elapsed_s_ = reported_elapsed_s;
+    if (reported_elapsed_s) caller_clock_ = true;
     const double seg = fixed_segmentation_s_.value_or(segmentation_s);
     if (!shared_) own_.flight_s += leg_s, own_.segmentation_s += seg;
     slowest_segmentation_s_ = std::max(slowest_segmentation_s_, seg);
@@ -81,25 +82,33 @@ class PlannerClock {
   /// Both [s]: what a forecast charges per image beyond its flight.
   [[nodiscard]] double per_image_estimate() const { return segmentation_estimate() + planning_estimate(); }
 
-  /// Whether segmentation and planning times are both fixed (the budget then reserves exactly).
+  /// Whether segmentation and planning times are both fixed.
   [[nodiscard]] bool times_fixed() const { return fixed_segmentation_s_.has_value() && fixed_planning_s_.has_value(); }
 
-  /// What the budget reserves for each step still to come beyond its flight [s]: with fixed
-  /// segmentation and planning times, their sum (exact); otherwise a bound learned from the
-  /// steps so far, each step's advance of the mission clock beyond the flight model's leg: the
-  /// largest of k steps times (k + 1) / k (for processing times spread uniformly up to some
-  /// limit, an unbiased estimate of the limit; generous while few steps are seen), and never
-  /// less than segmentation_estimate(). 0 before the first image.
+  /// Whether the budget reserves exactly: segmentation and planning times both fixed, and the
+  /// mission time the account's, never a clock the caller reported. A caller's clock (a vehicle's)
+  /// advances by whatever a step really costs (braking, hovering, the link, processing slower
+  /// than the fixed times say), which fixed times do not bound.
+  [[nodiscard]] bool reserves_exactly() const { return times_fixed() && !caller_clock_; }
+
+  /// What the budget reserves for each step still to come beyond its flight [s]: where it
+  /// reserves exactly (reserves_exactly()), the fixed segmentation and planning times' sum;
+  /// otherwise a bound learned from the steps so far, each step's advance of the mission clock
+  /// beyond the flight model's leg: the largest of k steps times (k + 1) / k (for processing
+  /// times spread uniformly up to some limit, an unbiased estimate of the limit; generous while
+  /// few steps are seen), and never less than segmentation_estimate() (with fixed times, never
+  /// less than their sum). 0 before the first image.
   [[nodiscard]] double step_bound() const {
-    if (times_fixed()) return per_image_estimate();
-    if (steps_ == 0) return segmentation_estimate();
+    if (reserves_exactly()) return per_image_estimate();
+    const double floor = times_fixed() ? per_image_estimate() : segmentation_estimate();
+    if (steps_ == 0) return floor;
     const double k = static_cast<double>(steps_);
-    return std::max(segmentation_estimate(), slowest_step_s_ * (k + 1.0) / k);
+    return std::max(floor, slowest_step_s_ * (k + 1.0) / k);
   }
 
   /// What the budget reserves for the step in progress beyond the bounds of those to come [s]:
-  /// with measured times, one more bound (the decision being made is not yet charged).
-  [[nodiscard]] double this_step_reserve() const { return times_fixed() ? 0.0 : step_bound(); }
+  /// unless it reserves exactly, one more bound (the decision being made is not yet charged).
+  [[nodiscard]] double this_step_reserve() const { return reserves_exactly() ? 0.0 : step_bound(); }
 
  private:
   std::optional<double> fixed_segmentation_s_;
@@ -112,6 +121,7 @@ class PlannerClock {
   std::size_t steps_ = 0;                 ///< images reported
   double untaken_planning_s_ = 0.0;
   std::optional<double> reported_elapsed_s_;
+  bool caller_clock_ = false;  ///< whether any image came with the caller's mission time
 
   [[nodiscard]] TimeAccount& account() noexcept { return shared_ ? *shared_ : own_; }
   [[nodiscard]] const TimeAccount& account() const noexcept { return shared_ ? *shared_ : own_; }
