@@ -451,7 +451,9 @@ TEST_CASE("adaptive planner (tour): each descent flown at once or after the surv
     for (const auto& d : tour.decisions)
       if (d.candidates.at(0).deferred) deferred_images += static_cast<std::size_t>(d.candidates[0].images);
     const auto& last_decision = tour.decisions.back();
-    CHECK(after == deferred_images + (last_decision.candidates[0].deferred ? 0 : last_decision.candidates[0].images));
+    CHECK(after == deferred_images + (last_decision.candidates[0].deferred
+                                          ? 0
+                                          : static_cast<std::size_t>(last_decision.candidates[0].images)));
     // Outcomes name their descent; the simulation's realised gains come in decision order.
     CHECK(all.outcomes.size() == tour.decisions.size());
     for (std::size_t k = 0; k < tour.decisions.size(); ++k) {
@@ -687,7 +689,8 @@ TEST_CASE("AdaptivePlanner: stepping by hand over WeedMap gives run_adaptive_mis
   // Each flag both ways, in two missions: without a budget the caller reports the elapsed time,
   // with one the planner keeps its own clock (a budget driven by the reported time: "the elapsed
   // time the caller reports drives the budget" below).
-  for (const auto& [budget, report_elapsed] : {std::pair{false, true}, std::pair{true, false}}) {
+  for (const auto& flags : {std::pair{false, true}, std::pair{true, false}}) {
+    const bool budget = flags.first, report_elapsed = flags.second;  // named: CAPTURE's lambda captures them
     CAPTURE(budget);
     CAPTURE(report_elapsed);
     AdaptiveOptions o = weedmap_options(f);

@@ -683,10 +683,11 @@ void write_dem(const fs::path& file, const std::string& srs_text, double e0, dou
   OGRSpatialReference srs;
   srs.SetFromUserInput(srs_text.c_str());
   d->SetSpatialRef(&srs);
-  std::vector<float> values(static_cast<std::size_t>(w) * h);
+  std::vector<float> values(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
   for (int r = 0; r < h; ++r)
     for (int c = 0; c < w; ++c)
-      values[static_cast<std::size_t>(r) * w + c] = static_cast<float>(z(e0 + (c + 0.5) * px, n1 - (r + 0.5) * px));
+      values[static_cast<std::size_t>(r) * static_cast<std::size_t>(w) + static_cast<std::size_t>(c)] =
+          static_cast<float>(z(e0 + (c + 0.5) * px, n1 - (r + 0.5) * px));
   REQUIRE(d->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, w, h, values.data(), w, h, GDT_Float32, 0, 0) == CE_None);
 }
 

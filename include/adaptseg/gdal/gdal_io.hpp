@@ -40,6 +40,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <iomanip>
@@ -323,7 +324,7 @@ inline FieldGeo field_geo_of(const RasterGrid& g, const std::filesystem::path& f
   b.importFromWkt(ig.crs_wkt.c_str());
   const double tol = 1e-6 * grid.pixel_size_m();
   bool same = ig.width_px == grid.width_px && ig.height_px == grid.height_px;
-  for (int i = 0; i < 6; ++i) same = same && std::abs(ig.geotransform[i] - grid.geotransform[i]) <= tol;
+  for (std::size_t i = 0; i < 6; ++i) same = same && std::abs(ig.geotransform[i] - grid.geotransform[i]) <= tol;
   if (!same)
     field_error(y.yaml, "'" + *y.image_file + "' and '" + y.labels_file + "' are not on the same grid (" +
                             std::to_string(ig.width_px) + "x" + std::to_string(ig.height_px) + " px from (" +
