@@ -78,6 +78,7 @@ namespace adaptseg {
   const double su = image.width_px / static_cast<double>(image.footprint_px.width);
   const double sv = image.height_px / static_cast<double>(image.footprint_px.height);
   std::vector<cv::Mat> out;
+  cv::Mat up;  // each plane on the footprint: one buffer for all planes
   for (const cv::Mat& plane : planes) {
     detail::require(plane.type() == CV_32FC1 && plane.cols == image.width_px && plane.rows == image.height_px,
                     "planes_on_grid: planes must be CV_32FC1 of the image's size", plane.cols);
@@ -86,7 +87,6 @@ namespace adaptseg {
       const cv::Rect fp = image.footprint_px;
       const cv::Rect inside = fp & rect;
       if (inside.area() > 0) {
-        cv::Mat up;
         cv::resize(plane, up, fp.size(), 0, 0, cv::INTER_NEAREST_EXACT);
         up(inside - fp.tl()).copyTo(grid(inside - rect.tl()));
       }

@@ -54,30 +54,31 @@ class OracleSegmenter {
     detail::require(image.width_px > 0 && image.height_px > 0, "OracleSegmenter::segment: image size must be positive",
                     image.width_px);
     const cv::Size out_size(image.width_px, image.height_px);
+    if (image.ground_truth.size() == out_size) return at_map_gsd(image, with_probabilities);
     Segmentation out;
-    if (image.ground_truth.size() == out_size) {
-      out.labels = image.ground_truth.clone();
-      for (int c = 0; with_probabilities && c < num_classes_; ++c) {
-        cv::Mat one_hot;
-        cv::compare(out.labels, c, one_hot, cv::CMP_EQ);
-        one_hot.convertTo(one_hot, CV_32F, 1.0 / 255.0);
-        out.probabilities.push_back(one_hot);
-      }
-      return out;
+    // The working buffers, kept by the thread from one image to the next (allocated again only
+    // where the size changes): a simulated mission segments hundreds of images of a few sizes,
+    // and under the sanitizers every fresh buffer is fresh pages (the oracle's allocations were
+    // two fifths of the page faults of 50 simulated missions in test_adaptive_planner; kept,
+    // that case ran in 16 s instead of 29). What the call returns is its own.
+    thread_local Scratch scratch;
+    auto& [mask, indicator, votes, better, best_votes, total] = scratch;
+    best_votes.create(out_size, CV_32F);
+    best_votes.setTo(0.0f);
+    if (with_probabilities) {
+      total.create(out_size, CV_32F);
+      total.setTo(0.0f);
     }
-    cv::Mat best_votes(out_size, CV_32F, cv::Scalar(0.0f));
-    cv::Mat total(out_size, CV_32F, cv::Scalar(0.0f));
     out.labels = cv::Mat(out_size, CV_8UC1, cv::Scalar(image.ignore_label));
-    cv::Mat indicator, votes;
     for (int c = 0; c < num_classes_; ++c) {
-      cv::compare(image.ground_truth, c, indicator, cv::CMP_EQ);  // 255 where class c
-      if (cv::countNonZero(indicator) == 0) {
+      cv::compare(image.ground_truth, c, mask, cv::CMP_EQ);  // 255 where class c
+      if (cv::countNonZero(mask) == 0) {
         if (with_probabilities) out.probabilities.emplace_back(out_size, CV_32F, cv::Scalar(0.0f));
         continue;
       }
-      indicator.convertTo(indicator, CV_32F, 1.0 / 255.0);
+      mask.convertTo(indicator, CV_32F, 1.0 / 255.0);
       cv::resize(indicator, votes, out_size, 0, 0, cv::INTER_AREA);  // area fraction of c
-      const cv::Mat better = votes > best_votes;                     // strict: ties keep the lower index
+      cv::compare(votes, best_votes, better, cv::CMP_GT);            // strict: ties keep the lower index
       votes.copyTo(best_votes, better);
       out.labels.setTo(c, better);
       if (with_probabilities) {
@@ -97,6 +98,24 @@ class OracleSegmenter {
     }
     return out;
   }
+
+  /// At the orthomosaic's GSD: the ground truth itself, one-hot probabilities.
+  [[nodiscard]] Segmentation at_map_gsd(const Image& image, bool with_probabilities) const {
+    Segmentation out;
+    out.labels = image.ground_truth.clone();
+    for (int c = 0; with_probabilities && c < num_classes_; ++c) {
+      cv::Mat one_hot;
+      cv::compare(out.labels, c, one_hot, cv::CMP_EQ);
+      one_hot.convertTo(one_hot, CV_32F, 1.0 / 255.0);
+      out.probabilities.push_back(one_hot);
+    }
+    return out;
+  }
+
+  /// The class loop's buffers (vote()).
+  struct Scratch {
+    cv::Mat mask, indicator, votes, better, best_votes, total;
+  };
 
   int num_classes_;
 };

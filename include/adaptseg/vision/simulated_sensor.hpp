@@ -73,7 +73,10 @@ class SimulatedSensor {
     };
     img.ground_truth = cut(field_.labels(), cv::Scalar(field_.ignore_label()));
     if (field_.has_image()) {
-      const cv::Mat rgb = cut(field_.image(), cv::Scalar(0, 0, 0));
+      // A footprint inside the orthomosaic is resampled where it lies, without a copy.
+      const bool inside = !frame.turned() && (img.footprint_px & cv::Rect(0, 0, field_.image().cols,
+                                                                          field_.image().rows)) == img.footprint_px;
+      const cv::Mat rgb = inside ? field_.image()(img.footprint_px) : cut(field_.image(), cv::Scalar(0, 0, 0));
       cv::resize(rgb, img.bgr, cv::Size(img.width_px, img.height_px), 0, 0, cv::INTER_AREA);
     }
     return img;
