@@ -2,9 +2,11 @@
 # Installs the Debian packages adaptseg needs, or says which are missing.
 #   scripts/deps.sh build   compiler, CMake and the C++ libraries (library, examples, tests)
 #   scripts/deps.sh test    build + what the test suite runs (Python for the data converters,
+#                           matplotlib for the figures cli:adaptseg_evaluate:unseen_tile checks,
 #                           GDAL's ogrinfo, gdalinfo, gdal_translate, gdaltransform for the
 #                           exports and GeoTIFF fields, doxygen for docs:doxygen, pyflakes3,
-#                           clang-format and clang-tidy for the lint tests)
+#                           clang-format and clang-tidy for the lint tests, Clang's front end
+#                           for headers:alone)
 #   scripts/deps.sh docs    doxygen, for the API reference (scripts/docs.sh)
 #   scripts/deps.sh bench   test + what the benchmarks compare against (scikit-learn, with
 #                           OpenBLAS as well as the reference BLAS)
@@ -30,7 +32,7 @@ demo=(cmake g++ make libeigen3-dev liblbfgspp-dev libyaml-cpp-dev nlohmann-json3
       python3 python3-matplotlib)
 case "${1:-build}" in
   build) want=("${build[@]}") ;;
-  test) want=("${build[@]}" "${python[@]}" gdal-bin doxygen pyflakes3 clang-format-14 clang-tidy-14) ;;
+  test) want=("${build[@]}" "${python[@]}" python3-matplotlib gdal-bin doxygen pyflakes3 clang-format-14 clang-tidy-14 clang-14) ;;
   docs) want=(doxygen) ;;
   bench) want=("${build[@]}" "${python[@]}" gdal-bin doxygen python3-sklearn python3-torch libopenblas0-pthread) ;;
   plots) want=("${build[@]}" "${python[@]}" python3-matplotlib) ;;
