@@ -132,7 +132,10 @@ const mPerDegLat = (lat) => 111132.92 - 559.82 * Math.cos(2 * lat * RAD) + 1.175
   0.0023 * Math.cos(6 * lat * RAD);
 const mPerDegLon = (lat) => 111412.84 * Math.cos(lat * RAD) - 93.5 * Math.cos(3 * lat * RAD) + 0.118 * Math.cos(5 * lat * RAD);
 
-// A seeded generator (mulberry32), so that a run drops a reproducible share of datagrams.
+// Seeded generators (mulberry32), one per direction, so that which datagrams a run drops is
+// reproducible in each direction: with one generator shared by both, the draws interleaved with
+// the timing of the two directions, and a run could drop nothing of what it received (CI:
+// dropped_in 0 of 54 at 10 %).
 function makeRandom(seed) {
   let a = seed >>> 0;
   return () => {
@@ -143,7 +146,8 @@ function makeRandom(seed) {
     return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
   };
 }
-const random = makeRandom(opt.seed);
+const randomOut = makeRandom(opt.seed);
+const randomIn = makeRandom(opt.seed ^ 0x5bd1e995);
 
 // ---------------------------------------------------------------- state
 const start = performance.now();
@@ -191,7 +195,7 @@ function send(msg, compid = COMP_AUTOPILOT) {
   if (linkLost()) return;
   const buffer = protocols[compid].serialize(msg, sequences[compid]);
   sequences[compid] = (sequences[compid] + 1) & 0xFF;
-  if (opt.drop > 0 && random() < opt.drop) {
+  if (opt.drop > 0 && randomOut() < opt.drop) {
     counts.dropped_out += 1;
     return;
   }
@@ -455,7 +459,7 @@ socket.on('message', (buffer) => {
     counts.ignored_after_link_loss += 1;
     return;
   }
-  if (opt.drop > 0 && random() < opt.drop) {
+  if (opt.drop > 0 && randomIn() < opt.drop) {
     counts.dropped_in += 1;
     return;
   }
