@@ -20,7 +20,7 @@
 #include "common/strategies.hpp"
 
 #include <adaptseg/vision/decision_model.hpp>
-#include <adaptseg/vision/image_summary.hpp>
+#include <adaptseg/vision/grid_inputs.hpp>
 
 #include <algorithm>
 #include <array>
@@ -108,13 +108,16 @@ std::vector<Cell> study_field(const Field& field, Backend& backend, const Camera
   field_cm.add(field.labels(), top_map.labels(), field.ignore_label());
   const cv::Rect grid(0, 0, field.width_px(), field.height_px());
   std::vector<Cell> out;
+  GridInputs fine_inputs;  // each finer image's over its cell (buffers reused)
   for (std::size_t t = 0; t < tops.size(); ++t) {
     const cv::Rect region = images[t].footprint_px & grid;
     const cv::Mat field_px = field.valid_mask()(region);
-    std::vector<std::vector<cv::Mat>> top_planes;  // per class
+    // Each class's decision inputs over the region, summed cell by cell (GridInputs: the sums of
+    // cell_inputs() of planes_on_grid() of pixel_inputs(), to the bit, without the planes).
+    std::vector<GridInputs> top_inputs;  // per class
     for (int c : classes)
-      top_planes.push_back(
-          planes_on_grid(images[t], pixel_inputs(segs[t], std::vector<int>{c}, field.ignore_label()), region));
+      top_inputs.emplace_back(images[t], segs[t], std::vector<int>{c}, field.ignore_label(), region,
+                              kEveryDecisionInputList);
     for (double g : gsds) {
       const auto sub =
           planner.plan(tops[t].footprint, g, Eigen::Vector2d(tops[t].position.x(), tops[t].position.y()), keep);
@@ -147,10 +150,11 @@ std::vector<Cell> study_field(const Field& field, Backend& backend, const Camera
           c.cls = field.classes()[static_cast<std::size_t>(classes[k])].name;
           c.region = t;
           c.gsd_cm = g;
-          c.top = cell_inputs(top_planes[k], field_px, cell_local);
+          c.top = top_inputs[k].cell(field_px, cell_local);
           if (!(c.top.field_px > 0.0)) continue;
-          const auto fine_planes = planes_on_grid(shifted, pixel_inputs(fine, l, field.ignore_label()), cell_local);
-          c.fine = cell_inputs(fine_planes, field_px(cell_local), cv::Rect(0, 0, cell.width, cell.height));
+          fine_inputs.assign(shifted, fine, l, field.ignore_label(), cell_local, kEveryDecisionInputList,
+                             GridInputs::Cells::one);
+          c.fine = fine_inputs.cell(field_px(cell_local), cv::Rect(0, 0, cell.width, cell.height));
           c.field_share = c.top.field_px / std::max(1, field.valid_pixels());
           c.field_sigma = semantic_ratio(top_map.labels(), l, field.ignore_label());
           c.relabelled = relabelling(top_map.labels()(cell), after, field.valid_mask()(cell), l).interest_share;

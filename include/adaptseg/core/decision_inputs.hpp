@@ -65,6 +65,13 @@ inline constexpr std::array<DecisionInputInfo, 8> kDecisionInputs{{
 
 inline constexpr std::size_t kDecisionInputCount = kDecisionInputs.size();
 
+/// Every decision input, in enum order, as a list (e.g. a GridInputs of them all).
+inline constexpr std::array<DecisionInput, kDecisionInputCount> kEveryDecisionInputList = [] {
+  std::array<DecisionInput, kDecisionInputCount> all{};
+  for (std::size_t k = 0; k < kDecisionInputCount; ++k) all[k] = kDecisionInputs[k].input;
+  return all;
+}();
+
 namespace detail {
 /// Every decision input: pixel_input_values()'s default.
 inline constexpr std::array<bool, kDecisionInputCount> kEveryDecisionInput = [] {

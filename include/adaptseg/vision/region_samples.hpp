@@ -9,7 +9,7 @@
 #include <adaptseg/core/decision.hpp>
 #include <adaptseg/core/lawnmower_planner.hpp>
 #include <adaptseg/vision/descent_coverage.hpp>
-#include <adaptseg/vision/image_summary.hpp>
+#include <adaptseg/vision/grid_inputs.hpp>
 #include <adaptseg/vision/metrics.hpp>
 #include <adaptseg/vision/segmentation_backend.hpp>
 #include <adaptseg/vision/semantic_map.hpp>
@@ -96,7 +96,7 @@ class SampleCollector {
     SemanticMap map;                ///< its segmentation on the map grid
     cv::Mat field_px;               ///< the region's field pixels: where relabelling is counted
     ConfusionMatrix field_without;  ///< the field's confusion without this region's top-level map
-    std::vector<cv::Mat> planes;    ///< the decision inputs on the region's map grid (ranked only)
+    GridInputs inputs;              ///< the decision inputs over the region's map grid (ranked only)
     ConfusionMatrix cm;             ///< the top-level image's own confusion
     double sigma = 0.0;             ///< its semantic ratio
   };
@@ -130,7 +130,7 @@ class SampleCollector {
     here.add(field_.labels()(r.inside), field_map_.labels()(r.inside), field_.ignore_label());
     r.field_without -= here;
     if (ranked_)
-      r.planes = planes_on_grid(top_image, pixel_inputs(top_segmentation, interest_, field_.ignore_label()), region);
+      r.inputs.assign(top_image, top_segmentation, interest_, field_.ignore_label(), region, kEveryDecisionInputList);
     return r;
   }
 
@@ -162,8 +162,9 @@ class SampleCollector {
         fine_inputs.emplace_back();
         continue;
       }
-      const auto planes = planes_on_grid(img, pixel_inputs(seg, interest_, field_.ignore_label()), cell);
-      fine_inputs.push_back(cell_inputs(planes, r.field_px(cell), cv::Rect(0, 0, cell.width, cell.height)));
+      fine_inputs_.assign(img, seg, interest_, field_.ignore_label(), cell, kEveryDecisionInputList,
+                          GridInputs::Cells::one);
+      fine_inputs.push_back(fine_inputs_.cell(r.field_px(cell), cv::Rect(0, 0, cell.width, cell.height)));
     }
     ConfusionMatrix sub_cm(n_);
     sub_cm.add(top_images_[r.index].ground_truth, local.labels(), field_.ignore_label());
@@ -202,7 +203,7 @@ class SampleCollector {
       c.region = r.index;
       c.top_gsd_cm = top_gsd_cm_;
       c.sub_gsd_cm = g;
-      c.top = cell_inputs(r.planes, r.field_px, cell);
+      c.top = r.inputs.cell(r.field_px, cell);
       if (!(c.top.field_px > 0.0)) continue;
       c.fine = fine_inputs[k];
       c.field_share = c.top.field_px / field_px_total_;
@@ -247,6 +248,9 @@ class SampleCollector {
   double field_sigma_ = 0.0;
   double field_px_total_;
   cv::Rect grid_;
+  /// Ranked: the last finer image's decision inputs over its cell (buffers reused). GridInputs
+  /// sums of every input give cell_inputs() of planes_on_grid() of pixel_inputs(), to the bit.
+  GridInputs fine_inputs_;
 };
 
 }  // namespace detail
