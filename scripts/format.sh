@@ -17,6 +17,12 @@ mapfile -d '' files < <(git ls-files -z '*.hpp' '*.cpp' '*.h' '*.cc' 2>/dev/null
 case "${1:-}" in
   "") "$fmt" -i --style=file "${files[@]}" ;;
   --check)
+    # One process for every file (one per file cost 29 s of the 2-core VM's CPU, most of it
+    # starting clang-format 226 times); only where that fails, file by file to name them.
+    if "$fmt" --style=file --dry-run -Werror "${files[@]}" >/dev/null 2>&1; then
+      echo "format.sh: ${#files[@]} files formatted"
+      exit 0
+    fi
     bad=()
     for f in "${files[@]}"; do
       "$fmt" --style=file --dry-run -Werror "$f" >/dev/null 2>&1 || bad+=("$f")
