@@ -6,15 +6,26 @@
 # Then the georeferenced loop: GNSS poses on a geo-referenced area, the same area
 # given as a GeoJSON polygon (--area), and a loop that stops on a missing image leaving what it
 # flew in --out.
-#   test_live_cli.sh LIVE_BINARY MISSION_BINARY CALIBRATE_BINARY EXAMPLES_DIR PYTHON gdal|nogdal
+#   test_live_cli.sh LIVE_BINARY MISSION_BINARY CALIBRATE_BINARY EXAMPLES_DIR PYTHON gdal|nogdal [DUBAI_MODEL]
+# DUBAI_MODEL: the Dubai quarter's model (the CTest fixture dubai_quarter_model,
+# calibrate_dubai_quarter.sh); without it the script calibrates the same model itself.
 set -uo pipefail
-live=$1 mission=$2 calibrate=$3 examples=$4 python=$5 gdal=${6:-nogdal}
+live=$1 mission=$2 calibrate=$3 examples=$4 python=$5 gdal=${6:-nogdal} dubai_model=${7:-}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 field="$examples/data/weedmap-000"
 region="$field:0.5,0,1,0.5"
 times=(--seg-time-s 0.1 --plan-time-s 0)
 fail() { echo "FAIL: $*" >&2; exit 1; }
+# dubai_model OUT: the Dubai quarter's model at OUT, the fixture's where given (calibrate_dubai_quarter.sh).
+dubai_model() {
+  if [ -n "$dubai_model" ]; then
+    cp "$dubai_model" "$1" || fail "no Dubai model at $dubai_model"
+  else
+    bash "$(dirname "$0")/calibrate_dubai_quarter.sh" "$calibrate" "$examples" "$1" 2>"$work/err" ||
+      fail "calibrating with the network: $(cat "$work/err")"
+  fi
+}
 
 "$calibrate" --field "$field" --region 0,0,0.5,0.5 --segmenter oracle "${times[@]}" --out "$work/model.yaml" \
   >/dev/null 2>"$work/calibrate.log" || fail "calibration: $(cat "$work/calibrate.log")"
@@ -287,8 +298,7 @@ PY
 # and cropped to 16:9, which is refused saying what to do.
 dubai="$examples/data/dubai-tile-4:0,0,0.5,0.5"
 net="$examples/models/mobilenetv2-dubai"
-"$calibrate" --field "$dubai" --segmenter network --network "$net" "${times[@]}" --out "$work/dubai.yaml" \
-  >/dev/null 2>"$work/err" || fail "calibrating with the network: $(cat "$work/err")"
+dubai_model "$work/dubai.yaml"
 "$live" --record-from "$dubai" --decision-model "$work/dubai.yaml" --images "$work/dubai" >/dev/null || fail "recording Dubai"
 network=(--segmenter network --network "$net" "${times[@]}")
 "$live" --images "$work/dubai" --decision-model "$work/dubai.yaml" "${network[@]}" --out "$work/live-dubai" \

@@ -27,11 +27,13 @@
 # footprint edge across a map pixel: the maps may differ in 0.5 % of their pixels at most.
 # Two utility thresholds per weighting are tried, not ten: the setting chosen, and the model, are
 # the same (it descends everywhere), in about half the time (121 s -> 70 s under the sanitizers).
-#   test_live_mavlink_cli.sh LIVE_BINARY MISSION_BINARY CALIBRATE_BINARY EXAMPLES_DIR PYTHON
+#   test_live_mavlink_cli.sh LIVE_BINARY MISSION_BINARY CALIBRATE_BINARY EXAMPLES_DIR PYTHON [DUBAI_MODEL]
+# DUBAI_MODEL: the Dubai quarter's model (the CTest fixture dubai_quarter_model,
+# calibrate_dubai_quarter.sh); without it the script calibrates the same model itself.
 # Exit 77 (CTest's SKIP_RETURN_CODE) without node or the pinned node-mavlink:
 #   (cd tests/mavlink && npm ci)     # scripts/test.sh does it where npm exists
 set -uo pipefail
-live=$1 mission=$2 calibrate=$3 examples=$4 python=$5
+live=$1 mission=$2 calibrate=$3 examples=$4 python=$5 dubai_model=${6:-}
 emulator="$(cd "$(dirname "$0")/../mavlink" && pwd)/emulator.mjs"
 source "$(dirname "$emulator")/require_node_mavlink.sh" "the emulated autopilot"
 work=$(mktemp -d)
@@ -99,8 +101,12 @@ fly() {
 # refused at the first picture (exit 2, one line, nothing lost).
 dubai="$examples/data/dubai-tile-4:0,0,0.5,0.5"
 net="$examples/models/mobilenetv2-dubai"
-"$calibrate" --field "$dubai" --segmenter network --network "$net" "${times[@]}" --out "$work/dubai.yaml" \
-  >/dev/null 2>"$work/err" || fail "calibrating with the network: $(cat "$work/err")"
+if [ -n "$dubai_model" ]; then
+  cp "$dubai_model" "$work/dubai.yaml" || fail "no Dubai model at $dubai_model"
+else
+  bash "$(dirname "$0")/calibrate_dubai_quarter.sh" "$calibrate" "$examples" "$work/dubai.yaml" 2>"$work/err" ||
+    fail "calibrating with the network: $(cat "$work/err")"
+fi
 "$live" --record-from "$dubai" --decision-model "$work/dubai.yaml" --images "$work/dubai" --record-gnss --geo-origin 25.2,55.3,10,30 --grid centred \
   >/dev/null || fail "recording Dubai"
 mkdir -p "$work/card" "$work/plain" "$work/camera" "$work/camera-plain"
