@@ -17,15 +17,6 @@ field="$examples/data/weedmap-000"
 region="$field:0.5,0,1,0.5"
 times=(--seg-time-s 0.1 --plan-time-s 0)
 fail() { echo "FAIL: $*" >&2; exit 1; }
-# dubai_model OUT: the Dubai quarter's model at OUT, the fixture's where given (calibrate_dubai_quarter.sh).
-dubai_model() {
-  if [ -n "$dubai_model" ]; then
-    cp "$dubai_model" "$1" || fail "no Dubai model at $dubai_model"
-  else
-    bash "$(dirname "$0")/calibrate_dubai_quarter.sh" "$calibrate" "$examples" "$1" 2>"$work/err" ||
-      fail "calibrating with the network: $(cat "$work/err")"
-  fi
-}
 
 "$calibrate" --field "$field" --region 0,0,0.5,0.5 --segmenter oracle "${times[@]}" --out "$work/model.yaml" \
   >/dev/null 2>"$work/calibrate.log" || fail "calibration: $(cat "$work/calibrate.log")"
@@ -298,7 +289,8 @@ PY
 # and cropped to 16:9, which is refused saying what to do.
 dubai="$examples/data/dubai-tile-4:0,0,0.5,0.5"
 net="$examples/models/mobilenetv2-dubai"
-dubai_model "$work/dubai.yaml"
+bash "$(dirname "$0")/calibrate_dubai_quarter.sh" "$calibrate" "$examples" "$work/dubai.yaml" "$dubai_model" \
+  2>"$work/err" || fail "calibrating with the network: $(cat "$work/err")"
 "$live" --record-from "$dubai" --decision-model "$work/dubai.yaml" --images "$work/dubai" >/dev/null || fail "recording Dubai"
 network=(--segmenter network --network "$net" "${times[@]}")
 "$live" --images "$work/dubai" --decision-model "$work/dubai.yaml" "${network[@]}" --out "$work/live-dubai" \

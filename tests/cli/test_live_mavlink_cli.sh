@@ -101,12 +101,8 @@ fly() {
 # refused at the first picture (exit 2, one line, nothing lost).
 dubai="$examples/data/dubai-tile-4:0,0,0.5,0.5"
 net="$examples/models/mobilenetv2-dubai"
-if [ -n "$dubai_model" ]; then
-  cp "$dubai_model" "$work/dubai.yaml" || fail "no Dubai model at $dubai_model"
-else
-  bash "$(dirname "$0")/calibrate_dubai_quarter.sh" "$calibrate" "$examples" "$work/dubai.yaml" 2>"$work/err" ||
-    fail "calibrating with the network: $(cat "$work/err")"
-fi
+bash "$(dirname "$0")/calibrate_dubai_quarter.sh" "$calibrate" "$examples" "$work/dubai.yaml" "$dubai_model" \
+  2>"$work/err" || fail "calibrating with the network: $(cat "$work/err")"
 "$live" --record-from "$dubai" --decision-model "$work/dubai.yaml" --images "$work/dubai" --record-gnss --geo-origin 25.2,55.3,10,30 --grid centred \
   >/dev/null || fail "recording Dubai"
 mkdir -p "$work/card" "$work/plain" "$work/camera" "$work/camera-plain"
