@@ -290,53 +290,69 @@ inline std::size_t choose_setting(std::span<const RuleTrial> trials, std::span<c
   return grid;
 }
 
-/// Per fold, the gain ratios and margin biases its trials fly with.
-struct FoldCorrections {
-  std::vector<std::vector<GainRatio>> ratios;
-  std::vector<std::vector<MarginBias>> biases;
-  std::vector<double> jump_bounds;         ///< the jump guard's (CalibrationOptions::jump_guard), else `base`'s
-  std::vector<double> relabel_transfers;   ///< b (CalibrationOptions::relabel_transfer), else `base`'s
-  std::vector<double> relabel_region_sds;  ///< τ_r (CalibrationOptions::relabel_region_spread), else `base`'s
-  std::vector<double> relabel_field_sds;   ///< ω_χ (CalibrationOptions::relabel_field_spread), else `base`'s
+/// What one fold's trials fly with beyond the setting tried (FrontAwarePolicy::Params' own
+/// fields of the same names): the gain ratios and margin biases measured on the other folds'
+/// flights, the jump guard's bound and the relabelled factor's b, τ_r and ω_χ measured on the other
+/// fields' cells; each the search's base parameters' where its option is off.
+struct FoldCorrection {
+  std::vector<GainRatio> gain_ratios;
+  std::vector<MarginBias> margin_biases;
+  double jump_bound = 0.0;         ///< the jump guard's (CalibrationOptions::jump_guard)
+  double relabel_transfer = 0.0;   ///< b (CalibrationOptions::relabel_transfer)
+  double relabel_region_sd = 0.0;  ///< τ_r (CalibrationOptions::relabel_region_spread)
+  double relabel_field_sd = 0.0;   ///< ω_χ (CalibrationOptions::relabel_field_spread)
+
+  /// `p`'s own: the correction that changes nothing.
+  [[nodiscard]] static FoldCorrection of(const FrontAwarePolicy::Params& p) {
+    return {p.gain_ratios, p.margin_biases, p.jump_bound, p.relabel_transfer, p.relabel_region_sd, p.relabel_field_sd};
+  }
+  void apply_to(FrontAwarePolicy::Params& p) const {
+    p.gain_ratios = gain_ratios;
+    p.margin_biases = margin_biases;
+    p.jump_bound = jump_bound;
+    p.relabel_transfer = relabel_transfer;
+    p.relabel_region_sd = relabel_region_sd;
+    p.relabel_field_sd = relabel_field_sd;
+  }
 };
 
-/// The gain ratios and margin biases of every fold, measured on the other folds' flights only,
-/// as its model was fitted without its field; the model's own (on every fold's flight) into
-/// `base`. Without `gain_ratios` and `margin_biases`, or with one field, `base`'s for every fold.
-/// With `jump_guard` and ranked cells, each fold's jump bound from the other fields' cells; with
-/// `relabel_transfer`, `relabel_region_spread` and `relabel_field_spread`, its b, τ_r and ω_χ so.
+/// The jump guard's bound and the relabelled factor's b, τ_r and ω_χ measured on `cells` into
+/// `c`, each where `options` asks for it (with ranked cells: the callers' test): a fold's from
+/// the other fields' cells, the calibrated model's from every field's.
+inline void measure_on_cells(FoldCorrection& c, std::span<const CellSample> cells, const CalibrationOptions& options,
+                             DecisionInput input) {
+  if (options.jump_guard) c.jump_bound = jump_bound(cells);
+  if (options.relabel_transfer) c.relabel_transfer = relabel_transfer(cells, input);
+  if (options.relabel_region_spread) c.relabel_region_sd = relabel_region_sd(cells, input);
+  if (options.relabel_field_spread) c.relabel_field_sd = relabel_field_sd(cells, input);
+}
+
+/// Every fold's correction: the gain ratios and margin biases measured on the other folds'
+/// flights only, as its model was fitted without its field, and the model's own (on every
+/// fold's flight) into `base`; without `gain_ratios` and `margin_biases`, or with one field,
+/// `base`'s for every fold. The jump bound, b, τ_r and ω_χ from the other fields' cells
+/// (measure_on_cells()).
 template <class Fly>
-[[nodiscard]] FoldCorrections fold_corrections(const RuleSearchInputs& in, std::span<const FrontAwareFold> folds,
-                                               const FrontAwareGrid& grid, FrontAwarePolicy::Params& base, Fly& fly) {
+[[nodiscard]] std::vector<FoldCorrection> fold_corrections(const RuleSearchInputs& in,
+                                                           std::span<const FrontAwareFold> folds,
+                                                           const FrontAwareGrid& grid, FrontAwarePolicy::Params& base,
+                                                           Fly& fly) {
   const CalibrationOptions& options = in.options;
-  FoldCorrections c{std::vector<std::vector<GainRatio>>(folds.size(), base.gain_ratios),
-                    std::vector<std::vector<MarginBias>>(folds.size(), base.margin_biases),
-                    std::vector<double>(folds.size(), base.jump_bound),
-                    std::vector<double>(folds.size(), base.relabel_transfer),
-                    std::vector<double>(folds.size(), base.relabel_region_sd),
-                    std::vector<double>(folds.size(), base.relabel_field_sd)};
-  if (options.jump_guard && grid.ranked)
-    for (std::size_t k = 0; k < folds.size(); ++k) c.jump_bounds[k] = jump_bound(folds[k].cells);
-  if (options.relabel_transfer && grid.ranked)
+  std::vector<FoldCorrection> c(folds.size(), FoldCorrection::of(base));
+  if (grid.ranked)
     for (std::size_t k = 0; k < folds.size(); ++k)
-      c.relabel_transfers[k] = relabel_transfer(folds[k].cells, in.adaptive.cell_input);
-  if (options.relabel_region_spread && grid.ranked)
-    for (std::size_t k = 0; k < folds.size(); ++k)
-      c.relabel_region_sds[k] = relabel_region_sd(folds[k].cells, in.adaptive.cell_input);
-  if (options.relabel_field_spread && grid.ranked)
-    for (std::size_t k = 0; k < folds.size(); ++k)
-      c.relabel_field_sds[k] = relabel_field_sd(folds[k].cells, in.adaptive.cell_input);
+      measure_on_cells(c[k], folds[k].cells, options, in.adaptive.cell_input);
   if (!(options.gain_ratios || options.margin_biases) || in.fields.size() < 2) return c;
   const std::vector<AdaptiveResult> flights = measuring_flights(in, folds, grid, base, fly);
   std::vector<const std::vector<CurvePoint>*> curves;
   for (const FrontAwareFold& f : folds) curves.push_back(f.curve);
   if (options.gain_ratios) {
     base.gain_ratios = fold_gain_ratios(flights);
-    for (std::size_t k = 0; k < folds.size(); ++k) c.ratios[k] = fold_gain_ratios(flights, k);
+    for (std::size_t k = 0; k < folds.size(); ++k) c[k].gain_ratios = fold_gain_ratios(flights, k);
   }
   if (options.margin_biases) {
     base.margin_biases = fold_margin_biases(flights, curves);
-    for (std::size_t k = 0; k < folds.size(); ++k) c.biases[k] = fold_margin_biases(flights, curves, k);
+    for (std::size_t k = 0; k < folds.size(); ++k) c[k].margin_biases = fold_margin_biases(flights, curves, k);
   }
   return c;
 }
@@ -356,7 +372,7 @@ template <class Fly>
   FrontAwarePolicy::Params base = options.front_aware;
   base.online = true;
   detail::apply_sigma_prior(base, estimate_sigma_prior(traces), options.sigma_prior);
-  const detail::FoldCorrections corrections = detail::fold_corrections(in, folds, grid, base, fly);
+  const std::vector<detail::FoldCorrection> corrections = detail::fold_corrections(in, folds, grid, base, fly);
   std::vector<RuleTrial> trials;
   std::vector<detail::FrontAwareSetting> settings;
   for (std::size_t pi = 0; pi < grid.poolings.size(); ++pi) {
@@ -372,12 +388,7 @@ template <class Fly>
                                        grid.top_levels.size() > 1 ? &grid.top_levels[ti] : nullptr);
         for (std::size_t k = 0; k < folds.size(); ++k) {
           FrontAwarePolicy::Params fold_params = p;
-          fold_params.gain_ratios = corrections.ratios[k];
-          fold_params.margin_biases = corrections.biases[k];
-          fold_params.jump_bound = corrections.jump_bounds[k];
-          fold_params.relabel_transfer = corrections.relabel_transfers[k];
-          fold_params.relabel_region_sd = corrections.relabel_region_sds[k];
-          fold_params.relabel_field_sd = corrections.relabel_field_sds[k];
+          corrections[k].apply_to(fold_params);
           double margin = 0.0;
           const AdaptiveResult r = detail::fly_fold(in, folds[k], models[k], fold_params, fly, margin);
           detail::add_to_trial(t, r, margin);
@@ -395,14 +406,13 @@ template <class Fly>
   if (grid.ranked && model.cells() && model.cells()->pooling() != pooling) {
     model.set_cells(CellGainModel::fit(cells_of_every_field(in.cells), in.adaptive.cell_input, pooling));
   }
+  // Its jump bound, b, τ_r and ω_χ from every field's cells.
   FrontAwarePolicy::Params params = settings[best].params;
-  if (options.jump_guard && grid.ranked) params.jump_bound = jump_bound(cells_of_every_field(in.cells));
-  if (options.relabel_transfer && grid.ranked)
-    params.relabel_transfer = relabel_transfer(cells_of_every_field(in.cells), in.adaptive.cell_input);
-  if (options.relabel_region_spread && grid.ranked)
-    params.relabel_region_sd = relabel_region_sd(cells_of_every_field(in.cells), in.adaptive.cell_input);
-  if (options.relabel_field_spread && grid.ranked)
-    params.relabel_field_sd = relabel_field_sd(cells_of_every_field(in.cells), in.adaptive.cell_input);
+  if (grid.ranked) {
+    detail::FoldCorrection whole = detail::FoldCorrection::of(params);
+    detail::measure_on_cells(whole, cells_of_every_field(in.cells), options, in.adaptive.cell_input);
+    whole.apply_to(params);
+  }
   return {DecisionFunction(FrontAwarePolicy(std::move(model), reference, params)), std::move(trials)};
 }
 
