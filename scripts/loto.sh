@@ -37,6 +37,12 @@
 #       examples/models/mobilenetv2-dubai-loto/tile-<k> (model.onnx, model.yaml, its logs and
 #       held-out scores), the six fits in its temperatures.csv, and the deployment network
 #       (mobilenetv2-dubai-all) given the median of all six.
+#   bash scripts/loto.sh stage TILES
+#       here: each network of TILES (comma-separated) trained by recipe-cpu (or eval) copied into
+#       LOTO_BUNDLE/tile-<k> as bundle would copy it, without a temperature (bundle fits and sets
+#       those once all six are there, taking staged tiles from LOTO_BUNDLE): a set trained over
+#       several sessions on the CPU kept tile by tile (committed) where the checkpoints are lost
+#       with the machine. Never over a network already there.
 #   bash scripts/loto.sh decision [CLASSES]
 #       here, after bundle: the deployment network's decision model per class of interest
 #       (CLASSES space-separated, default "building road vegetation water"), calibrated on the six
@@ -85,6 +91,16 @@ train_fields() {  # every bundled tile but $1, comma-separated
   local k=$1 out=""
   for t in "${tiles_all[@]}"; do [ "$t" = "$k" ] || out+="${out:+,}dubai-tile-$t"; done
   echo "$out"
+}
+
+# Tile $1's network trained here ($wroot/model-k, its training and held-out scores) into
+# $dest/tile-k, as it was exported (bundle then sets its temperature).
+stage_tile() {
+  local k=$1
+  mkdir -p "$dest/tile-$k"
+  for f in model.onnx model.yaml train_log.csv val_log.csv val_ema_log.csv; do cp "$wroot/model-$k/$f" "$dest/tile-$k/"; done
+  cp "$wroot/eval-$k.json" "$dest/tile-$k/held_out_eval.json"
+  [ ! -f "$wroot/train-$k.log" ] || cp "$wroot/train-$k.log" "$dest/tile-$k/train.log"
 }
 
 case "${1:-}" in
@@ -218,12 +234,7 @@ bundle)
     others=()
     for j in "${tiles_all[@]}"; do [ "$j" = "$k" ] || others+=("${fitted[$j]}"); done
     t=$(median "${others[@]}")
-    mkdir -p "$dest/tile-$k"
-    if [ "${src[$k]}" != "$dest/tile-$k" ]; then
-      for f in model.onnx model.yaml train_log.csv val_log.csv val_ema_log.csv; do cp "$wroot/model-$k/$f" "$dest/tile-$k/"; done
-      cp "$wroot/eval-$k.json" "$dest/tile-$k/held_out_eval.json"
-      [ ! -f "$wroot/train-$k.log" ] || cp "$wroot/train-$k.log" "$dest/tile-$k/train.log"
-    fi
+    [ "${src[$k]}" = "$dest/tile-$k" ] || stage_tile "$k"
     "$fit" --network "$dest/tile-$k" --set "$t" >/dev/null
     echo "dubai-tile-$k,${fitted[$k]},$t" >>"$dest/temperatures.csv"
   done
@@ -231,6 +242,16 @@ bundle)
   [ "$dest" != examples/models/mobilenetv2-dubai-loto ] ||
     "$fit" --network examples/models/mobilenetv2-dubai-all --set "$(median "${fitted[@]}")"
   cat "$dest/temperatures.csv"
+  ;;
+stage)
+  IFS=, read -r -a tiles <<<"${2:?tiles, comma-separated}"
+  for k in "${tiles[@]}"; do
+    [ -s "$wroot/model-$k/model.onnx" ] && [ -s "$wroot/eval-$k.json" ] ||
+      { echo "no $wroot/model-$k with its eval-$k.json: bash $0 recipe-cpu $k (or eval)" >&2; exit 1; }
+    [ ! -e "$dest/tile-$k/model.onnx" ] || { echo "$dest/tile-$k holds a network already; not overwritten" >&2; exit 1; }
+    stage_tile "$k"
+    echo "$dest/tile-$k (no temperature yet: bundle sets it once all six are here)"
+  done
   ;;
 decision)
   read -r -a classes <<<"${2:-building road vegetation water}"
@@ -288,7 +309,7 @@ mirror)
   echo "wrote $to/tile-{1..6}/ensemble.yaml"
   ;;
 *)
-  sed -n '2,72p' "$0" >&2
+  sed -n '2,78p' "$0" >&2
   exit 2
   ;;
 esac
