@@ -139,8 +139,7 @@ def train(run: Run, args, t_start: float) -> int:
             g["lr"] = lr * s
         x = x.to(device, non_blocking=True)
         y = y.to(device, non_blocking=True)
-        if cuda:
-            x = x.contiguous(memory_format=torch.channels_last)
+        x = x.contiguous(memory_format=torch.channels_last)
         with torch.autocast(device_type=device.type, dtype=torch.bfloat16, enabled=cuda):
             logits = logits_to(model(x), y.shape[-2:])
         loss = criterion(logits.float(), y)

@@ -209,9 +209,7 @@ def network(args, ckpt: dict, resume: bool, ckpt_path: Path, device, cuda: bool)
     for m in frozen_encoder_modules(model, ckpt.get("frozen_blocks", 0)):
         for p in m.parameters():
             p.requires_grad = False
-    model.to(device)
-    if cuda:
-        model = model.to(memory_format=torch.channels_last)
+    model = model.to(device, memory_format=torch.channels_last)
     trainable = [p for p in model.parameters() if p.requires_grad]
     if ckpt["optimizer"] == "Adam":
         opt = torch.optim.Adam(trainable, lr=args.lr, weight_decay=ckpt["weight_decay"])
