@@ -16,6 +16,17 @@ orders the fields' own slopes: the Spearman rank correlation over the fields, an
 the line in it fitted on the others forecasts with their own sign (as the entropy line above). Six
 fields tell a covariate from chance poorly: one that orders the slopes at every pair of GSDs, with
 one sign, is what a design could use.
+
+  entropy_slopes.py CELLS.csv INPUT --within
+
+--within: for cells of sub-fields named FIELD[region] (adaptseg_calibrate --train FIELD:x0,y0,x1,y1,
+e.g. each tile's quadrants), how far the sub-fields' own slopes spread between the fields and
+within them, per pair of GSDs: each sub-field's slope (as above) and its sampling variance (the
+sandwich variance of the weighted fit over its cells); within a field, the sub-fields' spread about
+their field's mean less the sampling variance; between the fields, the spread of the fields' means
+less what the spread within makes of a mean of n sub-fields (n the harmonic mean); and the local
+share, within / (within + between) (- where both are 0). A slope that is the field's would leave
+nothing within.
 """
 import math
 import sys
@@ -109,16 +120,73 @@ def covariates(pairs, fields, inp):
     print("\n".join(rows))
 
 
+def slope_sampling_var(cells, inp, mean_px, b):
+    """The sandwich variance of own_slope's slope `b` over `cells` (its cells' scatter about the
+    line, each weighted as in the fit)."""
+    wxx = num = 0.0
+    for c in cells:
+        x = float(c["top_" + inp])
+        w = float(c["field_px"]) / mean_px
+        wxx += w * x * x
+        num += (w * x * (normalized_gain(c) - b * x)) ** 2
+    return num / (wxx * wxx) if wxx > 0 else math.nan
+
+
+def within(pairs, fields, inp):
+    """Prints, per pair of GSDs, the sub-fields' own slopes' spread between and within their fields
+    beyond the cells' sampling scatter (--within)."""
+    group = {n: n.split("[", 1)[0] for n in fields}
+    sizes = [sum(1 for n in fields if group[n] == g) for g in set(group.values())]
+    if len(sizes) < 2 or min(sizes) < 2:
+        sys.exit("--within: needs two fields or more, each of two sub-fields or more, named FIELD[region]")
+    print(f"input {inp}: the sub-fields' own slopes, their spread between the fields and within them "
+          "beyond the cells' sampling scatter (standard deviations)")
+    print("| top -> descent [cm/px] | sub-fields | mean slope | between fields | within fields | "
+          "sampling | local share |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for key in sorted(pairs):
+        cells = pairs[key]
+        mean_px = sum(float(c["field_px"]) for c in cells) / len(cells)
+        own = {}
+        for n in fields:
+            cs = [c for c in cells if c["field"] == n]
+            b = own_slope(cs, inp, mean_px)[0] if cs else math.nan
+            if math.isfinite(b):
+                own[n] = (b, slope_sampling_var(cs, inp, mean_px, b))
+        by = {}
+        for n, (b, _) in own.items():
+            by.setdefault(group[n], []).append(b)
+        by = {g: bs for g, bs in by.items() if len(bs) >= 2}
+        n_sub = sum(len(bs) for bs in by.values())
+        if len(by) < 2:
+            continue
+        means = {g: sum(bs) / len(bs) for g, bs in by.items()}
+        within_var = sum((b - means[g]) ** 2 for g, bs in by.items() for b in bs) / (n_sub - len(by))
+        sampling = sum(own[n][1] for n in own if group[n] in by) / n_sub
+        grand = sum(means.values()) / len(means)
+        between_var = sum((m - grand) ** 2 for m in means.values()) / (len(means) - 1)
+        n_h = len(by) / sum(1.0 / len(bs) for bs in by.values())
+        w_true = max(0.0, within_var - sampling)
+        b_true = max(0.0, between_var - within_var / n_h)
+        share = f"{w_true / (w_true + b_true):.2f}" if w_true + b_true > 0 else "-"
+        mean_b = sum(b for bs in by.values() for b in bs) / n_sub
+        print(f"| {key[0]:g} -> {key[1]:g} | {n_sub} | {mean_b:+.3f} | {math.sqrt(b_true):.3f} | "
+              f"{math.sqrt(w_true):.3f} | {math.sqrt(sampling):.3f} | {share} |")
+
+
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     flags = [a for a in argv if a.startswith("--")]
     args = [a for a in argv if not a.startswith("--")]
-    if len(args) != 2 or any(f != "--covariates" for f in flags):
+    if len(args) != 2 or len(flags) > 1 or any(f not in ("--covariates", "--within") for f in flags):
         sys.exit(__doc__)
     path, inp = args
     pairs, fields = cell_pairs(path, inp)
-    if flags:
+    if flags == ["--covariates"]:
         covariates(pairs, fields, inp)
+        return 0
+    if flags == ["--within"]:
+        within(pairs, fields, inp)
         return 0
     if any("top_entropy" not in cells[0] for cells in pairs.values()):
         sys.exit(f"{path}: no column top_entropy")
