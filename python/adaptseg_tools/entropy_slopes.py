@@ -21,14 +21,16 @@ one sign, is what a design could use.
 
 --within: for cells of sub-fields named FIELD[region] (adaptseg_calibrate --train FIELD:x0,y0,x1,y1,
 e.g. each tile's quadrants), how far the sub-fields' own slopes spread between the fields and
-within them, per pair of GSDs: each sub-field's slope (as above) and its sampling variance (the
-sandwich variance of the weighted fit over its cells); within a field, the sub-fields' spread about
-their field's mean less the sampling variance; between the fields, the spread of the fields' means
-less what the spread within makes of a mean of n sub-fields (n the harmonic mean); and the local
-share, within / (within + between) (- where both are 0). A slope that is the field's would leave
-nothing within.
+within them, per pair of GSDs: each sub-field's slope (as above); within a field, the sub-fields'
+spread about their field's mean less what the cells' sampling scatter alone makes of it (the same
+spread with each field's cells dealt at random to its sub-fields, 200 times, seeded), with p, the
+share of those deals that spread as far as the real sub-fields (1 + count over 1 + deals); between
+the fields, the spread of the fields' means less what the spread within makes of a mean of n
+sub-fields (n the harmonic mean); and the local share, within / (within + between) (- where both
+are 0). A slope that is the field's would leave nothing within, and p would be far from 0.
 """
 import math
+import random
 import sys
 
 from .proxy_slopes import cell_pairs, normalized_gain
@@ -120,49 +122,72 @@ def covariates(pairs, fields, inp):
     print("\n".join(rows))
 
 
-def slope_sampling_var(cells, inp, mean_px, b):
-    """The sandwich variance of own_slope's slope `b` over `cells` (its cells' scatter about the
-    line, each weighted as in the fit)."""
-    wxx = num = 0.0
-    for c in cells:
-        x = float(c["top_" + inp])
-        w = float(c["field_px"]) / mean_px
-        wxx += w * x * x
-        num += (w * x * (normalized_gain(c) - b * x)) ** 2
-    return num / (wxx * wxx) if wxx > 0 else math.nan
+def pooled_within(slopes):
+    """The pooled variance of sub-field slopes about their field's mean ({field: [slope, ...]},
+    fields of two or more), and its degrees of freedom."""
+    ss = dof = 0.0
+    for bs in slopes.values():
+        m = sum(bs) / len(bs)
+        ss += sum((b - m) ** 2 for b in bs)
+        dof += len(bs) - 1
+    return (ss / dof if dof > 0 else math.nan), dof
 
 
-def within(pairs, fields, inp):
+def sub_field_slopes(cells_by_sub, group, inp, mean_px):
+    """{field: [slope of each of its sub-fields with a finite slope]}, fields of two or more."""
+    by = {}
+    for n, cs in cells_by_sub.items():
+        b = own_slope(cs, inp, mean_px)[0]
+        if math.isfinite(b):
+            by.setdefault(group[n], []).append(b)
+    return {g: bs for g, bs in by.items() if len(bs) >= 2}
+
+
+def within(pairs, fields, inp, shuffles=200):
     """Prints, per pair of GSDs, the sub-fields' own slopes' spread between and within their fields
-    beyond the cells' sampling scatter (--within)."""
+    beyond the cells' sampling scatter (--within). The sampling part is measured, not modelled:
+    each field's cells dealt at random to its sub-fields, as many to each as it has, `shuffles`
+    times (seeded), leave sub-fields with no place of their own, so the spread of their slopes
+    within the fields is what the cells alone make."""
     group = {n: n.split("[", 1)[0] for n in fields}
     sizes = [sum(1 for n in fields if group[n] == g) for g in set(group.values())]
     if len(sizes) < 2 or min(sizes) < 2:
         sys.exit("--within: needs two fields or more, each of two sub-fields or more, named FIELD[region]")
     print(f"input {inp}: the sub-fields' own slopes, their spread between the fields and within them "
-          "beyond the cells' sampling scatter (standard deviations)")
+          f"beyond the cells' sampling scatter (standard deviations; sampling: cells dealt at random to "
+          f"the sub-fields of their field, {shuffles} times)")
     print("| top -> descent [cm/px] | sub-fields | mean slope | between fields | within fields | "
-          "sampling | local share |")
-    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
+          "sampling | p (within from sampling alone) | local share |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
     for key in sorted(pairs):
         cells = pairs[key]
         mean_px = sum(float(c["field_px"]) for c in cells) / len(cells)
-        own = {}
-        for n in fields:
-            cs = [c for c in cells if c["field"] == n]
-            b = own_slope(cs, inp, mean_px)[0] if cs else math.nan
-            if math.isfinite(b):
-                own[n] = (b, slope_sampling_var(cs, inp, mean_px, b))
-        by = {}
-        for n, (b, _) in own.items():
-            by.setdefault(group[n], []).append(b)
-        by = {g: bs for g, bs in by.items() if len(bs) >= 2}
-        n_sub = sum(len(bs) for bs in by.values())
+        subs = {}
+        for c in cells:
+            subs.setdefault(c["field"], []).append(c)
+        by = sub_field_slopes(subs, group, inp, mean_px)
         if len(by) < 2:
             continue
+        within_var, _ = pooled_within(by)
+        rng = random.Random(f"{key[0]}:{key[1]}")
+        shuffled, at_least = [], 0
+        for _ in range(shuffles):
+            dealt = {}
+            for g in by:
+                names = [n for n in subs if group[n] == g]
+                pool = [c for n in names for c in subs[n]]
+                rng.shuffle(pool)
+                i = 0
+                for n in names:
+                    dealt[n] = pool[i:i + len(subs[n])]
+                    i += len(subs[n])
+            v, _ = pooled_within(sub_field_slopes(dealt, group, inp, mean_px))
+            if math.isfinite(v):
+                shuffled.append(v)
+                at_least += v >= within_var
+        sampling = sum(shuffled) / len(shuffled) if shuffled else math.nan
+        n_sub = sum(len(bs) for bs in by.values())
         means = {g: sum(bs) / len(bs) for g, bs in by.items()}
-        within_var = sum((b - means[g]) ** 2 for g, bs in by.items() for b in bs) / (n_sub - len(by))
-        sampling = sum(own[n][1] for n in own if group[n] in by) / n_sub
         grand = sum(means.values()) / len(means)
         between_var = sum((m - grand) ** 2 for m in means.values()) / (len(means) - 1)
         n_h = len(by) / sum(1.0 / len(bs) for bs in by.values())
@@ -170,8 +195,9 @@ def within(pairs, fields, inp):
         b_true = max(0.0, between_var - within_var / n_h)
         share = f"{w_true / (w_true + b_true):.2f}" if w_true + b_true > 0 else "-"
         mean_b = sum(b for bs in by.values() for b in bs) / n_sub
+        p = (1 + at_least) / (1 + len(shuffled))
         print(f"| {key[0]:g} -> {key[1]:g} | {n_sub} | {mean_b:+.3f} | {math.sqrt(b_true):.3f} | "
-              f"{math.sqrt(w_true):.3f} | {math.sqrt(sampling):.3f} | {share} |")
+              f"{math.sqrt(w_true):.3f} | {math.sqrt(sampling):.3f} | {p:.3f} | {share} |")
 
 
 def main(argv=None):
