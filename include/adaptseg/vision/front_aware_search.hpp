@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -297,12 +298,12 @@ inline std::size_t choose_setting(std::span<const RuleTrial> trials, std::span<c
 struct FoldCorrection {
   std::vector<GainRatio> gain_ratios;
   std::vector<MarginBias> margin_biases;
-  double jump_bound = 0.0;         ///< the jump guard's (CalibrationOptions::jump_guard)
-  double relabel_transfer = 0.0;   ///< b (CalibrationOptions::relabel_transfer)
-  double relabel_region_sd = 0.0;  ///< τ_r (CalibrationOptions::relabel_region_spread)
-  double relabel_field_sd = 0.0;   ///< ω_χ (CalibrationOptions::relabel_field_spread)
+  double jump_bound = std::numeric_limits<double>::infinity();  ///< the jump guard's (CalibrationOptions::jump_guard)
+  double relabel_transfer = 1.0;                                ///< b (CalibrationOptions::relabel_transfer)
+  double relabel_region_sd = 0.0;                               ///< τ_r (CalibrationOptions::relabel_region_spread)
+  double relabel_field_sd = 0.0;                                ///< ω_χ (CalibrationOptions::relabel_field_spread)
 
-  /// `p`'s own: the correction that changes nothing.
+  /// `p`'s own: the correction that changes nothing (a default one: that of default Params).
   [[nodiscard]] static FoldCorrection of(const FrontAwarePolicy::Params& p) {
     return {p.gain_ratios, p.margin_biases, p.jump_bound, p.relabel_transfer, p.relabel_region_sd, p.relabel_field_sd};
   }
