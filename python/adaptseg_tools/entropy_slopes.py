@@ -123,32 +123,33 @@ def covariates(pairs, fields, inp):
 
 
 def pooled_within(slopes):
-    """The pooled variance of sub-field slopes about their field's mean ({field: [slope, ...]},
-    fields of two or more), and its degrees of freedom."""
+    """The pooled variance of sub-field slopes about their field's mean ({field: {sub-field:
+    slope}}, fields of two or more)."""
     ss = dof = 0.0
     for bs in slopes.values():
-        m = sum(bs) / len(bs)
-        ss += sum((b - m) ** 2 for b in bs)
+        m = sum(bs.values()) / len(bs)
+        ss += sum((b - m) ** 2 for b in bs.values())
         dof += len(bs) - 1
-    return (ss / dof if dof > 0 else math.nan), dof
+    return ss / dof if dof > 0 else math.nan
 
 
 def sub_field_slopes(cells_by_sub, group, inp, mean_px):
-    """{field: [slope of each of its sub-fields with a finite slope]}, fields of two or more."""
+    """{field: {sub-field: its slope}} of the sub-fields whose slope is finite, fields of two or
+    more such."""
     by = {}
     for n, cs in cells_by_sub.items():
         b = own_slope(cs, inp, mean_px)[0]
         if math.isfinite(b):
-            by.setdefault(group[n], []).append(b)
+            by.setdefault(group[n], {})[n] = b
     return {g: bs for g, bs in by.items() if len(bs) >= 2}
 
 
 def within(pairs, fields, inp, shuffles=200):
     """Prints, per pair of GSDs, the sub-fields' own slopes' spread between and within their fields
     beyond the cells' sampling scatter (--within). The sampling part is measured, not modelled:
-    each field's cells dealt at random to its sub-fields, as many to each as it has, `shuffles`
-    times (seeded), leave sub-fields with no place of their own, so the spread of their slopes
-    within the fields is what the cells alone make."""
+    each field's cells dealt at random to its sub-fields (those with a slope), as many to each as
+    it has, `shuffles` times (seeded), so that a sub-field no longer stands for a place and the
+    spread of the slopes within the fields is what the cells alone make."""
     group = {n: n.split("[", 1)[0] for n in fields}
     sizes = [sum(1 for n in fields if group[n] == g) for g in set(group.values())]
     if len(sizes) < 2 or min(sizes) < 2:
@@ -168,33 +169,32 @@ def within(pairs, fields, inp, shuffles=200):
         by = sub_field_slopes(subs, group, inp, mean_px)
         if len(by) < 2:
             continue
-        within_var, _ = pooled_within(by)
+        within_var = pooled_within(by)
         rng = random.Random(f"{key[0]}:{key[1]}")
         shuffled, at_least = [], 0
         for _ in range(shuffles):
             dealt = {}
-            for g in by:
-                names = [n for n in subs if group[n] == g]
-                pool = [c for n in names for c in subs[n]]
+            for bs in by.values():
+                pool = [c for n in bs for c in subs[n]]
                 rng.shuffle(pool)
                 i = 0
-                for n in names:
+                for n in bs:
                     dealt[n] = pool[i:i + len(subs[n])]
                     i += len(subs[n])
-            v, _ = pooled_within(sub_field_slopes(dealt, group, inp, mean_px))
+            v = pooled_within(sub_field_slopes(dealt, group, inp, mean_px))
             if math.isfinite(v):
                 shuffled.append(v)
                 at_least += v >= within_var
         sampling = sum(shuffled) / len(shuffled) if shuffled else math.nan
         n_sub = sum(len(bs) for bs in by.values())
-        means = {g: sum(bs) / len(bs) for g, bs in by.items()}
+        means = {g: sum(bs.values()) / len(bs) for g, bs in by.items()}
         grand = sum(means.values()) / len(means)
         between_var = sum((m - grand) ** 2 for m in means.values()) / (len(means) - 1)
         n_h = len(by) / sum(1.0 / len(bs) for bs in by.values())
         w_true = max(0.0, within_var - sampling)
         b_true = max(0.0, between_var - within_var / n_h)
         share = f"{w_true / (w_true + b_true):.2f}" if w_true + b_true > 0 else "-"
-        mean_b = sum(b for bs in by.values() for b in bs) / n_sub
+        mean_b = sum(b for bs in by.values() for b in bs.values()) / n_sub
         p = (1 + at_least) / (1 + len(shuffled))
         print(f"| {key[0]:g} -> {key[1]:g} | {n_sub} | {mean_b:+.3f} | {math.sqrt(b_true):.3f} | "
               f"{math.sqrt(w_true):.3f} | {math.sqrt(sampling):.3f} | {p:.3f} | {share} |")
