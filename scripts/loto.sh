@@ -27,9 +27,10 @@
 #       out/loto/work-<k> (an interrupted call resumes where it stopped), exported to
 #       out/loto/model-<k> and scored on tile k as `eval` does. About 100 minutes a tile on the
 #       2-core VM with nothing else running on 2026-11-29; on 2026-12-03 the same kind of VM took
-#       6.3 to 6.9 s a step channels-last (about 3.3 hours a tile), 9 to 10 s before. What
-#       rebuilds the bundled leave-one-tile-out networks (examples/models/mobilenetv2-dubai-loto)
-#       when their checkpoints are gone.
+#       6.0 to 6.2 s a training step channels-last (about 3 hours a tile), 9.9 to 10.2 s
+#       contiguous as before (benchmarks/train_cpu_layout.sh). What rebuilds the bundled
+#       leave-one-tile-out networks (examples/models/mobilenetv2-dubai-loto) when their
+#       checkpoints are gone.
 #   bash scripts/loto.sh bundle
 #       here, once out/loto/model-<k> exist for k = 1..6 (recipe-cpu, or eval after a device
 #       call; a tile bundled already, examples/models/mobilenetv2-dubai-loto/tile-<k>, is taken
@@ -311,7 +312,7 @@ mirror)
   echo "wrote $to/tile-{1..6}/ensemble.yaml"
   ;;
 *)
-  sed -n '2,80p' "$0" >&2
+  sed -n '2,81p' "$0" >&2
   exit 2
   ;;
 esac

@@ -30,9 +30,10 @@ makes the `altitude` batches on the training device instead of in CPU workers (d
 the same draws and resampling, different rounding; for a GPU, whose pace the CPU workers set),
 a whole batch at a time, --prefetch steps ahead by a thread on a CUDA stream of its own.
 
-Devices: the network and its batches are channels-last on either device (on the 2-core AMD EPYC
-VM's CPU a step of the MobileNetV2 deployment recipe took 0.6 to 0.7 of the time it takes
-contiguous, the same losses to five digits; ERFNet's about the same time either way); --device
+Devices: the network and its batches are channels-last on either device (--memory-format; on the
+2-core AMD EPYC VM's CPU a step of the MobileNetV2 deployment recipe took 0.61 of the time it
+takes contiguous, the same losses to five digits: benchmarks/train_cpu_layout.sh, docs/benchmarks.md;
+ERFNet's about the same either way); --device
 cuda runs the network in bfloat16 autocast with data workers, --device cpu in float32. A
 checkpoint written on one continues on the other.
 --max-minutes stops a run with a checkpoint before a wall-clock limit (for sessions of
@@ -95,6 +96,9 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--work-dir", required=True)
     ap.add_argument("--model-dir", required=True)
     ap.add_argument("--device", choices=("auto", "cpu", "cuda"), default="auto")
+    ap.add_argument("--memory-format", choices=("channels-last", "contiguous"), default="channels-last",
+                    help="the network's and the batches' layout (contiguous: as the CPU trained before "
+                         "2026-12-03, e.g. to retrain a network trained so bit for bit)")
     ap.add_argument("--workers", type=int, default=-1,
                     help="data worker processes (-1: none on CPU, up to 12 on CUDA)")
     ap.add_argument("--sampler", choices=("cpu", "device"), default="cpu",

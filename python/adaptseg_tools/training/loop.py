@@ -16,6 +16,7 @@ from .. import device_sampler
 from ..fieldio import IGNORE
 from .export import export
 from .models import set_train_mode
+from .start import memory_format
 from .network_path import logits_to
 from .samples import Sampler, StepBatches
 from .start import Run
@@ -125,6 +126,7 @@ def train(run: Run, args, t_start: float) -> int:
     ckpt["devices"] = sorted(set(ckpt.get("devices", [])) | {args.device})
     ckpt["torch_versions"] = sorted(set(ckpt.get("torch_versions", [])) | {str(torch.__version__)})
     set_train_mode(model, ckpt)
+    layout = memory_format(args)
     step = ckpt["step"]
     run_loss, run_n, t_log = 0.0, 0, time.time()
     if fit_stage and fit_from == step:  # resumed inside the measurement: it starts now (data start-up included)
@@ -139,7 +141,7 @@ def train(run: Run, args, t_start: float) -> int:
             g["lr"] = lr * s
         x = x.to(device, non_blocking=True)
         y = y.to(device, non_blocking=True)
-        x = x.contiguous(memory_format=torch.channels_last)
+        x = x.contiguous(memory_format=layout)
         with torch.autocast(device_type=device.type, dtype=torch.bfloat16, enabled=cuda):
             logits = logits_to(model(x), y.shape[-2:])
         loss = criterion(logits.float(), y)

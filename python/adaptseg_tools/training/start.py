@@ -186,6 +186,11 @@ def new_checkpoint(args, train_names: list[str], train_fields: list[FieldData], 
     return ckpt
 
 
+def memory_format(args):
+    """The torch layout --memory-format names."""
+    return torch.contiguous_format if args.memory_format == "contiguous" else torch.channels_last
+
+
 def network(args, ckpt: dict, resume: bool, ckpt_path: Path, device, cuda: bool):
     """The checkpoint's network on the device (initialised as the command line says, or resumed)
     and its optimizer: NetSpec, network, trained parameters, optimizer and per-group learning-rate
@@ -209,7 +214,7 @@ def network(args, ckpt: dict, resume: bool, ckpt_path: Path, device, cuda: bool)
     for m in frozen_encoder_modules(model, ckpt.get("frozen_blocks", 0)):
         for p in m.parameters():
             p.requires_grad = False
-    model = model.to(device, memory_format=torch.channels_last)
+    model = model.to(device, memory_format=memory_format(args))
     trainable = [p for p in model.parameters() if p.requires_grad]
     if ckpt["optimizer"] == "Adam":
         opt = torch.optim.Adam(trainable, lr=args.lr, weight_decay=ckpt["weight_decay"])
