@@ -27,8 +27,9 @@
 #       out/loto/work-<k> (an interrupted call resumes where it stopped), exported to
 #       out/loto/model-<k> and scored on tile k as `eval` does. About 100 minutes a tile on the
 #       2-core VM with nothing else running on 2026-11-29; on 2026-12-03 the same kind of VM took
-#       6.0 to 6.2 s a training step channels-last (about 3 hours a tile), 9.9 to 10.2 s
-#       contiguous as before (benchmarks/train_cpu_layout.sh). What rebuilds the bundled
+#       6.0 to 6.2 s a training step channels-last in short runs, 9.9 to 10.2 s contiguous as
+#       before (benchmarks/train_cpu_layout.sh), and a long run (steps 250-400) at about 10 s a step of
+#       wall clock channels-last (about five hours; docs/benchmarks.md). What rebuilds the bundled
 #       leave-one-tile-out networks (examples/models/mobilenetv2-dubai-loto) when their
 #       checkpoints are gone.
 #   bash scripts/loto.sh bundle
@@ -312,7 +313,7 @@ mirror)
   echo "wrote $to/tile-{1..6}/ensemble.yaml"
   ;;
 *)
-  sed -n '2,81p' "$0" >&2
+  sed -n '2,82p' "$0" >&2
   exit 2
   ;;
 esac
