@@ -28,10 +28,10 @@
 #       out/loto/model-<k> and scored on tile k as `eval` does. About 100 minutes a tile on the
 #       2-core VM with nothing else running on 2026-11-29; on 2026-12-03 the same kind of VM took
 #       6.0 to 6.2 s a training step channels-last in short runs, 9.9 to 10.2 s contiguous as
-#       before (benchmarks/train_cpu_layout.sh), and a long run (steps 250-400) at about 10 s a step of
-#       wall clock channels-last (about five hours; docs/benchmarks.md). What rebuilds the bundled
-#       leave-one-tile-out networks (examples/models/mobilenetv2-dubai-loto) when their
-#       checkpoints are gone.
+#       before (benchmarks/train_cpu_layout.sh), and a long run (steps 250-400) at about 10 s a
+#       step of wall clock channels-last (about five hours a tile; docs/benchmarks.md). What
+#       rebuilds the bundled leave-one-tile-out networks (examples/models/mobilenetv2-dubai-loto)
+#       when their checkpoints are gone.
 #   bash scripts/loto.sh bundle
 #       here, once out/loto/model-<k> exist for k = 1..6 (recipe-cpu, or eval after a device
 #       call; a tile bundled already, examples/models/mobilenetv2-dubai-loto/tile-<k>, is taken
