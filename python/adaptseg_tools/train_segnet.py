@@ -32,10 +32,10 @@ a whole batch at a time, --prefetch steps ahead by a thread on a CUDA stream of 
 
 Devices: the network and its batches are channels-last on either device (--memory-format; on the
 2-core AMD EPYC VM's CPU a step of the MobileNetV2 deployment recipe took 0.61 of the time it
-takes contiguous, the same losses to five digits: benchmarks/train_cpu_layout.sh, docs/benchmarks.md;
-ERFNet's about the same either way); --device
-cuda runs the network in bfloat16 autocast with data workers, --device cpu in float32. A
-checkpoint written on one continues on the other.
+takes contiguous, the same losses to five digits: benchmarks/train_cpu_layout.sh,
+docs/benchmarks.md; ERFNet's about the same either way); --device cuda runs the network in
+bfloat16 autocast with data workers, --device cpu in float32. A checkpoint written on one
+continues on the other.
 --max-minutes stops a run with a checkpoint before a wall-clock limit (for sessions of
 limited length); --resume continues it. --minutes M instead fits the learning-rate cycle into M
 minutes: at the end of the warm-up the cycle's length (at most --steps) is set from the

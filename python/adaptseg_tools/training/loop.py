@@ -16,10 +16,9 @@ from .. import device_sampler
 from ..fieldio import IGNORE
 from .export import export
 from .models import set_train_mode
-from .start import memory_format
 from .network_path import logits_to
 from .samples import Sampler, StepBatches
-from .start import Run
+from .start import Run, memory_format
 from .validation import evaluate
 
 
