@@ -25,11 +25,10 @@
 #       GPU run's schedule without --minutes) on the CPU, one held-out tile after another (TILES
 #       comma-separated, default 1,2,3,4,5,6), checkpoints every 100 steps into
 #       out/loto/work-<k> (an interrupted call resumes where it stopped), exported to
-#       out/loto/model-<k> and scored on tile k as `eval` does. About 100 minutes a tile on the
-#       2-core VM with nothing else running on 2026-11-29; on 2026-12-03 the same kind of VM took
-#       6.0 to 6.2 s a training step channels-last in short runs, 9.9 to 10.2 s contiguous as
-#       before (benchmarks/train_cpu_layout.sh), and a long run (steps 250-400) at about 10 s a
-#       step of wall clock channels-last (about five hours a tile; docs/benchmarks.md). What
+#       out/loto/model-<k> and scored on tile k as `eval` does. About an hour a tile on the
+#       2-core VM with nothing else running (2026-12-03: about 15 images a second, the freed
+#       memory kept; about five hours before, when glibc unmapped and faulted in each step's
+#       activations again: benchmarks/train_cpu.sh, docs/benchmarks.md). What
 #       rebuilds the bundled leave-one-tile-out networks (examples/models/mobilenetv2-dubai-loto)
 #       when their checkpoints are gone.
 #   bash scripts/loto.sh bundle

@@ -31,11 +31,12 @@ the same draws and resampling, different rounding; for a GPU, whose pace the CPU
 a whole batch at a time, --prefetch steps ahead by a thread on a CUDA stream of its own.
 
 Devices: the network and its batches are channels-last on either device (--memory-format; on the
-2-core AMD EPYC VM's CPU a step of the MobileNetV2 deployment recipe took 0.61 of the time it
-takes contiguous, the same losses to five digits: benchmarks/train_cpu_layout.sh,
-docs/benchmarks.md; ERFNet's about the same either way); --device cuda runs the network in
-bfloat16 autocast with data workers, --device cpu in float32. A checkpoint written on one
-continues on the other.
+2-core AMD EPYC VM's CPU a step of the MobileNetV2 deployment recipe took 0.84 of the time it
+takes contiguous, the same losses to five digits: benchmarks/train_cpu.sh, docs/benchmarks.md;
+ERFNet's about the same either way); --device cuda runs the network in bfloat16 autocast with
+data workers, --device cpu in float32. A checkpoint written on one continues on the other. On
+the CPU the C library keeps the memory a step frees for the next (--keep-freed-memory, the
+default: 0.21 of the time a step takes with glibc's default, on that VM).
 --max-minutes stops a run with a checkpoint before a wall-clock limit (for sessions of
 limited length); --resume continues it. --minutes M instead fits the learning-rate cycle into M
 minutes: at the end of the warm-up the cycle's length (at most --steps) is set from the
@@ -149,6 +150,10 @@ def build_parser() -> argparse.ArgumentParser:
                     help="new runs: also keep an exponential moving average of the weights (decay in "
                          "(0, 1), e.g. 0.998), validate it next to the trained weights and export it")
     ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--keep-freed-memory", action=argparse.BooleanOptionalAction, default=True,
+                    help="--device cpu: the C library keeps freed memory for reuse instead of returning it "
+                         "to the system (training.start.keep_freed_memory: several times faster on a VM "
+                         "with slow page faults, a larger resident set)")
     ap.add_argument("--max-minutes", type=float, default=0.0,
                     help="> 0: checkpoint and stop after this much wall-clock time (continue with --resume)")
     ap.add_argument("--minutes", type=float, default=0.0,

@@ -17,6 +17,7 @@ import torch.nn as nn
 
 from .. import mobilenet_v2
 from .fields import FieldData, load_field
+from .host_memory import keep_freed_memory
 from .models import build_model, frozen_encoder_modules, net_spec
 from .network_path import NetSpec, channel_stats
 
@@ -67,6 +68,10 @@ def start(args) -> Run:
     cuda = device.type == "cuda"
     torch.set_num_threads(args.threads)
     cv2.setNumThreads(1)
+    if not cuda and args.keep_freed_memory:
+        print("host memory: " + ("freed memory kept for reuse (glibc mallopt)" if keep_freed_memory()
+                                 else "this C library has no mallopt; freed memory goes back to the system"),
+              flush=True)
     work = Path(args.work_dir)
     work.mkdir(parents=True, exist_ok=True)
     ckpt_path = work / "checkpoint.pt"
