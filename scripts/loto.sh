@@ -71,6 +71,11 @@
 #       LOTO_BUNDLE under test-time mirror (an ensemble of one member, mirror: true: its
 #       probabilities the mean over the image and its left-right mirror, its temperature as
 #       bundled; two passes per image). Flown with LOTO_NETWORKS=DEST bash scripts/results.sh loto.
+#   bash scripts/loto.sh ensemble DEST FOLDER FOLDER...
+#       here: DEST/tile-<k>/ensemble.yaml for k = 1..6, the ensemble of FOLDER/tile-<k> over the
+#       FOLDERs given (each a bundled set of six, e.g. examples/models/mobilenetv2-dubai-loto and
+#       its seed-1 twin), weighted alike, each at its temperature as bundled: every tile's members
+#       never saw it. Flown with LOTO_NETWORKS=DEST bash scripts/results.sh loto.
 #   bash scripts/loto.sh cpu TILE [--resume]
 #       here, no accelerator: one training of examples/models/mobilenetv2-dubai's CPU recipe
 #       (2000 steps of 8 crops) on the five tiles but TILE, exported to out/loto-cpu/model-TILE
@@ -104,6 +109,20 @@ stage_tile() {
   for f in model.onnx model.yaml train_log.csv val_log.csv val_ema_log.csv; do cp "$wroot/model-$k/$f" "$dest/tile-$k/"; done
   cp "$wroot/eval-$k.json" "$dest/tile-$k/held_out_eval.json"
   [ ! -f "$wroot/train-$k.log" ] || cp "$wroot/train-$k.log" "$dest/tile-$k/train.log"
+}
+
+# $1/ensemble.yaml: description $2, the networks $4... as members (found relative to the file), each
+# with the line $3 below its model line.
+write_ensemble() {
+  local to=$1 description=$2 line=$3 net
+  for net in "${@:4}"; do
+    [ -s "$net/model.onnx" ] || { echo "no $net/model.onnx: bundle its set first (bash $0 bundle)" >&2; exit 2; }
+  done
+  mkdir -p "$to"
+  {
+    printf '%s\n' "description: $description" "members:"
+    for net in "${@:4}"; do printf '%s\n' "  - model: $(realpath --relative-to="$to" "$net")" "$line"; done
+  } >"$to/ensemble.yaml"
 }
 
 case "${1:-}" in
@@ -302,17 +321,24 @@ cpu)
 mirror)
   to=${2:-out/loto-mirror}
   for k in "${tiles_all[@]}"; do
-    [ -s "$dest/tile-$k/model.onnx" ] || { echo "no $dest/tile-$k/model.onnx: run 'bash $0 bundle' first" >&2; exit 2; }
-    mkdir -p "$to/tile-$k"
-    # Members are found relative to ensemble.yaml.
-    member=$(realpath --relative-to="$to/tile-$k" "$dest/tile-$k")
-    printf '%s\n' "description: $dest/tile-$k under test-time mirror (its probabilities the mean over the image and its left-right mirror)" \
-      "members:" "  - model: $member" "    mirror: true" >"$to/tile-$k/ensemble.yaml"
+    write_ensemble "$to/tile-$k" \
+      "$dest/tile-$k under test-time mirror (its probabilities the mean over the image and its left-right mirror)" \
+      "    mirror: true" "$dest/tile-$k"
+  done
+  echo "wrote $to/tile-{1..6}/ensemble.yaml"
+  ;;
+ensemble)
+  to=${2:?destination folder}
+  folders=("${@:3}")
+  [ "${#folders[@]}" -ge 2 ] || { echo "ensemble: DEST and at least two folders of tile-1 ... tile-6" >&2; exit 2; }
+  for k in "${tiles_all[@]}"; do
+    write_ensemble "$to/tile-$k" "the networks that never saw dubai-tile-$k: ${folders[*]/%//tile-$k}" \
+      "    weight: 1" "${folders[@]/%//tile-$k}"
   done
   echo "wrote $to/tile-{1..6}/ensemble.yaml"
   ;;
 *)
-  sed -n '2,82p' "$0" >&2
+  sed -n '2,86p' "$0" >&2
   exit 2
   ;;
 esac
