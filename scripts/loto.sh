@@ -111,13 +111,18 @@ stage_tile() {
   [ ! -f "$wroot/train-$k.log" ] || cp "$wroot/train-$k.log" "$dest/tile-$k/train.log"
 }
 
+# Exits unless every folder given holds a network: checked before anything is written.
+need_networks() {
+  local net
+  for net in "$@"; do
+    [ -s "$net/model.onnx" ] || { echo "no $net/model.onnx: bundle its set first (bash $0 bundle)" >&2; exit 2; }
+  done
+}
+
 # $1/ensemble.yaml: description $2, the networks $4... as members (found relative to the file), each
 # with the line $3 below its model line.
 write_ensemble() {
   local to=$1 description=$2 line=$3 net
-  for net in "${@:4}"; do
-    [ -s "$net/model.onnx" ] || { echo "no $net/model.onnx: bundle its set first (bash $0 bundle)" >&2; exit 2; }
-  done
   mkdir -p "$to"
   {
     printf '%s\n' "description: $description" "members:"
@@ -320,6 +325,7 @@ cpu)
   ;;
 mirror)
   to=${2:-out/loto-mirror}
+  need_networks "${tiles_all[@]/#/$dest/tile-}"
   for k in "${tiles_all[@]}"; do
     write_ensemble "$to/tile-$k" \
       "$dest/tile-$k under test-time mirror (its probabilities the mean over the image and its left-right mirror)" \
@@ -331,6 +337,7 @@ ensemble)
   to=${2:?destination folder}
   folders=("${@:3}")
   [ "${#folders[@]}" -ge 2 ] || { echo "ensemble: DEST and at least two folders of tile-1 ... tile-6" >&2; exit 2; }
+  for f in "${folders[@]}"; do need_networks "${tiles_all[@]/#/$f/tile-}"; done
   for k in "${tiles_all[@]}"; do
     write_ensemble "$to/tile-$k" "the networks that never saw dubai-tile-$k: ${folders[*]/%//tile-$k}" \
       "    weight: 1" "${folders[@]/%//tile-$k}"
