@@ -2,28 +2,30 @@
 # The MobileNetV2 deployment recipe's training step on the CPU, two settings of train_segnet.py
 # side by side (docs/benchmarks.md, "Training on the CPU"):
 #
-#   bash benchmarks/train_cpu.sh layout|memory ENCODER_WEIGHTS.pt [STEPS] [ROUNDS]
+#   bash benchmarks/train_cpu.sh layout|memory [STEPS] [ROUNDS]
 #
 # layout: --memory-format contiguous against channels-last (freed memory kept in both).
 # memory: --no-keep-freed-memory (glibc's default: large allocations mapped and unmapped each
 #         time) against --keep-freed-memory (channels-last in both).
-# ENCODER_WEIGHTS.pt: MobileNetV2's ImageNet encoder (`bash scripts/loto.sh weights` writes
-# .device/mnv2_enc.pt). ROUNDS (default 2) pairs of runs, the first setting then the second, each
-# alone: recipe-cpu's settings (scripts/loto.sh; tile 1 held out, seed 1, batch 32, crops of
-# 300 px, two threads, one data worker) for STEPS steps (default 12, a multiple of 4; the learning
-# rate still in its warm-up). Prints each run's seconds per training step (train_log.csv elapsed_s,
-# the step itself without waiting for its batch) over the steps after the fourth (the first four
-# start the worker and the caches), its wall-clock seconds, kernel CPU seconds and minor page
-# faults (the whole run with its data worker, startup included), its last logged loss, then the
-# median ratio of the seconds per step. About 10 minutes on the 2-core VM with nothing else running.
+# The recipe's ImageNet encoder weights first: `bash scripts/loto.sh weights` writes
+# .device/mnv2_enc.pt. ROUNDS (default 2) pairs of runs, the first setting then the second, each
+# alone: recipe-cpu's settings (scripts/loto_recipe.sh and scripts/loto.sh; tile 1 held out,
+# seed 1, batch 32, crops of 300 px, two threads, one data worker) for STEPS steps (default 12,
+# a multiple of 4; the learning rate still in its warm-up). Prints each run's seconds per training
+# step (train_log.csv elapsed_s, the step itself without waiting for its batch) over the steps
+# after the fourth (the first four start the worker and the caches), its wall-clock seconds, kernel
+# CPU seconds and minor page faults (the whole run with its data worker, startup included), its
+# last logged loss, then the median ratio of the seconds per step. About 10 minutes on the 2-core
+# VM with nothing else running.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # The Python tools run from the source tree (python/README.md).
 export PYTHONPATH="$PWD/python${PYTHONPATH:+:$PYTHONPATH}"
 compare=${1:?layout or memory}
-enc=${2:?MobileNetV2 encoder weights}
-steps=${3:-12}
-rounds=${4:-2}
+steps=${2:-12}
+rounds=${3:-2}
+source scripts/loto_recipe.sh
+[ -s .device/mnv2_enc.pt ] || { echo "no .device/mnv2_enc.pt: run 'bash scripts/loto.sh weights' first" >&2; exit 2; }
 case "$compare" in
   layout) settings=("--memory-format contiguous" "--memory-format channels-last") ;;
   memory) settings=("--no-keep-freed-memory" "--keep-freed-memory") ;;
@@ -38,12 +40,11 @@ for r in $(seq "$rounds"); do
   for i in 0 1; do
     # Run under a parent that records its children's (the run's and its worker's) resource use.
     # shellcheck disable=SC2086  # the setting is two words or one, split on purpose
-    "$py" - "$work/$i-$r.usage" "$py" -m adaptseg_tools.train_segnet --arch mobilenetv2 \
-      --encoder-weights "$enc" --frozen-blocks 4 --no-image-pooling --lr 1e-3 --weight-decay 0.01 \
-      --ema 0.998 --augment altitude --seed 1 --sampler cpu --device cpu --workers 1 --threads 2 \
+    "$py" - "$work/$i-$r.usage" "$py" -m adaptseg_tools.train_segnet "${loto_recipe[@]}" \
+      --seed 1 --sampler cpu --device cpu --workers 1 --threads 2 \
       --train-fields dubai-tile-2,dubai-tile-3,dubai-tile-4,dubai-tile-5,dubai-tile-6 \
       --val-field dubai-tile-1 --test-field none --val-every 0 --ckpt-every 100000 --log-every 4 --no-export \
-      --steps "$steps" --batch 32 --crop 300 --warmup 100 ${settings[$i]} \
+      --steps "$steps" "${loto_batch[@]}" ${settings[$i]} \
       --work-dir "$work/$i-$r" --model-dir "$work/unused" >"$work/$i-$r.log" 2>&1 <<'PY' ||
 import resource, subprocess, sys, time
 t = time.monotonic()

@@ -90,6 +90,8 @@ cd "$(dirname "$0")/.."
 export PYTHONPATH="$PWD/python${PYTHONPATH:+:$PYTHONPATH}"
 # The interpreter with PyTorch: a device machine's plain python3, else Debian's (this machine's).
 py=${PYTHON:-$(python3 -c 'import torch, cv2' 2>/dev/null && echo python3 || echo /usr/bin/python3)}
+# The recipe's train_segnet arguments: loto_recipe, loto_batch.
+source scripts/loto_recipe.sh
 tiles_all=(1 2 3 4 5 6)
 # Where recipe-cpu, eval and bundle work (LOTO_WORK), and the folder bundle fills and decision
 # reads (LOTO_BUNDLE): another seed's networks go beside the bundled ones, never over them.
@@ -147,7 +149,7 @@ train)
     device=$("$py" -c 'import torch; print("cuda" if torch.cuda.is_available() else "cpu")')
   else
     schedule=(--steps "${LOTO_STEP_CAP:-1784}" --minutes "$minutes" --max-minutes "$(awk -v m="$minutes" 'BEGIN { print m * 1.08 }')"
-              --batch 32 --crop 300 --warmup 100)
+              "${loto_batch[@]}")
     device=cuda
   fi
   sampler=cpu
@@ -155,8 +157,7 @@ train)
   work=$(mktemp -d)
   pids=()
   for k in "${tiles[@]}"; do
-    "$py" -m adaptseg_tools.train_segnet --arch mobilenetv2 --encoder-weights .device/mnv2_enc.pt \
-      --frozen-blocks 4 --no-image-pooling --lr 1e-3 --weight-decay 0.01 --ema 0.998 --augment altitude --seed "${LOTO_SEED:-0}" \
+    "$py" -m adaptseg_tools.train_segnet "${loto_recipe[@]}" --seed "${LOTO_SEED:-0}" \
       --sampler "$sampler" --prefetch "${PREFETCH:-2}" --device "$device" --train-fields "$(train_fields "$k")" --val-field "dubai-tile-$k" \
       --test-field none --threads 1 --val-every 0 --ckpt-every 100 --log-every 50 --no-export \
       "${schedule[@]}" --work-dir "$work/loto-$k" --model-dir "$work/unused-$k" >"$work/loto-$k.log" 2>&1 &
@@ -223,11 +224,10 @@ recipe-cpu)
     if [ ! -s "$work/done" ]; then
       resume=()
       [ -s "$work/checkpoint.pt" ] && resume=(--resume)
-      "$py" -m adaptseg_tools.train_segnet --arch mobilenetv2 --encoder-weights .device/mnv2_enc.pt \
-        --frozen-blocks 4 --no-image-pooling --lr 1e-3 --weight-decay 0.01 --ema 0.998 --augment altitude --seed "${LOTO_SEED:-0}" \
+      "$py" -m adaptseg_tools.train_segnet "${loto_recipe[@]}" --seed "${LOTO_SEED:-0}" \
         --sampler cpu --device cpu --workers 1 --threads "${LOTO_THREADS:-2}" --train-fields "$(train_fields "$k")" \
         --val-field "dubai-tile-$k" --test-field none --val-every 0 --ckpt-every 100 --log-every 50 --no-export \
-        --steps 1784 --batch 32 --crop 300 --warmup 100 --work-dir "$work" --model-dir "$wroot/unused-$k" \
+        --steps 1784 "${loto_batch[@]}" --work-dir "$work" --model-dir "$wroot/unused-$k" \
         "${resume[@]}" >>"$wroot/train-$k.log" 2>&1 || { echo "training $k failed: $wroot/train-$k.log" >&2; exit 1; }
       date -u +%FT%TZ >"$work/done"
     fi
