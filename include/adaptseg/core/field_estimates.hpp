@@ -138,26 +138,23 @@ class FieldScale {
   /// A forecast gain `base` before s, times s (FactorEstimate::scaled).
   [[nodiscard]] double scaled(double base) const noexcept { return estimate().scaled(base); }
 
-  /// The estimate of a second factor s' of the same prior N(1, ω²) that moves b times as far from
-  /// 1 as s does, s' = 1 + b·(s − 1) + e (FrontAwarePolicy::Params::relabel_transfer), e the part
-  /// of its spread between fields that s does not explain, Var e = (1 − b²)·ω²: mean
-  /// 1 + b·(mean − 1), variance b²·Var(s) + (1 − b²)·ω². b = 1: s's own; b = 0: the prior, however
+  /// The estimate of a second factor s' that moves b times as far from 1 as s does, s' = 1 +
+  /// c·(s − 1) + e (FrontAwarePolicy::Params::relabel_transfer b), with its own prior spread ω'
+  /// (`gain_sd`; FrontAwarePolicy::Params::relabel_field_sd) told apart from s's ω: c = min(b,
+  /// ω'/ω) (s cannot explain more of s''s spread between fields than there is), e the part of the
+  /// spread between fields that c·s does not explain, Var e = ω'² − c²·ω². Mean 1 + c·(mean − 1),
+  /// variance c²·Var(s) + ω'² − c²·ω²: ω'² before any observation, whatever ω. ω' = ω (the
+  /// one-argument form): c = b, Var e = (1 − b²)·ω²; b = 1: s's own; b = 0: the prior, however
   /// much s has learnt.
-  [[nodiscard]] FactorEstimate transferred(double b) const noexcept {
-    if (b == 1.0) return estimate();
-    return {1.0 + b * (mean_ - 1.0), b * b * var_ + (1.0 - b * b) * prior_sd_ * prior_sd_};
+  [[nodiscard]] FactorEstimate transferred(double b, double gain_sd) const noexcept {
+    const double r = gain_sd / prior_sd_;
+    const double c = std::min(b, r);
+    const double mean = c == 1.0 ? mean_ : 1.0 + c * (mean_ - 1.0);
+    return {mean, c * c * var_ + std::max(0.0, r * r - c * c) * prior_sd_ * prior_sd_};
   }
 
-  /// As transferred(b), with the second factor's own prior spread ω' (`gain_sd`) told apart from
-  /// s's ω (FrontAwarePolicy::Params::relabel_field_sd): s' = 1 + c·(s − 1) + e, c = min(b, ω'/ω)
-  /// (s cannot explain more of s''s spread between fields than there is), Var e = ω'² − c²·ω²,
-  /// the part that c·s does not explain: mean 1 + c·(mean − 1), variance c²·Var(s) + ω'² − c²·ω²,
-  /// ω'² before any observation, whatever ω.
-  [[nodiscard]] FactorEstimate transferred(double b, double gain_sd) const noexcept {
-    const double c = std::min(b, gain_sd / prior_sd_);
-    const double mean = c == 1.0 ? mean_ : 1.0 + c * (mean_ - 1.0);
-    return {mean, c * c * var_ + std::max(0.0, gain_sd * gain_sd - c * c * prior_sd_ * prior_sd_)};
-  }
+  /// transferred(b, ω): s' of s's own prior spread.
+  [[nodiscard]] FactorEstimate transferred(double b) const noexcept { return transferred(b, prior_sd_); }
 
  private:
   double prior_sd_ = 0.5;
