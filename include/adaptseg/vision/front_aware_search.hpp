@@ -317,6 +317,12 @@ struct FoldCorrection {
   }
 };
 
+/// Whether `options` asks for anything measured on the cells (measure_on_cells()).
+[[nodiscard]] inline bool measures_on_cells(const CalibrationOptions& options) noexcept {
+  return options.jump_guard || options.relabel_transfer || options.relabel_region_spread ||
+         options.relabel_field_spread;
+}
+
 /// The jump guard's bound and the relabelled factor's b, τ_r and ω_χ measured on `cells` into
 /// `c`, each where `options` asks for it (with ranked cells: the callers' test): a fold's from
 /// the other fields' cells, the calibrated model's from every field's.
@@ -340,7 +346,7 @@ template <class Fly>
                                                            Fly& fly) {
   const CalibrationOptions& options = in.options;
   std::vector<FoldCorrection> c(folds.size(), FoldCorrection::of(base));
-  if (grid.ranked)
+  if (grid.ranked && measures_on_cells(options))
     for (std::size_t k = 0; k < folds.size(); ++k)
       measure_on_cells(c[k], folds[k].cells, options, in.adaptive.cell_input);
   if (!(options.gain_ratios || options.margin_biases) || in.fields.size() < 2) return c;
@@ -409,7 +415,7 @@ template <class Fly>
   }
   // Its jump bound, b, τ_r and ω_χ from every field's cells.
   FrontAwarePolicy::Params params = settings[best].params;
-  if (grid.ranked) {
+  if (grid.ranked && detail::measures_on_cells(options)) {
     detail::FoldCorrection whole = detail::FoldCorrection::of(params);
     detail::measure_on_cells(whole, cells_of_every_field(in.cells), options, in.adaptive.cell_input);
     whole.apply_to(params);
