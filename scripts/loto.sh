@@ -113,11 +113,14 @@ stage_tile() {
   [ ! -f "$wroot/train-$k.log" ] || cp "$wroot/train-$k.log" "$dest/tile-$k/train.log"
 }
 
-# Exits unless every folder given holds a network: checked before anything is written.
+# Exits unless every folder given holds a network with its temperature (a staged tile has none
+# until bundle sets it: flown so, it would be at 1): checked before anything is written.
 need_networks() {
   local net
   for net in "$@"; do
     [ -s "$net/model.onnx" ] || { echo "no $net/model.onnx: bundle its set first (bash $0 bundle)" >&2; exit 2; }
+    grep -q '^temperature:' "$net/model.yaml" 2>/dev/null ||
+      { echo "no temperature in $net/model.yaml: bundle its set first (bash $0 bundle)" >&2; exit 2; }
   done
 }
 

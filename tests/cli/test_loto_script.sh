@@ -1,0 +1,92 @@
+#!/usr/bin/env bash
+# scripts/loto.sh's file work on stand-in networks (nothing trained, built or flown): stage copies
+# a finished tile without its temperature and never over a staged one; mirror and ensemble write
+# each tile's ensemble.yaml with members that resolve to the networks, and refuse, before writing
+# anything, a set with a network missing or without its temperature. A few seconds.
+#   test_loto_script.sh SOURCE_DIR
+set -uo pipefail
+source "$(dirname "$0")/cli_common.sh"
+loto="$1/scripts/loto.sh"
+[ -f "$loto" ] || fail "no $loto"
+export PYTHON=true  # no interpreter probe: these subcommands run no Python
+
+# network DIR [TEMPERATURE]: a stand-in network folder (an ONNX file's place, its metadata).
+network() {
+  mkdir -p "$1"
+  echo onnx >"$1/model.onnx"
+  { echo "arch: mobilenetv2"; [ -z "${2:-}" ] || echo "temperature: $2"; } >"$1/model.yaml"
+}
+# set_of DIR [TEMPERATURE]: tile-1 ... tile-6 of a bundled set.
+set_of() { for k in 1 2 3 4 5 6; do network "$1/tile-$k" "${2:-}"; done; }
+# refused FRAGMENT ARGS...: loto.sh ARGS exits non-zero, saying FRAGMENT on stderr.
+refused() {
+  local fragment=$1
+  shift
+  bash "$loto" "$@" >"$work/out" 2>"$work/err" && fail "loto.sh $* succeeded (want a refusal)"
+  grep -qF -- "$fragment" "$work/err" || fail "loto.sh $*: stderr lacks '$fragment': $(cat "$work/err")"
+  echo "ok: refused: $(head -1 "$work/err")"
+}
+
+# --- stage: a trained tile (recipe-cpu's files in LOTO_WORK) into LOTO_BUNDLE ---
+w="$work/work" b="$work/bundle"
+network "$w/model-2"
+for f in train_log.csv val_log.csv val_ema_log.csv; do echo "step" >"$w/model-2/$f"; done
+echo '{"fields": {}}' >"$w/eval-2.json"
+echo "training done" >"$w/train-2.log"
+export LOTO_WORK=$w LOTO_BUNDLE=$b
+bash "$loto" stage 2 >"$work/out" 2>&1 || fail "stage 2: $(cat "$work/out")"
+for f in model.onnx model.yaml train_log.csv val_log.csv val_ema_log.csv; do
+  cmp -s "$w/model-2/$f" "$b/tile-2/$f" || fail "stage 2 did not copy $f"
+done
+cmp -s "$w/eval-2.json" "$b/tile-2/held_out_eval.json" || fail "stage 2: held_out_eval.json is not eval-2.json"
+cmp -s "$w/train-2.log" "$b/tile-2/train.log" || fail "stage 2: train.log is not train-2.log"
+grep -q '^temperature:' "$b/tile-2/model.yaml" && fail "stage 2 set a temperature"
+echo "ok: stage 2 copied the network, its logs and its held-out scores"
+echo "changed" >"$w/model-2/model.onnx"
+refused "holds a network already" stage 2
+cmp -s "$b/tile-2/model.onnx" <(echo onnx) || fail "a refused stage overwrote tile-2"
+refused "no $w/model-3" stage 3
+[ -e "$b/tile-3" ] && fail "a refused stage 3 left $b/tile-3"
+
+# --- ensemble: each tile's networks of several sets together ---
+set_of "$work/seed0" 1.5
+set_of "$work/seed1" 1.25
+unset LOTO_WORK LOTO_BUNDLE
+bash "$loto" ensemble "$work/ens" "$work/seed0" "$work/seed1" >"$work/out" 2>&1 || fail "ensemble: $(cat "$work/out")"
+for k in 1 2 3 4 5 6; do
+  e="$work/ens/tile-$k/ensemble.yaml"
+  [ -s "$e" ] || fail "ensemble wrote no $e"
+  mapfile -t members < <(sed -n 's/^  - model: //p' "$e")
+  [ "${#members[@]}" -eq 2 ] || fail "$e: ${#members[@]} members (want 2)"
+  for i in 0 1; do
+    [ "$(realpath "$work/ens/tile-$k/${members[$i]}")" = "$(realpath "$work/seed$i/tile-$k")" ] ||
+      fail "$e: member $i is ${members[$i]}, not seed$i/tile-$k"
+  done
+  [ "$(grep -c '^    weight: 1$' "$e")" -eq 2 ] || fail "$e: not every member weighted 1"
+done
+echo "ok: ensemble wrote six ensemble.yaml, two members each, relative to their file"
+refused "ensemble: DEST and at least two folders" ensemble "$work/one" "$work/seed0"
+# A staged set (no temperature yet) or a missing tile is refused before anything is written.
+set_of "$work/staged"
+refused "no temperature in $work/staged/tile-1/model.yaml" ensemble "$work/ens2" "$work/seed0" "$work/staged"
+rm -r "$work/seed1/tile-6"
+refused "no $work/seed1/tile-6/model.onnx" ensemble "$work/ens3" "$work/seed0" "$work/seed1"
+[ -e "$work/ens2" ] || [ -e "$work/ens3" ] && fail "a refused ensemble wrote files"
+
+# --- mirror: each network of LOTO_BUNDLE under test-time mirror ---
+LOTO_BUNDLE="$work/seed0" bash "$loto" mirror "$work/mir" >"$work/out" 2>&1 || fail "mirror: $(cat "$work/out")"
+for k in 1 2 3 4 5 6; do
+  e="$work/mir/tile-$k/ensemble.yaml"
+  m=$(sed -n 's/^  - model: //p' "$e")
+  [ "$(realpath "$work/mir/tile-$k/$m")" = "$(realpath "$work/seed0/tile-$k")" ] || fail "$e: member $m"
+  grep -qx '    mirror: true' "$e" || fail "$e: no mirror: true"
+done
+echo "ok: mirror wrote six ensembles of one mirrored member"
+LOTO_BUNDLE="$work/staged" refused "no temperature" mirror "$work/mir2"
+[ -e "$work/mir2" ] && fail "a refused mirror wrote files"
+
+# --- no subcommand: the usage, exit 2 ---
+bash "$loto" >"$work/out" 2>"$work/err"
+[ $? -eq 2 ] || fail "loto.sh without a subcommand: exit code not 2"
+grep -q "^# Usage\|bash scripts/loto.sh ensemble DEST FOLDER FOLDER" "$work/err" || fail "no usage on stderr"
+echo "PASS"
