@@ -3,7 +3,9 @@
 Every band is a whole-field lawnmower at that GSD (footprints as adaptseg's LawnmowerPlanner
 places them, images rendered as its SimulatedSensor renders them, as in eval_segnet.py). Each
 member runs on the path of the C++ backend (resampled to its input size, logits back to the
-camera size) in PyTorch on the weights its model.onnx was exported from; its probabilities are
+camera size) in PyTorch on the weights its model.onnx was exported from (model.pt), or, where the
+folder has only its model.onnx (the bundled leave-one-tile-out networks), through OpenCV's DNN
+module as the C++ backend runs it; its probabilities are
 softmax(logits / T) with the temperature of its model.yaml (1 where it has none). An ensemble's
 labels are the argmax of its members' weighted mean probabilities (ties to the lower class), as
 adaptseg::EnsembleSegmenter gives them. Labels are scored against the orthomosaic labels at
@@ -38,7 +40,7 @@ import yaml
 from . import REPO
 from .fieldio import IGNORE
 from .training.fields import capture, lawnmower_rects, load_field
-from .training.models import load_exported
+from .training.models import load_exported, net_spec
 from .training.network_path import logits_to, to_network_size, to_tensor
 from .training.validation import confusion, miou
 
@@ -54,6 +56,28 @@ def member_probabilities(model, spec, meta, bgr: np.ndarray, mirror: bool = Fals
         logits = logits_to(model(x).float(), bgr.shape[:2])[0]
     t = float(meta.get("temperature", 1.0))
     return torch.softmax(logits / t, dim=0).numpy()
+
+
+def load_member(model_dir: Path):
+    """A member's network, NetSpec and metadata: its PyTorch weights (model.pt) where the folder has
+    them, else its model.onnx run by OpenCV's DNN module, the C++ backend's runtime (the bundled
+    networks ship no model.pt; their export checked both agree, model.yaml's `check`)."""
+    model_dir = Path(model_dir)
+    if (model_dir / "model.pt").is_file():
+        return load_exported(model_dir)
+    if not (model_dir / "model.onnx").is_file():
+        raise SystemExit(f"{model_dir}: neither model.pt nor model.onnx")
+    meta = yaml.safe_load((model_dir / "model.yaml").read_text())
+    spec = net_spec({"arch": meta.get("arch", "erfnet"), "camera_wh": list(meta["training"]["camera"]),
+                     "input_wh": [meta["input"]["width"], meta["input"]["height"]],
+                     "mean": meta["input"]["mean"], "std": meta["input"]["std"]})
+    net = cv2.dnn.readNetFromONNX(str(model_dir / "model.onnx"))
+
+    def model(x: torch.Tensor) -> torch.Tensor:
+        net.setInput(np.ascontiguousarray(x.numpy()))
+        return torch.from_numpy(net.forward().copy())
+
+    return model, spec, meta
 
 
 def member_dir(value: str) -> tuple[Path, bool]:
@@ -109,7 +133,7 @@ def main():
     nets = {}
     for name, d in member_dirs.items():
         model_dir, mirror = member_dir(d)
-        model, spec, meta = load_exported(model_dir)
+        model, spec, meta = load_member(model_dir)
         nets[name] = (model, spec, meta, mirror)
     classes = next(iter(nets.values()))[2]["classes"]
     for name, (_, _, meta, _) in nets.items():
@@ -160,7 +184,7 @@ def main():
     for r in rows:
         label = r if r in member_dirs else f"{r} ({' + '.join(n for n, _ in ensembles[r])})"
         print(f"| {label} | " + " | ".join(f"{b[r]['miou']:.3f}" for fr in results.values() for b in fr.values()) + " |")
-    print("\nPyTorch time per image and member (this machine, "
+    print("\ntime per image and member (this machine, "
           f"{args.threads} threads): " + ", ".join(f"{n} {1000 * s / max(1, sum(b['images'] for fr in results.values() for b in fr.values())):.0f} ms"
                                                   for n, s in seconds.items()))
     if args.json:
