@@ -40,7 +40,7 @@ import yaml
 from . import REPO
 from .fieldio import IGNORE
 from .training.fields import capture, lawnmower_rects, load_field
-from .training.models import load_exported, net_spec
+from .training.models import exported_checkpoint, load_exported, net_spec
 from .training.network_path import logits_to, to_network_size, to_tensor
 from .training.validation import confusion, miou
 
@@ -68,9 +68,7 @@ def load_member(model_dir: Path):
     if not (model_dir / "model.onnx").is_file():
         raise SystemExit(f"{model_dir}: neither model.pt nor model.onnx")
     meta = yaml.safe_load((model_dir / "model.yaml").read_text())
-    spec = net_spec({"arch": meta.get("arch", "erfnet"), "camera_wh": list(meta["training"]["camera"]),
-                     "input_wh": [meta["input"]["width"], meta["input"]["height"]],
-                     "mean": meta["input"]["mean"], "std": meta["input"]["std"]})
+    spec = net_spec(exported_checkpoint(meta))
     net = cv2.dnn.readNetFromONNX(str(model_dir / "model.onnx"))
 
     def model(x: torch.Tensor) -> torch.Tensor:

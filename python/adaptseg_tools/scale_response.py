@@ -34,6 +34,7 @@ import torch
 from . import REPO
 from .eval_ensemble import load_member, member_probabilities
 from .fieldio import IGNORE
+from .proxy_table import spearman
 from .training.fields import capture, lawnmower_rects, load_field
 from .training.validation import confusion, miou
 
@@ -100,24 +101,9 @@ def measure(model_dir: Path, field_dir: Path, factors: list[float]) -> dict:
 
 
 def rank_correlation(x: list[float], y: list[float]) -> float:
-    """Spearman's rho over the pairs where both are numbers (nan under three pairs)."""
+    """Spearman's rho (proxy_table.spearman) over the pairs where both are numbers."""
     pairs = [(a, b) for a, b in zip(x, y) if not (math.isnan(a) or math.isnan(b))]
-    if len(pairs) < 3:
-        return math.nan
-
-    def ranks(v):
-        order = np.argsort(v, kind="stable")
-        r = np.empty(len(v))
-        r[order] = np.arange(len(v))
-        for value in set(v):  # ties share their mean rank
-            idx = [i for i, w in enumerate(v) if w == value]
-            r[idx] = np.mean(r[idx])
-        return r
-
-    a, b = ranks([p[0] for p in pairs]), ranks([p[1] for p in pairs])
-    if a.std() == 0 or b.std() == 0:
-        return math.nan
-    return float(np.corrcoef(a, b)[0, 1])
+    return spearman([p[0] for p in pairs], [p[1] for p in pairs])
 
 
 def main(argv=None):

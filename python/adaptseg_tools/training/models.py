@@ -40,14 +40,20 @@ def set_train_mode(model, ckpt):
                 m.eval()
 
 
+def exported_checkpoint(meta: dict) -> dict:
+    """What net_spec reads, from an exported model.yaml's metadata (train_segnet.py's, or
+    train_erfnet.py's before it, which names no arch)."""
+    return {"arch": meta.get("arch", "erfnet"), "camera_wh": list(meta["training"]["camera"]),
+            "input_wh": [meta["input"]["width"], meta["input"]["height"]],
+            "mean": meta["input"]["mean"], "std": meta["input"]["std"]}
+
+
 def load_exported(model_dir: Path):
     """The network of an exported model directory (model.yaml + model.pt), in eval mode, with its
     NetSpec and metadata. Reads the metadata of train_segnet.py and of train_erfnet.py before it."""
     meta = yaml.safe_load((Path(model_dir) / "model.yaml").read_text())
-    arch = meta.get("arch", "erfnet")
-    ckpt = {"arch": arch, "camera_wh": list(meta["training"]["camera"]),
-            "input_wh": [meta["input"]["width"], meta["input"]["height"]],
-            "mean": meta["input"]["mean"], "std": meta["input"]["std"]}
+    ckpt = exported_checkpoint(meta)
+    arch = ckpt["arch"]
     if arch == "erfnet":
         ckpt.update(width=meta["width"], dropout_scale=1.0)
     else:
