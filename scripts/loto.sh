@@ -130,7 +130,9 @@ write_ensemble() {
   local to=$1 description=$2 line=$3 net
   mkdir -p "$to"
   {
-    printf '%s\n' "description: $description" "members:"
+    # A double-quoted YAML scalar: the description may hold ": " or " #", which a plain one may not.
+    description=${description//\\/\\\\}
+    printf '%s\n' "description: \"${description//\"/\\\"}\"" "members:"
     for net in "${@:4}"; do printf '%s\n' "  - model: $(realpath --relative-to="$to" "$net")" "$line"; done
   } >"$to/ensemble.yaml"
 }

@@ -63,7 +63,20 @@ for k in 1 2 3 4 5 6; do
       fail "$e: member $i is ${members[$i]}, not seed$i/tile-$k"
   done
   [ "$(grep -c '^    weight: 1$' "$e")" -eq 2 ] || fail "$e: not every member weighted 1"
+  # The description holds ": " (a plain YAML scalar may not; yaml-cpp refused the file): quoted.
+  grep -qx "description: \"the networks that never saw dubai-tile-$k: .*seed0/tile-$k .*seed1/tile-$k\"" "$e" ||
+    fail "$e: description not a double-quoted scalar: $(head -1 "$e")"
 done
+# Where a YAML parser is at hand, the file parses to the description and two members.
+if /usr/bin/python3 -c 'import yaml' 2>/dev/null; then
+  /usr/bin/python3 - "$work/ens/tile-3/ensemble.yaml" <<'EOF' || fail "ensemble.yaml does not parse as written"
+import sys, yaml
+d = yaml.safe_load(open(sys.argv[1]))
+assert d["description"].startswith("the networks that never saw dubai-tile-3: "), d
+assert [m["weight"] for m in d["members"]] == [1, 1], d
+EOF
+  echo "ok: ensemble.yaml parses (PyYAML)"
+fi
 echo "ok: ensemble wrote six ensemble.yaml, two members each, relative to their file"
 refused "ensemble: DEST and at least two folders" ensemble "$work/one" "$work/seed0"
 # A staged set (no temperature yet) or a missing tile is refused before anything is written.
