@@ -124,16 +124,23 @@ need_networks() {
   done
 }
 
+# $1 as a double-quoted YAML scalar: a description or a folder's name may hold ": " or " #",
+# which a plain scalar may not (yaml-cpp refuses the file).
+yaml_string() {
+  local text=${1//\\/\\\\}
+  printf '"%s"' "${text//\"/\\\"}"
+}
+
 # $1/ensemble.yaml: description $2, the networks $4... as members (found relative to the file), each
 # with the line $3 below its model line.
 write_ensemble() {
   local to=$1 description=$2 line=$3 net
   mkdir -p "$to"
   {
-    # A double-quoted YAML scalar: the description may hold ": " or " #", which a plain one may not.
-    description=${description//\\/\\\\}
-    printf '%s\n' "description: \"${description//\"/\\\"}\"" "members:"
-    for net in "${@:4}"; do printf '%s\n' "  - model: $(realpath --relative-to="$to" "$net")" "$line"; done
+    printf '%s\n' "description: $(yaml_string "$description")" "members:"
+    for net in "${@:4}"; do
+      printf '%s\n' "  - model: $(yaml_string "$(realpath --relative-to="$to" "$net")")" "$line"
+    done
   } >"$to/ensemble.yaml"
 }
 

@@ -56,7 +56,7 @@ bash "$loto" ensemble "$work/ens" "$work/seed0" "$work/seed1" >"$work/out" 2>&1 
 for k in 1 2 3 4 5 6; do
   e="$work/ens/tile-$k/ensemble.yaml"
   [ -s "$e" ] || fail "ensemble wrote no $e"
-  mapfile -t members < <(sed -n 's/^  - model: //p' "$e")
+  mapfile -t members < <(sed -n 's/^  - model: "\(.*\)"$/\1/p' "$e")
   [ "${#members[@]}" -eq 2 ] || fail "$e: ${#members[@]} members (want 2)"
   for i in 0 1; do
     [ "$(realpath "$work/ens/tile-$k/${members[$i]}")" = "$(realpath "$work/seed$i/tile-$k")" ] ||
@@ -90,7 +90,7 @@ refused "no $work/seed1/tile-6/model.onnx" ensemble "$work/ens3" "$work/seed0" "
 LOTO_BUNDLE="$work/seed0" bash "$loto" mirror "$work/mir" >"$work/out" 2>&1 || fail "mirror: $(cat "$work/out")"
 for k in 1 2 3 4 5 6; do
   e="$work/mir/tile-$k/ensemble.yaml"
-  m=$(sed -n 's/^  - model: //p' "$e")
+  m=$(sed -n 's/^  - model: "\(.*\)"$/\1/p' "$e")
   [ "$(realpath "$work/mir/tile-$k/$m")" = "$(realpath "$work/seed0/tile-$k")" ] || fail "$e: member $m"
   grep -qx '    mirror: true' "$e" || fail "$e: no mirror: true"
 done
