@@ -89,7 +89,7 @@ int main(int argc, char** argv) {
     options.adaptive.top_gsd_cm = top_factor * g0;
     for (double f : candidate_factors) options.adaptive.candidate_gsd_cm.push_back(f * g0);
     for (double f : lawnmower_factors) options.lawnmower_gsd_cm.push_back(f * g0);
-    calibration.apply(options, common);
+    calibration.apply(options, common, g0);
     for (const auto& f : fields)
       std::fprintf(stderr, "calibrating on %s (%dx%d px, %.2f cm/px) with %s ...\n", f.name().c_str(), f.width_px(),
                    f.height_px(), g0, segmenter.name.c_str());

@@ -128,7 +128,7 @@ int main(int argc, char** argv) {
       for (std::size_t k = 0; k + 1 < lawnmower_factors.size(); ++k)
         co.adaptive.candidate_gsd_cm.push_back(lawnmower_factors[k] * g0);
       for (double f : lawnmower_factors) co.lawnmower_gsd_cm.push_back(f * g0);
-      calibration.apply(co, common);
+      calibration.apply(co, common, g0);
       std::string names;
       for (const auto& f : trains) names += (names.empty() ? "" : ", ") + f.name();
       std::fprintf(stderr, "[%6.1f s] calibrating on %s ...\n", elapsed(), names.c_str());

@@ -482,6 +482,19 @@ TEST_CASE("calibration: another slope pooling replaces the first only where the 
   // Of several beyond the noise, the best mean; one alone is the one.
   CHECK(select({trial({0.0, 0.0, 0.0}), trial({0.01, 0.011, 0.012}), trial({0.02, 0.021, 0.022})}) == 2);
   CHECK(select({trial({0.0, 0.01})}) == 0);
+  // Better on one fold alone: the mean difference d/n equals the standard error d/n, a tie that
+  // rounding decides without a tolerance; with one (the finest descent's choice) the first stays.
+  const auto strict = [](std::vector<RuleTrial> trials) {
+    std::vector<const RuleTrial*> p;
+    for (const RuleTrial& t : trials) p.push_back(&t);
+    return adaptseg::detail::select_pooling(p, 1e-9);
+  };
+  for (const double d : {0.0177, 0.0035, 0.02})
+    CHECK(strict({trial({0.0111, -0.0015, -0.0047, 0.0, 0.0065}),
+                  trial({0.0111, -0.0015, -0.0047 + d, 0.0, 0.0065})}) == 0);
+  // On two folds it is beyond the noise, with or without the tolerance.
+  CHECK(strict({trial({0.0, 0.0, 0.0, 0.0, 0.0}), trial({0.0, 0.01, 0.01, 0.0, 0.0})}) == 1);
+  CHECK(select({trial({0.0, 0.0, 0.0, 0.0, 0.0}), trial({0.0, 0.01, 0.01, 0.0, 0.0})}) == 1);
 }
 
 TEST_CASE(
@@ -522,6 +535,62 @@ TEST_CASE(
   options.top_levels = {TopLevelChoice::hull, TopLevelChoice::hull};
   CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
                        doctest::Contains("top_levels names a choice twice"), std::invalid_argument);
+}
+
+TEST_CASE("calibration: the finest descent GSD tried with the setting kept, the first kept unless another is better") {
+  const std::vector<Field> fields = two_blob_fields();
+  OracleSegmenter oracle(fields.front().num_classes());
+  CalibrationOptions options = ranked_options();
+  options.slope_poolings = {SlopePooling::cells};
+  const std::vector<double> candidates = options.adaptive.candidate_gsd_cm;
+  REQUIRE(candidates.size() >= 2);
+  const double coarsest = *std::max_element(candidates.begin(), candidates.end());
+  options.finest_descent_gsd_cm = {0.0, coarsest};
+  const CalibrationResult cal = calibrate(std::span<const Field>(fields), oracle, options);
+  // Every z with the first (no limit), then the setting kept with the other: one trial more.
+  const std::size_t zs = options.confidences.size();
+  REQUIRE(cal.trials.size() == zs + 1);
+  int any = 0, limited = 0;
+  for (const auto& trial : cal.trials) {
+    any += trial.description.ends_with(" finest=any");
+    limited += trial.description.ends_with(" finest=" + adaptseg::detail::format_number(coarsest));
+  }
+  CHECK(any == static_cast<int>(zs));
+  CHECK(limited == 1);
+  // The one kept is first, and the model's rule flies its limit; it is the limited trial only
+  // where that beats the same setting without the limit beyond the folds' noise.
+  const std::string suffix = " finest=" + adaptseg::detail::format_number(coarsest);
+  const FrontAwarePolicy& rule = std::get<FrontAwarePolicy>(cal.decision_function.rule());
+  const bool kept_limit = cal.trials.front().description.ends_with(suffix);
+  CHECK(rule.params().finest_descent_gsd_cm == (kept_limit ? coarsest : 0.0));
+  const auto limited_trial = std::find_if(cal.trials.begin(), cal.trials.end(),
+                                          [&](const RuleTrial& t) { return t.description.ends_with(suffix); });
+  REQUIRE(limited_trial != cal.trials.end());
+  CHECK(limited_trial->margins.size() == fields.size());
+  const std::string stem = limited_trial->description.substr(0, limited_trial->description.size() - suffix.size());
+  const auto unlimited = std::find_if(cal.trials.begin(), cal.trials.end(),
+                                      [&](const RuleTrial& t) { return t.description == stem + " finest=any"; });
+  REQUIRE(unlimited != cal.trials.end());
+  const std::vector<const RuleTrial*> pair{&*unlimited, &*limited_trial};
+  CHECK(adaptseg::detail::select_pooling(pair, 1e-9) == (kept_limit ? 1u : 0u));
+  CHECK(cal.trials.front().description == (kept_limit ? limited_trial : unlimited)->description);
+  // One GSD: no name in the trials, and the rule flies it; none: no limit (as before the list).
+  options.finest_descent_gsd_cm = {coarsest};
+  const CalibrationResult one = calibrate(std::span<const Field>(fields), oracle, options);
+  CHECK(one.trials.size() == zs);
+  CHECK(one.trials.front().description.find("finest=") == std::string::npos);
+  CHECK(std::get<FrontAwarePolicy>(one.decision_function.rule()).params().finest_descent_gsd_cm == coarsest);
+  options.finest_descent_gsd_cm.clear();
+  CHECK(std::get<FrontAwarePolicy>(calibrate(std::span<const Field>(fields), oracle, options).decision_function.rule())
+            .params()
+            .finest_descent_gsd_cm == 0.0);
+  // A GSD named twice, or a negative one, is refused up front.
+  options.finest_descent_gsd_cm = {0.0, 0.0};
+  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
+                       doctest::Contains("finest_descent_gsd_cm names a GSD twice"), std::invalid_argument);
+  options.finest_descent_gsd_cm = {-1.0};
+  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
+                       doctest::Contains("finest_descent_gsd_cm must hold finite GSDs >= 0"), std::invalid_argument);
 }
 
 TEST_CASE(
@@ -873,6 +942,16 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
                                                         "curve_agreement: 1.5", "wrong_agreement.yaml")),
                        doctest::Contains("curve_agreement must be in [0, 1]"), std::invalid_argument);
   p.curve_agreement = 0.0;
+  // The finest descent GSD: kept (files without the key: 0, no limit); a negative one refused.
+  CHECK(rule_of(back).finest_descent_gsd_cm == 0.0);
+  p.finest_descent_gsd_cm = 2.0;
+  policy.set_params(p);
+  corrected.save(tmp.path() / "finest.yaml");
+  CHECK(rule_of(DecisionModel::load(tmp.path() / "finest.yaml")).finest_descent_gsd_cm == 2.0);
+  CHECK_THROWS_WITH_AS((void)DecisionModel::load(edited("finest.yaml", "finest_descent_gsd_cm: 2",
+                                                        "finest_descent_gsd_cm: -2", "wrong_finest.yaml")),
+                       doctest::Contains("finest_descent_gsd_cm must be finite and >= 0"), std::invalid_argument);
+  p.finest_descent_gsd_cm = 0.0;
   // The jump guard's bound: kept (files without the key: none, infinity).
   CHECK(std::isinf(rule_of(back).jump_bound));
   p.jump_bound = 0.25;

@@ -560,6 +560,21 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     CHECK_THROWS_WITH_AS(FrontAwarePolicy(with_cells(1.0), reference, {.curve_agreement = 1.5}),
                          doctest::Contains("curve_agreement must be in [0, 1]"), std::invalid_argument);
   }
+  SUBCASE("the finest descent GSD: no descent to a finer candidate, which is still assessed") {
+    // β = 4 descends to 1 cm/px (both offers are 1 cm/px); a limit at 1 cm/px (up to rounding)
+    // or none keeps it, one at 2 cm/px takes none and still reports both.
+    for (const double g : {0.0, 1.0, 1.0 + 1e-12}) {
+      FrontAwarePolicy p(with_cells(4.0), reference, {.finest_descent_gsd_cm = g});
+      CHECK(p.decide(s.region(0, 0.1)).descend);
+    }
+    FrontAwarePolicy coarse(with_cells(4.0), reference, {.finest_descent_gsd_cm = 2.0});
+    const Decision d = coarse.decide(s.region(0, 0.1));
+    CHECK_FALSE(d.descend);
+    CHECK(d.scores.size() == 2);
+    CHECK(d.scores[1].predicted_field_gain > 0.0);
+    CHECK_THROWS_WITH_AS(FrontAwarePolicy(with_cells(1.0), reference, {.finest_descent_gsd_cm = -1.0}),
+                         doctest::Contains("finest_descent_gsd_cm must be finite and >= 0"), std::invalid_argument);
+  }
   SUBCASE("against the field's own predicted curve, the forecasts' scale cancels") {
     // The training curve rises by 0.2 mIoU over 145 s: against it, a descent of twice the cells'
     // gain looks better than one of half of it. Against the curve the same model predicts for

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -252,6 +253,7 @@ struct CalibrationCli {
   bool relabel_region_spread = false;
   bool relabel_field_spread = false;
   double curve_agreement = 0.0;
+  std::vector<double> finest_descent_factors;
 
   void add_to(CLI::App& app) {
     options_ = {
@@ -358,6 +360,13 @@ struct CalibrationCli {
                        "the model)")
             ->check(CLI::Range(0.0, 1.0))
             ->capture_default_str(),
+        app.add_option("--finest-descent", finest_descent_factors,
+                       "front-aware rule: the finest GSDs a descent may be limited to, as multiples of the "
+                       "training fields' GSD (0: no limit), comma-separated, each tried on the training fields' "
+                       "folds with the setting the rest of the search kept; the first is kept unless another "
+                       "beats it beyond the folds' noise (one standard error), and the one kept is saved in the "
+                       "model (default: no limit, not searched)")
+            ->delimiter(','),
         app.add_option("--sigma-prior", sigma_prior,
                        "front-aware rule with several training fields: the prior of the field's share of L "
                        "(sigma-hat): given (weight 0.25 fields, no spread), spread (its spread over the training "
@@ -378,9 +387,10 @@ struct CalibrationCli {
   }
 
   /// Sets the rule and the settings it tries, the descent coverage, I's inputs and the time
-  /// charged per image of `options` (`common`: the programs' --seg-time-s and --plan-time-s).
+  /// charged per image of `options` (`common`: the programs' --seg-time-s and --plan-time-s;
+  /// `field_gsd_cm`: the training fields' GSD, which --finest-descent's factors multiply).
   /// @throws std::invalid_argument as check_calibration_options (a choice given twice).
-  void apply(CalibrationOptions& options, const CommonOptions& common) const {
+  void apply(CalibrationOptions& options, const CommonOptions& common, double field_gsd_cm) const {
     options.threshold_steps = threshold_steps;
     options.rule = rule;
     options.confidences = confidences;
@@ -395,6 +405,18 @@ struct CalibrationCli {
     options.relabel_region_spread = relabel_region_spread;
     options.relabel_field_spread = relabel_field_spread;
     options.front_aware.curve_agreement = curve_agreement;
+    options.finest_descent_gsd_cm.clear();
+    for (std::size_t k = 0; k < finest_descent_factors.size(); ++k) {
+      const double f = finest_descent_factors[k];
+      if (!(std::isfinite(f) && f >= 0.0))
+        throw std::invalid_argument("--finest-descent " + fmt(f, 3) +
+                                    " is not a GSD factor: give multiples of the field's GSD, 0 for no limit");
+      if (std::find(finest_descent_factors.begin(), finest_descent_factors.begin() + static_cast<std::ptrdiff_t>(k),
+                    f) != finest_descent_factors.begin() + static_cast<std::ptrdiff_t>(k))
+        throw std::invalid_argument("--finest-descent names the factor " + fmt(f, 3) +
+                                    " twice: give each limit once (0: no limit)");
+      options.finest_descent_gsd_cm.push_back(f * field_gsd_cm);
+    }
     options.top_levels.clear();
     for (const auto& name : top_levels) options.top_levels.push_back(parse_top_level_choice(name));
     options.cell_inputs.clear();

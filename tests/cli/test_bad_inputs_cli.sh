@@ -49,6 +49,10 @@ adaptseg_calibrate)
     --out "$work/m.yaml" --top-level hull,convex
   expect_error "top_levels names a choice twice: (got hull)" --field "$weedmap" --out "$work/m.yaml" \
     --top-level hull,hull
+  expect_error "--finest-descent names the factor 2.000 twice: give each limit once (0: no limit)" \
+    --field "$weedmap" --out "$work/m.yaml" --finest-descent 0,2,2
+  expect_error "--finest-descent -1.000 is not a GSD factor: give multiples of the field's GSD, 0 for no limit" \
+    --field "$weedmap" --out "$work/m.yaml" --finest-descent 0,-1
   expect_error "max_vertical_speed_mps must be finite and >= 0" --field "$weedmap" --out "$work/m.yaml" \
     --vertical-speed -1
   expect_error "--map-fusion: mean not in {finest,pooled}" --field "$weedmap" --out "$work/m.yaml" \

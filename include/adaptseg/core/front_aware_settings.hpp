@@ -240,6 +240,10 @@ struct FrontAwareParams {
   double sigma_prior_weight = 0.25;  ///< k > 0: weight of the training fields' σ in σ̂ [fields]
   double sigma_prior_sd = 0.0;       ///< τ >= 0: spread of a field's σ about the training fields' mean
   double curve_agreement = 0.0;      ///< q in [0, 1]; 0: no such check
+  /// The finest GSD a descent may fly [cm/px] (CalibrationOptions::finest_descent_gsd_cm, the
+  /// training folds' choice); candidates finer than it are assessed and reported, never taken.
+  /// 0: any candidate.
+  double finest_descent_gsd_cm = 0.0;
   /// The jump guard's bound (JumpGuard; adaptive and non-adaptive alike; infinity: none):
   /// after a descent image beyond it the UAV descends no more (trusts_descent_image()).
   double jump_bound = std::numeric_limits<double>::infinity();
@@ -287,6 +291,8 @@ struct FrontAwareParams {
                     "FrontAwarePolicy::Params::sigma_prior_sd must be in [0, 1]", sigma_prior_sd);
     detail::require(std::isfinite(curve_agreement) && curve_agreement >= 0.0 && curve_agreement <= 1.0,
                     "FrontAwarePolicy::Params::curve_agreement must be in [0, 1]", curve_agreement);
+    detail::require(std::isfinite(finest_descent_gsd_cm) && finest_descent_gsd_cm >= 0.0,
+                    "FrontAwarePolicy::Params::finest_descent_gsd_cm must be finite and >= 0", finest_descent_gsd_cm);
     detail::require(!std::isnan(jump_bound), "FrontAwarePolicy::Params::jump_bound must not be NaN", jump_bound);
     detail::require(std::isfinite(relabel_transfer) && relabel_transfer >= 0.0 && relabel_transfer <= 1.0,
                     "FrontAwarePolicy::Params::relabel_transfer must be in [0, 1]", relabel_transfer);

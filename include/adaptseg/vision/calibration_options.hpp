@@ -106,6 +106,15 @@ struct CalibrationOptions {
   /// unless another's best setting has a larger mean front margin on the folds. Without ranked
   /// cells: the first only. Empty (the default): `front_aware.top_level` alone.
   std::vector<TopLevelChoice> top_levels{};
+  /// Front-aware rule: the finest GSDs a descent may be limited to
+  /// (FrontAwarePolicy::Params::finest_descent_gsd_cm) [cm/px], tried on the folds after the
+  /// rest of the search: every setting above is flown with the first, and with the setting
+  /// kept each other one is flown over the same folds; the first is kept unless another beats
+  /// it by more than one standard error of their paired margins (detail::select_pooling's
+  /// rule). Which descent GSDs pay on a field the model never saw differs from what the cells
+  /// forecast (docs/method.md, "The finest descent chosen by the folds"). Empty (the
+  /// default): `front_aware.finest_descent_gsd_cm` alone, no such trial. 0 in the list: no limit.
+  std::vector<double> finest_descent_gsd_cm{};
   /// Front-aware rule, several training fields: measure FrontAwarePolicy::Params::gain_ratios
   /// on the folds before the search. Each training field is flown with the model of the others
   /// (the first slope pooling and top-level choice, z = 0); per descent GSD, the ratio of what

@@ -50,6 +50,8 @@ struct FrontAwareRule {
     if (p.top_level != TopLevelChoice::undominated)
       e << YAML::Key << "top_level" << YAML::Value << to_string(p.top_level);
     if (p.curve_agreement > 0.0) e << YAML::Key << "curve_agreement" << YAML::Value << num(p.curve_agreement);
+    if (p.finest_descent_gsd_cm > 0.0)
+      e << YAML::Key << "finest_descent_gsd_cm" << YAML::Value << num(p.finest_descent_gsd_cm);
     if (std::isfinite(p.jump_bound)) e << YAML::Key << "jump_bound" << YAML::Value << num(p.jump_bound);
     if (p.field_factor != FieldFactorSource::scene_check)
       e << YAML::Key << "field_factor" << YAML::Value << to_string(p.field_factor);
@@ -123,6 +125,7 @@ struct FrontAwareRule {
          .sigma_prior_weight = rule.number("sigma_prior_weight"),
          .sigma_prior_sd = rule.has("sigma_prior_sd") ? rule.number("sigma_prior_sd") : 0.0,
          .curve_agreement = rule.has("curve_agreement") ? rule.number("curve_agreement") : 0.0,
+         .finest_descent_gsd_cm = rule.has("finest_descent_gsd_cm") ? rule.number("finest_descent_gsd_cm") : 0.0,
          .jump_bound = rule.has("jump_bound") ? rule.number("jump_bound") : std::numeric_limits<double>::infinity(),
          .curve = read_curve(rule),
          .top_level =
@@ -203,7 +206,8 @@ struct FrontAwareRule {
 
   /// Refuses options its search cannot use (before calibrate() samples anything).
   /// @throws std::invalid_argument if `confidences` or `slope_poolings` is empty,
-  ///         `slope_poolings` or `top_levels` names a value twice, or `relabel_transfer`,
+  ///         `slope_poolings`, `top_levels` or `finest_descent_gsd_cm` names a value twice,
+  ///         `finest_descent_gsd_cm` holds a negative or non-finite GSD, or `relabel_transfer`,
   ///         `relabel_region_spread` or `relabel_field_spread` is asked without the relabelled
   ///         field factor.
   static void check_options(const CalibrationOptions& options) {
@@ -217,6 +221,14 @@ struct FrontAwareRule {
       for (std::size_t j = 0; j < k; ++j)
         detail::require(options.top_levels[j] != options.top_levels[k],
                         "calibrate: top_levels names a choice twice:", to_string(options.top_levels[k]));
+    for (std::size_t k = 0; k < options.finest_descent_gsd_cm.size(); ++k) {
+      const double g = options.finest_descent_gsd_cm[k];
+      detail::require(std::isfinite(g) && g >= 0.0,
+                      "calibrate: finest_descent_gsd_cm must hold finite GSDs >= 0 (0: no limit); got", g);
+      for (std::size_t j = 0; j < k; ++j)
+        detail::require(options.finest_descent_gsd_cm[j] != g,
+                        "calibrate: finest_descent_gsd_cm names a GSD twice:", g);
+    }
     detail::require(!options.relabel_transfer || options.front_aware.field_factor == FieldFactorSource::relabelled,
                     "calibrate: relabel_transfer (how far the gain follows the relabelled share) needs the field "
                     "factor 'relabelled'; the field factor",
@@ -240,7 +252,10 @@ struct FrontAwareRule {
   /// and several fields this for each of `slope_poolings`, and the first pooling kept unless
   /// another beats it by more than the folds' noise (detail::select_pooling); with ranked cells
   /// all that for each of `top_levels`, the first kept unless another has a larger mean front
-  /// margin (detail::choose_setting; front_aware_search.hpp). `fly(field, policy, curve,
+  /// margin (detail::choose_setting; front_aware_search.hpp); with several
+  /// `finest_descent_gsd_cm`, every setting flown with the first and the setting kept then
+  /// flown with each other one, the first kept unless another beats it by more than the folds'
+  /// noise (detail::choose_finest_descent). `fly(field, policy, curve,
   /// margin)` flies an adaptive mission of `policy` and scores it against `curve`
   /// (detail::fly_scored).
   /// @throws std::invalid_argument as check_options.

@@ -2,7 +2,7 @@
 /// @file
 /// The front-aware rule's calibration search (FrontAwareRule::search, front_aware_rule.hpp):
 /// its settings (the confidence level z, the cell gain model's slope pooling, the top-level
-/// choice) tried on the training fields, each field flown with a model fitted without it, with
+/// choice, the finest descent GSD) tried on the training fields, each field flown with a model fitted without it, with
 /// σ̂'s prior estimated from their top-level images (sigma_prior.hpp) and, where asked for, the
 /// jump guard's bound from the other fields' cells. docs/method.md, "The front-aware rule".
 
@@ -14,6 +14,7 @@
 #include <adaptseg/vision/calibration_options.hpp>
 #include <adaptseg/vision/detail/fold_corrections.hpp>
 #include <adaptseg/vision/detail/number_text.hpp>
+#include <adaptseg/vision/detail/trial_choice.hpp>
 #include <adaptseg/vision/sigma_prior.hpp>
 
 #include <algorithm>
@@ -29,39 +30,6 @@
 namespace adaptseg {
 
 namespace detail {
-
-/// Which of several settings of the same folds to keep (`trials`, the best of each slope
-/// pooling, CalibrationOptions::slope_poolings' order): the first, unless another beats it on
-/// the folds by more than one standard error of their paired differences, m̄ − m̄₁ >
-/// sd(m − m₁) / sqrt(n) over the n folds (the one-standard-error rule of cross-validation,
-/// Breiman et al. 1984, towards the first, the default); of those that do, the best mean.
-/// Five training fields tell two poolings apart poorly, and a setting the folds prefer by less
-/// than their own scatter is as likely to lose on a new field (docs/results.md, "Slopes pooled
-/// over the cells or over the fields, chosen by the folds").
-inline std::size_t select_pooling(std::span<const RuleTrial* const> trials) {
-  std::size_t best = 0;
-  const std::vector<double>& first = trials.front()->margins;
-  for (std::size_t k = 1; k < trials.size(); ++k) {
-    const std::vector<double>& m = trials[k]->margins;
-    if (m.size() != first.size() || m.size() < 2) continue;
-    const double n = static_cast<double>(m.size());
-    double mean = 0.0;
-    for (std::size_t f = 0; f < m.size(); ++f) mean += (m[f] - first[f]) / n;
-    double ss = 0.0;
-    for (std::size_t f = 0; f < m.size(); ++f) ss += std::pow(m[f] - first[f] - mean, 2);
-    if (mean > std::sqrt(ss / (n - 1.0) / n) && trials[k]->front_margin > trials[best]->front_margin) best = k;
-  }
-  return best;
-}
-
-/// A trial's name: its z, its slope pooling and its top-level choice where the search tried
-/// several.
-inline std::string z_text(double z, const SlopePooling* pooling = nullptr, const TopLevelChoice* top_level = nullptr) {
-  std::string s = "front-aware z=" + format_number(z);
-  if (pooling) s += " slopes=" + to_string(*pooling);
-  if (top_level) s += " top=" + to_string(*top_level);
-  return s;
-}
 
 /// One fold of the search: a training field flown with a model fitted without it (one field:
 /// the field or one of its halves, with the whole field's model).
@@ -364,11 +332,50 @@ template <class Fly>
   return c;
 }
 
+/// The finest descent GSD kept (CalibrationOptions::finest_descent_gsd_cm, two or more): the
+/// setting kept, `trials[best]` (flown with the first GSD of the list), flown over the same
+/// `folds` (their `models` of its pooling, their `corrections`) with each other GSD, each a
+/// trial and a setting appended to `trials` and `settings`; of them and `trials[best]`, the
+/// first unless another beats it by more than one standard error of their paired margins
+/// (select_pooling's rule, a gain on one fold alone never enough). Returns the index kept.
+/// Which descent GSDs pay on new ground is a property of the candidates that no forecast of a
+/// cell has shown to transfer (docs/method.md, "The finest descent chosen by the folds"); the
+/// folds, each flown as new ground, see it.
+template <class Fly>
+std::size_t choose_finest_descent(const RuleSearchInputs& in, std::span<const FrontAwareFold> folds,
+                                  std::span<const GainModel> models, std::span<const FoldCorrection> corrections,
+                                  const FrontAwareGrid& grid, std::vector<RuleTrial>& trials,
+                                  std::vector<FrontAwareSetting>& settings, std::size_t best, Fly& fly) {
+  const std::vector<double>& finest = in.options.finest_descent_gsd_cm;
+  std::vector<std::size_t> tried{best};
+  for (std::size_t g = 1; g < finest.size(); ++g) {
+    FrontAwareSetting s = settings[best];
+    s.params.finest_descent_gsd_cm = finest[g];
+    RuleTrial t;
+    t.description = z_text(s.z, grid.poolings.size() > 1 ? &grid.poolings[s.pooling] : nullptr,
+                           grid.top_levels.size() > 1 ? &grid.top_levels[s.top_level] : nullptr, &finest[g]);
+    for (std::size_t k = 0; k < folds.size(); ++k) {
+      FrontAwarePolicy::Params fold_params = s.params;
+      corrections[k].apply_to(fold_params);
+      double margin = 0.0;
+      const AdaptiveResult r = fly_fold(in, folds[k], models[k], fold_params, fly, margin);
+      add_to_trial(t, r, margin);
+    }
+    trials.push_back(std::move(t));
+    settings.push_back(std::move(s));
+    tried.push_back(trials.size() - 1);
+  }
+  std::vector<const RuleTrial*> candidates;
+  for (std::size_t k : tried) candidates.push_back(&trials[k]);
+  return tried[select_pooling(candidates, 1e-9)];
+}
+
 }  // namespace detail
 
 /// The front-aware rule's calibration search (FrontAwareRule::search, which documents it):
-/// every setting of `in.options` flown over the folds by `fly`, the one kept first in the
-/// trials, the rule with it over the model of every field.
+/// every setting of `in.options` flown over the folds by `fly` (then, with several finest
+/// descent GSDs, the one kept with each: detail::choose_finest_descent), the one kept first in
+/// the trials, the rule with it over the model of every field.
 template <class Fly>
 [[nodiscard]] RuleSearchResult search_front_aware(const RuleSearchInputs& in, Fly&& fly) {
   const CalibrationOptions& options = in.options;
@@ -378,13 +385,18 @@ template <class Fly>
   const std::vector<detail::FrontAwareFold> folds = detail::front_aware_folds(in, reference, traces, grid.ranked);
   FrontAwarePolicy::Params base = options.front_aware;
   base.online = true;
+  const std::vector<double>& finest = options.finest_descent_gsd_cm;
+  if (!finest.empty()) base.finest_descent_gsd_cm = finest.front();
+  const double* finest_named = finest.size() > 1 ? &finest.front() : nullptr;
   detail::apply_sigma_prior(base, estimate_sigma_prior(traces), options.sigma_prior);
   const std::vector<detail::FoldCorrection> corrections = detail::fold_corrections(in, folds, grid, base, fly);
   std::vector<RuleTrial> trials;
   std::vector<detail::FrontAwareSetting> settings;
+  std::vector<std::vector<GainModel>> models_of_pooling;
   for (std::size_t pi = 0; pi < grid.poolings.size(); ++pi) {
     FrontAwarePolicy::Params pooled = base;
-    const std::vector<GainModel> models = detail::pooled_fold_models(in, folds, grid, grid.poolings[pi], pooled);
+    models_of_pooling.push_back(detail::pooled_fold_models(in, folds, grid, grid.poolings[pi], pooled));
+    const std::vector<GainModel>& models = models_of_pooling.back();
     for (std::size_t ti = 0; ti < grid.top_levels.size(); ++ti)
       for (double z : options.confidences) {
         FrontAwarePolicy::Params p = pooled;
@@ -392,7 +404,7 @@ template <class Fly>
         p.top_level = grid.top_levels[ti];
         RuleTrial t;
         t.description = detail::z_text(z, grid.poolings.size() > 1 ? &grid.poolings[pi] : nullptr,
-                                       grid.top_levels.size() > 1 ? &grid.top_levels[ti] : nullptr);
+                                       grid.top_levels.size() > 1 ? &grid.top_levels[ti] : nullptr, finest_named);
         for (std::size_t k = 0; k < folds.size(); ++k) {
           FrontAwarePolicy::Params fold_params = p;
           corrections[k].apply_to(fold_params);
@@ -404,7 +416,10 @@ template <class Fly>
         settings.push_back({pi, ti, z, p});
       }
   }
-  const std::size_t best = detail::choose_setting(trials, settings, grid);
+  std::size_t best = detail::choose_setting(trials, settings, grid);
+  if (finest.size() > 1)
+    best = detail::choose_finest_descent(in, folds, models_of_pooling[settings[best].pooling], corrections, grid,
+                                         trials, settings, best, fly);
   std::rotate(trials.begin(), trials.begin() + static_cast<std::ptrdiff_t>(best),
               trials.begin() + static_cast<std::ptrdiff_t>(best) + 1);
   // The model of every field, its cell gain model pooled as chosen.

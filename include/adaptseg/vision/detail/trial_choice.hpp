@@ -1,0 +1,63 @@
+#pragma once
+/// @file
+/// The front-aware search's trials (front_aware_search.hpp): a trial's name, and which of
+/// several settings flown over the same folds to keep, by the one-standard-error rule.
+
+#include <adaptseg/core/cell_gain_model.hpp>
+#include <adaptseg/core/front_aware_settings.hpp>
+#include <adaptseg/vision/calibration_options.hpp>
+#include <adaptseg/vision/detail/number_text.hpp>
+
+#include <cmath>
+#include <cstddef>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace adaptseg::detail {
+
+/// Which of several settings of the same folds to keep (`trials`, the best of each slope
+/// pooling, CalibrationOptions::slope_poolings' order): the first, unless another beats it on
+/// the folds by more than one standard error of their paired differences, m̄ − m̄₁ >
+/// sd(m − m₁) / sqrt(n) over the n folds (the one-standard-error rule of cross-validation,
+/// Breiman et al. 1984, towards the first, the default); of those that do, the best mean.
+/// Five training fields tell two poolings apart poorly, and a setting the folds prefer by less
+/// than their own scatter is as likely to lose on a new field (docs/results.md, "Slopes pooled
+/// over the cells or over the fields, chosen by the folds").
+///
+/// `tie_tolerance`: a relative margin the mean difference must exceed the standard error by.
+/// Where the settings differ on one fold alone, the mean difference d/n equals the standard error
+/// d/n exactly, so that without it rounding decides; the finest descent's choice passes 1e-9
+/// (a difference on one fold alone is then never beyond the noise), the pooling's 0, as it was
+/// chosen when its defaults were fixed.
+inline std::size_t select_pooling(std::span<const RuleTrial* const> trials, double tie_tolerance = 0.0) {
+  std::size_t best = 0;
+  const std::vector<double>& first = trials.front()->margins;
+  for (std::size_t k = 1; k < trials.size(); ++k) {
+    const std::vector<double>& m = trials[k]->margins;
+    if (m.size() != first.size() || m.size() < 2) continue;
+    const double n = static_cast<double>(m.size());
+    double mean = 0.0;
+    for (std::size_t f = 0; f < m.size(); ++f) mean += (m[f] - first[f]) / n;
+    double ss = 0.0;
+    for (std::size_t f = 0; f < m.size(); ++f) ss += std::pow(m[f] - first[f] - mean, 2);
+    if (mean > std::sqrt(ss / (n - 1.0) / n) * (1.0 + tie_tolerance) &&
+        trials[k]->front_margin > trials[best]->front_margin)
+      best = k;
+  }
+  return best;
+}
+
+/// A trial's name: its z, its slope pooling, its top-level choice and its finest descent GSD
+/// (`finest=G` in cm/px, `finest=any` for no limit) where the search tried several.
+inline std::string z_text(double z, const SlopePooling* pooling = nullptr, const TopLevelChoice* top_level = nullptr,
+                          const double* finest_descent_gsd_cm = nullptr) {
+  std::string s = "front-aware z=" + format_number(z);
+  if (pooling) s += " slopes=" + to_string(*pooling);
+  if (top_level) s += " top=" + to_string(*top_level);
+  if (finest_descent_gsd_cm)
+    s += " finest=" + (*finest_descent_gsd_cm > 0.0 ? format_number(*finest_descent_gsd_cm) : std::string("any"));
+  return s;
+}
+
+}  // namespace adaptseg::detail
