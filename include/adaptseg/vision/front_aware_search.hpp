@@ -2,9 +2,10 @@
 /// @file
 /// The front-aware rule's calibration search (FrontAwareRule::search, front_aware_rule.hpp):
 /// its settings (the confidence level z, the cell gain model's slope pooling, the top-level
-/// choice, the finest descent GSD) tried on the training fields, each field flown with a model fitted without it, with
-/// σ̂'s prior estimated from their top-level images (sigma_prior.hpp) and, where asked for, the
-/// jump guard's bound from the other fields' cells. docs/method.md, "The front-aware rule".
+/// choice, the finest descent GSD) tried on the training fields, each field flown with a model
+/// fitted without it, with σ̂'s prior estimated from their top-level images (sigma_prior.hpp)
+/// and, where asked for, the jump guard's bound from the other fields' cells. docs/method.md,
+/// "The front-aware rule".
 
 #include <adaptseg/core/front_aware_policy.hpp>
 #include <adaptseg/core/jump_guard.hpp>
