@@ -591,6 +591,12 @@ TEST_CASE("calibration: the finest descent GSD tried with the setting kept, the 
   options.finest_descent_gsd_cm = {-1.0};
   CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
                        doctest::Contains("finest_descent_gsd_cm must hold finite GSDs >= 0"), std::invalid_argument);
+  // It belongs to the front-aware rule: the utility rule refuses it rather than ignore it.
+  options.finest_descent_gsd_cm = {0.0, coarsest};
+  options.rule = "utility";
+  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
+                       doctest::Contains("finest_descent_gsd_cm belongs to the front-aware rule"),
+                       std::invalid_argument);
 }
 
 TEST_CASE(

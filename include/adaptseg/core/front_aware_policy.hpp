@@ -63,8 +63,8 @@ namespace adaptseg {
 ///   With `curve_agreement` q > 0, only to a GSD g whose lawnmower mapped better than the top
 ///   level's on at least a share q of the training fields (finer_lawnmower_share(): where
 ///   flying finer lost on the fields, the cells' forecast of a gain is not trusted).
-///   With `finest_descent_gsd_cm` > 0, to no GSD finer than it (the finest GSD whose descents
-///   paid on the training folds, chosen there: CalibrationOptions::finest_descent_gsd_cm).
+///   With `finest_descent_gsd_cm` > 0, to no GSD finer than it (a limit chosen on the training
+///   folds: CalibrationOptions::finest_descent_gsd_cm).
 ///
 /// Field correction (`online`; beyond the paper, §3.2.3's idea applied to what is observable):
 /// a descent's relabelled share χ (Relabelling::interest_share, the region's field pixels whose
