@@ -333,6 +333,20 @@ template <class Fly>
   return c;
 }
 
+/// Every fold flown with `params` (each with its own correction), into `t`.
+template <class Fly>
+void fly_trial(const RuleSearchInputs& in, std::span<const FrontAwareFold> folds, std::span<const GainModel> models,
+               std::span<const FoldCorrection> corrections, const FrontAwarePolicy::Params& params, RuleTrial& t,
+               Fly& fly) {
+  for (std::size_t k = 0; k < folds.size(); ++k) {
+    FrontAwarePolicy::Params fold_params = params;
+    corrections[k].apply_to(fold_params);
+    double margin = 0.0;
+    const AdaptiveResult r = fly_fold(in, folds[k], models[k], fold_params, fly, margin);
+    add_to_trial(t, r, margin);
+  }
+}
+
 /// The finest descent GSD kept (CalibrationOptions::finest_descent_gsd_cm, two or more): the
 /// setting kept, `trials[best]` (flown with the first GSD of the list), flown over the same
 /// `folds` (their `models` of its pooling, their `corrections`) with each other GSD, each a
@@ -355,13 +369,7 @@ std::size_t choose_finest_descent(const RuleSearchInputs& in, std::span<const Fr
     RuleTrial t;
     t.description = z_text(s.z, grid.poolings.size() > 1 ? &grid.poolings[s.pooling] : nullptr,
                            grid.top_levels.size() > 1 ? &grid.top_levels[s.top_level] : nullptr, &finest[g]);
-    for (std::size_t k = 0; k < folds.size(); ++k) {
-      FrontAwarePolicy::Params fold_params = s.params;
-      corrections[k].apply_to(fold_params);
-      double margin = 0.0;
-      const AdaptiveResult r = fly_fold(in, folds[k], models[k], fold_params, fly, margin);
-      add_to_trial(t, r, margin);
-    }
+    fly_trial(in, folds, models, corrections, s.params, t, fly);
     trials.push_back(std::move(t));
     settings.push_back(std::move(s));
     tried.push_back(trials.size() - 1);
@@ -406,13 +414,7 @@ template <class Fly>
         RuleTrial t;
         t.description = detail::z_text(z, grid.poolings.size() > 1 ? &grid.poolings[pi] : nullptr,
                                        grid.top_levels.size() > 1 ? &grid.top_levels[ti] : nullptr, finest_named);
-        for (std::size_t k = 0; k < folds.size(); ++k) {
-          FrontAwarePolicy::Params fold_params = p;
-          corrections[k].apply_to(fold_params);
-          double margin = 0.0;
-          const AdaptiveResult r = detail::fly_fold(in, folds[k], models[k], fold_params, fly, margin);
-          detail::add_to_trial(t, r, margin);
-        }
+        detail::fly_trial(in, folds, models, corrections, p, t, fly);
         trials.push_back(std::move(t));
         settings.push_back({pi, ti, z, p});
       }
