@@ -376,7 +376,7 @@ std::size_t choose_finest_descent(const RuleSearchInputs& in, std::span<const Fr
   }
   std::vector<const RuleTrial*> candidates;
   for (std::size_t k : tried) candidates.push_back(&trials[k]);
-  return tried[select_pooling(candidates, 1e-9)];
+  return tried[select_pooling(candidates)];
 }
 
 }  // namespace detail
