@@ -11,7 +11,7 @@ import os
 import sys
 import tempfile
 
-from tool_output import printed
+from tool_output import check_refused, printed
 
 from adaptseg_tools import loto_targets
 
@@ -58,13 +58,7 @@ def main():
         # A folder without runs named ...-CLASS-tile-K is refused, naming it.
         empty = os.path.join(tmp, "empty")
         os.makedirs(empty)
-        try:
-            loto_targets.main([f"x={empty}"])
-        except SystemExit as e:
-            if "no runs named" not in str(e):
-                sys.exit(f"unexpected refusal: {e}")
-        else:
-            sys.exit("an empty folder was not refused")
+        check_refused(loto_targets.main, [f"x={empty}"], "no runs named", "an empty folder")
     print("ok: loto_targets.py counts every target")
 
 

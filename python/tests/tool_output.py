@@ -29,3 +29,14 @@ def check_on_csv(main, csv_text, args, rows):
         if want not in text:
             sys.exit(f"no row {want}:\n{text}")
     return text
+
+
+def check_refused(main, argv, reason, what):
+    """Exits unless `main(argv)` exits with a message containing `reason` (`what`: what is refused)."""
+    try:
+        main(argv)
+    except SystemExit as e:
+        if reason not in str(e):
+            sys.exit(f"unexpected refusal of {what}: {e}")
+    else:
+        sys.exit(f"{what} was not refused")

@@ -1,0 +1,99 @@
+"""How far a training field's fold margin moves with which other fields its model was fitted on.
+
+Usage: PYTHONPATH=python /usr/bin/python3 -m adaptseg_tools.fold_composition [--z Z] CALIBRATION.log ROWDIR
+
+CALIBRATION.log is adaptseg_calibrate's output for one class of interest on all six Dubai tiles
+(`bash scripts/loto.sh decision` writes out/loto/decision-CLASS.log): each setting's margin on
+every field, the field flown with the model fitted on the other five. ROWDIR holds the same
+class's 24 runs of `scripts/results.sh loto` (adaptseg_evaluate logs ...-CLASS-tile-K.log):
+test tile K's calibration flew each of its five training fields with the model fitted on the
+other four. So each field j is flown, per setting, by six models: one fitted on the five other
+tiles, and five fitted on four of them (one per left-out test tile K != j), the same in all but
+which one other field each leaves out.
+
+Prints, as Markdown, per slope pooling at confidence level Z (default 0, the setting that
+descends most) and per field: its margin under the five-field model, under each four-field
+model (by the tile K it lacks), and their range; then per pooling the mean margin of each kind
+of model. A field whose margin swings by more than the differences the search's choices turn on
+(fold means of a few thousandths) is flown by a decision that hangs on which fields calibrated it.
+"""
+import argparse
+import os
+import re
+import statistics
+import sys
+
+SIX = re.compile(r"^\s+front-aware z=(\S+) slopes=([a-z-]+)\s+\S+\s+\S+\s+\S+\s+\S+\s+\d+\s+(.*)$")
+TRIED = re.compile(r"tried front-aware z=(\S+) slopes=([a-z-]+)(?: finest=(\S+))?: front margin \S+, \d+ descents, "
+                   r"per field (.*)$")
+RUN = re.compile(r"-(building|road|vegetation|water)-tile-([1-9])\.log$")
+TILES = [1, 2, 3, 4, 5, 6]
+
+
+def six_field(path, z):
+    """{pooling: [margin of tile 1..6]} of the calibration on all six tiles, at `z`."""
+    out = {}
+    with open(path) as f:
+        for line in f:
+            m = SIX.match(line)
+            if m and float(m.group(1)) == z:
+                out[m.group(2)] = [float(v) for v in m.group(3).split()]
+    bad = [p for p, v in out.items() if len(v) != len(TILES)]
+    if not out or bad:
+        sys.exit(f"{path}: no setting at z={z} with a margin for each of six fields (adaptseg_calibrate's "
+                 "output on the six tiles, with slope poolings?)")
+    return out
+
+
+def row_of(directory, cls, z):
+    """{(pooling, test tile K): [margin of each training tile, tiles in order without K]}."""
+    out = {}
+    for name in os.listdir(directory):
+        m = RUN.search(name)
+        if not m or m.group(1) != cls:
+            continue
+        k = int(m.group(2))
+        with open(os.path.join(directory, name)) as f:
+            for line in f:
+                t = TRIED.search(line)
+                if t and float(t.group(1)) == z and t.group(3) in (None, "any"):
+                    out[(t.group(2), k)] = [float(v) for v in t.group(4).split()]
+    if not out:
+        sys.exit(f"no {cls} run's log with settings at z={z} in {directory}")
+    return out
+
+
+def main(argv):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--z", type=float, default=0.0)
+    parser.add_argument("calibration")
+    parser.add_argument("row")
+    args = parser.parse_args(argv)
+    m = re.search(r"decision-(building|road|vegetation|water)\.log$", args.calibration)
+    if not m:
+        sys.exit(f"{args.calibration}: expected a decision-CLASS.log of scripts/loto.sh decision")
+    cls = m.group(1)
+    six = six_field(args.calibration, args.z)
+    row = row_of(args.row, cls, args.z)
+    for pooling, five in six.items():
+        print(f"\n{cls}, slopes={pooling}, z={args.z:g}\n")
+        print("| field | five-field model | four-field models (without tile K) | range |")
+        print("| ---: | ---: | --- | ---: |")
+        fours_all = []
+        for j in TILES:
+            fours = []
+            for k in TILES:
+                per = row.get((pooling, k))
+                if k == j or per is None:
+                    continue
+                fours.append((k, per[[t for t in TILES if t != k].index(j)]))
+            fours_all += [v for _, v in fours]
+            values = [five[j - 1]] + [v for _, v in fours]
+            cells = ", ".join(f"{v:+.4f} (K={k})" for k, v in fours)
+            print(f"| {j} | {five[j - 1]:+.4f} | {cells} | {max(values) - min(values):.4f} |")
+        if fours_all:
+            print(f"\nmean: five-field {statistics.mean(five):+.4f}, four-field {statistics.mean(fours_all):+.4f}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
