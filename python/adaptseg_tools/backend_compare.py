@@ -1,6 +1,7 @@
 """Which backend gives the better map per second: runs of the same experiment (field, class of
 interest, calibration) flown with different segmentation backends, each measured against every
-backend's lawnmower curve.
+backend's lawnmower curve. A NET with no run under ROOT is left out (named on standard error); with
+fewer than two flown, it says so and compares nothing.
 
 Usage: PYTHONPATH=python /usr/bin/python3 -m adaptseg_tools.backend_compare ROOT NET [NET...]
 
@@ -35,6 +36,15 @@ def main():
                 case = name[len(net) + 1:]
                 if "-fly" in case and not any(n != net and name.startswith(n + "-") and len(n) > len(net) for n in nets):
                     runs[case][net] = read_csv(path)
+    # A backend with no run under ROOT (scripts/results.sh network with NETS=... flies a subset) is
+    # left out, so that the others are still compared; with fewer than two there is nothing to.
+    flown = [n for n in nets if any(n in by_net for by_net in runs.values())]
+    if len(flown) < len(nets):
+        print(f"no runs of {[n for n in nets if n not in flown]} under {root}: left out", file=sys.stderr)
+    nets = flown
+    if len(nets) < 2:
+        print(f"fewer than two backends flown under {root} ({nets}): nothing to compare")
+        return
     cases = [c for c in sorted(runs) if all(n in runs[c] and any(r["strategy"] == "adaptive" for r in runs[c][n])
                                             for n in nets)]
     if not cases:
