@@ -19,35 +19,41 @@ fold margin. The logs print margins to four decimals: a comparison of settings t
 some fold, with the mean difference within 1e-4 of its standard error, is marked "near"
 (rounding may have decided it).
 """
-import math
 import os
 import re
 import sys
+
+from .fold_table import beats, paired_difference
 
 RUN = re.compile(r"(building|road|vegetation|water)-tile-([1-9])$")
 TRIED = re.compile(r"tried (.+?): front margin ([-+\d.]+), (\d+) descents, per field (.*)$")
 
 
-def kept_trial(log):
-    """The kept setting of a run's log: (name, mean fold margin, descents, [fold margins])."""
+def tried_settings(log):
+    """Every setting an adaptseg_evaluate log lists as tried, the kept one first: (name, mean fold
+    margin, descents, [fold margins])."""
     with open(log) as f:
         for line in f:
             m = TRIED.search(line)
             if m:
-                return m.group(1), float(m.group(2)), int(m.group(3)), [float(v) for v in m.group(4).split()]
-    sys.exit(f"{log}: no 'tried ...' line (an adaptseg_evaluate log of a calibrated run?)")
+                yield m.group(1), float(m.group(2)), int(m.group(3)), [float(v) for v in m.group(4).split()]
 
 
-def beats(first, other):
-    """Whether `other` beats `first` beyond one standard error of the paired fold margins, and
-    whether the comparison is within the logs' rounding of the standard error."""
-    d = [b - a for a, b in zip(first, other)]
-    n = len(d)
-    if n < 2 or len(first) != len(other):
-        return False, False
-    mean = sum(d) / n
-    se = math.sqrt(sum((x - mean) ** 2 for x in d) / (n - 1) / n)
-    return mean > se * (1.0 + 1e-9), any(d) and abs(mean - se) < 1e-4
+def kept_trial(log):
+    """The kept setting of a run's log (tried_settings()' first)."""
+    kept = next(tried_settings(log), None)
+    if kept is None:
+        sys.exit(f"{log}: no 'tried ...' line (an adaptseg_evaluate log of a calibrated run?)")
+    return kept
+
+
+def near_tie(first, other):
+    """Whether the settings differ on some fold and their mean difference lies within the logs'
+    rounding (1e-4) of its standard error, so that the four printed decimals may decide."""
+    if len(first) != len(other) or len(first) < 2 or first == other:
+        return False
+    mean, se = paired_difference(other, first)
+    return abs(mean - se) < 1e-4
 
 
 def choose(trials):
@@ -55,9 +61,8 @@ def choose(trials):
     whether any comparison was near."""
     best, near = 0, False
     for k in range(1, len(trials)):
-        wins, close = beats(trials[0][3], trials[k][3])
-        near |= close
-        if wins and trials[k][1] > trials[best][1]:
+        near |= near_tie(trials[0][3], trials[k][3])
+        if beats(trials[k][3], trials[0][3]) and trials[k][1] > trials[best][1]:
             best = k
     return best, near
 

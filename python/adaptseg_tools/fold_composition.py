@@ -23,21 +23,27 @@ import re
 import statistics
 import sys
 
-SIX = re.compile(r"^\s+front-aware z=(\S+) slopes=([a-z-]+)\s+\S+\s+\S+\s+\S+\s+\S+\s+\d+\s+(.*)$")
-TRIED = re.compile(r"tried front-aware z=(\S+) slopes=([a-z-]+)(?: finest=(\S+))?: front margin \S+, \d+ descents, "
-                   r"per field (.*)$")
+from .fold_choice import tried_settings
+from .fold_table import read
+
+SETTING = re.compile(r"^front-aware z=(\S+) slopes=([a-z-]+)(?: finest=(\S+))?$")
 RUN = re.compile(r"-(building|road|vegetation|water)-tile-([1-9])\.log$")
 TILES = [1, 2, 3, 4, 5, 6]
 
 
+def settings_at(settings, z):
+    """{pooling: fold margins} of the (name, mean, descents, folds) `settings` at `z`, no limit."""
+    out = {}
+    for name, *_, folds in settings:
+        m = SETTING.match(name)
+        if m and float(m.group(1)) == z and m.group(3) in (None, "any"):
+            out[m.group(2)] = folds
+    return out
+
+
 def six_field(path, z):
     """{pooling: [margin of tile 1..6]} of the calibration on all six tiles, at `z`."""
-    out = {}
-    with open(path) as f:
-        for line in f:
-            m = SIX.match(line)
-            if m and float(m.group(1)) == z:
-                out[m.group(2)] = [float(v) for v in m.group(3).split()]
+    out = settings_at([(name, mean, descents, folds) for name, _, mean, descents, folds in read(path)], z)
     bad = [p for p, v in out.items() if len(v) != len(TILES)]
     if not out or bad:
         sys.exit(f"{path}: no setting at z={z} with a margin for each of six fields (adaptseg_calibrate's "
@@ -50,14 +56,9 @@ def row_of(directory, cls, z):
     out = {}
     for name in os.listdir(directory):
         m = RUN.search(name)
-        if not m or m.group(1) != cls:
-            continue
-        k = int(m.group(2))
-        with open(os.path.join(directory, name)) as f:
-            for line in f:
-                t = TRIED.search(line)
-                if t and float(t.group(1)) == z and t.group(3) in (None, "any"):
-                    out[(t.group(2), k)] = [float(v) for v in t.group(4).split()]
+        if m and m.group(1) == cls:
+            for pooling, folds in settings_at(tried_settings(os.path.join(directory, name)), z).items():
+                out[(pooling, int(m.group(2)))] = folds
     if not out:
         sys.exit(f"no {cls} run's log with settings at z={z} in {directory}")
     return out
