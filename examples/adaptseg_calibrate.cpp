@@ -66,7 +66,8 @@ int main(int argc, char** argv) {
     for (const auto& spec : train_specs) fields.push_back(adaptseg::examples::load_field_spec(spec));
     if (fields.empty()) throw std::invalid_argument("give a training field: --field DIR or --train DIR (repeatable)");
     segmenter.validate();
-    const auto networks = segmenter.network_per_field(fields);  // its mistakes before any work
+    std::vector<std::size_t> grounds;
+    const auto networks = segmenter.network_per_field(fields, &grounds);  // its mistakes before any work
     const adaptseg::Field& field = fields.front();
     const adaptseg::MissionOptions mission = common.resolve(field);
     const double g0 = field.gsd_cm();
@@ -90,6 +91,7 @@ int main(int argc, char** argv) {
     for (double f : candidate_factors) options.adaptive.candidate_gsd_cm.push_back(f * g0);
     for (double f : lawnmower_factors) options.lawnmower_gsd_cm.push_back(f * g0);
     calibration.apply(options, common, g0);
+    options.field_grounds = grounds;
     for (const auto& f : fields)
       std::fprintf(stderr, "calibrating on %s (%dx%d px, %.2f cm/px) with %s ...\n", f.name().c_str(), f.width_px(),
                    f.height_px(), g0, segmenter.name.c_str());

@@ -119,7 +119,8 @@ int main(int argc, char** argv) {
       std::vector<adaptseg::Field> trains;
       for (const auto& spec : train_specs) trains.push_back(adaptseg::examples::load_field_spec(spec));
       segmenter.validate();
-      const auto networks = segmenter.network_per_field(trains);  // its mistakes before any work
+      std::vector<std::size_t> grounds;
+      const auto networks = segmenter.network_per_field(trains, &grounds);  // its mistakes before any work
       const adaptseg::Field& train = trains.front();
       adaptseg::CalibrationOptions co;
       co.adaptive.mission = common.resolve(train);
@@ -129,6 +130,7 @@ int main(int argc, char** argv) {
         co.adaptive.candidate_gsd_cm.push_back(lawnmower_factors[k] * g0);
       for (double f : lawnmower_factors) co.lawnmower_gsd_cm.push_back(f * g0);
       calibration.apply(co, common, g0);
+      co.field_grounds = grounds;
       std::string names;
       for (const auto& f : trains) names += (names.empty() ? "" : ", ") + f.name();
       std::fprintf(stderr, "[%6.1f s] calibrating on %s ...\n", elapsed(), names.c_str());

@@ -491,6 +491,65 @@ TEST_CASE("calibration: another slope pooling replaces the first only where the 
   // On two folds it is beyond the noise.
   CHECK(select({trial({0.0, 0.0, 0.0, 0.0, 0.0}), trial({0.0, 0.01, 0.01, 0.0, 0.0})}) == 1);
 }
+TEST_CASE("calibration: two looks at one ground count once in the one-standard-error rule") {
+  const std::vector<RuleTrial> trials{trial({0.0, 0.0, 0.0, 0.0, 0.0, 0.0}), trial({0.01, 0.01, 0.0, 0.0, 0.0, 0.0})};
+  const std::vector<const RuleTrial*> p{&trials[0], &trials[1]};
+  // Six fields: better on two of them, beyond the noise.
+  CHECK(adaptseg::detail::select_pooling(p) == 1);
+  // Three grounds, each seen by two networks: better on one ground alone, never enough.
+  const std::vector<std::size_t> grounds{0, 0, 2, 2, 4, 4};
+  CHECK(adaptseg::detail::select_pooling(p, grounds) == 0);
+  // Every fold its own ground: as without grounds.
+  const std::vector<std::size_t> own{0, 1, 2, 3, 4, 5};
+  CHECK(adaptseg::detail::select_pooling(p, own) == 1);
+  // Better on two grounds of three (one look each): beyond the noise of the grounds' means.
+  const std::vector<RuleTrial> two{trial({0.0, 0.0, 0.0, 0.0, 0.0, 0.0}), trial({0.01, 0.0, 0.01, 0.0, 0.0, 0.0})};
+  CHECK(adaptseg::detail::select_pooling(std::vector<const RuleTrial*>{&two[0], &two[1]}, grounds) == 1);
+}
+
+TEST_CASE("calibration: a field seen by two networks leaves its fold with its every look") {
+  const std::vector<Field> two = two_blob_fields();
+  const std::vector<Field> fields{two[0], two[0], two[1]};  // field 0 looked at twice
+  OracleSegmenter oracle(fields.front().num_classes());
+  CalibrationOptions options = ranked_options();
+  options.slope_poolings = {SlopePooling::cells};
+  options.field_grounds = {0, 0, 2};
+  const CalibrationResult cal = calibrate(std::span<const Field>(fields), oracle, options);
+  // One fold per look; the two looks of field 0, each with a model of field 1 alone (the other
+  // look left out with it), fly the same mission (one segmenter here).
+  REQUIRE(!cal.trials.empty());
+  for (const RuleTrial& t : cal.trials) {
+    REQUIRE(t.margins.size() == 3);
+    CHECK(t.margins[0] == t.margins[1]);
+  }
+  // ... the fold of field 0 given once, beside field 1 (the same model: fitted on field 1).
+  CalibrationOptions once = options;
+  once.field_grounds.clear();
+  const CalibrationResult single = calibrate(std::span<const Field>(two), oracle, once);
+  REQUIRE(single.trials.size() == cal.trials.size());
+  for (std::size_t k = 0; k < cal.trials.size(); ++k) {
+    REQUIRE(single.trials[k].margins.size() == 2);
+    CHECK(single.trials[k].margins[0] == doctest::Approx(cal.trials[k].margins[0]).epsilon(1e-12));
+  }
+  // Had the fold of one look kept the other, one ground of two would be its own model: given
+  // only looks of one ground, the folds have nothing to fit and the calibration says so.
+  const std::vector<Field> one{two[0], two[0]};
+  options.field_grounds = {0, 0};
+  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(one), oracle, options),
+                       doctest::Contains("every training field is of one ground"), std::invalid_argument);
+  // Grounds not one per field, or naming another than the first of their ground: refused.
+  options.field_grounds = {0, 0};
+  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
+                       doctest::Contains("one ground per training field"), std::invalid_argument);
+  options.field_grounds = {0, 2, 2};
+  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
+                       doctest::Contains("must name the first field"), std::invalid_argument);
+  // The gain ratios leave one flight out, not a ground: not with grounds.
+  options.field_grounds = {0, 0, 2};
+  options.gain_ratios = true;
+  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
+                       doctest::Contains("not with field_grounds"), std::invalid_argument);
+}
 
 TEST_CASE(
     "calibration: several top-level choices, each with every setting, the first kept unless another's is better") {

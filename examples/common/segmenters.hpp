@@ -41,6 +41,10 @@ struct SegmenterOptions {
   /// network, calibration: networks for the training fields --network was trained on, each such
   /// field segmented by the first of them that never saw it (cross-fitting, calibrate()).
   std::vector<std::filesystem::path> calibration_networks;
+  /// network, calibration: each training field --network was trained on segmented by every
+  /// calibration network that never saw it, one calibration field per network (their folds in
+  /// the search leave the field's every copy out), instead of by the first only.
+  bool calibration_network_each = false;
 
   void add_to(CLI::App& app) {
     accept_old_value(app.add_option("--segmenter", name,
@@ -76,7 +80,16 @@ struct SegmenterOptions {
                        "there, the decision learns that flying lower gains little (cross-fitting; the missions fly "
                        "--network)");
     accept_old_spelling(app, current, "--calibration-model-file", calibration_networks);
-    for (CLI::Option* e : excludes) current->excludes(e);
+    CLI::Option* each = app.add_flag(
+        "--calibration-network-each", calibration_network_each,
+        "calibration: each such field segmented by every --calibration-network that never saw it, one calibration "
+        "field per network (the search's fold of a field leaves its every copy out), not by the first only: more "
+        "looks of networks on ground they never trained on");
+    each->needs(current);
+    for (CLI::Option* e : excludes) {
+      current->excludes(e);
+      each->excludes(e);
+    }
   }
 
   /// Where calibration keeps the network's segmentations (--segmentation-cache), if anywhere:
@@ -101,9 +114,14 @@ struct SegmenterOptions {
   /// --network). Without --calibration-network, --network for every field.
   /// @throws std::invalid_argument for a network whose metadata names no training fields (it
   ///         cannot be told whether it saw a field), or a field no given network is new to.
-  [[nodiscard]] std::vector<std::filesystem::path> network_per_field(std::span<const Field> fields) const {
-    std::vector<std::filesystem::path> out(fields.size());
-    if (calibration_networks.empty()) return out;
+  /// With --calibration-network-each, `fields` gains a copy of such a field per further network
+  /// that never saw it, each copy after the field, and the result names one network per entry;
+  /// `grounds`, where given, receives each entry's ground (CalibrationOptions::field_grounds:
+  /// the index of the field's first entry).
+  [[nodiscard]] std::vector<std::filesystem::path> network_per_field(
+      std::vector<Field>& fields, std::vector<std::size_t>* grounds = nullptr) const {
+    if (grounds) grounds->clear();
+    if (calibration_networks.empty()) return std::vector<std::filesystem::path>(fields.size());
     const auto trained_on = [](const std::filesystem::path& file, const char* flag) {
       std::vector<std::string> t = network_training_fields(file);
       if (t.empty())
@@ -118,19 +136,33 @@ struct SegmenterOptions {
     const std::vector<std::string> mission = trained_on(network, "--network");
     std::vector<std::vector<std::string>> pool;
     for (const auto& file : calibration_networks) pool.push_back(trained_on(file, "network"));
-    for (std::size_t k = 0; k < fields.size(); ++k) {
+    std::vector<Field> expanded;
+    std::vector<std::filesystem::path> networks;
+    for (Field& f : fields) {
       // A part of a field ("dubai-tile-1[0,0,0.5,1]", Field::sub_field) is that field's ground.
-      const std::string& full = fields[k].name();
-      const std::string field = full.back() == ']' ? full.substr(0, full.rfind('[')) : full;
-      if (!knows(mission, field)) continue;
-      std::size_t j = 0;
-      while (j < pool.size() && knows(pool[j], field)) ++j;
-      if (j == pool.size())
+      const std::string full = f.name();
+      const std::string ground = full.back() == ']' ? full.substr(0, full.rfind('[')) : full;
+      std::vector<std::filesystem::path> new_to;  // the calibration networks that never saw it
+      if (knows(mission, ground))
+        for (std::size_t j = 0; j < pool.size(); ++j)
+          if (!knows(pool[j], ground)) new_to.push_back(calibration_networks[j]);
+      if (knows(mission, ground) && new_to.empty())
         throw std::invalid_argument("--calibration-network: every network given was trained on calibration field '" +
                                     full + "' (as --network " + network.string() + " was): give one that never saw it");
-      out[k] = calibration_networks[j];
+      if (new_to.empty()) new_to.emplace_back();  // --network never saw it
+      if (!calibration_network_each) new_to.resize(1);
+      const std::size_t at = expanded.size();
+      expanded.push_back(std::move(f));
+      for (std::size_t j = 1; j < new_to.size(); ++j) {
+        Field copy = expanded[at];
+        expanded.push_back(std::move(copy));
+      }
+      networks.insert(networks.end(), new_to.begin(), new_to.end());
+      if (grounds) grounds->insert(grounds->end(), new_to.size(), at);
     }
-    return out;
+    fields = std::move(expanded);
+    if (grounds && !calibration_network_each) grounds->clear();  // every field its own
+    return networks;
   }
 
   /// Calls `f(backend)` with the chosen backend built for `field` seen by `camera`, behind

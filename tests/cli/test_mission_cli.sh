@@ -188,9 +188,9 @@ cross_fit)
   # network given again, the evaluation MobileNetV2 (tiles 1, 2, 3, 5). The model names the
   # missions' network and, per field, the one that segmented it; without the flag no field_segmenters.
   [ -x "$calibrate" ] || fail "cross_fit needs the adaptseg_calibrate binary as 5th argument"
-  common=(--field "$examples/data/dubai-tile-4" --region 0,0,0.5,0.5 --segmenter network --threads 1
-          --network "$examples/models/mobilenetv2-dubai-all" --seg-time-s 0.1 --plan-time-s 0 --confidence 1
-          --interest water --top-factor 3 --candidate-factors 1 --lawnmower-factors 1,3)
+  opts=(--segmenter network --threads 1 --network "$examples/models/mobilenetv2-dubai-all" --seg-time-s 0.1
+        --plan-time-s 0 --confidence 1 --interest water --top-factor 3 --candidate-factors 1 --lawnmower-factors 1,3)
+  common=(--field "$examples/data/dubai-tile-4" --region 0,0,0.5,0.5 "${opts[@]}")
   "$calibrate" "${common[@]}" --calibration-network "$examples/models/mobilenetv2-dubai-all" \
     --calibration-network "$examples/models/mobilenetv2-dubai" --out "$work/cross.yaml" 2>"$work/cross.log" ||
     fail "cross-fitted calibration failed: $(tail -3 "$work/cross.log")"
@@ -204,6 +204,31 @@ cross_fit)
   # The same network for the missions and the field: other segmentations, another model.
   ! cmp -s "$work/cross.yaml" "$work/plain.yaml" || fail "cross-fitting changed nothing"
   echo "ok: cross-fitted calibration"
+  # With --calibration-network-each every network that never saw a field segments it, one
+  # calibration field each: tile 4 by mobilenetv2-dubai (tiles 1, 2, 3, 5) and the leave-one-tile-
+  # out network of tile 4, tile 6 by mobilenetv2-dubai and that of tile 6; four fields, two grounds.
+  "$calibrate" --train "$examples/data/dubai-tile-4:0,0,0.5,0.5" --train "$examples/data/dubai-tile-6:0,0,0.5,0.5" \
+    "${opts[@]}" --calibration-network-each \
+    --calibration-network "$examples/models/mobilenetv2-dubai" \
+    --calibration-network "$examples/models/mobilenetv2-dubai-loto/tile-4" \
+    --calibration-network "$examples/models/mobilenetv2-dubai-loto/tile-6" --out "$work/each.yaml" 2>"$work/each.log" ||
+    fail "calibration with --calibration-network-each failed: $(tail -3 "$work/each.log")"
+  grep -q '^  field_segmenters: \[erfnet:mobilenetv2-dubai-[0-9a-f]*, erfnet:tile-4-[0-9a-f]*, erfnet:mobilenetv2-dubai-[0-9a-f]*, erfnet:tile-6-[0-9a-f]*\]$' "$work/each.yaml" ||
+    fail "not each field by each network that never saw it: $(grep -A1 calibration_fields "$work/each.yaml")"
+  [ "$(grep -c 'calibration field dubai-tile-[46]\[0,0,0.5,0.5\] segmented by' "$work/each.log")" = 4 ] ||
+    fail "not four calibration fields: $(grep 'calibration field' "$work/each.log")"
+  # Looks of one ground alone leave the folds nothing to fit: refused before any segmentation.
+  if "$calibrate" "${common[@]}" --calibration-network-each --calibration-network "$examples/models/mobilenetv2-dubai" \
+    --calibration-network "$examples/models/mobilenetv2-dubai-loto/tile-4" --out "$work/one.yaml" >"$work/one.log" 2>&1; then
+    fail "looks of one ground alone accepted"
+  fi
+  grep -q "every training field is of one ground" "$work/one.log" || fail "no clear error: $(tail -3 "$work/one.log")"
+  # The flag means nothing without --calibration-network.
+  if "$calibrate" "${common[@]}" --calibration-network-each --out "$work/one.yaml" >"$work/one.log" 2>&1; then
+    fail "--calibration-network-each without --calibration-network accepted"
+  fi
+  grep -q "requires" "$work/one.log" || fail "no clear error: $(tail -3 "$work/one.log")"
+  echo "ok: each calibration field segmented by every network that never saw it"
   # The model knows its network by the bytes of its weights and metadata, not by the folder's
   # name: in the same folder, changed weights or a changed temperature are another network, and
   # the mission refuses the model.

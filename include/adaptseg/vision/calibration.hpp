@@ -48,7 +48,8 @@ namespace detail {
 /// of interest filled from the first field, and the declared segmentation and planning times.
 /// @throws std::invalid_argument for no field, fields with other class sets than the first's,
 ///         invalid options (check_calibration_options), gain ratios or margin biases asked of
-///         one field, or no label of interest.
+///         one field or with field grounds, field grounds not one per field or all one (the
+///         folds need two), or no label of interest.
 [[nodiscard]] inline AdaptiveOptions calibration_settings(std::span<const Field> fields,
                                                           const CalibrationOptions& options) {
   require(!fields.empty(), "calibrate: at least one training field is needed; count", fields.size());
@@ -57,6 +58,19 @@ namespace detail {
           "calibrate: gain_ratios and margin_biases are measured by flying each training field with the model of "
           "the others, which needs at least two training fields; count",
           fields.size());
+  require(options.field_grounds.empty() || options.field_grounds.size() == fields.size(),
+          "calibrate: field_grounds needs one ground per training field (or none); count",
+          options.field_grounds.size());
+  require(fields.size() < 2 || options.field_grounds.empty() ||
+              std::any_of(options.field_grounds.begin(), options.field_grounds.end(),
+                          [&](std::size_t g) { return g != options.field_grounds.front(); }),
+          "calibrate: every training field is of one ground (field_grounds: one field seen by several networks), "
+          "and each fold leaves its ground out: give another field; fields",
+          fields.size());
+  require(options.field_grounds.empty() || !(options.gain_ratios || options.margin_biases),
+          "calibrate: gain_ratios and margin_biases leave one fold's flight out, not its ground's: not with "
+          "field_grounds; grounds",
+          options.field_grounds.size());
   const auto names = [](const Field& f) {
     std::vector<std::string> v;
     for (const auto& c : f.classes()) v.push_back(c.name);

@@ -115,6 +115,14 @@ struct CalibrationOptions {
   /// forecast (docs/method.md, "The finest descent chosen by the folds"). Empty (the
   /// default): `front_aware.finest_descent_gsd_cm` alone, no such trial. 0 in the list: no limit.
   std::vector<double> finest_descent_gsd_cm{};
+  /// Front-aware rule, several training fields: per training field, the index of its ground
+  /// (the first field of that ground), equal for the fields that are one field segmented by
+  /// several networks (the programs' --calibration-network-each: each a look of a network on
+  /// ground it never trained on). Fields of one ground leave the search's folds together, each
+  /// fold's model fitted on the other grounds only, and the one-standard-error rule averages
+  /// their paired differences before it counts the grounds (detail::select_pooling). Empty (the
+  /// default): every field its own ground.
+  std::vector<std::size_t> field_grounds{};
   /// Front-aware rule, several training fields: measure FrontAwarePolicy::Params::gain_ratios
   /// on the folds before the search. Each training field is flown with the model of the others
   /// (the first slope pooling and top-level choice, z = 0); per descent GSD, the ratio of what

@@ -207,7 +207,8 @@ struct FrontAwareRule {
   /// Refuses options its search cannot use (before calibrate() samples anything).
   /// @throws std::invalid_argument if `confidences` or `slope_poolings` is empty,
   ///         `slope_poolings`, `top_levels` or `finest_descent_gsd_cm` names a value twice,
-  ///         `finest_descent_gsd_cm` holds a negative or non-finite GSD, or `relabel_transfer`,
+  ///         `finest_descent_gsd_cm` holds a negative or non-finite GSD, `field_grounds` names a
+  ///         ground that is not the first field of its own, or `relabel_transfer`,
   ///         `relabel_region_spread` or `relabel_field_spread` is asked without the relabelled
   ///         field factor.
   static void check_options(const CalibrationOptions& options) {
@@ -229,6 +230,12 @@ struct FrontAwareRule {
         detail::require(options.finest_descent_gsd_cm[j] != g,
                         "calibrate: finest_descent_gsd_cm names a GSD twice:", g);
     }
+    for (std::size_t k = 0; k < options.field_grounds.size(); ++k)
+      detail::require(
+          options.field_grounds[k] <= k && options.field_grounds[options.field_grounds[k]] == options.field_grounds[k],
+          "calibrate: field_grounds[k] must name the first field of k's ground (<= k, its own ground "
+          "itself); at k =",
+          k);
     detail::require(!options.relabel_transfer || options.front_aware.field_factor == FieldFactorSource::relabelled,
                     "calibrate: relabel_transfer (how far the gain follows the relabelled share) needs the field "
                     "factor 'relabelled'; the field factor",

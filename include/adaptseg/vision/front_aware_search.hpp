@@ -103,9 +103,17 @@ std::vector<TopLevelTrace> top_level_traces(const RuleSearchInputs& in, std::spa
   return traces;
 }
 
+/// Each fold's ground (select_pooling; CalibrationOptions::field_grounds): empty where every
+/// fold is its own (no grounds given, or one field's layouts).
+[[nodiscard]] inline std::vector<std::size_t> fold_grounds(const RuleSearchInputs& in) {
+  if (in.fields.size() < 2) return {};
+  return in.options.field_grounds;
+}
+
 /// One fold per training field, its model fitted without it (one field: its layouts, the whole
 /// field's model); each fold's σ̂ prior from the other fields' `traces` (where there are any)
-/// and, with ranked cells, the other fields' cells.
+/// and, with ranked cells, the other fields' cells. The fields of one ground
+/// (CalibrationOptions::field_grounds) leave each one's fold together.
 inline std::vector<FrontAwareFold> front_aware_folds(const RuleSearchInputs& in,
                                                      std::span<const ReferenceCurve> reference,
                                                      std::span<const TopLevelTrace> traces, bool ranked) {
@@ -117,13 +125,14 @@ inline std::vector<FrontAwareFold> front_aware_folds(const RuleSearchInputs& in,
       folds.push_back({&in.halves[k], &in.half_curves[k], in.model, all, std::nullopt, {}});
     return folds;
   }
+  const std::vector<std::size_t> grounds = fold_grounds(in);
   for (std::size_t k = 0; k < in.fields.size(); ++k) {
     std::vector<RegionSample> rest;
     std::vector<ReferenceCurve> rest_reference;
     std::vector<TopLevelTrace> rest_traces;
     std::vector<CellSample> rest_cells;
     for (std::size_t j = 0; j < in.fields.size(); ++j) {
-      if (j == k) continue;
+      if (j == k || (!grounds.empty() && grounds[j] == grounds[k])) continue;  // k, or its ground by another network
       rest.insert(rest.end(), in.samples[j].begin(), in.samples[j].end());
       rest_reference.push_back(reference[j]);
       if (!traces.empty()) rest_traces.push_back(traces[j]);
@@ -223,7 +232,7 @@ std::vector<AdaptiveResult> measuring_flights(const RuleSearchInputs& in, std::s
 /// pooling's unless another beats it by more than the folds' noise (select_pooling); of the
 /// top levels, the first's unless another has a larger mean front margin.
 inline std::size_t choose_setting(std::span<const RuleTrial> trials, std::span<const FrontAwareSetting> settings,
-                                  const FrontAwareGrid& grid) {
+                                  const FrontAwareGrid& grid, std::span<const std::size_t> grounds = {}) {
   const std::size_t none = trials.size();
   std::vector<std::vector<std::size_t>> best(grid.top_levels.size(),
                                              std::vector<std::size_t>(grid.poolings.size(), none));
@@ -237,7 +246,7 @@ inline std::size_t choose_setting(std::span<const RuleTrial> trials, std::span<c
   for (const std::vector<std::size_t>& of_level : best) {
     std::vector<const RuleTrial*> candidates;
     for (std::size_t b : of_level) candidates.push_back(&trials[b]);
-    const std::size_t k = of_level[select_pooling(candidates)];
+    const std::size_t k = of_level[select_pooling(candidates, grounds)];
     if (chosen == none || trials[k].front_margin > trials[chosen].front_margin) chosen = k;
   }
   return chosen;
@@ -376,7 +385,7 @@ std::size_t choose_finest_descent(const RuleSearchInputs& in, std::span<const Fr
   }
   std::vector<const RuleTrial*> candidates;
   for (std::size_t k : tried) candidates.push_back(&trials[k]);
-  return tried[select_pooling(candidates)];
+  return tried[select_pooling(candidates, fold_grounds(in))];
 }
 
 }  // namespace detail
@@ -419,7 +428,7 @@ template <class Fly>
         settings.push_back({pi, ti, z, p});
       }
   }
-  std::size_t best = detail::choose_setting(trials, settings, grid);
+  std::size_t best = detail::choose_setting(trials, settings, grid, detail::fold_grounds(in));
   if (finest.size() > 1)
     best = detail::choose_finest_descent(in, folds, models_of_pooling[settings[best].pooling], corrections, grid,
                                          trials, settings, best, fly);

@@ -31,18 +31,37 @@ namespace adaptseg::detail {
 /// tolerance since 2026-12-04 (the finest descent's from the start): of 240 pooling comparisons
 /// in five leave-one-tile-out rows, 13 were such ties and each had kept the first, and the bundled
 /// decision models calibrate to the same files, so no choice moved (docs/journal/2026-12-loto.md).
-inline std::size_t select_pooling(std::span<const RuleTrial* const> trials) {
+///
+/// `ground`, where given, names each fold's ground (an index; equal for the folds of one field
+/// segmented by several networks, --calibration-network-each): the paired differences of one
+/// ground are averaged first and n counts the grounds, so that two looks at one field are not
+/// taken for two fields' worth of evidence. Empty: every fold its own ground.
+inline std::size_t select_pooling(std::span<const RuleTrial* const> trials, std::span<const std::size_t> ground = {}) {
   constexpr double tie_tolerance = 1e-9;
   std::size_t best = 0;
   const std::vector<double>& first = trials.front()->margins;
   for (std::size_t k = 1; k < trials.size(); ++k) {
     const std::vector<double>& m = trials[k]->margins;
     if (m.size() != first.size() || m.size() < 2) continue;
-    const double n = static_cast<double>(m.size());
+    std::vector<double> d;  // the paired differences, one per ground
+    if (ground.size() == m.size()) {
+      std::vector<double> sum, count;
+      for (std::size_t f = 0; f < m.size(); ++f) {
+        if (ground[f] >= sum.size()) sum.resize(ground[f] + 1, 0.0), count.resize(ground[f] + 1, 0.0);
+        sum[ground[f]] += m[f] - first[f];
+        count[ground[f]] += 1.0;
+      }
+      for (std::size_t g = 0; g < sum.size(); ++g)
+        if (count[g] > 0.0) d.push_back(sum[g] / count[g]);
+    } else {
+      for (std::size_t f = 0; f < m.size(); ++f) d.push_back(m[f] - first[f]);
+    }
+    if (d.size() < 2) continue;
+    const double n = static_cast<double>(d.size());
     double mean = 0.0;
-    for (std::size_t f = 0; f < m.size(); ++f) mean += (m[f] - first[f]) / n;
+    for (double x : d) mean += x / n;
     double ss = 0.0;
-    for (std::size_t f = 0; f < m.size(); ++f) ss += std::pow(m[f] - first[f] - mean, 2);
+    for (double x : d) ss += std::pow(x - mean, 2);
     if (mean > std::sqrt(ss / (n - 1.0) / n) * (1.0 + tie_tolerance) &&
         trials[k]->front_margin > trials[best]->front_margin)
       best = k;
