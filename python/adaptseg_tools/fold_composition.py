@@ -1,6 +1,7 @@
 """How far a training field's fold margin moves with which other fields its model was fitted on.
 
 Usage: PYTHONPATH=python /usr/bin/python3 -m adaptseg_tools.fold_composition [--z Z] CALIBRATION.log ROWDIR
+       PYTHONPATH=python /usr/bin/python3 -m adaptseg_tools.fold_composition --looks ROWDIR
 
 CALIBRATION.log is adaptseg_calibrate's output for one class of interest on all six Dubai tiles
 (`bash scripts/loto.sh decision` writes out/loto/decision-CLASS.log): each setting's margin on
@@ -16,6 +17,13 @@ descends most) and per field: its margin under the five-field model, under each 
 model (by the tile K it lacks), and their range; then per pooling the mean margin of each kind
 of model. A field whose margin swings by more than the differences the search's choices turn on
 (fold means of a few thousandths) is flown by a decision that hangs on which fields calibrated it.
+
+--looks ROWDIR: a row flown with --calibration-network-each, each of the five training tiles
+segmented by several networks that never saw it (their looks adjacent in each setting's fold
+margins, under one model fitted on the other tiles' looks): per class, over every setting and
+training tile where a look's margin is not 0, how far the other looks' margins differ from the
+first's (pairs; differing by more than 0.005; of opposite signs beyond 0.001; the mean absolute
+difference; their correlation). What the network's own draw on a field does to its fold margin.
 """
 import argparse
 import os
@@ -64,12 +72,63 @@ def row_of(directory, cls, z):
     return out
 
 
+TRAINING_TILES = len(TILES) - 1
+
+
+def look_pairs(directory):
+    """{class: [(first look's margin, another look's margin)]} over every run, setting and
+    training tile of a row calibrated with several looks per tile."""
+    out = {}
+    for name in sorted(os.listdir(directory)):
+        m = RUN.search(name)
+        if not m:
+            continue
+        for _, _, _, folds in tried_settings(os.path.join(directory, name)):
+            looks = len(folds) // TRAINING_TILES
+            if looks < 2 or len(folds) % TRAINING_TILES:
+                sys.exit(f"{name}: {len(folds)} fold margins, not several looks of each of "
+                         f"{TRAINING_TILES} training tiles (a row flown with --calibration-network-each?)")
+            for t in range(TRAINING_TILES):
+                group = folds[t * looks:(t + 1) * looks]
+                out.setdefault(m.group(1), []).extend(
+                    (group[0], v) for v in group[1:] if group[0] != 0.0 or v != 0.0)
+    if not out:
+        sys.exit(f"no run's log (...-CLASS-tile-K.log) in {directory}")
+    return out
+
+
+def print_looks(directory):
+    pairs = look_pairs(directory)
+    print("| class | pairs of looks | differ by > 0.005 | opposite signs beyond 0.001 | mean abs difference "
+          "| correlation |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: |")
+    for cls in sorted(pairs) + ["all"]:
+        p = [x for v in pairs.values() for x in v] if cls == "all" else pairs[cls]
+        if not p:
+            continue
+        a, b = [x for x, _ in p], [y for _, y in p]
+        far = sum(abs(x - y) > 0.005 for x, y in p)
+        flips = sum((x > 0.001 and y < -0.001) or (x < -0.001 and y > 0.001) for x, y in p)
+        mad = statistics.mean(abs(x - y) for x, y in p)
+        corr = (f"{statistics.correlation(a, b):+.2f}" if len(p) >= 2 and len(set(a)) > 1 and len(set(b)) > 1
+                else "—")
+        print(f"| {cls} | {len(p)} | {far} | {flips} | {mad:.4f} | {corr} |")
+
+
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--z", type=float, default=0.0)
-    parser.add_argument("calibration")
-    parser.add_argument("row")
+    parser.add_argument("--looks", metavar="ROWDIR", help="a row flown with --calibration-network-each")
+    parser.add_argument("calibration", nargs="?")
+    parser.add_argument("row", nargs="?")
     args = parser.parse_args(argv)
+    if args.looks:
+        if args.calibration:
+            sys.exit("--looks takes the row alone")
+        print_looks(args.looks)
+        return
+    if not args.row:
+        sys.exit("expected CALIBRATION.log ROWDIR (or --looks ROWDIR)")
     m = re.search(r"decision-(building|road|vegetation|water)\.log$", args.calibration)
     if not m:
         sys.exit(f"{args.calibration}: expected a decision-CLASS.log of scripts/loto.sh decision")

@@ -4,7 +4,8 @@
 A calibration on six tiles whose field j has margin j/1000 under the five-field model, and six
 leave-one-tile-out runs whose calibration for test tile K flies field j at j/1000 + K/5000: the
 table must pair each field with the four-field margins of the five runs that trained on it, in
-the order of their training tiles, and give their range.
+the order of their training tiles, and give their range; with --looks, a row of two looks per
+training tile must pair each tile's looks.
 """
 import os
 import sys
@@ -41,7 +42,23 @@ def main():
         # A log that is not a six-tile calibration is refused, naming it.
         check_refused(fold_composition.main, [os.path.join(row, "net-road-tile-1.log"), row], "decision-CLASS.log",
                       "a run's log as a six-tile calibration")
-    print("ok: fold_composition.py pairs each field's margins")
+        # --looks: a row whose training tiles were each seen by two networks (adjacent margins).
+        looks = os.path.join(tmp, "looks")
+        os.makedirs(looks)
+        with open(os.path.join(looks, "net-road-tile-1.log"), "w") as f:
+            # Tile pairs: (+0.0100, +0.0020) differ by 0.008; (+0.0030, -0.0030) opposite signs;
+            # (0, 0) left out; (+0.0010, +0.0012); (-0.0040, -0.0010).
+            f.write("           tried front-aware z=0 slopes=cells: front margin +0.0010, 3 descents, per field "
+                    "+0.0100 +0.0020 +0.0030 -0.0030 +0.0000 +0.0000 +0.0010 +0.0012 -0.0040 -0.0010\n")
+        text = printed(fold_composition.main, ["--looks", looks])[1]
+        # Four pairs, two beyond 0.005 (0.008, 0.006), one of opposite signs, mean |d| (0.008 + 0.006 + 0.0002 +
+        # 0.003) / 4.
+        if "| road | 4 | 2 | 1 | 0.0043 |" not in text:
+            sys.exit(f"wrong looks row:\n{text}")
+        # One look per tile (an ordinary row) is refused, naming the option the row needs.
+        check_refused(fold_composition.main, ["--looks", row], "--calibration-network-each",
+                      "a row of one look per tile")
+    print("ok: fold_composition.py pairs each field's margins, and the looks of one field")
 
 
 if __name__ == "__main__":
