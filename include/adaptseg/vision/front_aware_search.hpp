@@ -103,13 +103,6 @@ std::vector<TopLevelTrace> top_level_traces(const RuleSearchInputs& in, std::spa
   return traces;
 }
 
-/// Each fold's ground (select_pooling; CalibrationOptions::field_grounds): empty where every
-/// fold is its own (no grounds given, or one field's layouts).
-[[nodiscard]] inline std::vector<std::size_t> fold_grounds(const RuleSearchInputs& in) {
-  if (in.fields.size() < 2) return {};
-  return in.options.field_grounds;
-}
-
 /// One fold per training field, its model fitted without it (one field: its layouts, the whole
 /// field's model); each fold's σ̂ prior from the other fields' `traces` (where there are any)
 /// and, with ranked cells, the other fields' cells. The fields of one ground

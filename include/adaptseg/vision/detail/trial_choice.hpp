@@ -69,6 +69,13 @@ inline std::size_t select_pooling(std::span<const RuleTrial* const> trials, std:
   return best;
 }
 
+/// Each fold's ground (select_pooling; CalibrationOptions::field_grounds): empty where every
+/// fold is its own (no grounds given, or one field's layouts).
+[[nodiscard]] inline std::vector<std::size_t> fold_grounds(const RuleSearchInputs& in) {
+  if (in.fields.size() < 2) return {};
+  return in.options.field_grounds;
+}
+
 /// A trial's name: its z, its slope pooling, its top-level choice and its finest descent GSD
 /// (`finest=G` in cm/px, `finest=any` for no limit) where the search tried several.
 inline std::string z_text(double z, const SlopePooling* pooling = nullptr, const TopLevelChoice* top_level = nullptr,
