@@ -158,10 +158,9 @@ struct SegmenterOptions {
         expanded.push_back(std::move(copy));
       }
       networks.insert(networks.end(), new_to.begin(), new_to.end());
-      if (grounds) grounds->insert(grounds->end(), new_to.size(), at);
+      if (grounds && calibration_network_each) grounds->insert(grounds->end(), new_to.size(), at);
     }
-    fields = std::move(expanded);
-    if (grounds && !calibration_network_each) grounds->clear();  // every field its own
+    fields = std::move(expanded);  // without --calibration-network-each, `grounds` stays empty: each its own
     return networks;
   }
 

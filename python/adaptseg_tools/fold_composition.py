@@ -37,6 +37,7 @@ from .fold_table import read
 SETTING = re.compile(r"^front-aware z=(\S+) slopes=([a-z-]+)(?: finest=(\S+))?$")
 RUN = re.compile(r"-(building|road|vegetation|water)-tile-([1-9])\.log$")
 TILES = [1, 2, 3, 4, 5, 6]
+TRAINING_TILES = len(TILES) - 1
 
 
 def settings_at(settings, z):
@@ -70,9 +71,6 @@ def row_of(directory, cls, z):
     if not out:
         sys.exit(f"no {cls} run's log with settings at z={z} in {directory}")
     return out
-
-
-TRAINING_TILES = len(TILES) - 1
 
 
 def look_pairs(directory):

@@ -32,8 +32,9 @@ namespace adaptseg::detail {
 /// in five leave-one-tile-out rows, 13 were such ties and each had kept the first, and the bundled
 /// decision models calibrate to the same files, so no choice moved (docs/journal/2026-12-loto.md).
 ///
-/// `ground`, where given, names each fold's ground (an index; equal for the folds of one field
-/// segmented by several networks, --calibration-network-each): the paired differences of one
+/// `ground`, where given, names each fold's ground (the index of its ground's first fold, at most
+/// its own, as CalibrationOptions::field_grounds; equal for the folds of one field segmented by
+/// several networks, --calibration-network-each): the paired differences of one
 /// ground are averaged first and n counts the grounds, so that two looks at one field are not
 /// taken for two fields' worth of evidence. Empty: every fold its own ground.
 inline std::size_t select_pooling(std::span<const RuleTrial* const> trials, std::span<const std::size_t> ground = {}) {
@@ -43,19 +44,16 @@ inline std::size_t select_pooling(std::span<const RuleTrial* const> trials, std:
   for (std::size_t k = 1; k < trials.size(); ++k) {
     const std::vector<double>& m = trials[k]->margins;
     if (m.size() != first.size() || m.size() < 2) continue;
-    std::vector<double> d;  // the paired differences, one per ground
-    if (ground.size() == m.size()) {
-      std::vector<double> sum, count;
-      for (std::size_t f = 0; f < m.size(); ++f) {
-        if (ground[f] >= sum.size()) sum.resize(ground[f] + 1, 0.0), count.resize(ground[f] + 1, 0.0);
-        sum[ground[f]] += m[f] - first[f];
-        count[ground[f]] += 1.0;
-      }
-      for (std::size_t g = 0; g < sum.size(); ++g)
-        if (count[g] > 0.0) d.push_back(sum[g] / count[g]);
-    } else {
-      for (std::size_t f = 0; f < m.size(); ++f) d.push_back(m[f] - first[f]);
+    // The paired differences, one per ground (its folds' mean), in the grounds' order.
+    std::vector<double> sum(m.size(), 0.0), count(m.size(), 0.0);
+    for (std::size_t f = 0; f < m.size(); ++f) {
+      const std::size_t g = ground.size() == m.size() ? ground[f] : f;
+      sum[g] += m[f] - first[f];
+      count[g] += 1.0;
     }
+    std::vector<double> d;
+    for (std::size_t g = 0; g < sum.size(); ++g)
+      if (count[g] > 0.0) d.push_back(sum[g] / count[g]);
     if (d.size() < 2) continue;
     const double n = static_cast<double>(d.size());
     double mean = 0.0;
