@@ -5,7 +5,8 @@ Four runs of a configuration and the oracle's of the same folds, named as script
 names them, with margins chosen so that every target's count is known: two runs above +0.001,
 one below max(non-adaptive, 0) - 0.002, three descents whose forecasts and realised gains are
 proportional (correlation +1), and the oracle above 0 in two of the three runs where some
-strategy beats the curve.
+strategy beats the curve. The same four runs flown again (a second seed's networks) pool with
+the first as one configuration of eight runs, and a folder of other runs is refused for it.
 """
 import os
 import sys
@@ -55,6 +56,26 @@ def main():
             sys.exit(f"summary {summary}, want {want}\n{text}")
         if "| water | 2 | -0.0030 (0) | +0.0000 (0) |" not in lines:
             sys.exit(f"no per-run row for water on tile 2:\n{text}")
+        # Pooled with a second flight of the same four runs: eight runs, each counted once.
+        again = os.path.join(tmp, "again")
+        write_run(again, "mobilenetv2-loto-building-tile-1", -0.001, 0.0, [(0.01, 0.01)])
+        write_run(again, "mobilenetv2-loto-road-tile-1", 0.003, 0.0, [(0.02, 0.04)])
+        write_run(again, "mobilenetv2-loto-water-tile-2", 0.0, 0.0)
+        write_run(again, "mobilenetv2-loto-water-tile-3", 0.0005, 0.0)
+        text = printed(loto_targets.main, ["--oracle", oracle, f"both={loto}+{again}"])[1]
+        lines = text.splitlines()
+        summary = [c.strip() for c in lines[2].strip("|").split("|")]
+        # margins 0.004 0.0015 -0.003 0.0007 / -0.001 0.003 0 0.0005: three above, median
+        # +0.0006, mean +0.0007, one below (water 2 of the first), five descents; beatable in both
+        # flights: building 1 and water 3 (the oracle's) and road 1, the oracle above 0 in four.
+        want = ["both", "8", "3", "+0.0006", "+0.0007", "1", "5", "+0.98", "4 of 6"]
+        if summary != want:
+            sys.exit(f"pooled summary {summary}, want {want}\n{text}")
+        if "| road | 1 | +0.0015 (1) / +0.0030 (1) | -0.0010 (0) |" not in lines:
+            sys.exit(f"no pooled per-run row for road on tile 1:\n{text}")
+        other = os.path.join(tmp, "other")
+        write_run(other, "mobilenetv2-loto-building-tile-2", 0.0, 0.0)
+        check_refused(loto_targets.main, [f"x={loto}+{other}"], "other runs", "a pool of different runs")
         # A folder without runs named ...-CLASS-tile-K is refused, naming it.
         empty = os.path.join(tmp, "empty")
         os.makedirs(empty)
