@@ -10,6 +10,7 @@
 //                      --network examples/models/ensemble-dubai --out ensemble-model.yaml
 
 #include "common/cell_csv.hpp"
+#include "common/host_memory.hpp"
 #include "common/segmenters.hpp"
 #include "common/strategies.hpp"
 
@@ -19,6 +20,7 @@
 #include <utility>
 
 int main(int argc, char** argv) {
+  adaptseg::examples::keep_freed_memory();  // each mission's maps reuse the last one's pages
   namespace fs = std::filesystem;
   CLI::App app{"Initialise the adaptive decision function on training fields and save it.", "adaptseg_calibrate"};
   fs::path field_dir, out_file, samples_csv, cell_samples_csv;

@@ -8,6 +8,7 @@
 //                     --segmenter network --network examples/models/ensemble-dubai --out out/eval-ensemble
 
 #include "common/cell_csv.hpp"
+#include "common/host_memory.hpp"
 #include "common/segmenters.hpp"
 #include "common/strategies.hpp"
 
@@ -56,6 +57,7 @@ std::string slug(const std::string& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  adaptseg::examples::keep_freed_memory();  // each mission's maps reuse the last one's pages
   CLI::App app{"Run every strategy on test fields and write the paper's tables and figures.", "adaptseg_evaluate"};
   std::vector<std::string> train_specs;
   std::vector<std::string> test_specs;

@@ -16,6 +16,7 @@
 //       --network examples/models/mobilenetv2-dubai --csv out/cells.csv
 
 #include "common/cell_csv.hpp"
+#include "common/host_memory.hpp"
 #include "common/segmenters.hpp"
 #include "common/strategies.hpp"
 
@@ -170,6 +171,7 @@ std::vector<Cell> study_field(const Field& field, Backend& backend, const Camera
 }  // namespace
 
 int main(int argc, char** argv) {
+  adaptseg::examples::keep_freed_memory();  // each mission's maps reuse the last one's pages
   CLI::App app{"How well each decision input ranks the cells a descent could re-map by what they gain.",
                "adaptseg_cell_study"};
   std::vector<std::string> field_specs;
