@@ -36,6 +36,19 @@ def write_run(root, name, adaptive, nonadaptive, descents=()):
         f.write("adaptive,stay,,\n")
 
 
+def check_targets(argv, want, row, what):
+    """Runs loto_targets on `argv` and exits unless its summary row's cells are `want` (label,
+    runs, > +0.001, median, mean, below, descents, correlation, oracle where beatable) and its
+    per-run rows include `row` (`what`: that row, in the message)."""
+    text = printed(loto_targets.main, argv)[1]
+    lines = text.splitlines()
+    summary = [c.strip() for c in lines[2].strip("|").split("|")]
+    if summary != want:
+        sys.exit(f"summary {summary}, want {want}\n{text}")
+    if row not in lines:
+        sys.exit(f"no per-run row for {what}:\n{text}")
+
+
 def main():
     with tempfile.TemporaryDirectory() as tmp:
         loto, oracle = os.path.join(tmp, "loto"), os.path.join(tmp, "oracle")
@@ -47,32 +60,21 @@ def main():
         write_run(oracle, "dubai-road-tile-1", -0.001, -0.001)  # beatable (loto's +0.0015), oracle not > 0
         write_run(oracle, "dubai-water-tile-2", 0.0, 0.0)  # nobody beats the curve here
         write_run(oracle, "dubai-water-tile-3", 0.002, 0.002)
-        text = printed(loto_targets.main, ["--oracle", oracle, f"base={loto}"])[1]
-        lines = text.splitlines()
-        summary = [c.strip() for c in lines[2].strip("|").split("|")]
-        # runs, > +0.001, median, mean, below, descents, correlation, oracle where beatable
-        want = ["base", "4", "2", "+0.0011", "+0.0008", "1", "3", "+1.00", "2 of 3"]
-        if summary != want:
-            sys.exit(f"summary {summary}, want {want}\n{text}")
-        if "| water | 2 | -0.0030 (0) | +0.0000 (0) |" not in lines:
-            sys.exit(f"no per-run row for water on tile 2:\n{text}")
+        check_targets(["--oracle", oracle, f"base={loto}"],
+                      ["base", "4", "2", "+0.0011", "+0.0008", "1", "3", "+1.00", "2 of 3"],
+                      "| water | 2 | -0.0030 (0) | +0.0000 (0) |", "water on tile 2")
         # Pooled with a second flight of the same four runs: eight runs, each counted once.
         again = os.path.join(tmp, "again")
         write_run(again, "mobilenetv2-loto-building-tile-1", -0.001, 0.0, [(0.01, 0.01)])
         write_run(again, "mobilenetv2-loto-road-tile-1", 0.003, 0.0, [(0.02, 0.04)])
         write_run(again, "mobilenetv2-loto-water-tile-2", 0.0, 0.0)
         write_run(again, "mobilenetv2-loto-water-tile-3", 0.0005, 0.0)
-        text = printed(loto_targets.main, ["--oracle", oracle, f"both={loto}+{again}"])[1]
-        lines = text.splitlines()
-        summary = [c.strip() for c in lines[2].strip("|").split("|")]
         # margins 0.004 0.0015 -0.003 0.0007 / -0.001 0.003 0 0.0005: three above, median
         # +0.0006, mean +0.0007, one below (water 2 of the first), five descents; beatable in both
         # flights: building 1 and water 3 (the oracle's) and road 1, the oracle above 0 in four.
-        want = ["both", "8", "3", "+0.0006", "+0.0007", "1", "5", "+0.98", "4 of 6"]
-        if summary != want:
-            sys.exit(f"pooled summary {summary}, want {want}\n{text}")
-        if "| road | 1 | +0.0015 (1) / +0.0030 (1) | -0.0010 (0) |" not in lines:
-            sys.exit(f"no pooled per-run row for road on tile 1:\n{text}")
+        check_targets(["--oracle", oracle, f"both={loto}+{again}"],
+                      ["both", "8", "3", "+0.0006", "+0.0007", "1", "5", "+0.98", "4 of 6"],
+                      "| road | 1 | +0.0015 (1) / +0.0030 (1) | -0.0010 (0) |", "pooled road on tile 1")
         other = os.path.join(tmp, "other")
         write_run(other, "mobilenetv2-loto-building-tile-2", 0.0, 0.0)
         check_refused(loto_targets.main, [f"x={loto}+{other}"], "other runs", "a pool of different runs")
