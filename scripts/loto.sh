@@ -12,8 +12,9 @@
 #       one GPU, each fitting its learning-rate cycle into MINUTES (train_segnet.py --minutes) but
 #       at most LOTO_STEP_CAP steps (environment; default 1784, the deployment network's
 #       schedule), batches made on the GPU (--sampler device, PREFETCH batches ahead, default 2),
-#       checkpoints to $OUT/loto-<k>.pt (7.5 MB each) and the logs
-#       to $OUT/loto-logs.tar.gz, seed LOTO_SEED (environment; default 0, the bundled networks').
+#       each network's exported weights (train_segnet --slim-checkpoint: no optimiser state) to
+#       $OUT/loto-<k>.pt and the logs to $OUT/loto-logs.tar.gz, seed LOTO_SEED (environment;
+#       default 0, the bundled networks').
 #       TILES: the held-out tiles (default 1,2,3,4,5,6). STEPS > 0
 #       trains that many steps instead of fitting MINUTES, on the CPU if there is no GPU (a
 #       rehearsal of the call here).
@@ -66,6 +67,12 @@
 #       examples/models/mobilenetv2-dubai-loto) and sets the deployment network's temperature
 #       only from the default folder; decision reads LOTO_BUNDLE and writes into LOTO_WORK unless
 #       it is the default. scripts/results.sh loto flies such a folder with LOTO_NETWORKS.
+#   LOTO_ARCH=erfnet bash scripts/loto.sh train|eval|recipe-cpu|bundle|stage ...
+#       the six with the bundled ERFNet's recipe instead (scripts/loto_recipe.sh: its first
+#       learning-rate cycle, at most 1563 steps), in out/loto-erfnet into
+#       examples/models/erfnet-dubai-loto unless LOTO_WORK and LOTO_BUNDLE say otherwise; decision
+#       refuses it (the deployment network is a MobileNetV2). train brings back each network's
+#       exported weights alone (train_segnet --slim-checkpoint, 8 MB), which eval exports.
 #   bash scripts/loto.sh mirror [DEST]
 #       here: DEST/tile-<k>/ensemble.yaml (default out/loto-mirror) for k = 1..6, each network of
 #       LOTO_BUNDLE under test-time mirror (an ensemble of one member, mirror: true: its
@@ -90,13 +97,23 @@ cd "$(dirname "$0")/.."
 export PYTHONPATH="$PWD/python${PYTHONPATH:+:$PYTHONPATH}"
 # The interpreter with PyTorch: a device machine's plain python3, else Debian's (this machine's).
 py=${PYTHON:-$(python3 -c 'import torch, cv2' 2>/dev/null && echo python3 || echo /usr/bin/python3)}
-# The recipe's train_segnet arguments: loto_recipe, loto_batch.
+# The recipe's train_segnet arguments (LOTO_ARCH): loto_arch, loto_recipe, loto_batch, loto_steps.
 source scripts/loto_recipe.sh
 tiles_all=(1 2 3 4 5 6)
 # Where recipe-cpu, eval and bundle work (LOTO_WORK), and the folder bundle fills and decision
 # reads (LOTO_BUNDLE): another seed's networks go beside the bundled ones, never over them.
-wroot=${LOTO_WORK:-out/loto}
-dest=${LOTO_BUNDLE:-examples/models/mobilenetv2-dubai-loto}
+if [ "$loto_arch" = erfnet ]; then
+  wroot=${LOTO_WORK:-out/loto-erfnet}
+  dest=${LOTO_BUNDLE:-examples/models/erfnet-dubai-loto}
+else
+  wroot=${LOTO_WORK:-out/loto}
+  dest=${LOTO_BUNDLE:-examples/models/mobilenetv2-dubai-loto}
+fi
+# The MobileNetV2 recipe starts from ImageNet weights that a device machine cannot download.
+need_encoder() {
+  [ "$loto_arch" != mobilenetv2 ] || [ -s .device/mnv2_enc.pt ] ||
+    { echo "no .device/mnv2_enc.pt: run 'bash $0 weights' here first" >&2; exit 2; }
+}
 train_fields() {  # every bundled tile but $1, comma-separated
   local k=$1 out=""
   for t in "${tiles_all[@]}"; do [ "$t" = "$k" ] || out+="${out:+,}dubai-tile-$t"; done
@@ -155,12 +172,14 @@ train)
   IFS=, read -r -a tiles <<<"${3:-1,2,3,4,5,6}"
   steps=${4:-0}
   out=${OUT:?set OUT (the device tool sets it)}
-  [ -s .device/mnv2_enc.pt ] || { echo "no .device/mnv2_enc.pt: run 'bash $0 weights' here first" >&2; exit 2; }
+  need_encoder
   if [ "$steps" -gt 0 ]; then
-    schedule=(--steps "$steps" --warmup 1 --batch 2 --crop 150 --val-max-images 2)
+    crop=150  # ERFNet's crops map to whole multiples of 8 network pixels
+    [ "$loto_arch" = mobilenetv2 ] || crop=160
+    schedule=(--steps "$steps" --warmup 1 --batch 2 --crop "$crop" --val-max-images 2)
     device=$("$py" -c 'import torch; print("cuda" if torch.cuda.is_available() else "cpu")')
   else
-    schedule=(--steps "${LOTO_STEP_CAP:-1784}" --minutes "$minutes" --max-minutes "$(awk -v m="$minutes" 'BEGIN { print m * 1.08 }')"
+    schedule=(--steps "${LOTO_STEP_CAP:-$loto_steps}" --minutes "$minutes" --max-minutes "$(awk -v m="$minutes" 'BEGIN { print m * 1.08 }')"
               "${loto_batch[@]}")
     device=cuda
   fi
@@ -178,7 +197,10 @@ train)
   status=0
   for p in "${pids[@]}"; do wait "$p" || status=1; done
   for k in "${tiles[@]}"; do
-    [ -s "$work/loto-$k/checkpoint.pt" ] && cp "$work/loto-$k/checkpoint.pt" "$out/loto-$k.pt"
+    # The exported weights alone: an ERFNet checkpoint (33 MB) is over what a device call brings back.
+    [ ! -s "$work/loto-$k/checkpoint.pt" ] ||
+      "$py" -m adaptseg_tools.train_segnet --work-dir "$work/loto-$k" --model-dir "$work/unused-$k" \
+        --slim-checkpoint "$out/loto-$k.pt" || status=1
     tail -n 3 "$work/loto-$k.log"
   done
   tar czf "$out/loto-logs.tar.gz" -C "$work" --exclude='*.pt' .
@@ -193,7 +215,7 @@ eval)
     work=$wroot/work-$k
     mkdir -p "$work"
     cp "$ckpt" "$work/checkpoint.pt"
-    "$py" -m adaptseg_tools.train_segnet --arch mobilenetv2 --work-dir "$work" --model-dir "$wroot/model-$k" \
+    "$py" -m adaptseg_tools.train_segnet --arch "$loto_arch" --work-dir "$work" --model-dir "$wroot/model-$k" \
       --export-only --train-fields "$(train_fields "$k")" --val-field "dubai-tile-$k" --test-field none \
       >"$wroot/export-$k.log" 2>&1 || { echo "export of $ckpt failed: $wroot/export-$k.log" >&2; exit 1; }
     # The device call's training logs beside the network, as recipe-cpu leaves them.
@@ -229,7 +251,7 @@ PY
   ;;
 recipe-cpu)
   IFS=, read -r -a tiles <<<"${2:-1,2,3,4,5,6}"
-  [ -s .device/mnv2_enc.pt ] || { echo "no .device/mnv2_enc.pt: run 'bash $0 weights' here first" >&2; exit 2; }
+  need_encoder
   mkdir -p "$wroot"
   for k in "${tiles[@]}"; do
     work=$wroot/work-$k
@@ -239,11 +261,11 @@ recipe-cpu)
       "$py" -m adaptseg_tools.train_segnet "${loto_recipe[@]}" --seed "${LOTO_SEED:-0}" \
         --sampler cpu --device cpu --workers 1 --threads "${LOTO_THREADS:-2}" --train-fields "$(train_fields "$k")" \
         --val-field "dubai-tile-$k" --test-field none --val-every 0 --ckpt-every 100 --log-every 50 --no-export \
-        --steps 1784 "${loto_batch[@]}" --work-dir "$work" --model-dir "$wroot/unused-$k" \
+        --steps "$loto_steps" "${loto_batch[@]}" --work-dir "$work" --model-dir "$wroot/unused-$k" \
         "${resume[@]}" >>"$wroot/train-$k.log" 2>&1 || { echo "training $k failed: $wroot/train-$k.log" >&2; exit 1; }
       date -u +%FT%TZ >"$work/done"
     fi
-    "$py" -m adaptseg_tools.train_segnet --arch mobilenetv2 --work-dir "$work" --model-dir "$wroot/model-$k" \
+    "$py" -m adaptseg_tools.train_segnet --arch "$loto_arch" --work-dir "$work" --model-dir "$wroot/model-$k" \
       --export-only --train-fields "$(train_fields "$k")" --val-field "dubai-tile-$k" --test-field none \
       >"$wroot/export-$k.log" 2>&1 || { echo "export of tile $k failed: $wroot/export-$k.log" >&2; exit 1; }
     "$py" -m adaptseg_tools.eval_ensemble --members "loto$k=$wroot/model-$k" \
@@ -294,6 +316,8 @@ stage)
   ;;
 decision)
   read -r -a classes <<<"${2:-building road vegetation water}"
+  [ "$loto_arch" = mobilenetv2 ] ||
+    { echo "decision: the deployment network is the MobileNetV2 trained on all six tiles (no ERFNet's yet)" >&2; exit 2; }
   deploy=examples/models/mobilenetv2-dubai-all
   trains=() crossed=()
   for k in "${tiles_all[@]}"; do
@@ -357,7 +381,7 @@ ensemble)
   echo "wrote $to/tile-{1..6}/ensemble.yaml"
   ;;
 *)
-  sed -n '2,86p' "$0" >&2
+  sed -n '2,93p' "$0" >&2
   exit 2
   ;;
 esac

@@ -65,6 +65,9 @@ Usage:
                            train a finished run N steps more under a new learning-rate
                            cycle (peak LR); an interrupted extension resumes with --resume
   ... --export-only        re-export model.onnx/model.yaml/model.pt from the checkpoint
+  ... --slim-checkpoint P  write the checkpoint with the exported weights alone to P (no optimiser
+                           state, no second copy: a quarter of ERFNet's 33 MB): --export-only
+                           takes it, --resume refuses it
   ... --init-weights DIR   a new run from the weights of an exported model (DIR/model.pt), e.g. a
                            bundled model trained further in a later session
 """
@@ -166,15 +169,34 @@ def build_parser() -> argparse.ArgumentParser:
                     help="with --resume of a finished run: train STEPS more steps under a new "
                          "learning-rate cycle (warm-up to --lr, then poly decay; a warm restart)")
     ap.add_argument("--export-only", action="store_true", help="export WORK_DIR/checkpoint.pt and exit")
+    ap.add_argument("--slim-checkpoint", default="", metavar="PATH",
+                    help="write WORK_DIR/checkpoint.pt with the exported weights alone (no optimiser state) to "
+                         "PATH and exit: what a device call brings back, for --export-only here")
     ap.add_argument("--no-export", action="store_true")
     ap.add_argument("--export-graph", choices=("subpixel", "deconv"), default="deconv",
                     help="ERFNet: how transposed convolutions are written to ONNX (same function)")
     return ap
 
 
+def slim_checkpoint(src: Path, dst: Path) -> None:
+    """dst: the checkpoint src with the weights that are exported (the moving average where there is
+    one) as its network and no optimiser state, everything else (recipe, steps, logs) as it was.
+    --export-only exports it as it would src; --resume refuses it."""
+    import torch
+    ckpt = torch.load(src, map_location="cpu", weights_only=False)  # our own file
+    if ckpt.get("ema_model") is not None:
+        ckpt["model"] = ckpt["ema_model"]  # the same tensors: saved once
+    ckpt["optimizer_state"] = None
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    torch.save(ckpt, dst)
+
+
 def main(argv=None):
     """Trains, resumes, extends or re-exports as the command line says; returns the exit code."""
     args = build_parser().parse_args(argv)
+    if args.slim_checkpoint:
+        slim_checkpoint(Path(args.work_dir) / "checkpoint.pt", Path(args.slim_checkpoint))
+        return 0
     t_start = time.time()
     run = start(args)
 

@@ -98,6 +98,10 @@ echo "ok: mirror wrote six ensembles of one mirrored member"
 LOTO_BUNDLE="$work/staged" refused "no temperature" mirror "$work/mir2"
 [ -e "$work/mir2" ] && fail "a refused mirror wrote files"
 
+# --- LOTO_ARCH: the ERFNet recipe has no deployment network to calibrate; an unknown one is refused ---
+LOTO_ARCH=erfnet refused "no ERFNet's yet" decision
+LOTO_ARCH=resnet refused "LOTO_ARCH=resnet: mobilenetv2 or erfnet" stage 2
+
 # --- no subcommand: the usage, exit 2 ---
 bash "$loto" >"$work/out" 2>"$work/err"
 [ $? -eq 2 ] || fail "loto.sh without a subcommand: exit code not 2"

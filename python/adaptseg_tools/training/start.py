@@ -231,7 +231,11 @@ def network(args, ckpt: dict, resume: bool, ckpt_path: Path, device, cuda: bool)
         lr_scales = [1.0, float(ckpt["encoder_lr_scale"])]
     if resume:
         model.load_state_dict(ckpt["model"])
-        opt.load_state_dict(ckpt["optimizer_state"])
+        if ckpt.get("optimizer_state") is not None:
+            opt.load_state_dict(ckpt["optimizer_state"])
+        elif not args.export_only:  # slim_checkpoint's: the exported weights alone
+            raise SystemExit(f"{ckpt_path} holds the exported weights alone (no optimiser state): "
+                             "it can be exported (--export-only), not resumed")
         torch.set_rng_state(ckpt["torch_rng"])
         if cuda and ckpt.get("cuda_rng") is not None:
             torch.cuda.set_rng_state(ckpt["cuda_rng"])
