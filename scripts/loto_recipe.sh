@@ -5,9 +5,9 @@
 #   mobilenetv2 (default)  the deployment MobileNetV2's (examples/models/mobilenetv2-dubai-all/README.md):
 #                          ImageNet encoder weights from .device/mnv2_enc.pt (bash scripts/loto.sh
 #                          weights), 1784 steps of 32 crops of 300 px
-#   erfnet                 the bundled ERFNet's first learning-rate cycle (examples/models/erfnet-dubai/
-#                          README.md, "The run"): full width, from scratch, at most 1563 steps of 32
-#                          crops of 352 px; cycle 2 gained nothing on its validation tile
+#   erfnet                 the bundled ERFNet's first learning-rate cycle (its README's "The run":
+#                          examples/models/erfnet-dubai/README.md): full width, from scratch, at most
+#                          1563 steps of 32 crops of 352 px; cycle 2 gained nothing on its validation tile
 # Sets
 #   loto_arch    the network (train_segnet --arch)
 #   loto_recipe  the network, its initialisation, optimiser and augmentation
