@@ -10,8 +10,8 @@
 #   bash scripts/loto.sh train MINUTES [TILES] [STEPS]
 #       on a CUDA machine (the `device` tool: carry .device): the trainings side by side on its
 #       one GPU, each fitting its learning-rate cycle into MINUTES (train_segnet.py --minutes) but
-#       at most LOTO_STEP_CAP steps (environment; default 1784, the deployment network's
-#       schedule), batches made on the GPU (--sampler device, PREFETCH batches ahead, default 2),
+#       at most LOTO_STEP_CAP steps (environment; default the recipe's: 1784 for the MobileNetV2,
+#       1563 for the ERFNet), batches made on the GPU (--sampler device, PREFETCH batches ahead, default 2),
 #       each network's exported weights (train_segnet --slim-checkpoint: no optimiser state) to
 #       $OUT/loto-<k>.pt and the logs to $OUT/loto-logs.tar.gz, seed LOTO_SEED (environment;
 #       default 0, the bundled networks').
