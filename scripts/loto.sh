@@ -8,7 +8,10 @@
 #       here (npm and node needed): the ImageNet encoder weights into .device/mnv2_enc.pt, the
 #       folder a device call carries (it reaches no network).
 #   bash scripts/loto.sh train MINUTES [TILES] [STEPS]
-#       on a CUDA machine (the `device` tool: carry .device): the trainings side by side on its
+#       on a CUDA machine (the `device` tool: carry .device; a call carries 64 MiB, so first here
+#       `bash scripts/device_travel.sh size .device`, and where it is over, `bash
+#       scripts/device_travel.sh aside` (examples/models, which train reads none of) before the
+#       call and `bash scripts/device_travel.sh restore` after): the trainings side by side on its
 #       one GPU, each fitting its learning-rate cycle into MINUTES (train_segnet.py --minutes) but
 #       at most LOTO_STEP_CAP steps (environment; default the recipe's: 1784 for the MobileNetV2,
 #       1563 for the ERFNet), batches made on the GPU (--sampler device, PREFETCH batches ahead, default 2),
