@@ -5,8 +5,9 @@
 # lawnmowers at 5, 10 and 15 cm/px, adaptseg_tools.eval_ensemble).
 #
 #   bash scripts/loto.sh weights
-#       here (npm and node needed): the ImageNet encoder weights into .device/mnv2_enc.pt, the
-#       folder a device call carries (it reaches no network).
+#       here (npm and node needed): the ImageNet encoder weights into .device/mnv2_enc.pt and
+#       .device/mnv2_140_enc.pt (LOTO_ARCH=mobilenetv2-140), the folder a device call carries (it
+#       reaches no network).
 #   bash scripts/loto.sh train MINUTES [TILES] [STEPS]
 #       on a CUDA machine (the `device` tool: carry .device; a call carries 64 MiB, so first here
 #       `bash scripts/device_travel.sh size .device`, and where it is over, `bash
@@ -70,6 +71,12 @@
 #       examples/models/mobilenetv2-dubai-loto) and sets the deployment network's temperature
 #       only from the default folder; decision reads LOTO_BUNDLE and writes into LOTO_WORK unless
 #       it is the default. scripts/results.sh loto flies such a folder with LOTO_NETWORKS.
+#   LOTO_ARCH=mobilenetv2-140 bash scripts/loto.sh train|eval|recipe-cpu|bundle|stage ...
+#       the deployment's recipe on the width-1.4 MobileNetV2 with every block (scripts/loto_recipe.sh,
+#       adaptseg_tools.mobilenet_v2_140), in out/loto-mnv2-140 into
+#       examples/models/mobilenetv2-140-dubai-loto unless LOTO_WORK and LOTO_BUNDLE say otherwise;
+#       decision refuses it. 15 MB of ONNX a network: bring the six back as train does and keep
+#       them out of the repository until they earn their place.
 #   LOTO_ARCH=erfnet bash scripts/loto.sh train|eval|recipe-cpu|bundle|stage ...
 #       the six with the bundled ERFNet's recipe instead (scripts/loto_recipe.sh: its first
 #       learning-rate cycle, at most 1563 steps), in out/loto-erfnet into
@@ -100,22 +107,30 @@ cd "$(dirname "$0")/.."
 export PYTHONPATH="$PWD/python${PYTHONPATH:+:$PYTHONPATH}"
 # The interpreter with PyTorch: a device machine's plain python3, else Debian's (this machine's).
 py=${PYTHON:-$(python3 -c 'import torch, cv2' 2>/dev/null && echo python3 || echo /usr/bin/python3)}
-# The recipe's train_segnet arguments (LOTO_ARCH): loto_arch, loto_recipe, loto_batch, loto_steps.
+# The recipe's train_segnet arguments (LOTO_ARCH): loto_net, loto_arch, loto_encoder, loto_recipe,
+# loto_batch, loto_steps.
 source scripts/loto_recipe.sh
 tiles_all=(1 2 3 4 5 6)
 # Where recipe-cpu, eval and bundle work (LOTO_WORK), and the folder bundle fills and decision
 # reads (LOTO_BUNDLE): another seed's networks go beside the bundled ones, never over them.
-if [ "$loto_arch" = erfnet ]; then
+case "$loto_net" in
+erfnet)
   wroot=${LOTO_WORK:-out/loto-erfnet}
   dest=${LOTO_BUNDLE:-examples/models/erfnet-dubai-loto}
-else
+  ;;
+mobilenetv2-140)
+  wroot=${LOTO_WORK:-out/loto-mnv2-140}
+  dest=${LOTO_BUNDLE:-examples/models/mobilenetv2-140-dubai-loto}
+  ;;
+*)
   wroot=${LOTO_WORK:-out/loto}
   dest=${LOTO_BUNDLE:-examples/models/mobilenetv2-dubai-loto}
-fi
-# The MobileNetV2 recipe starts from ImageNet weights that a device machine cannot download.
+  ;;
+esac
+# The MobileNetV2 recipes start from ImageNet weights that a device machine cannot download.
 need_encoder() {
-  [ "$loto_arch" != mobilenetv2 ] || [ -s .device/mnv2_enc.pt ] ||
-    { echo "no .device/mnv2_enc.pt: run 'bash $0 weights' here first" >&2; exit 2; }
+  [ -z "$loto_encoder" ] || [ -s "$loto_encoder" ] ||
+    { echo "no $loto_encoder: run 'bash $0 weights' here first" >&2; exit 2; }
 }
 train_fields() {  # every bundled tile but $1, comma-separated
   local k=$1 out=""
@@ -167,8 +182,11 @@ write_ensemble() {
 case "${1:-}" in
 weights)
   mkdir -p .device
-  grep -qx '/.device/' .git/info/exclude 2>/dev/null || echo '/.device/' >>.git/info/exclude
+  exclude=$(git rev-parse --git-path info/exclude)
+  mkdir -p "$(dirname "$exclude")"
+  grep -qx '/.device/' "$exclude" 2>/dev/null || echo '/.device/' >>"$exclude"
   "$py" -m adaptseg_tools.mobilenet_v2 --out .device/mnv2_enc.pt
+  "$py" -m adaptseg_tools.mobilenet_v2_140 --out .device/mnv2_140_enc.pt
   ;;
 train)
   minutes=${2:?minutes}
@@ -319,8 +337,8 @@ stage)
   ;;
 decision)
   read -r -a classes <<<"${2:-building road vegetation water}"
-  [ "$loto_arch" = mobilenetv2 ] ||
-    { echo "decision: the deployment network is the MobileNetV2 trained on all six tiles (no ERFNet's yet)" >&2; exit 2; }
+  [ "$loto_net" = mobilenetv2 ] ||
+    { echo "decision: the deployment network is the width-1.0 MobileNetV2 trained on all six tiles (no $loto_net one yet)" >&2; exit 2; }
   deploy=examples/models/mobilenetv2-dubai-all
   trains=() crossed=()
   for k in "${tiles_all[@]}"; do

@@ -50,8 +50,43 @@ BN_EPS = 1e-3  # Keras BatchNormalization default, as in the topology
 # the last row cut after its first block).
 BLOCKS = [(1, 16, 1), (6, 24, 2), (6, 24, 1), (6, 32, 2), (6, 32, 1), (6, 32, 1),
           (6, 64, 2), (6, 64, 1), (6, 64, 1), (6, 64, 1), (6, 96, 1)]
-# Encoder outputs used as decoder skips: block index -> stride.
-TAPS = {2: 4, 5: 8, 10: 16}
+# The rest of Table 2 (block_11 .. block_16): 96 x 2 more, 160 x 3 (stride 2), 320 x 1.
+BLOCKS_FULL = BLOCKS + [(6, 96, 1), (6, 96, 1), (6, 160, 2), (6, 160, 1), (6, 160, 1), (6, 320, 1)]
+# Encoder outputs used as decoder skips: block index -> stride (the last block is stride 16's).
+TAPS = {2: 4, 5: 8}
+# The encoders train_segnet builds (--encoder): width multiplier, last block, and the weights
+# that initialise it (the module that imports them).
+ENCODERS = {
+    # Keras Applications MobileNetV2 1.0 from nsfwjs's mobilenet_v2 (this module): stem .. block_10.
+    "mnv2-100-b10": (1.0, 10),
+    # TF-Hub's MobileNetV2 1.4 (imagenet/mobilenet_v2_140_224) from nsfwjs's mobilenet_v2_mid
+    # (adaptseg_tools.mobilenet_v2_140): every block, the stride-32 ones dilated to stay at 16.
+    "mnv2-140-b16": (1.4, 16),
+}
+
+
+def make_divisible(v: float, divisor: int = 8) -> int:
+    """Channels of width multiplier * nominal channels, as TF's MobileNetV2 rounds them (to a
+    multiple of 8, never below 90 % of the product)."""
+    n = max(divisor, int(v + divisor / 2) // divisor * divisor)
+    return n + divisor if n < 0.9 * v else n
+
+
+def encoder_layout(width: float, last_block: int) -> tuple[int, list[tuple[int, int, int, int]]]:
+    """Stem channels and (expansion, channels, stride, dilation) of blocks 0 .. last_block. Width
+    1.0 keeps the nominal channels (16 for expanded_conv where TF would round too). Output stride
+    16 as DeepLab's MobileNetV2 keeps it (TF-slim's output_stride): the block that would reach
+    stride 32 keeps stride 16, and the blocks after it dilate their depthwise convolutions by 2."""
+    if not 10 <= last_block < len(BLOCKS_FULL):
+        raise ValueError(f"last block {last_block}: 10 .. {len(BLOCKS_FULL) - 1}")
+    blocks, stride, rate = [], 2, 1
+    for t, c, s in BLOCKS_FULL[:last_block + 1]:
+        dilation = rate
+        if stride * s > 16:
+            s, rate = 1, rate * s
+        stride *= s
+        blocks.append((t, c if width == 1.0 else make_divisible(c * width), s, dilation))
+    return (32 if width == 1.0 else make_divisible(32 * width)), blocks
 
 
 def keras_pad(x: torch.Tensor) -> torch.Tensor:
@@ -62,9 +97,9 @@ def keras_pad(x: torch.Tensor) -> torch.Tensor:
 class ConvBN(nn.Sequential):
     """Convolution without bias, batch norm (eps 1e-3), optional ReLU6; stride 2 pads as TF."""
 
-    def __init__(self, cin, cout, k, stride=1, groups=1, relu6=True):
-        pad = 0 if stride == 2 else k // 2
-        layers = [nn.Conv2d(cin, cout, k, stride, pad, groups=groups, bias=False),
+    def __init__(self, cin, cout, k, stride=1, groups=1, relu6=True, dilation=1):
+        pad = 0 if stride == 2 else dilation * (k // 2)
+        layers = [nn.Conv2d(cin, cout, k, stride, pad, dilation=dilation, groups=groups, bias=False),
                   nn.BatchNorm2d(cout, eps=BN_EPS)]
         if relu6:
             layers.append(nn.ReLU6())
@@ -79,11 +114,11 @@ class InvertedResidual(nn.Module):
     """1x1 expansion (t > 1), 3x3 depthwise (stride s), linear 1x1 projection; identity shortcut
     when the shape is kept (Sandler et al., Fig. 4, Table 1)."""
 
-    def __init__(self, cin, t, cout, stride):
+    def __init__(self, cin, t, cout, stride, dilation=1):
         super().__init__()
         hidden = cin * t
         self.expand = ConvBN(cin, hidden, 1) if t != 1 else None
-        self.depthwise = ConvBN(hidden, hidden, 3, stride, groups=hidden)
+        self.depthwise = ConvBN(hidden, hidden, 3, stride, groups=hidden, dilation=dilation)
         self.project = ConvBN(hidden, cout, 1, relu6=False)
         self.residual = stride == 1 and cin == cout
 
@@ -94,20 +129,21 @@ class InvertedResidual(nn.Module):
 
 
 class MobileNetV2Encoder(nn.Module):
-    """Stem (3x3 stride-2 conv, 32 channels) and blocks expanded_conv, block_1 .. block_10 of
-    MobileNetV2 (width 1.0). forward() returns the features at strides 4, 8 and 16 (24, 32 and
-    96 channels: the outputs of block_2, block_5 and block_10)."""
+    """Stem (3x3 stride-2 conv) and blocks expanded_conv, block_1 .. block_<last_block> of
+    MobileNetV2 at a width multiplier; the default, width 1.0 to block_10, is the bundled networks'.
+    forward() returns the features at strides 4, 8 and 16 (the outputs of block_2, block_5 and the
+    last block: 24, 32 and 96 channels by default; `channels`)."""
 
-    channels = {4: 24, 8: 32, 16: 96}
-
-    def __init__(self):
+    def __init__(self, width: float = 1.0, last_block: int = 10):
         super().__init__()
-        self.stem = ConvBN(3, 32, 3, 2)
-        blocks, cin = [], 32
-        for t, c, s in BLOCKS:
-            blocks.append(InvertedResidual(cin, t, c, s))
+        stem, layout = encoder_layout(width, last_block)
+        self.stem = ConvBN(3, stem, 3, 2)
+        blocks, cin = [], stem
+        for t, c, s, d in layout:
+            blocks.append(InvertedResidual(cin, t, c, s, d))
             cin = c
         self.blocks = nn.ModuleList(blocks)
+        self.channels = {4: layout[2][1], 8: layout[5][1], 16: layout[-1][1]}
 
     def forward(self, x):
         x = self.stem(x)
@@ -116,7 +152,7 @@ class MobileNetV2Encoder(nn.Module):
             x = b(x)
             if i in TAPS:
                 feats[TAPS[i]] = x
-        return feats[4], feats[8], feats[16]
+        return feats[4], feats[8], x
 
 
 class SepConv(nn.Sequential):
@@ -162,10 +198,11 @@ class MobileNetV2Seg(nn.Module):
 
     stride = 4
 
-    def __init__(self, num_classes: int, dropout: float = 0.1, aspp=128, mid=96, low=64, image_pooling=True):
+    def __init__(self, num_classes: int, dropout: float = 0.1, aspp=128, mid=96, low=64, image_pooling=True,
+                 encoder: str = "mnv2-100-b10"):
         super().__init__()
-        c = MobileNetV2Encoder.channels
-        self.encoder = MobileNetV2Encoder()
+        self.encoder = MobileNetV2Encoder(*ENCODERS[encoder])
+        c = self.encoder.channels
         branches = [conv1x1(c[16], aspp)] + [SepConv(c[16], aspp, d) for d in (2, 4, 8)]
         if image_pooling:
             branches.append(ImagePooling(c[16], aspp))

@@ -79,7 +79,7 @@ import sys
 import time
 from pathlib import Path
 
-from . import REPO
+from . import REPO, mobilenet_v2
 from .training.export import export
 from .training.loop import train
 from .training.start import start
@@ -112,8 +112,12 @@ def build_parser() -> argparse.ArgumentParser:
                     help="--sampler device on CUDA: batches made ahead by a thread on a stream of its own (0: each "
                          "made when the step asks for it)")
     ap.add_argument("--width", type=float, default=0.5, help="ERFNet width multiplier")
+    ap.add_argument("--encoder", choices=tuple(mobilenet_v2.ENCODERS), default="mnv2-100-b10",
+                    help="MobileNetV2: the encoder (mobilenet_v2.ENCODERS): width 1.0 to block_10 (the bundled "
+                         "networks') or width 1.4, every block (adaptseg_tools.mobilenet_v2_140)")
     ap.add_argument("--encoder-weights", default="",
-                    help="MobileNetV2 encoder state_dict from mobilenet_v2.py (default: import with npm)")
+                    help="MobileNetV2 encoder state_dict from mobilenet_v2.py, or mobilenet_v2_140.py for "
+                         "--encoder mnv2-140-b16 (default: import with npm)")
     ap.add_argument("--init-weights", default="", metavar="MODEL_DIR",
                     help="start a new run from an exported model's weights (MODEL_DIR/model.pt, same "
                          "architecture and options), e.g. to train a bundled model further once its "

@@ -98,9 +98,13 @@ echo "ok: mirror wrote six ensembles of one mirrored member"
 LOTO_BUNDLE="$work/staged" refused "no temperature" mirror "$work/mir2"
 [ -e "$work/mir2" ] && fail "a refused mirror wrote files"
 
-# --- LOTO_ARCH: the ERFNet recipe has no deployment network to calibrate; an unknown one is refused ---
-LOTO_ARCH=erfnet refused "no ERFNet's yet" decision
-LOTO_ARCH=resnet refused "LOTO_ARCH=resnet: mobilenetv2 or erfnet" stage 2
+# --- LOTO_ARCH: the ERFNet and width-1.4 recipes have no deployment network to calibrate; an
+# unknown one is refused; a recipe's missing encoder weights are named ---
+LOTO_ARCH=erfnet refused "no erfnet one yet" decision
+LOTO_ARCH=mobilenetv2-140 refused "no mobilenetv2-140 one yet" decision
+LOTO_ARCH=resnet refused "LOTO_ARCH=resnet: mobilenetv2, mobilenetv2-140 or erfnet" stage 2
+(cd "$work" && mkdir -p repo/scripts && cp "$1"/scripts/loto.sh "$1"/scripts/loto_recipe.sh repo/scripts/)
+OUT="$work" loto="$work/repo/scripts/loto.sh" LOTO_ARCH=mobilenetv2-140 refused "no .device/mnv2_140_enc.pt" train 1
 
 # --- no subcommand: the usage, exit 2 ---
 bash "$loto" >"$work/out" 2>"$work/err"

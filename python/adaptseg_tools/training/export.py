@@ -16,7 +16,8 @@ import yaml
 
 from ..erfnet import ERFNetInference, erfnet_channels
 from ..fieldio import IGNORE
-from .models import net_spec
+from .. import mobilenet_v2
+from .models import DEFAULT_ENCODER, net_spec
 
 
 def export(model, ckpt, args, model_dir: Path, val_result):
@@ -59,12 +60,22 @@ def export(model, ckpt, args, model_dir: Path, val_result):
                 else "deconv: transposed convolutions exported as ConvTranspose"}
         dropout = [round(0.03 * ckpt["dropout_scale"], 4), round(0.3 * ckpt["dropout_scale"], 4)]
     else:
+        # The default encoder's words as every bundled model.yaml has them (a re-export stays the
+        # same file); another names itself (`encoder`, which load_exported reads).
+        encoder = ckpt.get("encoder", DEFAULT_ENCODER)
         arch = {"architecture": "MobileNetV2 encoder (Sandler et al. 2018, width 1.0, stem .. block_10, "
                                 "ImageNet weights from npm nsfwjs 4.3.0) + DeepLabv3+-style separable "
-                                "decoder (examples/tools/mobilenet_v2.py)",
-                "encoder_frozen_blocks": int(ckpt["frozen_blocks"]),
-                "image_pooling": bool(ckpt.get("image_pooling", False)),
-                "encoder_lr_scale": float(ckpt["encoder_lr_scale"])}
+                                "decoder (examples/tools/mobilenet_v2.py)"}
+        if encoder != DEFAULT_ENCODER:
+            width, last = mobilenet_v2.ENCODERS[encoder]
+            arch = {"architecture": f"MobileNetV2 encoder (Sandler et al. 2018, width {width:g}, stem .. "
+                                    f"block_{last}, the blocks past stride 16 dilated; ImageNet weights of "
+                                    "TF-Hub's mobilenet_v2_140_224 from npm nsfwjs 4.3.0) + DeepLabv3+-style "
+                                    "separable decoder (python/adaptseg_tools/mobilenet_v2_140.py)",
+                    "encoder": encoder}
+        arch.update({"encoder_frozen_blocks": int(ckpt["frozen_blocks"]),
+                     "image_pooling": bool(ckpt.get("image_pooling", False)),
+                     "encoder_lr_scale": float(ckpt["encoder_lr_scale"])})
         dropout = [float(ckpt["dropout"])]
     meta = {
         "format": "adaptseg-segnet-1",

@@ -15,12 +15,16 @@ from .. import mobilenet_v2
 from ..erfnet import ERFNet
 from .network_path import NetSpec
 
+# The encoder of a checkpoint or model.yaml that names none (all before 2026-12-04).
+DEFAULT_ENCODER = "mnv2-100-b10"
+
 
 def build_model(ckpt: dict, nc: int) -> nn.Module:
     if ckpt["arch"] == "erfnet":
         d = ckpt["dropout_scale"]
         return ERFNet(nc, ckpt["width"], 0.03 * d, 0.3 * d)
-    return mobilenet_v2.MobileNetV2Seg(nc, ckpt["dropout"], image_pooling=ckpt.get("image_pooling", False))
+    return mobilenet_v2.MobileNetV2Seg(nc, ckpt["dropout"], image_pooling=ckpt.get("image_pooling", False),
+                                       encoder=ckpt.get("encoder", DEFAULT_ENCODER))
 
 
 def frozen_encoder_modules(model, frozen_blocks: int):
@@ -57,7 +61,8 @@ def load_exported(model_dir: Path):
     if arch == "erfnet":
         ckpt.update(width=meta["width"], dropout_scale=1.0)
     else:
-        ckpt.update(dropout=0.0, image_pooling=bool(meta.get("image_pooling", False)))
+        ckpt.update(dropout=0.0, image_pooling=bool(meta.get("image_pooling", False)),
+                    encoder=meta.get("encoder", DEFAULT_ENCODER))
     model = build_model(ckpt, len(meta["classes"]))
     model.load_state_dict(torch.load(Path(model_dir) / "model.pt", map_location="cpu"))
     model.eval()

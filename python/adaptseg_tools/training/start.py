@@ -15,10 +15,10 @@ import numpy as np
 import torch
 import torch.nn as nn
 
-from .. import mobilenet_v2
+from .. import mobilenet_v2, mobilenet_v2_140
 from .fields import FieldData, load_field
 from .host_memory import keep_freed_memory
-from .models import build_model, frozen_encoder_modules, net_spec
+from .models import DEFAULT_ENCODER, build_model, frozen_encoder_modules, net_spec
 from .network_path import NetSpec, channel_stats
 
 
@@ -184,10 +184,13 @@ def new_checkpoint(args, train_names: list[str], train_fields: list[FieldData], 
             "weight_decay": args.weight_decay, "optimizer": "Adam" if erf else "AdamW", "sampler": args.sampler,
             "train_seconds": 0.0, "last_val": None, "devices": []}
     if erf:
+        if args.encoder != DEFAULT_ENCODER:
+            raise SystemExit(f"--encoder {args.encoder}: a MobileNetV2 option (--arch mobilenetv2)")
         ckpt.update(width=args.width, dropout_scale=args.dropout_scale)
     else:
         ckpt.update(dropout=args.dropout, frozen_blocks=args.frozen_blocks,
-                    encoder_lr_scale=args.encoder_lr_scale, image_pooling=not args.no_image_pooling)
+                    encoder_lr_scale=args.encoder_lr_scale, image_pooling=not args.no_image_pooling,
+                    encoder=args.encoder)
     return ckpt
 
 
@@ -213,9 +216,14 @@ def network(args, ckpt: dict, resume: bool, ckpt_path: Path, device, cuda: bool)
         ckpt["init_weights"] = str(args.init_weights)
         print(f"initialised from {src}", flush=True)
     elif not resume and ckpt["arch"] == "mobilenetv2":
+        importer = mobilenet_v2_140 if ckpt.get("encoder") == mobilenet_v2_140.ENCODER else mobilenet_v2
         enc = (torch.load(args.encoder_weights, map_location="cpu") if args.encoder_weights
-               else mobilenet_v2.import_weights(None))
-        model.encoder.load_state_dict(enc)
+               else importer.import_weights(None))
+        try:
+            model.encoder.load_state_dict(enc)
+        except RuntimeError as e:
+            raise SystemExit(f"--encoder-weights {args.encoder_weights}: not the weights of --encoder "
+                             f"{ckpt.get('encoder')} ({importer.__name__} writes those): {e}") from None
     for m in frozen_encoder_modules(model, ckpt.get("frozen_blocks", 0)):
         for p in m.parameters():
             p.requires_grad = False
