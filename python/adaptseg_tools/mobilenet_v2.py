@@ -340,11 +340,16 @@ def fetch_package(workdir: Path) -> Path:
     return workdir / "package"
 
 
-def import_weights(package: Path | None) -> dict[str, torch.Tensor]:
+def from_package(package: Path | None, use):
+    """use(unpacked package): of `package`, or of nsfwjs 4.3.0 fetched into a scratch folder."""
     if package is not None:
-        return encoder_state_dict(*load_tfjs(package))
+        return use(package)
     with tempfile.TemporaryDirectory() as tmp:
-        return encoder_state_dict(*load_tfjs(fetch_package(Path(tmp))))
+        return use(fetch_package(Path(tmp)))
+
+
+def import_weights(package: Path | None) -> dict[str, torch.Tensor]:
+    return from_package(package, lambda p: encoder_state_dict(*load_tfjs(p)))
 
 
 def main(argv=None):
@@ -352,12 +357,16 @@ def main(argv=None):
     ap.add_argument("--package", type=Path, help="unpacked nsfwjs 4.3.0 package (default: fetch with npm)")
     ap.add_argument("--out", type=Path, required=True, help="where to write the encoder state_dict (.pt)")
     args = ap.parse_args(argv)
-    sd = import_weights(args.package)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    torch.save(sd, args.out)
-    print(f"wrote {args.out}: MobileNetV2 stem .. block_{LAST_FROZEN_BLOCK}, "
-          f"{sum(v.numel() for k, v in sd.items() if not k.endswith('num_batches_tracked'))} values")
+    save_encoder(import_weights(args.package), args.out, f"MobileNetV2 stem .. block_{LAST_FROZEN_BLOCK}")
     return 0
+
+
+def save_encoder(sd: dict[str, torch.Tensor], out: Path, what: str):
+    """Writes an encoder state_dict for train_segnet --encoder-weights, saying what and how big."""
+    out.parent.mkdir(parents=True, exist_ok=True)
+    torch.save(sd, out)
+    print(f"wrote {out}: {what}, "
+          f"{sum(v.numel() for k, v in sd.items() if not k.endswith('num_batches_tracked'))} values")
 
 
 if __name__ == "__main__":

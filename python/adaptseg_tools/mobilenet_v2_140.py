@@ -42,7 +42,8 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from .mobilenet_v2 import BN_EPS, ENCODERS, MobileNetV2Encoder, dequantize, fetch_package, run_node
+from .mobilenet_v2 import (BN_EPS, ENCODERS, MobileNetV2Encoder, dequantize, from_package, run_node,
+                           save_encoder)
 
 ENCODER = "mnv2-140-b16"
 MODEL_DIR = "dist/models/mobilenet_v2_mid"
@@ -174,10 +175,7 @@ def check_tfjs(package: Path) -> int:
 
 
 def import_weights(package: Path | None) -> dict[str, torch.Tensor]:
-    if package is not None:
-        return encoder_state_dict(*load_graph(package))
-    with tempfile.TemporaryDirectory() as tmp:
-        return encoder_state_dict(*load_graph(fetch_package(Path(tmp))))
+    return from_package(package, lambda p: encoder_state_dict(*load_graph(p)))
 
 
 def main(argv=None):
@@ -187,17 +185,10 @@ def main(argv=None):
     ap.add_argument("--check-tfjs", action="store_true", help="compare the import with TF.js instead (docstring)")
     args = ap.parse_args(argv)
     if args.check_tfjs:
-        if args.package is not None:
-            return check_tfjs(args.package)
-        with tempfile.TemporaryDirectory() as tmp:
-            return check_tfjs(fetch_package(Path(tmp)))
+        return from_package(args.package, check_tfjs)
     if args.out is None:
         ap.error("--out is required (or --check-tfjs)")
-    sd = import_weights(args.package)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    torch.save(sd, args.out)
-    print(f"wrote {args.out}: MobileNetV2 1.4 stem .. block_16 ({ENCODER}), "
-          f"{sum(v.numel() for k, v in sd.items() if not k.endswith('num_batches_tracked'))} values")
+    save_encoder(import_weights(args.package), args.out, f"MobileNetV2 1.4 stem .. block_16 ({ENCODER})")
     return 0
 
 

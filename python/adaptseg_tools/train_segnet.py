@@ -1,6 +1,7 @@
 """Train a segmentation network for adaptseg's ONNX backend (adaptseg::ErfnetSegmenter) and
 export it: ERFNet from scratch (--arch erfnet) or MobileNetV2 with ImageNet weights and a
-light decoder (--arch mobilenetv2, adaptseg_tools.mobilenet_v2).
+light decoder (--arch mobilenetv2, adaptseg_tools.mobilenet_v2; --encoder mnv2-140-b16 for the
+width-1.4 one with every block, adaptseg_tools.mobilenet_v2_140).
 
 The network sees exactly what adaptseg's simulated camera produces (SimulatedSensor,
 include/adaptseg/vision/simulated_sensor.hpp): the footprint of a camera (default 480x360 px) at a

@@ -15,14 +15,12 @@ Needs torch, as eval_ensemble does: CTest's tools:class_map is skipped (exit 77)
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 import tempfile
 from pathlib import Path
 
-if importlib.util.find_spec("torch") is None:
-    print("torch is not installed (Debian python3-torch): skipped")
-    sys.exit(77)
+from tool_output import check, require_torch
+
+require_torch()
 
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
@@ -32,12 +30,6 @@ from adaptseg_tools import REPO, class_map  # noqa: E402
 from adaptseg_tools.eval_ensemble import load_member  # noqa: E402
 from adaptseg_tools.fieldio import IGNORE  # noqa: E402
 from adaptseg_tools.training.fields import load_field  # noqa: E402
-
-
-def check(cond: bool, what: str):
-    if not cond:
-        print(f"FAIL: {what}")
-        sys.exit(1)
 
 
 def refused(argv, fragment):

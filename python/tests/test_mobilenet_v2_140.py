@@ -19,15 +19,14 @@ Needs torch (Debian python3-torch): CTest's tools:mobilenet_v2_140 is skipped (e
 
 from __future__ import annotations
 
-import importlib.util
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
-if importlib.util.find_spec("torch") is None:
-    print("torch is not installed (Debian python3-torch): skipped")
-    sys.exit(77)
+from tool_output import check, require_torch
+
+require_torch()
 
 import numpy as np  # noqa: E402
 import torch  # noqa: E402
@@ -36,12 +35,6 @@ import yaml  # noqa: E402
 
 from adaptseg_tools import REPO, mobilenet_v2, mobilenet_v2_140  # noqa: E402
 from adaptseg_tools.training.models import load_exported  # noqa: E402
-
-
-def check(cond: bool, what: str):
-    if not cond:
-        print(f"FAIL: {what}")
-        sys.exit(1)
 
 
 def refused(fn, fragment: str):

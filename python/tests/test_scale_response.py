@@ -17,23 +17,15 @@ Needs torch (Debian python3-torch), as eval_ensemble does: CTest's tools:scale_r
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import sys
 
-if importlib.util.find_spec("torch") is None:
-    print("torch is not installed (Debian python3-torch): skipped")
-    sys.exit(77)
+from tool_output import check, require_torch
+
+require_torch()
 
 import yaml  # noqa: E402
 
 from adaptseg_tools import REPO, scale_response  # noqa: E402
-
-
-def check(cond: bool, what: str):
-    if not cond:
-        print(f"FAIL: {what}")
-        sys.exit(1)
 
 
 def main():

@@ -1,10 +1,26 @@
 """Shared by the Python tools' self-tests (python/tests/test_*.py, run by CTest as scripts, so
-this folder is on the import path): a tool's main() run in-process and what it printed."""
+this folder is on the import path): a tool's main() run in-process and what it printed; the
+skip without torch and the failing check."""
 import contextlib
+import importlib.util
 import io
 import os
 import sys
 import tempfile
+
+
+def require_torch():
+    """Exits 77 (CTest's skip) where torch is not installed, saying so."""
+    if importlib.util.find_spec("torch") is None:
+        print("torch is not installed (Debian python3-torch): skipped")
+        sys.exit(77)
+
+
+def check(cond: bool, what: str):
+    """Exits 1 with FAIL: what, where cond is false."""
+    if not cond:
+        print(f"FAIL: {what}")
+        sys.exit(1)
 
 
 def printed(main, argv):
