@@ -35,7 +35,11 @@
 #       memory kept; about five hours before, when glibc unmapped and faulted in each step's
 #       activations again: benchmarks/train_cpu.sh, docs/benchmarks.md). What
 #       rebuilds the bundled leave-one-tile-out networks (examples/models/mobilenetv2-dubai-loto)
-#       when their checkpoints are gone.
+#       when their checkpoints are gone. LOTO_STEP_CAP=N (environment): the recipe's cycle in N
+#       steps instead (its warm-up as it is), to compare two recipes on the CPU in less time, e.g.
+#       LOTO_STEP_CAP=300 LOTO_WORK=out/ab-100 bash scripts/loto.sh recipe-cpu 4 beside
+#       LOTO_ARCH=mobilenetv2-140 LOTO_STEP_CAP=300 LOTO_WORK=out/ab-140 ... (held-out mIoU in
+#       LOTO_WORK/eval-<k>.json; never bundle such networks).
 #   bash scripts/loto.sh bundle
 #       here, once out/loto/model-<k> exist for k = 1..6 (recipe-cpu, or eval after a device
 #       call; a tile bundled already, examples/models/mobilenetv2-dubai-loto/tile-<k>, is taken
@@ -282,7 +286,7 @@ recipe-cpu)
       "$py" -m adaptseg_tools.train_segnet "${loto_recipe[@]}" --seed "${LOTO_SEED:-0}" \
         --sampler cpu --device cpu --workers 1 --threads "${LOTO_THREADS:-2}" --train-fields "$(train_fields "$k")" \
         --val-field "dubai-tile-$k" --test-field none --val-every 0 --ckpt-every 100 --log-every 50 --no-export \
-        --steps "$loto_steps" "${loto_batch[@]}" --work-dir "$work" --model-dir "$wroot/unused-$k" \
+        --steps "${LOTO_STEP_CAP:-$loto_steps}" "${loto_batch[@]}" --work-dir "$work" --model-dir "$wroot/unused-$k" \
         "${resume[@]}" >>"$wroot/train-$k.log" 2>&1 || { echo "training $k failed: $wroot/train-$k.log" >&2; exit 1; }
       date -u +%FT%TZ >"$work/done"
     fi

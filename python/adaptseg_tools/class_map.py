@@ -32,15 +32,26 @@ from .training.fields import capture, lawnmower_rects, load_field
 HIT, FALSE, MISS, REST = (0, 200, 0), (0, 0, 255), (0, 128, 255), (40, 40, 40)  # BGR
 
 
-def painted_labels(model, spec, meta, field, gsd_cm: float) -> np.ndarray:
+def painted_labels(model, spec, meta, field, gsd_cm: float, images: list | None = None) -> np.ndarray:
     """The field's frame (its labels' shape) with each lawnmower image's labels at `gsd_cm`
-    painted in, in flight order; IGNORE where no image fell."""
+    painted in, in flight order; IGNORE where no image fell. With `images`, appends per image
+    with labelled ground its footprint's origin (c0, r0, field pixels), the number of its labelled
+    field pixels the network gives each class (`predicted`) and the labels give each class
+    (`true`), and the mean top-class probability over them (`confidence`)."""
     out = np.full(field.labels.shape, IGNORE, np.uint8)
     h, w = out.shape
+    nc = len(field.classes)
     for (c0, r0, fw, fh) in lawnmower_rects(field, gsd_cm, tuple(spec.camera_wh)):
-        bgr, _, _ = capture(field, c0, r0, fw, fh, tuple(spec.camera_wh))
-        lab = member_probabilities(model, spec, meta, bgr).argmax(0).astype(np.uint8)
-        lab = cv2.resize(lab, (fw, fh), interpolation=cv2.INTER_NEAREST_EXACT)
+        bgr, _, truth = capture(field, c0, r0, fw, fh, tuple(spec.camera_wh))
+        prob = member_probabilities(model, spec, meta, bgr)
+        lab = cv2.resize(prob.argmax(0).astype(np.uint8), (fw, fh), interpolation=cv2.INTER_NEAREST_EXACT)
+        valid = truth != IGNORE  # the footprint's labels, at the field's resolution as `lab`
+        if images is not None and valid.any():
+            top = cv2.resize(prob.max(0).astype(np.float32), (fw, fh), interpolation=cv2.INTER_NEAREST_EXACT)
+            images.append({"c0": c0, "r0": r0, "pixels": int(valid.sum()),
+                           "predicted": np.bincount(lab[valid], minlength=nc)[:nc],
+                           "true": np.bincount(truth[valid], minlength=nc)[:nc],
+                           "confidence": float(top[valid].mean())})
         ra, ca, rb, cb = max(r0, 0), max(c0, 0), min(r0 + fh, h), min(c0 + fw, w)
         out[ra:rb, ca:cb] = lab[ra - r0:rb - r0, ca - c0:cb - c0]
     return out
@@ -72,6 +83,8 @@ def main(argv=None):
     ap.add_argument("--bands", default="1,3", help="GSD factors of the field's GSD (default 1,3)")
     ap.add_argument("--scale", type=int, default=4, help="the picture's reduction (default 4)")
     ap.add_argument("--out", default="out/class_map.png")
+    ap.add_argument("--images", type=int, default=0, metavar="N",
+                    help="also list per band the N images whose share of the class most exceeds the truth's")
     ap.add_argument("--threads", type=int, default=2)
     args = ap.parse_args(argv)
     torch.set_num_threads(args.threads)
@@ -82,8 +95,8 @@ def main(argv=None):
         bands = [float(v) for v in args.bands.split(",")]
     except ValueError:
         raise SystemExit(f"--bands {args.bands}: comma-separated numbers") from None
-    if not bands or min(bands) <= 0 or args.scale < 1:
-        raise SystemExit("--bands must be positive factors and --scale at least 1")
+    if not bands or min(bands) <= 0 or args.scale < 1 or args.images < 0:
+        raise SystemExit("--bands must be positive factors, --scale at least 1 and --images not negative")
     model, spec, meta = load_member(Path(args.network))
     if meta["classes"] != field.classes:
         raise SystemExit(f"{args.network}: classes {meta['classes']} differ from the field's {field.classes}")
@@ -92,17 +105,30 @@ def main(argv=None):
     def small(img):
         return cv2.resize(img, None, fx=1 / args.scale, fy=1 / args.scale, interpolation=cv2.INTER_AREA)
 
-    panels = [small(field.image)]
+    panels, listed = [small(field.image)], {}
     print(f"| {field.name}, {args.cls} | IoU | predicted share | true share |")
     print("| --- | ---: | ---: | ---: |")
     for fac in bands:
         gsd = field.gsd_cm * fac
-        labels = painted_labels(model, spec, meta, field, gsd)
+        images = []
+        labels = painted_labels(model, spec, meta, field, gsd, images)
         n = class_counts(labels, field.labels, cls)
         iou = n["hit"] / max(1, n["hit"] + n["false"] + n["miss"])
         print(f"| {gsd:g} cm/px | {iou:.3f} | {(n['hit'] + n['false']) / n['ground']:.4f} | "
               f"{(n['hit'] + n['miss']) / n['ground']:.4f} |")
         panels.append(small(panel(labels, field.labels, cls)))
+        listed[gsd] = sorted(images, key=lambda m: (m["true"][cls] - m["predicted"][cls]) / m["pixels"])[:args.images]
+    for gsd, images in listed.items():
+        if not images:
+            continue
+        print(f"\n{gsd:g} cm/px, the {len(images)} images whose share of {args.cls} most exceeds the truth's "
+              f"(footprint origin in field pixels; the class the labels give most of the image):")
+        print(f"| c0 | r0 | predicted {args.cls} | true {args.cls} | mostly, truly | mean top probability |")
+        print("| ---: | ---: | ---: | ---: | --- | ---: |")
+        for m in images:
+            top = int(np.argmax(m["true"]))
+            print(f"| {m['c0']} | {m['r0']} | {m['predicted'][cls] / m['pixels']:.2f} | {m['true'][cls] / m['pixels']:.2f} | "
+                  f"{field.classes[top]} {m['true'][top] / m['pixels']:.2f} | {m['confidence']:.2f} |")
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     cv2.imwrite(str(out), np.concatenate(panels, axis=1))
