@@ -60,7 +60,7 @@ ENCODERS = {
     # Keras Applications MobileNetV2 1.0 from nsfwjs's mobilenet_v2 (this module): stem .. block_10.
     "mnv2-100-b10": (1.0, 10),
     # TF-Hub's MobileNetV2 1.4 (imagenet/mobilenet_v2_140_224) from nsfwjs's mobilenet_v2_mid
-    # (adaptseg_tools.mobilenet_v2_140): every block, the stride-32 ones dilated to stay at 16.
+    # (adaptseg_tools.mobilenet_v2_140): every block at output stride 16 (encoder_layout).
     "mnv2-140-b16": (1.4, 16),
 }
 

@@ -69,7 +69,7 @@ def export(model, ckpt, args, model_dir: Path, val_result):
         if encoder != DEFAULT_ENCODER:
             width, last = mobilenet_v2.ENCODERS[encoder]
             arch = {"architecture": f"MobileNetV2 encoder (Sandler et al. 2018, width {width:g}, stem .. "
-                                    f"block_{last}, the blocks past stride 16 dilated; ImageNet weights of "
+                                    f"block_{last} at output stride 16, the blocks after block_13 dilated by 2; ImageNet weights of "
                                     "TF-Hub's mobilenet_v2_140_224 from npm nsfwjs 4.3.0) + DeepLabv3+-style "
                                     "separable decoder (python/adaptseg_tools/mobilenet_v2_140.py)",
                     "encoder": encoder}
