@@ -406,7 +406,7 @@ ensemble)
   echo "wrote $to/tile-{1..6}/ensemble.yaml"
   ;;
 *)
-  sed -n '2,93p' "$0" >&2
+  sed -n '2,/^set -euo pipefail/{/^set -euo pipefail/!p}' "$0" >&2  # the comment above, whatever its length
   exit 2
   ;;
 esac
