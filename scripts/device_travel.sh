@@ -13,7 +13,7 @@
 #       not restored.
 #   bash scripts/device_travel.sh restore
 #       moves everything in .device-aside/ back where it was, refusing to overwrite a file that
-#       has reappeared there, then checks that git misses no tracked file.
+#       has reappeared there, then checks that git misses no tracked file under what was set aside.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 limit=$((64 * 1024 * 1024))
@@ -44,7 +44,7 @@ size() {
   done
   total=$((total + carried))
   echo "largest files of the work tree that travel:"
-  sort -rn "$list" | head -5 | awk '{ printf "  %10d  %s\n", $1, substr($0, index($0, " ") + 1) }'
+  sort -rn "$list" | awk 'NR <= 5 { printf "  %10d  %s\n", $1, substr($0, index($0, " ") + 1) }'
   awk -v t="$total" -v l="$limit" 'BEGIN { printf "travels: %d bytes (%.1f MiB) of %.0f MiB\n", t, t / 1048576, l / 1048576 }'
   if [ "$total" -gt "$limit" ]; then
     echo "over the limit by $((total - limit)) bytes: bash $0 aside [PATH...] first" >&2
