@@ -63,6 +63,9 @@ ENCODERS = {
     # (adaptseg_tools.mobilenet_v2_140): every block at output stride 16 (encoder_layout).
     "mnv2-140-b16": (1.4, 16),
 }
+# The bundled networks' encoder, and that of a checkpoint or model.yaml that names none (all
+# before 2026-12-04).
+DEFAULT_ENCODER = "mnv2-100-b10"
 
 
 def make_divisible(v: float, divisor: int = 8) -> int:
@@ -199,7 +202,7 @@ class MobileNetV2Seg(nn.Module):
     stride = 4
 
     def __init__(self, num_classes: int, dropout: float = 0.1, aspp=128, mid=96, low=64, image_pooling=True,
-                 encoder: str = "mnv2-100-b10"):
+                 encoder: str = DEFAULT_ENCODER):
         super().__init__()
         self.encoder = MobileNetV2Encoder(*ENCODERS[encoder])
         c = self.encoder.channels

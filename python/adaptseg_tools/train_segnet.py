@@ -113,7 +113,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help="--sampler device on CUDA: batches made ahead by a thread on a stream of its own (0: each "
                          "made when the step asks for it)")
     ap.add_argument("--width", type=float, default=0.5, help="ERFNet width multiplier")
-    ap.add_argument("--encoder", choices=tuple(mobilenet_v2.ENCODERS), default="mnv2-100-b10",
+    ap.add_argument("--encoder", choices=tuple(mobilenet_v2.ENCODERS), default=mobilenet_v2.DEFAULT_ENCODER,
                     help="MobileNetV2: the encoder (mobilenet_v2.ENCODERS): width 1.0 to block_10 (the bundled "
                          "networks') or width 1.4, every block (adaptseg_tools.mobilenet_v2_140)")
     ap.add_argument("--encoder-weights", default="",

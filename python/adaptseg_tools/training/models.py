@@ -15,8 +15,7 @@ from .. import mobilenet_v2
 from ..erfnet import ERFNet
 from .network_path import NetSpec
 
-# The encoder of a checkpoint or model.yaml that names none (all before 2026-12-04).
-DEFAULT_ENCODER = "mnv2-100-b10"
+DEFAULT_ENCODER = mobilenet_v2.DEFAULT_ENCODER  # export.py and start.py read it from here
 
 
 def build_model(ckpt: dict, nc: int) -> nn.Module:
