@@ -25,6 +25,10 @@
 #   bash scripts/loto.sh eval DIR
 #       here: exports every DIR/loto-<k>.pt (PyTorch 1.13 and OpenCV 4.6 check it loads and
 #       matches) to out/loto/model-<k>/ and prints its field mIoU on tile k.
+#   bash scripts/loto.sh scores [FILE...]
+#       here: the table eval ends with (each held-out tile's field mIoU per GSD, their mean, the
+#       classes' mean IoU) from LOTO_WORK's eval-<k>.json, or from the FILEs given (one network's
+#       eval_ensemble --json on its held-out tile), e.g. a bundled set's tile-*/held_out_eval.json.
 #   bash scripts/loto.sh recipe-cpu TILES
 #       here, no accelerator: the deployment recipe itself (1784 steps of 32 crops, seed 0; the
 #       GPU run's schedule without --minutes) on the CPU, one held-out tile after another (TILES
@@ -142,6 +146,33 @@ train_fields() {  # every bundled tile but $1, comma-separated
   echo "$out"
 }
 
+# The estimate from held-out scores (eval_ensemble --json of one network on its tile, as eval and
+# recipe-cpu write them): each held-out tile's field mIoU per GSD, their mean, and per class.
+print_scores() {
+  local f
+  for f in "$@"; do [ -s "$f" ] || { echo "no $f: bash $0 eval DIR or recipe-cpu first" >&2; exit 2; }; done
+  "$py" - "$@" <<'PY'
+import json, sys
+rows, classes = [], None
+for path in sys.argv[1:]:
+    d = json.load(open(path))
+    classes = d["classes"]
+    (name, bands), = d["fields"].items()
+    (member,) = d["members"]
+    rows.append((name, {b["gsd_cm"]: b[member] for b in bands.values()}))
+gsds = sorted({g for _, r in rows for g in r})
+print("| held-out tile | " + " | ".join(f"{g:g} cm/px" for g in gsds) + " |")
+print("| --- |" + " ---: |" * len(gsds))
+for name, r in rows:
+    print(f"| {name} | " + " | ".join(f"{r[g]['miou']:.3f}" for g in gsds) + " |")
+print("| mean | " + " | ".join(f"{sum(r[g]['miou'] for _, r in rows) / len(rows):.3f}" for g in gsds) + " |")
+print("\nclass IoU, mean over the held-out tiles (tiles where the class occurs):")
+for c, cls in enumerate(classes):
+    vals = {g: [r[g]["iou"][c] for _, r in rows if r[g]["iou"][c] is not None] for g in gsds}
+    print(f"  {cls:<11}" + "  ".join(f"{g:g} cm/px {sum(v) / len(v):.3f} (n={len(v)})" for g, v in vals.items() if v))
+PY
+}
+
 # Tile $1's network trained here ($wroot/model-k, its training and held-out scores) into
 # $dest/tile-k, as it was exported (bundle then sets its temperature).
 stage_tile() {
@@ -252,27 +283,11 @@ eval)
     "$py" -m adaptseg_tools.eval_ensemble --members "loto$k=$wroot/model-$k" \
       --fields "examples/data/dubai-tile-$k" --bands 1,2,3 --json "$wroot/eval-$k.json"
   done
-  # The estimate: each held-out tile's field mIoU per GSD, their mean, and per class.
-  "$py" - "$wroot"/eval-*.json <<'PY'
-import json, sys
-rows, classes = [], None
-for path in sys.argv[1:]:
-    d = json.load(open(path))
-    classes = d["classes"]
-    (name, bands), = d["fields"].items()
-    (member,) = d["members"]
-    rows.append((name, {b["gsd_cm"]: b[member] for b in bands.values()}))
-gsds = sorted({g for _, r in rows for g in r})
-print("| held-out tile | " + " | ".join(f"{g:g} cm/px" for g in gsds) + " |")
-print("| --- |" + " ---: |" * len(gsds))
-for name, r in rows:
-    print(f"| {name} | " + " | ".join(f"{r[g]['miou']:.3f}" for g in gsds) + " |")
-print("| mean | " + " | ".join(f"{sum(r[g]['miou'] for _, r in rows) / len(rows):.3f}" for g in gsds) + " |")
-print("\nclass IoU, mean over the held-out tiles (tiles where the class occurs):")
-for c, cls in enumerate(classes):
-    vals = {g: [r[g]["iou"][c] for _, r in rows if r[g]["iou"][c] is not None] for g in gsds}
-    print(f"  {cls:<11}" + "  ".join(f"{g:g} cm/px {sum(v) / len(v):.3f} (n={len(v)})" for g, v in vals.items() if v))
-PY
+  print_scores "$wroot"/eval-*.json
+  ;;
+scores)
+  shift
+  if [ $# -gt 0 ]; then print_scores "$@"; else print_scores "$wroot"/eval-*.json; fi
   ;;
 recipe-cpu)
   IFS=, read -r -a tiles <<<"${2:-1,2,3,4,5,6}"

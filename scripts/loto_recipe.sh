@@ -7,8 +7,8 @@
 #                          weights), 1784 steps of 32 crops of 300 px
 #   mobilenetv2-140        the same recipe on the width-1.4 MobileNetV2 with every block
 #                          (train_segnet --encoder mnv2-140-b16, adaptseg_tools.mobilenet_v2_140):
-#                          TF-Hub's ImageNet weights from .device/mnv2_140_enc.pt; about 2.7 times
-#                          the CPU time a step (2-core VM)
+#                          TF-Hub's ImageNet weights from .device/mnv2_140_enc.pt; about twice
+#                          the CPU time a step (2-core VM, alone: 8.5 against 18 crops a second)
 #   erfnet                 the bundled ERFNet's first learning-rate cycle (its README's "The run":
 #                          examples/models/erfnet-dubai/README.md): full width, from scratch, at most
 #                          1563 steps of 32 crops of 352 px; cycle 2 gained nothing on its validation tile
