@@ -1,0 +1,102 @@
+#!/usr/bin/env python3
+"""Self-test of two_looks.py (run by CTest; exit code != 0 on failure).
+
+1. compare() on a hand-made field of eight pixels and two classes, every measure worked out by
+   hand: the two maps' IoU, the pooled map (weights 1 / GSD), the union, the additions and
+   removals with how often each is right, the bonuses and the break-even.
+2. A lawnmower fused with itself changes nothing: pooled, union, top and fine are one map, the
+   bonuses 0, nothing added or removed.
+3. The bundled leave-one-tile-out network of tile 1 on tile 1: its 15 cm/px lawnmower painted as
+   log-probabilities gives each class the IoU its training recorded in model.yaml (within 0.002,
+   as class_map's painter); main() with --bands 2 prints a row per class and the summary.
+4. Bad bands, an unknown class and an odd list of NETWORK FIELD are refused.
+
+Part 3 needs torch, as eval_ensemble does: CTest's tools:two_looks is skipped (exit 77) without it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from tool_output import check, check_refused, printed, require_torch
+
+from adaptseg_tools import two_looks
+
+
+def log_probs(labels, sure):
+    """2 x 1 x N log-probabilities: each pixel's label with probability `sure`, the other 1 − sure."""
+    lab = np.array(labels)[None, :]
+    p1 = np.where(lab == 1, sure, 1.0 - sure)
+    return np.log(np.stack([1.0 - p1, p1])).astype(np.float32)
+
+
+def hand_made():
+    # truth:        1 1 1 1 0 0 0 0
+    # top  (15):    1 1 0 0 1 0 0 0   sure 0.9 except pixels 2 and 4 (0.6)
+    # fine (5):     1 0 1 1 1 1 0 0   sure 0.8
+    truth = np.array([[1, 1, 1, 1, 0, 0, 0, 0]], np.uint8)
+    top = log_probs([1, 1, 0, 0, 1, 0, 0, 0], 0.9)
+    top[:, 0, 2] = np.log([0.6, 0.4])
+    top[:, 0, 4] = np.log([0.4, 0.6])
+    fine = log_probs([1, 0, 1, 1, 1, 1, 0, 0], 0.8)
+    r = two_looks.compare(top, fine, 15.0, 5.0, truth, 1)
+    # top: L at 0, 1, 4 → TP 2, FP 1, FN 2: IoU 2/5. fine: L at 0, 2, 3, 4, 5 → TP 3, FP 2, FN 1: 3/6.
+    check(math.isclose(r["top"], 0.4) and math.isclose(r["fine"], 0.5), f"top {r['top']}, fine {r['fine']}")
+    # pooled, per pixel log p / 15 + log p' / 5 (fine weighs three times): pixel 1, top sure L (0.9)
+    # against fine's 0.8 for 0: ln 0.9/15 + ln 0.2/5 < ln 0.1/15 + ln 0.8/5, so 0; pixels 2, 3 the
+    # fine look's L; 4, 5 L (fine says L); 0 L. Pooled L at 0, 2, 3, 4, 5 = fine: IoU 3/6.
+    check(math.isclose(r["pooled"], 0.5), f"pooled {r['pooled']}")
+    # union: L at 0..5 → TP 4, FP 2: IoU 4/6.
+    check(math.isclose(r["union"], 4 / 6), f"union {r['union']}")
+    # added (fine L, top not): 2, 3, 5 over 8 pixels, right at 2 and 3; removed (top L, fine not): 1, wrong.
+    check(math.isclose(r["added"], 3 / 8) and math.isclose(r["added_right"], 2 / 3), f"added {r}")
+    check(math.isclose(r["removed"], 1 / 8) and r["removed_right"] == 0.0, f"removed {r}")
+    check(math.isclose(r["pooled_bonus"], 0.0) and math.isclose(r["union_bonus"], 4 / 6 - 0.5), f"bonuses {r}")
+    check(math.isclose(r["break_even"], 0.4 / 1.4), f"break-even {r['break_even']}")
+    # Ignored pixels count nowhere: the same with two more pixels the labels ignore.
+    wide = np.concatenate([truth, np.array([[255, 255]], np.uint8)], axis=1)
+    pad = np.log(np.full((2, 1, 2), 0.5, np.float32))
+    r2 = two_looks.compare(np.concatenate([top, pad], 2), np.concatenate([fine, pad], 2), 15.0, 5.0, wide, 1)
+    check(all(math.isclose(r[k], r2[k]) for k in ("top", "pooled", "union", "added", "removed")), f"{r2}")
+    print("ok: the hand-made field's measures")
+
+
+def main():
+    hand_made()
+    require_torch()
+    from adaptseg_tools import REPO
+    from adaptseg_tools.eval_ensemble import load_member
+    from adaptseg_tools.training.fields import load_field
+    import yaml
+
+    net = REPO / "examples" / "models" / "mobilenetv2-dubai-loto" / "tile-1"
+    fdir = REPO / "examples" / "data" / "dubai-tile-1"
+    field = load_field(fdir)
+    model, spec, meta = load_member(net)
+    lp = two_looks.painted_log_probabilities(model, spec, meta, field, 3 * field.gsd_cm)
+    record = next(b for b in yaml.safe_load((net / "model.yaml").read_text())["validation"]["bands"]
+                  if b["gsd_factor"] == 3.0)
+    for c, name in enumerate(field.classes):
+        r = two_looks.compare(lp, lp, 15.0, 15.0, field.labels, c)
+        check(abs(r["top"] - record["iou_ortho"][c]) < 0.002,
+              f"{name}: painted IoU {r['top']:.4f} against the recorded {record['iou_ortho'][c]:.4f}")
+        check(r["top"] == r["fine"] == r["pooled"] == r["union"] and r["added"] == r["removed"] == 0.0
+              and r["pooled_bonus"] == r["union_bonus"] == 0.0, f"{name}: a lawnmower fused with itself: {r}")
+    print("ok: tile 1's lawnmower: the recorded IoU; fused with itself, the same map")
+
+    rc, text = printed(two_looks.main, [str(net), str(fdir), "--bands", "2"])
+    check(rc is None, f"main returned {rc}")
+    for name in ("building", "road", "vegetation", "water"):
+        check(f"| {name} | dubai-tile-1 | 15 → 10 |" in text, f"no row for {name}:\n{text}")
+        check(f"| {name} | 10 | 1 |" in text, f"no summary for {name}:\n{text}")
+    print("ok: main prints a row and a summary per class")
+
+    check_refused(two_looks.main, [str(net), str(fdir), "--bands", "3"], "below --top", "a band as coarse as the top")
+    check_refused(two_looks.main, [str(net), str(fdir), "--classes", "forest"], "no class forest", "an unknown class")
+    check_refused(two_looks.main, [str(net)], "NETWORK FIELD", "a network without its field")
+    print("two_looks: all checks passed")
+
+
+if __name__ == "__main__":
+    main()
