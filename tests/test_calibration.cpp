@@ -1257,8 +1257,14 @@ TEST_CASE("decision model: file round trip and compatibility checks") {
     t::write_file(tmp.path() / "bad_fusion.yaml",
                   std::string(text).replace(text.find("map_fusion: pooled"), 18, "map_fusion: mean"));
     CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "bad_fusion.yaml"),
-                         doctest::Contains("map fusion must be 'finest' or 'pooled', not 'mean'"),
+                         doctest::Contains("map fusion must be 'finest', 'pooled' or 'pooled-interest', not 'mean'"),
                          std::invalid_argument);
+    DecisionModel kept = m;
+    kept.map_fusion = MapFusion::pooled_interest;
+    kept.save(tmp.path() / "kept.yaml");
+    CHECK(t::read_file(tmp.path() / "kept.yaml").find("map_fusion: pooled-interest\n") != std::string::npos);
+    CHECK(DecisionModel::load(tmp.path() / "kept.yaml").adaptive_options(MissionOptions{}).mission.map_fusion ==
+          MapFusion::pooled_interest);
   }
   {  // the vertical speed limit: kept when set, absent from the file (0) when not
     CHECK(back.timing.max_vertical_speed_mps == 0.0);

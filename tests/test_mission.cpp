@@ -138,4 +138,12 @@ TEST_CASE("mission: a pooled map maps WeedMap at the field's GSD exactly and nee
   CHECK_THROWS_WITH_AS((void)run_lawnmower_mission(f, f.gsd_cm(), labels_only, o),
                        doctest::Contains("map fusion 'pooled' needs a backend that gives class probabilities"),
                        std::invalid_argument);
+  // Keeping the labels of interest any image gave changes nothing where every look is sure, and
+  // needs the probabilities as well.
+  o.map_fusion = MapFusion::pooled_interest;
+  const MissionResult kept = run_lawnmower_mission(f, f.gsd_cm(), oracle, o);
+  CHECK(cv::countNonZero(kept.fused_labels != finest.fused_labels) == 0);
+  CHECK_THROWS_WITH_AS((void)run_lawnmower_mission(f, f.gsd_cm(), labels_only, o),
+                       doctest::Contains("map fusion 'pooled-interest' needs a backend that gives class probabilities"),
+                       std::invalid_argument);
 }

@@ -203,6 +203,62 @@ TEST_CASE("map, pooled: a sure coarse look keeps what an unsure finer look contr
   CHECK(cv::countNonZero(finest.labels() == 1) == 12);
 }
 
+TEST_CASE("map, pooled-interest: a label of interest any look gave stays, whichever look pooling prefers") {
+  // As the pooled case above: a coarse look (GSD 3) sure of class 0, a finer one (GSD 1) unsure of
+  // class 1 over the upper-left quarter; pooling keeps 0 there, keeping class 1 of interest gives 1.
+  SemanticMap pooled(cv::Size(8, 6), 255, MapFusion::pooled);
+  SemanticMap kept(cv::Size(8, 6), 255, MapFusion::pooled_interest, {1});
+  SemanticMap other(cv::Size(8, 6), 255, MapFusion::pooled_interest, {2});  // no look says 2
+  for (SemanticMap* m : {&pooled, &kept, &other}) {
+    m->fuse(image_at({0, 0, 8, 6}, 3.0), uniform_segmentation(4, 3, 3, 0, 0.9f));
+    m->fuse(image_at({0, 0, 4, 3}, 1.0), uniform_segmentation(4, 3, 3, 1, 0.4f));
+  }
+  CHECK(kept.fusion() == MapFusion::pooled_interest);
+  CHECK(cv::countNonZero(pooled.labels() == 0) == 48);
+  CHECK(cv::countNonZero(kept.labels() == 1) == 12);
+  CHECK(cv::countNonZero(kept.labels() == 0) == 36);
+  CHECK(cv::countNonZero(other.labels() != pooled.labels()) == 0);
+  CHECK(cv::countNonZero(kept.gsd_cm() != pooled.gsd_cm()) == 0);
+
+  // A sure closer look does not remove a label of interest a coarse look gave: coarse says 1
+  // (0.9), the closer look 0 (0.95) over the quarter. Pooled: 0 there; kept: 1 everywhere.
+  SemanticMap removed(cv::Size(8, 6), 255, MapFusion::pooled),
+      stays(cv::Size(8, 6), 255, MapFusion::pooled_interest, {1});
+  for (SemanticMap* m : {&removed, &stays}) {
+    m->fuse(image_at({0, 0, 8, 6}, 3.0), uniform_segmentation(4, 3, 3, 1, 0.9f));
+    m->fuse(image_at({0, 0, 4, 3}, 1.0), uniform_segmentation(4, 3, 3, 0, 0.95f));
+  }
+  CHECK(cv::countNonZero(removed.labels() == 0) == 12);
+  CHECK(cv::countNonZero(stays.labels() == 1) == 48);
+
+  // Two labels of interest, both seen in the quarter: the one of the larger pooled sum. Coarse 0
+  // (0.9); then 1 (0.4; 0 and 2 at 0.3); then 2 (0.5; 0 and 1 at 0.25). Sums: 0: ln 0.9 / 3 +
+  // ln 0.3 + ln 0.25 = -2.625; 1: ln 0.05 / 3 + ln 0.4 + ln 0.25 = -3.301; 2: ln 0.05 / 3 +
+  // ln 0.3 + ln 0.5 = -2.896. Pooled: 0; of interest {1, 2}: 2; of interest {1} alone: 1.
+  SemanticMap both(cv::Size(8, 6), 255, MapFusion::pooled_interest, {1, 2});
+  SemanticMap one(cv::Size(8, 6), 255, MapFusion::pooled_interest, {1});
+  for (SemanticMap* m : {&both, &one}) {
+    m->fuse(image_at({0, 0, 8, 6}, 3.0), uniform_segmentation(4, 3, 3, 0, 0.9f));
+    m->fuse(image_at({0, 0, 4, 3}, 1.0), uniform_segmentation(4, 3, 3, 1, 0.4f));
+    m->fuse(image_at({0, 0, 4, 3}, 1.0), uniform_segmentation(4, 3, 3, 2, 0.5f));
+  }
+  CHECK(cv::countNonZero(both.labels() == 2) == 12);
+  CHECK(cv::countNonZero(one.labels() == 1) == 12);
+  CHECK(cv::countNonZero(both.labels() == 0) == 36);
+
+  // It needs one to eight labels of interest, each a label.
+  CHECK_THROWS_WITH_AS(SemanticMap(cv::Size(8, 6), 255, MapFusion::pooled_interest),
+                       doctest::Contains("needs one to eight labels of interest"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(SemanticMap(cv::Size(8, 6), 255, MapFusion::pooled_interest, {0, 1, 2, 3, 4, 5, 6, 7, 8}),
+                       doctest::Contains("needs one to eight labels of interest"), std::invalid_argument);
+  CHECK_THROWS_WITH_AS(SemanticMap(cv::Size(8, 6), 255, MapFusion::pooled_interest, {255}),
+                       doctest::Contains("a label of interest must be in 0..254"), std::invalid_argument);
+  CHECK(to_string(MapFusion::pooled_interest) == std::string("pooled-interest"));
+  CHECK(parse_map_fusion("pooled-interest") == MapFusion::pooled_interest);
+  CHECK(pools_probabilities(MapFusion::pooled_interest));
+  CHECK_FALSE(pools_probabilities(MapFusion::finest));
+}
+
 TEST_CASE("map, pooled: one-hot looks give finest-wins, and the oracle's lawnmowers map the ground truth") {
   // A finer look's weight (1 / GSD) exceeds a coarser one's, so where every look is sure the
   // finest decides, as with MapFusion::finest.
@@ -242,7 +298,8 @@ TEST_CASE("map, pooled: labels alone, missing or mismatched probabilities are re
   CHECK(to_string(MapFusion::pooled) == std::string("pooled"));
   CHECK(parse_map_fusion("finest") == MapFusion::finest);
   CHECK_THROWS_WITH_AS(static_cast<void>(parse_map_fusion("mean")),
-                       doctest::Contains("map fusion must be 'finest' or 'pooled', not 'mean'"), std::invalid_argument);
+                       doctest::Contains("map fusion must be 'finest', 'pooled' or 'pooled-interest', not 'mean'"),
+                       std::invalid_argument);
 }
 
 TEST_CASE("map, pooled: a turned camera pools where fuse(labels) would write") {

@@ -153,7 +153,8 @@ struct CommonOptions {
         ->delimiter(',');
     app.add_option("--map-fusion", map_fusion,
                    "how the map combines the images of one pixel: 'finest' (the finest GSD's label, the paper's) or "
-                   "'pooled' (the class probabilities pooled, each image weighted by 1 / GSD; needs a network)")
+                   "'pooled' (the class probabilities pooled, each image weighted by 1 / GSD; needs a network) or "
+                   "'pooled-interest' (pooled, but a pixel any image labelled with a label of interest keeps one)")
         ->check(CLI::IsMember(detail::names_of(kMapFusions)))
         ->capture_default_str();
   }

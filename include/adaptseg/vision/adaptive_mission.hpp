@@ -135,7 +135,7 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
   // What each descent gained is scored at the end against the ground truth: its region's map
   // before it, the map pixels its images covered, and the top-level images alone.
   std::vector<detail::PendingDescent> descents;
-  SemanticMap top_only(field.labels().size(), field.ignore_label(), options.mission.map_fusion);
+  SemanticMap top_only(field.labels().size(), field.ignore_label(), options.mission.map_fusion, mission.interest());
   while (const auto w = planner.next()) {
     if (w->level == 1 && w->step == 0) {  // a descent starts: its region's map before it
       const cv::Rect region = planner.region_rect(w->top_index);
@@ -146,7 +146,7 @@ template <SegmentationBackend Backend, DecisionPolicy Policy>
     }
     // With the backend's class probabilities where the decision reads them (a coverage that ranks
     // cells: the top-level images' decision inputs, a descent's scene check) or the map does
-    // (MapFusion::pooled); checked once, by the mission, which ran the backend.
+    // (MapFusion::pooled, pooled_interest); checked once, by the mission, which ran the backend.
     const auto visit = mission.visit(w->waypoint, w->level, planner.wants_probabilities());
     planner.report(visit.image, visit.segmentation, visit.record->segmentation_s);
     if (w->level == 0) top_only.fuse(visit.image, visit.segmentation.get());

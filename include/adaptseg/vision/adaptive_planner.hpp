@@ -89,7 +89,7 @@ class AdaptivePlanner {
   AdaptivePlanner(SurveyArea area, Policy& policy, AdaptiveOptions options, TimeAccount* shared = nullptr)
       : grid_(std::move(area), CameraModel(options.mission.camera), options.grid_anchor),
         timing_(options.mission.timing),
-        map_(grid_.size(), grid_.area().ignore_label, options.mission.map_fusion),
+        map_(grid_.size(), grid_.area().ignore_label, options.mission.map_fusion, options.mission.interest),
         policy_(policy),
         options_(std::move(options)),
         coverage_(descent_coverage_info(options_.coverage)),
@@ -194,7 +194,7 @@ class AdaptivePlanner {
   /// Whether the planner reads the class probabilities behind each image's labels: for the decision
   /// inputs of a coverage that ranks cells, and for a pooled map (which refuses labels alone).
   [[nodiscard]] bool wants_probabilities() const noexcept {
-    return coverage_.ranks_cells || map_.fusion() == MapFusion::pooled;
+    return coverage_.ranks_cells || pools_probabilities(map_.fusion());
   }
 
   /// The Image of a camera frame `bgr` (CV_8UC3, B, G, R of the camera's size, or empty) taken at

@@ -180,13 +180,15 @@ template <SegmentationBackend Backend>
   const LawnmowerPlanner planner(mission.camera(), overlap);
   const auto plan = planner.plan(field.area(), gsd_cm, {0.0, 0.0}, [&](const Area& a) { return field.has_valid(a); });
   const double per_waypoint = plan.empty() ? 0.0 : detail::seconds_since(t0) / static_cast<double>(plan.size());
-  SemanticMap map(field.labels().size(), field.ignore_label(), options.map_fusion);
-  const bool pooled = options.map_fusion == MapFusion::pooled;
+  SemanticMap map(field.labels().size(), field.ignore_label(), options.map_fusion, mission.interest());
+  const bool pooled = pools_probabilities(options.map_fusion);
   for (const auto& w : plan) {
     mission.charge_planning(per_waypoint);
     const auto v = mission.visit(w, 0, pooled);
     detail::require(!pooled || !v.segmentation.get().probabilities.empty(),
-                    "Mission: map fusion 'pooled' needs a backend that gives class probabilities", backend.name());
+                    std::string("Mission: map fusion '") + to_string(options.map_fusion) +
+                        "' needs a backend that gives class probabilities",
+                    backend.name());
     map.fuse(v.image, v.segmentation.get());
   }
   return std::move(mission).finish(map);

@@ -54,8 +54,8 @@ class SampleCollector {
         planner_(camera),
         n_(field.num_classes()),
         ranked_(covers_.ranks_cells),
-        pooled_(fusion == MapFusion::pooled),
-        field_map_(field.labels().size(), field.ignore_label(), fusion),
+        pooled_(pools_probabilities(fusion)),
+        field_map_(field.labels().size(), field.ignore_label(), fusion, interest),
         field_cm_(n_),
         field_px_total_(std::max(1, field.valid_pixels())),
         grid_(0, 0, field.width_px(), field.height_px()) {
@@ -117,7 +117,7 @@ class SampleCollector {
                 region,
                 region & grid_,
                 top_image,
-                SemanticMap(region.size(), field_.ignore_label(), fusion_),
+                SemanticMap(region.size(), field_.ignore_label(), fusion_, interest_),
                 cv::Mat(region.size(), CV_8UC1, cv::Scalar(0)),
                 field_cm_,
                 {},
@@ -146,7 +146,7 @@ class SampleCollector {
     // Fuse the sub-lawnmower into a map of the region alone (pixel frame shifted). Cells a
     // coverage leaves out keep their top-level labels, as in the mission's map; a pooled map
     // pools the finer images with the top-level one everywhere.
-    SemanticMap local(r.region.size(), field_.ignore_label(), fusion_);
+    SemanticMap local(r.region.size(), field_.ignore_label(), fusion_, interest_);
     if (covers_.flies || pooled_) local.fuse(r.local, top_segmentations_[r.index]);
     // Ranked: each finer image's own decision inputs over its cell (the scene check's proxy).
     std::vector<CellInputs> fine_inputs;

@@ -12,8 +12,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace adaptseg {
@@ -21,8 +23,10 @@ namespace adaptseg {
 /// Per orthomosaic pixel, the label of the finest-GSD observation that covered it ("we
 /// preserve the results obtained with the highest resolution", paper §3.1), among equally
 /// fine observations the latest; or, with MapFusion::pooled, the class of the largest sum over
-/// the observations of log p_c / GSD (each probability floored at kPooledFloor). Pixels never
-/// observed hold `unknown_label()`.
+/// the observations of log p_c / GSD (each probability floored at kPooledFloor); with
+/// MapFusion::pooled_interest the same, except that a pixel some observation labelled with a
+/// label of interest keeps the label of interest of the largest sum among those it was given.
+/// Pixels never observed hold `unknown_label()`.
 class SemanticMap {
  public:
   /// The smallest probability pooling reads: no single image vetoes a class outright.
@@ -31,13 +35,29 @@ class SemanticMap {
   /// @param size the orthomosaic's size [px].
   /// @param unknown_label value of pixels never observed (the field's ignore label).
   /// @param fusion how observations of one pixel combine; `pooled` keeps one float plane per
-  ///        class besides the labels (4 bytes per pixel and class), allocated at the first image.
-  /// @throws std::invalid_argument for an empty size or a label outside 0..255.
-  explicit SemanticMap(cv::Size size, int unknown_label = 255, MapFusion fusion = MapFusion::finest)
-      : unknown_(unknown_label), fusion_(fusion) {
+  ///        class besides the labels (4 bytes per pixel and class), allocated at the first image;
+  ///        `pooled_interest` one byte per pixel more (which labels of interest it was given).
+  /// @param interest the labels of interest (MapFusion::pooled_interest: one to eight; the
+  ///        other fusions ignore them).
+  /// @throws std::invalid_argument for an empty size, a label outside 0..255, or with
+  ///         MapFusion::pooled_interest no label of interest, more than eight, or one outside
+  ///         0..254.
+  explicit SemanticMap(cv::Size size, int unknown_label = 255, MapFusion fusion = MapFusion::finest,
+                       std::vector<int> interest = {})
+      : unknown_(unknown_label), fusion_(fusion), interest_(std::move(interest)) {
     detail::require(size.width > 0 && size.height > 0, "SemanticMap: size must be positive", size.width * size.height);
     detail::require(unknown_label >= 0 && unknown_label <= 255, "SemanticMap: unknown_label must be in 0..255",
                     unknown_label);
+    if (fusion_ == MapFusion::pooled_interest) {
+      detail::require(!interest_.empty() && interest_.size() <= 8,
+                      "SemanticMap: map fusion 'pooled-interest' needs one to eight labels of interest",
+                      interest_.size());
+      for (int l : interest_)
+        detail::require(l >= 0 && l < 255, "SemanticMap: a label of interest must be in 0..254", l);
+      seen_ = cv::Mat(size, CV_8UC1, cv::Scalar(0));
+    } else {
+      interest_.clear();
+    }
     labels_ = cv::Mat(size, CV_8UC1, cv::Scalar(unknown_label));
     gsd_ = cv::Mat(size, CV_32F, cv::Scalar(std::numeric_limits<double>::infinity()));
   }
@@ -89,7 +109,10 @@ class SemanticMap {
   /// Fuses `segmentation` of `image`: as fuse(image, labels) for MapFusion::finest; for
   /// MapFusion::pooled each orthomosaic pixel the image covers (where its label is not the
   /// ignore label) adds log(max(p_c, kPooledFloor)) / GSD to class c's sum, and takes the class
-  /// of the largest sum (ties to the lower class).
+  /// of the largest sum (ties to the lower class); for MapFusion::pooled_interest the same,
+  /// unless that class is not of interest and some image (this one included) labelled the
+  /// pixel with a label of interest: then the one of those with the largest sum (ties to the
+  /// first in the list).
   /// @throws std::invalid_argument as fuse(image, labels); for a pooled map also if the
   ///         probabilities are missing, are not CV_32FC1 planes of the image's size, or their
   ///         number differs from the first image's.
@@ -112,7 +135,8 @@ class SemanticMap {
     const float weight = 1.0f / static_cast<float>(image.gsd_cm);
     const auto gsd = static_cast<float>(image.gsd_cm);
     each_pixel(image, labels.size(), [&](int x, int y, int u, int v) {
-      if (labels.at<unsigned char>(v, u) == image.ignore_label) return;
+      const unsigned char label = labels.at<unsigned char>(v, u);
+      if (label == image.ignore_label) return;
       int best = 0;
       float best_sum = -std::numeric_limits<float>::infinity();
       for (std::size_t c = 0; c < pooled_.size(); ++c) {
@@ -123,6 +147,7 @@ class SemanticMap {
           best = static_cast<int>(c);
         }
       }
+      if (!interest_.empty()) best = kept_interest(x, y, label, best);
       labels_.at<unsigned char>(y, x) = static_cast<unsigned char>(best);
       float& held = gsd_.at<float>(y, x);
       held = std::min(held, gsd);
@@ -141,6 +166,32 @@ class SemanticMap {
     detail::require(labels.type() == CV_8UC1 && labels.cols == image.width_px && labels.rows == image.height_px,
                     "SemanticMap::fuse: labels must be CV_8UC1 of the image's size",
                     std::to_string(labels.cols) + "x" + std::to_string(labels.rows));
+  }
+
+  /// MapFusion::pooled_interest at map pixel (x, y), which an image labelled `label`: marks the
+  /// label as seen there if it is of interest, and returns the label the pixel takes: `best`
+  /// (the pooled class) if it is of interest or no label of interest was seen there, else the
+  /// seen label of interest of the largest pooled sum (ties to the first in the list).
+  [[nodiscard]] int kept_interest(int x, int y, unsigned char label, int best) {
+    unsigned char& seen = seen_.at<unsigned char>(y, x);
+    int pooled_is_interest = 0;
+    for (std::size_t j = 0; j < interest_.size(); ++j) {
+      if (label == interest_[j]) seen = static_cast<unsigned char>(seen | (1U << j));
+      if (best == interest_[j]) pooled_is_interest = 1;
+    }
+    if (pooled_is_interest != 0 || seen == 0) return best;
+    int kept = best;
+    float kept_sum = -std::numeric_limits<float>::infinity();
+    for (std::size_t j = 0; j < interest_.size(); ++j) {
+      const auto c = static_cast<std::size_t>(interest_[j]);
+      if ((seen & (1U << j)) == 0 || c >= pooled_.size()) continue;
+      const float sum = pooled_[c].at<float>(y, x);
+      if (sum > kept_sum) {
+        kept_sum = sum;
+        kept = interest_[j];
+      }
+    }
+    return kept;
   }
 
   /// Which camera row / column each footprint row / column of a `camera` image over a footprint
@@ -202,6 +253,10 @@ class SemanticMap {
   cv::Mat gsd_;
   int unknown_;
   MapFusion fusion_;
+  // MapFusion::pooled_interest: the labels of interest, and per pixel which of them (bit j: the
+  // j-th) some image gave it; empty for the other fusions.
+  std::vector<int> interest_;
+  cv::Mat seen_;
   // MapFusion::pooled: per class the sum of the images' weighted log-probabilities (allocated at
   // the first image), and fuse()'s scratch: the log-probabilities of one image.
   std::vector<cv::Mat> pooled_, log_;

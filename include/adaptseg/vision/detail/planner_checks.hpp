@@ -23,8 +23,10 @@ namespace adaptseg::detail {
 /// @throws std::invalid_argument for a map fused by `fusion` 'pooled' and a segmentation `s`
 ///         without class probabilities (`why` says so).
 inline void check_pooled(MapFusion fusion, const Segmentation& s, const char* why) {
-  require(fusion == MapFusion::finest || !s.probabilities.empty(),
-          "AdaptivePlanner::report: map fusion 'pooled' needs the class probabilities behind the labels", why);
+  require(!pools_probabilities(fusion) || !s.probabilities.empty(),
+          std::string("AdaptivePlanner::report: map fusion '") + to_string(fusion) +
+              "' needs the class probabilities behind the labels",
+          why);
 }
 
 /// @throws std::invalid_argument if `budget_s` is set and does not afford the top-level coverage
