@@ -11,7 +11,9 @@ probabilities, then per class of interest L (IoU of L against the field's labels
     log(max(p_c, 1/256)) / GSD summed), the map a descent everywhere would leave;
   - `union`: L wherever either lawnmower's map says L, the rest as `pooled` (the class of
     interest kept where any look saw it);
-  - `bonus`: pooled (or union) minus the better of the two lawnmowers alone: what fusing two
+  - `trim`: L where the pooled map says L and the top level did too (the closer look may
+    remove the class but not add it);
+  - `bonus`: pooled (or union, or trim) minus the better of the two lawnmowers alone: what fusing two
     looks maps beyond either, before any time is counted (a descent must add this and more
     than the lawnmower curve rises over its seconds);
   - the closer look's additions (pixels it calls L where the top level did not) and removals
@@ -76,14 +78,16 @@ def compare(top_lp: np.ndarray, fine_lp: np.ndarray, top_gsd: float, fine_gsd: f
     fine = (fine_lp.argmax(0) == cls) & valid
     pooled = ((top_lp / top_gsd + fine_lp / fine_gsd).argmax(0) == cls) & valid
     union = pooled | top | fine
+    trim = pooled & top
     n = max(1, int(valid.sum()))
     added, removed = fine & ~top, top & ~fine
     r = {"top": iou(top, t), "fine": iou(fine, t), "pooled": iou(pooled, t), "union": iou(union, t),
+         "trim": iou(trim, t),
          "added": int(added.sum()) / n, "removed": int(removed.sum()) / n,
          "added_right": float(t[added].mean()) if added.any() else float("nan"),
          "removed_right": float((~t[removed]).mean()) if removed.any() else float("nan")}
     best = max(r["top"], r["fine"])
-    r["pooled_bonus"], r["union_bonus"] = r["pooled"] - best, r["union"] - best
+    r["pooled_bonus"], r["union_bonus"], r["trim_bonus"] = r["pooled"] - best, r["union"] - best, r["trim"] - best
     r["break_even"] = r["top"] / (1.0 + r["top"])
     return r
 
@@ -112,7 +116,7 @@ def main(argv=None):
     if args.top <= 0 or any(b <= 0 or b >= args.top for b in bands):
         raise SystemExit(f"--bands {args.bands}: each must be above 0 and below --top {args.top}")
     wanted = args.classes.split(",")
-    summary: dict[tuple[str, float], list[tuple[float, float]]] = {}
+    summary: dict[tuple[str, float], list[tuple[float, float, float]]] = {}
     rows = []
     for label, net, fdir in pairs_of(args):
         field = load_field(fdir)
@@ -128,22 +132,25 @@ def main(argv=None):
             for name in wanted:
                 r = compare(top_lp, fine_lp, top_gsd, fine_gsd, field.labels, field.classes.index(name))
                 rows.append((name, label, top_gsd, fine_gsd, r))
-                summary.setdefault((name, fine_gsd), []).append((r["pooled_bonus"], r["union_bonus"]))
-    print("| class | field | GSD top → fine [cm/px] | IoU top | fine | pooled | union | bonus pooled | union "
-          "| added [% of ground] | right | break-even | removed [%] | right |")
-    print("| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+                summary.setdefault((name, fine_gsd), []).append((r["pooled_bonus"], r["union_bonus"], r["trim_bonus"]))
+    print("| class | field | GSD top → fine [cm/px] | IoU top | fine | pooled | union | trim | bonus pooled | union "
+          "| trim | added [% of ground] | right | break-even | removed [%] | right |")
+    print("| --- | --- | --- |" + " ---: |" * 13)
     for name, label, top_gsd, fine_gsd, r in sorted(rows, key=lambda x: (wanted.index(x[0]), x[3], x[1])):
         print(f"| {name} | {label} | {top_gsd:g} → {fine_gsd:g} | {r['top']:.3f} | {r['fine']:.3f} | "
-              f"{r['pooled']:.3f} | {r['union']:.3f} | {r['pooled_bonus']:+.3f} | {r['union_bonus']:+.3f} | "
+              f"{r['pooled']:.3f} | {r['union']:.3f} | {r['trim']:.3f} | {r['pooled_bonus']:+.3f} | "
+              f"{r['union_bonus']:+.3f} | {r['trim_bonus']:+.3f} | "
               f"{100 * r['added']:.2f} | {r['added_right']:.2f} | {r['break_even']:.2f} | "
               f"{100 * r['removed']:.2f} | {r['removed_right']:.2f} |")
     print()
-    print("| class | fine GSD [cm/px] | fields | mean bonus, pooled | above +0.001 | mean bonus, union | above +0.001 |")
-    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
+    print("| class | fine GSD [cm/px] | fields | mean bonus, pooled | above +0.001 | mean bonus, union | above +0.001 "
+          "| mean bonus, trim | above +0.001 |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
     for (name, fine_gsd), v in sorted(summary.items(), key=lambda x: (wanted.index(x[0][0]), x[0][1])):
         a = np.array(v)
         print(f"| {name} | {fine_gsd:g} | {len(v)} | {a[:, 0].mean():+.4f} | {int((a[:, 0] > 0.001).sum())} | "
-              f"{a[:, 1].mean():+.4f} | {int((a[:, 1] > 0.001).sum())} |")
+              f"{a[:, 1].mean():+.4f} | {int((a[:, 1] > 0.001).sum())} | {a[:, 2].mean():+.4f} | "
+              f"{int((a[:, 2] > 0.001).sum())} |")
 
 
 if __name__ == "__main__":

@@ -2,9 +2,9 @@
 """Self-test of two_looks.py (run by CTest; exit code != 0 on failure).
 
 1. compare() on a hand-made field of eight pixels and two classes, every measure worked out by
-   hand: the two maps' IoU, the pooled map (weights 1 / GSD), the union, the additions and
+   hand: the two maps' IoU, the pooled map (weights 1 / GSD), the union, the trim, the additions and
    removals with how often each is right, the bonuses and the break-even.
-2. A lawnmower fused with itself changes nothing: pooled, union, top and fine are one map, the
+2. A lawnmower fused with itself changes nothing: pooled, union, trim, top and fine are one map, the
    bonuses 0, nothing added or removed.
 3. The bundled leave-one-tile-out network of tile 1 on tile 1: its 15 cm/px lawnmower painted as
    log-probabilities gives each class the IoU its training recorded in model.yaml (within 0.002,
@@ -49,6 +49,8 @@ def hand_made():
     check(math.isclose(r["pooled"], 0.5), f"pooled {r['pooled']}")
     # union: L at 0..5 → TP 4, FP 2: IoU 4/6.
     check(math.isclose(r["union"], 4 / 6), f"union {r['union']}")
+    # trim: pooled L where the top level said L too: 0 and 4 → TP 1, FP 1, FN 3: IoU 1/5.
+    check(math.isclose(r["trim"], 0.2) and math.isclose(r["trim_bonus"], 0.2 - 0.5), f"trim {r}")
     # added (fine L, top not): 2, 3, 5 over 8 pixels, right at 2 and 3; removed (top L, fine not): 1, wrong.
     check(math.isclose(r["added"], 3 / 8) and math.isclose(r["added_right"], 2 / 3), f"added {r}")
     check(math.isclose(r["removed"], 1 / 8) and r["removed_right"] == 0.0, f"removed {r}")
@@ -58,7 +60,7 @@ def hand_made():
     wide = np.concatenate([truth, np.array([[255, 255]], np.uint8)], axis=1)
     pad = np.log(np.full((2, 1, 2), 0.5, np.float32))
     r2 = two_looks.compare(np.concatenate([top, pad], 2), np.concatenate([fine, pad], 2), 15.0, 5.0, wide, 1)
-    check(all(math.isclose(r[k], r2[k]) for k in ("top", "pooled", "union", "added", "removed")), f"{r2}")
+    check(all(math.isclose(r[k], r2[k]) for k in ("top", "pooled", "union", "trim", "added", "removed")), f"{r2}")
     print("ok: the hand-made field's measures")
 
 
@@ -81,8 +83,9 @@ def main():
         r = two_looks.compare(lp, lp, 15.0, 15.0, field.labels, c)
         check(abs(r["top"] - record["iou_ortho"][c]) < 0.002,
               f"{name}: painted IoU {r['top']:.4f} against the recorded {record['iou_ortho'][c]:.4f}")
-        check(r["top"] == r["fine"] == r["pooled"] == r["union"] and r["added"] == r["removed"] == 0.0
-              and r["pooled_bonus"] == r["union_bonus"] == 0.0, f"{name}: a lawnmower fused with itself: {r}")
+        check(r["top"] == r["fine"] == r["pooled"] == r["union"] == r["trim"] and r["added"] == r["removed"] == 0.0
+              and r["pooled_bonus"] == r["union_bonus"] == r["trim_bonus"] == 0.0,
+              f"{name}: a lawnmower fused with itself: {r}")
     print("ok: tile 1's lawnmower: the recorded IoU; fused with itself, the same map")
 
     rc, text = printed(two_looks.main, [str(net), str(fdir), "--bands", "2"])
