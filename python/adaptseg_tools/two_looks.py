@@ -46,6 +46,7 @@ from .fieldio import IGNORE
 from .training.fields import capture, lawnmower_rects, load_field
 
 LOG_FLOOR = 1.0 / 256.0  # SemanticMap's floor under a pooled probability
+FUSIONS = ("pooled", "union", "trim")  # the two looks fused, each with its bonus (module docstring)
 
 
 def painted_log_probabilities(model, spec, meta, field, gsd_cm: float) -> np.ndarray:
@@ -77,17 +78,15 @@ def compare(top_lp: np.ndarray, fine_lp: np.ndarray, top_gsd: float, fine_gsd: f
     top = (top_lp.argmax(0) == cls) & valid
     fine = (fine_lp.argmax(0) == cls) & valid
     pooled = ((top_lp / top_gsd + fine_lp / fine_gsd).argmax(0) == cls) & valid
-    union = pooled | top | fine
-    trim = pooled & top
+    fused = {"pooled": pooled, "union": pooled | top | fine, "trim": pooled & top}
     n = max(1, int(valid.sum()))
     added, removed = fine & ~top, top & ~fine
-    r = {"top": iou(top, t), "fine": iou(fine, t), "pooled": iou(pooled, t), "union": iou(union, t),
-         "trim": iou(trim, t),
+    r = {"top": iou(top, t), "fine": iou(fine, t), **{f: iou(fused[f], t) for f in FUSIONS},
          "added": int(added.sum()) / n, "removed": int(removed.sum()) / n,
          "added_right": float(t[added].mean()) if added.any() else float("nan"),
          "removed_right": float((~t[removed]).mean()) if removed.any() else float("nan")}
     best = max(r["top"], r["fine"])
-    r["pooled_bonus"], r["union_bonus"], r["trim_bonus"] = r["pooled"] - best, r["union"] - best, r["trim"] - best
+    r.update({f"{f}_bonus": r[f] - best for f in FUSIONS})
     r["break_even"] = r["top"] / (1.0 + r["top"])
     return r
 
@@ -132,25 +131,22 @@ def main(argv=None):
             for name in wanted:
                 r = compare(top_lp, fine_lp, top_gsd, fine_gsd, field.labels, field.classes.index(name))
                 rows.append((name, label, top_gsd, fine_gsd, r))
-                summary.setdefault((name, fine_gsd), []).append((r["pooled_bonus"], r["union_bonus"], r["trim_bonus"]))
-    print("| class | field | GSD top → fine [cm/px] | IoU top | fine | pooled | union | trim | bonus pooled | union "
-          "| trim | added [% of ground] | right | break-even | removed [%] | right |")
-    print("| --- | --- | --- |" + " ---: |" * 13)
+                summary.setdefault((name, fine_gsd), []).append([r[f"{f}_bonus"] for f in FUSIONS])
+    print("| class | field | GSD top → fine [cm/px] | IoU top | fine | " + " | ".join(FUSIONS) + " | bonus "
+          + " | ".join(FUSIONS) + " | added [% of ground] | right | break-even | removed [%] | right |")
+    print("| --- | --- | --- |" + " ---: |" * (7 + 2 * len(FUSIONS)))
     for name, label, top_gsd, fine_gsd, r in sorted(rows, key=lambda x: (wanted.index(x[0]), x[3], x[1])):
         print(f"| {name} | {label} | {top_gsd:g} → {fine_gsd:g} | {r['top']:.3f} | {r['fine']:.3f} | "
-              f"{r['pooled']:.3f} | {r['union']:.3f} | {r['trim']:.3f} | {r['pooled_bonus']:+.3f} | "
-              f"{r['union_bonus']:+.3f} | {r['trim_bonus']:+.3f} | "
+              + "".join(f"{r[f]:.3f} | " for f in FUSIONS) + "".join(f"{r[f + '_bonus']:+.3f} | " for f in FUSIONS) +
               f"{100 * r['added']:.2f} | {r['added_right']:.2f} | {r['break_even']:.2f} | "
               f"{100 * r['removed']:.2f} | {r['removed_right']:.2f} |")
     print()
-    print("| class | fine GSD [cm/px] | fields | mean bonus, pooled | above +0.001 | mean bonus, union | above +0.001 "
-          "| mean bonus, trim | above +0.001 |")
-    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    print("| class | fine GSD [cm/px] | fields |" + "".join(f" mean bonus, {f} | above +0.001 |" for f in FUSIONS))
+    print("| --- | ---: | ---: |" + " ---: | ---: |" * len(FUSIONS))
     for (name, fine_gsd), v in sorted(summary.items(), key=lambda x: (wanted.index(x[0][0]), x[0][1])):
         a = np.array(v)
-        print(f"| {name} | {fine_gsd:g} | {len(v)} | {a[:, 0].mean():+.4f} | {int((a[:, 0] > 0.001).sum())} | "
-              f"{a[:, 1].mean():+.4f} | {int((a[:, 1] > 0.001).sum())} | {a[:, 2].mean():+.4f} | "
-              f"{int((a[:, 2] > 0.001).sum())} |")
+        print(f"| {name} | {fine_gsd:g} | {len(v)} |"
+              + "".join(f" {a[:, k].mean():+.4f} | {int((a[:, k] > 0.001).sum())} |" for k in range(len(FUSIONS))))
 
 
 if __name__ == "__main__":
