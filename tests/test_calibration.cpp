@@ -939,7 +939,7 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
   DecisionModel corrected = model;
   auto& policy = std::get<FrontAwarePolicy>(corrected.decision_function.rule());
   FrontAwarePolicy::Params p = policy.params();
-  for (const CurveSource source : {CurveSource::field, CurveSource::corrected}) {
+  for (const CurveSource source : {CurveSource::field, CurveSource::corrected, CurveSource::mixture}) {
     p.curve = source;
     policy.set_params(p);
     corrected.save(tmp.path() / "corrected.yaml");

@@ -654,6 +654,54 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     CHECK_FALSE(a.descend);
     CHECK_FALSE(uncorrected.decide(rich.region(0, 0.1)).descend);  // the prediction: flying lower pays
   }
+  SUBCASE("the mixture: the corrected curves and the training fields' own, as one set") {
+    // Field a's real curve rises 0.2 to 1 cm/px; its input 0.05 against this field's 0.1 (X̂
+    // shrunk towards 0.05 after one region) makes the corrected curve rise about half as much
+    // again. The mixture weighs a descent against the
+    // mean of the two rises (its margin the mean of theirs), with their disagreement as spread:
+    // at z = 0 it decides as that mean does, at z > 0 it is more cautious than either alone
+    // where the gain lies between them.
+    for (double beta : {0.5, 1.0, 2.0}) {
+      FrontAwarePolicy t(with_cells(beta), reference, {});
+      FrontAwarePolicy c(with_cells(beta), reference, {.curve = CurveSource::corrected});
+      FrontAwarePolicy m(with_cells(beta), reference, {.curve = CurveSource::mixture});
+      const Decision dt = t.decide(s.region(0, 0.1));
+      const Decision dc = c.decide(s.region(0, 0.1));
+      const Decision dm = m.decide(s.region(0, 0.1));
+      REQUIRE(dm.scores.size() == 2);
+      for (std::size_t k = 0; k < 2; ++k) {
+        const double rt = dt.scores[k].predicted_curve_rise, rc = dc.scores[k].predicted_curve_rise;
+        CHECK(rc > 1.2 * rt);
+        CHECK(dm.scores[k].predicted_curve_rise == doctest::Approx((rt + rc) / 2.0));
+        CHECK(dm.scores[k].predicted_front_margin ==
+              doctest::Approx((dt.scores[k].predicted_front_margin + dc.scores[k].predicted_front_margin) / 2.0));
+        CHECK(dm.scores[k].predicted_field_gain == doctest::Approx(dt.scores[k].predicted_field_gain));
+      }
+    }
+    // With β = 2.25 the 4-cell offer's gain beats the training rise but not the corrected one,
+    // and their mean: at z = 0 the mixture takes it as the training curve does; at z = 1 their
+    // disagreement (sd_D = |r_c − r_t| / √2) refuses it, where the training curve alone still
+    // takes it.
+    const FrontAwarePolicy::Params bold{.confidence = 0.0, .scale_prior_sd = 0.01, .curve = CurveSource::mixture};
+    FrontAwarePolicy t0(with_cells(2.25), reference, {.confidence = 0.0, .scale_prior_sd = 0.01});
+    FrontAwarePolicy c0(with_cells(2.25), reference,
+                        {.confidence = 0.0, .scale_prior_sd = 0.01, .curve = CurveSource::corrected});
+    FrontAwarePolicy m0(with_cells(2.25), reference, bold);
+    FrontAwarePolicy m1(with_cells(2.25), reference,
+                        {.confidence = 1.0, .scale_prior_sd = 0.01, .curve = CurveSource::mixture});
+    const Decision a = t0.decide(s.region(0, 0.1)), b = c0.decide(s.region(0, 0.1)), mm = m0.decide(s.region(0, 0.1));
+    const double gain = mm.scores[1].predicted_field_gain;
+    CHECK(gain > a.scores[1].predicted_curve_rise);
+    CHECK(gain < b.scores[1].predicted_curve_rise);
+    CHECK(a.descend);
+    CHECK_FALSE(b.descend);
+    CHECK(gain > mm.scores[1].predicted_curve_rise);
+    CHECK(mm.descend);
+    CHECK(mm.candidate == 1);
+    FrontAwarePolicy t1(with_cells(2.25), reference, {.confidence = 1.0, .scale_prior_sd = 0.01});
+    CHECK(t1.decide(s.region(0, 0.1)).descend);
+    CHECK_FALSE(m1.decide(s.region(0, 0.1)).descend);
+  }
   // A flatter training curve (0.05 over 145 s): the cells' descents are worth their time.
   const std::vector<ReferenceCurve> flat{{"a", {{1.0, 0.80}, {3.0, 0.75}}, 0.2, 0.05}};
   SUBCASE("the scene check: a finer look less sure than the coarse one stops the descents") {

@@ -298,7 +298,8 @@ struct CalibrationCli {
                        "front-aware rule with --coverage ranked: the lawnmower curve a descent is compared with, "
                        "the training fields' (training), this field's as the cell gain model predicts it from "
                        "the top-level images (field), or that prediction scaled per training field by its real "
-                       "lawnmowers' rise against the predicted one (corrected)")
+                       "lawnmowers' rise against the predicted one (corrected), or the corrected curves and the "
+                       "training fields' together, their disagreement part of the curve's spread (mixture)")
             ->check(CLI::IsMember(detail::names_of(kCurveSources)))
             ->capture_default_str(),
         app.add_option("--field-factor", field_factor,

@@ -261,18 +261,24 @@ class FrontAwarePolicy {
   /// this field's lawnmower times, the upper envelope of that predicted curve (the best
   /// lawnmower at a time or sooner, as the front margin reads it); or, with a cell gain model
   /// and a curve source other than `training`, this field's curve as predicted (field_curve),
-  /// `weight` = a / σ̂.
+  /// `weight` = a / σ̂; with `mixture` both sets, the predicted ones raised to the training
+  /// fields' mean mIoU at the top level.
   [[nodiscard]] PredictedCurves predicted_curves(const DecisionContext& c, double weight) const {
     PredictedCurves p;
     p.t0 = c.elapsed_s + c.rest_s;
-    if (params_.curve != CurveSource::training && model_.cells() && c.region_share > 0.0 && weight > 0.0) {
+    const bool predicts = model_.cells() && c.region_share > 0.0 && weight > 0.0;
+    if (params_.curve != CurveSource::training && predicts) {
       const double x = field_input_estimate(c);
-      if (params_.curve == CurveSource::corrected)
-        for (const auto& r : reference_) p.curves.push_back(field_curve(c, x, weight / c.region_share, &r));
-      else
+      if (params_.curve == CurveSource::field)
         p.curves.push_back(field_curve(c, x, weight / c.region_share, nullptr));
+      else
+        for (const auto& r : reference_) p.curves.push_back(field_curve(c, x, weight / c.region_share, &r));
       p.level = detail::mean_reference_miou(reference_, c.top_gsd_cm);
-      return p;
+      if (params_.curve != CurveSource::mixture) return p;
+      // With the training fields' own curves below, which are absolute: these from the level.
+      for (auto& curve : p.curves)
+        for (auto& point : curve) point.miou += p.level;
+      p.level = 0.0;
     }
     for (const auto& r : reference_) {
       std::vector<CurvePoint> curve;

@@ -68,22 +68,29 @@ inline constexpr std::array<detail::NamedValue<TopLevelChoice>, 2> kTopLevelChoi
 ///   inside a coarse map, which the model is fitted on, predict a network's lawnmower poorly: it
 ///   re-maps every cell with its neighbours (docs/results.md, "The field curve against the real
 ///   ones").
-/// Without a cell gain model `field` and `corrected` read the training fields' curves.
-enum class CurveSource { training, field, corrected };
+/// - `mixture`: the `corrected` curves and the training fields' own together, one curve per
+///   training field from each: their mean rise the one a descent must beat and their spread its
+///   sd_D, so that where the two estimates of this field's curve disagree the lower bound is as
+///   unsure as their disagreement (on new ground the training fields' real curves predict a
+///   descent's real rise better, the corrected ones the oracle's; docs/journal/2026-12-loto.md,
+///   thirty-ninth and fortieth sessions).
+/// Without a cell gain model `field`, `corrected` and `mixture` read the training fields' curves.
+enum class CurveSource { training, field, corrected, mixture };
 
 /// Every curve source by name (`--curve` of the programs; the model file keeps the flags
-/// `field_curve` and `curve_ratio` of earlier versions, docs/data_format.md).
-inline constexpr std::array<detail::NamedValue<CurveSource>, 3> kCurveSources{{
+/// `field_curve` and `curve_ratio` of earlier versions and `curve_mixture`, docs/data_format.md).
+inline constexpr std::array<detail::NamedValue<CurveSource>, 4> kCurveSources{{
     {CurveSource::training, "training"},
     {CurveSource::field, "field"},
     {CurveSource::corrected, "corrected"},
+    {CurveSource::mixture, "mixture"},
 }};
 
 /// The name of a curve source.
 [[nodiscard]] inline std::string to_string(CurveSource c) { return detail::name_of(kCurveSources, c, "curve source"); }
 
 /// Parses a curve source's name.
-/// @throws std::invalid_argument for anything but `training`, `field` or `corrected`.
+/// @throws std::invalid_argument for anything but `training`, `field`, `corrected` or `mixture`.
 [[nodiscard]] inline CurveSource parse_curve_source(std::string_view name) {
   return detail::value_named(kCurveSources, name, "curve source");
 }

@@ -46,7 +46,9 @@ struct FrontAwareRule {
     e << YAML::Key << "sigma_prior_sd" << YAML::Value << num(p.sigma_prior_sd);
     // The curve source as the flags of earlier versions, so that their files keep their bytes.
     if (p.curve != CurveSource::training) e << YAML::Key << "field_curve" << YAML::Value << detail::flag_text(true);
-    if (p.curve == CurveSource::corrected) e << YAML::Key << "curve_ratio" << YAML::Value << detail::flag_text(true);
+    if (p.curve == CurveSource::corrected || p.curve == CurveSource::mixture)
+      e << YAML::Key << "curve_ratio" << YAML::Value << detail::flag_text(true);
+    if (p.curve == CurveSource::mixture) e << YAML::Key << "curve_mixture" << YAML::Value << detail::flag_text(true);
     if (p.top_level != TopLevelChoice::undominated)
       e << YAML::Key << "top_level" << YAML::Value << to_string(p.top_level);
     if (p.curve_agreement > 0.0) e << YAML::Key << "curve_agreement" << YAML::Value << num(p.curve_agreement);
@@ -182,11 +184,14 @@ struct FrontAwareRule {
     return out;
   }
 
-  /// The curve source of the flags `field_curve` and `curve_ratio` (absent: false; the ratio
-  /// alone, which earlier versions ignored, reads the training fields' curves as they did).
+  /// The curve source of the flags `field_curve`, `curve_ratio` and `curve_mixture` (absent:
+  /// false; the ratio alone, which earlier versions ignored, reads the training fields' curves as
+  /// they did; the mixture only with both).
   [[nodiscard]] static CurveSource read_curve(const detail::YamlReader& rule) {
-    if (!(rule.has("field_curve") && rule.flag("field_curve"))) return CurveSource::training;
-    return rule.has("curve_ratio") && rule.flag("curve_ratio") ? CurveSource::corrected : CurveSource::field;
+    const auto set = [&](const char* key) { return rule.has(key) && rule.flag(key); };
+    if (!set("field_curve")) return CurveSource::training;
+    if (!set("curve_ratio")) return CurveSource::field;
+    return set("curve_mixture") ? CurveSource::mixture : CurveSource::corrected;
   }
 
   /// The value under `key` of `rule`, one of `table`'s names (a TopLevelChoice, a
