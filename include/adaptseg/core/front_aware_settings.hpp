@@ -72,8 +72,9 @@ inline constexpr std::array<detail::NamedValue<TopLevelChoice>, 2> kTopLevelChoi
 ///   training field from each: their mean rise the one a descent must beat and their spread its
 ///   sd_D, so that where the two estimates of this field's curve disagree the lower bound is as
 ///   unsure as their disagreement (on new ground the training fields' real curves predict a
-///   descent's real rise better, the corrected ones the oracle's; docs/journal/2026-12-loto.md,
-///   thirty-ninth and fortieth sessions).
+///   descent's real rise better, the corrected ones the oracle's). Flown on the
+///   leave-one-tile-out runs it did worse than either: the calibration's folds answer the wider
+///   spread with z = 0 (docs/journal/2026-12-loto.md, fortieth session).
 /// Without a cell gain model `field`, `corrected` and `mixture` read the training fields' curves.
 enum class CurveSource { training, field, corrected, mixture };
 
