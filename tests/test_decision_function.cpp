@@ -436,6 +436,10 @@ DescentOutcome cell_outcome(double top_input, double fine_input) {
 TEST_CASE("front-aware policy with cells: gain from the cells' input, the field's own curve, the scene check") {
   const CellScenario s(0.1);
   const std::vector<ReferenceCurve> reference{{"a", {{1.0, 0.95}, {3.0, 0.75}}, 0.2, 0.05}};
+  // The decision at the first region of `s` of a policy with cells of slope β against `curves`.
+  const auto decided = [&s](double beta, const std::vector<ReferenceCurve>& curves, FrontAwarePolicy::Params p) {
+    return FrontAwarePolicy(with_cells(beta), curves, p).decide(s.region(0, 0.1));
+  };
   SUBCASE("the forecast is β·Σ w·x over the cells, as a share of the field's L") {
     FrontAwarePolicy p(with_cells(1.0), reference, {});
     const Decision d = p.decide(s.region(0, 0.1));
@@ -613,12 +617,9 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     // uncorrected field curve weighs it as if flying lower gained β/2.
     const std::vector<ReferenceCurve> alike{{"a", {{1.0, 0.95}, {3.0, 0.75}}, 0.2, 0.1}};
     for (double beta : {0.5, 1.0}) {
-      FrontAwarePolicy training(with_cells(beta), alike, {});
-      FrontAwarePolicy corrected(with_cells(beta), alike, {.curve = CurveSource::corrected});
-      FrontAwarePolicy field(with_cells(beta), alike, {.curve = CurveSource::field});
-      const Decision t = training.decide(s.region(0, 0.1));
-      const Decision c = corrected.decide(s.region(0, 0.1));
-      const Decision f = field.decide(s.region(0, 0.1));
+      const Decision t = decided(beta, alike, {});
+      const Decision c = decided(beta, alike, {.curve = CurveSource::corrected});
+      const Decision f = decided(beta, alike, {.curve = CurveSource::field});
       REQUIRE(t.scores.size() == 2);
       for (std::size_t k = 0; k < 2; ++k) {
         CHECK(c.scores[k].predicted_front_margin == doctest::Approx(t.scores[k].predicted_front_margin));
@@ -657,17 +658,13 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
   SUBCASE("the mixture: the corrected curves and the training fields' own, as one set") {
     // Field a's real curve rises 0.2 to 1 cm/px; its input 0.05 against this field's 0.1 (X̂
     // shrunk towards 0.05 after one region) makes the corrected curve rise about half as much
-    // again. The mixture weighs a descent against the
-    // mean of the two rises (its margin the mean of theirs), with their disagreement as spread:
-    // at z = 0 it decides as that mean does, at z > 0 it is more cautious than either alone
-    // where the gain lies between them.
+    // again. The mixture weighs a descent against the mean of the two rises (its margin the mean
+    // of theirs), with their disagreement as spread: at z = 0 it decides as that mean does, at
+    // z > 0 it is more cautious than the training curve alone where the gain lies between them.
     for (double beta : {0.5, 1.0, 2.0}) {
-      FrontAwarePolicy t(with_cells(beta), reference, {});
-      FrontAwarePolicy c(with_cells(beta), reference, {.curve = CurveSource::corrected});
-      FrontAwarePolicy m(with_cells(beta), reference, {.curve = CurveSource::mixture});
-      const Decision dt = t.decide(s.region(0, 0.1));
-      const Decision dc = c.decide(s.region(0, 0.1));
-      const Decision dm = m.decide(s.region(0, 0.1));
+      const Decision dt = decided(beta, reference, {});
+      const Decision dc = decided(beta, reference, {.curve = CurveSource::corrected});
+      const Decision dm = decided(beta, reference, {.curve = CurveSource::mixture});
       REQUIRE(dm.scores.size() == 2);
       for (std::size_t k = 0; k < 2; ++k) {
         const double rt = dt.scores[k].predicted_curve_rise, rc = dc.scores[k].predicted_curve_rise;
@@ -682,14 +679,11 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     // and their mean: at z = 0 the mixture takes it as the training curve does; at z = 1 their
     // disagreement (sd_D = |r_c − r_t| / √2) refuses it, where the training curve alone still
     // takes it.
-    const FrontAwarePolicy::Params bold{.confidence = 0.0, .scale_prior_sd = 0.01, .curve = CurveSource::mixture};
-    FrontAwarePolicy t0(with_cells(2.25), reference, {.confidence = 0.0, .scale_prior_sd = 0.01});
-    FrontAwarePolicy c0(with_cells(2.25), reference,
-                        {.confidence = 0.0, .scale_prior_sd = 0.01, .curve = CurveSource::corrected});
-    FrontAwarePolicy m0(with_cells(2.25), reference, bold);
-    FrontAwarePolicy m1(with_cells(2.25), reference,
-                        {.confidence = 1.0, .scale_prior_sd = 0.01, .curve = CurveSource::mixture});
-    const Decision a = t0.decide(s.region(0, 0.1)), b = c0.decide(s.region(0, 0.1)), mm = m0.decide(s.region(0, 0.1));
+    const auto at = [&](double z, CurveSource curve) {
+      return decided(2.25, reference, {.confidence = z, .scale_prior_sd = 0.01, .curve = curve});
+    };
+    const Decision a = at(0.0, CurveSource::training), b = at(0.0, CurveSource::corrected);
+    const Decision mm = at(0.0, CurveSource::mixture);
     const double gain = mm.scores[1].predicted_field_gain;
     CHECK(gain > a.scores[1].predicted_curve_rise);
     CHECK(gain < b.scores[1].predicted_curve_rise);
@@ -698,9 +692,8 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     CHECK(gain > mm.scores[1].predicted_curve_rise);
     CHECK(mm.descend);
     CHECK(mm.candidate == 1);
-    FrontAwarePolicy t1(with_cells(2.25), reference, {.confidence = 1.0, .scale_prior_sd = 0.01});
-    CHECK(t1.decide(s.region(0, 0.1)).descend);
-    CHECK_FALSE(m1.decide(s.region(0, 0.1)).descend);
+    CHECK(at(1.0, CurveSource::training).descend);
+    CHECK_FALSE(at(1.0, CurveSource::mixture).descend);
   }
   // A flatter training curve (0.05 over 145 s): the cells' descents are worth their time.
   const std::vector<ReferenceCurve> flat{{"a", {{1.0, 0.80}, {3.0, 0.75}}, 0.2, 0.05}};
