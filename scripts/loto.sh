@@ -27,8 +27,9 @@
 #       matches) to out/loto/model-<k>/ and prints its field mIoU on tile k.
 #   bash scripts/loto.sh scores [FILE...]
 #       here: the table eval ends with (each held-out tile's field mIoU per GSD, their mean, the
-#       classes' mean IoU) from LOTO_WORK's eval-<k>.json, or from the FILEs given (one network's
-#       eval_ensemble --json on its held-out tile), e.g. a bundled set's tile-*/held_out_eval.json.
+#       classes' mean IoU, each tile's class IoU per GSD) from LOTO_WORK's eval-<k>.json, or from
+#       the FILEs given (one network's eval_ensemble --json on its held-out tile), e.g. a bundled
+#       set's tile-*/held_out_eval.json.
 #   bash scripts/loto.sh recipe-cpu TILES
 #       here, no accelerator: the deployment recipe itself (1784 steps of 32 crops, seed 0; the
 #       GPU run's schedule without --minutes) on the CPU, one held-out tile after another (TILES
@@ -147,7 +148,8 @@ train_fields() {  # every bundled tile but $1, comma-separated
 }
 
 # The estimate from held-out scores (eval_ensemble --json of one network on its tile, as eval and
-# recipe-cpu write them): each held-out tile's field mIoU per GSD, their mean, and per class.
+# recipe-cpu write them): each held-out tile's field mIoU per GSD, their mean, per class, and each
+# tile's class IoU per GSD.
 print_scores() {
   local f
   for f in "$@"; do [ -s "$f" ] || { echo "no $f: bash $0 eval DIR or recipe-cpu first" >&2; exit 2; }; done
@@ -170,6 +172,12 @@ print("\nclass IoU, mean over the held-out tiles (tiles where the class occurs):
 for c, cls in enumerate(classes):
     vals = {g: [r[g]["iou"][c] for _, r in rows if r[g]["iou"][c] is not None] for g in gsds}
     print(f"  {cls:<11}" + "  ".join(f"{g:g} cm/px {sum(v) / len(v):.3f} (n={len(v)})" for g, v in vals.items() if v))
+print("\nclass IoU per held-out tile, " + " / ".join(f"{g:g}" for g in gsds) + " cm/px (- where the class is absent):")
+print("| held-out tile | " + " | ".join(classes) + " |")
+print("| --- |" + " ---: |" * len(classes))
+for name, r in rows:
+    cell = lambda c: " / ".join("-" if r[g]["iou"][c] is None else f"{r[g]['iou'][c]:.3f}" for g in gsds)
+    print(f"| {name} | " + " | ".join(cell(c) for c in range(len(classes))) + " |")
 PY
 }
 

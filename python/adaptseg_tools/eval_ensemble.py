@@ -17,6 +17,13 @@ mirror); an ensemble is NAME=MEMBER+MEMBER[+...] (equal weights) or an ensemble 
 (ensemble.yaml, its members resolved relative to it, each matched to the member of that
 directory and mirror setting).
 
+With --match-colour each member sees the field's images matched, per channel, to the mean and
+standard deviation of the fields it trained on (model.yaml's training fields, read from
+examples/data): x' = (x - mu_field) / sd_field * sd_train + mu_train, mu_field and sd_field over the
+field's labelled ground (what a flight would estimate from its top-level images), mu_train and
+sd_train the means of its training fields' own. A diagnosis of whether new ground differs from the
+training fields in colour alone; the C++ backend has no such step.
+
 Usage:
   PYTHONPATH=python /usr/bin/python3 -m adaptseg_tools.eval_ensemble \\
       --members mnv2=examples/models/mobilenetv2-dubai,erf=examples/models/erfnet-dubai \\
@@ -56,6 +63,34 @@ def member_probabilities(model, spec, meta, bgr: np.ndarray, mirror: bool = Fals
         logits = logits_to(model(x).float(), bgr.shape[:2])[0]
     t = float(meta.get("temperature", 1.0))
     return torch.softmax(logits / t, dim=0).numpy()
+
+
+def colour_stats(field) -> tuple[np.ndarray, np.ndarray]:
+    """Per-channel (BGR) mean and standard deviation of a field's image over its labelled ground."""
+    pixels = field.image[field.labels != IGNORE].astype(np.float64)
+    return pixels.mean(0), pixels.std(0)
+
+
+def training_colour(meta: dict, cache: dict) -> tuple[np.ndarray, np.ndarray]:
+    """The mean over a member's training fields (model.yaml) of their per-channel means and
+    standard deviations."""
+    names = (meta.get("training") or {}).get("fields") or []
+    if not names:
+        raise SystemExit("--match-colour: a member's model.yaml names no training fields")
+    for name in names:
+        if name not in cache:
+            d = REPO / "examples" / "data" / name
+            if not (d / "field.yaml").is_file():
+                raise SystemExit(f"--match-colour: training field {name} is not in {d.parent}")
+            cache[name] = colour_stats(load_field(d))
+    return np.mean([cache[n][0] for n in names], 0), np.mean([cache[n][1] for n in names], 0)
+
+
+def match_colour(bgr: np.ndarray, field_colour, train_colour) -> np.ndarray:
+    """An 8-bit image with each channel moved from the field's mean and standard deviation to the
+    training fields' (--match-colour), rounded and clipped to 0..255."""
+    (mu_f, sd_f), (mu_t, sd_t) = field_colour, train_colour
+    return np.clip((bgr - mu_f) / np.maximum(sd_f, 1e-6) * sd_t + mu_t + 0.5, 0, 255).astype(np.uint8)
 
 
 def load_member(model_dir: Path):
@@ -121,6 +156,8 @@ def main():
     ap.add_argument("--fields", default=",".join(str(REPO / "examples" / "data" / f"dubai-tile-{k}") for k in (4, 6)))
     ap.add_argument("--bands", default="1,3", help="GSD factors of the fields' GSD")
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--match-colour", action="store_true",
+                    help="match each field's colour to each member's training fields (a diagnosis)")
     ap.add_argument("--json")
     args = ap.parse_args()
     torch.set_num_threads(args.threads)
@@ -141,6 +178,8 @@ def main():
     if len(cams) != 1:
         raise SystemExit(f"members trained for different cameras: {sorted(cams)}")
     cam_wh = cams.pop()
+    stats_cache: dict = {}
+    train_colour = {n: training_colour(meta, stats_cache) for n, (_, _, meta, _) in nets.items()} if args.match_colour else {}
     nc = len(classes)
     bands = [float(v) for v in args.bands.split(",")]
     rows = list(member_dirs) + list(ensembles)
@@ -151,6 +190,7 @@ def main():
         if field.classes != classes:
             raise SystemExit(f"{fdir}: classes {field.classes} differ from the members' {classes}")
         results[field.name] = {}
+        field_colour = colour_stats(field) if args.match_colour else None
         for fac in bands:
             gsd = field.gsd_cm * fac
             cms = {r: np.zeros((nc, nc + 1), np.int64) for r in rows}
@@ -161,8 +201,9 @@ def main():
                     continue
                 probs = {}
                 for name, (model, spec, meta, mirror) in nets.items():
+                    image = rgb if field_colour is None else match_colour(rgb, field_colour, train_colour[name])
                     t0 = time.perf_counter()
-                    probs[name] = member_probabilities(model, spec, meta, rgb, mirror)
+                    probs[name] = member_probabilities(model, spec, meta, image, mirror)
                     seconds[name] += time.perf_counter() - t0
                 labels = {n: p.argmax(0) for n, p in probs.items()}
                 for ens, mem in ensembles.items():
@@ -186,7 +227,7 @@ def main():
           f"{args.threads} threads): " + ", ".join(f"{n} {1000 * s / max(1, sum(b['images'] for fr in results.values() for b in fr.values())):.0f} ms"
                                                   for n, s in seconds.items()))
     if args.json:
-        Path(args.json).write_text(json.dumps({"classes": classes, "members": member_dirs,
+        Path(args.json).write_text(json.dumps({"classes": classes, "members": member_dirs, "match_colour": args.match_colour,
                                                "ensembles": {k: v for k, v in ensembles.items()},
                                                "fields": results}, indent=2) + "\n")
 

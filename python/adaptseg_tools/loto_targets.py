@@ -15,6 +15,8 @@ lawnmower curve's upper envelope, `front_margin` of results.csv):
     target >= 0.5);
   - the oracle above 0 in the runs where any strategy (this configuration's or the oracle's)
     beats the curve (target: all);
+with several configurations, in how many runs any of them is above +0.001 (each run's best
+adaptive margin over them: what the configurations reach together) and the runs where none is;
 then one row per run: class, tile, each configuration's adaptive margin (descents), a pooled
 configuration's margins side by side ("a / b", in the order of its folders).
 """
@@ -89,6 +91,19 @@ def main(argv):
         r = correlation([f for f, _ in pairs], [g for _, g in pairs])
         print(f"| {label} | {len(a)} | {sum(v > 0.001 for v in a)} | {statistics.median(a):+.4f} | "
               f"{statistics.mean(a):+.4f} | {below} | {len(pairs)} | {r:+.2f} | {oracle_cell} |")
+
+    if len(configs) > 1:
+        # What the configurations reach together: each run's best adaptive margin over all of
+        # them (a pooled configuration's flights counted as runs of their class and tile).
+        best = {}
+        for _, runs, _ in configs:
+            for k, v in runs.items():
+                if "adaptive" in v:
+                    best[k[:2]] = max(best.get(k[:2], float("-inf")), v["adaptive"][0])
+        won = [k for k in sorted(best) if best[k] > 0.001]
+        never = ", ".join(f"{c} {t}" for c, t in sorted(best) if best[(c, t)] <= 0.001) or "none"
+        print(f"\nany configuration above +0.001: {len(won)} of {len(best)} runs (each run's best "
+              f"adaptive margin over the configurations); in none: {never}")
 
     print()
     print("| class | tile |" + "".join(f" {c[0]} |" for c in configs) + (" oracle |" if oracle else ""))

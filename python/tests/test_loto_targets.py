@@ -7,6 +7,7 @@ one below max(non-adaptive, 0) - 0.002, three descents whose forecasts and reali
 proportional (correlation +1), and the oracle above 0 in two of the three runs where some
 strategy beats the curve. The same four runs flown again (a second seed's networks) pool with
 the first as one configuration of eight runs, and a folder of other runs is refused for it.
+Side by side the two flights reach +0.001 together in two runs of four.
 """
 import os
 import sys
@@ -75,6 +76,15 @@ def main():
         check_targets(["--oracle", oracle, f"both={loto}+{again}"],
                       ["both", "8", "3", "+0.0006", "+0.0007", "1", "5", "+0.98", "4 of 6"],
                       "| road | 1 | +0.0015 (1) / +0.0030 (1) | -0.0010 (0) |", "pooled road on tile 1")
+        # Side by side, each run's best over the two: building 1 (+0.004) and road 1 (+0.003)
+        # above +0.001, water 2 (0) and water 3 (+0.0007) in none.
+        text = printed(loto_targets.main, [f"base={loto}", f"again={again}"])[1]
+        want = ("any configuration above +0.001: 2 of 4 runs (each run's best adaptive margin over "
+                "the configurations); in none: water 2, water 3")
+        if want not in text.splitlines():
+            sys.exit(f"no line {want!r}:\n{text}")
+        if "any configuration" in printed(loto_targets.main, [f"base={loto}"])[1]:
+            sys.exit("one configuration printed what several reach together")
         other = os.path.join(tmp, "other")
         write_run(other, "mobilenetv2-loto-building-tile-2", 0.0, 0.0)
         check_refused(loto_targets.main, [f"x={loto}+{other}"], "other runs", "a pool of different runs")

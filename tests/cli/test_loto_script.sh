@@ -117,10 +117,14 @@ grep -qx '| dubai-tile-5 | 0.300 | 0.200 |' "$work/out" || fail "scores: tile 5'
 grep -qx '| mean | 0.400 | 0.300 |' "$work/out" || fail "scores: the mean row: $(cat "$work/out")"
 # water: at 5 cm/px on both tiles (0.7, 0.5), at 15 on neither (null: the class absent there)
 grep -qx '  water      5 cm/px 0.600 (n=2)' "$work/out" || fail "scores: water's mean: $(cat "$work/out")"
+# each tile's class IoU, finest GSD first; water absent at 15 cm/px
+grep -qx '| held-out tile | building | land | road | vegetation | water |' "$work/out" || fail "scores: class header: $(cat "$work/out")"
+grep -qx '| dubai-tile-5 | 0.500 / 0.500 | 0.600 / 0.600 | 0.400 / 0.400 | 0.300 / 0.300 | 0.500 / - |' "$work/out" ||
+  fail "scores: tile 5's classes: $(cat "$work/out")"
 # the FILEs given instead of LOTO_WORK's
 PYTHON=/usr/bin/python3 bash "$loto" scores "$sw/eval-5.json" >"$work/out" 2>&1 || fail "scores FILE: $(cat "$work/out")"
 grep -qx '| mean | 0.300 | 0.200 |' "$work/out" || fail "scores FILE: the mean row: $(cat "$work/out")"
-echo "ok: scores printed each tile's row, the mean and the classes' means"
+echo "ok: scores printed each tile's row, the mean, the classes' means and each tile's classes"
 refused "no $sw/eval-9.json" scores "$sw/eval-9.json"
 
 # --- LOTO_ARCH: the ERFNet and width-1.4 recipes have no deployment network to calibrate; an
