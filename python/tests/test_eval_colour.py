@@ -78,7 +78,7 @@ def main():
     check(np.abs(got - affine)[within].max() <= 0.5, "a pixel inside 0..255 is not the affine match, rounded")
     check((got[affine <= 0] == 0).all() and (got[affine >= 255] == 255).all(), "a pixel outside 0..255 is not clipped")
     check(within.mean() > 0.5, "most of the tile clipped: the check would say little")
-    # Uniform noise of the field's mean and spread, matched: the training mean and spread (no clipping).
+    # Gaussian noise, matched to a mean and spread well inside 0..255: those, within rounding (no clipping).
     rng = np.random.default_rng(0)
     noise = np.clip(rng.normal(128, 20, (300, 400, 3)), 0, 255).round().astype(np.uint8)
     n_mu, n_sd = noise.reshape(-1, 3).mean(0), noise.reshape(-1, 3).std(0)
