@@ -314,8 +314,9 @@ struct CalibrationCli {
                        "calibrated, the one whose lawnmower falls least short of the faster ones on the training "
                        "fields' curves, field by field (undominated), or from there a finer one while the predicted "
                        "curve rises faster per second up to it than beyond it (hull); comma-separated, each tried "
-                       "with every confidence level on the training fields, the first kept unless another has a "
-                       "better mean front margin; the one kept is saved in the model")
+                       "with every confidence level on the training fields, the first kept unless another beats it "
+                       "by more than one standard error of their paired fold margins; the one kept is saved in "
+                       "the model")
             ->delimiter(',')
             ->check(CLI::IsMember(detail::names_of(kTopLevelChoices)))
             ->capture_default_str(),

@@ -103,8 +103,9 @@ struct CalibrationOptions {
   std::vector<SlopePooling> slope_poolings{SlopePooling::cells, SlopePooling::fields};
   /// Front-aware rule, DescentCoverage::ranked: the top-level choices tried (TopLevelChoice;
   /// each replaces `front_aware.top_level`), each with every pooling and z; the first is kept
-  /// unless another's best setting has a larger mean front margin on the folds. Without ranked
-  /// cells: the first only. Empty (the default): `front_aware.top_level` alone.
+  /// unless another's best setting beats it by more than one standard error of their paired
+  /// margins on the folds (detail::select_pooling's rule). Without ranked cells: the first
+  /// only. Empty (the default): `front_aware.top_level` alone.
   std::vector<TopLevelChoice> top_levels{};
   /// Front-aware rule: the finest GSDs a descent may be limited to
   /// (FrontAwarePolicy::Params::finest_descent_gsd_cm) [cm/px], tried on the folds after the

@@ -263,8 +263,8 @@ struct FrontAwareRule {
   /// its halves, with the model of the whole field), ties to the larger z; with ranked cells
   /// and several fields this for each of `slope_poolings`, and the first pooling kept unless
   /// another beats it by more than the folds' noise (detail::select_pooling); with ranked cells
-  /// all that for each of `top_levels`, the first kept unless another has a larger mean front
-  /// margin (detail::choose_setting; front_aware_search.hpp); with several
+  /// all that for each of `top_levels`, the first kept unless another beats it by more than
+  /// the folds' noise (detail::choose_setting; front_aware_search.hpp); with several
   /// `finest_descent_gsd_cm`, every setting flown with the first and the setting kept then
   /// flown with each other one, the first kept unless another beats it by more than the folds'
   /// noise (detail::choose_finest_descent). `fly(field, policy, curve,

@@ -223,7 +223,10 @@ std::vector<AdaptiveResult> measuring_flights(const RuleSearchInputs& in, std::s
 /// The setting kept (an index into `trials` and `settings`, in the same order): per pooling and
 /// top level, its z of best mean front margin (ties to the larger z); per top level, the first
 /// pooling's unless another beats it by more than the folds' noise (select_pooling); of the
-/// top levels, the first's unless another has a larger mean front margin.
+/// top levels' so kept, the first's unless another beats it by more than the folds' noise
+/// (select_pooling again, the same grounds). Until 2026-12-05 any larger mean front margin took
+/// another top level, and `hull` was kept for building on tile 1 for a gain on one training
+/// field alone (docs/journal/2026-12-loto.md, forty-second session).
 inline std::size_t choose_setting(std::span<const RuleTrial> trials, std::span<const FrontAwareSetting> settings,
                                   const FrontAwareGrid& grid, std::span<const std::size_t> grounds = {}) {
   const std::size_t none = trials.size();
@@ -235,14 +238,15 @@ inline std::size_t choose_setting(std::span<const RuleTrial> trials, std::span<c
         (trials[k].front_margin == trials[b].front_margin && settings[k].z > settings[b].z))
       b = k;
   }
-  std::size_t chosen = none;
+  std::vector<std::size_t> of_levels;
+  std::vector<const RuleTrial*> levels;
   for (const std::vector<std::size_t>& of_level : best) {
     std::vector<const RuleTrial*> candidates;
     for (std::size_t b : of_level) candidates.push_back(&trials[b]);
-    const std::size_t k = of_level[select_pooling(candidates, grounds)];
-    if (chosen == none || trials[k].front_margin > trials[chosen].front_margin) chosen = k;
+    of_levels.push_back(of_level[select_pooling(candidates, grounds)]);
+    levels.push_back(&trials[of_levels.back()]);
   }
-  return chosen;
+  return of_levels[select_pooling(levels, grounds)];
 }
 
 /// The search's grid beyond z from the calibration options: the slope poolings (distinct ones,
