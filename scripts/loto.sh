@@ -71,7 +71,9 @@
 #       for the paper's fusion): the models record it and the missions flown with them pool;
 #       and β a line in the field's entropy tried first (--slope-pooling
 #       field-entropy,cells,fields; LOTO_SLOPE_POOLING another list), what did best on the
-#       leave-one-tile-out folds with pooled maps (docs/results.md). What a user flies a new site
+#       leave-one-tile-out folds with pooled maps (docs/results.md); and the top level chosen by
+#       the folds (--top-level undominated,hull; LOTO_TOP_LEVEL another list), since the
+#       forty-second session (docs/results.md). What a user flies a new site
 #       with (docs/programs.md, "A new site"). Segmentations are cached in
 #       out/results/segmentation-cache.
 #   LOTO_SEED=1 LOTO_WORK=out/loto-seed1 LOTO_BUNDLE=out/loto-seed1/bundle bash scripts/loto.sh ...
@@ -386,7 +388,7 @@ decision)
     build/release/examples/adaptseg_calibrate "${trains[@]}" --interest "$cls" --segmenter network --network "$deploy" \
       "${crossed[@]}" --threads "${LOTO_THREADS:-2}" --segmentation-cache out/results/segmentation-cache \
       --map-fusion "${LOTO_MAP_FUSION:-pooled}" --slope-pooling "${LOTO_SLOPE_POOLING:-field-entropy,cells,fields}" \
-      --out "$models/decision-$cls.yaml" >"$wroot/decision-$cls.log" 2>&1 ||
+      --top-level "${LOTO_TOP_LEVEL:-undominated,hull}" --out "$models/decision-$cls.yaml" >"$wroot/decision-$cls.log" 2>&1 ||
       { echo "calibration for $cls failed: $wroot/decision-$cls.log" >&2; exit 1; }
     echo "$models/decision-$cls.yaml"
   done
