@@ -583,9 +583,8 @@ TEST_CASE(
   REQUIRE(best_undominated != nullptr);
   REQUIRE(best_hull->margins.size() == 2);
   REQUIRE(best_undominated->margins.size() == 2);
-  const double d0 = best_undominated->margins[0] - best_hull->margins[0];
-  const double d1 = best_undominated->margins[1] - best_hull->margins[1];
-  const bool beyond = (d0 + d1) / 2.0 > std::abs(d0 - d1) / 2.0 * (1.0 + 1e-9);  // sd/√2 of two: |d0 − d1|/2
+  const std::vector<const RuleTrial*> levels{best_hull, best_undominated};
+  const bool beyond = adaptseg::detail::select_pooling(levels) == 1;
   CHECK(rule.params().top_level == (beyond ? TopLevelChoice::undominated : TopLevelChoice::hull));
   // One choice: no name in the trials; none: the parameters' own (as before the list).
   options.top_levels = {TopLevelChoice::undominated};
