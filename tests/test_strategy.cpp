@@ -180,7 +180,8 @@ TEST_CASE("decisions.csv: one column table for the header and every row, in any 
   const std::string header = decisions_csv_header();
   CHECK(header.rfind("field,strategy,decision,image,sigma,action,gsd_cm,images,extra_time_s,", 0) == 0);
   CHECK(header.find(",realised_field_gain,flown,") != std::string::npos);
-  CHECK(header.find(",realised_delta_fn,forecast_curve_rise,forecast_end_s\n") != std::string::npos);
+  CHECK(header.find(",realised_delta_fn,forecast_curve_rise,forecast_end_s,realised_field_gain_region\n") !=
+        std::string::npos);
   const auto columns = [](const std::string& line) { return std::count(line.begin(), line.end(), ',') + 1; };
   CHECK(columns(header.substr(0, header.size() - 1)) == static_cast<long>(kDecisionColumns.size()));
 
@@ -239,4 +240,41 @@ TEST_CASE("decisions.csv: one column table for the header and every row, in any 
   CHECK(std::string(kDecisionColumns[23].name) == "realised_delta_tp");
   CHECK(adaptseg::detail::format_fixed(-0.5, 3) == "-0.500");
   CHECK(adaptseg::detail::format_fixed(1234567.0, 1) == "1234567.0");
+}
+
+TEST_CASE("realised descents: the field gain inside the region apart from where the images overhang it") {
+  // 8 x 4 px, the class of interest (weed, 2) in columns 2-3 (inside the descent's region,
+  // columns 0-3) and 5-6 (beyond it, where the descent's images overhang). The top level saw
+  // none of it; the descent's finer images, over both halves, all of it.
+  cv::Mat truth(4, 8, CV_8UC1, cv::Scalar(0));
+  truth.colRange(2, 4).setTo(2);
+  truth.colRange(5, 7).setTo(2);
+  const Field f("overhang", 1.0, truth, t::soil_crop_weed(), {2});
+  const auto image_at = [](cv::Rect fp, double gsd) {
+    Image img;
+    img.footprint_px = fp;
+    img.gsd_cm = gsd;
+    img.width_px = fp.width;
+    img.height_px = fp.height;
+    return img;
+  };
+  SemanticMap top_only(truth.size());
+  top_only.fuse(image_at({0, 0, 8, 4}, 2.0), cv::Mat(4, 8, CV_8UC1, cv::Scalar(0)));
+  SemanticMap map(truth.size());
+  map.fuse(image_at({0, 0, 8, 4}, 2.0), cv::Mat(4, 8, CV_8UC1, cv::Scalar(0)));
+  const cv::Rect region(0, 0, 4, 4);
+  detail::PendingDescent d{0, region, map.labels()(region).clone(), cv::Rect(0, 0, 8, 4), 1.0};
+  map.fuse(image_at({0, 0, 8, 4}, 1.0), truth);
+  MissionResult mission;
+  mission.interest = {2};
+  mission.fused_labels = map.labels();
+  mission.confusion = ConfusionMatrix(f.num_classes());
+  mission.confusion.add(truth, map.labels(), f.ignore_label());
+  const std::vector<RealisedDescent> r =
+      detail::realised_descents(f, {d}, top_only, cv::Mat(4, 8, CV_32F, cv::Scalar(1.0f)), mission);
+  REQUIRE(r.size() == 1);
+  CHECK(r[0].field_gain == doctest::Approx(1.0));         // weed IoU 0 -> 1
+  CHECK(r[0].field_gain_region == doctest::Approx(0.5));  // its 8 pixels inside alone: 0.5
+  CHECK(r[0].delta_tp == 16);
+  CHECK(r[0].region_delta_miou() == doctest::Approx(-1.0));
 }

@@ -10,6 +10,11 @@ a miss corrected, one added costs as much. And Δσ, what the UAV saw: the regio
 descent minus its top-level σ (observed_sigma_sub − sigma; a descent that writes the class where
 it is absent raises it far beyond the others). Then, over all descents: how often the region's
 gain and the field's disagree in sign, and for those, whether the descent added false positives.
+Where decisions.csv has it (adaptseg_evaluate since 2026-12-06), also the realised field gain of
+the descent's pixels inside its region alone (realised_field_gain_region: what the forecast
+models, calibration re-mapping a region's cells within the region) and, over all descents, the
+forecast's correlation with it and how much of the realised gain came from where the images
+overhang the region.
 
 With --curve, per descent also the lawnmower curve it had to beat: the rise the rule predicted
 over the descent's extra time (forecast_curve_rise) against the rise of the field's real curve
@@ -240,21 +245,24 @@ def main(argv: list[str] | None = None) -> int:
         curves = {(Path(run).name, field): env for run in args.runs for field, env in real_curves(Path(run)).items()}
         curve_table(rows, curves)
         return 0
-    print("| run | decision | GSD [cm/px] | images | forecast field gain | realised field gain | region gain | "
-          "ΔTP [px] | ΔFP [px] | Δσ |")
-    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
-    forecast, realised = [], []
+    inside = all(d.get("realised_field_gain_region", "") not in ("", None) for _, d in rows) and bool(rows)
+    print("| run | decision | GSD [cm/px] | images | forecast field gain | realised field gain | "
+          + ("of which inside the region | " if inside else "") + "region gain | ΔTP [px] | ΔFP [px] | Δσ |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | " + ("---: | " if inside else "") + "---: | ---: | ---: | ---: |")
+    forecast, realised, realised_inside = [], [], []
     disagree = disagree_fp = 0
     for run, d in rows:
         fg, rg = number(d["forecast_field_gain"]), number(d["realised_field_gain"])
+        rgi = number(d["realised_field_gain_region"]) if inside else math.nan
         region = -number(d["realised_region_delta_miou"])
         tp, fp = int(d["realised_delta_tp"]), int(d["realised_delta_fp"])
         d_sigma = number(d.get("observed_sigma_sub", "")) - number(d.get("sigma", ""))
         print(f"| {run} | {d['decision']} | {number(d['gsd_cm']):g} | {d['images']} | {fg:+.4f} | {rg:+.4f} | "
-              f"{region:+.4f} | {tp:+d} | {fp:+d} | {d_sigma:+.3f} |")
+              + (f"{rgi:+.4f} | " if inside else "") + f"{region:+.4f} | {tp:+d} | {fp:+d} | {d_sigma:+.3f} |")
         if math.isfinite(fg) and math.isfinite(rg):
             forecast.append(fg)
             realised.append(rg)
+            realised_inside.append(rgi)
         if math.isfinite(region) and math.isfinite(rg) and (region > 0) != (rg > 0):
             disagree += 1
             disagree_fp += fp > 0
@@ -263,6 +271,10 @@ def main(argv: list[str] | None = None) -> int:
           f"the region's gain and the field's disagree in sign in {disagree}, of which {disagree_fp} added false "
           f"positives; false positives added in {sum(int(d['realised_delta_fp']) > 0 for _, d in rows)} descents, "
           f"misses corrected (ΔTP > 0) in {sum(int(d['realised_delta_tp']) > 0 for _, d in rows)}")
+    if inside and forecast:
+        print(f"inside the regions alone: forecast and realised correlate at "
+              f"{correlation(forecast, realised_inside):+.2f}; realised {sum(realised_inside):+.4f} of "
+              f"{sum(realised):+.4f} in all (where the images overhang: {sum(realised) - sum(realised_inside):+.4f})")
     return 0
 
 

@@ -64,6 +64,21 @@ def main():
                 sys.exit(f"table: no row {want}:\n{plain}")
         if "false positives added in 1 descents, misses corrected (ΔTP > 0) in 2" not in plain:
             sys.exit(f"table summary:\n{plain}")
+        # With the gain inside the region (adaptseg_evaluate since 2026-12-06): one more column,
+        # and how much of the realised gain came from where the images overhang the region.
+        inside = os.path.join(tmp, "inside")
+        os.makedirs(inside)
+        with open(os.path.join(inside, "decisions.csv"), "w") as f:
+            lines = DECISIONS.splitlines()
+            f.write(lines[0] + ",realised_field_gain_region\n" + lines[1] + ",0.012\n" + lines[2] + ",\n" +
+                    lines[3] + ",-0.002\n")
+        split = table([inside])
+        if "| inside | 0 | 10 | 2 | +0.0150 | +0.0200 | +0.0120 | +0.0500 | +100 | -10 | +0.020 |" not in split:
+            sys.exit(f"table with the gain inside the region: no row for the first descent:\n{split}")
+        if "realised +0.0100 of +0.0210 in all (where the images overhang: +0.0110)" not in split:
+            sys.exit(f"table with the gain inside the region: summary:\n{split}")
+        if "of which inside the region" in plain:
+            sys.exit("table: a column for the gain inside the region where decisions.csv has none")
         hindsight = table(["--hindsight", run])
         if "| run | 2 | -0.0090 | 1 | +0.0100 |" not in hindsight:
             sys.exit(f"hindsight: the first descent alone should end +0.0100 above the curve:\n{hindsight}")

@@ -41,7 +41,7 @@ want="field,strategy,decision,image,sigma,action,gsd_cm,images,extra_time_s,fore
 want+="forecast_delta_miou_std,forecast_relabelled_interest,forecast_field_gain,forecast_front_margin,observed_sigma_sub,"
 want+="observed_relabelled,observed_relabelled_interest,realised_region_delta_miou,realised_field_gain,flown,"
 want+="observed_top_input,observed_fine_input,realised_delta_tp,realised_delta_fp,realised_delta_fn,forecast_curve_rise,"
-want+="forecast_end_s"
+want+="forecast_end_s,realised_field_gain_region"
 [ "$(head -1 "$work/e/decisions.csv")" = "$want" ] || fail "decisions.csv header: $(head -1 "$work/e/decisions.csv")"
 # Every realised descent's pixel counts: present, whole numbers, and a class's true positives and
 # false negatives (its pixels, whatever the map says) moving by opposite amounts.
@@ -52,7 +52,7 @@ awk -F, '$2 == "adaptive" && $6 == "descend" { n++
   fail "decisions.csv: realised_delta_tp / fp / fn missing, not whole, or TP and FN not moving together"
 descents=$(awk -F, '$2 == "adaptive" {print $12}' "$work/e/results.csv")
 awk -F, -v n="$descents" '$2 == "adaptive" {rows++} $2 == "adaptive" && $6 == "descend" {
-    d++; if ($13 == "" || $14 == "" || $18 == "" || $20 == "" || $14 <= 0 || $20 <= 0) bad++ }
+    d++; if ($13 == "" || $14 == "" || $18 == "" || $20 == "" || $14 <= 0 || $20 <= 0 || $29 !~ /^-?[0-9]+\.[0-9]+$/) bad++ }
   END {exit !(rows > 0 && d == n && d > 0 && bad == 0)}' "$work/e/decisions.csv" ||
   fail "decisions.csv: adaptive's $descents descents not all recorded with forecast, observation and realised gain"
 echo "ok: decisions.csv records adaptive's $descents descents"

@@ -53,7 +53,7 @@ struct DecisionColumn {
 };
 
 /// Every column of decisions.csv, in order (docs/data_format.md says what each holds).
-inline const std::array<DecisionColumn, 28> kDecisionColumns{{
+inline const std::array<DecisionColumn, 29> kDecisionColumns{{
     {"field", [](const DecisionRow& r) { return csv_field(r.field); }},
     {"strategy", [](const DecisionRow& r) { return std::string(r.strategy); }},
     {"decision", [](const DecisionRow& r) { return std::to_string(r.index); }},
@@ -127,6 +127,10 @@ inline const std::array<DecisionColumn, 28> kDecisionColumns{{
      [](const DecisionRow& r) { return r.score() ? detail::finite6(r.score()->predicted_curve_rise) : std::string(); }},
     {"forecast_end_s",
      [](const DecisionRow& r) { return r.score() ? detail::finite6(r.score()->predicted_end_s) : std::string(); }},
+    {"realised_field_gain_region",
+     [](const DecisionRow& r) {
+       return r.realised ? detail::format_fixed(r.realised->field_gain_region, 6) : std::string();
+     }},
 }};
 
 /// The header line of decisions.csv (with its line break).

@@ -33,6 +33,12 @@ struct RealisedDescent {
   /// mapped last (also beyond its region, where its images overhang) labelled as the top-level
   /// images labelled them: the descent's contribution to the mission's result.
   double field_gain = 0.0;
+  /// field_gain counting only the pixels inside the descent's region (its top-level footprint):
+  /// what the forecast models, since calibration re-maps a region's cells within the region
+  /// (region_samples.hpp). The rest of field_gain comes from where the descent's images overhang
+  /// the region (a sub-lawnmower whose footprints do not divide the region's: 12.5 or 10 cm/px
+  /// from 15) and lands in the neighbours' map.
+  double field_gain_region = 0.0;
   /// The same comparison in pixels, summed over the classes of L: how many more true positives,
   /// false positives and false negatives the field's map holds with this descent than without
   /// it. A corrected miss is one less false negative and one more true positive; a label of L
@@ -104,6 +110,15 @@ struct PendingDescent {
     without -= with_it;
     without += without_it;
     r.field_gain = final_miou - without.miou(interest).value_or(0.0);
+    if (const cv::Rect inside = d.covered & d.region; inside.area() > 0) {
+      const cv::Mat owned_inside = map_gsd_cm(inside) == static_cast<float>(d.gsd_cm);
+      cv::Mat reverted_inside = final_labels(inside).clone();
+      top_only.labels()(inside).copyTo(reverted_inside, owned_inside);
+      ConfusionMatrix without_inside = mission.confusion;
+      without_inside -= region_confusion(inside, final_labels(inside));
+      without_inside += region_confusion(inside, reverted_inside);
+      r.field_gain_region = final_miou - without_inside.miou(interest).value_or(0.0);
+    }
     const PixelCounts a = with_it.counts(interest), b = without_it.counts(interest);
     r.delta_tp = a.tp - b.tp;
     r.delta_fp = a.fp - b.fp;
