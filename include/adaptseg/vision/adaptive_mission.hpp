@@ -101,25 +101,28 @@ struct PendingDescent {
     r.decision = d.decision;
     std::tie(r.region_miou_before, r.region_miou_after) =
         paired_miou(region_confusion(d.region, d.before), region_confusion(d.region, final_labels(d.region)), interest);
-    const cv::Mat owned = map_gsd_cm(d.covered) == static_cast<float>(d.gsd_cm);
-    cv::Mat reverted = final_labels(d.covered).clone();
-    top_only.labels()(d.covered).copyTo(reverted, owned);
-    const ConfusionMatrix with_it = region_confusion(d.covered, final_labels(d.covered));
-    const ConfusionMatrix without_it = region_confusion(d.covered, reverted);
-    ConfusionMatrix without = mission.confusion;
-    without -= with_it;
-    without += without_it;
-    r.field_gain = final_miou - without.miou(interest).value_or(0.0);
-    if (const cv::Rect inside = d.covered & d.region; inside.area() > 0) {
-      const cv::Mat owned_inside = map_gsd_cm(inside) == static_cast<float>(d.gsd_cm);
-      cv::Mat reverted_inside = final_labels(inside).clone();
-      top_only.labels()(inside).copyTo(reverted_inside, owned_inside);
-      ConfusionMatrix without_inside = mission.confusion;
-      without_inside -= region_confusion(inside, final_labels(inside));
-      without_inside += region_confusion(inside, reverted_inside);
-      r.field_gain_region = final_miou - without_inside.miou(interest).value_or(0.0);
-    }
-    const PixelCounts a = with_it.counts(interest), b = without_it.counts(interest);
+    // The confusions over `rect` of the final map and of the same with the pixels this descent
+    // mapped last labelled as the top-level images labelled them; the field's gain between them.
+    struct Reverted {
+      ConfusionMatrix with_it, without_it;
+      double field_gain;
+    };
+    const auto revert = [&](const cv::Rect& rect) {
+      const cv::Mat owned = map_gsd_cm(rect) == static_cast<float>(d.gsd_cm);
+      cv::Mat reverted = final_labels(rect).clone();
+      top_only.labels()(rect).copyTo(reverted, owned);
+      Reverted x{region_confusion(rect, final_labels(rect)), region_confusion(rect, reverted), 0.0};
+      ConfusionMatrix without = mission.confusion;
+      without -= x.with_it;
+      without += x.without_it;
+      x.field_gain = final_miou - without.miou(interest).value_or(0.0);
+      return x;
+    };
+    const Reverted all = revert(d.covered);
+    r.field_gain = all.field_gain;
+    if (const cv::Rect inside = d.covered & d.region; inside.area() > 0)
+      r.field_gain_region = revert(inside).field_gain;
+    const PixelCounts a = all.with_it.counts(interest), b = all.without_it.counts(interest);
     r.delta_tp = a.tp - b.tp;
     r.delta_fp = a.fp - b.fp;
     r.delta_fn = a.fn - b.fn;
