@@ -1080,6 +1080,13 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
     CHECK(rule_of(DecisionModel::load(tmp.path() / "spread.yaml")).*spread == 0.25);
     p.*spread = 0.0;
   }
+  // Learning that may only stop descents: kept where set (absent: false).
+  CHECK_FALSE(rule_of(back).learn_stop_only);
+  p.learn_stop_only = true;
+  policy.set_params(p);
+  corrected.save(tmp.path() / "stop_only.yaml");
+  CHECK(rule_of(DecisionModel::load(tmp.path() / "stop_only.yaml")).learn_stop_only);
+  p.learn_stop_only = false;
   // Fields of another class set are refused.
   const Field other("o", 1.0, a.labels(), {{"a", {0, 0, 0}}, {"b", {1, 1, 1}}, {"c", {2, 2, 2}}}, {1});
   const std::vector<Field> mixed{a, other};

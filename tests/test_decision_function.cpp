@@ -334,6 +334,13 @@ TEST_CASE("front-aware policy: what a descent relabelled changes a later decisio
     CHECK_FALSE(adaptive.decide(s.region(1)).descend);
     CHECK(fixed.decide(s.region(1)).descend);
   }
+  SUBCASE("learning that may only stop descents still stops them") {
+    FrontAwarePolicy stop_only(fitted(), s.reference(0.6 * gain), {.online = true, .learn_stop_only = true});
+    REQUIRE(stop_only.decide(s.region(0)).descend);
+    stop_only.observe(Scenario::outcome(0.25));
+    CHECK(stop_only.field_scale() < 0.5);
+    CHECK_FALSE(stop_only.decide(s.region(1)).descend);
+  }
   SUBCASE("a descent that changes more than forecast makes a later, costlier one worth it") {
     const auto reference = s.reference(1.5 * gain);
     FrontAwarePolicy adaptive(fitted(), reference, {.online = true});
@@ -344,8 +351,23 @@ TEST_CASE("front-aware policy: what a descent relabelled changes a later decisio
       p->observe(Scenario::outcome(4.0 * 1.2));  // four times the relabelling C forecast at σ 0.6
     }
     CHECK(adaptive.field_scale() > 3.0);
-    CHECK(adaptive.decide(s.region(1)).descend);
+    const Decision learnt = adaptive.decide(s.region(1));
+    CHECK(learnt.descend);
     CHECK_FALSE(fixed.decide(s.region(1)).descend);
+    // Learning that may only stop descents learns as much, forecasts as much, and adds no descent
+    // that the frozen rule does not take.
+    FrontAwarePolicy stop_only(fitted(), reference, {.online = true, .learn_stop_only = true});
+    REQUIRE(stop_only.decide(s.region(0, 0.6, true)).descend);
+    stop_only.observe(Scenario::outcome(4.0 * 1.2));
+    CHECK(stop_only.field_scale() == doctest::Approx(adaptive.field_scale()));
+    const Decision capped = stop_only.decide(s.region(1));
+    CHECK_FALSE(capped.descend);
+    CHECK(capped.scores[0].predicted_field_gain == doctest::Approx(learnt.scores[0].predicted_field_gain));
+    // The non-adaptive rule ignores the setting: nothing it learns to cap.
+    FrontAwarePolicy fixed_stop_only(fitted(), reference, {.online = false, .learn_stop_only = true});
+    REQUIRE(fixed_stop_only.decide(s.region(0, 0.6, true)).descend);
+    fixed_stop_only.observe(Scenario::outcome(4.0 * 1.2));
+    CHECK(fixed_stop_only.field_scale() == 1.0);
   }
   SUBCASE("outcomes reported after all the decisions (a tour) are weighed against their own forecast") {
     FrontAwarePolicy adaptive(fitted(), s.reference(0.0), {.online = true});

@@ -253,6 +253,7 @@ struct CalibrationCli {
   bool relabel_transfer = false;
   bool relabel_region_spread = false;
   bool relabel_field_spread = false;
+  bool learn_stop_only = false;
   double curve_agreement = 0.0;
   std::vector<double> finest_descent_factors;
 
@@ -352,6 +353,9 @@ struct CalibrationCli {
                      "front-aware rule with --field-factor relabelled: the field factor's prior spread from how "
                      "far the training fields' relabelled shares strayed from the forecast on their cells, not "
                      "from how far their gains did (measured; saved in the model)"),
+        app.add_flag("--learn-stop-only", learn_stop_only,
+                     "front-aware rule: what the field factor learns in flight may only stop descents, never add "
+                     "one: each candidate's bound is capped by the non-adaptive rule's (saved in the model)"),
         app.add_flag("--margin-biases", margin_biases,
                      "front-aware rule, several training fields: add to each descent's forecast margin what "
                      "descents to its GSD ended above theirs per second when the training fields were flown "
@@ -408,6 +412,7 @@ struct CalibrationCli {
     options.relabel_region_spread = relabel_region_spread;
     options.relabel_field_spread = relabel_field_spread;
     options.front_aware.curve_agreement = curve_agreement;
+    options.front_aware.learn_stop_only = learn_stop_only;
     options.finest_descent_gsd_cm.clear();
     for (std::size_t k = 0; k < finest_descent_factors.size(); ++k) {
       const double f = finest_descent_factors[k];

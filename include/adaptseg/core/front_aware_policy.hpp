@@ -78,6 +78,10 @@ namespace adaptseg {
 /// the scene check unless `field_factor` says otherwise: FieldFactorSource; learnt from the
 /// relabelled share, s's prior spread may be its own, `relabel_field_sd`). Also the paper's
 /// update of O. `online = false` (non-adaptive) keeps s = 1, Var(s) = ω² and O as initialised.
+/// With `learn_stop_only`, what s learns may only stop descents: each candidate's lower bound is
+/// the lesser of the learnt one and the one the non-adaptive rule computes in the same context
+/// (s at its prior), so that learning can end the descents early where the field changes less
+/// than forecast, and never adds one the frozen rule would not take at that point.
 class FrontAwarePolicy {
  public:
   /// Behaviour (FrontAwareParams); validated by the constructor.
@@ -130,7 +134,7 @@ class FrontAwarePolicy {
     share_.reset();
     forecast_gain_ = 0.0;
     chosen_.clear();
-    scale_ = FieldScale(relabel_field_spread() ? params_.relabel_field_sd : params_.scale_prior_sd);
+    scale_ = prior_scale();
     guard_ = JumpGuard(params_.jump_bound);
   }
 
@@ -144,13 +148,22 @@ class FrontAwarePolicy {
       model_.set_field_entropy(
           share_.entropy(model_.cells()->entropy_reference(c.top_gsd_cm), params_.sigma_prior_weight));
     const auto [weight, sigma_cv2] = gain_weight(c);
-    const PredictedCurves curves = predicted_curves(c, weight);
+    const PredictedCurves curves = predicted_curves(c, weight, scale_);
+    // The frozen rule's curves, where learning may only stop descents (Params::learn_stop_only).
+    std::optional<PredictedCurves> frozen;
+    if (caps_learning()) frozen = predicted_curves(c, weight, prior_scale());
     Decision d;
     std::optional<std::size_t> best_index;
     double best = 0.0;
     std::vector<Assessment> assessed;
     for (std::size_t k = 0; k < c.candidates.size(); ++k) {
-      assessed.push_back(assess(c, c.candidates[k], curves, weight, sigma_cv2));
+      assessed.push_back(assess(c, c.candidates[k], curves, weight, sigma_cv2, scale_));
+      if (frozen) {
+        // No higher than the frozen rule's bound, and none where the frozen rule forecasts no gain.
+        const Assessment f = assess(c, c.candidates[k], *frozen, weight, sigma_cv2, prior_scale());
+        assessed.back().lower =
+            f.gain > 0.0 ? std::min(assessed.back().lower, f.lower) : -std::numeric_limits<double>::infinity();
+      }
       if (assessed.back().gain > 0.0 && assessed.back().lower > best && agreed(c.top_gsd_cm, c.candidates[k].gsd_cm)) {
         best = assessed.back().lower;
         best_index = k;
@@ -263,16 +276,16 @@ class FrontAwarePolicy {
   /// and a curve source other than `training`, this field's curve as predicted (field_curve),
   /// `weight` = a / σ̂; with `mixture` both sets, the predicted ones raised to the training
   /// fields' mean mIoU at the top level.
-  [[nodiscard]] PredictedCurves predicted_curves(const DecisionContext& c, double weight) const {
+  [[nodiscard]] PredictedCurves predicted_curves(const DecisionContext& c, double weight, const FieldScale& s) const {
     PredictedCurves p;
     p.t0 = c.elapsed_s + c.rest_s;
     const bool predicts = model_.cells() && c.region_share > 0.0 && weight > 0.0;
     if (params_.curve != CurveSource::training && predicts) {
       const double x = field_input_estimate(c);
       if (params_.curve == CurveSource::field)
-        p.curves.push_back(field_curve(c, x, weight / c.region_share, nullptr));
+        p.curves.push_back(field_curve(c, x, weight / c.region_share, nullptr, s));
       else
-        for (const auto& r : reference_) p.curves.push_back(field_curve(c, x, weight / c.region_share, &r));
+        for (const auto& r : reference_) p.curves.push_back(field_curve(c, x, weight / c.region_share, &r, s));
       p.level = detail::mean_reference_miou(reference_, c.top_gsd_cm);
       if (params_.curve != CurveSource::mixture) return p;
       // With the training fields' own curves below, which are absolute: these from the level.
@@ -332,19 +345,20 @@ class FrontAwarePolicy {
   }
 
   /// One candidate's forecast gain ĝ and its variance, the curves' rise over its extra time and
-  /// the lower bound (ĝ − ΔD̄ + b·T) − z·sqrt(Var ĝ + sd_D²) (class comment).
+  /// the lower bound (ĝ − ΔD̄ + b·T) − z·sqrt(Var ĝ + sd_D²) (class comment), with the field
+  /// factor `scale` (the one learnt so far, or its prior: Params::learn_stop_only).
   [[nodiscard]] Assessment assess(const DecisionContext& c, const Candidate& cand, const PredictedCurves& p,
-                                  double weight, double sigma_cv2) const {
+                                  double weight, double sigma_cv2, const FieldScale& scale) const {
     const double delta_h = c.top_altitude_m - cand.altitude_m;
     const GainForecast f = model_.forecast(delta_h, c.sigma);
     Assessment a;
     a.score = scored(cand, f);
     const BaseGain b = base_gain(c, cand, f, delta_h, weight);
-    const FactorEstimate s = gain_factor();
+    const FactorEstimate s = gain_factor(scale);
     a.gain = s.scaled(b.mean);
     const double gain_var = s.mean * s.mean * b.sd * b.sd + s.var * b.mean * b.mean + a.gain * a.gain * sigma_cv2;
     a.score.predicted_field_gain = a.gain;
-    if (std::isfinite(b.relabelled.mean)) a.score.predicted_relabelled = std::abs(scale_.mean()) * b.relabelled.mean;
+    if (std::isfinite(b.relabelled.mean)) a.score.predicted_relabelled = std::abs(scale.mean()) * b.relabelled.mean;
     a.score.utility = utility(a.gain, cand.extra_time_s);
     const auto [rise, rise_var] = curve_rise(p.curves, p.t0, cand.extra_time_s);
     // What descents to this GSD ended above their forecast margin on the training fields as new ground.
@@ -366,17 +380,26 @@ class FrontAwarePolicy {
     return params_.curve_agreement <= 0.0 || finer_lawnmower_share(reference_, top, gsd) >= params_.curve_agreement;
   }
 
-  /// A forecast gain `base` before the field factor s, times s (FieldScale::scaled).
-  [[nodiscard]] double scaled(double base) const noexcept { return scale_.scaled(base); }
-
-  /// The factor a descent's forecast gain is scaled by: s, or with s learnt from the relabelled
-  /// share, 1 + b·(s − 1) (Params::relabel_transfer b; FieldScale::transferred), with the gain's
-  /// own prior spread ω where s has its own (Params::relabel_field_sd).
-  [[nodiscard]] FactorEstimate gain_factor() const noexcept {
-    if (params_.field_factor != FieldFactorSource::relabelled) return scale_.estimate();
-    return relabel_field_spread() ? scale_.transferred(params_.relabel_transfer, params_.scale_prior_sd)
-                                  : scale_.transferred(params_.relabel_transfer);
+  /// The factor a descent's forecast gain is scaled by, from the field factor `s`: s, or with s
+  /// learnt from the relabelled share, 1 + b·(s − 1) (Params::relabel_transfer b;
+  /// FieldScale::transferred), with the gain's own prior spread ω where s has its own
+  /// (Params::relabel_field_sd).
+  [[nodiscard]] FactorEstimate gain_factor(const FieldScale& s) const noexcept {
+    if (params_.field_factor != FieldFactorSource::relabelled) return s.estimate();
+    return relabel_field_spread() ? s.transferred(params_.relabel_transfer, params_.scale_prior_sd)
+                                  : s.transferred(params_.relabel_transfer);
   }
+
+  /// The field factor before any observation: s = 1 with its prior spread (ω, or ω_χ where s has
+  /// its own: Params::relabel_field_sd); what begin_mission() starts from and the non-adaptive
+  /// rule keeps.
+  [[nodiscard]] FieldScale prior_scale() const noexcept {
+    return FieldScale(relabel_field_spread() ? params_.relabel_field_sd : params_.scale_prior_sd);
+  }
+
+  /// Whether each candidate's bound is capped by the frozen rule's (Params::learn_stop_only; only
+  /// an adaptive rule learns).
+  [[nodiscard]] bool caps_learning() const noexcept { return params_.online && params_.learn_stop_only; }
 
   /// Whether s, learnt from the relabelled share, has a prior spread of its own (ω_χ).
   [[nodiscard]] bool relabel_field_spread() const noexcept {
@@ -393,18 +416,19 @@ class FrontAwarePolicy {
 
   /// The lawnmower curve of this field as the cell gain model predicts it (CurveSource::field),
   /// relative to the top level's mIoU: at each lawnmower GSD g finer than the top level,
-  /// s·β(top, g)·X̂·(1 / σ̂) (s by scaled(); none with FieldFactorSource::relabelled), `x` = X̂,
+  /// s·β(top, g)·X̂·(1 / σ̂) (s = `scale`, FieldScale::scaled; none with
+  /// FieldFactorSource::relabelled), `x` = X̂,
   /// `inv_sigma` = 1 / σ̂; 0 at the top level; its upper envelope. With a training field
   /// `corrected_by`, each rise times that field's real / predicted rise (CurveSource::corrected).
   [[nodiscard]] std::vector<CurvePoint> field_curve(const DecisionContext& c, double x, double inv_sigma,
-                                                    const ReferenceCurve* corrected_by) const {
+                                                    const ReferenceCurve* corrected_by, const FieldScale& scale) const {
     std::vector<CurvePoint> curve;
     for (const auto& l : c.lawnmowers) {
       if (l.gsd_cm > c.top_gsd_cm) continue;  // coarser than the top level: not what it compares with
       const double slope = l.gsd_cm < c.top_gsd_cm ? model_.cells()->at(c.top_gsd_cm, l.gsd_cm).gain_slope : 0.0;
       const double ratio = corrected_by ? corrected_rise_ratio(*corrected_by, c.top_gsd_cm, l.gsd_cm, slope) : 1.0;
       const double rise = slope * x * inv_sigma * ratio;
-      curve.push_back({l.time_s, params_.field_factor == FieldFactorSource::relabelled ? rise : scaled(rise)});
+      curve.push_back({l.time_s, params_.field_factor == FieldFactorSource::relabelled ? rise : scale.scaled(rise)});
     }
     return upper_envelope(std::move(curve));
   }

@@ -276,6 +276,10 @@ struct FrontAwareParams {
   /// the gain's factor keeps its own prior spread ω (`scale_prior_sd`), of which s explains
   /// b·ω_χ (FieldScale::transferred). 0: s's prior spread is ω.
   double relabel_field_sd = 0.0;
+  /// With `online`: what the field factor learns may only stop descents, never add one
+  /// (FrontAwarePolicy's class comment): each candidate's lower bound is capped by the
+  /// non-adaptive rule's in the same context.
+  bool learn_stop_only = false;
   /// Per descent GSD, the factor on a candidate's forecast field gain (mean and spread): what
   /// descents to it realised of their forecast on the training fields, each flown with a model
   /// that never saw it (CalibrationOptions::gain_ratios). Not listed: 1. Empty: none.

@@ -60,6 +60,7 @@ struct FrontAwareRule {
     if (p.relabel_transfer != 1.0) e << YAML::Key << "relabel_transfer" << YAML::Value << num(p.relabel_transfer);
     if (p.relabel_region_sd > 0.0) e << YAML::Key << "relabel_region_sd" << YAML::Value << num(p.relabel_region_sd);
     if (p.relabel_field_sd > 0.0) e << YAML::Key << "relabel_field_sd" << YAML::Value << num(p.relabel_field_sd);
+    if (p.learn_stop_only) e << YAML::Key << "learn_stop_only" << YAML::Value << detail::flag_text(true);
     std::vector<std::pair<double, double>> ratios, biases;
     for (const GainRatio& x : p.gain_ratios) ratios.emplace_back(x.gsd_cm, x.ratio);
     for (const MarginBias& x : p.margin_biases) biases.emplace_back(x.gsd_cm, x.per_s);
@@ -137,6 +138,7 @@ struct FrontAwareRule {
          .relabel_transfer = rule.has("relabel_transfer") ? rule.number("relabel_transfer") : 1.0,
          .relabel_region_sd = rule.has("relabel_region_sd") ? rule.number("relabel_region_sd") : 0.0,
          .relabel_field_sd = rule.has("relabel_field_sd") ? rule.number("relabel_field_sd") : 0.0,
+         .learn_stop_only = rule.has("learn_stop_only") && rule.flag("learn_stop_only"),
          .gain_ratios = read_gain_ratios(rule),
          .margin_biases = read_margin_biases(rule)});
   }
