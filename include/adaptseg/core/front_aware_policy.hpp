@@ -329,21 +329,6 @@ class FrontAwarePolicy {
     return b;
   }
 
-  /// The curves' rise over a descent of `extra_s` from `t0`: mean ΔD̄ over the curves and its
-  /// variance sd_D² between them (0 with one curve).
-  static std::pair<double, double> curve_rise(const std::vector<std::vector<CurvePoint>>& curves, double t0,
-                                              double extra_s) {
-    double rise_sum = 0.0, rise_sq = 0.0;
-    for (const auto& curve : curves) {
-      const double rise = rising_miou_at_time(curve, t0 + extra_s) - rising_miou_at_time(curve, t0);
-      rise_sum += rise;
-      rise_sq += rise * rise;
-    }
-    const double n = static_cast<double>(curves.size());
-    const double rise = rise_sum / n;
-    return {rise, curves.size() > 1 ? std::max(0.0, (rise_sq - n * rise * rise) / (n - 1.0)) : 0.0};
-  }
-
   /// One candidate's forecast gain ĝ and its variance, the curves' rise over its extra time and
   /// the lower bound (ĝ − ΔD̄ + b·T) − z·sqrt(Var ĝ + sd_D²) (class comment), with the field
   /// factor `scale` (the one learnt so far, or its prior: Params::learn_stop_only).
@@ -360,7 +345,7 @@ class FrontAwarePolicy {
     a.score.predicted_field_gain = a.gain;
     if (std::isfinite(b.relabelled.mean)) a.score.predicted_relabelled = std::abs(scale.mean()) * b.relabelled.mean;
     a.score.utility = utility(a.gain, cand.extra_time_s);
-    const auto [rise, rise_var] = curve_rise(p.curves, p.t0, cand.extra_time_s);
+    const auto [rise, rise_var] = detail::curve_rise(p.curves, p.t0, cand.extra_time_s);
     // What descents to this GSD ended above their forecast margin on the training fields as new ground.
     const double bias = margin_bias_at(params_.margin_biases, cand.gsd_cm) * cand.extra_time_s;
     a.lower = a.gain - rise + bias - params_.confidence * std::sqrt(gain_var + rise_var);

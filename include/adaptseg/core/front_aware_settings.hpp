@@ -236,6 +236,22 @@ namespace detail {
   for (const auto& c : curves) s += miou_at_time(c, t);
   return s / static_cast<double>(curves.size());
 }
+
+/// The rise of `curves` over a descent of `extra_s` from `t0` (rising_miou_at_time(), as the
+/// front-aware rule reads them): mean ΔD̄ over the curves and its variance sd_D² between them
+/// (0 with one curve).
+[[nodiscard]] inline std::pair<double, double> curve_rise(const std::vector<std::vector<CurvePoint>>& curves, double t0,
+                                                          double extra_s) {
+  double rise_sum = 0.0, rise_sq = 0.0;
+  for (const auto& curve : curves) {
+    const double rise = rising_miou_at_time(curve, t0 + extra_s) - rising_miou_at_time(curve, t0);
+    rise_sum += rise;
+    rise_sq += rise * rise;
+  }
+  const double n = static_cast<double>(curves.size());
+  const double rise = rise_sum / n;
+  return {rise, curves.size() > 1 ? std::max(0.0, (rise_sq - n * rise * rise) / (n - 1.0)) : 0.0};
+}
 }  // namespace detail
 
 /// The front-aware rule's behaviour (FrontAwarePolicy::Params; the class comment there says what
