@@ -1385,3 +1385,70 @@ TEST_CASE("decision model: a plain YAML file, every fitted number a key, written
     CHECK(back->camera.image_width_px == m.camera.image_width_px);
   }
 }
+
+namespace {
+/// The oracle, but below `false_below_cm` it calls a band of the soil crop (class 1): a network
+/// that writes a false class when flown lower, on the fields it segments.
+struct FalseWhenLow {
+  OracleSegmenter oracle{3};
+  double false_below_cm = 0.0;
+  [[nodiscard]] std::string name() const { return "false-when-low"; }
+  [[nodiscard]] cv::Mat segment(const Image& image) { return segment_with_probabilities(image).labels; }
+  [[nodiscard]] Segmentation segment_with_probabilities(const Image& image) {
+    Segmentation s = oracle.segment_with_probabilities(image);
+    if (image.gsd_cm >= false_below_cm) return s;
+    for (int r = 0; r < s.labels.rows; ++r)
+      for (int c = 0; c < s.labels.cols; ++c)
+        if (s.labels.at<std::uint8_t>(r, c) == 0 && (r / 8) % 3 == 0) {
+          s.labels.at<std::uint8_t>(r, c) = 1;
+          for (std::size_t k = 0; k < s.probabilities.size(); ++k)
+            s.probabilities[k].at<float>(r, c) = k == 1 ? 1.0f : 0.0f;
+        }
+    return s;
+  }
+};
+}  // namespace
+
+TEST_CASE("calibration: frozen folds fly the non-adaptive rule; the rule kept still learns in flight") {
+  // The second field's network writes a false class below 2.5 cm/px. Flown as new ground by the
+  // model of the other two, its first descent relabels far more than forecast, and the
+  // relabelled field factor learns to descend more where every descent loses.
+  const std::vector<Field> fields{t::blob_field(1300, 1000, 1.0, 4, 15), t::blob_field(1000, 1300, 1.0, 11, 15),
+                                  t::blob_field(1500, 1100, 1.0, 23, 15)};
+  std::vector<FalseWhenLow> networks(3);
+  networks[1].false_below_cm = 2.5;
+  const std::vector<FalseWhenLow*> backends{&networks[0], &networks[1], &networks[2]};
+  const std::span<FalseWhenLow* const> segmented_by(backends);
+  CalibrationOptions options = ranked_options();
+  options.slope_poolings = {SlopePooling::cells};
+  options.front_aware.field_factor = FieldFactorSource::relabelled;
+  const auto z0 = [](const CalibrationResult& c) {
+    const auto t = std::find_if(c.trials.begin(), c.trials.end(),
+                                [](const RuleTrial& r) { return r.description == "front-aware z=0"; });
+    REQUIRE(t != c.trials.end());
+    return *t;
+  };
+  const CalibrationResult learning = calibrate(std::span<const Field>(fields), segmented_by, options);
+  options.frozen_folds = true;
+  const CalibrationResult frozen = calibrate(std::span<const Field>(fields), segmented_by, options);
+  // Learning in the folds' flights adds descents that lose; frozen, the folds fly one.
+  CHECK(z0(learning).descents > z0(frozen).descents);
+  CHECK(z0(frozen).descents >= 1);
+  CHECK(z0(learning).front_margin < z0(frozen).front_margin);
+  // The rule calibrated learns in flight either way.
+  CHECK(learning.decision_function.online());
+  CHECK(frozen.decision_function.online());
+  // The folds learn nothing, so a cap on what is learnt moves none of their margins.
+  options.front_aware.learn_stop_only = true;
+  const CalibrationResult capped = calibrate(std::span<const Field>(fields), segmented_by, options);
+  REQUIRE(capped.trials.size() == frozen.trials.size());
+  for (std::size_t k = 0; k < frozen.trials.size(); ++k) {
+    CHECK(capped.trials[k].description == frozen.trials[k].description);
+    CHECK(capped.trials[k].margins == frozen.trials[k].margins);
+  }
+  // Only the front-aware rule has folds to fly frozen.
+  options.front_aware.learn_stop_only = false;
+  options.rule = "utility";
+  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), segmented_by, options),
+                       doctest::Contains("frozen_folds belongs to the front-aware rule"), std::invalid_argument);
+}

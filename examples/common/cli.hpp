@@ -254,6 +254,7 @@ struct CalibrationCli {
   bool relabel_region_spread = false;
   bool relabel_field_spread = false;
   bool learn_stop_only = false;
+  bool frozen_folds = false;
   double curve_agreement = 0.0;
   std::vector<double> finest_descent_factors;
 
@@ -356,6 +357,10 @@ struct CalibrationCli {
         app.add_flag("--learn-stop-only", learn_stop_only,
                      "front-aware rule: what the field factor learns in flight may only stop descents, never add "
                      "one: each candidate's bound is capped by the non-adaptive rule's (saved in the model)"),
+        app.add_flag("--frozen-folds", frozen_folds,
+                     "front-aware rule: the folds that choose the setting fly the non-adaptive rule, so that "
+                     "what is learnt in a fold's flight cannot move the choice (the rule calibrated still "
+                     "learns in flight)"),
         app.add_flag("--margin-biases", margin_biases,
                      "front-aware rule, several training fields: add to each descent's forecast margin what "
                      "descents to its GSD ended above theirs per second when the training fields were flown "
@@ -413,6 +418,7 @@ struct CalibrationCli {
     options.relabel_field_spread = relabel_field_spread;
     options.front_aware.curve_agreement = curve_agreement;
     options.front_aware.learn_stop_only = learn_stop_only;
+    options.frozen_folds = frozen_folds;
     options.finest_descent_gsd_cm.clear();
     for (std::size_t k = 0; k < finest_descent_factors.size(); ++k) {
       const double f = finest_descent_factors[k];

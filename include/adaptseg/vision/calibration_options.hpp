@@ -168,6 +168,12 @@ struct CalibrationOptions {
   /// fold's the other fields' only. false (the default): `front_aware`'s ω_χ (0: s's prior spread
   /// is ω).
   bool relabel_field_spread = false;
+  /// Front-aware rule: the folds that choose the setting (and measure `gain_ratios` and
+  /// `margin_biases`) fly the non-adaptive rule, so that what the field factor and O learn in a
+  /// fold's flight cannot move the choice; the rule calibrated still learns in flight, and is
+  /// judged against its frozen twin run by run (docs/method.md, "Folds flown frozen"). false (the
+  /// default): the folds fly the adaptive rule, as the deployment does.
+  bool frozen_folds = false;
   /// Front-aware rule, σ̂'s prior (FrontAwarePolicy `sigma_prior_weight` k, `sigma_prior_sd` τ)
   /// with several training fields: `given` keeps `front_aware`'s; `spread` estimates τ on the
   /// training fields (estimate_sigma_prior) and keeps k; `estimated` estimates both. Each fold

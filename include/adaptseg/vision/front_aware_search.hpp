@@ -399,7 +399,7 @@ template <class Fly>
   const std::vector<TopLevelTrace> traces = detail::top_level_traces(in, reference, fly);
   const std::vector<detail::FrontAwareFold> folds = detail::front_aware_folds(in, reference, traces, grid.ranked);
   FrontAwarePolicy::Params base = options.front_aware;
-  base.online = true;
+  base.online = !options.frozen_folds;
   const std::vector<double>& finest = options.finest_descent_gsd_cm;
   if (!finest.empty()) base.finest_descent_gsd_cm = finest.front();
   const double* finest_named = finest.size() > 1 ? &finest.front() : nullptr;
@@ -411,7 +411,6 @@ template <class Fly>
   for (std::size_t pi = 0; pi < grid.poolings.size(); ++pi) {
     FrontAwarePolicy::Params pooled = base;
     models_of_pooling.push_back(detail::pooled_fold_models(in, folds, grid, grid.poolings[pi], pooled));
-    const std::vector<GainModel>& models = models_of_pooling.back();
     for (std::size_t ti = 0; ti < grid.top_levels.size(); ++ti)
       for (double z : options.confidences) {
         FrontAwarePolicy::Params p = pooled;
@@ -420,7 +419,7 @@ template <class Fly>
         RuleTrial t;
         t.description = detail::z_text(z, grid.poolings.size() > 1 ? &grid.poolings[pi] : nullptr,
                                        grid.top_levels.size() > 1 ? &grid.top_levels[ti] : nullptr, finest_named);
-        detail::fly_trial(in, folds, models, corrections, p, t, fly);
+        detail::fly_trial(in, folds, models_of_pooling.back(), corrections, p, t, fly);
         trials.push_back(std::move(t));
         settings.push_back({pi, ti, z, p});
       }
@@ -437,8 +436,9 @@ template <class Fly>
   if (grid.ranked && model.cells() && model.cells()->pooling() != pooling) {
     model.set_cells(CellGainModel::fit(cells_of_every_field(in.cells), in.adaptive.cell_input, pooling));
   }
-  // Its jump bound, b, τ_r and ω_χ from every field's cells.
+  // It learns in flight (the folds may have flown it frozen); its jump bound, b, τ_r, ω_χ from every field's cells.
   FrontAwarePolicy::Params params = settings[best].params;
+  params.online = true;
   if (grid.ranked && detail::measures_on_cells(options)) {
     detail::FoldCorrection whole = detail::FoldCorrection::of(params);
     detail::measure_on_cells(whole, cells_of_every_field(in.cells), options, in.adaptive.cell_input);
