@@ -1387,8 +1387,8 @@ TEST_CASE("decision model: a plain YAML file, every fitted number a key, written
 }
 
 namespace {
-/// The oracle, but below `false_below_cm` it calls a band of the soil crop (class 1): a network
-/// that writes a false class when flown lower, on the fields it segments.
+/// The oracle, but below `false_below_cm` it labels bands of the soil as crop (class 1): a
+/// network that writes a false class when flown lower.
 struct FalseWhenLow {
   OracleSegmenter oracle{3};
   double false_below_cm = 0.0;
