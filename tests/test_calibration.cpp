@@ -1409,7 +1409,7 @@ struct FalseWhenLow {
 };
 }  // namespace
 
-TEST_CASE("calibration: frozen folds fly the non-adaptive rule; the rule kept still learns in flight") {
+TEST_CASE("calibration: frozen folds fly the non-adaptive rule, and the rule kept still learns in flight") {
   // The second field's network writes a false class below 2.5 cm/px. Flown as new ground by the
   // model of the other two, its first descent relabels far more than forecast, and the
   // relabelled field factor learns to descend more where every descent loses.
