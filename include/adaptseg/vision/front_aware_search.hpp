@@ -188,12 +188,13 @@ inline std::vector<GainModel> pooled_fold_models(const RuleSearchInputs& in, std
   return models;
 }
 
-/// One fold flown by `fly` with the front-aware rule over `model` and `params`, σ̂'s prior the
-/// fold's own estimate (estimated without its field) where one is asked for; `margin` its front
-/// margin.
+/// One fold (every trial's and measuring flight's) flown by `fly` with the front-aware rule over
+/// `model` and `params`, learning in flight unless CalibrationOptions::frozen_folds, σ̂'s prior
+/// the fold's own estimate (estimated without its field) where asked for; `margin` its margin.
 template <class Fly>
 AdaptiveResult fly_fold(const RuleSearchInputs& in, const FrontAwareFold& fold, const GainModel& model,
                         FrontAwarePolicy::Params params, Fly& fly, double& margin) {
+  params.online = !in.options.frozen_folds;
   apply_sigma_prior(params, fold.sigma_prior, in.options.sigma_prior);
   FrontAwarePolicy policy(model, fold.reference, params);
   return fly(*fold.field, policy, *fold.curve, margin);
@@ -399,7 +400,7 @@ template <class Fly>
   const std::vector<TopLevelTrace> traces = detail::top_level_traces(in, reference, fly);
   const std::vector<detail::FrontAwareFold> folds = detail::front_aware_folds(in, reference, traces, grid.ranked);
   FrontAwarePolicy::Params base = options.front_aware;
-  base.online = !options.frozen_folds;
+  base.online = true;
   const std::vector<double>& finest = options.finest_descent_gsd_cm;
   if (!finest.empty()) base.finest_descent_gsd_cm = finest.front();
   const double* finest_named = finest.size() > 1 ? &finest.front() : nullptr;
@@ -436,9 +437,8 @@ template <class Fly>
   if (grid.ranked && model.cells() && model.cells()->pooling() != pooling) {
     model.set_cells(CellGainModel::fit(cells_of_every_field(in.cells), in.adaptive.cell_input, pooling));
   }
-  // It learns in flight (the folds may have flown it frozen); its jump bound, b, τ_r, ω_χ from every field's cells.
+  // Its jump bound, b, τ_r and ω_χ from every field's cells.
   FrontAwarePolicy::Params params = settings[best].params;
-  params.online = true;
   if (grid.ranked && detail::measures_on_cells(options)) {
     detail::FoldCorrection whole = detail::FoldCorrection::of(params);
     detail::measure_on_cells(whole, cells_of_every_field(in.cells), options, in.adaptive.cell_input);
