@@ -7,9 +7,10 @@
 #
 # The calibration `scripts/results.sh loto` runs for CLASS (default road) with TILE (default 3)
 # held out: the five other bundled Dubai tiles, each segmented by the leave-one-tile-out
-# MobileNetV2 that never saw it, the deployment's flags (pooled maps, β a line in the field's
-# entropy tried first), one thread, segmentations from out/results/segmentation-cache. One
-# warm-up run (it fills the cache where it is cold), then ROUNDS (default 2) pairs, given back
+# MobileNetV2 that never saw it, the deployment's flags when it was measured (2026-12-04: pooled
+# maps, β a line in the field's entropy tried first, then `cells` and `fields`), one thread,
+# segmentations from out/results/segmentation-cache. One warm-up run (it fills the cache where it
+# is cold), then ROUNDS (default 2) pairs, given back
 # then kept, each alone. Prints each run's wall-clock seconds, user and kernel CPU seconds, minor
 # page faults and peak resident size, the median ratio of the wall-clock seconds, and checks that
 # the two settings wrote the same model byte for byte. About 8 minutes on the 2-core VM with

@@ -69,12 +69,13 @@
 #       field's network) into examples/models/mobilenetv2-dubai-all/decision-<class>.yaml, logs in
 #       out/loto/decision-<class>.log, with pooled maps (--map-fusion pooled; LOTO_MAP_FUSION=finest
 #       for the paper's fusion): the models record it and the missions flown with them pool;
-#       and β a line in the field's entropy tried first (--slope-pooling
-#       field-entropy,cells,fields; LOTO_SLOPE_POOLING another list), what did best on the
-#       leave-one-tile-out folds with pooled maps (docs/results.md); and the top level chosen by
-#       the folds (--top-level undominated,hull; LOTO_TOP_LEVEL another list), since the
-#       forty-second session (docs/results.md). What a user flies a new site
-#       with (docs/programs.md, "A new site"). Segmentations are cached in
+#       and β a line in the field's entropy tried first, then the slopes pooled over the fields
+#       (--slope-pooling field-entropy,fields; LOTO_SLOPE_POOLING another list; `cells` dropped
+#       in the forty-sixth session: it weighs the fields by their cells, not as draws of a new
+#       field), what did best on the leave-one-tile-out folds with pooled maps (docs/results.md);
+#       and the top level chosen by the folds (--top-level undominated,hull; LOTO_TOP_LEVEL
+#       another list), since the forty-second session (docs/results.md). What a user flies a
+#       new site with (docs/programs.md, "A new site"). Segmentations are cached in
 #       out/results/segmentation-cache.
 #   LOTO_SEED=1 LOTO_WORK=out/loto-seed1 LOTO_BUNDLE=out/loto-seed1/bundle bash scripts/loto.sh ...
 #       another seed of the six: train and recipe-cpu train with LOTO_SEED; eval, recipe-cpu and
@@ -387,7 +388,7 @@ decision)
   for cls in "${classes[@]}"; do
     build/release/examples/adaptseg_calibrate "${trains[@]}" --interest "$cls" --segmenter network --network "$deploy" \
       "${crossed[@]}" --threads "${LOTO_THREADS:-2}" --segmentation-cache out/results/segmentation-cache \
-      --map-fusion "${LOTO_MAP_FUSION:-pooled}" --slope-pooling "${LOTO_SLOPE_POOLING:-field-entropy,cells,fields}" \
+      --map-fusion "${LOTO_MAP_FUSION:-pooled}" --slope-pooling "${LOTO_SLOPE_POOLING:-field-entropy,fields}" \
       --top-level "${LOTO_TOP_LEVEL:-undominated,hull}" --out "$models/decision-$cls.yaml" >"$wroot/decision-$cls.log" 2>&1 ||
       { echo "calibration for $cls failed: $wroot/decision-$cls.log" >&2; exit 1; }
     echo "$models/decision-$cls.yaml"
