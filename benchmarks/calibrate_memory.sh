@@ -10,10 +10,10 @@
 # MobileNetV2 that never saw it, the deployment's flags when it was measured (2026-12-04: pooled
 # maps, β a line in the field's entropy tried first, then `cells` and `fields`), one thread,
 # segmentations from out/results/segmentation-cache. One warm-up run (it fills the cache where it
-# is cold), then ROUNDS (default 2) pairs, given back then kept, each alone. Prints each run's wall-clock seconds, user and kernel CPU seconds, minor
-# page faults and peak resident size, the median ratio of the wall-clock seconds, and checks that
-# the two settings wrote the same model byte for byte. About 8 minutes on the 2-core VM with
-# nothing else running.
+# is cold), then ROUNDS (default 2) pairs, given back then kept, each alone. Prints each run's
+# wall-clock seconds, user and kernel CPU seconds, minor page faults and peak resident size, the
+# median ratio of the wall-clock seconds, and checks that the two settings wrote the same model
+# byte for byte. About 8 minutes on the 2-core VM with nothing else running.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 rounds=${1:-2}
