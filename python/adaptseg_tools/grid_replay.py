@@ -1,0 +1,236 @@
+"""What a calibration would keep with fewer settings to try, replayed from flown runs' logs.
+
+Usage: PYTHONPATH=python /usr/bin/python3 -m adaptseg_tools.grid_replay [options] DIR [LABEL=DIR ...]
+
+DIR holds the runs of one configuration of `scripts/results.sh loto` (adaptseg_evaluate output
+folders ...-CLASS-tile-K and their logs ...-CLASS-tile-K.log) flown with a front-aware search
+over z, slope poolings and top levels. Each log lists every setting its calibration tried, the
+kept one first and then the rest in the search's order, with its mean front margin over the
+training folds and each fold's ("tried front-aware z=Z slopes=P top=T: front margin M, N
+descents, per field m1 m2 ..."). A calibration that tries fewer settings flies the same folds,
+so what it keeps can be replayed from those lines, as detail::choose_setting decides: per
+pooling and top level the z of best mean (ties to the larger z); per top level the first
+pooling's unless another beats it by more than one standard error of their paired fold margins
+(detail::select_pooling; of several, the best mean); of the top levels so kept, the first's
+unless another beats it the same way.
+
+  --slope-pooling A,B   the poolings the replay tries, in this order (the first the default);
+                        default: as flown
+  --top-level A,B       the top-level choices, likewise
+  --z A,B               the z values, likewise (their order does not matter)
+  --out OUT             one link per run (folder and log) to a flown run that kept the replayed
+                        setting, from DIR or the LABEL=DIRs after it (each flown with the same
+                        flags but the search's lists), so that `adaptseg_tools.loto_targets
+                        replay=OUT` scores the replayed grid without flying it; OUT must be new
+                        or empty
+
+The flown order is read from the lines after the first (the search's order); a pooling or top
+level tried with one z only and kept would be missing there, and is put first. Each run is
+first replayed with the grid as flown: a run whose replay does not keep what its log says it
+kept is marked "MISMATCH" (its replayed choice is then not to be trusted). The logs print
+margins to four decimals: a comparison whose mean difference lies within 1e-4 of its standard
+error, or two z values of equal printed mean and different folds, is marked "near" (rounding
+may have decided it).
+
+Prints, as Markdown, per run: the setting kept as flown, the setting the replay keeps (its mean
+fold margin), and where a flown run kept that setting ("to fly" where none did), then the count
+of runs that change and of those still to fly. The test run of a setting is the same whichever
+list the search tried it among (the test flight reads only the kept setting and the model),
+which is why a flown run that kept it stands in.
+"""
+import os
+import re
+import sys
+
+from .fold_choice import near_tie, runs_of
+from .fold_table import beats
+
+TRIED = re.compile(
+    r"tried front-aware z=(\S+) slopes=(\S+) top=(\S+)(?: (finest=\S+))?: front margin ([-+\d.]+), (\d+) descents, "
+    r"per field (.*)$"
+)
+
+
+class Trial:
+    """One setting tried: z, pooling, top level, mean fold margin, fold margins."""
+
+    def __init__(self, z, pooling, top, mean, folds):
+        self.z, self.pooling, self.top, self.mean, self.folds = z, pooling, top, mean, folds
+
+    def setting(self):
+        return (self.z, self.pooling, self.top)
+
+
+def read_trials(log):
+    """The settings a run's log lists as tried, the kept one first."""
+    out = []
+    with open(log) as f:
+        for line in f:
+            m = TRIED.search(line)
+            if not m:
+                continue
+            if m.group(4):
+                sys.exit(f"{log}: the search also tried the finest descent GSD ({m.group(4)}): not replayed")
+            out.append(Trial(float(m.group(1)), m.group(2), m.group(3), float(m.group(5)),
+                             [float(v) for v in m.group(7).split()]))
+    if not out:
+        sys.exit(f"{log}: no 'tried front-aware z=.. slopes=.. top=..' line (a run flown with several "
+                 "slope poolings and top levels?)")
+    return out
+
+
+KEPT = re.compile(r"tried front-aware z=(\S+?)(?: slopes=(\S+?))?(?: top=(\S+?))?(?: finest=\S+)?: front margin ([-+\d.]+), "
+                  r"\d+ descents, per field (.*)$")
+
+
+def flew(log, trial):
+    """Whether a flown run's log kept `trial`'s setting: its first `tried` line names the same z
+    and, where it names them, the same pooling and top level (a search that tried one alone omits
+    it), with the same mean and fold margins (the same setting flies the same folds)."""
+    with open(log) as f:
+        for line in f:
+            m = KEPT.search(line)
+            if m:
+                return (float(m.group(1)) == trial.z and m.group(2) in (None, trial.pooling)
+                        and m.group(3) in (None, trial.top) and float(m.group(4)) == trial.mean
+                        and [float(v) for v in m.group(5).split()] == trial.folds)
+    return False
+
+
+def flown_order(trials, attribute):
+    """The flown order of a dimension: first appearance after the kept trial, the kept one's
+    value first where it appears only there."""
+    order = list(dict.fromkeys(getattr(t, attribute) for t in trials[1:]))
+    kept = getattr(trials[0], attribute)
+    return order if kept in order else [kept] + order
+
+
+def select(candidates):
+    """detail::select_pooling on Trials: index kept, and whether a comparison was near."""
+    best, near = 0, False
+    first = candidates[0].folds
+    for k in range(1, len(candidates)):
+        near |= near_tie(first, candidates[k].folds)
+        if beats(candidates[k].folds, first) and candidates[k].mean > candidates[best].mean:
+            best = k
+    return best, near
+
+
+def choose(trials, poolings, tops, zs=None):
+    """detail::choose_setting over the trials within the lists: (Trial kept, near)."""
+    near, of_levels = False, []
+    for top in tops:
+        of_level = []
+        for pooling in poolings:
+            group = [t for t in trials if t.pooling == pooling and t.top == top and (zs is None or t.z in zs)]
+            if not group:
+                continue
+            best = group[0]
+            for t in group[1:]:
+                if t.mean > best.mean or (t.mean == best.mean and t.z > best.z):
+                    best = t
+            near |= any(t is not best and t.mean == best.mean and t.folds != best.folds for t in group)
+            of_level.append(best)
+        if of_level:
+            k, n = select(of_level)
+            near |= n
+            of_levels.append(of_level[k])
+    if not of_levels:
+        return None, near
+    k, n = select(of_levels)
+    return of_levels[k], near or n
+
+
+def name(setting):
+    z, pooling, top = setting
+    return f"z={z:g} {pooling} {top}"
+
+
+def parse_list(text, option):
+    items = [s for s in text.split(",") if s]
+    if not items:
+        sys.exit(f"{option}: an empty list")
+    return items
+
+
+def main(argv):
+    options = {"--slope-pooling": None, "--top-level": None, "--z": None, "--out": None}
+    rest = []
+    k = 0
+    while k < len(argv):
+        if argv[k] in options:
+            if k + 1 >= len(argv):
+                sys.exit(f"{argv[k]} needs a value")
+            options[argv[k]] = argv[k + 1]
+            k += 2
+        elif argv[k].startswith("-"):
+            sys.exit(f"unknown option {argv[k]}\n" + __doc__.split("\n\n")[1])
+        else:
+            rest.append(argv[k])
+            k += 1
+    if not rest:
+        sys.exit(__doc__.split("\n\n")[1])
+    poolings = tops = zs = None
+    if options["--slope-pooling"] is not None:
+        poolings = parse_list(options["--slope-pooling"], "--slope-pooling")
+    if options["--top-level"] is not None:
+        tops = parse_list(options["--top-level"], "--top-level")
+    if options["--z"] is not None:
+        try:
+            zs = {float(v) for v in parse_list(options["--z"], "--z")}
+        except ValueError:
+            sys.exit(f"--z: numbers, got {options['--z']!r}")
+    flown = [("", rest[0])]
+    for c in rest[1:]:
+        label, _, d = c.partition("=")
+        if not d:
+            sys.exit(f"expected LABEL=DIR after DIR, got {c!r}")
+        flown.append((label, d))
+    runs = [(label, d, runs_of(d)) for label, d in flown]
+    out = options["--out"]
+    if out:
+        if os.path.exists(out) and os.listdir(out):
+            sys.exit(f"{out} exists and is not empty")
+        os.makedirs(out, exist_ok=True)
+
+    print("| class | tile | kept as flown | replay keeps (fold mean) | flown in |")
+    print("| --- | ---: | --- | --- | --- |")
+    changed = to_fly = mismatched = 0
+    for key in sorted(runs[0][2]):
+        trials = read_trials(os.path.join(runs[0][1], runs[0][2][key] + ".log"))
+        as_flown, _ = choose(trials, flown_order(trials, "pooling"), flown_order(trials, "top"))
+        mismatch = as_flown.setting() != trials[0].setting()
+        mismatched += mismatch
+        want_p = poolings or flown_order(trials, "pooling")
+        want_t = tops or flown_order(trials, "top")
+        for p in want_p:
+            if p not in {t.pooling for t in trials}:
+                sys.exit(f"{runs[0][2][key]}: slope pooling {p!r} was not tried")
+        for t in want_t:
+            if t not in {tr.top for tr in trials}:
+                sys.exit(f"{runs[0][2][key]}: top level {t!r} was not tried")
+        kept, near = choose(trials, want_p, want_t, zs)
+        if kept is None:
+            sys.exit(f"{runs[0][2][key]}: no setting tried within the lists")
+        where = None
+        for label, d, of in runs:
+            if key in of and flew(os.path.join(d, of[key] + ".log"), kept):
+                where = (label or "DIR", d, of[key])
+                break
+        moved = kept.setting() != trials[0].setting()
+        changed += moved
+        to_fly += where is None
+        if out and where:
+            for n in (where[2], where[2] + ".log"):
+                os.symlink(os.path.abspath(os.path.join(where[1], n)), os.path.join(out, n))
+        print(f"| {key[0]} | {key[1]} | {name(trials[0].setting())}{' MISMATCH' if mismatch else ''} | "
+              f"{name(kept.setting())} ({kept.mean:+.4f}){' (near)' if near else ''}"
+              f"{' (changed)' if moved else ''} | {where[0] if where else 'to fly'} |")
+    total = len(runs[0][2])
+    print(f"\n{changed} of {total} runs change, {to_fly} still to fly; "
+          f"{mismatched} whose replay as flown does not keep what they kept.")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
