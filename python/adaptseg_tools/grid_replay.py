@@ -1,4 +1,4 @@
-"""What a calibration would keep with fewer settings to try, replayed from flown runs' logs.
+r"""What a calibration would keep with fewer settings to try, replayed from flown runs' logs.
 
 Usage: PYTHONPATH=python /usr/bin/python3 -m adaptseg_tools.grid_replay [options] DIR [LABEL=DIR ...]
 
@@ -23,6 +23,14 @@ unless another beats it the same way.
                         flags but the search's lists), so that `adaptseg_tools.loto_targets
                         replay=OUT` scores the replayed grid without flying it; OUT must be new
                         or empty
+  --to-fly FILE         the runs still to fly, one folder name a line (e.g.
+                        mobilenetv2-loto-building-tile-3), for flying those alone:
+                          mkdir -p out/results/$CONFIG && CONFIG=... EXTRA=... PYTHONPATH=python \
+                          /usr/bin/python3 -m adaptseg_tools.experiments --dry-run loto \
+                          | grep -F -f <(sed 's|.*|/&.log|' FILE) | tr '\n' '\0' \
+                          | nice xargs -0 -P 2 -I{} bash -c {}
+                        (the dry run's commands of those runs; CONFIG a new folder, EXTRA the
+                        smaller search's flags; then pass out/results/$CONFIG as a LABEL=DIR)
 
 The flown order is read from the lines after the first (the search's order); a pooling or top
 level tried with one z only and kept would be missing there, and is put first. Each run is
@@ -154,7 +162,7 @@ def parse_list(text, option):
 
 
 def main(argv):
-    options = {"--slope-pooling": None, "--top-level": None, "--z": None, "--out": None}
+    options = {"--slope-pooling": None, "--top-level": None, "--z": None, "--out": None, "--to-fly": None}
     rest = []
     k = 0
     while k < len(argv):
@@ -193,6 +201,7 @@ def main(argv):
             sys.exit(f"{out} exists and is not empty")
         os.makedirs(out, exist_ok=True)
 
+    unflown = []
     print("| class | tile | kept as flown | replay keeps (fold mean) | flown in |")
     print("| --- | ---: | --- | --- | --- |")
     changed = to_fly = mismatched = 0
@@ -220,12 +229,17 @@ def main(argv):
         moved = kept.setting() != trials[0].setting()
         changed += moved
         to_fly += where is None
+        if where is None:
+            unflown.append(runs[0][2][key])
         if out and where:
             for n in (where[2], where[2] + ".log"):
                 os.symlink(os.path.abspath(os.path.join(where[1], n)), os.path.join(out, n))
         print(f"| {key[0]} | {key[1]} | {name(trials[0].setting())}{' MISMATCH' if mismatch else ''} | "
               f"{name(kept.setting())} ({kept.mean:+.4f}){' (near)' if near else ''}"
               f"{' (changed)' if moved else ''} | {where[0] if where else 'to fly'} |")
+    if options["--to-fly"]:
+        with open(options["--to-fly"], "w") as f:
+            f.writelines(n + "\n" for n in unflown)
     total = len(runs[0][2])
     print(f"\n{changed} of {total} runs change, {to_fly} still to fly; "
           f"{mismatched} whose replay as flown does not keep what they kept.")

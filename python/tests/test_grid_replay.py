@@ -82,7 +82,11 @@ def main():
         check("1 whose replay as flown does not keep" in text, f"the mismatch not counted:\n{text}")
 
         # field-entropy alone: building moves to the setting row b flew, water to one nobody flew.
-        text = printed(grid_replay.main, ["--slope-pooling", "field-entropy", "--out", out, a, f"b={b}"])[1]
+        to_fly = os.path.join(tmp, "to-fly.txt")
+        text = printed(grid_replay.main, ["--slope-pooling", "field-entropy", "--out", out, "--to-fly", to_fly, a,
+                                          f"b={b}"])[1]
+        with open(to_fly) as f:
+            check(f.read() == "net-water-tile-3\n", "the run to fly not listed in --to-fly's file")
         for row in ("| building | 1 | z=0 fields hull | z=0 field-entropy hull (+0.0020) (changed) | b |",
                     "| road | 2 | z=2 field-entropy undominated | z=2 field-entropy undominated (+0.0000) | DIR |",
                     "| water | 3 | z=0 fields undominated MISMATCH | z=0 field-entropy undominated (+0.0040) (changed) "
