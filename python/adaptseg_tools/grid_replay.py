@@ -12,7 +12,9 @@ so what it keeps can be replayed from those lines, as detail::choose_setting dec
 pooling and top level the z of best mean (ties to the larger z); per top level the first
 pooling's unless another beats it by more than one standard error of their paired fold margins
 (detail::select_pooling; of several, the best mean); of the top levels so kept, the first's
-unless another beats it the same way.
+unless another beats it the same way. A row calibrated on several looks of each field
+(--calibration-network-each; its "calibrating on" line names a field once per look) counts the
+looks of one field as one ground, as the programs' CalibrationOptions::field_grounds do.
 
   --slope-pooling A,B   the poolings the replay tries, in this order (the first the default);
                         default: as flown
@@ -50,13 +52,47 @@ import os
 import re
 import sys
 
-from .fold_choice import near_tie, runs_of
-from .fold_table import beats
+from .fold_choice import runs_of
 
 TRIED = re.compile(
     r"tried front-aware z=(\S+) slopes=(\S+) top=(\S+)(?: (finest=\S+))?: front margin ([-+\d.]+), (\d+) descents, "
     r"per field (.*)$"
 )
+
+
+CALIBRATING = re.compile(r"calibrating on (.*) \.\.\.$")
+
+
+def fold_grounds(log):
+    """Each training fold's ground, as the programs set CalibrationOptions::field_grounds: with
+    --calibration-network-each one field's looks by several networks are listed one after
+    another under one name ("calibrating on A, A, B, B, ..."), one ground; every other fold its
+    own."""
+    with open(log) as f:
+        for line in f:
+            m = CALIBRATING.search(line)
+            if m:
+                names = m.group(1).split(", ")
+                return [next(j for j in range(k, -1, -1) if j == 0 or names[j - 1] != names[k]) for k in
+                        range(len(names))]
+    return None
+
+
+def paired(folds, first, grounds):
+    """Mean and standard error of `folds` − `first`, one difference per ground (its folds' mean),
+    as detail::select_pooling counts them; None for fewer than two grounds."""
+    if len(folds) != len(first):
+        return None
+    by_ground = {}
+    for k, (a, b) in enumerate(zip(folds, first)):
+        g = grounds[k] if grounds and len(grounds) == len(folds) else k
+        by_ground.setdefault(g, []).append(a - b)
+    d = [sum(v) / len(v) for _, v in sorted(by_ground.items())]
+    n = len(d)
+    if n < 2:
+        return None
+    mean = sum(d) / n
+    return mean, (sum((x - mean) ** 2 for x in d) / (n - 1) / n) ** 0.5
 
 
 class Trial:
@@ -113,18 +149,25 @@ def flown_order(trials, attribute):
     return order if kept in order else [kept] + order
 
 
-def select(candidates):
-    """detail::select_pooling on Trials: index kept, and whether a comparison was near."""
+def select(candidates, grounds=None):
+    """detail::select_pooling on Trials: index kept (the first unless another beats it by more
+    than one standard error of the paired differences, by a relative 1e-9; of several, the best
+    mean), and whether a comparison was near (settings that differ, the mean difference within
+    the logs' rounding, 1e-4, of its standard error)."""
     best, near = 0, False
     first = candidates[0].folds
     for k in range(1, len(candidates)):
-        near |= near_tie(first, candidates[k].folds)
-        if beats(candidates[k].folds, first) and candidates[k].mean > candidates[best].mean:
+        d = paired(candidates[k].folds, first, grounds)
+        if d is None:
+            continue
+        mean, se = d
+        near |= candidates[k].folds != first and abs(mean - se) < 1e-4
+        if mean > se * (1.0 + 1e-9) and candidates[k].mean > candidates[best].mean:
             best = k
     return best, near
 
 
-def choose(trials, poolings, tops, zs=None):
+def choose(trials, poolings, tops, zs=None, grounds=None):
     """detail::choose_setting over the trials within the lists: (Trial kept, near)."""
     near, of_levels = False, []
     for top in tops:
@@ -140,12 +183,12 @@ def choose(trials, poolings, tops, zs=None):
             near |= any(t is not best and t.mean == best.mean and t.folds != best.folds for t in group)
             of_level.append(best)
         if of_level:
-            k, n = select(of_level)
+            k, n = select(of_level, grounds)
             near |= n
             of_levels.append(of_level[k])
     if not of_levels:
         return None, near
-    k, n = select(of_levels)
+    k, n = select(of_levels, grounds)
     return of_levels[k], near or n
 
 
@@ -206,8 +249,9 @@ def main(argv):
     print("| --- | ---: | --- | --- | --- |")
     changed = to_fly = mismatched = 0
     for key in sorted(runs[0][2]):
-        trials = read_trials(os.path.join(runs[0][1], runs[0][2][key] + ".log"))
-        as_flown, _ = choose(trials, flown_order(trials, "pooling"), flown_order(trials, "top"))
+        log = os.path.join(runs[0][1], runs[0][2][key] + ".log")
+        trials, grounds = read_trials(log), fold_grounds(log)
+        as_flown, _ = choose(trials, flown_order(trials, "pooling"), flown_order(trials, "top"), grounds=grounds)
         mismatch = as_flown.setting() != trials[0].setting()
         mismatched += mismatch
         want_p = poolings or flown_order(trials, "pooling")
@@ -218,7 +262,7 @@ def main(argv):
         for t in want_t:
             if t not in {tr.top for tr in trials}:
                 sys.exit(f"{runs[0][2][key]}: top level {t!r} was not tried")
-        kept, near = choose(trials, want_p, want_t, zs)
+        kept, near = choose(trials, want_p, want_t, zs, grounds)
         if kept is None:
             sys.exit(f"{runs[0][2][key]}: no setting tried within the lists")
         where = None

@@ -12,6 +12,9 @@ first, then the search's order):
   fold_choice marks it): field-entropy kept.
 - water, tile 3: the log claims (0, fields, undominated), which its margins do not keep: a
   MISMATCH. Replayed with field-entropy alone it keeps a setting no row flew: "to fly".
+Then a run calibrated on two looks of each of three fields (--calibration-network-each): the
+looks of one field are one ground, so a difference the six looks would call beyond the noise is
+not (and is, where the six are six fields).
 """
 import os
 import sys
@@ -24,10 +27,13 @@ from adaptseg_tools import grid_replay
 ZERO = (0.0, 0.0, 0.0)
 
 
-def write_run(root, name, trials, names_pooling=True):
-    """trials: [(z, pooling, top, folds)], the kept one first."""
+def write_run(root, name, trials, names_pooling=True, fields=None):
+    """trials: [(z, pooling, top, folds)], the kept one first; fields: the calibration fields as
+    the log's "calibrating on" line lists them (none listed where not given)."""
     os.makedirs(os.path.join(root, name))
     with open(os.path.join(root, name + ".log"), "w") as f:
+        if fields:
+            f.write(f"[   0.8 s] calibrating on {', '.join(fields)} ...\n")
         f.write("[   1.0 s] calibrated: 128 samples, front-aware z=0, train front margin +0.0000, 0 descents\n")
         for z, pooling, top, folds in trials:
             mean = sum(folds) / len(folds)
@@ -105,6 +111,26 @@ def main():
                   for line in text.splitlines()), f"z=0 not kept on road:\n{text}")
         check(any(line.startswith("| building | 1 | z=0 fields hull | z=0 fields undominated (+0.0030) (changed)")
                   for line in text.splitlines()), f"undominated not kept on building:\n{text}")
+
+        # --calibration-network-each: two looks per field, one ground. `fields` beats
+        # `field-entropy` by one standard error counted over the six looks, not over the three
+        # grounds (detail::select_pooling averages a ground's looks first): field-entropy kept.
+        c, d = (os.path.join(tmp, n) for n in ("c", "d"))
+        base = (0.001,) * 6
+        better = tuple(b + x for b, x in zip(base, (0.004, 0.004, 0.002, 0.002, -0.002, -0.002)))
+        looks = grid({("field-entropy", "undominated"): base, ("field-entropy", "hull"): base,
+                      ("fields", "undominated"): better, ("fields", "hull"): better})
+        twins = ["dubai-tile-1", "dubai-tile-1", "dubai-tile-2", "dubai-tile-2", "dubai-tile-3", "dubai-tile-3"]
+        write_run(c, "net-building-tile-4", kept_first(looks, (0, "field-entropy", "undominated")), fields=twins)
+        text = printed(grid_replay.main, [c])[1]
+        check("| building | 4 | z=0 field-entropy undominated | z=0 field-entropy undominated" in text,
+              f"the looks of one field counted as several grounds:\n{text}")
+        # The same margins from six fields: `fields` beats it.
+        write_run(d, "net-building-tile-4", kept_first(looks, (0, "fields", "undominated")),
+                  fields=[f"dubai-tile-{k}" for k in range(1, 7)])
+        text = printed(grid_replay.main, [d])[1]
+        check("| building | 4 | z=0 fields undominated | z=0 fields undominated" in text,
+              f"six grounds not counted as six:\n{text}")
 
         # Nothing overwritten; a pooling never tried, or an empty list, refused.
         check_refused(grid_replay.main, ["--out", out, a], "not empty", "a filled OUT")
