@@ -118,8 +118,8 @@ def read_trials(log):
             out.append(Trial(float(m.group(1)), m.group(2), m.group(3), float(m.group(5)),
                              [float(v) for v in m.group(7).split()]))
     if not out:
-        sys.exit(f"{log}: no 'tried front-aware z=.. slopes=.. top=..' line (a run flown with several "
-                 "slope poolings and top levels?)")
+        sys.exit(f"{log}: no 'tried front-aware z=.. slopes=.. top=..' line (a run still calibrating, or one "
+                 "whose search tried a single slope pooling or top level?)")
     return out
 
 
