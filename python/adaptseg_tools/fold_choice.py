@@ -47,22 +47,23 @@ def kept_trial(log):
     return kept
 
 
-def near_tie(first, other):
+def near_tie(first, other, grounds=None):
     """Whether the settings differ on some fold and their mean difference lies within the logs'
-    rounding (1e-4) of its standard error, so that the four printed decimals may decide."""
+    rounding (1e-4) of its standard error, so that the four printed decimals may decide;
+    `grounds` as fold_table.paired_difference."""
     if len(first) != len(other) or len(first) < 2 or first == other:
         return False
-    mean, se = paired_difference(other, first)
+    mean, se = paired_difference(other, first, grounds)
     return abs(mean - se) < 1e-4
 
 
-def choose(trials):
+def choose(trials, grounds=None):
     """Index kept among `trials` (each (name, mean, descents, folds)), the first the default, and
-    whether any comparison was near."""
+    whether any comparison was near; `grounds` as fold_table.paired_difference."""
     best, near = 0, False
     for k in range(1, len(trials)):
-        near |= near_tie(trials[0][3], trials[k][3])
-        if beats(trials[k][3], trials[0][3]) and trials[k][1] > trials[best][1]:
+        near |= near_tie(trials[0][3], trials[k][3], grounds)
+        if beats(trials[k][3], trials[0][3], grounds) and trials[k][1] > trials[best][1]:
             best = k
     return best, near
 

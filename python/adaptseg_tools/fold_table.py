@@ -38,21 +38,31 @@ def read(path):
     return out
 
 
-def paired_difference(folds, first):
-    """The mean of `folds` − `first` (paired, one margin per fold) and its standard error."""
+def paired_difference(folds, first, grounds=None):
+    """The mean of `folds` − `first` (paired, one margin per fold) and its standard error. With
+    `grounds` (each fold's ground, CalibrationOptions::field_grounds: the looks of one field by
+    several networks), one difference per ground, its folds' mean, as detail::select_pooling
+    counts them; the standard error is infinite for fewer than two."""
     d = [a - b for a, b in zip(folds, first)]
+    if grounds and len(grounds) == len(d):
+        by_ground = {}
+        for g, x in zip(grounds, d):
+            by_ground.setdefault(g, []).append(x)
+        d = [sum(v) / len(v) for _, v in sorted(by_ground.items())]
     n = len(d)
     mean = sum(d) / n
+    if n < 2:
+        return mean, float("inf")
     return mean, (sum((x - mean) ** 2 for x in d) / (n - 1) / n) ** 0.5
 
 
-def beats(folds, first):
+def beats(folds, first, grounds=None):
     """Whether `folds` beat `first` (paired) by more than one standard error of the differences,
     as detail::select_pooling decides: by a relative 1e-9 more, so that a difference on one fold
-    alone (mean and standard error then equal) is never enough."""
+    alone (mean and standard error then equal) is never enough; `grounds` as paired_difference."""
     if len(folds) != len(first) or len(folds) < 2:
         return False
-    mean, se = paired_difference(folds, first)
+    mean, se = paired_difference(folds, first, grounds)
     return mean > se * (1.0 + 1e-9)
 
 

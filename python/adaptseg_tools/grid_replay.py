@@ -52,14 +52,11 @@ import os
 import re
 import sys
 
-from .fold_choice import runs_of
+from .fold_choice import choose as select, runs_of, tried_settings
 
-TRIED = re.compile(
-    r"tried front-aware z=(\S+) slopes=(\S+) top=(\S+)(?: (finest=\S+))?: front margin ([-+\d.]+), (\d+) descents, "
-    r"per field (.*)$"
-)
-
-
+# A trial's name (detail::z_text): its z, and its slope pooling, top level and finest descent GSD
+# where the search tried several.
+SETTING = re.compile(r"front-aware z=(\S+?)(?: slopes=(\S+?))?(?: top=(\S+?))?(?: (finest=\S+))?$")
 CALIBRATING = re.compile(r"calibrating on (.*) \.\.\.$")
 
 
@@ -78,67 +75,48 @@ def fold_grounds(log):
     return None
 
 
-def paired(folds, first, grounds):
-    """Mean and standard error of `folds` − `first`, one difference per ground (its folds' mean),
-    as detail::select_pooling counts them; None for fewer than two grounds."""
-    if len(folds) != len(first):
-        return None
-    by_ground = {}
-    for k, (a, b) in enumerate(zip(folds, first)):
-        g = grounds[k] if grounds and len(grounds) == len(folds) else k
-        by_ground.setdefault(g, []).append(a - b)
-    d = [sum(v) / len(v) for _, v in sorted(by_ground.items())]
-    n = len(d)
-    if n < 2:
-        return None
-    mean = sum(d) / n
-    return mean, (sum((x - mean) ** 2 for x in d) / (n - 1) / n) ** 0.5
-
-
 class Trial:
-    """One setting tried: z, pooling, top level, mean fold margin, fold margins."""
+    """One setting tried: z, pooling and top level (None where the search tried one alone and the
+    log does not name it), the finest descent GSD where it tried several ("finest=G"), mean fold
+    margin, fold margins."""
 
-    def __init__(self, z, pooling, top, mean, folds):
-        self.z, self.pooling, self.top, self.mean, self.folds = z, pooling, top, mean, folds
+    def __init__(self, log, name, mean, folds):
+        m = SETTING.fullmatch(name)
+        if not m:
+            sys.exit(f"{log}: a setting tried that is not the front-aware rule's: {name!r}")
+        self.z, self.pooling, self.top, self.finest = float(m.group(1)), m.group(2), m.group(3), m.group(4)
+        self.mean, self.folds = mean, folds
 
     def setting(self):
         return (self.z, self.pooling, self.top)
 
+    def as_tuple(self):
+        """As fold_choice.choose takes a trial: (name, mean, descents, folds)."""
+        return (None, self.mean, None, self.folds)
+
 
 def read_trials(log):
     """The settings a run's log lists as tried, the kept one first."""
-    out = []
-    with open(log) as f:
-        for line in f:
-            m = TRIED.search(line)
-            if not m:
-                continue
-            if m.group(4):
-                sys.exit(f"{log}: the search also tried the finest descent GSD ({m.group(4)}): not replayed")
-            out.append(Trial(float(m.group(1)), m.group(2), m.group(3), float(m.group(5)),
-                             [float(v) for v in m.group(7).split()]))
-    if not out:
+    out = [Trial(log, name, mean, folds) for name, mean, _, folds in tried_settings(log)]
+    if any(t.finest for t in out):
+        sys.exit(f"{log}: the search also tried the finest descent GSD: not replayed")
+    if not out or any(t.pooling is None or t.top is None for t in out):
         sys.exit(f"{log}: no 'tried front-aware z=.. slopes=.. top=..' line (a run still calibrating, or one "
                  "whose search tried a single slope pooling or top level?)")
     return out
 
 
-KEPT = re.compile(r"tried front-aware z=(\S+?)(?: slopes=(\S+?))?(?: top=(\S+?))?(?: finest=\S+)?: front margin ([-+\d.]+), "
-                  r"\d+ descents, per field (.*)$")
-
-
 def flew(log, trial):
     """Whether a flown run's log kept `trial`'s setting: its first `tried` line names the same z
     and, where it names them, the same pooling and top level (a search that tried one alone omits
-    it), with the same mean and fold margins (the same setting flies the same folds)."""
-    with open(log) as f:
-        for line in f:
-            m = KEPT.search(line)
-            if m:
-                return (float(m.group(1)) == trial.z and m.group(2) in (None, trial.pooling)
-                        and m.group(3) in (None, trial.top) and float(m.group(4)) == trial.mean
-                        and [float(v) for v in m.group(5).split()] == trial.folds)
-    return False
+    it), with the same mean and fold margins (the same setting flies the same folds), and no finest
+    descent GSD chosen beside them."""
+    name, mean, _, folds = next(tried_settings(log), (None, None, None, None))
+    if name is None:
+        return False
+    kept = Trial(log, name, mean, folds)
+    return (kept.z == trial.z and kept.pooling in (None, trial.pooling) and kept.top in (None, trial.top)
+            and not kept.finest and kept.mean == trial.mean and kept.folds == trial.folds)
 
 
 def flown_order(trials, attribute):
@@ -147,24 +125,6 @@ def flown_order(trials, attribute):
     order = list(dict.fromkeys(getattr(t, attribute) for t in trials[1:]))
     kept = getattr(trials[0], attribute)
     return order if kept in order else [kept] + order
-
-
-def select(candidates, grounds=None):
-    """detail::select_pooling on Trials: index kept (the first unless another beats it by more
-    than one standard error of the paired differences, by a relative 1e-9; of several, the best
-    mean), and whether a comparison was near (settings that differ, the mean difference within
-    the logs' rounding, 1e-4, of its standard error)."""
-    best, near = 0, False
-    first = candidates[0].folds
-    for k in range(1, len(candidates)):
-        d = paired(candidates[k].folds, first, grounds)
-        if d is None:
-            continue
-        mean, se = d
-        near |= candidates[k].folds != first and abs(mean - se) < 1e-4
-        if mean > se * (1.0 + 1e-9) and candidates[k].mean > candidates[best].mean:
-            best = k
-    return best, near
 
 
 def choose(trials, poolings, tops, zs=None, grounds=None):
@@ -183,12 +143,12 @@ def choose(trials, poolings, tops, zs=None, grounds=None):
             near |= any(t is not best and t.mean == best.mean and t.folds != best.folds for t in group)
             of_level.append(best)
         if of_level:
-            k, n = select(of_level, grounds)
+            k, n = select([t.as_tuple() for t in of_level], grounds)
             near |= n
             of_levels.append(of_level[k])
     if not of_levels:
         return None, near
-    k, n = select(of_levels, grounds)
+    k, n = select([t.as_tuple() for t in of_levels], grounds)
     return of_levels[k], near or n
 
 
@@ -251,16 +211,16 @@ def main(argv):
     for key in sorted(runs[0][2]):
         log = os.path.join(runs[0][1], runs[0][2][key] + ".log")
         trials, grounds = read_trials(log), fold_grounds(log)
-        as_flown, _ = choose(trials, flown_order(trials, "pooling"), flown_order(trials, "top"), grounds=grounds)
+        flown_p, flown_t = flown_order(trials, "pooling"), flown_order(trials, "top")
+        as_flown, _ = choose(trials, flown_p, flown_t, grounds=grounds)
         mismatch = as_flown.setting() != trials[0].setting()
         mismatched += mismatch
-        want_p = poolings or flown_order(trials, "pooling")
-        want_t = tops or flown_order(trials, "top")
+        want_p, want_t = poolings or flown_p, tops or flown_t
         for p in want_p:
-            if p not in {t.pooling for t in trials}:
+            if p not in flown_p:
                 sys.exit(f"{runs[0][2][key]}: slope pooling {p!r} was not tried")
         for t in want_t:
-            if t not in {tr.top for tr in trials}:
+            if t not in flown_t:
                 sys.exit(f"{runs[0][2][key]}: top level {t!r} was not tried")
         kept, near = choose(trials, want_p, want_t, zs, grounds)
         if kept is None:
