@@ -100,6 +100,12 @@
 #       LOTO_BUNDLE under test-time mirror (an ensemble of one member, mirror: true: its
 #       probabilities the mean over the image and its left-right mirror, its temperature as
 #       bundled; two passes per image). Flown with LOTO_NETWORKS=DEST bash scripts/results.sh loto.
+#   bash scripts/loto.sh coarse [DEST] [G]
+#       here: DEST/tile-<k>/ensemble.yaml (default out/loto-coarse) for k = 1..6, each network of
+#       LOTO_BUNDLE with a test-time coarser look (OnnxParams::test_time_coarse_gsd_cm G, default
+#       10: an image finer than G cm/px also segmented shrunk to min(G, 2 x its GSD), the
+#       probabilities the mean of the two passes; its temperature as bundled). Flown with
+#       LOTO_NETWORKS=DEST bash scripts/results.sh loto.
 #   bash scripts/loto.sh ensemble DEST FOLDER FOLDER...
 #       here: DEST/tile-<k>/ensemble.yaml for k = 1..6, the ensemble of FOLDER/tile-<k> over the
 #       FOLDERs given (each a bundled set of six, e.g. examples/models/mobilenetv2-dubai-loto and
@@ -417,6 +423,18 @@ mirror)
     write_ensemble "$to/tile-$k" \
       "$dest/tile-$k under test-time mirror (its probabilities the mean over the image and its left-right mirror)" \
       "    mirror: true" "$dest/tile-$k"
+  done
+  echo "wrote $to/tile-{1..6}/ensemble.yaml"
+  ;;
+coarse)
+  to=${2:-out/loto-coarse}
+  g=${3:-10}
+  [[ $g =~ ^[0-9]*\.?[0-9]+$ && ! $g =~ ^[0.]+$ ]] || { echo "coarse: G must be a GSD > 0 in cm/px (got '$g')" >&2; exit 2; }
+  need_networks "${tiles_all[@]/#/$dest/tile-}"
+  for k in "${tiles_all[@]}"; do
+    write_ensemble "$to/tile-$k" \
+      "$dest/tile-$k with a test-time coarser look (images finer than $g cm/px also segmented at min($g, 2 x their GSD), the probabilities the mean)" \
+      "    coarse_gsd_cm: $g" "$dest/tile-$k"
   done
   echo "wrote $to/tile-{1..6}/ensemble.yaml"
   ;;

@@ -202,6 +202,86 @@ TEST_CASE("test-time mirror: a network's probabilities are the mean over the ima
   CHECK(worst < 1e-6);
 }
 
+TEST_CASE("test-time coarser look: which images get a second pass, and its probabilities keep the contract") {
+  // OnnxParams::test_time_coarse_gsd_cm: a pass at min(G, 2 x the image's GSD) where that is at
+  // least 10 % coarser; the image of tile 6 at 10 cm/px gets one at 15 with G = 15 and none
+  // with G = 10, where the result is the plain segmenter's byte for byte.
+  const Image img = tile6_image();
+  REQUIRE(img.gsd_cm == doctest::Approx(10.0));
+  OnnxSegmenter plain(mnv2(), kParams);
+  OnnxParams p10 = kParams, p15 = kParams;
+  p10.test_time_coarse_gsd_cm = 10.0;
+  p15.test_time_coarse_gsd_cm = 15.0;
+  OnnxSegmenter c10(mnv2(), p10), c15(mnv2(), p15);
+  Image at = img;
+  const auto coarse = [&](OnnxSegmenter& s, double gsd) {
+    at.gsd_cm = gsd;
+    return s.coarse_gsd_cm(at);
+  };
+  CHECK(coarse(plain, 5.0) == 0.0);
+  CHECK(coarse(c10, 5.0) == 10.0);
+  CHECK(coarse(c10, 7.5) == 10.0);
+  CHECK(coarse(c10, 9.5) == 0.0);  // 10 is less than 10 % coarser
+  CHECK(coarse(c10, 2.0) == 4.0);  // at most twice the image's GSD
+  CHECK(coarse(c15, 10.0) == 15.0);
+  const Segmentation s = plain.segment_with_probabilities(img), same = c10.segment_with_probabilities(img);
+  CHECK(cv::countNonZero(same.labels != s.labels) == 0);
+  for (std::size_t c = 0; c < s.probabilities.size(); ++c)
+    CHECK(cv::norm(same.probabilities[c], s.probabilities[c], cv::NORM_INF) == 0.0);
+  const Segmentation m = c15.segment_with_probabilities(img);
+  CHECK(cv::countNonZero(m.labels != c15.segment(img)) == 0);
+  check_probabilities(m.probabilities, m.labels, img, plain.num_classes(), "coarse");  // no-data corner kept
+  const int changed = cv::countNonZero(m.labels != s.labels);
+  CAPTURE(changed);
+  CHECK(changed > 50);
+  CHECK(changed < img.width_px * img.height_px / 4);
+  // ERFNet takes the smaller input too; an ensemble member's own `coarse_gsd_cm` is that segmenter.
+  CHECK_NOTHROW(OnnxSegmenter(erfnet(), p15));
+  t::TempDir tmp;
+  t::write_file(tmp.path() / "ensemble.yaml", "members:\n  - model: " + mnv2().string() + "\n    coarse_gsd_cm: 15\n");
+  REQUIRE(read_ensemble_file(tmp.path()).at(0).coarse_gsd_cm == 15.0);
+  EnsembleSegmenter one(tmp.path(), kParams);
+  const Segmentation e = one.segment_with_probabilities(img);
+  for (std::size_t c = 0; c < m.probabilities.size(); ++c)
+    CHECK(cv::norm(e.probabilities[c], m.probabilities[c], cv::NORM_INF) < 1e-6);
+  // Refused: a negative GSD, and an image without one when the look is on.
+  OnnxParams bad = kParams;
+  bad.test_time_coarse_gsd_cm = -1.0;
+  CHECK_THROWS_WITH_AS(OnnxSegmenter(mnv2(), bad), doctest::Contains("test_time_coarse_gsd_cm must be 0 (off)"),
+                       std::invalid_argument);
+  Image no_gsd = img;
+  no_gsd.gsd_cm = 0.0;
+  CHECK_THROWS_WITH_AS((void)c15.segment(no_gsd), doctest::Contains("needs the image's GSD"), std::invalid_argument);
+  CHECK_NOTHROW((void)plain.segment(no_gsd));
+}
+
+TEST_CASE("test-time coarser look: tile 5 at 5 cm/px, by the network that never saw it, maps better") {
+  // What the look is for (docs/journal/2026-12-loto.md, forty-eighth session): held-out tile 5
+  // at its own GSD by examples/models/mobilenetv2-dubai-loto/tile-5, every other image of the
+  // lawnmower (eval_ensemble over all of them: field mIoU 0.506 plain, 0.533 with coarse 10).
+  // A coarse pass that is lost, misplaced (planes not resampled to the image) or not averaged
+  // falls to the plain number or below it.
+  const Field f = Field::load(t::example_field("dubai-tile-5"));
+  const CameraModel camera;
+  const SimulatedSensor sensor(f, camera);
+  const auto plan = LawnmowerPlanner(camera).plan(f.area(), f.gsd_cm());
+  const OnnxParams p{.resize_to_network = true, .num_threads = 2};
+  OnnxParams pc = p;
+  pc.test_time_coarse_gsd_cm = 10.0;
+  const fs::path net = models() / "mobilenetv2-dubai-loto" / "tile-5";
+  OnnxSegmenter plain(net, f, camera, p), coarse(net, f, camera, pc);
+  ConfusionMatrix cp(f.num_classes()), cc(f.num_classes());
+  for (std::size_t k = 0; k < plan.size(); k += 2) {
+    const Image img = sensor.capture(plan[k]);
+    cp += image_confusion(img, plain.segment(img), f.num_classes());
+    cc += image_confusion(img, coarse.segment(img), f.num_classes());
+  }
+  const double mp = cp.miou_all().value(), mc = cc.miou_all().value();
+  CAPTURE(mp);
+  CAPTURE(mc);
+  CHECK(mc > mp + 0.01);
+}
+
 TEST_CASE("ensemble: the bundled ensemble passes the backend conformance suite on held-out tile 6") {
   const Field f = Field::load(t::example_field("dubai-tile-6"));
   const CameraModel camera;
@@ -290,7 +370,8 @@ TEST_CASE("ensemble: bad member lists are refused with one line naming the probl
   refused(with("members: []\n"), "'members' must be a non-empty list");
   refused(with("models:\n  - model: x\n"), "unknown key 'models' (known: members, description)");
   refused(with("description: x\n"), "missing key 'members'");
-  refused(with("members:\n  - path: x\n"), "unknown key 'members[0].path' (known: model, weight, mirror)");
+  refused(with("members:\n  - path: x\n"),
+          "unknown key 'members[0].path' (known: model, weight, mirror, coarse_gsd_cm)");
   refused(with("members:\n  - model: x\n    mirror: yes please\n"),
           "'members[0].mirror' must be true or false (got 'yes please')");
   refused(with("members:\n  - weight: 2\n"), "missing key 'members[0].model'");

@@ -11,11 +11,13 @@ labels are the argmax of its members' weighted mean probabilities (ties to the l
 adaptseg::EnsembleSegmenter gives them. Labels are scored against the orthomosaic labels at
 orthomosaic resolution; field mIoU over the classes present in truth or prediction.
 
-Members are named NAME=MODEL_DIR, or NAME=MODEL_DIR@mirror for the network with test-time mirror
-(ErfnetParams::test_time_mirror: the mean of its probabilities over the image and its left-right
-mirror); an ensemble is NAME=MEMBER+MEMBER[+...] (equal weights) or an ensemble directory
-(ensemble.yaml, its members resolved relative to it, each matched to the member of that
-directory and mirror setting).
+Members are named NAME=MODEL_DIR, NAME=MODEL_DIR@mirror for the network with test-time mirror
+(OnnxParams::test_time_mirror: the mean of its probabilities over the image and its left-right
+mirror), NAME=MODEL_DIR@coarseG for the network with a test-time coarser look
+(OnnxParams::test_time_coarse_gsd_cm G: an image finer than G cm/px also segmented shrunk to
+min(G, 2 x its GSD), the mean of the passes), or both (@mirror@coarseG); an ensemble is
+NAME=MEMBER+MEMBER[+...] (equal weights) or an ensemble directory (ensemble.yaml, its members
+resolved relative to it, each matched to the member of that directory and those settings).
 
 With --match-colour each member sees the field's images matched, per channel, to the mean and
 standard deviation of the fields it trained on (model.yaml's training fields, read from
@@ -28,7 +30,8 @@ Usage:
   PYTHONPATH=python /usr/bin/python3 -m adaptseg_tools.eval_ensemble \\
       --members mnv2=examples/models/mobilenetv2-dubai,erf=examples/models/erfnet-dubai \\
       --ensembles both=mnv2+erf [--fields F1,F2] [--bands 1,3] [--json out.json]
-  (a mirrored member: mnv2m=examples/models/mobilenetv2-dubai@mirror)
+  (a mirrored member: mnv2m=examples/models/mobilenetv2-dubai@mirror; with the coarser look:
+   c=examples/models/mobilenetv2-dubai-loto/tile-5@coarse10)
 """
 
 from __future__ import annotations
@@ -52,17 +55,38 @@ from .training.network_path import logits_to, to_network_size, to_tensor
 from .training.validation import confusion, miou
 
 
-def member_probabilities(model, spec, meta, bgr: np.ndarray, mirror: bool = False) -> np.ndarray:
-    """C x H x W probabilities of a camera image, the C++ backend's path; with `mirror` the mean
-    of those of the image and of its left-right mirror (flipped back)."""
-    if mirror:
-        back = member_probabilities(model, spec, meta, np.ascontiguousarray(bgr[:, ::-1]))[:, :, ::-1]
-        return 0.5 * (member_probabilities(model, spec, meta, bgr) + back)
-    x = torch.from_numpy(to_tensor(to_network_size(bgr, spec.input_wh), spec.mean, spec.std))[None]
+def coarse_gsd(coarse_gsd_cm: float, gsd_cm: float) -> float:
+    """OnnxSegmenter::coarse_gsd_cm: the GSD of the coarser pass for an image at `gsd_cm`,
+    min(G, 2 x gsd_cm) where at least 10 % coarser, else 0 (none)."""
+    if coarse_gsd_cm <= 0:
+        return 0.0
+    g = min(coarse_gsd_cm, 2.0 * gsd_cm)
+    return g if g >= 1.1 * gsd_cm else 0.0
+
+
+def one_pass(model, spec, meta, bgr: np.ndarray, input_wh, flip: bool) -> np.ndarray:
+    """softmax(logits / T) of one pass at input size `input_wh`, mirrored (and flipped back)
+    where `flip`."""
+    image = np.ascontiguousarray(bgr[:, ::-1]) if flip else bgr
+    x = torch.from_numpy(to_tensor(to_network_size(image, input_wh), spec.mean, spec.std))[None]
     with torch.no_grad():
         logits = logits_to(model(x).float(), bgr.shape[:2])[0]
-    t = float(meta.get("temperature", 1.0))
-    return torch.softmax(logits / t, dim=0).numpy()
+    p = torch.softmax(logits / float(meta.get("temperature", 1.0)), dim=0).numpy()
+    return np.ascontiguousarray(p[:, :, ::-1]) if flip else p
+
+
+def member_probabilities(model, spec, meta, bgr: np.ndarray, mirror: bool = False,
+                         coarse_gsd_cm: float = 0.0, gsd_cm: float = 0.0) -> np.ndarray:
+    """C x H x W probabilities of a camera image, the C++ backend's path (OnnxSegmenter): with
+    `mirror` the mean of those of the image and of its left-right mirror (flipped back); with
+    `coarse_gsd_cm` also those of the image shrunk to coarse_gsd() (each side of the input a
+    multiple of 32 px), the mean over every pass."""
+    sizes = [tuple(spec.input_wh)]
+    g = coarse_gsd(coarse_gsd_cm, gsd_cm)
+    if g > 0:
+        sizes.append(tuple(max(32, int(round(v * gsd_cm / g / 32.0)) * 32) for v in spec.input_wh))
+    passes = [one_pass(model, spec, meta, bgr, wh, flip) for wh in sizes for flip in ((False, True) if mirror else (False,))]
+    return passes[0] if len(passes) == 1 else sum(passes) / len(passes)
 
 
 def colour_stats(field) -> tuple[np.ndarray, np.ndarray]:
@@ -113,10 +137,19 @@ def load_member(model_dir: Path):
     return model, spec, meta
 
 
-def member_dir(value: str) -> tuple[Path, bool]:
-    """NAME=VALUE's model directory (resolved) and whether it is mirrored (VALUE ends in @mirror)."""
-    mirror = value.endswith("@mirror")
-    return Path(value[:-len("@mirror")] if mirror else value).resolve(), mirror
+def member_dir(value: str) -> tuple[Path, bool, float]:
+    """NAME=VALUE's model directory (resolved), whether it is mirrored (@mirror) and its coarser
+    look's GSD (@coarseG; 0: none)."""
+    path, *tags = value.split("@")
+    mirror, coarse = False, 0.0
+    for tag in tags:
+        if tag == "mirror":
+            mirror = True
+        elif tag.startswith("coarse") and tag[len("coarse"):].replace(".", "", 1).isdigit() and float(tag[6:]) > 0:
+            coarse = float(tag[len("coarse"):])
+        else:
+            raise SystemExit(f"{value}: unknown setting @{tag} (known: @mirror, @coarseG with G > 0 in cm/px)")
+    return Path(path).resolve(), mirror, coarse
 
 
 def parse_pairs(text: str) -> dict[str, str]:
@@ -136,10 +169,11 @@ def ensemble_members(spec: str, members: dict) -> list[tuple[str, float]]:
         doc = yaml.safe_load((path / "ensemble.yaml").read_text())
         out = []
         for m in doc["members"]:
-            want = ((path / m["model"]).resolve(), bool(m.get("mirror", False)))
+            want = ((path / m["model"]).resolve(), bool(m.get("mirror", False)), float(m.get("coarse_gsd_cm", 0.0)))
             name = next((k for k, v in members.items() if member_dir(v) == want), None)
             if name is None:
-                raise SystemExit(f"{spec}: member {m['model']}{'@mirror' if want[1] else ''} is not among --members")
+                tags = ("@mirror" if want[1] else "") + (f"@coarse{want[2]:g}" if want[2] else "")
+                raise SystemExit(f"{spec}: member {m['model']}{tags} is not among --members")
             out.append((name, float(m.get("weight", 1.0))))
         return out
     names = spec.split("+")
@@ -167,19 +201,19 @@ def main():
     ensembles = {name: ensemble_members(spec, member_dirs) for name, spec in parse_pairs(args.ensembles).items()}
     nets = {}
     for name, d in member_dirs.items():
-        model_dir, mirror = member_dir(d)
+        model_dir, mirror, coarse = member_dir(d)
         model, spec, meta = load_member(model_dir)
-        nets[name] = (model, spec, meta, mirror)
+        nets[name] = (model, spec, meta, mirror, coarse)
     classes = next(iter(nets.values()))[2]["classes"]
-    for name, (_, _, meta, _) in nets.items():
+    for name, (_, _, meta, _, _) in nets.items():
         if meta["classes"] != classes:
             raise SystemExit(f"member {name}: classes {meta['classes']} differ from {classes}")
-    cams = {tuple(s.camera_wh) for _, s, _, _ in nets.values()}
+    cams = {tuple(s.camera_wh) for _, s, _, _, _ in nets.values()}
     if len(cams) != 1:
         raise SystemExit(f"members trained for different cameras: {sorted(cams)}")
     cam_wh = cams.pop()
     stats_cache: dict = {}
-    train_colour = {n: training_colour(meta, stats_cache) for n, (_, _, meta, _) in nets.items()} if args.match_colour else {}
+    train_colour = {n: training_colour(meta, stats_cache) for n, (_, _, meta, _, _) in nets.items()} if args.match_colour else {}
     nc = len(classes)
     bands = [float(v) for v in args.bands.split(",")]
     rows = list(member_dirs) + list(ensembles)
@@ -200,10 +234,10 @@ def main():
                 if (gt != IGNORE).sum() == 0:
                     continue
                 probs = {}
-                for name, (model, spec, meta, mirror) in nets.items():
+                for name, (model, spec, meta, mirror, coarse) in nets.items():
                     image = rgb if field_colour is None else match_colour(rgb, field_colour, train_colour[name])
                     t0 = time.perf_counter()
-                    probs[name] = member_probabilities(model, spec, meta, image, mirror)
+                    probs[name] = member_probabilities(model, spec, meta, image, mirror, coarse, gsd)
                     seconds[name] += time.perf_counter() - t0
                 labels = {n: p.argmax(0) for n, p in probs.items()}
                 for ens, mem in ensembles.items():

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # scripts/loto.sh's file work on stand-in networks (nothing trained, built or flown): stage copies
-# a finished tile without its temperature and never over a staged one; mirror and ensemble write
+# a finished tile without its temperature and never over a staged one; mirror, coarse and ensemble write
 # each tile's ensemble.yaml with members that resolve to the networks, and refuse, before writing
 # anything, a set with a network missing or without its temperature. A few seconds.
 #   test_loto_script.sh SOURCE_DIR
@@ -97,6 +97,23 @@ done
 echo "ok: mirror wrote six ensembles of one mirrored member"
 LOTO_BUNDLE="$work/staged" refused "no temperature" mirror "$work/mir2"
 [ -e "$work/mir2" ] && fail "a refused mirror wrote files"
+
+# --- coarse: each network of LOTO_BUNDLE with a test-time coarser look (default 10 cm/px) ---
+LOTO_BUNDLE="$work/seed0" bash "$loto" coarse "$work/co" >"$work/out" 2>&1 || fail "coarse: $(cat "$work/out")"
+LOTO_BUNDLE="$work/seed0" bash "$loto" coarse "$work/co12" 12.5 >"$work/out" 2>&1 || fail "coarse 12.5: $(cat "$work/out")"
+for k in 1 2 3 4 5 6; do
+  e="$work/co/tile-$k/ensemble.yaml"
+  m=$(sed -n 's/^  - model: "\(.*\)"$/\1/p' "$e")
+  [ "$(realpath "$work/co/tile-$k/$m")" = "$(realpath "$work/seed0/tile-$k")" ] || fail "$e: member $m"
+  grep -qx '    coarse_gsd_cm: 10' "$e" || fail "$e: no coarse_gsd_cm: 10"
+  grep -qx '    coarse_gsd_cm: 12.5' "$work/co12/tile-$k/ensemble.yaml" || fail "co12/tile-$k: no coarse_gsd_cm: 12.5"
+done
+echo "ok: coarse wrote six ensembles of one member with the coarser look"
+LOTO_BUNDLE="$work/staged" refused "no temperature" coarse "$work/co2"
+[ -e "$work/co2" ] && fail "a refused coarse wrote files"
+LOTO_BUNDLE="$work/seed0" refused "G must be a GSD > 0" coarse "$work/co3" 0
+LOTO_BUNDLE="$work/seed0" refused "G must be a GSD > 0" coarse "$work/co3" ten
+[ -e "$work/co3" ] && fail "a refused coarse wrote files"
 
 # --- scores: the held-out table from eval_ensemble's JSON (Python's json module only) ---
 # held_out K MIOU5 MIOU15 WATER5: tile K's scores as eval_ensemble --json writes them (two GSDs).

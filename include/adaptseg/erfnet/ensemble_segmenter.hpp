@@ -18,6 +18,7 @@
 ///   - model: ../mobilenetv2-dubai
 ///     weight: 1        # optional, default 1; > 0; weights are normalised
 ///     mirror: true     # optional, default false: OnnxParams::test_time_mirror for this member
+///     coarse_gsd_cm: 10  # optional, default 0 (off): OnnxParams::test_time_coarse_gsd_cm for it
 ///   - model: ../erfnet-dubai
 /// description: free text  # optional
 /// @endcode
@@ -51,6 +52,9 @@ struct EnsembleMember {
   /// OnnxParams::test_time_mirror for this member (its probabilities: the mean over the image
   /// and its mirror; it still counts once in the votes and the disagreement).
   bool mirror = false;
+  /// OnnxParams::test_time_coarse_gsd_cm for this member where not 0 (else the ensemble's): its
+  /// probabilities also count a pass over the image at a coarser GSD.
+  double coarse_gsd_cm = 0.0;
 };
 
 /// An ensemble's segmentation of one image (EnsembleSegmenter::segment_with_disagreement()).
@@ -74,7 +78,8 @@ struct EnsembleSegmentation {
 /// comment above), member paths resolved relative to the directory.
 /// @throws std::invalid_argument naming the file and the problem: no such directory or file, a
 ///         YAML error, an unknown key, no members, a member without `model`, a weight that is
-///         not a number > 0, a `mirror` that is not true or false.
+///         not a number > 0, a `mirror` that is not true or false, a `coarse_gsd_cm` that is not a
+///         number (OnnxSegmenter refuses one < 0).
 [[nodiscard]] inline std::vector<EnsembleMember> read_ensemble_file(const std::filesystem::path& dir) {
   const std::filesystem::path file = dir / "ensemble.yaml";
   const auto fail = [&](const std::string& what) {
@@ -90,11 +95,12 @@ struct EnsembleSegmentation {
   r.only_keys({"members", "description"});
   std::vector<EnsembleMember> members;
   for (const detail::YamlReader& m : r.maps("members")) {
-    m.only_keys({"model", "weight", "mirror"});
+    m.only_keys({"model", "weight", "mirror", "coarse_gsd_cm"});
     EnsembleMember member;
     member.model_dir = dir / m.text("model");
     if (m.has("weight")) member.weight = m.number("weight");
     if (m.has("mirror")) member.mirror = m.flag("mirror");
+    if (m.has("coarse_gsd_cm")) member.coarse_gsd_cm = m.number("coarse_gsd_cm");
     members.push_back(std::move(member));
   }
   if (members.empty()) fail("'members' must be a non-empty list of {model: DIR, weight: W}");
@@ -123,7 +129,8 @@ struct EnsembleSegmentation {
 class EnsembleSegmenter {
  public:
   /// Applied to every member (classes, camera size, resampling, no-data, threads, DNN backend,
-  /// test-time mirror, which a member's own `mirror` adds to); `name` is the ensemble's
+  /// test-time mirror, which a member's own `mirror` adds to, and the coarser look, which a
+  /// member's own `coarse_gsd_cm` replaces); `name` is the ensemble's
   /// (OnnxParams' default, "erfnet", becomes "ensemble"; member k is named
   /// `name/<its folder>`).
   using Params = OnnxParams;
@@ -156,6 +163,7 @@ class EnsembleSegmenter {
       Params p = params_;
       p.name = params_.name + "/" + specs_[k].model_dir.filename().string();
       p.test_time_mirror = params_.test_time_mirror || specs_[k].mirror;
+      if (specs_[k].coarse_gsd_cm != 0.0) p.test_time_coarse_gsd_cm = specs_[k].coarse_gsd_cm;
       try {
         members_.emplace_back(specs_[k].model_dir, std::move(p));
       } catch (const std::invalid_argument& e) {

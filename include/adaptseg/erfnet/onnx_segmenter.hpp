@@ -14,6 +14,7 @@
 
 #include <adaptseg/core/camera.hpp>
 #include <adaptseg/core/error.hpp>
+#include <adaptseg/erfnet/detail/onnx_planes.hpp>
 #include <adaptseg/erfnet/onnx_model_info.hpp>
 #include <adaptseg/vision/field.hpp>
 #include <adaptseg/vision/segmentation_backend.hpp>
@@ -22,9 +23,8 @@
 #include <opencv2/dnn.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include <array>
+#include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <utility>
@@ -60,6 +60,16 @@ struct OnnxParams {
   /// (measured: examples/models/ensemble-dubai/README.md, "Test-time mirror"). logits() stays one
   /// pass.
   bool test_time_mirror = false;
+  /// Test-time coarser look [cm/px]; 0: off. > 0: where an image is finer than this (its
+  /// Image::gsd_cm), the network also segments it resampled to min(this, 2 x its GSD) (the input
+  /// shrunk by that ratio, each side a multiple of 32 px, INTER_AREA), and the probabilities are
+  /// the mean of the passes (with test_time_mirror, of the mirrored passes too), labels its
+  /// argmax. A descent's image at 5 cm/px then also counts what the network makes of the same
+  /// ground at 10 (coarse 10): on ground the network never trained on, the mean maps finer images
+  /// better than either pass (docs/journal/2026-12-loto.md, forty-eighth session). The network
+  /// must take the smaller input (fully convolutional; checked at construction); images at or
+  /// coarser than this get one pass as before.
+  double test_time_coarse_gsd_cm = 0.0;
   /// 1..256: `cv::setNumThreads(num_threads)` at construction. NOTE: this is OpenCV's
   /// process-wide thread count and affects all OpenCV calls. 0: leave it unchanged.
   int num_threads = 0;
@@ -77,8 +87,9 @@ struct OnnxParams {
 /// (exactly the training normalisation, from the metadata), forward, then argmax over the
 /// logits (ties to the lower class index) for `segment`, softmax of the logits over the model's
 /// temperature for `probabilities` (both from one pass: `segment_with_probabilities`). With
-/// OnnxParams::test_time_mirror a second pass over the mirrored image: probabilities are the
-/// mean of the two, labels its argmax.
+/// OnnxParams::test_time_mirror a second pass over the mirrored image, with
+/// OnnxParams::test_time_coarse_gsd_cm one over the image shrunk to a coarser GSD: probabilities
+/// are the mean of the passes, labels its argmax.
 /// Every pixel with RGB content gets a class: the network cannot know the field boundary,
 /// so pixels inside the footprint but outside the labelled field are labelled too (metrics
 /// skip them through the ground truth's ignore label). Pixels without RGB content (exactly
@@ -170,37 +181,42 @@ class OnnxSegmenter {
   ///         with labels only), an RGB that is not CV_8UC3 of `width_px x height_px`, or a
   ///         size the network cannot take.
   [[nodiscard]] cv::Mat segment(const Image& image) {
-    if (params_.test_time_mirror) return segment_with_probabilities(image).labels;
-    cv::Mat labels = argmax(logits(image));
-    if (params_.black_is_no_data) labels.setTo(cv::Scalar(image.ignore_label), no_data_mask(image.bgr));
+    if (params_.test_time_mirror || coarse_gsd_cm(image) > 0.0) return segment_with_probabilities(image).labels;
+    cv::Mat labels = detail::onnx_argmax(logits(image));
+    if (params_.black_is_no_data) labels.setTo(cv::Scalar(image.ignore_label), detail::onnx_no_data_mask(image.bgr));
     return labels;
   }
 
-  /// segment() and probabilities() from one forward pass (two with
-  /// OnnxParams::test_time_mirror) (SegmentsWithProbabilities).
-  /// @throws std::invalid_argument as segment().
+  /// segment() and probabilities() from one forward pass (more with OnnxParams::test_time_mirror
+  /// and test_time_coarse_gsd_cm: the mean of the passes' probabilities) (SegmentsWithProbabilities).
+  /// @throws std::invalid_argument as segment(), and for an image without a GSD
+  ///         (Image::gsd_cm <= 0) when test_time_coarse_gsd_cm is set.
   [[nodiscard]] Segmentation segment_with_probabilities(const Image& image) {
     Segmentation s;
-    s.probabilities = logits(image);
-    if (params_.test_time_mirror) {
-      softmax_in_place(s.probabilities);
-      Image mirrored = image;
-      mirrored.bgr = cv::Mat();  // a new buffer: `image` shares its pixels with the copy
-      cv::flip(image.bgr, mirrored.bgr, 1);
-      std::vector<cv::Mat> back = logits(mirrored);
-      softmax_in_place(back);
-      cv::Mat flipped;
-      for (std::size_t c = 0; c < back.size(); ++c) {
-        cv::flip(back[c], flipped, 1);
-        cv::addWeighted(s.probabilities[c], 0.5, flipped, 0.5, 0.0, s.probabilities[c]);
-      }
-      s.labels = argmax(s.probabilities);
+    const double coarse = coarse_gsd_cm(image);
+    if (!params_.test_time_mirror && coarse == 0.0) {
+      s.probabilities = logits(image);
+      s.labels = detail::onnx_argmax(s.probabilities);
+      detail::onnx_softmax_in_place(s.probabilities, info_.temperature);
     } else {
-      s.labels = argmax(s.probabilities);
-      softmax_in_place(s.probabilities);
+      check_image(image);
+      std::vector<cv::Size> inputs{input_size()};
+      if (coarse > 0.0) inputs.push_back(coarse_input_size(image.gsd_cm / coarse));
+      int passes = 0;
+      for (const cv::Size& in : inputs)
+        for (const bool flip : {false, true}) {
+          if (flip && !params_.test_time_mirror) continue;
+          std::vector<cv::Mat> p = pass_probabilities(image, in, flip);
+          if (passes++ == 0)
+            s.probabilities = std::move(p);
+          else
+            for (std::size_t c = 0; c < p.size(); ++c) s.probabilities[c] += p[c];
+        }
+      for (auto& p : s.probabilities) p *= 1.0 / passes;
+      s.labels = detail::onnx_argmax(s.probabilities);
     }
     if (params_.black_is_no_data) {
-      const cv::Mat mask = no_data_mask(image.bgr);
+      const cv::Mat mask = detail::onnx_no_data_mask(image.bgr);
       s.labels.setTo(cv::Scalar(image.ignore_label), mask);
       for (auto& p : s.probabilities) p.setTo(cv::Scalar(0.0), mask);
     }
@@ -222,16 +238,57 @@ class OnnxSegmenter {
   /// @throws std::invalid_argument as segment().
   [[nodiscard]] std::vector<cv::Mat> logits(const Image& image) {
     check_image(image);
-    const cv::Size in = input_size();
-    const cv::Size out_size(image.width_px, image.height_px);
-    cv::Mat rgb = image.bgr;
-    if (rgb.size() != in) {
-      const bool shrink = rgb.cols > in.width;
-      cv::resize(image.bgr, rgb, in, 0, 0, shrink ? cv::INTER_AREA : cv::INTER_LINEAR);
-    }
-    net_.setInput(to_blob(rgb));
+    return forward(image.bgr, input_size(), image.bgr.size());
+  }
+
+  /// The GSD [cm/px] of the coarser pass OnnxParams::test_time_coarse_gsd_cm adds for `image`:
+  /// min(that, 2 x the image's GSD) where it is at least 10 % coarser than the image, else 0 (one
+  /// pass at the network's input size).
+  /// @throws std::invalid_argument for an image without a GSD (Image::gsd_cm <= 0) when it is set.
+  [[nodiscard]] double coarse_gsd_cm(const Image& image) const {
+    if (params_.test_time_coarse_gsd_cm <= 0.0) return 0.0;
+    detail::require(std::isfinite(image.gsd_cm) && image.gsd_cm > 0.0,
+                    "OnnxSegmenter: OnnxParams::test_time_coarse_gsd_cm needs the image's GSD (Image::gsd_cm > 0)",
+                    image.gsd_cm);
+    const double g = std::min(params_.test_time_coarse_gsd_cm, 2.0 * image.gsd_cm);
+    return g >= 1.1 * image.gsd_cm ? g : 0.0;
+  }
+
+ private:
+  /// The network's input size scaled by `scale` (<= 1), each side rounded to a multiple of 32 px
+  /// (at least 32): a size every encoder's strides divide.
+  [[nodiscard]] cv::Size coarse_input_size(double scale) const {
+    const auto side = [&](int px) { return std::max(32, static_cast<int>(std::lround(px * scale / 32.0)) * 32); };
+    return {side(info_.input_width_px), side(info_.input_height_px)};
+  }
+
+  /// softmax(logits / T) of one pass over `image` fed at input size `in`, left-right mirrored
+  /// (and its planes flipped back) where `flip`; planes at the image's size.
+  [[nodiscard]] std::vector<cv::Mat> pass_probabilities(const Image& image, cv::Size in, bool flip) {
+    cv::Mat bgr;  // a new buffer where flipped: `image` keeps its pixels
+    if (flip)
+      cv::flip(image.bgr, bgr, 1);
+    else
+      bgr = image.bgr;
+    std::vector<cv::Mat> planes = forward(bgr, in, bgr.size());
+    detail::onnx_softmax_in_place(planes, info_.temperature);
+    for (auto& p : planes)
+      if (flip) {
+        cv::Mat back;
+        cv::flip(p, back, 1);
+        p = back;
+      }
+    return planes;
+  }
+
+  /// The network's logits for `bgr` resampled to input size `in` (INTER_AREA shrinking,
+  /// INTER_LINEAR enlarging), one CV_32FC1 plane per class resampled bilinearly to `out_size`.
+  [[nodiscard]] std::vector<cv::Mat> forward(const cv::Mat& bgr, cv::Size in, cv::Size out_size) {
+    cv::Mat rgb = bgr;
+    if (rgb.size() != in) cv::resize(bgr, rgb, in, 0, 0, bgr.cols > in.width ? cv::INTER_AREA : cv::INTER_LINEAR);
+    net_.setInput(detail::onnx_blob(rgb, info_));
     cv::Mat out = net_.forward();
-    const cv::Size net_out = output_size();
+    const cv::Size net_out(in.width / info_.output_stride, in.height / info_.output_stride);
     ADAPTSEG_ASSERT(out.dims == 4 && out.size[1] == num_classes() && out.size[2] == net_out.height &&
                     out.size[3] == net_out.width);
     std::vector<cv::Mat> planes(static_cast<std::size_t>(num_classes()));
@@ -247,50 +304,6 @@ class OnnxSegmenter {
   }
 
  private:
-  /// Per pixel, the index of the largest plane (ties to the lower index).
-  [[nodiscard]] static cv::Mat argmax(const std::vector<cv::Mat>& planes) {
-    const cv::Size size = planes.front().size();
-    cv::Mat labels(size, CV_8UC1);
-    const auto n = planes.size();
-    std::vector<const float*> rows(n);
-    for (int r = 0; r < size.height; ++r) {
-      for (std::size_t c = 0; c < n; ++c) rows[c] = planes[c].ptr<float>(r);
-      auto* out = labels.ptr<std::uint8_t>(r);
-      for (int x = 0; x < size.width; ++x) {
-        std::size_t best = 0;
-        float best_v = rows[0][x];
-        for (std::size_t c = 1; c < n; ++c)
-          if (rows[c][x] > best_v) {  // strict: ties keep the lower index
-            best_v = rows[c][x];
-            best = c;
-          }
-        out[x] = static_cast<std::uint8_t>(best);
-      }
-    }
-    return labels;
-  }
-
-  /// Logits -> softmax(logits / T) per pixel, in place.
-  void softmax_in_place(std::vector<cv::Mat>& planes) const {
-    const cv::Size size = planes.front().size();
-    const auto n = planes.size();
-    const auto inv_t = static_cast<float>(1.0 / info_.temperature);
-    std::vector<float*> rows(n);
-    for (int r = 0; r < size.height; ++r) {
-      for (std::size_t c = 0; c < n; ++c) rows[c] = planes[c].ptr<float>(r);
-      for (int x = 0; x < size.width; ++x) {
-        float m = rows[0][x];
-        for (std::size_t c = 1; c < n; ++c) m = std::max(m, rows[c][x]);
-        float sum = 0.0f;
-        for (std::size_t c = 0; c < n; ++c) {
-          rows[c][x] = std::exp((rows[c][x] - m) * inv_t);
-          sum += rows[c][x];
-        }
-        for (std::size_t c = 0; c < n; ++c) rows[c][x] /= sum;
-      }
-    }
-  }
-
   static std::filesystem::path checked_dir(const std::filesystem::path& dir) {
     if (!std::filesystem::is_directory(dir))
       throw std::invalid_argument("OnnxSegmenter: model directory not found: " + dir.string());
@@ -307,6 +320,9 @@ class OnnxSegmenter {
     detail::require(params_.num_threads >= 0 && params_.num_threads <= 256, "OnnxParams: num_threads must be in 0..256",
                     params_.num_threads);
     detail::require(!params_.name.empty(), "OnnxParams: name must not be empty", "''");
+    detail::require(std::isfinite(params_.test_time_coarse_gsd_cm) && params_.test_time_coarse_gsd_cm >= 0.0,
+                    "OnnxParams: test_time_coarse_gsd_cm must be 0 (off) or a GSD > 0 [cm/px]",
+                    params_.test_time_coarse_gsd_cm);
     const auto targets = cv::dnn::getAvailableTargets(static_cast<cv::dnn::Backend>(params_.dnn_backend));
     bool target_ok = false;
     for (const auto t : targets) target_ok = target_ok || static_cast<int>(t) == params_.dnn_target;
@@ -361,8 +377,15 @@ class OnnxSegmenter {
     if (net_.empty()) throw std::invalid_argument("OnnxSegmenter: ONNX model " + onnx_file.string() + " is empty");
     net_.setPreferableBackend(params_.dnn_backend);
     net_.setPreferableTarget(params_.dnn_target);
-    // Shape inference (no forward pass): the output must be 1 x classes x H x W.
-    const cv::dnn::MatShape in_shape{1, 3, info_.input_height_px, info_.input_width_px};
+    check_output_shape(onnx_file, input_size());
+    // The coarser look's smallest input (half the input size) must work as well.
+    if (params_.test_time_coarse_gsd_cm > 0.0) check_output_shape(onnx_file, coarse_input_size(0.5));
+  }
+
+  /// Shape inference (no forward pass): for a 1 x 3 x in input the output must be 1 x classes x
+  /// (in / the output stride).
+  void check_output_shape(const std::filesystem::path& onnx_file, cv::Size in) {
+    const cv::dnn::MatShape in_shape{1, 3, in.height, in.width};
     cv::dnn::MatShape out_shape;
     try {
       const std::vector<int> outs = net_.getUnconnectedOutLayers();
@@ -374,10 +397,11 @@ class OnnxSegmenter {
       if (!out_shapes.empty()) out_shape = out_shapes.front();
     } catch (const cv::Exception& e) {
       throw std::invalid_argument("OnnxSegmenter: ONNX model " + onnx_file.string() + " does not take a 1x3x" +
-                                  std::to_string(info_.input_height_px) + "x" + std::to_string(info_.input_width_px) +
-                                  " input: " + e.what());
+                                  std::to_string(in.height) + "x" + std::to_string(in.width) + " input" +
+                                  (in == input_size() ? "" : " (OnnxParams::test_time_coarse_gsd_cm)") + ": " +
+                                  e.what());
     }
-    const cv::Size net_out = output_size();
+    const cv::Size net_out(in.width / info_.output_stride, in.height / info_.output_stride);
     const cv::dnn::MatShape expected{1, num_classes(), net_out.height, net_out.width};
     if (out_shape != expected) {
       std::string got;
@@ -404,34 +428,6 @@ class OnnxSegmenter {
                     std::to_string(image.bgr.cols) + "x" + std::to_string(image.bgr.rows) + " vs " +
                         std::to_string(image.width_px) + "x" + std::to_string(image.height_px));
     check_size(image.bgr.size(), "OnnxSegmenter (image)");
-  }
-
-  /// NCHW float blob, `(v / 255 - mean) / std` in the network's channel order.
-  cv::Mat to_blob(const cv::Mat& bgr) const {
-    const int h = bgr.rows, w = bgr.cols;
-    const int shape[] = {1, 3, h, w};
-    cv::Mat blob(4, shape, CV_32F);
-    std::array<float*, 3> dst{};
-    for (int k = 0; k < 3; ++k) dst[static_cast<std::size_t>(k)] = blob.ptr<float>(0, k);
-    // Network channel k reads BGR channel src[k].
-    const std::array<int, 3> src = info_.rgb_order ? std::array<int, 3>{2, 1, 0} : std::array<int, 3>{0, 1, 2};
-    for (int r = 0; r < h; ++r) {
-      const auto* p = bgr.ptr<std::uint8_t>(r);
-      for (int x = 0; x < w; ++x)
-        for (std::size_t k = 0; k < 3; ++k) {
-          const float v = static_cast<float>(p[3 * x + src[k]]) / 255.0f;
-          dst[k][static_cast<std::size_t>(r) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] =
-              (v - info_.mean[k]) / info_.std[k];
-        }
-    }
-    return blob;
-  }
-
-  /// 255 where all three channels are 0.
-  static cv::Mat no_data_mask(const cv::Mat& bgr) {
-    cv::Mat mask;
-    cv::inRange(bgr, cv::Scalar(0, 0, 0), cv::Scalar(0, 0, 0), mask);
-    return mask;
   }
 
   Params params_;
