@@ -256,7 +256,7 @@ TEST_CASE("test-time coarser look: which images get a second pass, and its proba
 }
 
 TEST_CASE("test-time coarser look: tile 5 at 5 cm/px, by the network that never saw it, maps better") {
-  // What the look is for (docs/journal/2026-12-loto.md, forty-eighth session): held-out tile 5
+  // What the look is for (docs/journal/2026-12-coarse.md): held-out tile 5
   // at its own GSD by examples/models/mobilenetv2-dubai-loto/tile-5, every other image of the
   // lawnmower (eval_ensemble over all of them: field mIoU 0.506 plain, 0.533 with coarse 10).
   // A coarse pass that is lost, misplaced (planes not resampled to the image) or not averaged

@@ -64,11 +64,11 @@ struct OnnxParams {
   /// Image::gsd_cm), the network also segments it resampled to min(this, 2 x its GSD) (the input
   /// shrunk by that ratio, each side a multiple of 32 px, INTER_AREA), and the probabilities are
   /// the mean of the passes (with test_time_mirror, of the mirrored passes too), labels its
-  /// argmax. A descent's image at 5 cm/px then also counts what the network makes of the same
-  /// ground at 10 (coarse 10): on ground the network never trained on, the mean maps finer images
-  /// better than either pass (docs/journal/2026-12-loto.md, forty-eighth session). The network
-  /// must take the smaller input (fully convolutional; checked at construction); images at or
-  /// coarser than this get one pass as before.
+  /// argmax. An image at 5 cm/px then also counts what the network makes of the same ground at
+  /// 10 (coarse 10): on the Dubai tiles the leave-one-tile-out networks never saw, the mean maps
+  /// 5 cm/px images better on five tiles of six, though flown it made no better descents
+  /// (docs/journal/2026-12-coarse.md). The network must take the smaller input (fully
+  /// convolutional; checked at construction); images at or coarser than this get one pass.
   double test_time_coarse_gsd_cm = 0.0;
   /// 1..256: `cv::setNumThreads(num_threads)` at construction. NOTE: this is OpenCV's
   /// process-wide thread count and affects all OpenCV calls. 0: leave it unchanged.
