@@ -80,11 +80,11 @@ def member_probabilities(model, spec, meta, bgr: np.ndarray, mirror: bool = Fals
     """C x H x W probabilities of a camera image, the C++ backend's path (OnnxSegmenter): with
     `mirror` the mean of those of the image and of its left-right mirror (flipped back); with
     `coarse_gsd_cm` also those of the image shrunk to coarse_gsd() (each side of the input a
-    multiple of 32 px), the mean over every pass."""
+    multiple of 32 px, halves rounded up as C++'s std::lround does), the mean over every pass."""
     sizes = [tuple(spec.input_wh)]
     g = coarse_gsd(coarse_gsd_cm, gsd_cm)
     if g > 0:
-        sizes.append(tuple(max(32, int(round(v * gsd_cm / g / 32.0)) * 32) for v in spec.input_wh))
+        sizes.append(tuple(max(32, int(np.floor(v * gsd_cm / g / 32.0 + 0.5)) * 32) for v in spec.input_wh))
     passes = [one_pass(model, spec, meta, bgr, wh, flip) for wh in sizes for flip in ((False, True) if mirror else (False,))]
     return passes[0] if len(passes) == 1 else sum(passes) / len(passes)
 
