@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 import time
 from pathlib import Path
@@ -143,10 +144,11 @@ def member_dir(value: str) -> tuple[Path, bool, float]:
     path, *tags = value.split("@")
     mirror, coarse = False, 0.0
     for tag in tags:
+        g = re.fullmatch(r"coarse(\d+\.?\d*|\.\d+)", tag)
         if tag == "mirror":
             mirror = True
-        elif tag.startswith("coarse") and tag[len("coarse"):].replace(".", "", 1).isdigit() and float(tag[6:]) > 0:
-            coarse = float(tag[len("coarse"):])
+        elif g and float(g.group(1)) > 0:
+            coarse = float(g.group(1))
         else:
             raise SystemExit(f"{value}: unknown setting @{tag} (known: @mirror, @coarseG with G > 0 in cm/px)")
     return Path(path).resolve(), mirror, coarse
