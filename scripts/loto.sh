@@ -106,6 +106,15 @@
 #       10: an image finer than G cm/px also segmented shrunk to min(G, 2 x its GSD), the
 #       probabilities the mean of the two passes; its temperature as bundled). Flown with
 #       LOTO_NETWORKS=DEST bash scripts/results.sh loto.
+#   LOTO_ARCH=mobilenetv2-140 bash scripts/loto.sh partial [DEST]
+#       here, while a set is trained tile by tile on the CPU over several sessions: DEST/tile-<k>
+#       (default out/loto-partial) for k = 1..6, the network trained here (LOTO_WORK/model-k,
+#       recipe-cpu) where there is one, each at the median of the temperatures the other networks
+#       trained here fit on their own held-out tiles (at least two needed; never its own tile's;
+#       the fits in DEST/temperatures.csv), and LOTO_BASE/tile-k (default
+#       examples/models/mobilenetv2-dubai-loto, a link) for the rest. Flown with
+#       LOTO_NETWORKS=DEST bash scripts/results.sh loto, or only the trained tiles' runs: a mixed
+#       set, so its runs say what the new networks change on their tiles, not what the six would.
 #   bash scripts/loto.sh ensemble DEST FOLDER FOLDER...
 #       here: DEST/tile-<k>/ensemble.yaml for k = 1..6, the ensemble of FOLDER/tile-<k> over the
 #       FOLDERs given (each a bundled set of six, e.g. examples/models/mobilenetv2-dubai-loto and
@@ -437,6 +446,44 @@ coarse)
       "    coarse_gsd_cm: $g" "$dest/tile-$k"
   done
   echo "wrote $to/tile-{1..6}/ensemble.yaml"
+  ;;
+partial)
+  to=${2:-out/loto-partial}
+  base=${LOTO_BASE:-examples/models/mobilenetv2-dubai-loto}
+  need_networks "${tiles_all[@]/#/$base/tile-}"
+  trained=()
+  for k in "${tiles_all[@]}"; do [ ! -s "$wroot/model-$k/model.onnx" ] || trained+=("$k"); done
+  [ "${#trained[@]}" -ge 2 ] ||
+    { echo "partial: ${#trained[@]} network(s) in $wroot/model-<k>; two are needed (bash $0 recipe-cpu K)" >&2; exit 2; }
+  source scripts/configure.sh
+  configure_for results build/release >/dev/null
+  cmake --build build/release -j2 --target adaptseg_fit_temperature >/dev/null
+  fit=build/release/examples/adaptseg_fit_temperature
+  declare -A fitted
+  mkdir -p "$to"
+  for k in "${trained[@]}"; do
+    "$fit" --network "$wroot/model-$k" --field "examples/data/dubai-tile-$k" --threads 2 >"$to/temperature-$k.log"
+    fitted[$k]=$(sed -n 's/^temperature: \([0-9.]*\).*/\1/p' "$to/temperature-$k.log")
+    [ -n "${fitted[$k]}" ] || { echo "no temperature in $to/temperature-$k.log" >&2; exit 1; }
+  done
+  median() { printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { print (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2) }'; }
+  echo "tile,network,fitted_on_held_out_tile,set" >"$to/temperatures.csv"
+  for k in "${tiles_all[@]}"; do
+    rm -rf "$to/tile-$k"
+    if [ -n "${fitted[$k]:-}" ]; then
+      others=()
+      for j in "${trained[@]}"; do [ "$j" = "$k" ] || others+=("${fitted[$j]}"); done
+      t=$(median "${others[@]}")
+      mkdir -p "$to/tile-$k"
+      cp "$wroot/model-$k/model.onnx" "$wroot/model-$k/model.yaml" "$to/tile-$k/"
+      "$fit" --network "$to/tile-$k" --set "$t" >/dev/null
+      echo "$k,$wroot/model-$k,${fitted[$k]},$t" >>"$to/temperatures.csv"
+    else
+      ln -s "$(realpath --relative-to="$to" "$base/tile-$k")" "$to/tile-$k"
+      echo "$k,$base/tile-$k,,as bundled" >>"$to/temperatures.csv"
+    fi
+  done
+  cat "$to/temperatures.csv"
   ;;
 ensemble)
   to=${2:?destination folder}

@@ -2,7 +2,8 @@
 # scripts/loto.sh's file work on stand-in networks (nothing trained, built or flown): stage copies
 # a finished tile without its temperature and never over a staged one; mirror, coarse and ensemble write
 # each tile's ensemble.yaml with members that resolve to the networks, and refuse, before writing
-# anything, a set with a network missing or without its temperature. A few seconds.
+# anything, a set with a network missing or without its temperature; partial refuses fewer than two
+# networks trained here. A few seconds.
 #   test_loto_script.sh SOURCE_DIR
 set -uo pipefail
 source "$(dirname "$0")/cli_common.sh"
@@ -114,6 +115,14 @@ LOTO_BUNDLE="$work/staged" refused "no temperature" coarse "$work/co2"
 LOTO_BUNDLE="$work/seed0" refused "G must be a GSD > 0" coarse "$work/co3" 0
 LOTO_BUNDLE="$work/seed0" refused "G must be a GSD > 0" coarse "$work/co3" ten
 [ -e "$work/co3" ] && fail "a refused coarse wrote files"
+
+# --- partial: needs two networks trained here (each's temperature the others' fits), refused
+# before anything is built or written with fewer ---
+pw="$work/partial-work"
+network "$pw/model-5"
+LOTO_WORK=$pw LOTO_BASE="$work/seed0" refused "partial: 1 network(s) in $pw/model-<k>; two are needed" partial "$work/part"
+LOTO_WORK=$pw LOTO_BASE="$work/staged" refused "no temperature in $work/staged/tile-1/model.yaml" partial "$work/part"
+[ -e "$work/part" ] && fail "a refused partial wrote files"
 
 # --- scores: the held-out table from eval_ensemble's JSON (Python's json module only) ---
 # held_out K MIOU5 MIOU15 WATER5: tile K's scores as eval_ensemble --json writes them (two GSDs).
