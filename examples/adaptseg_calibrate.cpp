@@ -109,25 +109,25 @@ int main(int argc, char** argv) {
     if (!samples_csv.empty()) {
       std::ostringstream os;
       os << "field,top_gsd_cm,sub_gsd_cm,delta_h_m,sigma_top,sigma_sub,miou_top,miou_sub,relabelled,"
-            "relabelled_interest,region_share,field_sigma,field_gain\n";
+            "relabelled_interest,region_share,field_sigma,field_gain,added_interest,removed_interest\n";
       for (const auto& s : cal.samples)
         os << adaptseg::examples::csv_field(fields[s.field].name()) << ',' << s.top_gsd_cm << ',' << s.sub_gsd_cm << ','
            << s.delta_h_m << ',' << s.sigma_top << ',' << s.sigma_sub << ',' << s.miou_top << ',' << s.miou_sub << ','
            << s.relabelled.share << ',' << s.relabelled.interest_share << ',' << s.region_share << ',' << s.field_sigma
-           << ',' << s.field_gain << '\n';
+           << ',' << s.field_gain << ',' << s.relabelled.added_share << ',' << s.relabelled.removed_share << '\n';
       adaptseg::examples::write_text(samples_csv, os.str());
     }
     if (!cell_samples_csv.empty()) {
       std::ostringstream os;
       os << "field,region,top_gsd_cm,sub_gsd_cm,field_px,field_share,field_sigma,relabelled,field_gain,delta_tp,"
-            "delta_fp,field_tp,field_fp,field_fn";
+            "delta_fp,field_tp,field_fp,field_fn,added,removed";
       adaptseg::examples::write_input_columns_header(os);
       os << '\n';
       for (const auto& c : cal.cell_samples) {
         os << adaptseg::examples::csv_field(fields[c.field].name()) << ',' << c.region << ',' << c.top_gsd_cm << ','
            << c.sub_gsd_cm << ',' << c.top.field_px << ',' << c.field_share << ',' << c.field_sigma << ','
            << c.relabelled << ',' << c.field_gain << ',' << c.delta_tp << ',' << c.delta_fp << ',' << c.field_tp << ','
-           << c.field_fp << ',' << c.field_fn;
+           << c.field_fp << ',' << c.field_fn << ',' << c.added << ',' << c.removed;
         adaptseg::examples::write_input_columns(os, c.top, c.fine);
         os << '\n';
       }

@@ -75,6 +75,22 @@ TEST_CASE("metrics: per-image confusion compares at the orthomosaic's resolution
   CHECK(cm.iou(1).value() == doctest::Approx(3.0 / 4.0));
 }
 
+TEST_CASE("metrics: relabelling splits the changes with L involved into added and removed") {
+  // L = {1, 2}. before: 1 1 2 0 0 3 1 | after: 1 0 1 2 3 0 1; the last pixel outside the field.
+  const cv::Mat before = (cv::Mat_<std::uint8_t>(1, 7) << 1, 1, 2, 0, 0, 3, 1);
+  const cv::Mat after = (cv::Mat_<std::uint8_t>(1, 7) << 1, 0, 1, 2, 3, 0, 0);
+  const cv::Mat field = (cv::Mat_<std::uint8_t>(1, 7) << 1, 1, 1, 1, 1, 1, 0);
+  const std::vector<int> l{1, 2};
+  const Relabelling r = relabelling(before, after, field, l);
+  CHECK(r.share == doctest::Approx(5.0 / 6.0));           // all but the first field pixel changed
+  CHECK(r.interest_share == doctest::Approx(3.0 / 6.0));  // 1 -> 0, 2 -> 1 (within L), 0 -> 2
+  CHECK(r.added_share == doctest::Approx(1.0 / 6.0));     // 0 -> 2
+  CHECK(r.removed_share == doctest::Approx(1.0 / 6.0));   // 1 -> 0 (the pixel outside the field not counted)
+  const Relabelling none = relabelling(before, after, cv::Mat(1, 7, CV_8UC1, cv::Scalar(0)), l);
+  CHECK(none.added_share == 0.0);
+  CHECK(none.removed_share == 0.0);
+}
+
 TEST_CASE("front margin: measured against the curve's upper envelope, not a curve that falls") {
   // A lawnmower that is slower and maps worse (0.4 at 200 s) than a faster one (0.5 at 100 s).
   const std::vector<CurvePoint> curve{{300.0, 0.6}, {100.0, 0.5}, {200.0, 0.4}};

@@ -303,7 +303,7 @@ determinism)
   cells=$(sed -n 's/^\([0-9]*\) cell samples$/\1/p' "$work/a/calibrate.log")
   [ -n "$cells" ] && [ "$cells" -gt 0 ] && [ "$(($(wc -l <"$work/a/cells.csv") - 1))" = "$cells" ] ||
     fail "cells.csv does not hold the $cells cell samples reported"
-  head -1 "$work/a/cells.csv" | grep -q '^field,region,top_gsd_cm,sub_gsd_cm,field_px,field_share,field_sigma,relabelled,field_gain,delta_tp,delta_fp,field_tp,field_fp,field_fn,top_sigma,.*,fine_expected_error,' ||
+  head -1 "$work/a/cells.csv" | grep -q '^field,region,top_gsd_cm,sub_gsd_cm,field_px,field_share,field_sigma,relabelled,field_gain,delta_tp,delta_fp,field_tp,field_fp,field_fn,added,removed,top_sigma,.*,fine_expected_error,' ||
     fail "cells.csv header: $(head -1 "$work/a/cells.csv")"
   # The scene check's slopes: proxy_slopes.py refits from cells.csv the gain slope, the proxy
   # slope and its spread between the fields that the calibration printed (CellGainModel::fit).

@@ -76,6 +76,10 @@ struct CellSample {
   /// Share of the cell's field pixels whose label the re-mapping changed with L involved
   /// (observable in flight: no truth needed).
   double relabelled = 0.0;
+  /// Of those, the shares that entered L and that left it (Relabelling::added_share,
+  /// removed_share; observable in flight).
+  double added = 0.0;
+  double removed = 0.0;
   /// Field mIoU over L of the top-level map with only this cell re-mapped, minus without.
   double field_gain = 0.0;
   /// The same comparison in pixels, summed over the classes of L (as RealisedDescent's): how

@@ -23,10 +23,14 @@ namespace adaptseg {
 /// What a re-mapping changed in a map region, seen without ground truth (`relabelling()` in
 /// metrics.hpp measures it): the share of the region's field pixels whose label differs before
 /// and after, and the share whose label changed with a label of interest on either side (a
-/// change into, out of, or within L).
+/// change into, out of, or within L); of those, the shares that entered L (added: not in L
+/// before, in L after) and that left it (removed), which raise and lower the map's L by the
+/// closer look's word, whichever of its labels is right.
 struct Relabelling {
   double share = 0.0;           ///< label changed [0, 1]
   double interest_share = 0.0;  ///< label changed, old or new label in L [0, 1]
+  double added_share = 0.0;     ///< not in L before, in L after [0, 1]
+  double removed_share = 0.0;   ///< in L before, not in L after [0, 1]
 };
 
 /// One region seen from h_max and from h' (paper Eq. `eq:veg2h`: a row of O and of I).

@@ -232,7 +232,7 @@ class ConfusionMatrix {
                   std::to_string(before.cols) + "x" + std::to_string(before.rows) + " vs " +
                       std::to_string(after.cols) + "x" + std::to_string(after.rows));
   const auto lut = detail::label_lut(interest);
-  std::int64_t n = 0, changed = 0, changed_l = 0;
+  std::int64_t n = 0, changed = 0, changed_l = 0, added = 0, removed = 0;
   for (int r = 0; r < before.rows; ++r) {
     const auto* b = before.ptr<std::uint8_t>(r);
     const auto* a = after.ptr<std::uint8_t>(r);
@@ -243,11 +243,13 @@ class ConfusionMatrix {
       if (a[c] == b[c]) continue;
       ++changed;
       changed_l += lut[a[c]] || lut[b[c]] ? 1 : 0;
+      added += lut[a[c]] && !lut[b[c]] ? 1 : 0;
+      removed += lut[b[c]] && !lut[a[c]] ? 1 : 0;
     }
   }
   if (n == 0) return {};
-  return {static_cast<double>(changed) / static_cast<double>(n),
-          static_cast<double>(changed_l) / static_cast<double>(n)};
+  const auto share = [n](std::int64_t k) { return static_cast<double>(k) / static_cast<double>(n); };
+  return {share(changed), share(changed_l), share(added), share(removed)};
 }
 
 /// Confusion of one image's segmentation against its ground truth at the orthomosaic's

@@ -208,7 +208,10 @@ class SampleCollector {
       c.fine = fine_inputs[k];
       c.field_share = c.top.field_px / field_px_total_;
       c.field_sigma = field_sigma_;
-      c.relabelled = relabelling(r.map.labels()(cell), after(cell), r.field_px(cell), interest_).interest_share;
+      const Relabelling changed = relabelling(r.map.labels()(cell), after(cell), r.field_px(cell), interest_);
+      c.relabelled = changed.interest_share;
+      c.added = changed.added_share;
+      c.removed = changed.removed_share;
       ConfusionMatrix cell_cm = field_cm_;
       ConfusionMatrix before_cell(n_), after_cell(n_);
       before_cell.add(field_.labels()(cell_in), field_map_.labels()(cell_in), field_.ignore_label());
