@@ -220,6 +220,9 @@ need_networks() {
   done
 }
 
+# The median of the numbers given (the mean of the middle two for an even count).
+median() { printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { print (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2) }'; }
+
 # $1 as a double-quoted YAML scalar: a description or a folder's name may hold ": " or " #",
 # which a plain scalar may not (yaml-cpp refuses the file).
 yaml_string() {
@@ -354,7 +357,6 @@ bundle)
     fitted[$k]=$(sed -n 's/^temperature: \([0-9.]*\).*/\1/p' "$wroot/temperature-$k.log")
     [ -n "${fitted[$k]}" ] || { echo "no temperature in $wroot/temperature-$k.log" >&2; exit 1; }
   done
-  median() { printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { print (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2) }'; }
   mkdir -p "$dest"
   echo "held_out_tile,fitted_on_held_out_tile,bundled_median_of_the_other_five" >"$dest/temperatures.csv"
   for k in "${tiles_all[@]}"; do
@@ -466,7 +468,6 @@ partial)
     fitted[$k]=$(sed -n 's/^temperature: \([0-9.]*\).*/\1/p' "$to/temperature-$k.log")
     [ -n "${fitted[$k]}" ] || { echo "no temperature in $to/temperature-$k.log" >&2; exit 1; }
   done
-  median() { printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { print (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2) }'; }
   echo "tile,network,fitted_on_held_out_tile,set" >"$to/temperatures.csv"
   for k in "${tiles_all[@]}"; do
     rm -rf "$to/tile-$k"
