@@ -457,6 +457,10 @@ partial)
   for k in "${tiles_all[@]}"; do [ ! -s "$wroot/model-$k/model.onnx" ] || trained+=("$k"); done
   [ "${#trained[@]}" -ge 2 ] ||
     { echo "partial: ${#trained[@]} network(s) in $wroot/model-<k>; two are needed (bash $0 recipe-cpu K)" >&2; exit 2; }
+  # DEST's tiles are replaced: only a folder partial wrote, or a new or empty one.
+  header="tile,network,fitted_on_held_out_tile,set"
+  [ ! -d "$to" ] || [ -z "$(ls -A "$to")" ] || [ "$(head -n 1 "$to/temperatures.csv" 2>/dev/null)" = "$header" ] ||
+    { echo "partial: $to holds files that partial did not write; not overwritten" >&2; exit 2; }
   source scripts/configure.sh
   configure_for results build/release >/dev/null
   cmake --build build/release -j2 --target adaptseg_fit_temperature >/dev/null
@@ -468,7 +472,7 @@ partial)
     fitted[$k]=$(sed -n 's/^temperature: \([0-9.]*\).*/\1/p' "$to/temperature-$k.log")
     [ -n "${fitted[$k]}" ] || { echo "no temperature in $to/temperature-$k.log" >&2; exit 1; }
   done
-  echo "tile,network,fitted_on_held_out_tile,set" >"$to/temperatures.csv"
+  echo "$header" >"$to/temperatures.csv"
   for k in "${tiles_all[@]}"; do
     rm -rf "$to/tile-$k"
     if [ -n "${fitted[$k]:-}" ]; then

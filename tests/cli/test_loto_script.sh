@@ -3,7 +3,7 @@
 # a finished tile without its temperature and never over a staged one; mirror, coarse and ensemble write
 # each tile's ensemble.yaml with members that resolve to the networks, and refuse, before writing
 # anything, a set with a network missing or without its temperature; partial refuses fewer than two
-# networks trained here. A few seconds.
+# networks trained here and a folder it did not write. A few seconds.
 #   test_loto_script.sh SOURCE_DIR
 set -uo pipefail
 source "$(dirname "$0")/cli_common.sh"
@@ -123,6 +123,9 @@ network "$pw/model-5"
 LOTO_WORK=$pw LOTO_BASE="$work/seed0" refused "partial: 1 network(s) in $pw/model-<k>; two are needed" partial "$work/part"
 LOTO_WORK=$pw LOTO_BASE="$work/staged" refused "no temperature in $work/staged/tile-1/model.yaml" partial "$work/part"
 [ -e "$work/part" ] && fail "a refused partial wrote files"
+network "$pw/model-3"
+LOTO_WORK=$pw LOTO_BASE="$work/seed0" refused "partial: $work/seed1 holds files that partial did not write" partial "$work/seed1"
+[ -s "$work/seed1/tile-3/model.onnx" ] || fail "a refused partial touched $work/seed1"
 
 # --- scores: the held-out table from eval_ensemble's JSON (Python's json module only) ---
 # held_out K MIOU5 MIOU15 WATER5: tile K's scores as eval_ensemble --json writes them (two GSDs).
