@@ -24,17 +24,7 @@ import csv
 import math
 import sys
 
-
-def correlation(a: list[float], b: list[float]) -> float:
-    n = len(a)
-    if n < 3:
-        return math.nan
-    ma, mb = sum(a) / n, sum(b) / n
-    saa = sum((x - ma) ** 2 for x in a)
-    sbb = sum((y - mb) ** 2 for y in b)
-    if saa == 0 or sbb == 0:
-        return math.nan
-    return sum((x - ma) * (y - mb) for x, y in zip(a, b)) / math.sqrt(saa * sbb)
+from .descent_table import correlation
 
 
 def cells_of(rows: list[dict], top: float | None) -> list[dict]:
