@@ -223,6 +223,29 @@ need_networks() {
 # The median of the numbers given (the mean of the middle two for an even count).
 median() { printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { print (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2) }'; }
 
+# adaptseg_fit_temperature built in build/release, its path in $fit (bundle, partial).
+build_fitter() {
+  source scripts/configure.sh
+  configure_for results build/release >/dev/null
+  cmake --build build/release -j2 --target adaptseg_fit_temperature >/dev/null
+  fit=build/release/examples/adaptseg_fit_temperature
+}
+
+# fit_own_tile K NET LOG: fitted[K] (an associative array the caller declares), the temperature
+# network NET fits on dubai-tile-K, the tile it never saw; the fit's output in LOG.
+fit_own_tile() {
+  "$fit" --network "$2" --field "examples/data/dubai-tile-$1" --threads 2 >"$3"
+  fitted[$1]=$(sed -n 's/^temperature: \([0-9.]*\).*/\1/p' "$3")
+  [ -n "${fitted[$1]}" ] || { echo "no temperature in $3" >&2; exit 1; }
+}
+
+# The median of fitted[] over every tile but $1: a network's temperature, never fitted on its own tile.
+median_of_others() {
+  local j others=()
+  for j in "${!fitted[@]}"; do [ "$j" = "$1" ] || others+=("${fitted[$j]}"); done
+  median "${others[@]}"
+}
+
 # $1 as a double-quoted YAML scalar: a description or a folder's name may hold ": " or " #",
 # which a plain scalar may not (yaml-cpp refuses the file).
 yaml_string() {
@@ -342,10 +365,7 @@ recipe-cpu)
   done
   ;;
 bundle)
-  source scripts/configure.sh
-  configure_for results build/release >/dev/null
-  cmake --build build/release -j2 --target adaptseg_fit_temperature >/dev/null
-  fit=build/release/examples/adaptseg_fit_temperature
+  build_fitter
   declare -A fitted src
   mkdir -p "$wroot"
   for k in "${tiles_all[@]}"; do
@@ -353,16 +373,12 @@ bundle)
     src[$k]=$wroot/model-$k
     [ -s "${src[$k]}/model.onnx" ] || src[$k]=$dest/tile-$k
     [ -s "${src[$k]}/model.onnx" ] || { echo "no $wroot/model-$k nor $dest/tile-$k: bash $0 recipe-cpu $k (or eval)" >&2; exit 1; }
-    "$fit" --network "${src[$k]}" --field "examples/data/dubai-tile-$k" --threads 2 >"$wroot/temperature-$k.log"
-    fitted[$k]=$(sed -n 's/^temperature: \([0-9.]*\).*/\1/p' "$wroot/temperature-$k.log")
-    [ -n "${fitted[$k]}" ] || { echo "no temperature in $wroot/temperature-$k.log" >&2; exit 1; }
+    fit_own_tile "$k" "${src[$k]}" "$wroot/temperature-$k.log"
   done
   mkdir -p "$dest"
   echo "held_out_tile,fitted_on_held_out_tile,bundled_median_of_the_other_five" >"$dest/temperatures.csv"
   for k in "${tiles_all[@]}"; do
-    others=()
-    for j in "${tiles_all[@]}"; do [ "$j" = "$k" ] || others+=("${fitted[$j]}"); done
-    t=$(median "${others[@]}")
+    t=$(median_of_others "$k")
     [ "${src[$k]}" = "$dest/tile-$k" ] || stage_tile "$k"
     "$fit" --network "$dest/tile-$k" --set "$t" >/dev/null
     echo "dubai-tile-$k,${fitted[$k]},$t" >>"$dest/temperatures.csv"
@@ -461,24 +477,15 @@ partial)
   header="tile,network,fitted_on_held_out_tile,set"
   [ ! -d "$to" ] || [ -z "$(ls -A "$to")" ] || [ "$(head -n 1 "$to/temperatures.csv" 2>/dev/null)" = "$header" ] ||
     { echo "partial: $to holds files that partial did not write; not overwritten" >&2; exit 2; }
-  source scripts/configure.sh
-  configure_for results build/release >/dev/null
-  cmake --build build/release -j2 --target adaptseg_fit_temperature >/dev/null
-  fit=build/release/examples/adaptseg_fit_temperature
+  build_fitter
   declare -A fitted
   mkdir -p "$to"
-  for k in "${trained[@]}"; do
-    "$fit" --network "$wroot/model-$k" --field "examples/data/dubai-tile-$k" --threads 2 >"$to/temperature-$k.log"
-    fitted[$k]=$(sed -n 's/^temperature: \([0-9.]*\).*/\1/p' "$to/temperature-$k.log")
-    [ -n "${fitted[$k]}" ] || { echo "no temperature in $to/temperature-$k.log" >&2; exit 1; }
-  done
+  for k in "${trained[@]}"; do fit_own_tile "$k" "$wroot/model-$k" "$to/temperature-$k.log"; done
   echo "$header" >"$to/temperatures.csv"
   for k in "${tiles_all[@]}"; do
     rm -rf "$to/tile-$k"
     if [ -n "${fitted[$k]:-}" ]; then
-      others=()
-      for j in "${trained[@]}"; do [ "$j" = "$k" ] || others+=("${fitted[$j]}"); done
-      t=$(median "${others[@]}")
+      t=$(median_of_others "$k")
       mkdir -p "$to/tile-$k"
       cp "$wroot/model-$k/model.onnx" "$wroot/model-$k/model.yaml" "$to/tile-$k/"
       "$fit" --network "$to/tile-$k" --set "$t" >/dev/null
