@@ -120,14 +120,17 @@ int main(int argc, char** argv) {
     if (!cell_samples_csv.empty()) {
       std::ostringstream os;
       os << "field,region,top_gsd_cm,sub_gsd_cm,field_px,field_share,field_sigma,relabelled,field_gain,delta_tp,"
-            "delta_fp,field_tp,field_fp,field_fn,added,removed";
+            "delta_fp,field_tp,field_fp,field_fn,added,removed,added_right,removed_right,added_confirmed,"
+            "removed_confirmed,added_confirmed_right,removed_confirmed_right";
       adaptseg::examples::write_input_columns_header(os);
       os << '\n';
       for (const auto& c : cal.cell_samples) {
         os << adaptseg::examples::csv_field(fields[c.field].name()) << ',' << c.region << ',' << c.top_gsd_cm << ','
            << c.sub_gsd_cm << ',' << c.top.field_px << ',' << c.field_share << ',' << c.field_sigma << ','
            << c.relabelled << ',' << c.field_gain << ',' << c.delta_tp << ',' << c.delta_fp << ',' << c.field_tp << ','
-           << c.field_fp << ',' << c.field_fn << ',' << c.added << ',' << c.removed;
+           << c.field_fp << ',' << c.field_fn << ',' << c.added << ',' << c.removed << ',' << c.right.added_share << ','
+           << c.right.removed_share << ',' << c.confirmed.added_share << ',' << c.confirmed.removed_share << ','
+           << c.confirmed_right.added_share << ',' << c.confirmed_right.removed_share;
         adaptseg::examples::write_input_columns(os, c.top, c.fine);
         os << '\n';
       }

@@ -91,6 +91,29 @@ TEST_CASE("metrics: relabelling splits the changes with L involved into added an
   CHECK(none.removed_share == 0.0);
 }
 
+TEST_CASE("metrics: agreeing_changes counts the changes into and out of L that every check also gives") {
+  // L = {1}. before: 0 0 0 1 1 1 2 0 | after: 1 1 1 0 2 0 1 1; the last pixel outside the field.
+  const cv::Mat before = (cv::Mat_<std::uint8_t>(1, 8) << 0, 0, 0, 1, 1, 1, 2, 0);
+  const cv::Mat after = (cv::Mat_<std::uint8_t>(1, 8) << 1, 1, 1, 0, 2, 0, 1, 1);
+  const cv::Mat truth = (cv::Mat_<std::uint8_t>(1, 8) << 1, 0, 1, 0, 3, 1, 1, 1);
+  const cv::Mat coarser = (cv::Mat_<std::uint8_t>(1, 8) << 1, 1, 0, 2, 1, 0, 0, 1);
+  const cv::Mat field = (cv::Mat_<std::uint8_t>(1, 8) << 1, 1, 1, 1, 1, 1, 1, 0);
+  const std::vector<int> l{1};
+  // Added: pixels 0, 1, 2, 6; removed: 3, 4, 5 (a change out of L to any other class).
+  const Relabelling right = agreeing_changes(before, after, {truth}, field, l);
+  CHECK(right.added_share == doctest::Approx(3.0 / 7.0));    // 0, 2, 6
+  CHECK(right.removed_share == doctest::Approx(2.0 / 7.0));  // 3, 4 (truth 3 is outside L too)
+  const Relabelling confirmed = agreeing_changes(before, after, {coarser}, field, l);
+  CHECK(confirmed.added_share == doctest::Approx(2.0 / 7.0));    // 0, 1
+  CHECK(confirmed.removed_share == doctest::Approx(2.0 / 7.0));  // 3, 5
+  const Relabelling both = agreeing_changes(before, after, {coarser, truth}, field, l);
+  CHECK(both.added_share == doctest::Approx(1.0 / 7.0));    // 0
+  CHECK(both.removed_share == doctest::Approx(1.0 / 7.0));  // 3
+  const Relabelling unchecked = agreeing_changes(before, after, {}, field, l);
+  CHECK(unchecked.added_share == doctest::Approx(relabelling(before, after, field, l).added_share));
+  CHECK_THROWS_AS((void)agreeing_changes(before, after, {cv::Mat(1, 7, CV_8UC1)}, field, l), std::invalid_argument);
+}
+
 TEST_CASE("front margin: measured against the curve's upper envelope, not a curve that falls") {
   // A lawnmower that is slower and maps worse (0.4 at 200 s) than a faster one (0.5 at 100 s).
   const std::vector<CurvePoint> curve{{300.0, 0.6}, {100.0, 0.5}, {200.0, 0.4}};

@@ -303,8 +303,25 @@ determinism)
   cells=$(sed -n 's/^\([0-9]*\) cell samples$/\1/p' "$work/a/calibrate.log")
   [ -n "$cells" ] && [ "$cells" -gt 0 ] && [ "$(($(wc -l <"$work/a/cells.csv") - 1))" = "$cells" ] ||
     fail "cells.csv does not hold the $cells cell samples reported"
-  head -1 "$work/a/cells.csv" | grep -q '^field,region,top_gsd_cm,sub_gsd_cm,field_px,field_share,field_sigma,relabelled,field_gain,delta_tp,delta_fp,field_tp,field_fp,field_fn,added,removed,top_sigma,.*,fine_expected_error,' ||
+  head -1 "$work/a/cells.csv" | grep -q '^field,region,top_gsd_cm,sub_gsd_cm,field_px,field_share,field_sigma,relabelled,field_gain,delta_tp,delta_fp,field_tp,field_fp,field_fn,added,removed,added_right,removed_right,added_confirmed,removed_confirmed,added_confirmed_right,removed_confirmed_right,top_sigma,.*,fine_expected_error,' ||
     fail "cells.csv header: $(head -1 "$work/a/cells.csv")"
+  # The checks of a closer look's changes: the right ones and the confirmed ones are parts of the
+  # changes, the confirmed right ones of both; confirmed where twice the cell's GSD is a
+  # candidate (the default factors 1 and 2), nan where not (1.5: 3 is none).
+  "$python" - "$work/a/cells.csv" <<'PY' || fail "cells.csv change checks out of order"
+import csv, math, sys
+confirmed = unconfirmed = 0
+for r in csv.DictReader(open(sys.argv[1], newline="")):
+    for side in ("added", "removed"):
+        n, right, conf, both = (float(r[side + k]) for k in ("", "_right", "_confirmed", "_confirmed_right"))
+        assert right <= n + 1e-12, r
+        if math.isnan(conf):
+            unconfirmed += 1
+            continue
+        confirmed += 1
+        assert conf <= n + 1e-12 and both <= min(conf, right) + 1e-12, r
+assert confirmed > 0 and unconfirmed > 0, (confirmed, unconfirmed)
+PY
   # The scene check's slopes: proxy_slopes.py refits from cells.csv the gain slope, the proxy
   # slope and its spread between the fields that the calibration printed (CellGainModel::fit).
   input=$(sed -n 's/^cell gain model of \([a-z_]*\) per pair.*/\1/p' "$work/a/calibrate.log")

@@ -5,6 +5,7 @@
 /// fitted to calibration samples of single cells re-mapped alone (the scores its input is chosen
 /// by on the training fields: cell_input_scores.hpp).
 
+#include <adaptseg/core/decision.hpp>
 #include <adaptseg/core/decision_inputs.hpp>
 #include <adaptseg/core/detail/field_slopes.hpp>
 #include <adaptseg/core/detail/gsd.hpp>
@@ -80,6 +81,14 @@ struct CellSample {
   /// removed_share; observable in flight).
   double added = 0.0;
   double removed = 0.0;
+  /// Truth needed: of those, the shares whose new side of L the ground truth gives (right).
+  Relabelling right{};
+  /// No truth: of those, the shares that the region's look at twice sub_gsd_cm also made, and of
+  /// these the right ones (NaN where twice sub_gsd_cm was not a candidate): whether a second,
+  /// coarser look that confirms a change tells a right one (only added_share, removed_share set).
+  Relabelling confirmed{.added_share = std::numeric_limits<double>::quiet_NaN(),
+                        .removed_share = std::numeric_limits<double>::quiet_NaN()};
+  Relabelling confirmed_right = confirmed;
   /// Field mIoU over L of the top-level map with only this cell re-mapped, minus without.
   double field_gain = 0.0;
   /// The same comparison in pixels, summed over the classes of L (as RealisedDescent's): how

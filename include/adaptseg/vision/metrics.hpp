@@ -16,6 +16,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <initializer_list>
 #include <optional>
 #include <span>
 #include <string>
@@ -250,6 +251,42 @@ class ConfusionMatrix {
   if (n == 0) return {};
   const auto share = [n](std::int64_t k) { return static_cast<double>(k) / static_cast<double>(n); };
   return {share(changed), share(changed_l), share(added), share(removed)};
+}
+
+/// Of a relabelling's changes into and out of L (`before` → `after`, as relabelling() counts
+/// them), the shares of the mask's pixels whose new side of L every map in `checks` also gives:
+/// with the ground truth as the check, the changes that are right; with another look at the
+/// region, the changes it confirms. Returned as a Relabelling's added_share and removed_share
+/// (its other members 0).
+/// @throws std::invalid_argument unless every map (and a non-empty mask) is CV_8UC1 of one size.
+[[nodiscard]] inline Relabelling agreeing_changes(const cv::Mat& before, const cv::Mat& after,
+                                                  std::initializer_list<cv::Mat> checks, const cv::Mat& field_mask,
+                                                  std::span<const int> interest) {
+  bool fits = before.type() == CV_8UC1 && after.type() == CV_8UC1 && before.size() == after.size() &&
+              (field_mask.empty() || (field_mask.type() == CV_8UC1 && field_mask.size() == before.size()));
+  for (const cv::Mat& c : checks) fits = fits && c.type() == CV_8UC1 && c.size() == before.size();
+  detail::require(fits, "agreeing_changes: every map (and the mask) must be CV_8UC1 of one size",
+                  std::to_string(before.cols) + "x" + std::to_string(before.rows));
+  const auto lut = detail::label_lut(interest);
+  std::int64_t n = 0, added = 0, removed = 0;
+  for (int r = 0; r < before.rows; ++r) {
+    const auto* b = before.ptr<std::uint8_t>(r);
+    const auto* a = after.ptr<std::uint8_t>(r);
+    const auto* m = field_mask.empty() ? nullptr : field_mask.ptr<std::uint8_t>(r);
+    for (int c = 0; c < before.cols; ++c) {
+      if (m != nullptr && m[c] == 0) continue;
+      ++n;
+      const bool in = lut[a[c]];
+      if (in == lut[b[c]]) continue;
+      const bool agreed = std::all_of(checks.begin(), checks.end(),
+                                      [&](const cv::Mat& k) { return lut[k.at<std::uint8_t>(r, c)] == in; });
+      if (!agreed) continue;
+      (in ? added : removed) += 1;
+    }
+  }
+  if (n == 0) return {};
+  const auto share = [n](std::int64_t k) { return static_cast<double>(k) / static_cast<double>(n); };
+  return {.added_share = share(added), .removed_share = share(removed)};
 }
 
 /// Confusion of one image's segmentation against its ground truth at the orthomosaic's

@@ -15,6 +15,8 @@
 #include <adaptseg/vision/semantic_map.hpp>
 #include <adaptseg/vision/simulated_sensor.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <optional>
 #include <span>
 #include <tuple>
@@ -78,10 +80,14 @@ class SampleCollector {
     CalibrationSamples out;
     for (std::size_t t = 0; t < tops_.size(); ++t) {
       const TopRegion r = top_region(t);
+      const std::size_t first_cell = out.cells.size();
+      afters_.clear();
+      cell_rects_.clear();
       for (double g : candidate_gsd_cm) {
         if (g < field_.gsd_cm() * (1.0 - 1e-9)) continue;
         descend(r, g, out);
       }
+      confirm(r, std::span(out.cells).subspan(first_cell));
     }
     return out;
   }
@@ -172,6 +178,7 @@ class SampleCollector {
     // the map keeps the top-level labels): C's target.
     cv::Mat after = r.map.labels().clone();
     local.labels().copyTo(after, local.labels() != field_.ignore_label());
+    if (ranked_) afters_.emplace_back(g, after);
     RegionSample s;
     s.field = field_index_;
     s.relabelled = relabelling(r.map.labels(), after, r.field_px, interest_);
@@ -193,7 +200,7 @@ class SampleCollector {
   /// Each cell of the sub-lawnmower `sub` re-mapped alone: the field's top-level map with the
   /// cell's pixels from the finer images (`after`; the cells of one sub-lawnmower tile the region).
   void cell_samples(const TopRegion& r, double g, const std::vector<Waypoint>& sub,
-                    const std::vector<CellInputs>& fine_inputs, const cv::Mat& after, CalibrationSamples& out) const {
+                    const std::vector<CellInputs>& fine_inputs, const cv::Mat& after, CalibrationSamples& out) {
     for (std::size_t k = 0; k < sub.size(); ++k) {
       const cv::Rect cell_in = field_.pixel_rect(sub[k].footprint) & r.inside;
       if (cell_in.area() == 0) continue;
@@ -212,6 +219,8 @@ class SampleCollector {
       c.relabelled = changed.interest_share;
       c.added = changed.added_share;
       c.removed = changed.removed_share;
+      c.right =
+          agreeing_changes(r.map.labels()(cell), after(cell), {field_.labels()(cell_in)}, r.field_px(cell), interest_);
       ConfusionMatrix cell_cm = field_cm_;
       ConfusionMatrix before_cell(n_), after_cell(n_);
       before_cell.add(field_.labels()(cell_in), field_map_.labels()(cell_in), field_.ignore_label());
@@ -226,6 +235,27 @@ class SampleCollector {
       c.field_fp = field_counts_.fp;
       c.field_fn = field_counts_.fn;
       out.cells.push_back(c);
+      cell_rects_.push_back(cell);
+    }
+  }
+
+  /// The region's cells (`cells`, cell_samples() of every candidate GSD, in order) checked
+  /// against the region's map at twice each cell's GSD where that was a candidate:
+  /// CellSample::confirmed and confirmed_right.
+  void confirm(const TopRegion& r, std::span<CellSample> cells) const {
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      CellSample& c = cells[i];
+      const auto find = [&](double g) {
+        return std::find_if(afters_.begin(), afters_.end(),
+                            [&](const auto& a) { return std::abs(a.first - g) <= 1e-9 * g; });
+      };
+      const auto coarser = find(2.0 * c.sub_gsd_cm), own = find(c.sub_gsd_cm);
+      if (coarser == afters_.end() || own == afters_.end()) continue;
+      const cv::Rect cell = cell_rects_[i];
+      const cv::Mat before = r.map.labels()(cell), after = own->second(cell), mask = r.field_px(cell);
+      c.confirmed = agreeing_changes(before, after, {coarser->second(cell)}, mask, interest_);
+      c.confirmed_right = agreeing_changes(
+          before, after, {coarser->second(cell), field_.labels()(cell + r.region.tl())}, mask, interest_);
     }
   }
 
@@ -254,6 +284,10 @@ class SampleCollector {
   /// Ranked: the last finer image's decision inputs over its cell (buffers reused). GridInputs
   /// sums of every input give cell_inputs() of planes_on_grid() of pixel_inputs(), to the bit.
   GridInputs fine_inputs_;
+  /// Ranked: the current region's map after the descent at each candidate GSD, and the region
+  /// frame's rectangle of each of its cell samples (confirm()).
+  std::vector<std::pair<double, cv::Mat>> afters_;
+  std::vector<cv::Rect> cell_rects_;
 };
 
 }  // namespace detail
