@@ -40,9 +40,15 @@ int main(int argc, char** argv) {
       ->excludes(field_opt);
   app.add_option("--out", out_file, "model file to write (YAML)")->required();
   app.add_option("--samples-csv", samples_csv, "also write the region samples (one per region and candidate) here");
-  app.add_option("--cell-samples-csv", cell_samples_csv,
-                 "also write the cell samples (--coverage ranked: one per cell of every top-level image and descent "
-                 "GSD, with every decision input the top-level and the finer image give it) here");
+  CLI::Option* cells_opt = app.add_option(
+      "--cell-samples-csv", cell_samples_csv,
+      "also write the cell samples (--coverage ranked: one per cell of every top-level image and descent "
+      "GSD, with every decision input the top-level and the finer image give it) here");
+  bool frame_check = false;
+  app.add_flag("--frame-check", frame_check,
+               "fly each descent again with frames shifted half a footprint along its rows, and say in the cell "
+               "samples which changes those frames make too (*_reframed columns; twice the segmentations)")
+      ->needs(cells_opt);
   app.add_option("--top-factor", top_factor, "top-level GSD as a multiple of the field's GSD")->capture_default_str();
   app.add_option("--candidate-factors", candidate_factors, "candidate lower GSDs, multiples of the field's GSD")
       ->delimiter(',')
@@ -93,6 +99,7 @@ int main(int argc, char** argv) {
     for (double f : candidate_factors) options.adaptive.candidate_gsd_cm.push_back(f * g0);
     for (double f : lawnmower_factors) options.lawnmower_gsd_cm.push_back(f * g0);
     calibration.apply(options, common, g0);
+    options.frame_check = frame_check;
     options.field_grounds = grounds;
     for (const auto& f : fields)
       std::fprintf(stderr, "calibrating on %s (%dx%d px, %.2f cm/px) with %s ...\n", f.name().c_str(), f.width_px(),
@@ -121,7 +128,8 @@ int main(int argc, char** argv) {
       std::ostringstream os;
       os << "field,region,top_gsd_cm,sub_gsd_cm,field_px,field_share,field_sigma,relabelled,field_gain,delta_tp,"
             "delta_fp,field_tp,field_fp,field_fn,added,removed,added_right,removed_right,added_confirmed,"
-            "removed_confirmed,added_confirmed_right,removed_confirmed_right";
+            "removed_confirmed,added_confirmed_right,removed_confirmed_right,added_reframed,removed_reframed,"
+            "added_reframed_right,removed_reframed_right";
       adaptseg::examples::write_input_columns_header(os);
       os << '\n';
       for (const auto& c : cal.cell_samples) {
@@ -130,7 +138,9 @@ int main(int argc, char** argv) {
            << c.relabelled << ',' << c.field_gain << ',' << c.delta_tp << ',' << c.delta_fp << ',' << c.field_tp << ','
            << c.field_fp << ',' << c.field_fn << ',' << c.added << ',' << c.removed << ',' << c.right.added_share << ','
            << c.right.removed_share << ',' << c.confirmed.added_share << ',' << c.confirmed.removed_share << ','
-           << c.confirmed_right.added_share << ',' << c.confirmed_right.removed_share;
+           << c.confirmed_right.added_share << ',' << c.confirmed_right.removed_share << ',' << c.reframed.added_share
+           << ',' << c.reframed.removed_share << ',' << c.reframed_right.added_share << ','
+           << c.reframed_right.removed_share;
         adaptseg::examples::write_input_columns(os, c.top, c.fine);
         os << '\n';
       }

@@ -4,7 +4,10 @@ Reads calibration's cell samples (`adaptseg_calibrate --cell-samples-csv`): per 
 its field pixels that the closer look moved into L (`added`) and out of it (`removed`), of those
 the ones the ground truth agrees with (`added_right`, `removed_right`), the ones the region's look
 at twice the cell's GSD also made (`added_confirmed`, `removed_confirmed`; no truth needed) and
-the confirmed ones that are right (`added_confirmed_right`, `removed_confirmed_right`).
+the confirmed ones that are right (`added_confirmed_right`, `removed_confirmed_right`). With
+`--check reframed` the check is instead the region flown again in frames shifted half a footprint
+along the rows, the same ground at the same GSD in another image's context (`*_reframed` columns,
+`adaptseg_calibrate --frame-check`).
 
 Per finer GSD that has a coarser check and per field, for additions and for removals: the pixels
 changed, the share that is right, the share the coarser look confirms, and the share right among
@@ -17,7 +20,7 @@ over the cells, per field and over all, the correlation of a cell's field gain w
 share, its confirmed share and, for reference, its right share (each times the cell's field
 share): does the confirmation forecast a cell's gain better than the relabelling it checks?
 
-Usage: change_checks.py CELLS_CSV [--top GSD]   (--top: only the cells seen from that top level)
+Usage: change_checks.py CELLS_CSV [--top GSD] [--check confirmed|reframed]   (--top: only the cells seen from that top level)
 """
 
 from __future__ import annotations
@@ -29,8 +32,13 @@ from collections import defaultdict
 
 from .descent_table import correlation
 
-COLUMNS = ("added", "removed", "added_right", "removed_right", "added_confirmed", "removed_confirmed",
-           "added_confirmed_right", "removed_confirmed_right")
+CHECKS = ("confirmed", "reframed")
+
+
+def columns(check: str) -> tuple[str, ...]:
+    """The CSV columns read with `check` (one of CHECKS) as the confirming look."""
+    return ("added", "removed", "added_right", "removed_right", f"added_{check}", f"removed_{check}",
+            f"added_{check}_right", f"removed_{check}_right")
 
 
 def usage() -> int:
@@ -38,13 +46,15 @@ def usage() -> int:
     return 2
 
 
-def totals(rows: list[dict], top: float | None) -> dict:
-    """(sub GSD, field) -> pixel sums of the COLUMNS and of the linear gains, over its cells."""
+def totals(rows: list[dict], top: float | None, check: str = "confirmed") -> dict:
+    """(sub GSD, field) -> pixel sums of the check's columns (named as the `confirmed` ones) and
+    of the linear gains, over its cells."""
+    names = columns(check)
     out: dict = defaultdict(lambda: defaultdict(float, per_cell=[]))
     for r in rows:
         if top is not None and abs(float(r["top_gsd_cm"]) - top) > 1e-6:
             continue
-        v = {k: float(r[k]) * float(r["field_px"]) for k in COLUMNS}
+        v = {k: float(r[n]) * float(r["field_px"]) for k, n in zip(columns("confirmed"), names)}
         if math.isnan(v["added_confirmed"]) or not float(r["field_px"]) > 0:
             continue
         tp, fp, fn = (float(r[k]) for k in ("field_tp", "field_fp", "field_fn"))
@@ -59,7 +69,7 @@ def totals(rows: list[dict], top: float | None) -> dict:
 
         t = out[(float(r["sub_gsd_cm"]), r["field"])]
         t["cells"] += 1
-        for k in COLUMNS:
+        for k in columns("confirmed"):
             t[k] += v[k]
         a_r, r_r = v["added_right"], v["removed_right"]
         a_w, r_w = v["added"] - a_r, v["removed"] - r_r
@@ -82,27 +92,32 @@ def ratio(a: float, b: float) -> float:
 
 
 def main(argv: list[str]) -> int:
-    top = None
-    if "--top" in argv:
-        i = argv.index("--top")
-        if i + 1 >= len(argv):
-            return usage()
-        top = float(argv[i + 1])
-        argv = argv[:i] + argv[i + 2:]
-    if len(argv) != 1:
+    top, check = None, "confirmed"
+    for flag in ("--top", "--check"):
+        if flag in argv:
+            i = argv.index(flag)
+            if i + 1 >= len(argv):
+                return usage()
+            if flag == "--top":
+                top = float(argv[i + 1])
+            else:
+                check = argv[i + 1]
+            argv = argv[:i] + argv[i + 2:]
+    if len(argv) != 1 or check not in CHECKS:
         return usage()
     with open(argv[0], newline="") as f:
         rows = list(csv.DictReader(f))
-    missing = [k for k in COLUMNS + ("field_px", "field_share", "relabelled", "field_gain", "field_tp", "field_fp",
+    missing = [k for k in columns(check) + ("field_px", "field_share", "relabelled", "field_gain", "field_tp", "field_fp",
                                                  "field_fn")
                if rows and k not in rows[0]]
     if missing:
         print(f"change_checks: {argv[0]} has no column {', '.join(missing)} "
               "(written by adaptseg_calibrate --cell-samples-csv since the checks were added)", file=sys.stderr)
         return 2
-    t = totals(rows, top)
+    t = totals(rows, top, check)
     if not t:
-        print("change_checks: no cell has a coarser check (twice its GSD is not a candidate)", file=sys.stderr)
+        print(f"change_checks: no cell has a {check} check (twice its GSD not a candidate, or no --frame-check)",
+              file=sys.stderr)
         return 2
     print("| GSD | field | cells | added px | right | confirmed | right if confirmed | right if not "
           "| removed px | right | confirmed | right if confirmed | right if not "

@@ -12,7 +12,8 @@ each) the field gains (+0.12, −0.10, +0.17) correlate with the relabelled shar
 at −0.17, with the confirmed ones (0.10, 0.10, 0.08) at −0.64 and with the right ones (0.14,
 0.04, 0.09) at +0.77. A 10 cm/px cell without a coarser check
 (nan) and a cell seen from another top level (left out by --top 15) change nothing; a CSV without
-the check columns is refused.
+the check columns is refused. The same columns named as the frame check's (`--check reframed`)
+give the same rows.
 """
 import os
 import tempfile
@@ -47,6 +48,19 @@ def main():
                     "a,15,5,1,0,1,0,0,0,0\n")
         rc, _ = printed(change_checks.main, [path])
         check(rc == 2, f"a CSV without the check columns: exit {rc}, want 2")
+    # The frame check read from its own columns: the confirmed ones renamed give the same rows;
+    # without them (the CSV above has none) --check reframed is refused, as is an unknown check.
+    head, *rows = CELLS.splitlines(keepends=True)
+    head = head.replace("_confirmed", "_reframed")
+    check_on_csv(change_checks.main, head + "".join(rows), ["--top", "15", "--check", "reframed"],
+                 ("| 5 | a | 1 | 100 | 0.60 | 0.50 | 0.80 | 0.40 |", "| 5 | all | 3 | -0.17 | -0.64 | +0.77 |"))
+    for args in (["--check", "reframed"], ["--check", "shifted"]):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "cells.csv")
+            with open(path, "w") as f:
+                f.write(CELLS)
+            rc, _ = printed(change_checks.main, [path, *args])
+            check(rc == 2, f"{args} on a CSV without its columns: exit {rc}, want 2")
     print("ok: change_checks.py splits a closer look's changes by the truth and by a coarser look's confirmation")
 
 

@@ -25,6 +25,7 @@ adaptseg_calibrate)
   expect_error "did you mean --candidate-factors?" --field "$weedmap" --out "$work/m.yaml" --candidate-factor 1
   expect_error "--top-factor" --field "$weedmap" --out "$work/m.yaml" --top-factor
   expect_error "give a training field" --out "$work/m.yaml"
+  expect_error "--frame-check requires --cell-samples-csv" --field "$weedmap" --out "$work/m.yaml" --frame-check
   expect_error "--lawnmower-factors 0.500 is finer than the field" --field "$weedmap" --out "$work/m.yaml" \
     --lawnmower-factors 0.5,1
   expect_error "--candidate-factors 0.500 is finer than the field" --field "$weedmap" --out "$work/m.yaml" \

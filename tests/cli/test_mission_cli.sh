@@ -287,8 +287,8 @@ determinism)
   for run in a b; do
     mkdir -p "$work/$run"
     "$calibrate" --field "$field" --region 0,0,0.5,0.2 --segmenter oracle --threshold-steps 2 "${fixed[@]}" \
-      --out "$work/$run/model.yaml" --cell-samples-csv "$work/$run/cells.csv" >"$work/$run/calibrate.log" 2>&1 ||
-      fail "calibration $run failed"
+      --out "$work/$run/model.yaml" --cell-samples-csv "$work/$run/cells.csv" --frame-check \
+      >"$work/$run/calibrate.log" 2>&1 || fail "calibration $run failed"
     "$mission" --field "$test" --strategy lawnmower --gsd 2 --segmenter oracle "${fixed[@]}" \
       --out "$work/$run/lawnmower" >/dev/null || fail "lawnmower $run failed"
     for s in adaptive linear; do
@@ -298,16 +298,21 @@ determinism)
   done
   cmp "$work/a/model.yaml" "$work/b/model.yaml" || fail "model.yaml differs between two calibrations"
   cmp "$work/a/cells.csv" "$work/b/cells.csv" || fail "the cell samples differ between two calibrations"
+  # --frame-check only adds the cell samples' *_reframed columns: the model is the same without.
+  "$calibrate" --field "$field" --region 0,0,0.5,0.2 --segmenter oracle --threshold-steps 2 "${fixed[@]}" \
+    --out "$work/plain.yaml" >/dev/null 2>&1 || fail "calibration without --frame-check failed"
+  cmp "$work/a/model.yaml" "$work/plain.yaml" || fail "--frame-check changed the model"
   # --cell-samples-csv: one row per cell sample the calibration reports, every decision input
   # of the top-level and the finer image as columns.
   cells=$(sed -n 's/^\([0-9]*\) cell samples$/\1/p' "$work/a/calibrate.log")
   [ -n "$cells" ] && [ "$cells" -gt 0 ] && [ "$(($(wc -l <"$work/a/cells.csv") - 1))" = "$cells" ] ||
     fail "cells.csv does not hold the $cells cell samples reported"
-  head -1 "$work/a/cells.csv" | grep -q '^field,region,top_gsd_cm,sub_gsd_cm,field_px,field_share,field_sigma,relabelled,field_gain,delta_tp,delta_fp,field_tp,field_fp,field_fn,added,removed,added_right,removed_right,added_confirmed,removed_confirmed,added_confirmed_right,removed_confirmed_right,top_sigma,.*,fine_expected_error,' ||
+  head -1 "$work/a/cells.csv" | grep -q '^field,region,top_gsd_cm,sub_gsd_cm,field_px,field_share,field_sigma,relabelled,field_gain,delta_tp,delta_fp,field_tp,field_fp,field_fn,added,removed,added_right,removed_right,added_confirmed,removed_confirmed,added_confirmed_right,removed_confirmed_right,added_reframed,removed_reframed,added_reframed_right,removed_reframed_right,top_sigma,.*,fine_expected_error,' ||
     fail "cells.csv header: $(head -1 "$work/a/cells.csv")"
   # The checks of a closer look's changes: the right ones and the confirmed ones are parts of the
   # changes, the confirmed right ones of both; confirmed where twice the cell's GSD is a
-  # candidate (the default factors 1 and 2), nan where not (1.5: 3 is none).
+  # candidate (the default factors 1 and 2), nan where not (1.5: 3 is none); the frames shifted
+  # half a footprint (--frame-check) check every cell.
   "$python" - "$work/a/cells.csv" <<'PY' || fail "cells.csv change checks out of order"
 import csv, math, sys
 confirmed = unconfirmed = 0
@@ -320,6 +325,9 @@ for r in csv.DictReader(open(sys.argv[1], newline="")):
             continue
         confirmed += 1
         assert conf <= n + 1e-12 and both <= min(conf, right) + 1e-12, r
+    for side in ("added", "removed"):
+        n, right, shifted, both = (float(r[side + k]) for k in ("", "_right", "_reframed", "_reframed_right"))
+        assert shifted <= n + 1e-12 and both <= min(shifted, right) + 1e-12, r
 assert confirmed > 0 and unconfirmed > 0, (confirmed, unconfirmed)
 PY
   # The scene check's slopes: proxy_slopes.py refits from cells.csv the gain slope, the proxy

@@ -89,6 +89,9 @@ struct CellSample {
   Relabelling confirmed{.added_share = std::numeric_limits<double>::quiet_NaN(),
                         .removed_share = std::numeric_limits<double>::quiet_NaN()};
   Relabelling confirmed_right = confirmed;
+  /// CalibrationOptions::frame_check: the same for the region's map from frames shifted half a
+  /// footprint along the rows, the same ground at the same GSD in another image's context.
+  Relabelling reframed = confirmed, reframed_right = confirmed;
   /// Field mIoU over L of the top-level map with only this cell re-mapped, minus without.
   double field_gain = 0.0;
   /// The same comparison in pixels, summed over the classes of L (as RealisedDescent's): how

@@ -43,7 +43,8 @@ template <SegmentationBackend Backend>
 class SampleCollector {
  public:
   SampleCollector(const Field& field, Backend& backend, const CameraModel& camera, double top_gsd_cm,
-                  const std::vector<int>& interest, DescentCoverage coverage, std::size_t field_index, MapFusion fusion)
+                  const std::vector<int>& interest, DescentCoverage coverage, std::size_t field_index, MapFusion fusion,
+                  bool frame_check)
       : field_(field),
         backend_(backend),
         camera_(camera),
@@ -56,6 +57,7 @@ class SampleCollector {
         planner_(camera),
         n_(field.num_classes()),
         ranked_(covers_.ranks_cells),
+        frame_check_(ranked_ && frame_check),
         pooled_(pools_probabilities(fusion)),
         field_map_(field.labels().size(), field.ignore_label(), fusion, interest),
         field_cm_(n_),
@@ -82,6 +84,7 @@ class SampleCollector {
       const TopRegion r = top_region(t);
       const std::size_t first_cell = out.cells.size();
       afters_.clear();
+      reframed_.clear();
       cell_rects_.clear();
       for (double g : candidate_gsd_cm) {
         if (g < field_.gsd_cm() * (1.0 - 1e-9)) continue;
@@ -179,6 +182,7 @@ class SampleCollector {
     cv::Mat after = r.map.labels().clone();
     local.labels().copyTo(after, local.labels() != field_.ignore_label());
     if (ranked_) afters_.emplace_back(g, after);
+    if (frame_check_) reframed_.emplace_back(g, reframed_after(r, sub));
     RegionSample s;
     s.field = field_index_;
     s.relabelled = relabelling(r.map.labels(), after, r.field_px, interest_);
@@ -239,23 +243,56 @@ class SampleCollector {
     }
   }
 
+  /// The mission's map of region `r` after the sub-lawnmower `sub` shifted half a footprint
+  /// along its rows both ways (frames another image's width apart from each original, those
+  /// shared by two neighbours flown once), as descend() makes it from `sub`.
+  [[nodiscard]] cv::Mat reframed_after(const TopRegion& r, const std::vector<Waypoint>& sub) {
+    std::vector<Waypoint> shifted;
+    for (const Waypoint& w : sub)
+      for (double side : {-0.5, 0.5}) {
+        Waypoint s = w;
+        const double dx = side * w.footprint.width_m();
+        s.position.x() += dx;
+        s.footprint.x_min_m += dx;
+        s.footprint.x_max_m += dx;
+        const auto same = [&](const Waypoint& o) { return (o.position - s.position).norm() < 1e-6; };
+        if (keep(s.footprint) && std::none_of(shifted.begin(), shifted.end(), same)) shifted.push_back(s);
+      }
+    SemanticMap local(r.region.size(), field_.ignore_label(), fusion_, interest_);
+    if (covers_.flies || pooled_) local.fuse(r.local, top_segmentations_[r.index]);
+    for (const Waypoint& w : shifted) {
+      Image img = sensor_.capture(w);
+      const Segmentation seg = segment(img);
+      img.footprint_px -= r.region.tl();
+      local.fuse(img, seg);
+    }
+    cv::Mat after = r.map.labels().clone();
+    local.labels().copyTo(after, local.labels() != field_.ignore_label());
+    return after;
+  }
+
   /// The region's cells (`cells`, cell_samples() of every candidate GSD, in order) checked
   /// against the region's map at twice each cell's GSD where that was a candidate:
   /// CellSample::confirmed and confirmed_right.
   void confirm(const TopRegion& r, std::span<CellSample> cells) const {
     for (std::size_t i = 0; i < cells.size(); ++i) {
       CellSample& c = cells[i];
-      const auto find = [&](double g) {
-        return std::find_if(afters_.begin(), afters_.end(),
-                            [&](const auto& a) { return std::abs(a.first - g) <= 1e-9 * g; });
+      const auto find = [](const auto& maps, double g) {
+        return std::find_if(maps.begin(), maps.end(), [&](const auto& a) { return std::abs(a.first - g) <= 1e-9 * g; });
       };
-      const auto coarser = find(2.0 * c.sub_gsd_cm), own = find(c.sub_gsd_cm);
-      if (coarser == afters_.end() || own == afters_.end()) continue;
+      const auto own = find(afters_, c.sub_gsd_cm);
+      if (own == afters_.end()) continue;
       const cv::Rect cell = cell_rects_[i];
-      const cv::Mat before = r.map.labels()(cell), after = own->second(cell), mask = r.field_px(cell);
-      c.confirmed = agreeing_changes(before, after, {coarser->second(cell)}, mask, interest_);
-      c.confirmed_right = agreeing_changes(
-          before, after, {coarser->second(cell), field_.labels()(cell + r.region.tl())}, mask, interest_);
+      const cv::Mat before = r.map.labels()(cell), after = own->second(cell), mask = r.field_px(cell),
+                    truth = field_.labels()(cell + r.region.tl());
+      const auto check = [&](const cv::Mat& other, Relabelling& agreed, Relabelling& right) {
+        agreed = agreeing_changes(before, after, {other(cell)}, mask, interest_);
+        right = agreeing_changes(before, after, {other(cell), truth}, mask, interest_);
+      };
+      if (const auto coarser = find(afters_, 2.0 * c.sub_gsd_cm); coarser != afters_.end())
+        check(coarser->second, c.confirmed, c.confirmed_right);
+      if (const auto shifted = find(reframed_, c.sub_gsd_cm); shifted != reframed_.end())
+        check(shifted->second, c.reframed, c.reframed_right);
     }
   }
 
@@ -270,7 +307,7 @@ class SampleCollector {
   SimulatedSensor sensor_;
   LawnmowerPlanner planner_;
   int n_;
-  bool ranked_, pooled_;
+  bool ranked_, frame_check_, pooled_;
   std::vector<Waypoint> tops_;
   std::vector<Image> top_images_;
   std::vector<Segmentation> top_segmentations_;
@@ -287,6 +324,7 @@ class SampleCollector {
   /// Ranked: the current region's map after the descent at each candidate GSD, and the region
   /// frame's rectangle of each of its cell samples (confirm()).
   std::vector<std::pair<double, cv::Mat>> afters_;
+  std::vector<std::pair<double, cv::Mat>> reframed_;  ///< frame_check_: reframed_after() per GSD
   std::vector<cv::Rect> cell_rects_;
 };
 
@@ -303,7 +341,7 @@ class SampleCollector {
 /// changes). Each sample's `field` is `field_index`. `fusion`: how the maps combine the images
 /// (MissionOptions::map_fusion); with MapFusion::pooled every image is segmented with its class
 /// probabilities and a descent's region map pools the top-level image with the finer ones, as the
-/// mission's map does.
+/// mission's map does. `frame_check`: CalibrationOptions::frame_check (cells only).
 /// @throws std::invalid_argument for a top GSD finer than the field's or candidates not finer
 ///         than the top, or an empty `interest`.
 template <SegmentationBackend Backend>
@@ -311,14 +349,16 @@ template <SegmentationBackend Backend>
                                                  double top_gsd_cm, const std::vector<double>& candidate_gsd_cm,
                                                  const std::vector<int>& interest,
                                                  DescentCoverage coverage = DescentCoverage::region,
-                                                 std::size_t field_index = 0, MapFusion fusion = MapFusion::finest) {
+                                                 std::size_t field_index = 0, MapFusion fusion = MapFusion::finest,
+                                                 bool frame_check = false) {
   detail::require(top_gsd_cm >= field.gsd_cm() * (1.0 - 1e-9),
                   "collect_region_samples: top_gsd_cm is finer than the field's GSD", top_gsd_cm);
   detail::require(!interest.empty(), "collect_region_samples: no labels of interest", 0);
   for (double g : candidate_gsd_cm)
     detail::require(std::isfinite(g) && g > 0.0 && g < top_gsd_cm,
                     "collect_region_samples: candidate GSDs must be finer than top_gsd_cm", g);
-  return detail::SampleCollector<Backend>(field, backend, camera, top_gsd_cm, interest, coverage, field_index, fusion)
+  return detail::SampleCollector<Backend>(field, backend, camera, top_gsd_cm, interest, coverage, field_index, fusion,
+                                          frame_check)
       .collect(candidate_gsd_cm);
 }
 
