@@ -9,7 +9,7 @@ the confirmed ones that are right (`added_confirmed_right`, `removed_confirmed_r
 along the rows, the same ground at the same GSD in another image's context (`*_reframed` columns,
 `adaptseg_calibrate --frame-check`).
 
-Per finer GSD that has a coarser check and per field, for additions and for removals: the pixels
+Per finer GSD whose cells have the check and per field, for additions and for removals: the pixels
 changed, the share that is right, the share the coarser look confirms, and the share right among
 the confirmed and among the unconfirmed changes. Then what the field's IoU of L gains, summed over
 its cells each re-mapped alone, in the linear exchange (ΔTP − IoU·ΔFP) / U of its top-level map

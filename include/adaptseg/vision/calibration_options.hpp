@@ -71,8 +71,8 @@ struct CalibrationOptions {
   std::optional<std::vector<double>> alternative_top_gsd_cm{};
   /// DescentCoverage::ranked: also fly each descent's sub-lawnmower shifted half a footprint
   /// along its rows, both ways, and record which of each cell's changes those frames make too
-  /// (CellSample::reframed; what a forward overlap of one half would show in flight). Twice the
-  /// segmentations; the model is the same either way.
+  /// (CellSample::reframed; what a forward overlap of one half would show in flight). About
+  /// twice the descents' segmentations; the model is the same either way.
   bool frame_check = false;
   GainModel::FitOptions fit{};  ///< what I predicts from, hyperparameter restarts
   int refit_every = 0;          ///< O's scheduled re-optimisation (GainModel)

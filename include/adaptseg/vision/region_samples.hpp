@@ -272,8 +272,9 @@ class SampleCollector {
   }
 
   /// The region's cells (`cells`, cell_samples() of every candidate GSD, in order) checked
-  /// against the region's map at twice each cell's GSD where that was a candidate:
-  /// CellSample::confirmed and confirmed_right.
+  /// against the region's map at twice each cell's GSD where that was a candidate
+  /// (CellSample::confirmed, confirmed_right) and, with frame_check_, against its map from the
+  /// shifted frames at the cell's own GSD (reframed, reframed_right).
   void confirm(const TopRegion& r, std::span<CellSample> cells) const {
     for (std::size_t i = 0; i < cells.size(); ++i) {
       CellSample& c = cells[i];
