@@ -222,6 +222,30 @@ class ConfusionMatrix {
   return {sa / n, sb / n};
 }
 
+namespace detail {
+
+/// Calls `visit(row, col, before_label, after_label)` for every pixel of `before` and `after`
+/// (CV_8UC1 of one size, checked by the caller) where `field_mask` is non-zero (every pixel if it
+/// is empty); returns how many it visited: what relabelling() and agreeing_changes() count over.
+template <class Visit>
+std::int64_t for_each_field_pixel(const cv::Mat& before, const cv::Mat& after, const cv::Mat& field_mask,
+                                  Visit&& visit) {
+  std::int64_t n = 0;
+  for (int r = 0; r < before.rows; ++r) {
+    const auto* b = before.ptr<std::uint8_t>(r);
+    const auto* a = after.ptr<std::uint8_t>(r);
+    const auto* m = field_mask.empty() ? nullptr : field_mask.ptr<std::uint8_t>(r);
+    for (int c = 0; c < before.cols; ++c) {
+      if (m != nullptr && m[c] == 0) continue;
+      ++n;
+      visit(r, c, b[c], a[c]);
+    }
+  }
+  return n;
+}
+
+}  // namespace detail
+
 /// Relabelling (decision.hpp) between two label maps of one region, over the pixels where `field_mask` is
 /// non-zero (all pixels if it is empty); 0 for a region without field pixels.
 /// @throws std::invalid_argument unless the maps (and a non-empty mask) are CV_8UC1 of one size.
@@ -233,21 +257,15 @@ class ConfusionMatrix {
                   std::to_string(before.cols) + "x" + std::to_string(before.rows) + " vs " +
                       std::to_string(after.cols) + "x" + std::to_string(after.rows));
   const auto lut = detail::label_lut(interest);
-  std::int64_t n = 0, changed = 0, changed_l = 0, added = 0, removed = 0;
-  for (int r = 0; r < before.rows; ++r) {
-    const auto* b = before.ptr<std::uint8_t>(r);
-    const auto* a = after.ptr<std::uint8_t>(r);
-    const auto* m = field_mask.empty() ? nullptr : field_mask.ptr<std::uint8_t>(r);
-    for (int c = 0; c < before.cols; ++c) {
-      if (m != nullptr && m[c] == 0) continue;
-      ++n;
-      if (a[c] == b[c]) continue;
-      ++changed;
-      changed_l += lut[a[c]] || lut[b[c]] ? 1 : 0;
-      added += lut[a[c]] && !lut[b[c]] ? 1 : 0;
-      removed += lut[b[c]] && !lut[a[c]] ? 1 : 0;
-    }
-  }
+  std::int64_t changed = 0, changed_l = 0, added = 0, removed = 0;
+  const std::int64_t n =
+      detail::for_each_field_pixel(before, after, field_mask, [&](int, int, std::uint8_t b, std::uint8_t a) {
+        if (a == b) return;
+        ++changed;
+        changed_l += lut[a] || lut[b] ? 1 : 0;
+        added += lut[a] && !lut[b] ? 1 : 0;
+        removed += lut[b] && !lut[a] ? 1 : 0;
+      });
   if (n == 0) return {};
   const auto share = [n](std::int64_t k) { return static_cast<double>(k) / static_cast<double>(n); };
   return {share(changed), share(changed_l), share(added), share(removed)};
@@ -268,22 +286,15 @@ class ConfusionMatrix {
   detail::require(fits, "agreeing_changes: every map (and the mask) must be CV_8UC1 of one size",
                   std::to_string(before.cols) + "x" + std::to_string(before.rows));
   const auto lut = detail::label_lut(interest);
-  std::int64_t n = 0, added = 0, removed = 0;
-  for (int r = 0; r < before.rows; ++r) {
-    const auto* b = before.ptr<std::uint8_t>(r);
-    const auto* a = after.ptr<std::uint8_t>(r);
-    const auto* m = field_mask.empty() ? nullptr : field_mask.ptr<std::uint8_t>(r);
-    for (int c = 0; c < before.cols; ++c) {
-      if (m != nullptr && m[c] == 0) continue;
-      ++n;
-      const bool in = lut[a[c]];
-      if (in == lut[b[c]]) continue;
-      const bool agreed = std::all_of(checks.begin(), checks.end(),
-                                      [&](const cv::Mat& k) { return lut[k.at<std::uint8_t>(r, c)] == in; });
-      if (!agreed) continue;
-      (in ? added : removed) += 1;
-    }
-  }
+  std::int64_t added = 0, removed = 0;
+  const std::int64_t n =
+      detail::for_each_field_pixel(before, after, field_mask, [&](int r, int c, std::uint8_t b, std::uint8_t a) {
+        const bool in = lut[a];
+        if (in == lut[b]) return;
+        if (std::all_of(checks.begin(), checks.end(),
+                        [&](const cv::Mat& k) { return lut[k.at<std::uint8_t>(r, c)] == in; }))
+          (in ? added : removed) += 1;
+      });
   if (n == 0) return {};
   const auto share = [n](std::int64_t k) { return static_cast<double>(k) / static_cast<double>(n); };
   return {.added_share = share(added), .removed_share = share(removed)};

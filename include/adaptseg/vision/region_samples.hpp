@@ -152,11 +152,8 @@ class SampleCollector {
     };
     const auto sub = planner_.plan(top.footprint, g, Eigen::Vector2d(top.position.x(), top.position.y()), keep_cell);
     if (sub.empty()) return;
-    // Fuse the sub-lawnmower into a map of the region alone (pixel frame shifted). Cells a
-    // coverage leaves out keep their top-level labels, as in the mission's map; a pooled map
-    // pools the finer images with the top-level one everywhere.
-    SemanticMap local(r.region.size(), field_.ignore_label(), fusion_, interest_);
-    if (covers_.flies || pooled_) local.fuse(r.local, top_segmentations_[r.index]);
+    // Fuse the sub-lawnmower into a map of the region alone (region_map()).
+    SemanticMap local = region_map(r);
     // Ranked: each finer image's own decision inputs over its cell (the scene check's proxy).
     std::vector<CellInputs> fine_inputs;
     for (const auto& w : sub) {
@@ -177,10 +174,8 @@ class SampleCollector {
     }
     ConfusionMatrix sub_cm(n_);
     sub_cm.add(top_images_[r.index].ground_truth, local.labels(), field_.ignore_label());
-    // What the descent changed in the mission's map (where the sub-lawnmower wrote nothing,
-    // the map keeps the top-level labels): C's target.
-    cv::Mat after = r.map.labels().clone();
-    local.labels().copyTo(after, local.labels() != field_.ignore_label());
+    // What the descent changed in the mission's map: C's target.
+    const cv::Mat after = map_after(r, local);
     if (ranked_) afters_.emplace_back(g, after);
     if (frame_check_) reframed_.emplace_back(g, reframed_after(r, sub));
     RegionSample s;
@@ -258,14 +253,28 @@ class SampleCollector {
         const auto same = [&](const Waypoint& o) { return (o.position - s.position).norm() < 1e-6; };
         if (keep(s.footprint) && std::none_of(shifted.begin(), shifted.end(), same)) shifted.push_back(s);
       }
-    SemanticMap local(r.region.size(), field_.ignore_label(), fusion_, interest_);
-    if (covers_.flies || pooled_) local.fuse(r.local, top_segmentations_[r.index]);
+    SemanticMap local = region_map(r);
     for (const Waypoint& w : shifted) {
       Image img = sensor_.capture(w);
       const Segmentation seg = segment(img);
       img.footprint_px -= r.region.tl();
       local.fuse(img, seg);
     }
+    return map_after(r, local);
+  }
+
+  /// A map of region `r` alone (pixel frame shifted) for a sub-lawnmower's images to be fused
+  /// into. Cells a coverage leaves out keep their top-level labels, as in the mission's map; a
+  /// pooled map pools the finer images with the top-level one everywhere.
+  [[nodiscard]] SemanticMap region_map(const TopRegion& r) const {
+    SemanticMap local(r.region.size(), field_.ignore_label(), fusion_, interest_);
+    if (covers_.flies || pooled_) local.fuse(r.local, top_segmentations_[r.index]);
+    return local;
+  }
+
+  /// The mission's map of region `r` after a descent fused into `local` (region_map()): the
+  /// top-level labels where the sub-lawnmower wrote nothing.
+  [[nodiscard]] cv::Mat map_after(const TopRegion& r, const SemanticMap& local) const {
     cv::Mat after = r.map.labels().clone();
     local.labels().copyTo(after, local.labels() != field_.ignore_label());
     return after;
