@@ -19,17 +19,30 @@ probabilities, then per class of interest L (IoU of L against the field's labels
   - the closer look's additions (pixels it calls L where the top level did not) and removals
     (L at the top level, not in the closer look): each as a share of the labelled ground and
     how often it is right (additions: truly L; removals: truly not L). An addition of precision
-    p raises IoU only where p > IoU / (1 + IoU) of the map it joins (`break-even`).
+    p raises IoU only where p > IoU / (1 + IoU) of the map it joins (`break-even`);
+  - with `--check DIR` (a second leave-one-tile-out set, e.g. the other seed's), `agreed`: the
+    pooled map, but a pixel takes a label other than the top level's only where the check
+    network's lawnmower at the finer GSD gives that label too (a second network as a gate on
+    what a closer look changes, every class at once);
+  - with `--curve FACTORS` (the lawnmower curve's GSD factors, e.g. 1,1.5,2,2.5,3), each fusion's
+    margin over the best of those lawnmowers (`over curve`): what two whole passes, the top level
+    and then the finer one everywhere, score against the lawnmower curve's upper envelope. Exact
+    where the two passes end after every lawnmower of the curve (the finer pass at the curve's
+    finest GSD: the envelope is flat beyond it), a lower bound otherwise. The summary then gives
+    per class the finer GSD the other fields choose (the largest mean pooled margin over the
+    curve, none where it is not positive) and what it scores on each field.
 
 Usage:
   PYTHONPATH=python /usr/bin/python3 -m adaptseg_tools.two_looks \\
       --loto examples/models/mobilenetv2-dubai-loto [--tiles 1,2,3,4,5,6] \\
-      [--top 3] [--bands 2,1] [--classes building,road,vegetation,water]
+      [--top 3] [--bands 2,1] [--classes building,road,vegetation,water] \\
+      [--check examples/models/mobilenetv2-dubai-loto-seed1] [--curve 1,1.5,2,2.5,3]
   (each tile-K network on examples/data/dubai-tile-K, the tile it never saw), or
   ... two_looks NETWORK FIELD [NETWORK FIELD ...] with the same options.
 --top and --bands are GSD factors of the field's own GSD (3 and 2 on the Dubai tiles: 15 and
 10 cm/px). Prints Markdown: one row per class, field and finer band, then per class and band
-the mean bonus and in how many fields it is above +0.001. Needs torch, as eval_ensemble does.
+the mean bonus and in how many fields it is above +0.001. --check needs --loto. Needs torch, as
+eval_ensemble does.
 """
 
 from __future__ import annotations
@@ -70,36 +83,85 @@ def iou(predicted: np.ndarray, truth: np.ndarray) -> float:
     return int((predicted & truth).sum()) / union if union else float("nan")
 
 
+def fusions_of(checked: bool) -> tuple[str, ...]:
+    """The fusions measured: FUSIONS, and `agreed` where a check network gates the changes."""
+    return FUSIONS + (("agreed",) if checked else ())
+
+
 def compare(top_lp: np.ndarray, fine_lp: np.ndarray, top_gsd: float, fine_gsd: float, truth: np.ndarray,
-            cls: int) -> dict:
-    """The measures of the module docstring for class `cls`, over the labelled pixels."""
+            cls: int, check_labels: np.ndarray | None = None, curve_best: float | None = None) -> dict:
+    """The measures of the module docstring for class `cls`, over the labelled pixels: with
+    `check_labels` (the check network's labels at the finer GSD) also `agreed`; with `curve_best`
+    (the best IoU of `cls` among the curve's lawnmowers) each fusion's `<fusion>_over_curve`."""
     valid = truth != IGNORE
     t = (truth == cls) & valid
-    top = (top_lp.argmax(0) == cls) & valid
+    top_labels, pooled_labels = top_lp.argmax(0), (top_lp / top_gsd + fine_lp / fine_gsd).argmax(0)
+    top = (top_labels == cls) & valid
     fine = (fine_lp.argmax(0) == cls) & valid
-    pooled = ((top_lp / top_gsd + fine_lp / fine_gsd).argmax(0) == cls) & valid
+    pooled = (pooled_labels == cls) & valid
     fused = {"pooled": pooled, "union": pooled | top | fine, "trim": pooled & top}
+    if check_labels is not None:
+        fused["agreed"] = (np.where(check_labels == pooled_labels, pooled_labels, top_labels) == cls) & valid
+    fusions = fusions_of(check_labels is not None)
     n = max(1, int(valid.sum()))
     added, removed = fine & ~top, top & ~fine
-    r = {"top": iou(top, t), "fine": iou(fine, t), **{f: iou(fused[f], t) for f in FUSIONS},
+    r = {"top": iou(top, t), "fine": iou(fine, t), **{f: iou(fused[f], t) for f in fusions},
          "added": int(added.sum()) / n, "removed": int(removed.sum()) / n,
          "added_right": float(t[added].mean()) if added.any() else float("nan"),
          "removed_right": float((~t[removed]).mean()) if removed.any() else float("nan")}
     best = max(r["top"], r["fine"])
-    r.update({f"{f}_bonus": r[f] - best for f in FUSIONS})
+    r.update({f"{f}_bonus": r[f] - best for f in fusions})
+    if curve_best is not None:
+        r.update({f"{f}_over_curve": r[f] - max(best, curve_best) for f in fusions})
     r["break_even"] = r["top"] / (1.0 + r["top"])
     return r
 
 
-def pairs_of(args) -> list[tuple[str, Path, Path]]:
-    """(label, network folder, field folder) to measure."""
+def pairs_of(args) -> list[tuple[str, Path, Path, Path | None]]:
+    """(label, network folder, field folder, check network folder or None) to measure."""
     if args.loto:
         tiles = [int(k) for k in args.tiles.split(",")]
-        return [(f"tile {k}", Path(args.loto) / f"tile-{k}", REPO / "examples" / "data" / f"dubai-tile-{k}")
-                for k in tiles]
+        return [(f"tile {k}", Path(args.loto) / f"tile-{k}", REPO / "examples" / "data" / f"dubai-tile-{k}",
+                 Path(args.check) / f"tile-{k}" if args.check else None) for k in tiles]
+    if args.check:
+        raise SystemExit("--check needs --loto (each tile's check network is the check set's tile-K)")
     if not args.pairs or len(args.pairs) % 2:
         raise SystemExit("give --loto DIR or NETWORK FIELD pairs")
-    return [(Path(f).name, Path(n), Path(f)) for n, f in zip(args.pairs[::2], args.pairs[1::2])]
+    return [(Path(f).name, Path(n), Path(f), None) for n, f in zip(args.pairs[::2], args.pairs[1::2])]
+
+
+def factors(text: str, option: str) -> list[float]:
+    """Comma-separated positive GSD factors."""
+    try:
+        values = [float(b) for b in text.split(",")]
+    except ValueError:
+        raise SystemExit(f"{option} {text}: comma-separated numbers") from None
+    if not values or min(values) <= 0:
+        raise SystemExit(f"{option} {text}: each must be above 0")
+    return values
+
+
+def labels_at(model, spec, meta, field, gsd_cm: float) -> np.ndarray:
+    """The lawnmower's labels at `gsd_cm` in the field's frame."""
+    return painted_log_probabilities(model, spec, meta, field, gsd_cm).argmax(0)
+
+
+def chosen_on_others(rows, wanted) -> list[tuple[str, str, str, float]]:
+    """Per class and field: the finer GSD whose mean pooled margin over the curve on the other
+    fields is largest, none (margin 0: the top level alone, a point of the curve) where that mean
+    is not positive, and the margin it scores on the field."""
+    margins: dict[tuple[str, str], dict[float, float]] = {}
+    for name, label, _, fine_gsd, r in rows:
+        margins.setdefault((name, label), {})[fine_gsd] = r["pooled_over_curve"]
+    out = []
+    for (name, label), own in sorted(margins.items(), key=lambda x: (wanted.index(x[0][0]), x[0][1])):
+        others = [m for (n, lab), m in margins.items() if n == name and lab != label]
+        if not others:
+            continue
+        mean = {g: float(np.mean([m[g] for m in others])) for g in own}
+        g = max(mean, key=mean.get)
+        out.append((name, label, f"{g:g}", own[g]) if mean[g] > 0 else (name, label, "none", 0.0))
+    return out
 
 
 def main(argv=None):
@@ -110,43 +172,75 @@ def main(argv=None):
     parser.add_argument("--top", type=float, default=3.0, help="the top level's GSD factor (default 3)")
     parser.add_argument("--bands", default="2", help="the finer lawnmowers' GSD factors (default 2)")
     parser.add_argument("--classes", default="building,road,vegetation,water")
+    parser.add_argument("--check", help="with --loto: a second set whose tile-K gates what the closer look changes")
+    parser.add_argument("--curve", help="the lawnmower curve's GSD factors: each fusion's margin over its best")
     args = parser.parse_args(argv)
-    bands = [float(b) for b in args.bands.split(",")]
-    if args.top <= 0 or any(b <= 0 or b >= args.top for b in bands):
+    bands = factors(args.bands, "--bands")
+    curve = factors(args.curve, "--curve") if args.curve else []
+    if args.top <= 0 or any(b >= args.top for b in bands):
         raise SystemExit(f"--bands {args.bands}: each must be above 0 and below --top {args.top}")
     wanted = args.classes.split(",")
-    summary: dict[tuple[str, float], list[tuple[float, float, float]]] = {}
+    fusions = fusions_of(bool(args.check))
+    summary: dict[tuple[str, float], list[list[float]]] = {}
     rows = []
-    for label, net, fdir in pairs_of(args):
+    for label, net, fdir, check_net in pairs_of(args):
         field = load_field(fdir)
         unknown = [c for c in wanted if c not in field.classes]
         if unknown:
             raise SystemExit(f"{fdir}: no class {', '.join(unknown)} (it has {', '.join(field.classes)})")
         model, spec, meta = load_member(net)
+        checker = load_member(check_net) if check_net else None
+        if checker and checker[2]["classes"] != meta["classes"]:
+            raise SystemExit(f"{check_net}: classes {checker[2]['classes']} differ from {net}'s {meta['classes']}")
+        curve_labels = [labels_at(model, spec, meta, field, f * field.gsd_cm) for f in curve]
         top_gsd = args.top * field.gsd_cm
         top_lp = painted_log_probabilities(model, spec, meta, field, top_gsd)
         for b in bands:
             fine_gsd = b * field.gsd_cm
             fine_lp = painted_log_probabilities(model, spec, meta, field, fine_gsd)
+            check_labels = labels_at(*checker, field, fine_gsd) if checker else None
             for name in wanted:
-                r = compare(top_lp, fine_lp, top_gsd, fine_gsd, field.labels, field.classes.index(name))
+                cls = field.classes.index(name)
+                best = None
+                if curve_labels:
+                    valid = field.labels != IGNORE
+                    truth = (field.labels == cls) & valid
+                    best = max(iou((m == cls) & valid, truth) for m in curve_labels)
+                r = compare(top_lp, fine_lp, top_gsd, fine_gsd, field.labels, cls, check_labels, best)
                 rows.append((name, label, top_gsd, fine_gsd, r))
-                summary.setdefault((name, fine_gsd), []).append([r[f"{f}_bonus"] for f in FUSIONS])
-    print("| class | field | GSD top → fine [cm/px] | IoU top | fine | " + " | ".join(FUSIONS) + " | bonus "
-          + " | ".join(FUSIONS) + " | added [% of ground] | right | break-even | removed [%] | right |")
-    print("| --- | --- | --- |" + " ---: |" * (7 + 2 * len(FUSIONS)))
+                summary.setdefault((name, fine_gsd), []).append(
+                    [r[f"{f}_bonus"] for f in fusions] + ([r[f"{f}_over_curve"] for f in fusions] if curve else []))
+    over = [f"over curve {f}" for f in fusions] if curve else []
+    print("| class | field | GSD top → fine [cm/px] | IoU top | fine | " + " | ".join(fusions) + " | bonus "
+          + " | ".join(fusions) + "".join(f" | {o}" for o in over)
+          + " | added [% of ground] | right | break-even | removed [%] | right |")
+    print("| --- | --- | --- |" + " ---: |" * (7 + 2 * len(fusions) + len(over)))
     for name, label, top_gsd, fine_gsd, r in sorted(rows, key=lambda x: (wanted.index(x[0]), x[3], x[1])):
         print(f"| {name} | {label} | {top_gsd:g} → {fine_gsd:g} | {r['top']:.3f} | {r['fine']:.3f} | "
-              + "".join(f"{r[f]:.3f} | " for f in FUSIONS) + "".join(f"{r[f + '_bonus']:+.3f} | " for f in FUSIONS) +
+              + "".join(f"{r[f]:.3f} | " for f in fusions) + "".join(f"{r[f + '_bonus']:+.3f} | " for f in fusions)
+              + "".join(f"{r[f + '_over_curve']:+.4f} | " for f in fusions if curve) +
               f"{100 * r['added']:.2f} | {r['added_right']:.2f} | {r['break_even']:.2f} | "
               f"{100 * r['removed']:.2f} | {r['removed_right']:.2f} |")
     print()
-    print("| class | fine GSD [cm/px] | fields |" + "".join(f" mean bonus, {f} | above +0.001 |" for f in FUSIONS))
-    print("| --- | ---: | ---: |" + " ---: | ---: |" * len(FUSIONS))
+    heads = [f"bonus, {f}" for f in fusions] + over
+    print("| class | fine GSD [cm/px] | fields |" + "".join(f" mean {h} | above +0.001 |" for h in heads))
+    print("| --- | ---: | ---: |" + " ---: | ---: |" * len(heads))
     for (name, fine_gsd), v in sorted(summary.items(), key=lambda x: (wanted.index(x[0][0]), x[0][1])):
         a = np.array(v)
         print(f"| {name} | {fine_gsd:g} | {len(v)} |"
-              + "".join(f" {a[:, k].mean():+.4f} | {int((a[:, k] > 0.001).sum())} |" for k in range(len(FUSIONS))))
+              + "".join(f" {a[:, k].mean():+.4f} | {int((a[:, k] > 0.001).sum())} |" for k in range(len(heads))))
+    if curve:
+        chosen = chosen_on_others(rows, wanted)
+        print()
+        print("Two passes, the finer GSD chosen on the other fields (pooled, margin over the curve's best):")
+        print("| class | field | finer GSD [cm/px] | margin |")
+        print("| --- | --- | --- | ---: |")
+        for name, label, g, m in chosen:
+            print(f"| {name} | {label} | {g} | {m:+.4f} |")
+        m = np.array([c[3] for c in chosen])
+        if len(m):
+            print(f"\n{int((m > 0.001).sum())} of {len(m)} above +0.001, median {np.median(m):+.4f}, "
+                  f"mean {m.mean():+.4f}, {int((m < -0.002).sum())} below −0.002")
 
 
 if __name__ == "__main__":

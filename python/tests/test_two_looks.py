@@ -3,13 +3,17 @@
 
 1. compare() on a hand-made field of eight pixels and two classes, every measure worked out by
    hand: the two maps' IoU, the pooled map (weights 1 / GSD), the union, the trim, the additions and
-   removals with how often each is right, the bonuses and the break-even.
+   removals with how often each is right, the bonuses and the break-even; the changes gated by a check
+   that is always right (`agreed`), and both fusions against a curve.
 2. A lawnmower fused with itself changes nothing: pooled, union, trim, top and fine are one map, the
    bonuses 0, nothing added or removed.
 3. The bundled leave-one-tile-out network of tile 1 on tile 1: its 15 cm/px lawnmower painted as
    log-probabilities gives each class the IoU its training recorded in model.yaml (within 0.002,
    as class_map's painter); main() with --bands 2 prints a row per class and the summary.
-4. Bad bands, an unknown class and an odd list of NETWORK FIELD are refused.
+   With --loto, --check (its own set as the check) and --curve (the two lawnmowers themselves): the
+   `agreed` columns, each margin over the curve equal to the bonus, and the two passes' table.
+4. Bad bands, an unknown class, an odd list of NETWORK FIELD, --check without --loto and a bad --curve
+   are refused.
 
 Part 3 needs torch, as eval_ensemble does: CTest's tools:two_looks is skipped (exit 77) without it.
 """
@@ -61,6 +65,14 @@ def hand_made():
     pad = np.log(np.full((2, 1, 2), 0.5, np.float32))
     r2 = two_looks.compare(np.concatenate([top, pad], 2), np.concatenate([fine, pad], 2), 15.0, 5.0, wide, 1)
     check(all(math.isclose(r[k], r2[k]) for k in ("top", "pooled", "union", "trim", "added", "removed")), f"{r2}")
+    # A check network that is always right gates the pooled map's changes: pixel 1 (pooled 0, check 1) keeps
+    # the top level's L, 3 (pooled L, check L) takes L, 4 (pooled L, check 0) keeps the top's L, 5 (pooled L,
+    # check 0) keeps the top's 0: L at 0..4, TP 4, FP 1: IoU 4/5. Against a curve whose best lawnmower has 0.6:
+    # pooled 0.5 - 0.6, agreed 0.8 - 0.6.
+    r3 = two_looks.compare(top, fine, 15.0, 5.0, truth, 1, check_labels=truth.copy(), curve_best=0.6)
+    check(math.isclose(r3["agreed"], 0.8) and math.isclose(r3["agreed_bonus"], 0.3), f"agreed {r3}")
+    check(math.isclose(r3["pooled_over_curve"], -0.1) and math.isclose(r3["agreed_over_curve"], 0.2), f"over {r3}")
+    check("agreed" not in r and "pooled_over_curve" not in r, "no check, no curve: neither measure")
     print("ok: the hand-made field's measures")
 
 
@@ -95,9 +107,23 @@ def main():
         check(f"| {name} | 10 | 1 |" in text, f"no summary for {name}:\n{text}")
     print("ok: main prints a row and a summary per class")
 
+    # Tile 1 by its own network as the check, the curve the top and finer lawnmowers themselves: the margin over
+    # the curve is the bonus, and the two passes' choice needs other fields (one field: none listed).
+    loto = str(REPO / "examples" / "models" / "mobilenetv2-dubai-loto")
+    rc, text = printed(two_looks.main, ["--loto", loto, "--tiles", "1", "--bands", "2", "--check", loto, "--curve", "2,3"])
+    check(rc is None and "| agreed | bonus pooled |" in text and "over curve agreed" in text, f"columns:\n{text}")
+    for line in text.splitlines():
+        if line.startswith("| building | tile 1 |"):
+            cols = [c.strip() for c in line.split("|")]
+            check(abs(float(cols[10]) - float(cols[14])) < 0.0006, f"pooled bonus {cols[10]} against over curve {cols[14]}")
+    check("Two passes, the finer GSD chosen on the other fields" in text, f"no two-pass table:\n{text}")
+    print("ok: --check and --curve on tile 1")
+
     check_refused(two_looks.main, [str(net), str(fdir), "--bands", "3"], "below --top", "a band as coarse as the top")
     check_refused(two_looks.main, [str(net), str(fdir), "--classes", "forest"], "no class forest", "an unknown class")
     check_refused(two_looks.main, [str(net)], "NETWORK FIELD", "a network without its field")
+    check_refused(two_looks.main, [str(net), str(fdir), "--check", loto], "--check needs --loto", "--check on pairs")
+    check_refused(two_looks.main, [str(net), str(fdir), "--curve", "2,x"], "comma-separated", "a bad --curve")
     print("two_looks: all checks passed")
 
 
