@@ -19,8 +19,11 @@ Prints, per field and summed over the fields (runs above +0.001, median, mean, b
   2. the same with the cells in random order: how much of 1 the stop earns, not the order;
   3. fixed plans, each field's chosen on the other fields of its calibration: the (top GSD, finer GSD, share of
      the cells) of largest mean margin there, or a top level alone, the cells ranked by each --rank column
-     (`field_gain`: perfectly; `random`; or a top-level input such as `top_ambiguity`); on a field where a finer
-     top level is no slower to fly (its geometry alone), that one is flown instead;
+     (`field_gain`: perfectly; `random`; a top-level input such as `top_ambiguity`; or `learnt`: a ridge
+     regression of the gain on every top-level input, `top_*` and `field_sigma`, fitted on the other fields'
+     cells; a column NaN throughout left out); on a field where a finer top level is no slower to fly (its geometry alone), that one is flown
+     instead; and per class each ranking's rank correlation with the realised gains within a field (the mean
+     over the fields and their plans);
   4. with --noise R,...: the same, ranked by the realised gain plus Gaussian noise scaled for a correlation R with
      it within each field (the rank correlation it realised is printed beside).
 
@@ -199,8 +202,53 @@ def with_noise(fields: list[Field], r: float, rng) -> list[float]:
             for c, v in zip(cells, noisy):
                 c["noisy"] = float(v)
             if len(g) > 2:
-                realised.append(float(np.corrcoef(np.argsort(np.argsort(noisy)), np.argsort(np.argsort(g)))[0, 1]))
+                realised.append(float(np.corrcoef(ranks(noisy), ranks(g))[0, 1]))
     return realised
+
+
+def ranks(x: np.ndarray) -> np.ndarray:
+    return np.argsort(np.argsort(x, kind="stable"), kind="stable").astype(float)
+
+
+def rank_correlation(fields: list[Field], key: str) -> float:
+    """The mean over the fields' plans of the rank correlation of `key` with the cells' realised gains."""
+    out = []
+    for f in fields:
+        for cells in f.cells.values():
+            x, g = np.array([c[key] for c in cells]), np.array([c["field_gain"] for c in cells])
+            ok = np.isfinite(x)
+            if ok.sum() > 2 and np.ptp(x[ok]) > 0 and np.ptp(g[ok]) > 0:
+                out.append(float(np.corrcoef(ranks(x[ok]), ranks(g[ok]))[0, 1]))
+    return float(np.mean(out)) if out else math.nan
+
+
+def learn(fields: list[Field], ridge: float = 1.0) -> None:
+    """Puts into each cell `learnt`: its gain as a ridge regression on the top-level inputs (`top_*` columns and
+    `field_sigma`, standardised, NaN as the mean) predicts it, fitted on the other fields' cells."""
+    every = [c for f in fields for cs in f.cells.values() for c in cs]
+    names = sorted(k for k in every[0] if (k.startswith("top_") and k != "top_gsd_cm") or k == "field_sigma")
+    names = [n for n in names if any(math.isfinite(c[n]) for c in every)]  # not a column that is NaN throughout
+
+    def matrix(cells):
+        return np.array([[c[n] for n in names] + [c["top_gsd_cm"], c["sub_gsd_cm"]] for c in cells], float)
+
+    for f in fields:
+        train = [c for g in fields if g is not f for cs in g.cells.values() for c in cs]
+        X, y = matrix(train), np.array([c["field_gain"] for c in train])
+        mean = np.nanmean(X, axis=0)
+        sd = np.nanstd(X, axis=0)
+        sd[~(sd > 0)] = 1.0
+        mean[~np.isfinite(mean)] = 0.0
+
+        def z(a):
+            a = (a - mean) / sd
+            return np.where(np.isfinite(a), a, 0.0)
+
+        Z = z(X)
+        beta = np.linalg.solve(Z.T @ Z + ridge * np.eye(Z.shape[1]), Z.T @ (y - y.mean()))
+        for cs in f.cells.values():
+            for c, v in zip(cs, z(matrix(cs)) @ beta):
+                c["learnt"] = float(v)
 
 
 def summary(margins: list[float]) -> str:
@@ -237,10 +285,13 @@ def main(argv=None):
     keys = args.rank.split(",")
     for interest, fields in sets:
         columns = set(next(iter(fields[0].cells.values()))[0])
-        unknown = [k for k in keys if k != "random" and k not in columns]
+        unknown = [k for k in keys if k not in ("random", "learnt") and k not in columns]
         if unknown:
             raise SystemExit(f"--rank: no column {', '.join(unknown)} in the cells of {interest}")
     rng = np.random.default_rng(args.seed)
+    if "learnt" in keys:
+        for _, fields in sets:
+            learn(fields)
 
     print("| class | field | clairvoyant | random order, best stop | "
           + " | ".join(f"fixed plan, {k}" for k in keys) + " |")
@@ -275,7 +326,14 @@ def main(argv=None):
         print(f"- fixed plan, the realised gain with noise (correlation {r:g}, rank correlation within a field "
               f"{np.mean(realised):.2f}): above +0.001 in {np.mean(counts):.1f} of {len(margins)} "
               f"(draws {', '.join(map(str, counts))}), median {np.mean(medians):+.4f}")
-
+    shown = [k for k in keys if k not in ("random", "field_gain")]
+    if shown:
+        print()
+        print("Rank correlation with the cells' realised gains within a field (mean over the fields and their plans):")
+        print("| class | " + " | ".join(shown) + " |")
+        print("| --- |" + " ---: |" * len(shown))
+        for interest, fields in sets:
+            print(f"| {interest} | " + " | ".join(f"{rank_correlation(fields, k):+.2f}" for k in shown) + " |")
 
 if __name__ == "__main__":
     main()

@@ -8,7 +8,8 @@
 3. The top level a field's geometry flies: a finer one that is no slower replaces a coarser one.
 4. Fixed plans on three hand-made fields: where every cell loses, each field keeps its top level alone
    (margin 0); where every cell gains, each descends into all its cells. A noisy ranking of correlation 1 is
-   the perfect one.
+   the perfect one; a rank correlation worked out by hand; gains a line in an input ranked perfectly by the
+   ridge fitted on the other fields (`learnt`).
 5. main() on a hand-made model, cells and times: a row per field, the summary lines; its refusals (odd pairs,
    an unknown --rank column, --noise out of (0, 1], cells of a field the model does not name).
 6. Given the built adaptseg_mission (CTest passes it): tile 2's lawnmowers at 12.5 and 15 cm/px flown from
@@ -89,6 +90,15 @@ def fixed():
     check(all(math.isclose(r, 1.0) for r in realised), f"correlation 1 realised {realised}")
     check(cc.fixed_plans(mixed, "noisy", 20.0, rng) == cc.fixed_plans(mixed, "field_gain", 20.0, rng),
           "a noisy ranking of correlation 1 is the perfect one")
+    # field(): top_ambiguity 0, 1, 2 against gains 0.02, 0.05, -0.01 (ranks 1, 2, 0): correlation -0.5.
+    check(math.isclose(cc.rank_correlation([field()], "top_ambiguity"), -0.5), "rank correlation")
+    # Gains a line in top_ambiguity on every field: the ridge fitted on the other fields ranks them perfectly.
+    lines = [field(n, gains=tuple(0.01 * a + 0.003 * i for a in (2.0, 0.0, 1.0))) for i, n in enumerate("ABC")]
+    for f in lines:
+        for c, a in zip(f.cells[(15.0, 5.0)], (2.0, 0.0, 1.0)):
+            c["top_ambiguity"], c["field_sigma"], c["top_gsd_cm"], c["sub_gsd_cm"] = a, 0.2, 15.0, 5.0
+    cc.learn(lines)
+    check(math.isclose(cc.rank_correlation(lines, "learnt"), 1.0), "the learnt ranking of a line")
     print("ok: fixed plans chosen on the other fields")
 
 
@@ -105,13 +115,15 @@ def run_main():
         (tmp / "times.csv").write_text("field,gsd_cm,time_s,images\n" + "".join(
             f"{n},5,300,30\n{n},15,100,4\n" for n in "ABC"))
         args = [str(tmp / "model.yaml"), str(tmp / "cells.csv"), "--times", str(tmp / "times.csv")]
-        rc, text = printed(cc.main, args + ["--rank", "field_gain,top_ambiguity", "--noise", "1", "--reps", "1"])
+        rc, text = printed(cc.main, args + ["--rank", "field_gain,top_ambiguity,learnt", "--noise", "1", "--reps", "1"])
         check(rc is None, f"main returned {rc}")
-        # A as in margins(); B's best first cell only meets the curve (0.33 at 130 s); C's first +0.01.
+        # A as in margins(); B's best first cell only meets the curve (0.33 at 130 s); C's first +0.01. The rank
+        # correlations of top_ambiguity (0, 1, 2) with the gains: A -0.5, B -0.5, C -1 (mean -0.67).
         for row in ("| road | A | +0.0300 |", "| road | B | +0.0000 |", "| road | C | +0.0100 |"):
             check(row in text, f"'{row}' missing:\n{text}")
         for head in ("- clairvoyant: 2 of 3", "- random order, best stop:", "- fixed plan, field_gain:",
-                     "- fixed plan, top_ambiguity:", "(correlation 1, rank correlation within a field 1.00)"):
+                     "- fixed plan, top_ambiguity:", "(correlation 1, rank correlation within a field 1.00)",
+                     "- fixed plan, learnt:", "| class | top_ambiguity | learnt |", "| road | -0.67 |"):
             check(head in text, f"'{head}' missing:\n{text}")
         print("ok: main() on a hand-made calibration")
         check_refused(cc.main, args[:1], "MODEL CELLS pairs", "a model without its cells")
