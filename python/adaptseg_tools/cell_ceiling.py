@@ -8,24 +8,27 @@ calibration declared, or given by --times CSV: field,gsd_cm,time_s,images).
 
 A plan is a top-level GSD, a finer GSD and the first n of the field's cells in some order, flown after the whole
 top level. Its time: the top-level lawnmower's, plus per cell the finer lawnmower's seconds per image, plus
---overhead-s per top-level region it enters (the climbs down and back: about 20 to 40 s at 5 cm/px in flown runs,
-decisions.csv's extra_time_s against its images). Its mIoU: the top level's plus the cells' field gains, taken as
-additive. Its margin: that mIoU less the field's lawnmower curve's upper envelope at its time (a running maximum,
-linear between the lawnmowers, flat beyond the ends, as front_margin reads it). An approximation of the planner:
-no cell is flown in flight order, and neighbouring cells' gains interact.
+--overhead-s per top-level region it enters (the climbs down and back), or per finer GSD the median that flown
+descents took beyond their images at the lawnmower's rate (--overhead-from RUN ...: adaptseg_evaluate run
+folders). Its mIoU: the top level's plus the cells' field gains, taken as additive. Its margin: that mIoU less the
+field's lawnmower curve's upper envelope at its time (a running maximum, linear between the lawnmowers, flat
+beyond the ends, as front_margin reads it). An approximation of the planner: no cell is flown in flight order, and
+neighbouring cells' gains interact.
 
 Prints, per field and summed over the fields (runs above +0.001, median, mean, below -0.002):
+  0. with --overhead-from, the overheads measured per finer GSD;
   1. clairvoyant: the plan of largest margin with the cells in order of realised gain (none: 0);
   2. the same with the cells in random order: how much of 1 the stop earns, not the order;
   3. fixed plans, each field's chosen on the other fields of its calibration: the (top GSD, finer GSD, share of
      the cells) of largest mean margin there, or a top level alone, the cells ranked by each --rank column
      (`field_gain`: perfectly; `random`; a top-level input such as `top_ambiguity`; or `learnt`: a ridge
      regression of the gain on every top-level input, `top_*` and `field_sigma`, fitted on the other fields'
-     cells; a column NaN throughout left out); on a field where a finer top level is no slower to fly (its geometry alone), that one is flown
-     instead; and per class each ranking's rank correlation with the realised gains within a field (the mean
+     cells; a column NaN throughout left out); on a field where a finer top level is no slower to fly (its
+     geometry alone), that one is flown instead; and per class each ranking's rank correlation with the realised gains within a field (the mean
      over the fields and their plans);
   4. with --noise R,...: the same, ranked by the realised gain plus Gaussian noise scaled for a correlation R with
-     it within each field (the rank correlation it realised is printed beside).
+     it within each field (the rank correlation it realised is printed beside);
+  5. first, with --sums: per field and plan the sum of its cells' gains (to set beside a whole-field measure).
 
 Usage:
   PYTHONPATH=python /usr/bin/python3 -m adaptseg_tools.cell_ceiling MODEL CELLS [MODEL CELLS ...] \\
@@ -81,9 +84,11 @@ class Field:
         """The top level alone against the curve (below 0 where a faster lawnmower maps better)."""
         return self.miou[top] - envelope_at(self.curve, self.times[top][0])
 
-    def margins(self, top: float, sub: float, order: list[dict], overhead_s: float) -> np.ndarray:
-        """The margin after each of the first n cells of `order`, n = 1, 2, ..."""
+    def margins(self, top: float, sub: float, order: list[dict], overhead: dict[float, float]) -> np.ndarray:
+        """The margin after each of the first n cells of `order`, n = 1, 2, ... (`overhead`: seconds per region
+        entered, per finer GSD)."""
         per_image = self.times[sub][0] / self.times[sub][1]
+        overhead_s = overhead[sub]
         regions, gain, out = set(), 0.0, []
         for n, cell in enumerate(order, 1):
             regions.add(cell["region"])
@@ -155,17 +160,17 @@ def ordered(cells: list[dict], key: str, rng) -> list[dict]:
     return sorted(cells, key=lambda c: -c[key] if not math.isnan(c[key]) else math.inf)
 
 
-def best_plan(field: Field, key: str, overhead_s: float, rng) -> float:
+def best_plan(field: Field, key: str, overhead: dict[float, float], rng) -> float:
     """The largest margin over every plan with the cells in `key`'s order (0: the top level alone, where that is
     not below the curve)."""
     best = max(0.0, max(field.top_margin(top) for top, _ in field.plans()))
     for top, sub in field.plans():
-        m = field.margins(top, sub, ordered(field.cells[(top, sub)], key, rng), overhead_s)
+        m = field.margins(top, sub, ordered(field.cells[(top, sub)], key, rng), overhead)
         best = max(best, float(m.max()))
     return best
 
 
-def fixed_plans(fields: list[Field], key: str, overhead_s: float, rng) -> list[tuple[str, str, float]]:
+def fixed_plans(fields: list[Field], key: str, overhead: dict[float, float], rng) -> list[tuple[str, str, float]]:
     """Per field: the plan of largest mean margin on the other fields, and its margin on this one."""
     margin: dict[tuple, dict[str, float]] = {}
     for f in fields:
@@ -173,7 +178,7 @@ def fixed_plans(fields: list[Field], key: str, overhead_s: float, rng) -> list[t
             flown = f.top_for(top)
             if (flown, sub) not in f.cells:
                 continue
-            m = f.margins(flown, sub, ordered(f.cells[(flown, sub)], key, rng), overhead_s)
+            m = f.margins(flown, sub, ordered(f.cells[(flown, sub)], key, rng), overhead)
             for share in SHARES:
                 margin.setdefault((top, sub, share), {})[f.name] = float(m[max(1, round(share * len(m))) - 1])
         for top in {t for t, _ in f.plans()}:
@@ -204,6 +209,26 @@ def with_noise(fields: list[Field], r: float, rng) -> list[float]:
             if len(g) > 2:
                 realised.append(float(np.corrcoef(ranks(noisy), ranks(g))[0, 1]))
     return realised
+
+
+def measured_overheads(run_dirs: list[Path]) -> dict[float, list[float]]:
+    """Per descent GSD, what each flown descent of the adaptive strategy took beyond its images at the lawnmower's
+    rate: decisions.csv's extra_time_s less images times the seconds per image of the same run's lawnmower at that
+    GSD (results.csv)."""
+    out: dict[float, list[float]] = {}
+    for d in run_dirs:
+        with open(Path(d) / "results.csv", newline="") as f:
+            rate = {float(r["gsd_cm"]): float(r["time_total"]) / int(r["images"]) for r in csv.DictReader(f)
+                    if r["strategy"] == "lawnmower" and int(r["images"]) > 0}
+        with open(Path(d) / "decisions.csv", newline="") as f:
+            for r in csv.DictReader(f):
+                if r["strategy"] != "adaptive" or r["action"] != "descend":
+                    continue
+                g = float(r["gsd_cm"])
+                if g not in rate:
+                    raise SystemExit(f"{d}: a descent to {g:g} cm/px and no lawnmower at it in results.csv")
+                out.setdefault(g, []).append(float(r["extra_time_s"]) - int(r["images"]) * rate[g])
+    return out
 
 
 def ranks(x: np.ndarray) -> np.ndarray:
@@ -265,10 +290,15 @@ def main(argv=None):
     parser.add_argument("--noise", default="", help="correlations R of noisy perfect rankings, comma-separated")
     parser.add_argument("--reps", type=int, default=3, help="draws per noisy ranking (default 3)")
     parser.add_argument("--overhead-s", type=float, default=20.0, help="seconds per region descended into")
+    parser.add_argument("--overhead-from", nargs="+", metavar="RUN",
+                        help="adaptseg_evaluate run folders: per finer GSD the median overhead of their flown descents "
+                             "(--overhead-s where they have none)")
     parser.add_argument("--times", help="CSV field,gsd_cm,time_s,images instead of flying adaptseg_mission")
     parser.add_argument("--mission", default=str(REPO / "build" / "release" / "examples" / "adaptseg_mission"))
     parser.add_argument("--fields-root", default=str(REPO / "examples" / "data"))
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--sums", action="store_true",
+                        help="also print per field and plan the sum of its cells' gains (all descended)")
     args = parser.parse_args(argv)
     if len(args.pairs) % 2:
         raise SystemExit("give MODEL CELLS pairs")
@@ -288,21 +318,39 @@ def main(argv=None):
         unknown = [k for k in keys if k not in ("random", "learnt") and k not in columns]
         if unknown:
             raise SystemExit(f"--rank: no column {', '.join(unknown)} in the cells of {interest}")
+    gsds = {sub for _, fields in sets for f in fields for _, sub in f.plans()}
+    overhead = {g: args.overhead_s for g in gsds}
+    if args.overhead_from:
+        for g, v in sorted(measured_overheads([Path(d) for d in args.overhead_from]).items()):
+            overhead[g] = float(np.median(v))
+            print(f"overhead at {g:g} cm/px: median {overhead[g]:+.1f} s over {len(v)} flown descents "
+                  f"(from {min(v):+.1f} to {max(v):+.1f})")
+        print()
     rng = np.random.default_rng(args.seed)
     if "learnt" in keys:
         for _, fields in sets:
             learn(fields)
 
+    if args.sums:
+        print("| class | field | top → finer GSD [cm/px] | cells | sum of their gains |")
+        print("| --- | --- | --- | ---: | ---: |")
+        for interest, fields in sets:
+            for f in fields:
+                for top, sub in f.plans():
+                    cells = f.cells[(top, sub)]
+                    print(f"| {interest} | {f.name} | {top:g} → {sub:g} | {len(cells)} | "
+                          f"{sum(c['field_gain'] for c in cells):+.4f} |")
+        print()
     print("| class | field | clairvoyant | random order, best stop | "
           + " | ".join(f"fixed plan, {k}" for k in keys) + " |")
     print("| --- | --- | ---: | ---: |" + " --- |" * len(keys))
     totals: dict[str, list[float]] = {}
     for interest, fields in sets:
-        rows = {f.name: [best_plan(f, "field_gain", args.overhead_s, rng), best_plan(f, "random", args.overhead_s, rng)]
+        rows = {f.name: [best_plan(f, "field_gain", overhead, rng), best_plan(f, "random", overhead, rng)]
                 for f in fields}
         labels = {f.name: [] for f in fields}
         for k in keys:
-            for name, label, m in fixed_plans(fields, k, args.overhead_s, rng):
+            for name, label, m in fixed_plans(fields, k, overhead, rng):
                 rows[name].append(m)
                 labels[name].append(label)
         for f in fields:
@@ -320,7 +368,7 @@ def main(argv=None):
             margins = []
             for _, fields in sets:
                 realised += with_noise(fields, r, rng)
-                margins += [m for _, _, m in fixed_plans(fields, "noisy", args.overhead_s, rng)]
+                margins += [m for _, _, m in fixed_plans(fields, "noisy", overhead, rng)]
             counts.append(int((np.array(margins) > 0.001).sum()))
             medians.append(float(np.median(margins)))
         print(f"- fixed plan, the realised gain with noise (correlation {r:g}, rank correlation within a field "

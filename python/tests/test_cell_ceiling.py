@@ -10,7 +10,8 @@
    (margin 0); where every cell gains, each descends into all its cells. A noisy ranking of correlation 1 is
    the perfect one; a rank correlation worked out by hand; gains a line in an input ranked perfectly by the
    ridge fitted on the other fields (`learnt`).
-5. main() on a hand-made model, cells and times: a row per field, the summary lines; its refusals (odd pairs,
+5. main() on a hand-made model, cells and times: a row per field, the summary lines, --sums, the overheads
+   measured on a hand-made run's flown descents (--overhead-from); its refusals (odd pairs,
    an unknown --rank column, --noise out of (0, 1], cells of a field the model does not name).
 6. Given the built adaptseg_mission (CTest passes it): tile 2's lawnmowers at 12.5 and 15 cm/px flown from
    the bundled field's geometry: four images each, 85.9 s and 102.4 s (the coarser one slower, so the fixed
@@ -29,6 +30,9 @@ import yaml
 from tool_output import check, check_refused, printed
 
 from adaptseg_tools import REPO, cell_ceiling as cc
+
+
+OVERHEAD = {5.0: 20.0}  # seconds per region entered, per finer GSD
 
 
 def cell(region, gain, **extra):
@@ -51,18 +55,18 @@ def envelope():
 
 def margins():
     f = field()
-    m = f.margins(15.0, 5.0, cc.ordered(f.cells[(15.0, 5.0)], "field_gain", None), 20.0)
+    m = f.margins(15.0, 5.0, cc.ordered(f.cells[(15.0, 5.0)], "field_gain", None), OVERHEAD)
     # Best first: 0.05 (region 0), 0.02 (region 0), -0.01 (region 1); 10 s an image at 5 cm/px.
     # 1: t = 100 + 20 + 10 = 130, envelope 0.3 + 0.2 * 30 / 200 = 0.33, mIoU 0.35: +0.02.
     # 2: t = 140 (no new region), envelope 0.34, mIoU 0.37: +0.03.
     # 3: t = 100 + 40 + 30 = 170 (region 1 entered), envelope 0.37, mIoU 0.36: -0.01.
     check(np.allclose(m, [0.02, 0.03, -0.01]), f"margins {m}")
-    check(math.isclose(cc.best_plan(f, "field_gain", 20.0, None), 0.03), "the clairvoyant plan")
+    check(math.isclose(cc.best_plan(f, "field_gain", OVERHEAD, None), 0.03), "the clairvoyant plan")
     # In the order of top_ambiguity (2, 1, 0): -0.01 first in region 1, then 0.05 and 0.02 in region 0.
-    m = f.margins(15.0, 5.0, cc.ordered(f.cells[(15.0, 5.0)], "top_ambiguity", None), 20.0)
+    m = f.margins(15.0, 5.0, cc.ordered(f.cells[(15.0, 5.0)], "top_ambiguity", None), OVERHEAD)
     check(np.allclose(m, [0.3 - 0.01 - 0.33, 0.3 + 0.04 - (0.3 + 0.2 * 60 / 200), -0.01]), f"ranked margins {m}")
     lose = field(gains=(-0.01, -0.02, -0.03))
-    check(cc.best_plan(lose, "field_gain", 20.0, None) == 0.0, "a field where every cell loses: 0")
+    check(cc.best_plan(lose, "field_gain", OVERHEAD, None) == 0.0, "a field where every cell loses: 0")
     print("ok: a hand-made field's margins and its clairvoyant plan")
 
 
@@ -79,16 +83,16 @@ def top_level():
 def fixed():
     rng = np.random.default_rng(0)
     losing = [field(n, gains=(-0.01, -0.02, -0.03)) for n in "ABC"]
-    for name, label, m in cc.fixed_plans(losing, "field_gain", 20.0, rng):
+    for name, label, m in cc.fixed_plans(losing, "field_gain", OVERHEAD, rng):
         check(label == "top 15 alone" and m == 0.0, f"{name}: {label}, {m}")
     gaining = [field(n, gains=(0.2, 0.2, 0.2)) for n in "ABC"]
-    for name, label, m in cc.fixed_plans(gaining, "field_gain", 20.0, rng):
+    for name, label, m in cc.fixed_plans(gaining, "field_gain", OVERHEAD, rng):
         # all three cells: t = 100 + 2 * 20 + 30 = 170, envelope 0.37, mIoU 0.3 + 0.6.
         check(label == "15 → 5, 100% of cells" and math.isclose(m, 0.9 - 0.37), f"{name}: {label}, {m}")
     mixed = [field(n, gains=g) for n, g in zip("ABC", [(0.05, -0.04, 0.01), (0.03, -0.02, 0.0), (0.04, 0.01, -0.05)])]
     realised = cc.with_noise(mixed, 1.0, rng)
     check(all(math.isclose(r, 1.0) for r in realised), f"correlation 1 realised {realised}")
-    check(cc.fixed_plans(mixed, "noisy", 20.0, rng) == cc.fixed_plans(mixed, "field_gain", 20.0, rng),
+    check(cc.fixed_plans(mixed, "noisy", OVERHEAD, rng) == cc.fixed_plans(mixed, "field_gain", OVERHEAD, rng),
           "a noisy ranking of correlation 1 is the perfect one")
     # field(): top_ambiguity 0, 1, 2 against gains 0.02, 0.05, -0.01 (ranks 1, 2, 0): correlation -0.5.
     check(math.isclose(cc.rank_correlation([field()], "top_ambiguity"), -0.5), "rank correlation")
@@ -126,6 +130,19 @@ def run_main():
                      "- fixed plan, learnt:", "| class | top_ambiguity | learnt |", "| road | -0.67 |"):
             check(head in text, f"'{head}' missing:\n{text}")
         print("ok: main() on a hand-made calibration")
+        rc, text = printed(cc.main, args + ["--sums", "--rank", "random"])
+        check("| road | B | 15 → 5 | 3 | +0.0100 |" in text, f"--sums: B's cells sum to 0.03 - 0.02 + 0:\n{text}")
+        # Flown descents: 50 s for 3 images and 40 s for 1 at 10 s an image: 20 and 30 s beyond (median 25).
+        run = tmp / "run"
+        run.mkdir()
+        (run / "results.csv").write_text("field,strategy,gsd_cm,time_total,images\nA,lawnmower,5,300,30\n"
+                                         "A,lawnmower,15,100,4\nA,adaptive,15,150,7\n")
+        (run / "decisions.csv").write_text("strategy,action,gsd_cm,images,extra_time_s\nadaptive,descend,5,3,50\n"
+                                           "adaptive,descend,5,1,40\nadaptive,continue,5,9,99\nnonadaptive,descend,5,1,90\n")
+        check(cc.measured_overheads([run]) == {5.0: [20.0, 30.0]}, f"overheads {cc.measured_overheads([run])}")
+        rc, text = printed(cc.main, args + ["--overhead-from", str(run), "--rank", "random"])
+        check("overhead at 5 cm/px: median +25.0 s over 2 flown descents" in text, f"--overhead-from:\n{text}")
+        print("ok: overheads measured on flown descents")
         check_refused(cc.main, args[:1], "MODEL CELLS pairs", "a model without its cells")
         check_refused(cc.main, args + ["--rank", "top_nothing"], "no column top_nothing", "an unknown column")
         check_refused(cc.main, args + ["--noise", "0"], "each in (0, 1]", "a correlation of 0")
