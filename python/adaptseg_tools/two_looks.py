@@ -143,7 +143,7 @@ def factors(text: str, option: str) -> list[float]:
 
 def labels_at(model, spec, meta, field, gsd_cm: float) -> np.ndarray:
     """The lawnmower's labels at `gsd_cm` in the field's frame."""
-    return painted_log_probabilities(model, spec, meta, field, gsd_cm).argmax(0)
+    return painted_log_probabilities(model, spec, meta, field, gsd_cm).argmax(0).astype(np.uint8)
 
 
 def chosen_on_others(rows, wanted) -> list[tuple[str, str, str, float]]:
