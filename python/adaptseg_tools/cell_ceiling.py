@@ -9,8 +9,8 @@ calibration declared, or given by --times CSV: field,gsd_cm,time_s,images).
 A plan is a top-level GSD, a finer GSD and the first n of the field's cells in some order, flown after the whole
 top level. Its time: the top-level lawnmower's, plus per cell the finer lawnmower's seconds per image, plus
 --overhead-s per top-level region it enters (the climbs down and back), or per finer GSD the median that flown
-descents took beyond their images at the lawnmower's rate (--overhead-from RUN ...: adaptseg_evaluate run
-folders). Its mIoU: the top level's plus the cells' field gains, taken as additive. Its margin: that mIoU less the
+descents took beyond their images at the lawnmower's rate, or where none was flown the candidates the rule weighed
+(--overhead-from RUN ...: adaptseg_evaluate run folders). Its mIoU: the top level's plus the cells' field gains, taken as additive. Its margin: that mIoU less the
 field's lawnmower curve's upper envelope at its time (a running maximum, linear between the lawnmowers, flat
 beyond the ends, as front_margin reads it). An approximation of the planner: no cell is flown in flight order, and
 neighbouring cells' gains interact.
@@ -211,23 +211,26 @@ def with_noise(fields: list[Field], r: float, rng) -> list[float]:
     return realised
 
 
-def measured_overheads(run_dirs: list[Path]) -> dict[float, list[float]]:
-    """Per descent GSD, what each flown descent of the adaptive strategy took beyond its images at the lawnmower's
-    rate: decisions.csv's extra_time_s less images times the seconds per image of the same run's lawnmower at that
-    GSD (results.csv)."""
-    out: dict[float, list[float]] = {}
+def measured_overheads(run_dirs: list[Path]) -> dict[float, dict[str, list[float]]]:
+    """Per descent GSD, what each descent of the adaptive strategy took beyond its images at the lawnmower's rate:
+    decisions.csv's extra_time_s less images times the seconds per image of the same run's lawnmower at that GSD
+    (results.csv); `flown` for the descents flown, `candidates` for those the rule weighed and did not take (their
+    extra time as the planner computed it)."""
+    out: dict[float, dict[str, list[float]]] = {}
     for d in run_dirs:
         with open(Path(d) / "results.csv", newline="") as f:
             rate = {float(r["gsd_cm"]): float(r["time_total"]) / int(r["images"]) for r in csv.DictReader(f)
                     if r["strategy"] == "lawnmower" and int(r["images"]) > 0}
         with open(Path(d) / "decisions.csv", newline="") as f:
             for r in csv.DictReader(f):
-                if r["strategy"] != "adaptive" or r["action"] != "descend":
+                if r["strategy"] != "adaptive" or r["action"] not in ("descend", "continue") or not r["images"]:
                     continue
                 g = float(r["gsd_cm"])
                 if g not in rate:
                     raise SystemExit(f"{d}: a descent to {g:g} cm/px and no lawnmower at it in results.csv")
-                out.setdefault(g, []).append(float(r["extra_time_s"]) - int(r["images"]) * rate[g])
+                kind = "flown" if r["action"] == "descend" else "candidates"
+                out.setdefault(g, {"flown": [], "candidates": []})[kind].append(
+                    float(r["extra_time_s"]) - int(r["images"]) * rate[g])
     return out
 
 
@@ -291,8 +294,8 @@ def main(argv=None):
     parser.add_argument("--reps", type=int, default=3, help="draws per noisy ranking (default 3)")
     parser.add_argument("--overhead-s", type=float, default=20.0, help="seconds per region descended into")
     parser.add_argument("--overhead-from", nargs="+", metavar="RUN",
-                        help="adaptseg_evaluate run folders: per finer GSD the median overhead of their flown descents "
-                             "(--overhead-s where they have none)")
+                        help="adaptseg_evaluate run folders: per finer GSD the median overhead of their flown descents, "
+                             "or where none was flown of the candidates the rule weighed (--overhead-s where neither)")
     parser.add_argument("--times", help="CSV field,gsd_cm,time_s,images instead of flying adaptseg_mission")
     parser.add_argument("--mission", default=str(REPO / "build" / "release" / "examples" / "adaptseg_mission"))
     parser.add_argument("--fields-root", default=str(REPO / "examples" / "data"))
@@ -321,9 +324,12 @@ def main(argv=None):
     gsds = {sub for _, fields in sets for f in fields for _, sub in f.plans()}
     overhead = {g: args.overhead_s for g in gsds}
     if args.overhead_from:
-        for g, v in sorted(measured_overheads([Path(d) for d in args.overhead_from]).items()):
+        for g, kinds in sorted(measured_overheads([Path(d) for d in args.overhead_from]).items()):
+            kind = "flown" if kinds["flown"] else "candidates"
+            v = kinds[kind]
             overhead[g] = float(np.median(v))
-            print(f"overhead at {g:g} cm/px: median {overhead[g]:+.1f} s over {len(v)} flown descents "
+            print(f"overhead at {g:g} cm/px: median {overhead[g]:+.1f} s over {len(v)} "
+                  f"{'flown descents' if kind == 'flown' else 'candidates not taken (none flown)'} "
                   f"(from {min(v):+.1f} to {max(v):+.1f})")
         print()
     rng = np.random.default_rng(args.seed)

@@ -11,8 +11,9 @@
    the perfect one; a rank correlation worked out by hand; gains a line in an input ranked perfectly by the
    ridge fitted on the other fields (`learnt`).
 5. main() on a hand-made model, cells and times: a row per field, the summary lines, --sums, the overheads
-   measured on a hand-made run's flown descents (--overhead-from); its refusals (odd pairs,
-   an unknown --rank column, --noise out of (0, 1], cells of a field the model does not name).
+   measured on a hand-made run's flown descents, or its candidates where none was flown (--overhead-from); its
+   refusals (odd pairs, an unknown --rank column, --noise out of (0, 1], cells of a field the model does not
+   name).
 6. Given the built adaptseg_mission (CTest passes it): tile 2's lawnmowers at 12.5 and 15 cm/px flown from
    the bundled field's geometry: four images each, 85.9 s and 102.4 s (the coarser one slower, so the fixed
    plans fly 12.5 there).
@@ -137,11 +138,18 @@ def run_main():
         run.mkdir()
         (run / "results.csv").write_text("field,strategy,gsd_cm,time_total,images\nA,lawnmower,5,300,30\n"
                                          "A,lawnmower,15,100,4\nA,adaptive,15,150,7\n")
+        # A candidate not taken at 5 (9 images in 99 s: 9 s beyond) does not count where descents were flown;
+        # at 15 none was flown: its candidate (1 image in 30 s at 25 s an image: 5 s beyond) gives the overhead.
         (run / "decisions.csv").write_text("strategy,action,gsd_cm,images,extra_time_s\nadaptive,descend,5,3,50\n"
-                                           "adaptive,descend,5,1,40\nadaptive,continue,5,9,99\nnonadaptive,descend,5,1,90\n")
-        check(cc.measured_overheads([run]) == {5.0: [20.0, 30.0]}, f"overheads {cc.measured_overheads([run])}")
+                                           "adaptive,descend,5,1,40\nadaptive,continue,5,9,99\nnonadaptive,descend,5,1,90\n"
+                                           "adaptive,continue,15,1,30\nadaptive,continue,,,\n")
+        got = cc.measured_overheads([run])
+        check(got == {5.0: {"flown": [20.0, 30.0], "candidates": [9.0]}, 15.0: {"flown": [], "candidates": [5.0]}},
+              f"overheads {got}")
         rc, text = printed(cc.main, args + ["--overhead-from", str(run), "--rank", "random"])
-        check("overhead at 5 cm/px: median +25.0 s over 2 flown descents" in text, f"--overhead-from:\n{text}")
+        check("overhead at 5 cm/px: median +25.0 s over 2 flown descents" in text
+              and "overhead at 15 cm/px: median +5.0 s over 1 candidates not taken (none flown)" in text,
+              f"--overhead-from:\n{text}")
         print("ok: overheads measured on flown descents")
         check_refused(cc.main, args[:1], "MODEL CELLS pairs", "a model without its cells")
         check_refused(cc.main, args + ["--rank", "top_nothing"], "no column top_nothing", "an unknown column")
