@@ -297,9 +297,11 @@ def main(argv=None):
                         help="adaptseg_evaluate run folders: per finer GSD the median overhead of their flown descents, "
                              "or where none was flown of the candidates the rule weighed (--overhead-s where neither)")
     parser.add_argument("--times", help="CSV field,gsd_cm,time_s,images instead of flying adaptseg_mission")
-    parser.add_argument("--mission", default=str(REPO / "build" / "release" / "examples" / "adaptseg_mission"))
-    parser.add_argument("--fields-root", default=str(REPO / "examples" / "data"))
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--mission", default=str(REPO / "build" / "release" / "examples" / "adaptseg_mission"),
+                        help="the adaptseg_mission program that flies the lawnmowers (default: the release build's)")
+    parser.add_argument("--fields-root", default=str(REPO / "examples" / "data"),
+                        help="the folder holding the fields the models name (default: examples/data)")
+    parser.add_argument("--seed", type=int, default=0, help="of the random orders and the noise (default 0)")
     parser.add_argument("--sums", action="store_true",
                         help="also print per field and plan the sum of its cells' gains (all descended)")
     args = parser.parse_args(argv)
@@ -388,6 +390,7 @@ def main(argv=None):
         print("| --- |" + " ---: |" * len(shown))
         for interest, fields in sets:
             print(f"| {interest} | " + " | ".join(f"{rank_correlation(fields, k):+.2f}" for k in shown) + " |")
+
 
 if __name__ == "__main__":
     main()
