@@ -10,10 +10,12 @@ A plan is a top-level GSD, a finer GSD and the first n of the field's cells in s
 top level. Its time: the top-level lawnmower's, plus per cell the finer lawnmower's seconds per image, plus
 --overhead-s per top-level region it enters (the climbs down and back), or per finer GSD the median that flown
 descents took beyond their images at the lawnmower's rate, or where none was flown the candidates the rule weighed
-(--overhead-from RUN ...: adaptseg_evaluate run folders). Its mIoU: the top level's plus the cells' field gains, taken as additive. Its margin: that mIoU less the
-field's lawnmower curve's upper envelope at its time (a running maximum, linear between the lawnmowers, flat
-beyond the ends, as front_margin reads it). An approximation of the planner: no cell is flown in flight order, and
-neighbouring cells' gains interact.
+(--overhead-from RUN ...: adaptseg_evaluate run folders). Its mIoU: the top level's plus the cells' field gains,
+taken as additive. Its margin: that mIoU less the field's lawnmower curve's upper envelope at its time
+(lawnmower_envelope, as the library's front_margin reads it: the running maximum, flat after a lawnmower a slower
+one does not beat and back on the curve where it climbs through that level, linear between its points, flat beyond
+its ends). An approximation of the planner: no cell is flown in flight order, and neighbouring cells' gains
+interact.
 
 Prints, per field and summed over the fields (runs above +0.001, median, mean, below -0.002):
   0. with --overhead-from, the overheads measured per finer GSD;
@@ -50,17 +52,10 @@ import numpy as np
 import yaml
 
 from . import REPO
+from .lawnmower_envelope import envelope_at, upper_envelope
+from .proxy_table import spearman
 
 SHARES = (0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0)  # the shares of a field's cells a fixed plan may descend into
-
-
-def envelope_at(curve: list[tuple[float, float]], t: float) -> float:
-    """The upper envelope of (time, mIoU) points at `t`: linear between its running maxima, flat beyond the ends."""
-    best, env = -math.inf, []
-    for time_s, miou in sorted(curve):
-        best = max(best, miou)
-        env.append((time_s, best))
-    return float(np.interp(t, [p[0] for p in env], [p[1] for p in env]))
 
 
 class Field:
@@ -68,7 +63,7 @@ class Field:
 
     def __init__(self, name: str, miou: dict[float, float], times: dict[float, tuple[float, int]]):
         self.name, self.miou, self.times = name, miou, times
-        self.curve = [(times[g][0], m) for g, m in miou.items()]
+        self.envelope = upper_envelope([(times[g][0], m) for g, m in miou.items()])  # as front_margin reads it
         self.cells: dict[tuple[float, float], list[dict]] = {}
 
     def plans(self) -> list[tuple[float, float]]:
@@ -82,7 +77,7 @@ class Field:
 
     def top_margin(self, top: float) -> float:
         """The top level alone against the curve (below 0 where a faster lawnmower maps better)."""
-        return self.miou[top] - envelope_at(self.curve, self.times[top][0])
+        return self.miou[top] - envelope_at(self.envelope, self.times[top][0])
 
     def margins(self, top: float, sub: float, order: list[dict], overhead: dict[float, float]) -> np.ndarray:
         """The margin after each of the first n cells of `order`, n = 1, 2, ... (`overhead`: seconds per region
@@ -94,7 +89,7 @@ class Field:
             regions.add(cell["region"])
             gain += cell["field_gain"]
             t = self.times[top][0] + len(regions) * overhead_s + n * per_image
-            out.append(self.miou[top] + gain - envelope_at(self.curve, t))
+            out.append(self.miou[top] + gain - envelope_at(self.envelope, t))
         return np.array(out)
 
 
@@ -206,8 +201,9 @@ def with_noise(fields: list[Field], r: float, rng) -> list[float]:
             noisy = rng.standard_normal(len(g)) if math.isinf(spread) else z + spread * rng.standard_normal(len(g))
             for c, v in zip(cells, noisy):
                 c["noisy"] = float(v)
-            if len(g) > 2:
-                realised.append(float(np.corrcoef(ranks(noisy), ranks(g))[0, 1]))
+            rho = spearman(list(noisy), list(g))
+            if not math.isnan(rho):
+                realised.append(rho)
     return realised
 
 
@@ -234,19 +230,15 @@ def measured_overheads(run_dirs: list[Path]) -> dict[float, dict[str, list[float
     return out
 
 
-def ranks(x: np.ndarray) -> np.ndarray:
-    return np.argsort(np.argsort(x, kind="stable"), kind="stable").astype(float)
-
-
 def rank_correlation(fields: list[Field], key: str) -> float:
     """The mean over the fields' plans of the rank correlation of `key` with the cells' realised gains."""
     out = []
     for f in fields:
         for cells in f.cells.values():
-            x, g = np.array([c[key] for c in cells]), np.array([c["field_gain"] for c in cells])
-            ok = np.isfinite(x)
-            if ok.sum() > 2 and np.ptp(x[ok]) > 0 and np.ptp(g[ok]) > 0:
-                out.append(float(np.corrcoef(ranks(x[ok]), ranks(g[ok]))[0, 1]))
+            pairs = [(c[key], c["field_gain"]) for c in cells if math.isfinite(c[key])]
+            rho = spearman([p[0] for p in pairs], [p[1] for p in pairs])
+            if not math.isnan(rho):
+                out.append(rho)
     return float(np.mean(out)) if out else math.nan
 
 

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Self-test of cell_ceiling.py (run by CTest; exit code != 0 on failure).
 
-1. The upper envelope of a curve whose slower point maps worse: flat there, linear between its running maxima,
-   flat beyond its ends.
+1. A field whose slower lawnmower maps worse: its margins read the library's upper envelope, flat there until
+   the curve climbs back through it.
 2. One hand-made field, its three cells' margins after each, worked out by hand (the overhead charged once per
    region entered); the clairvoyant plan is the best prefix.
 3. The top level a field's geometry flies: a finer one that is no slower replaces a coarser one.
@@ -47,11 +47,15 @@ def field(name="A", gains=(0.02, 0.05, -0.01), regions=(0, 0, 1)):
 
 
 def envelope():
-    curve = [(100.0, 0.3), (150.0, 0.2), (300.0, 0.5)]  # the 150 s lawnmower maps worse than the 100 s one
-    for t, want in ((50.0, 0.3), (100.0, 0.3), (150.0, 0.3), (225.0, 0.4), (300.0, 0.5), (900.0, 0.5)):
-        got = cc.envelope_at(curve, t)
-        check(math.isclose(got, want), f"envelope at {t}: {got}, not {want}")
-    print("ok: the upper envelope")
+    # The 10 cm/px lawnmower (150 s) maps worse than the 15 cm/px one (100 s): the envelope stays at 0.3 until the
+    # 10 -> 5 segment climbs through it (at 200 s), then follows the curve: 0.35 at 225 s, as front_margin reads it.
+    f = cc.Field("D", {5.0: 0.5, 10.0: 0.2, 15.0: 0.3}, {5.0: (300.0, 30), 10.0: (150.0, 9), 15.0: (100.0, 4)})
+    f.cells[(15.0, 5.0)] = [cell(0, 0.1)]
+    check(f.top_margin(15.0) == 0.0 and math.isclose(f.top_margin(10.0), -0.1), "the top levels against the curve")
+    # One cell: 100 s of top level, 115 s of overhead, 10 s an image: 225 s, mIoU 0.3 + 0.1.
+    m = f.margins(15.0, 5.0, f.cells[(15.0, 5.0)], {5.0: 115.0})
+    check(np.allclose(m, [0.4 - 0.35]), f"the margin at 225 s: {m}")
+    print("ok: the curve's upper envelope, as front_margin reads it")
 
 
 def margins():
