@@ -192,12 +192,15 @@ def main(argv=None):
         checker = load_member(check_net) if check_net else None
         if checker and checker[2]["classes"] != meta["classes"]:
             raise SystemExit(f"{check_net}: classes {checker[2]['classes']} differ from {net}'s {meta['classes']}")
-        curve_labels = [labels_at(model, spec, meta, field, f * field.gsd_cm) for f in curve]
         top_gsd = args.top * field.gsd_cm
-        top_lp = painted_log_probabilities(model, spec, meta, field, top_gsd)
+        lps = {f: painted_log_probabilities(model, spec, meta, field, f * field.gsd_cm) for f in [args.top, *bands]}
+        top_lp = lps[args.top]
+        # The curve's lawnmowers: those already painted (the top level, the bands) read off their maps.
+        curve_labels = [lps[f].argmax(0).astype(np.uint8) if f in lps else labels_at(model, spec, meta, field,
+                                                                                     f * field.gsd_cm) for f in curve]
         for b in bands:
             fine_gsd = b * field.gsd_cm
-            fine_lp = painted_log_probabilities(model, spec, meta, field, fine_gsd)
+            fine_lp = lps[b]
             check_labels = labels_at(*checker, field, fine_gsd) if checker else None
             for name in wanted:
                 cls = field.classes.index(name)
