@@ -1285,9 +1285,10 @@ TEST_CASE("decision model: file round trip and compatibility checks") {
     CHECK(pooled_back.adaptive_options(MissionOptions{}).mission.map_fusion == MapFusion::pooled);
     t::write_file(tmp.path() / "bad_fusion.yaml",
                   std::string(text).replace(text.find("map_fusion: pooled"), 18, "map_fusion: mean"));
-    CHECK_THROWS_WITH_AS((void)DecisionModel::load(tmp.path() / "bad_fusion.yaml"),
-                         doctest::Contains("map fusion must be 'finest', 'pooled' or 'pooled-interest', not 'mean'"),
-                         std::invalid_argument);
+    CHECK_THROWS_WITH_AS(
+        (void)DecisionModel::load(tmp.path() / "bad_fusion.yaml"),
+        doctest::Contains("map fusion must be 'finest', 'pooled', 'pooled-interest' or 'pooled-guarded', not 'mean'"),
+        std::invalid_argument);
     DecisionModel kept = m;
     kept.map_fusion = MapFusion::pooled_interest;
     kept.save(tmp.path() / "kept.yaml");

@@ -259,6 +259,56 @@ TEST_CASE("map, pooled-interest: a label of interest any look gave stays, whiche
   CHECK_FALSE(pools_probabilities(MapFusion::finest));
 }
 
+TEST_CASE("map, pooled-guarded: a closer look changes only what the coarsest look was unsure of") {
+  // 3 classes. Coarse looks (GSD 3) over the whole map, a finer one (GSD 1, sure of class 1 at
+  // 0.95) over the upper-left quarter. Pooled, the finer look wins there (the case above). The
+  // coarse look's own probability of its class decides the guarded map: 0.9 > 0.75 keeps class 0,
+  // 0.7 < 0.75 lets the finer look write class 1.
+  for (const float coarse : {0.9f, 0.7f}) {
+    CAPTURE(coarse);
+    SemanticMap pooled(cv::Size(8, 6), 255, MapFusion::pooled), guarded(cv::Size(8, 6), 255, MapFusion::pooled_guarded);
+    for (SemanticMap* m : {&pooled, &guarded}) {
+      m->fuse(image_at({0, 0, 8, 6}, 3.0), uniform_segmentation(4, 3, 3, 0, coarse));
+      m->fuse(image_at({0, 0, 4, 3}, 1.0), uniform_segmentation(4, 3, 3, 1, 0.95f));
+    }
+    CHECK(guarded.fusion() == MapFusion::pooled_guarded);
+    CHECK(cv::countNonZero(pooled.labels() == 1) == 12);
+    CHECK(cv::countNonZero(guarded.labels() == 1) == (coarse > SemanticMap::kGuardConfidence ? 0 : 12));
+    CHECK(cv::countNonZero(guarded.gsd_cm() != pooled.gsd_cm()) == 0);  // the finest look is recorded all the same
+  }
+
+  // Two coarse looks of one GSD pool: 0.7 twice over 3 classes (0.15 each for the others) gives
+  // class 0 the probability 0.49 / (0.49 + 2 * 0.0225) = 0.916 > 0.75, which guards it; the order
+  // of the looks does not matter, and a coarser look replaces what the finer ones pooled.
+  SemanticMap twice(cv::Size(8, 6), 255, MapFusion::pooled_guarded),
+      fine_first(cv::Size(8, 6), 255, MapFusion::pooled_guarded);
+  twice.fuse(image_at({0, 0, 8, 6}, 3.0), uniform_segmentation(4, 3, 3, 0, 0.7f));
+  twice.fuse(image_at({0, 0, 8, 6}, 3.0), uniform_segmentation(4, 3, 3, 0, 0.7f));
+  twice.fuse(image_at({0, 0, 4, 3}, 1.0), uniform_segmentation(4, 3, 3, 1, 0.95f));
+  CHECK(cv::countNonZero(twice.labels() == 0) == 48);
+  fine_first.fuse(image_at({0, 0, 4, 3}, 1.0), uniform_segmentation(4, 3, 3, 1, 0.95f));
+  CHECK(cv::countNonZero(fine_first.labels() == 1) == 12);  // alone, the finer look is the coarsest
+  fine_first.fuse(image_at({0, 0, 8, 6}, 3.0), uniform_segmentation(4, 3, 3, 0, 0.9f));
+  CHECK(cv::countNonZero(fine_first.labels() == 0) == 48);
+
+  // Where every look agrees, or only the coarse looks fell, the guarded map is the pooled one.
+  const Field f = t::blob_field(1300, 900, 1.0, 3, 20);
+  const SimulatedSensor sensor(f, CameraModel{});
+  OracleSegmenter oracle(f.num_classes());
+  SemanticMap pooled(f.labels().size(), f.ignore_label(), MapFusion::pooled);
+  SemanticMap guarded(f.labels().size(), f.ignore_label(), MapFusion::pooled_guarded);
+  for (const auto& w : LawnmowerPlanner(sensor.camera()).plan(f.area(), 3.0)) {
+    const Image img = sensor.capture(w);
+    const Segmentation s = oracle.segment_with_probabilities(img);
+    pooled.fuse(img, s);
+    guarded.fuse(img, s);
+  }
+  CHECK(cv::countNonZero(guarded.labels() != pooled.labels()) == 0);
+  CHECK(to_string(MapFusion::pooled_guarded) == std::string("pooled-guarded"));
+  CHECK(parse_map_fusion("pooled-guarded") == MapFusion::pooled_guarded);
+  CHECK(pools_probabilities(MapFusion::pooled_guarded));
+}
+
 TEST_CASE("map, pooled: one-hot looks give finest-wins, and the oracle's lawnmowers map the ground truth") {
   // A finer look's weight (1 / GSD) exceeds a coarser one's, so where every look is sure the
   // finest decides, as with MapFusion::finest.
@@ -297,9 +347,10 @@ TEST_CASE("map, pooled: labels alone, missing or mismatched probabilities are re
                        doctest::Contains("number of class planes changed"), std::invalid_argument);
   CHECK(to_string(MapFusion::pooled) == std::string("pooled"));
   CHECK(parse_map_fusion("finest") == MapFusion::finest);
-  CHECK_THROWS_WITH_AS(static_cast<void>(parse_map_fusion("mean")),
-                       doctest::Contains("map fusion must be 'finest', 'pooled' or 'pooled-interest', not 'mean'"),
-                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS(
+      static_cast<void>(parse_map_fusion("mean")),
+      doctest::Contains("map fusion must be 'finest', 'pooled', 'pooled-interest' or 'pooled-guarded', not 'mean'"),
+      std::invalid_argument);
 }
 
 TEST_CASE("map, pooled: a turned camera pools where fuse(labels) would write") {

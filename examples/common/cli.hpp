@@ -154,7 +154,8 @@ struct CommonOptions {
     app.add_option("--map-fusion", map_fusion,
                    "how the map combines the images of one pixel: 'finest' (the finest GSD's label, the paper's) or "
                    "'pooled' (the class probabilities pooled, each image weighted by 1 / GSD; needs a network) or "
-                   "'pooled-interest' (pooled, but a pixel any image labelled with a label of interest keeps one)")
+                   "'pooled-interest' (pooled, but a pixel any image labelled with a label of interest keeps one)"
+                   " or 'pooled-guarded' (pooled, but a pixel keeps its coarsest images' class where p > 0.75)")
         ->check(CLI::IsMember(detail::names_of(kMapFusions)))
         ->capture_default_str();
   }

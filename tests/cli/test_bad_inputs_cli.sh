@@ -56,7 +56,7 @@ adaptseg_calibrate)
     --field "$weedmap" --out "$work/m.yaml" --finest-descent 0,-1
   expect_error "max_vertical_speed_mps must be finite and >= 0" --field "$weedmap" --out "$work/m.yaml" \
     --vertical-speed -1
-  expect_error "--map-fusion: mean not in {finest,pooled,pooled-interest}" --field "$weedmap" --out "$work/m.yaml" \
+  expect_error "--map-fusion: mean not in {finest,pooled,pooled-interest,pooled-guarded}" --field "$weedmap" --out "$work/m.yaml" \
     --map-fusion mean
   # Cross-fitting: a field every network given was trained on, a flag the oracle has no use for.
   expect_error "every network given was trained on calibration field 'dubai-tile-1' (as --network" \

@@ -31,20 +31,34 @@ namespace adaptseg {
 ///   (docs/journal/2026-12-loto.md, thirty-eighth session). Not the default: flown on the 24
 ///   leave-one-tile-out runs it did worse than `pooled` (docs/results.md). Needs the labels of
 ///   interest.
-enum class MapFusion { finest, pooled, pooled_interest };
+/// - `pooled_guarded` (beyond the paper): as `pooled`, but where the images at the coarsest GSD
+///   that saw a pixel (the top level's, on a descended pixel) give their most likely class a
+///   pooled probability above SemanticMap::kGuardConfidence (0.75), the pixel keeps that class:
+///   a closer look changes only what the top level was unsure of. On ground a network never
+///   trained on, a closer look and a sure top level that disagree are mostly the closer look
+///   wrong (tile 5's sea called vegetation from 5 cm/px at a median confidence of 0.89, where the
+///   top level said water at 0.85), while the right changes fall where the top level hesitated
+///   (tile 6's vegetation called water from 15 cm/px at a median of 0.63;
+///   docs/journal/2026-12-guard.md). The threshold is what five of six leave-one-tile-out folds
+///   choose on their five training tiles (the other two: 0.7, within 0.0001 of 0.75's mean).
+///   Needs the class probabilities, and probabilities that hesitate where the network may be
+///   wrong: with one-hot ones (the oracle's) every pixel's coarsest look is sure, and no closer
+///   look changes the map.
+enum class MapFusion { finest, pooled, pooled_interest, pooled_guarded };
 
 /// Every fusion and its name (in model files and on the command line).
-inline constexpr std::array<detail::NamedValue<MapFusion>, 3> kMapFusions{{
+inline constexpr std::array<detail::NamedValue<MapFusion>, 4> kMapFusions{{
     {MapFusion::finest, "finest"},
     {MapFusion::pooled, "pooled"},
     {MapFusion::pooled_interest, "pooled-interest"},
+    {MapFusion::pooled_guarded, "pooled-guarded"},
 }};
 
-/// Whether `f` pools the images' class probabilities (`pooled`, `pooled_interest`): the backend
+/// Whether `f` pools the images' class probabilities (every fusion but `finest`): the backend
 /// must give them.
 [[nodiscard]] constexpr bool pools_probabilities(MapFusion f) noexcept { return f != MapFusion::finest; }
 
-/// "finest", "pooled" or "pooled-interest".
+/// "finest", "pooled", "pooled-interest" or "pooled-guarded".
 [[nodiscard]] inline const char* to_string(MapFusion f) { return detail::name_of(kMapFusions, f, "map fusion"); }
 
 /// Parses a fusion's name.

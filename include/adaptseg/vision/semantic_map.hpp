@@ -25,18 +25,26 @@ namespace adaptseg {
 /// fine observations the latest; or, with MapFusion::pooled, the class of the largest sum over
 /// the observations of log p_c / GSD (each probability floored at kPooledFloor); with
 /// MapFusion::pooled_interest the same, except that a pixel some observation labelled with a
-/// label of interest keeps the label of interest of the largest sum among those it was given.
+/// label of interest keeps the label of interest of the largest sum among those it was given;
+/// with MapFusion::pooled_guarded the same as pooled, except that a pixel whose coarsest images
+/// give their most likely class a pooled probability above kGuardConfidence keeps that class.
 /// Pixels never observed hold `unknown_label()`.
 class SemanticMap {
  public:
   /// The smallest probability pooling reads: no single image vetoes a class outright.
   static constexpr float kPooledFloor = 1.0f / 256.0f;
+  /// MapFusion::pooled_guarded: above this pooled probability of their most likely class, the
+  /// images at a pixel's coarsest GSD keep its label whatever finer images say (chosen on the
+  /// leave-one-tile-out folds' training tiles, map_fusion.hpp).
+  static constexpr float kGuardConfidence = 0.75f;
 
   /// @param size the orthomosaic's size [px].
   /// @param unknown_label value of pixels never observed (the field's ignore label).
   /// @param fusion how observations of one pixel combine; `pooled` keeps one float plane per
   ///        class besides the labels (4 bytes per pixel and class), allocated at the first image;
-  ///        `pooled_interest` one byte per pixel more (which labels of interest it was given).
+  ///        `pooled_interest` one byte per pixel more (which labels of interest it was given),
+  ///        `pooled_guarded` one float plane per class and one more (the coarsest images' sums
+  ///        and their GSD).
   /// @param interest the labels of interest (MapFusion::pooled_interest: one to eight; the
   ///        other fusions ignore them).
   /// @throws std::invalid_argument for an empty size, a label outside 0..255, or with
@@ -112,7 +120,10 @@ class SemanticMap {
   /// of the largest sum (ties to the lower class); for MapFusion::pooled_interest the same,
   /// unless that class is not of interest and some image (this one included) labelled the
   /// pixel with a label of interest: then the one of those with the largest sum (ties to the
-  /// first in the list).
+  /// first in the list); for MapFusion::pooled_guarded the pooled class, unless the images at the
+  /// coarsest GSD that covered the pixel (GSDs within 0.01 % count as one) give their class of
+  /// the largest sum of log(max(p_c, kPooledFloor)) a probability softmax(sums) above
+  /// kGuardConfidence: then that class (ties to the lower class).
   /// @throws std::invalid_argument as fuse(image, labels); for a pooled map also if the
   ///         probabilities are missing, are not CV_32FC1 planes of the image's size, or their
   ///         number differs from the first image's.
@@ -130,10 +141,14 @@ class SemanticMap {
       detail::require(p[c].type() == CV_32FC1 && p[c].size() == labels.size(),
                       "SemanticMap::fuse: probabilities must be CV_32FC1 planes of the image's size", c);
       if (pooled_[c].empty()) pooled_[c] = cv::Mat(labels_.size(), CV_32F, cv::Scalar(0.0f));
+      if (fusion_ == MapFusion::pooled_guarded && coarse_.size() <= c)
+        coarse_.emplace_back(labels_.size(), CV_32F, cv::Scalar(0.0f));
       cv::log(cv::max(p[c], kPooledFloor), log_[c]);  // once per camera pixel, not per map pixel
     }
     const float weight = 1.0f / static_cast<float>(image.gsd_cm);
     const auto gsd = static_cast<float>(image.gsd_cm);
+    if (fusion_ == MapFusion::pooled_guarded && coarse_gsd_.empty())
+      coarse_gsd_ = cv::Mat(labels_.size(), CV_32F, cv::Scalar(0.0f));
     each_pixel(image, labels.size(), [&](int x, int y, int u, int v) {
       const unsigned char label = labels.at<unsigned char>(v, u);
       if (label == image.ignore_label) return;
@@ -148,6 +163,7 @@ class SemanticMap {
         }
       }
       if (!interest_.empty()) best = kept_interest(x, y, label, best);
+      if (!coarse_.empty()) best = guarded(x, y, u, v, gsd, best);
       labels_.at<unsigned char>(y, x) = static_cast<unsigned char>(best);
       float& held = gsd_.at<float>(y, x);
       held = std::min(held, gsd);
@@ -192,6 +208,36 @@ class SemanticMap {
       }
     }
     return kept;
+  }
+
+  /// MapFusion::pooled_guarded at map pixel (x, y), which an image of `gsd` covers with its
+  /// camera pixel (u, v): adds the image's log-probabilities to the coarsest images' sums (which
+  /// it replaces where it is coarser, and leaves alone where it is finer), and returns the label
+  /// the pixel takes: those sums' class where its probability is above kGuardConfidence, else
+  /// `best` (the pooled class).
+  [[nodiscard]] int guarded(int x, int y, int u, int v, float gsd, int best) {
+    float& held = coarse_gsd_.at<float>(y, x);
+    const bool coarser = gsd > held * 1.0001f;
+    if (coarser || gsd >= held * 0.9999f) {
+      for (std::size_t c = 0; c < coarse_.size(); ++c) {
+        float& sum = coarse_[c].at<float>(y, x);
+        sum = (coarser ? 0.0f : sum) + log_[c].at<float>(v, u);
+      }
+      if (coarser) held = gsd;
+    }
+    int top = 0;
+    float top_sum = -std::numeric_limits<float>::infinity();
+    for (std::size_t c = 0; c < coarse_.size(); ++c) {
+      const float sum = coarse_[c].at<float>(y, x);
+      if (sum > top_sum) {
+        top_sum = sum;
+        top = static_cast<int>(c);
+      }
+    }
+    if (top == best) return best;
+    float z = 0.0f;  // 1 / the top class's softmax probability
+    for (const cv::Mat& plane : coarse_) z += std::exp(plane.at<float>(y, x) - top_sum);
+    return z * kGuardConfidence < 1.0f ? top : best;
   }
 
   /// Which camera row / column each footprint row / column of a `camera` image over a footprint
@@ -260,6 +306,10 @@ class SemanticMap {
   // MapFusion::pooled: per class the sum of the images' weighted log-probabilities (allocated at
   // the first image), and fuse()'s scratch: the log-probabilities of one image.
   std::vector<cv::Mat> pooled_, log_;
+  // MapFusion::pooled_guarded: per class the sum of log-probabilities of the images at each
+  // pixel's coarsest GSD (unweighted), and that GSD (0 where none fell yet); empty otherwise.
+  std::vector<cv::Mat> coarse_;
+  cv::Mat coarse_gsd_;
   // fuse()'s scratch: the camera column / row of each footprint column / row for the last
   // (camera, footprint) sizes, and one footprint row of labels.
   cv::Mat col_of_, row_of_;
