@@ -13,13 +13,19 @@ probabilities, then per class of interest L (IoU of L against the field's labels
     interest kept where any look saw it);
   - `trim`: L where the pooled map says L and the top level did too (the closer look may
     remove the class but not add it);
+  - `guarded`: the pooled map, but where the top level's own pooled probability of its class
+    (softmax of its images' summed log(max(p_c, 1/256))) is above `--guard` (default 0.75, the
+    library's SemanticMap::kGuardConfidence) the top level's label: MapFusion::pooled_guarded,
+    a closer look changing only what the top level was unsure of;
   - `bonus`: pooled (or union, or trim) minus the better of the two lawnmowers alone: what fusing two
     looks maps beyond either, before any time is counted (a descent must add this and more
     than the lawnmower curve rises over its seconds);
   - the closer look's additions (pixels it calls L where the top level did not) and removals
     (L at the top level, not in the closer look): each as a share of the labelled ground and
     how often it is right (additions: truly L; removals: truly not L). An addition of precision
-    p raises IoU only where p > IoU / (1 + IoU) of the map it joins (`break-even`);
+    p raises IoU only where p > IoU / (1 + IoU) of the map it joins (`break-even`); and of the
+    closer look's changes of label with L among the two labels, the share the top level was sure
+    of (its probability above the guard: `sure changes`, label-free, what the guard undoes);
   - with `--check DIR` (a second leave-one-tile-out set, e.g. the other seed's), `agreed`: the
     pooled map, but a pixel takes a label other than the top level's only where the check
     network's lawnmower at the finer GSD gives that label too (a second network as a gate on
@@ -30,13 +36,23 @@ probabilities, then per class of interest L (IoU of L against the field's labels
     where the two passes end after every lawnmower of the curve (the finer pass at the curve's
     finest GSD: the envelope is flat beyond it), a lower bound otherwise. The summary then gives
     per class the finer GSD the other fields choose (the largest mean pooled margin over the
-    curve, none where it is not positive) and what it scores on each field.
+    curve, none where it is not positive) and what it scores on each field;
+  - with `--guards T1,T2,...` the guard chosen on other fields: per threshold T the mean over
+    classes, bands and fields of the guarded map's IoU less the top level's, and per field the
+    T whose mean over the other fields is largest (how MapFusion::pooled_guarded's threshold
+    was chosen, docs/journal/2026-12-guard.md);
+  - with `--flips`, per field and finer band the closer look's changes of label (the top level's
+    class a, the finer lawnmower's b, a class of interest among them, at least 0.2 % of the
+    labelled ground): their share of the ground, how often the truth is b (the change right) or
+    a, and the median probability each look gives its own class there (`top_confidence` for the
+    top level, the same reading of the finer lawnmower's map).
 
 Usage:
   PYTHONPATH=python /usr/bin/python3 -m adaptseg_tools.two_looks \\
       --loto examples/models/mobilenetv2-dubai-loto [--tiles 1,2,3,4,5,6] \\
       [--top 3] [--bands 2,1] [--classes building,road,vegetation,water] \\
-      [--check examples/models/mobilenetv2-dubai-loto-seed1] [--curve 1,1.5,2,2.5,3]
+      [--check examples/models/mobilenetv2-dubai-loto-seed1] [--curve 1,1.5,2,2.5,3] \\
+      [--guard 0.75] [--guards 0.95,0.9,0.85,0.8,0.75,0.7,0.65,0.6] [--flips]
   (each tile-K network on examples/data/dubai-tile-K, the tile it never saw), or
   ... two_looks NETWORK FIELD [NETWORK FIELD ...] with the same options.
 --top and --bands are GSD factors of the field's own GSD (3 and 2 on the Dubai tiles: 15 and
@@ -59,7 +75,8 @@ from .fieldio import IGNORE
 from .training.fields import capture, lawnmower_rects, load_field
 
 LOG_FLOOR = 1.0 / 256.0  # SemanticMap's floor under a pooled probability
-FUSIONS = ("pooled", "union", "trim")  # the two looks fused, each with its bonus (module docstring)
+FUSIONS = ("pooled", "union", "trim", "guarded")  # the two looks fused, each with its bonus (module docstring)
+GUARD = 0.75  # SemanticMap::kGuardConfidence: MapFusion::pooled_guarded's threshold
 
 
 def painted_log_probabilities(model, spec, meta, field, gsd_cm: float) -> np.ndarray:
@@ -88,18 +105,28 @@ def fusions_of(checked: bool) -> tuple[str, ...]:
     return FUSIONS + (("agreed",) if checked else ())
 
 
+def top_confidence(top_lp: np.ndarray) -> np.ndarray:
+    """Per pixel the top level's pooled probability of its most likely class: the softmax of its
+    images' summed log-probabilities (1 / the sum of exp(s_c - max s)), as SemanticMap's guard reads it."""
+    return 1.0 / np.exp(top_lp - top_lp.max(0, keepdims=True)).sum(0)
+
+
 def compare(top_lp: np.ndarray, fine_lp: np.ndarray, top_gsd: float, fine_gsd: float, truth: np.ndarray,
-            cls: int, check_labels: np.ndarray | None = None, curve_best: float | None = None) -> dict:
+            cls: int, check_labels: np.ndarray | None = None, curve_best: float | None = None,
+            guard: float = GUARD, guards: tuple[float, ...] = ()) -> dict:
     """The measures of the module docstring for class `cls`, over the labelled pixels: with
     `check_labels` (the check network's labels at the finer GSD) also `agreed`; with `curve_best`
-    (the best IoU of `cls` among the curve's lawnmowers) each fusion's `<fusion>_over_curve`."""
+    (the best IoU of `cls` among the curve's lawnmowers) each fusion's `<fusion>_over_curve`; with
+    `guards`, `guard_gains`: per threshold the guarded map's IoU less the top level's."""
     valid = truth != IGNORE
     t = (truth == cls) & valid
     top_labels, pooled_labels = top_lp.argmax(0), (top_lp / top_gsd + fine_lp / fine_gsd).argmax(0)
     top = (top_labels == cls) & valid
     fine = (fine_lp.argmax(0) == cls) & valid
     pooled = (pooled_labels == cls) & valid
-    fused = {"pooled": pooled, "union": pooled | top | fine, "trim": pooled & top}
+    sure = top_confidence(top_lp)
+    fused = {"pooled": pooled, "union": pooled | top | fine, "trim": pooled & top,
+             "guarded": np.where(sure > guard, top, pooled)}
     if check_labels is not None:
         fused["agreed"] = (np.where(check_labels == pooled_labels, pooled_labels, top_labels) == cls) & valid
     fusions = fusions_of(check_labels is not None)
@@ -114,7 +141,35 @@ def compare(top_lp: np.ndarray, fine_lp: np.ndarray, top_gsd: float, fine_gsd: f
     if curve_best is not None:
         r.update({f"{f}_over_curve": r[f] - max(best, curve_best) for f in fusions})
     r["break_even"] = r["top"] / (1.0 + r["top"])
+    fine_labels = fine_lp.argmax(0)
+    changed = valid & (top_labels != fine_labels) & ((top_labels == cls) | (fine_labels == cls))
+    r["sure_changes"] = float((sure[changed] > guard).mean()) if changed.any() else float("nan")
+    if guards:
+        r["guard_gains"] = [iou(np.where(sure > g, top, pooled), t) - r["top"] for g in guards]
     return r
+
+
+def flips(top_lp: np.ndarray, fine_lp: np.ndarray, truth: np.ndarray, classes, wanted) -> list[tuple]:
+    """The closer look's changes of label (module docstring, `--flips`): (a, b, share of the
+    labelled ground, share truly b, share truly a, median top confidence, median fine confidence),
+    largest first, for the changes touching a class of `wanted` over at least 0.2 % of the ground."""
+    valid = truth != IGNORE
+    a_lab, b_lab = top_lp.argmax(0), fine_lp.argmax(0)
+    top_sure, fine_sure = top_confidence(top_lp), top_confidence(fine_lp)
+    interest = {classes.index(n) for n in wanted}
+    n = max(1, int(valid.sum()))
+    out = []
+    for a in range(len(classes)):
+        for b in range(len(classes)):
+            if a == b or not {a, b} & interest:
+                continue
+            m = valid & (a_lab == a) & (b_lab == b)
+            if m.sum() < 0.002 * n:
+                continue
+            t = truth[m]
+            out.append((classes[a], classes[b], m.sum() / n, float((t == b).mean()), float((t == a).mean()),
+                        float(np.median(top_sure[m])), float(np.median(fine_sure[m]))))
+    return sorted(out, key=lambda x: -x[2])
 
 
 def pairs_of(args) -> list[tuple[str, Path, Path, Path | None]]:
@@ -174,15 +229,21 @@ def main(argv=None):
     parser.add_argument("--classes", default="building,road,vegetation,water")
     parser.add_argument("--check", help="with --loto: a second set whose tile-K gates what the closer look changes")
     parser.add_argument("--curve", help="the lawnmower curve's GSD factors: each fusion's margin over its best")
+    parser.add_argument("--guard", type=float, default=GUARD, help=f"the guarded map's threshold (default {GUARD})")
+    parser.add_argument("--guards", help="thresholds to choose the guard from on the other fields, e.g. 0.9,0.8,0.7")
+    parser.add_argument("--flips", action="store_true", help="per field and band the closer look's changes of label")
     args = parser.parse_args(argv)
     bands = factors(args.bands, "--bands")
     curve = factors(args.curve, "--curve") if args.curve else []
+    guards = tuple(factors(args.guards, "--guards")) if args.guards else ()
+    if not 0 < args.guard <= 1 or any(g > 1 for g in guards):
+        raise SystemExit(f"--guard {args.guard} / --guards {args.guards}: each must be in (0, 1]")
     if args.top <= 0 or any(b >= args.top for b in bands):
         raise SystemExit(f"--bands {args.bands}: each must be above 0 and below --top {args.top}")
     wanted = args.classes.split(",")
     fusions = fusions_of(bool(args.check))
     summary: dict[tuple[str, float], list[list[float]]] = {}
-    rows = []
+    rows, flip_rows = [], []
     for label, net, fdir, check_net in pairs_of(args):
         field = load_field(fdir)
         unknown = [c for c in wanted if c not in field.classes]
@@ -202,6 +263,9 @@ def main(argv=None):
             fine_gsd = b * field.gsd_cm
             fine_lp = lps[b]
             check_labels = labels_at(*checker, field, fine_gsd) if checker else None
+            if args.flips:
+                flip_rows += [(label, top_gsd, fine_gsd, *f) for f in flips(top_lp, fine_lp, field.labels,
+                                                                           field.classes, wanted)]
             for name in wanted:
                 cls = field.classes.index(name)
                 best = None
@@ -209,21 +273,22 @@ def main(argv=None):
                     valid = field.labels != IGNORE
                     truth = (field.labels == cls) & valid
                     best = max(iou((m == cls) & valid, truth) for m in curve_labels)
-                r = compare(top_lp, fine_lp, top_gsd, fine_gsd, field.labels, cls, check_labels, best)
+                r = compare(top_lp, fine_lp, top_gsd, fine_gsd, field.labels, cls, check_labels, best,
+                            args.guard, guards)
                 rows.append((name, label, top_gsd, fine_gsd, r))
                 summary.setdefault((name, fine_gsd), []).append(
                     [r[f"{f}_bonus"] for f in fusions] + ([r[f"{f}_over_curve"] for f in fusions] if curve else []))
     over = [f"over curve {f}" for f in fusions] if curve else []
     print("| class | field | GSD top → fine [cm/px] | IoU top | fine | " + " | ".join(fusions) + " | bonus "
           + " | ".join(fusions) + "".join(f" | {o}" for o in over)
-          + " | added [% of ground] | right | break-even | removed [%] | right |")
-    print("| --- | --- | --- |" + " ---: |" * (7 + 2 * len(fusions) + len(over)))
+          + " | added [% of ground] | right | break-even | removed [%] | right | sure changes |")
+    print("| --- | --- | --- |" + " ---: |" * (8 + 2 * len(fusions) + len(over)))
     for name, label, top_gsd, fine_gsd, r in sorted(rows, key=lambda x: (wanted.index(x[0]), x[3], x[1])):
         print(f"| {name} | {label} | {top_gsd:g} → {fine_gsd:g} | {r['top']:.3f} | {r['fine']:.3f} | "
               + "".join(f"{r[f]:.3f} | " for f in fusions) + "".join(f"{r[f + '_bonus']:+.3f} | " for f in fusions)
               + "".join(f"{r[f + '_over_curve']:+.4f} | " for f in fusions if curve) +
               f"{100 * r['added']:.2f} | {r['added_right']:.2f} | {r['break_even']:.2f} | "
-              f"{100 * r['removed']:.2f} | {r['removed_right']:.2f} |")
+              f"{100 * r['removed']:.2f} | {r['removed_right']:.2f} | {r['sure_changes']:.2f} |")
     print()
     heads = [f"bonus, {f}" for f in fusions] + over
     print("| class | fine GSD [cm/px] | fields |" + "".join(f" mean {h} | above +0.001 |" for h in heads))
@@ -244,6 +309,36 @@ def main(argv=None):
         if len(m):
             print(f"\n{int((m > 0.001).sum())} of {len(m)} above +0.001, median {np.median(m):+.4f}, "
                   f"mean {m.mean():+.4f}, {int((m < -0.002).sum())} below −0.002")
+    if guards:
+        print_guard_choice(rows, guards)
+    if args.flips:
+        print("\nThe closer look's changes of label (top level a → finer lawnmower b):")
+        print("| field | GSD top → fine [cm/px] | a → b | share of ground [%] | truly b | truly a |"
+              " median p, top | median p, fine |")
+        print("| --- | --- | --- | ---: | ---: | ---: | ---: | ---: |")
+        for label, top_gsd, fine_gsd, a, b, share, right, wrong, p_top, p_fine in flip_rows:
+            print(f"| {label} | {top_gsd:g} → {fine_gsd:g} | {a} → {b} | {100 * share:.2f} | {right:.2f} | "
+                  f"{wrong:.2f} | {p_top:.2f} | {p_fine:.2f} |")
+
+
+def print_guard_choice(rows, guards) -> None:
+    """The guard chosen on other fields (module docstring): per threshold the mean gain of the
+    guarded map over the top level's, over every class, band and field, then per field the
+    threshold of the largest mean over the other fields."""
+    gains: dict[str, list[list[float]]] = {}
+    for _, label, _, _, r in rows:
+        gains.setdefault(label, []).append(r["guard_gains"])
+    every = np.array([g for v in gains.values() for g in v])
+    print("\nThe guard: the guarded map's IoU less the top level's, mean over classes, bands and fields:")
+    print("| threshold |" + "".join(f" {g:g} |" for g in guards))
+    print("| --- |" + " ---: |" * len(guards))
+    print("| all fields |" + "".join(f" {x:+.4f} |" for x in every.mean(0)))
+    for label in gains:
+        others = np.array([g for lab, v in gains.items() if lab != label for g in v])
+        if len(others):
+            mean = others.mean(0)
+            print(f"| without {label} |" + "".join(f" {x:+.4f} |" for x in mean)
+                  + f" chosen: {guards[int(np.argmax(mean))]:g} |")
 
 
 if __name__ == "__main__":

@@ -3,17 +3,20 @@
 
 1. compare() on a hand-made field of eight pixels and two classes, every measure worked out by
    hand: the two maps' IoU, the pooled map (weights 1 / GSD), the union, the trim, the additions and
-   removals with how often each is right, the bonuses and the break-even; the changes gated by a check
-   that is always right (`agreed`), and both fusions against a curve.
+   removals with how often each is right, the bonuses and the break-even, the changes the top level was sure
+   of; the guarded map (the top
+   level's label where it is sure) at three thresholds; the closer look's changes of label (--flips); the changes gated by a check that is always
+   right (`agreed`), and both fusions against a curve.
 2. A lawnmower fused with itself changes nothing: pooled, union, trim, top and fine are one map, the
    bonuses 0, nothing added or removed.
 3. The bundled leave-one-tile-out network of tile 1 on tile 1: its 15 cm/px lawnmower painted as
    log-probabilities gives each class the IoU its training recorded in model.yaml (within 0.002,
    as class_map's painter); main() with --bands 2 prints a row per class and the summary.
    With --loto, --check (its own set as the check) and --curve (the two lawnmowers themselves): the
-   `agreed` columns, each margin over the curve equal to the bonus, and the two passes' table.
+   `agreed` columns, each margin over the curve equal to the bonus, and the two passes' table; with
+   --guards, the guard table, its threshold 1 (no guard) the pooled map's mean gain over the top level.
 4. Bad bands, an unknown class, an odd list of NETWORK FIELD, --check without --loto and a bad --curve
-   are refused.
+   and a guard outside (0, 1] are refused.
 
 Part 3 needs torch, as eval_ensemble does: CTest's tools:two_looks is skipped (exit 77) without it.
 """
@@ -73,6 +76,20 @@ def hand_made():
     check(math.isclose(r3["agreed"], 0.8) and math.isclose(r3["agreed_bonus"], 0.3), f"agreed {r3}")
     check(math.isclose(r3["pooled_over_curve"], -0.1) and math.isclose(r3["agreed_over_curve"], 0.2), f"over {r3}")
     check("agreed" not in r and "pooled_over_curve" not in r, "no check, no curve: neither measure")
+    # The guard: the top level's own probability is 0.9 at every pixel but 2 and 4 (0.6). At 0.75 the top's label
+    # stays at the sure pixels and the pooled one is taken at 2 and 4 (both L): L at 0, 1, 2, 4, TP 3, FP 1, FN 1:
+    # IoU 3/5, bonus 0.6 - 0.5. At 1 nothing is sure (the pooled map, 0.5); at 0.5 everything is (the top's, 0.4).
+    check(math.isclose(r["guarded"], 0.6) and math.isclose(r["guarded_bonus"], 0.1), f"guarded {r}")
+    # The closer look changes pixels 1, 2, 3 and 5; the top level was sure (0.9 > 0.75) of 1, 3 and 5.
+    check(math.isclose(r["sure_changes"], 0.75), f"sure changes {r['sure_changes']}")
+    r4 = two_looks.compare(top, fine, 15.0, 5.0, truth, 1, guards=(1.0, 0.75, 0.5))
+    check(np.allclose(r4["guard_gains"], [0.1, 0.2, 0.0]), f"guard gains {r4['guard_gains']}")
+    check("guard_gains" not in r, "no guards, no guard gains")
+    # The closer look's changes of label: 0 → 1 at pixels 2, 3, 5 (truly 1 at 2 and 3; the top sure 0.6, 0.9,
+    # 0.9, the fine 0.8), 1 → 0 at pixel 1 (truly 1: wrong; 0.9 and 0.8).
+    f = two_looks.flips(top, fine, truth, ["c0", "c1"], ["c1"])
+    want = [("c0", "c1", 3 / 8, 2 / 3, 1 / 3, 0.9, 0.8), ("c1", "c0", 1 / 8, 0.0, 1.0, 0.9, 0.8)]
+    check(len(f) == 2 and all(x[:2] == w[:2] and np.allclose(x[2:], w[2:]) for x, w in zip(f, want)), f"flips {f}")
     print("ok: the hand-made field's measures")
 
 
@@ -115,15 +132,26 @@ def main():
     for line in text.splitlines():
         if line.startswith("| building | tile 1 |"):
             cols = [c.strip() for c in line.split("|")]
-            check(abs(float(cols[10]) - float(cols[14])) < 0.0006, f"pooled bonus {cols[10]} against over curve {cols[14]}")
+            check(abs(float(cols[11]) - float(cols[16])) < 0.0006, f"pooled bonus {cols[11]} against over curve {cols[16]}")
     check("Two passes, the finer GSD chosen on the other fields" in text, f"no two-pass table:\n{text}")
     print("ok: --check and --curve on tile 1")
+
+    rc, text = printed(two_looks.main, [str(net), str(fdir), "--bands", "2", "--guards", "1,0.75", "--flips"])
+    check("| dubai-tile-1 | 15 → 10 | " in text.split("The closer look's changes of label")[-1], f"no flips:\n{text}")
+    rows = [[c.strip() for c in line.split("|")] for line in text.splitlines() if "| dubai-tile-1 | 15 → 10 |" in line]
+    rows = [c for c in rows if c[1] in ("building", "road", "vegetation", "water")]  # not the --flips rows
+    pooled_gain = np.mean([float(c[6]) - float(c[4]) for c in rows])
+    table = next(line for line in text.splitlines() if line.startswith("| all fields |"))
+    check(rc is None and len(rows) == 4 and abs(float(table.split("|")[2]) - pooled_gain) < 0.001,
+          f"threshold 1 against the pooled map's mean gain {pooled_gain:+.4f}:\n{text}")
+    print("ok: --guards")
 
     check_refused(two_looks.main, [str(net), str(fdir), "--bands", "3"], "below --top", "a band as coarse as the top")
     check_refused(two_looks.main, [str(net), str(fdir), "--classes", "forest"], "no class forest", "an unknown class")
     check_refused(two_looks.main, [str(net)], "NETWORK FIELD", "a network without its field")
     check_refused(two_looks.main, [str(net), str(fdir), "--check", loto], "--check needs --loto", "--check on pairs")
     check_refused(two_looks.main, [str(net), str(fdir), "--curve", "2,x"], "comma-separated", "a bad --curve")
+    check_refused(two_looks.main, [str(net), str(fdir), "--guards", "0.8,1.5"], "each must be in (0, 1]", "a guard above 1")
     print("two_looks: all checks passed")
 
 
