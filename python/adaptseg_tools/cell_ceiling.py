@@ -27,14 +27,17 @@ Prints, per field and summed over the fields (runs above +0.001, median, mean, b
      regression of the gain on every top-level input, `top_*` and `field_sigma`, fitted on the other fields'
      cells; a column NaN throughout left out); on a field where a finer top level is no slower to fly (its
      geometry alone), that one is flown instead; and per class each ranking's rank correlation with the realised gains within a field (the mean
-     over the fields and their plans);
+     over the fields and their plans), and with --against COLUMN,... with those columns of the cells too (e.g.
+     `relabelled`, the share of a cell the closer look relabelled: whether an input sees where labels change
+     rather than where a change is right);
   4. with --noise R,...: the same, ranked by the realised gain plus Gaussian noise scaled for a correlation R with
      it within each field (the rank correlation it realised is printed beside);
   5. first, with --sums: per field and plan the sum of its cells' gains (to set beside a whole-field measure).
 
 Usage:
   PYTHONPATH=python /usr/bin/python3 -m adaptseg_tools.cell_ceiling MODEL CELLS [MODEL CELLS ...] \\
-      [--rank field_gain,random,top_ambiguity] [--noise 1,0.9,0.7,0.5] [--overhead-s 20] [--times CSV]
+      [--rank field_gain,random,top_ambiguity] [--noise 1,0.9,0.7,0.5] [--overhead-s 20] [--times CSV] \\
+      [--against relabelled]
 (MODEL and CELLS from one adaptseg_calibrate run, e.g. out/agree/model2-road.yaml out/agree/cells-road.csv.)
 """
 
@@ -230,12 +233,13 @@ def measured_overheads(run_dirs: list[Path]) -> dict[float, dict[str, list[float
     return out
 
 
-def rank_correlation(fields: list[Field], key: str) -> float:
-    """The mean over the fields' plans of the rank correlation of `key` with the cells' realised gains."""
+def rank_correlation(fields: list[Field], key: str, target: str = "field_gain") -> float:
+    """The mean over the fields' plans of the rank correlation of `key` with the cells' `target`
+    (their realised gains, or e.g. `relabelled`: how much of them the closer look relabelled)."""
     out = []
     for f in fields:
         for cells in f.cells.values():
-            pairs = [(c[key], c["field_gain"]) for c in cells if math.isfinite(c[key])]
+            pairs = [(c[key], c[target]) for c in cells if math.isfinite(c[key]) and math.isfinite(c[target])]
             rho = spearman([p[0] for p in pairs], [p[1] for p in pairs])
             if not math.isnan(rho):
                 out.append(rho)
@@ -294,6 +298,8 @@ def main(argv=None):
     parser.add_argument("--fields-root", default=str(REPO / "examples" / "data"),
                         help="the folder holding the fields the models name (default: examples/data)")
     parser.add_argument("--seed", type=int, default=0, help="of the random orders and the noise (default 0)")
+    parser.add_argument("--against", default="",
+                        help="cell columns to rank-correlate the rankings with besides the gains, e.g. relabelled")
     parser.add_argument("--sums", action="store_true",
                         help="also print per field and plan the sum of its cells' gains (all descended)")
     args = parser.parse_args(argv)
@@ -310,11 +316,15 @@ def main(argv=None):
     times = Times(args.times, Path(args.mission), Path(args.fields_root))
     sets = [read(Path(m), Path(c), times) for m, c in zip(args.pairs[::2], args.pairs[1::2])]
     keys = args.rank.split(",")
+    against = [a for a in args.against.split(",") if a]
     for interest, fields in sets:
         columns = set(next(iter(fields[0].cells.values()))[0])
         unknown = [k for k in keys if k not in ("random", "learnt") and k not in columns]
         if unknown:
             raise SystemExit(f"--rank: no column {', '.join(unknown)} in the cells of {interest}")
+        unknown = [a for a in against if a not in columns]
+        if unknown:
+            raise SystemExit(f"--against: no column {', '.join(unknown)} in the cells of {interest}")
     gsds = {sub for _, fields in sets for f in fields for _, sub in f.plans()}
     overhead = {g: args.overhead_s for g in gsds}
     if args.overhead_from:
@@ -375,13 +385,14 @@ def main(argv=None):
               f"{np.mean(realised):.2f}): above +0.001 in {np.mean(counts):.1f} of {len(margins)} "
               f"(draws {', '.join(map(str, counts))}), median {np.mean(medians):+.4f}")
     shown = [k for k in keys if k not in ("random", "field_gain")]
-    if shown:
+    for target in ["field_gain"] + against if shown else []:
         print()
-        print("Rank correlation with the cells' realised gains within a field (mean over the fields and their plans):")
+        what = "realised gains" if target == "field_gain" else target
+        print(f"Rank correlation with the cells' {what} within a field (mean over the fields and their plans):")
         print("| class | " + " | ".join(shown) + " |")
         print("| --- |" + " ---: |" * len(shown))
         for interest, fields in sets:
-            print(f"| {interest} | " + " | ".join(f"{rank_correlation(fields, k):+.2f}" for k in shown) + " |")
+            print(f"| {interest} | " + " | ".join(f"{rank_correlation(fields, k, target):+.2f}" for k in shown) + " |")
 
 
 if __name__ == "__main__":

@@ -8,12 +8,12 @@
 3. The top level a field's geometry flies: a finer one that is no slower replaces a coarser one.
 4. Fixed plans on three hand-made fields: where every cell loses, each field keeps its top level alone
    (margin 0); where every cell gains, each descends into all its cells. A noisy ranking of correlation 1 is
-   the perfect one; a rank correlation worked out by hand; gains a line in an input ranked perfectly by the
+   the perfect one; a rank correlation worked out by hand, with the gains and with another column; gains a line in an input ranked perfectly by the
    ridge fitted on the other fields (`learnt`).
-5. main() on a hand-made model, cells and times: a row per field, the summary lines, --sums, the overheads
+5. main() on a hand-made model, cells and times: a row per field, the summary lines, --against, --sums, the overheads
    measured on a hand-made run's flown descents, or its candidates where none was flown (--overhead-from); its
-   refusals (odd pairs, an unknown --rank column, --noise out of (0, 1], cells of a field the model does not
-   name).
+   refusals (odd pairs, an unknown --rank or --against column, --noise out of (0, 1], cells of a field the model
+   does not name).
 6. Given the built adaptseg_mission (CTest passes it): tile 2's lawnmowers at 12.5 and 15 cm/px flown from
    the bundled field's geometry: four images each, 85.9 s and 102.4 s (the coarser one slower, so the fixed
    plans fly 12.5 there).
@@ -101,6 +101,11 @@ def fixed():
           "a noisy ranking of correlation 1 is the perfect one")
     # field(): top_ambiguity 0, 1, 2 against gains 0.02, 0.05, -0.01 (ranks 1, 2, 0): correlation -0.5.
     check(math.isclose(cc.rank_correlation([field()], "top_ambiguity"), -0.5), "rank correlation")
+    # Against another column: top_ambiguity 0, 1, 2 against relabelled 0.1, 0.3, 0.2 (ranks 0, 2, 1): 0.5.
+    told = field()
+    for c, r in zip(told.cells[(15.0, 5.0)], (0.1, 0.3, 0.2)):
+        c["relabelled"] = r
+    check(math.isclose(cc.rank_correlation([told], "top_ambiguity", "relabelled"), 0.5), "rank correlation, relabelled")
     # Gains a line in top_ambiguity on every field: the ridge fitted on the other fields ranks them perfectly.
     lines = [field(n, gains=tuple(0.01 * a + 0.003 * i for a in (2.0, 0.0, 1.0))) for i, n in enumerate("ABC")]
     for f in lines:
@@ -135,6 +140,10 @@ def run_main():
                      "- fixed plan, learnt:", "| class | top_ambiguity | learnt |", "| road | -0.67 |"):
             check(head in text, f"'{head}' missing:\n{text}")
         print("ok: main() on a hand-made calibration")
+        rc, text = printed(cc.main, args + ["--rank", "top_ambiguity", "--against", "top_ambiguity"])
+        check("Rank correlation with the cells' top_ambiguity within a field" in text and "| road | +1.00 |" in text,
+              f"--against: a column against itself:\n{text}")
+        check_refused(cc.main, args + ["--against", "nothing"], "--against: no column nothing", "an unknown target")
         rc, text = printed(cc.main, args + ["--sums", "--rank", "random"])
         check("| road | B | 15 → 5 | 3 | +0.0100 |" in text, f"--sums: B's cells sum to 0.03 - 0.02 + 0:\n{text}")
         # Flown descents: 50 s for 3 images and 40 s for 1 at 10 s an image: 20 and 30 s beyond (median 25).
