@@ -39,7 +39,7 @@ namespace adaptseg {
 ///   wrong (tile 5's sea called vegetation from 5 cm/px at a median confidence of 0.89, where the
 ///   top level said water at 0.85), while the right changes fall where the top level hesitated
 ///   (tile 6's vegetation called water from 15 cm/px at a median of 0.63;
-///   docs/journal/2026-12-guard.md). The threshold is what five of six leave-one-tile-out folds
+///   docs/journal/2026-12-guard.md). The threshold is what four of six leave-one-tile-out folds
 ///   choose on their five training tiles (the other two: 0.7, within 0.0001 of 0.75's mean).
 ///   Needs the class probabilities, and probabilities that hesitate where the network may be
 ///   wrong: with one-hot ones (the oracle's) every pixel's coarsest look is sure, and no closer
