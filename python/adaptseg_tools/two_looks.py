@@ -44,8 +44,8 @@ probabilities, then per class of interest L (IoU of L against the field's labels
   - with `--flips`, per field and finer band the closer look's changes of label (the top level's
     class a, the finer lawnmower's b, a class of interest among them, at least 0.2 % of the
     labelled ground): their share of the ground, how often the truth is b (the change right) or
-    a, and the median probability each look gives its own class there (`top_confidence` for the
-    top level, the same reading of the finer lawnmower's map).
+    a, and the median probability each look gives its own class there (`confidence`: the
+    softmax of its images' summed log-probabilities, the guard's reading).
 
 Usage:
   PYTHONPATH=python /usr/bin/python3 -m adaptseg_tools.two_looks \\
@@ -105,10 +105,11 @@ def fusions_of(checked: bool) -> tuple[str, ...]:
     return FUSIONS + (("agreed",) if checked else ())
 
 
-def top_confidence(top_lp: np.ndarray) -> np.ndarray:
-    """Per pixel the top level's pooled probability of its most likely class: the softmax of its
-    images' summed log-probabilities (1 / the sum of exp(s_c - max s)), as SemanticMap's guard reads it."""
-    return 1.0 / np.exp(top_lp - top_lp.max(0, keepdims=True)).sum(0)
+def confidence(lp: np.ndarray) -> np.ndarray:
+    """Per pixel a lawnmower's pooled probability of its most likely class: the softmax of its
+    images' summed log-probabilities (1 / the sum of exp(s_c - max s)), as SemanticMap's guard
+    reads the top level's."""
+    return 1.0 / np.exp(lp - lp.max(0, keepdims=True)).sum(0)
 
 
 def compare(top_lp: np.ndarray, fine_lp: np.ndarray, top_gsd: float, fine_gsd: float, truth: np.ndarray,
@@ -124,7 +125,7 @@ def compare(top_lp: np.ndarray, fine_lp: np.ndarray, top_gsd: float, fine_gsd: f
     top = (top_labels == cls) & valid
     fine = (fine_lp.argmax(0) == cls) & valid
     pooled = (pooled_labels == cls) & valid
-    sure = top_confidence(top_lp)
+    sure = confidence(top_lp)
     fused = {"pooled": pooled, "union": pooled | top | fine, "trim": pooled & top,
              "guarded": np.where(sure > guard, top, pooled)}
     if check_labels is not None:
@@ -155,7 +156,7 @@ def flips(top_lp: np.ndarray, fine_lp: np.ndarray, truth: np.ndarray, classes, w
     largest first, for the changes touching a class of `wanted` over at least 0.2 % of the ground."""
     valid = truth != IGNORE
     a_lab, b_lab = top_lp.argmax(0), fine_lp.argmax(0)
-    top_sure, fine_sure = top_confidence(top_lp), top_confidence(fine_lp)
+    top_sure, fine_sure = confidence(top_lp), confidence(fine_lp)
     interest = {classes.index(n) for n in wanted}
     n = max(1, int(valid.sum()))
     out = []
@@ -330,15 +331,15 @@ def print_guard_choice(rows, guards) -> None:
         gains.setdefault(label, []).append(r["guard_gains"])
     every = np.array([g for v in gains.values() for g in v])
     print("\nThe guard: the guarded map's IoU less the top level's, mean over classes, bands and fields:")
-    print("| threshold |" + "".join(f" {g:g} |" for g in guards))
-    print("| --- |" + " ---: |" * len(guards))
-    print("| all fields |" + "".join(f" {x:+.4f} |" for x in every.mean(0)))
+    print("| threshold |" + "".join(f" {g:g} |" for g in guards) + " chosen |")
+    print("| --- |" + " ---: |" * len(guards) + " ---: |")
+    print("| all fields |" + "".join(f" {x:+.4f} |" for x in every.mean(0)) + " |")
     for label in gains:
         others = np.array([g for lab, v in gains.items() if lab != label for g in v])
         if len(others):
             mean = others.mean(0)
             print(f"| without {label} |" + "".join(f" {x:+.4f} |" for x in mean)
-                  + f" chosen: {guards[int(np.argmax(mean))]:g} |")
+                  + f" {guards[int(np.argmax(mean))]:g} |")
 
 
 if __name__ == "__main__":
