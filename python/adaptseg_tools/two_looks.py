@@ -142,8 +142,7 @@ def compare(top_lp: np.ndarray, fine_lp: np.ndarray, top_gsd: float, fine_gsd: f
     if curve_best is not None:
         r.update({f"{f}_over_curve": r[f] - max(best, curve_best) for f in fusions})
     r["break_even"] = r["top"] / (1.0 + r["top"])
-    fine_labels = fine_lp.argmax(0)
-    changed = valid & (top_labels != fine_labels) & ((top_labels == cls) | (fine_labels == cls))
+    changed = added | removed  # the closer look's changes of label with `cls` one of the two
     r["sure_changes"] = float((sure[changed] > guard).mean()) if changed.any() else float("nan")
     if guards:
         r["guard_gains"] = [iou(np.where(sure > g, top, pooled), t) - r["top"] for g in guards]
