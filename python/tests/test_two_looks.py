@@ -27,15 +27,9 @@ import math
 
 import numpy as np
 from tool_output import check, check_refused, printed, require_torch
+from tool_output import two_class_log_probs as log_probs
 
 from adaptseg_tools import two_looks
-
-
-def log_probs(labels, sure):
-    """2 x 1 x N log-probabilities: each pixel's label with probability `sure`, the other 1 − sure."""
-    lab = np.array(labels)[None, :]
-    p1 = np.where(lab == 1, sure, 1.0 - sure)
-    return np.log(np.stack([1.0 - p1, p1])).astype(np.float32)
 
 
 def hand_made():

@@ -47,6 +47,16 @@ def check_on_csv(main, csv_text, args, rows):
     return text
 
 
+def two_class_log_probs(labels, sure):
+    """2 x 1 x N log-probabilities of a hand-made row of pixels: each pixel's label (0 or 1) with
+    probability `sure`, the other 1 − sure (two_looks' and scale_trend's hand-made fields)."""
+    import numpy as np
+
+    lab = np.array(labels)[None, :]
+    p1 = np.where(lab == 1, sure, 1.0 - sure)
+    return np.log(np.stack([1.0 - p1, p1])).astype(np.float32)
+
+
 def check_refused(main, argv, reason, what):
     """Exits unless `main(argv)` exits with a message containing `reason` (`what`: what is refused)."""
     try:
