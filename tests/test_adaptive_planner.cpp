@@ -5,6 +5,7 @@
 #include <adaptseg/vision/adaptive_mission.hpp>
 #include <adaptseg/vision/adaptive_planner.hpp>
 #include <adaptseg/vision/oracle_segmenter.hpp>
+#include <adaptseg/vision/region_samples.hpp>
 
 #include <doctest/doctest.h>
 
@@ -237,6 +238,15 @@ TEST_CASE("adaptive planner: grid anchors by name, as the programs' --grid reads
   CHECK(std::string(to_string(GridAnchor::corner)) == "corner");
   CHECK_THROWS_WITH_AS(static_cast<void>(parse_grid_anchor("centered")),
                        "grid anchor must be 'corner' or 'centred', not 'centered'", std::invalid_argument);
+}
+
+TEST_CASE("adaptive planner: descent grids by name, as the programs' --descent-grid and model files read them") {
+  for (const auto& row : kDescentGrids) {
+    CHECK(parse_descent_grid(row.name) == row.value);
+    CHECK(std::string(to_string(row.value)) == row.name);
+  }
+  CHECK_THROWS_WITH_AS(static_cast<void>(parse_descent_grid("shared")),
+                       "descent grid must be 'region' or 'field', not 'shared'", std::invalid_argument);
 }
 
 TEST_CASE("adaptive planner: coverage 'ranked' offers the best k cells by their expected error, for every k") {
@@ -938,6 +948,44 @@ TEST_CASE("AdaptivePlanner: live images made from poses land where the simulator
     const Image sim = sensor.capture(w);
     CHECK(live.footprint_px == sim.footprint_px);
     CHECK(live.gsd_cm == doctest::Approx(sim.gsd_cm));
+  }
+}
+
+TEST_CASE(
+    "AdaptivePlanner: DescentGrid::field shares the field's finer lawnmower out among the regions, as calibration "
+    "flies it") {
+  const Field f = Field::load(t::example_field("weedmap-000"));
+  Scripted never{.gsd = 0.5};
+  AdaptiveOptions o = weedmap_options(f);
+  const Planner by_region(SurveyArea::of(f), never, o);
+  o.descent_grid = DescentGrid::field;
+  const Planner by_field(SurveyArea::of(f), never, o);
+  const LawnmowerPlanner lawnmower(by_field.camera());
+  const auto has_field = [&](const Area& a) { return f.has_valid(a); };
+  for (double g : o.candidate_gsd_cm) {
+    CAPTURE(g);
+    const auto whole = lawnmower.plan(f.area(), g, Eigen::Vector2d(f.area().x_min_m, f.area().y_min_m), has_field);
+    std::vector<int> taken(whole.size(), 0);
+    std::size_t regions = 0, fields = 0;
+    for (std::size_t i = 0; i < by_field.top_level().size(); ++i) {
+      regions += by_region.sub_plan(i, g).size();
+      for (const Waypoint& w : by_field.sub_plan(i, g)) {
+        ++fields;
+        for (std::size_t k = 0; k < whole.size(); ++k)
+          if ((whole[k].position - w.position).norm() < 1e-9) ++taken[k];
+      }
+    }
+    // Each image of the field's own lawnmower at g is flown by exactly one region's descent.
+    CHECK(fields == whole.size());
+    for (int n : taken) CHECK(n == 1);
+    // Where the finer footprint does not divide the top level's (3 cm/px over 2 and 2.5), the
+    // regions' own grids fly more images than the field needs.
+    if (g == 2.0 || g == 2.5) CHECK(regions > fields);
+    // Calibration lays the same sub-lawnmowers: one cell sample per image.
+    OracleSegmenter oracle(f.num_classes());
+    const auto samples = collect_samples(f, oracle, by_field.camera(), o.top_gsd_cm, {g}, f.interest(),
+                                         DescentCoverage::ranked, 0, MapFusion::finest, false, DescentGrid::field);
+    CHECK(samples.cells.size() == fields);
   }
 }
 

@@ -3,6 +3,7 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -168,4 +169,58 @@ TEST_CASE("descent schedules: the windows of a lawnmower, and every name parses 
   CHECK_THROWS_WITH_AS(static_cast<void>(adaptseg::parse_descent_schedule("later")),
                        "descent schedule must be 'immediate', 'tour' or 'row', not 'later'", std::invalid_argument);
   CHECK_THROWS_AS(static_cast<void>(to_string(static_cast<DescentSchedule>(7))), std::invalid_argument);
+}
+
+TEST_CASE("lawnmower: cells_centred_in shares a grid's cells out among regions that tile it, each cell once") {
+  // Top level 14.4 x 10.8 m at 3 cm/px, the finer grid 9.6 x 7.2 m at 2 cm/px: 1.5 cells a side.
+  for (const adaptseg::LawnmowerOverlap o : {adaptseg::LawnmowerOverlap{}, adaptseg::LawnmowerOverlap{0.2, 0.1}}) {
+    CAPTURE(o.along);
+    const LawnmowerPlanner planner(CameraModel{}, o);
+    const Area laid{0, 0, 40.0, 30.0};
+    const auto fine = planner.plan(laid, 2.0);
+    std::vector<int> taken(fine.size(), 0);
+    std::size_t per_region_min = fine.size(), per_region_max = 0;
+    for (const Waypoint& t : LawnmowerPlanner(CameraModel{}).plan(laid, 3.0)) {
+      const auto box = planner.cells_centred_in(laid, 2.0, t.footprint, laid);
+      REQUIRE(box.has_value());
+      // From either corner: the same cells of the laid grid, each centred in the region.
+      for (const Eigen::Vector2d& start : {Eigen::Vector2d(box->x_min_m, box->y_min_m), t.position.head<2>().eval()}) {
+        const auto cells = planner.plan(*box, 2.0, start);
+        for (const Waypoint& c : cells) {
+          const Eigen::Vector2d m = c.footprint.centre();
+          // In the region, or beyond the field's far edge where the region reaches it.
+          const bool far_x = t.footprint.x_max_m >= laid.x_max_m, far_y = t.footprint.y_max_m >= laid.y_max_m;
+          CHECK((m.x() >= t.footprint.x_min_m - 1e-9 && (far_x || m.x() < t.footprint.x_max_m) &&
+                 m.y() >= t.footprint.y_min_m - 1e-9 && (far_y || m.y() < t.footprint.y_max_m)));
+          std::size_t hits = 0;
+          for (std::size_t k = 0; k < fine.size(); ++k)
+            if ((fine[k].position - c.position).norm() < 1e-9) ++hits, taken[k] += start.x() == box->x_min_m ? 1 : 0;
+          CHECK(hits == 1);
+        }
+        per_region_min = std::min(per_region_min, cells.size());
+        per_region_max = std::max(per_region_max, cells.size());
+      }
+    }
+    // Every cell of the finer grid goes to exactly one region; regions get 1 to 4 of them.
+    for (int n : taken) CHECK(n == 1);
+    CHECK(per_region_min >= 1);
+    CHECK(per_region_max <= 4);
+  }
+  const LawnmowerPlanner planner(CameraModel{});
+  // A region beyond the laid grid holds no centre; a grid's own footprint holds exactly itself.
+  const Area laid{0, 0, 40.0, 30.0};
+  CHECK_FALSE(planner.cells_centred_in(laid, 2.0, {-20.0, 0.0, -10.0, 10.0}, {-20.0, 0.0, 40.0, 30.0}).has_value());
+  const auto self = planner.cells_centred_in(laid, 2.0, {9.6, 7.2, 19.2, 14.4}, laid);
+  REQUIRE(self.has_value());
+  CHECK(self->x_min_m == doctest::Approx(9.6));
+  CHECK(self->x_max_m == doctest::Approx(19.2));
+  CHECK(planner.plan(*self, 2.0).size() == 1);
+  // A region past the field's far edge takes the cells beyond it: the last column's centre (43.2 m) lies
+  // on the top level's far edge, outside every region's half-open span.
+  const auto last = planner.cells_centred_in(laid, 2.0, {28.8, 0.0, 43.2, 10.8}, laid);
+  REQUIRE(last.has_value());
+  CHECK(last->x_max_m == doctest::Approx(48.0));
+  CHECK_THROWS_AS(static_cast<void>(planner.cells_centred_in(laid, 0.0, {0, 0, 1, 1}, laid)), std::invalid_argument);
+  CHECK_THROWS_AS(static_cast<void>(planner.cells_centred_in({0, 0, 0.0, 30.0}, 2.0, {0, 0, 1, 1}, laid)),
+                  std::invalid_argument);
 }

@@ -888,11 +888,23 @@ TEST_CASE("robustness: decision model: refit count out of range") {
                        std::invalid_argument);
 }
 
-TEST_CASE("robustness: decision model: unknown descent coverage") {
+TEST_CASE("robustness: decision model: unknown descent coverage or grid") {
   const t::TempDir dir;
   const std::string text = replaced(model_text(), "descent_coverage: region", "descent_coverage: everywhere");
   CHECK_THROWS_WITH_AS((void)load_model_text(dir, text), Contains("'region', 'interest' or 'ranked'"),
                        std::invalid_argument);
+  const auto with_grid = [&](const std::string& g) {
+    return replaced(model_text(), "descent_coverage: region", "descent_coverage: region\ndescent_grid: " + g);
+  };
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, with_grid("shared")),
+                       Contains("descent grid must be 'region' or 'field', not 'shared'"), std::invalid_argument);
+  // A known grid is read, handed to the missions' options, and written back (a file without the key: region).
+  const DecisionModel m = load_model_text(dir, with_grid("field"));
+  CHECK(m.descent_grid == DescentGrid::field);
+  CHECK(m.adaptive_options({}).descent_grid == DescentGrid::field);
+  m.save(dir.path() / "again.yaml");
+  CHECK(DecisionModel::load(dir.path() / "again.yaml").descent_grid == DescentGrid::field);
+  CHECK(load_model_text(dir, model_text()).descent_grid == DescentGrid::region);
 }
 
 TEST_CASE("robustness: decision model: I with three inputs") {

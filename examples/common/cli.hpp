@@ -238,6 +238,7 @@ struct CalibrationCli {
   std::string rule = "front-aware";
   int threshold_steps = 10;
   std::string coverage = "ranked";
+  std::string descent_grid = to_string(DescentGrid::region);
   std::string gain_inputs = "delta-sigma-height";
   std::vector<double> confidences = kDefaultConfidences;
   std::string sigma_prior = to_string(CalibrationOptions::kDefaultSigmaPrior);
@@ -274,6 +275,14 @@ struct CalibrationCli {
                        "ranked by a decision input of the top-level image, e.g. the network's expected error about "
                        "L; the number of cells chosen in flight); saved in the model")
             ->check(CLI::IsMember(detail::names_of(kDescentCoverages)))
+            ->capture_default_str(),
+        app.add_option(
+               "--descent-grid", descent_grid,
+               "how a descent's sub-lawnmower is laid: region (on its top-level footprint, the paper's; where "
+               "the finer footprint does not divide it, neighbouring descents fly over the same ground) or field "
+               "(the cells of the whole field's lawnmower at the descent's GSD whose centres lie in the region: "
+               "no ground flown twice); saved in the model")
+            ->check(CLI::IsMember(detail::names_of(kDescentGrids)))
             ->capture_default_str(),
         app.add_option("--cell-input", cell_inputs,
                        "coverage ranked: the decision inputs tried for ranking and forecasting cells, comma-separated "
@@ -409,6 +418,7 @@ struct CalibrationCli {
     options.confidences = confidences;
     options.sigma_prior = parse_sigma_prior_source(sigma_prior);
     options.adaptive.coverage = parse_descent_coverage(coverage);
+    options.adaptive.descent_grid = parse_descent_grid(descent_grid);
     options.front_aware.curve = parse_curve_source(curve);
     options.front_aware.field_factor = parse_field_factor_source(field_factor);
     options.gain_ratios = gain_ratios;

@@ -13,8 +13,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace adaptseg {
@@ -122,6 +124,43 @@ class LawnmowerPlanner {
     const double h = (ny - 1) * fp.height_m * (1.0 - overlap_.across) + fp.height_m;
     const double dx = 0.5 * (w - area.width_m()), dy = 0.5 * (h - area.height_m());
     return {area.x_min_m - dx, area.y_min_m - dy, area.x_max_m + dx, area.y_max_m + dy};
+  }
+
+  /// The cells of the grid that plan() lays on `laid` at `gsd_cm` from its corner (x_min, y_min)
+  /// whose centres lie in `region` (x_min <= c < x_max on each axis, within 1e-9 of a step; where
+  /// `region` reaches an edge of `bounds`, the rectangle the regions were laid to cover, beyond
+  /// that edge too): the rectangle of their whole footprints, or nothing where no centre does.
+  /// plan() over it, from any corner, flies exactly those cells of the laid grid, so regions that
+  /// tile `bounds` (a lawnmower's footprints over it) share out its cells, each to one region
+  /// (AdaptiveOptions::descent_grid, DescentGrid::field).
+  /// @throws std::invalid_argument as plan().
+  [[nodiscard]] std::optional<Area> cells_centred_in(const Area& laid, double gsd_cm, const Area& region,
+                                                     const Area& bounds) const {
+    detail::require_positive(gsd_cm, "LawnmowerPlanner::cells_centred_in: gsd_cm");
+    detail::require(std::isfinite(laid.width_m()) && laid.width_m() > 0.0 && std::isfinite(laid.height_m()) &&
+                        laid.height_m() > 0.0,
+                    "LawnmowerPlanner::cells_centred_in: laid must have a finite positive size [m]",
+                    laid.width_m() * laid.height_m());
+    const Extent fp = camera_.footprint_at_gsd(gsd_cm);
+    // Per axis the first and last cell index whose centre lies in [lo, hi) (open where the
+    // region reaches the bounds' edge).
+    const auto span = [](double origin, double f, double step, int n, double lo, double hi, double b_lo, double b_hi) {
+      const double tol = 1e-9 * step;
+      const int first =
+          lo <= b_lo + tol ? 0 : std::max(0, static_cast<int>(std::ceil((lo - origin - 0.5 * f) / step - 1e-9)));
+      const int last = hi >= b_hi - tol
+                           ? n - 1
+                           : std::min(n - 1, static_cast<int>(std::ceil((hi - origin - 0.5 * f) / step - 1e-9)) - 1);
+      return std::pair{first, last};
+    };
+    const double sx = fp.width_m * (1.0 - overlap_.along), sy = fp.height_m * (1.0 - overlap_.across);
+    const auto [x0, x1] = span(laid.x_min_m, fp.width_m, sx, cells(laid.width_m(), fp.width_m, overlap_.along),
+                               region.x_min_m, region.x_max_m, bounds.x_min_m, bounds.x_max_m);
+    const auto [y0, y1] = span(laid.y_min_m, fp.height_m, sy, cells(laid.height_m(), fp.height_m, overlap_.across),
+                               region.y_min_m, region.y_max_m, bounds.y_min_m, bounds.y_max_m);
+    if (x0 > x1 || y0 > y1) return std::nullopt;
+    return Area{laid.x_min_m + x0 * sx, laid.y_min_m + y0 * sy, laid.x_min_m + x1 * sx + fp.width_m,
+                laid.y_min_m + y1 * sy + fp.height_m};
   }
 
   /// plan() keeping every cell.

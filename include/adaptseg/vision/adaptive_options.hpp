@@ -54,6 +54,35 @@ inline constexpr std::array<detail::NamedValue<GridAnchor>, 2> kGridAnchors{{
   return detail::value_named(kGridAnchors, s, "grid anchor");
 }
 
+/// How a descent's sub-lawnmower is laid (beyond the paper).
+enum class DescentGrid {
+  /// On its region, as AdaptiveOptions::grid_anchor says (the paper's W^{h'}): where the finer
+  /// footprint does not divide the region (15 to 10 cm/px: 1.5 footprints a side) the grid
+  /// overhangs it, 2 x 2 images covering 1.78 regions, and neighbouring descents fly over the
+  /// same ground.
+  region,
+  /// The cells of the whole area's lawnmower at the descent's GSD (laid as the top level's is)
+  /// whose centres lie in the region (LawnmowerPlanner::cells_centred_in): each cell belongs to
+  /// one region, so descents share out the finer lawnmower without flying any ground twice; a
+  /// region may get fewer images than a side of it needs (15 to 10 cm/px: 1 to 4, 2.25 on average).
+  field,
+};
+
+/// Every descent grid and its name (the programs' `--descent-grid`; model files' `descent_grid`).
+inline constexpr std::array<detail::NamedValue<DescentGrid>, 2> kDescentGrids{{
+    {DescentGrid::region, "region"},
+    {DescentGrid::field, "field"},
+}};
+
+/// "region" or "field".
+[[nodiscard]] inline const char* to_string(DescentGrid g) { return detail::name_of(kDescentGrids, g, "descent grid"); }
+
+/// Parses a descent grid's name.
+/// @throws std::invalid_argument naming both for anything else.
+[[nodiscard]] inline DescentGrid parse_descent_grid(const std::string& s) {
+  return detail::value_named(kDescentGrids, s, "descent grid");
+}
+
 /// Settings of an adaptive mission.
 struct AdaptiveOptions {
   /// Camera, timing, labels of interest, fixed per-image/waypoint times. AdaptivePlanner needs
@@ -82,6 +111,9 @@ struct AdaptiveOptions {
   /// When the chosen descents are flown: at once (the paper), or deferred to a tour after the
   /// survey or after each lawnmower row where that is cheaper.
   DescentSchedule schedule = DescentSchedule::immediate;
+  /// How each descent's sub-lawnmower is laid (DescentGrid). A decision model must be calibrated
+  /// with the same (its samples are flown so; DecisionModel::descent_grid).
+  DescentGrid descent_grid = DescentGrid::region;
 };
 
 /// The decision taken at one top-level waypoint.

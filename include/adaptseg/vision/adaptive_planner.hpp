@@ -87,7 +87,7 @@ class AdaptivePlanner {
   ///         descend to), a budget that is not positive, or one too small for the top-level
   ///         coverage alone.
   AdaptivePlanner(SurveyArea area, Policy& policy, AdaptiveOptions options, TimeAccount* shared = nullptr)
-      : grid_(std::move(area), CameraModel(options.mission.camera), options.grid_anchor),
+      : grid_(std::move(area), CameraModel(options.mission.camera), options.grid_anchor, options.descent_grid),
         timing_(options.mission.timing),
         map_(grid_.size(), grid_.area().ignore_label, options.mission.map_fusion, options.mission.interest),
         policy_(policy),
@@ -210,8 +210,9 @@ class AdaptivePlanner {
 
   /// The sub-lawnmower that re-maps the region of top-level waypoint `top_index` at `gsd_cm`
   /// (paper §3.2.1 W^{h'}): its grid laid as AdaptiveOptions::grid_anchor says (from the region's
-  /// corner nearest that waypoint, or centred on the region), visited from the corner nearest
-  /// the waypoint, cells without field skipped.
+  /// corner nearest that waypoint, or centred on the region), or with DescentGrid::field the
+  /// cells of the area's lawnmower at `gsd_cm` centred in the region, visited from the corner
+  /// nearest the waypoint, cells without field skipped.
   /// @throws std::invalid_argument for an index out of range or a GSD that is not positive.
   [[nodiscard]] std::vector<Waypoint> sub_plan(std::size_t top_index, double gsd_cm) const {
     detail::require(top_index < route_.top().size(), "AdaptivePlanner::sub_plan: top_index out of range", top_index);

@@ -84,6 +84,7 @@ struct DecisionModel {
   /// What the model's descents re-map (its samples were taken so); files without the key are
   /// `region`, the paper's.
   DescentCoverage coverage = DescentCoverage::region;
+  DescentGrid descent_grid = DescentGrid::region;  ///< how its descents were laid; files without the key: region
   DecisionFunction decision_function;
   LinearDecision::Params linear{};
   std::size_t samples = 0;          ///< region samples the GPs were fitted to
@@ -97,7 +98,7 @@ struct DecisionModel {
   MapFusion map_fusion = MapFusion::finest;
 
   /// The planner options of a mission flown with this model: its camera, timing, top and
-  /// candidate GSDs, descent coverage and map fusion, with `mission`'s labels of interest and
+  /// candidate GSDs, descent coverage and grid and map fusion, with `mission`'s labels of interest and
   /// fixed times.
   [[nodiscard]] AdaptiveOptions adaptive_options(MissionOptions mission,
                                                  std::optional<double> budget_s = std::nullopt) const {
@@ -105,6 +106,7 @@ struct DecisionModel {
     mission.timing = timing;
     mission.map_fusion = map_fusion;
     AdaptiveOptions o{std::move(mission), top_gsd_cm, candidate_gsd_cm, budget_s, coverage};
+    o.descent_grid = descent_grid;
     if (const auto& cells = decision_function.model().cells()) o.cell_input = cells->input();
     return o;
   }
@@ -242,6 +244,7 @@ struct DecisionModel {
     detail::emit_numbers(e, candidate_gsd_cm);
     e << YAML::Key << "descent_coverage" << YAML::Value << to_string(coverage);
     // Written only when not the paper's, so that earlier models keep their bytes.
+    if (descent_grid != DescentGrid::region) e << YAML::Key << "descent_grid" << YAML::Value << to_string(descent_grid);
     if (map_fusion != MapFusion::finest) e << YAML::Key << "map_fusion" << YAML::Value << to_string(map_fusion);
     e << YAML::Key << "linear" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "sigma_low" << YAML::Value
       << num(linear.sigma_low) << YAML::Key << "sigma_high" << YAML::Value << num(linear.sigma_high) << YAML::EndMap;
@@ -307,6 +310,7 @@ struct DecisionModel {
     m.top_gsd_cm = r.number("top_gsd_cm");
     m.candidate_gsd_cm = r.numbers("candidate_gsd_cm");
     if (r.has("descent_coverage")) m.coverage = parse_descent_coverage(r.text("descent_coverage"));
+    if (r.has("descent_grid")) m.descent_grid = parse_descent_grid(r.text("descent_grid"));
     if (r.has("map_fusion")) m.map_fusion = parse_map_fusion(r.text("map_fusion"));
     const auto lin = r.map("linear");
     m.linear = {lin.number("sigma_low"), lin.number("sigma_high")};

@@ -8,6 +8,7 @@
 #include <adaptseg/core/cell_gain_model.hpp>
 #include <adaptseg/core/decision.hpp>
 #include <adaptseg/core/lawnmower_planner.hpp>
+#include <adaptseg/vision/adaptive_options.hpp>
 #include <adaptseg/vision/descent_coverage.hpp>
 #include <adaptseg/vision/grid_inputs.hpp>
 #include <adaptseg/vision/metrics.hpp>
@@ -44,13 +45,14 @@ class SampleCollector {
  public:
   SampleCollector(const Field& field, Backend& backend, const CameraModel& camera, double top_gsd_cm,
                   const std::vector<int>& interest, DescentCoverage coverage, std::size_t field_index, MapFusion fusion,
-                  bool frame_check)
+                  bool frame_check, DescentGrid descent_grid)
       : field_(field),
         backend_(backend),
         camera_(camera),
         top_gsd_cm_(top_gsd_cm),
         interest_(interest),
         covers_(descent_coverage_info(coverage)),
+        descent_grid_(descent_grid),
         field_index_(field_index),
         fusion_(fusion),
         sensor_(field, camera),
@@ -150,7 +152,12 @@ class SampleCollector {
       return keep(a) && (!covers_.flies || covers_.flies(r.map.labels(), field_.pixel_rect(a) - r.region.tl(),
                                                          top_gsd_cm_, field_.gsd_cm(), interest_));
     };
-    const auto sub = planner_.plan(top.footprint, g, Eigen::Vector2d(top.position.x(), top.position.y()), keep_cell);
+    // The sub-lawnmower as AdaptivePlanner::sub_plan lays it (the field's grid from its corner).
+    const std::optional<Area> on = descent_grid_ == DescentGrid::field
+                                       ? planner_.cells_centred_in(field_.area(), g, top.footprint, field_.area())
+                                       : std::optional<Area>(top.footprint);
+    const auto sub = on ? planner_.plan(*on, g, Eigen::Vector2d(top.position.x(), top.position.y()), keep_cell)
+                        : std::vector<Waypoint>{};
     if (sub.empty()) return;
     // Fuse the sub-lawnmower into a map of the region alone (region_map()).
     SemanticMap local = region_map(r);
@@ -312,6 +319,7 @@ class SampleCollector {
   double top_gsd_cm_;
   const std::vector<int>& interest_;
   const DescentCoverageInfo& covers_;
+  DescentGrid descent_grid_;  ///< how each sub-lawnmower is laid (AdaptiveOptions::descent_grid)
   std::size_t field_index_;
   MapFusion fusion_;
   SimulatedSensor sensor_;
@@ -352,6 +360,8 @@ class SampleCollector {
 /// (MissionOptions::map_fusion); with MapFusion::pooled every image is segmented with its class
 /// probabilities and a descent's region map pools the top-level image with the finer ones, as the
 /// mission's map does. `frame_check`: CalibrationOptions::frame_check (cells only).
+/// `descent_grid`: how each sub-lawnmower is laid, as AdaptivePlanner::sub_plan lays it
+/// (AdaptiveOptions::descent_grid).
 /// @throws std::invalid_argument for a top GSD finer than the field's or candidates not finer
 ///         than the top, or an empty `interest`.
 template <SegmentationBackend Backend>
@@ -360,7 +370,8 @@ template <SegmentationBackend Backend>
                                                  const std::vector<int>& interest,
                                                  DescentCoverage coverage = DescentCoverage::region,
                                                  std::size_t field_index = 0, MapFusion fusion = MapFusion::finest,
-                                                 bool frame_check = false) {
+                                                 bool frame_check = false,
+                                                 DescentGrid descent_grid = DescentGrid::region) {
   detail::require(top_gsd_cm >= field.gsd_cm() * (1.0 - 1e-9),
                   "collect_region_samples: top_gsd_cm is finer than the field's GSD", top_gsd_cm);
   detail::require(!interest.empty(), "collect_region_samples: no labels of interest", 0);
@@ -368,7 +379,7 @@ template <SegmentationBackend Backend>
     detail::require(std::isfinite(g) && g > 0.0 && g < top_gsd_cm,
                     "collect_region_samples: candidate GSDs must be finer than top_gsd_cm", g);
   return detail::SampleCollector<Backend>(field, backend, camera, top_gsd_cm, interest, coverage, field_index, fusion,
-                                          frame_check)
+                                          frame_check, descent_grid)
       .collect(candidate_gsd_cm);
 }
 

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -22,12 +23,17 @@ namespace adaptseg::detail {
 
 /// A SurveyArea on its map grid (the valid mask's, or just enough to cover the area, every
 /// pixel of the area field where the mask is not given), seen by `camera`, with the
-/// lawnmowers' grids laid as `anchor` says (AdaptiveOptions::grid_anchor).
+/// lawnmowers' grids laid as `anchor` says (AdaptiveOptions::grid_anchor) and each descent's
+/// as `descent` says (AdaptiveOptions::descent_grid).
 class SurveyGrid {
  public:
   /// @throws std::invalid_argument for an invalid area (SurveyArea's contract).
-  SurveyGrid(SurveyArea area, CameraModel camera, GridAnchor anchor)
-      : area_(std::move(area)), camera_(std::move(camera)), anchor_(anchor), size_(grid_size(area_)) {
+  SurveyGrid(SurveyArea area, CameraModel camera, GridAnchor anchor, DescentGrid descent = DescentGrid::region)
+      : area_(std::move(area)),
+        camera_(std::move(camera)),
+        anchor_(anchor),
+        descent_(descent),
+        size_(grid_size(area_)) {
     if (area_.valid_mask.empty()) {
       area_.valid_mask = cv::Mat(size_, CV_8UC1, cv::Scalar(0));
       area_.valid_mask(pixel_rect(area_.area) & rect()).setTo(255);
@@ -92,24 +98,34 @@ class SurveyGrid {
   /// A lawnmower over the whole area at `gsd_cm`, its grid laid as the anchor says, the cells
   /// without field left out.
   [[nodiscard]] std::vector<Waypoint> lawnmower(double gsd_cm) const {
-    const LawnmowerPlanner planner(camera_);
-    const Area laid = anchor_ == GridAnchor::centred ? planner.centred_grid(area_.area, gsd_cm) : area_.area;
-    return planner.plan(laid, gsd_cm, Eigen::Vector2d(laid.x_min_m, laid.y_min_m), keep());
+    const Area laid = laid_grid(gsd_cm);
+    return LawnmowerPlanner(camera_).plan(laid, gsd_cm, Eigen::Vector2d(laid.x_min_m, laid.y_min_m), keep());
   }
 
   /// The sub-lawnmower over the region of top-level waypoint `t` at `gsd_cm` (paper §3.2.1
-  /// W^{h'}), laid on sub_grid(), visited from the corner nearest `t`, the cells `keep_cell`
-  /// keeps (default: those with field under them).
+  /// W^{h'}), laid on sub_grid() (DescentGrid::field: the cells of lawnmower(gsd_cm) centred in
+  /// the region; none where no centre is), visited from the corner nearest `t`, the cells
+  /// `keep_cell` keeps (default: those with field under them).
   template <class Keep>
   [[nodiscard]] std::vector<Waypoint> sub_lawnmower(const Waypoint& t, double gsd_cm, Keep&& keep_cell) const {
-    return LawnmowerPlanner(camera_).plan(sub_grid(t, gsd_cm), gsd_cm, Eigen::Vector2d(t.position.x(), t.position.y()),
-                                          std::forward<Keep>(keep_cell));
+    const LawnmowerPlanner planner(camera_);
+    const std::optional<Area> on = descent_ == DescentGrid::field
+                                       ? planner.cells_centred_in(laid_grid(gsd_cm), gsd_cm, t.footprint, area_.area)
+                                       : std::optional<Area>(sub_grid(t, gsd_cm));
+    if (!on) return {};
+    return planner.plan(*on, gsd_cm, Eigen::Vector2d(t.position.x(), t.position.y()), std::forward<Keep>(keep_cell));
   }
   [[nodiscard]] std::vector<Waypoint> sub_lawnmower(const Waypoint& t, double gsd_cm) const {
     return sub_lawnmower(t, gsd_cm, keep());
   }
 
  private:
+  /// The rectangle the whole area's lawnmower at `gsd_cm` is laid on: the area, or (centred)
+  /// the grid centred on it.
+  [[nodiscard]] Area laid_grid(double gsd_cm) const {
+    return anchor_ == GridAnchor::centred ? LawnmowerPlanner(camera_).centred_grid(area_.area, gsd_cm) : area_.area;
+  }
+
   /// The map grid's size: the mask's, or just enough to cover the area.
   static cv::Size grid_size(const SurveyArea& a) {
     const Area& r = a.area;
@@ -153,6 +169,7 @@ class SurveyGrid {
   SurveyArea area_;
   CameraModel camera_;
   GridAnchor anchor_;
+  DescentGrid descent_;
   cv::Size size_;
   double valid_px_ = 0.0;
 };
