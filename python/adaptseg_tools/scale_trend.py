@@ -2,11 +2,11 @@
 
 The top level's own inputs tell where a closer look changes labels, not whether the changes are
 right (docs/journal/2026-12-guard.md). A look coarser than the top level costs no flight: the
-top-level images shrunk, or a lawnmower higher up. This tool asks whether the way the labels move
-from that coarser look to the top level (the scale trend, label-free before any descent) tells
-what the next step, from the top level to a closer look, is worth. Per field and class of
-interest L, each map painted over the whole field as two_looks paints it (each image's
-log(max(p_c, 1/256)) summed per pixel, the map its argmax):
+top-level images shrunk (here a lawnmower at that GSD stands for it). This tool asks whether the
+way the labels move from that coarser look to the top level (the scale trend, label-free before
+any descent) tells what the next step, from the top level to a closer look, is worth. Per field
+and class of interest L, each map painted over the whole field as two_looks paints it (each
+image's log(max(p_c, 1/256)) summed per pixel, the map its argmax):
 
   - cells: the finer lawnmower's footprints (what a descent's images cover); a cell's `gain` is
     the field's IoU of L when that cell alone takes the pooled map of the top level and the finer
@@ -14,9 +14,9 @@ log(max(p_c, 1/256)) summed per pixel, the map its argmax):
   - per cell, four rankings: `ambiguity`, the share of the cell where the top level's pooled
     probability of L lies in (0.2, 0.8) (the deployment's decision input, DecisionInput::ambiguity,
     read off the pooled map rather than image by image); `unsure`, the mean of 1 − the top level's
-    pooled probability of its class (the guard's reading of how sure it is); `scale`, the share of the cell whose label
-    moves from the coarser look to the top level with L one of the two labels (label-free, before
-    any descent); and `relabelled`, the share whose label moves from the top level to the finer
+    pooled probability of its class (the guard's reading of how sure it is); `scale`, the share of
+    the cell whose label moves from the coarser look to the top level with L one of the two labels
+    (label-free, before any descent); and `relabelled`, the share whose label moves from the top level to the finer
     look with L one of the two (what a descent would show; not known before it);
   - per field, each ranking's rank correlation with the cells' gains (`rho`), and with the
     relabelled share (`rho rel`): how well it tells where labels change;
@@ -35,9 +35,9 @@ Usage:
   at --coarse times each top level's GSD, a lawnmower flown that high). Prints Markdown: a row per
   class, field, top level and closer look, then per class each ranking's mean rank correlation
   over them. --cells-csv writes PREFIX-CLASS.csv, the cells with their gains and rankings as
-  cell_ceiling reads them (top_ambiguity, top_unsure, top_scale, relabelled), to set beside a calibration's
-  model (its fields' lawnmower curves): what fixed plans ranked so would earn. Needs torch, as
-  eval_ensemble does.
+  cell_ceiling reads them (top_ambiguity, top_unsure, top_scale, relabelled), to set beside a
+  calibration's model (its fields' lawnmower curves): what fixed plans ranked so would earn.
+  Needs torch, as eval_ensemble does.
 """
 
 from __future__ import annotations
@@ -134,8 +134,8 @@ def write_cells(prefix: str, rows, wanted) -> None:
             for n, _, r in rows:
                 if n == name:
                     for c in r["cell_rows"]:
-                        w.writerow([r["field"], c["region"], f"{r['top_gsd']:g}", f"{r['fine_gsd']:g}", f"{c['gain']:.6g}",
-                                    f"{c['ambiguity']:.6g}", f"{c['unsure']:.6g}", f"{c['scale']:.6g}", f"{c['relabelled']:.6g}"])
+                        w.writerow([r["field"], c["region"], f"{r['top_gsd']:g}", f"{r['fine_gsd']:g}",
+                                    *(f"{c[k]:.6g}" for k in ("gain", "ambiguity", "unsure", "scale", "relabelled"))])
 
 
 def factors(text: str, option: str) -> list[float]:
@@ -196,7 +196,8 @@ def main(argv=None):
           + " | ".join(f"rho {k}" for k in RANKINGS) + " | " + " | ".join(f"rho rel {k}" for k in RANKINGS[:-1]) + " |")
     print("| --- | --- | --- |" + " ---: |" * (5 + 2 * len(RANKINGS) - 1))
     for name, label, r in sorted(rows, key=lambda x: (wanted.index(x[0]), x[1], -x[2]["top_gsd"], -x[2]["fine_gsd"])):
-        print(f"| {name} | {label} | {r['top_gsd']:g} → {r['fine_gsd']:g} | {r['cells']} | {r['field_gain']:+.4f} | {r['scale_share']:.4f} | "
+        print(f"| {name} | {label} | {r['top_gsd']:g} → {r['fine_gsd']:g} | {r['cells']} | {r['field_gain']:+.4f} | "
+              f"{r['scale_share']:.4f} | "
               f"{r['scale_sure']:.2f} | {r['sure_changes']:.2f} | "
               + " | ".join(fmt(r["rho"][k]) for k in RANKINGS) + " | "
               + " | ".join(fmt(r["rho_rel"][k]) for k in RANKINGS[:-1]) + " |")
