@@ -74,10 +74,7 @@ class LawnmowerPlanner {
   [[nodiscard]] std::vector<Waypoint> plan(const Area& area, double gsd_cm, const Eigen::Vector2d& start_xy,
                                            Keep&& keep) const {
     detail::require_positive(gsd_cm, "LawnmowerPlanner::plan: gsd_cm");
-    detail::require(std::isfinite(area.width_m()) && area.width_m() > 0.0 && std::isfinite(area.height_m()) &&
-                        area.height_m() > 0.0,
-                    "LawnmowerPlanner::plan: area must have a finite positive size [m]",
-                    area.width_m() * area.height_m());
+    require_extent(area, "LawnmowerPlanner::plan: area must have a finite positive size [m]");
     const Extent fp = camera_.footprint_at_gsd(gsd_cm);
     const double altitude = camera_.altitude_m(gsd_cm);
     const double step_x = fp.width_m * (1.0 - overlap_.along);
@@ -113,10 +110,7 @@ class LawnmowerPlanner {
   /// @throws std::invalid_argument if the GSD is not positive or the area is empty.
   [[nodiscard]] Area centred_grid(const Area& area, double gsd_cm) const {
     detail::require_positive(gsd_cm, "LawnmowerPlanner::centred_grid: gsd_cm");
-    detail::require(std::isfinite(area.width_m()) && area.width_m() > 0.0 && std::isfinite(area.height_m()) &&
-                        area.height_m() > 0.0,
-                    "LawnmowerPlanner::centred_grid: area must have a finite positive size [m]",
-                    area.width_m() * area.height_m());
+    require_extent(area, "LawnmowerPlanner::centred_grid: area must have a finite positive size [m]");
     const Extent fp = camera_.footprint_at_gsd(gsd_cm);
     const int nx = cells(area.width_m(), fp.width_m, overlap_.along);
     const int ny = cells(area.height_m(), fp.height_m, overlap_.across);
@@ -137,10 +131,7 @@ class LawnmowerPlanner {
   [[nodiscard]] std::optional<Area> cells_centred_in(const Area& laid, double gsd_cm, const Area& region,
                                                      const Area& bounds) const {
     detail::require_positive(gsd_cm, "LawnmowerPlanner::cells_centred_in: gsd_cm");
-    detail::require(std::isfinite(laid.width_m()) && laid.width_m() > 0.0 && std::isfinite(laid.height_m()) &&
-                        laid.height_m() > 0.0,
-                    "LawnmowerPlanner::cells_centred_in: laid must have a finite positive size [m]",
-                    laid.width_m() * laid.height_m());
+    require_extent(laid, "LawnmowerPlanner::cells_centred_in: laid must have a finite positive size [m]");
     const Extent fp = camera_.footprint_at_gsd(gsd_cm);
     // Per axis the first and last cell index whose centre lies in [lo, hi) (open where the
     // region reaches the bounds' edge).
@@ -174,6 +165,13 @@ class LawnmowerPlanner {
   }
 
  private:
+  /// Refuses, with `what`, a rectangle without a finite positive width and height.
+  static void require_extent(const Area& a, const char* what) {
+    detail::require(
+        std::isfinite(a.width_m()) && a.width_m() > 0.0 && std::isfinite(a.height_m()) && a.height_m() > 0.0, what,
+        a.width_m() * a.height_m());
+  }
+
   /// Number of footprints needed along one axis; a tolerance keeps exact multiples exact.
   static int cells(double length_m, double footprint_m, double overlap) {
     if (overlap == 0.0) return std::max(1, static_cast<int>(std::ceil(length_m / footprint_m - 1e-9)));

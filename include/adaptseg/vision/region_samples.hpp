@@ -10,6 +10,7 @@
 #include <adaptseg/core/lawnmower_planner.hpp>
 #include <adaptseg/vision/adaptive_options.hpp>
 #include <adaptseg/vision/descent_coverage.hpp>
+#include <adaptseg/vision/detail/survey_grid.hpp>
 #include <adaptseg/vision/grid_inputs.hpp>
 #include <adaptseg/vision/metrics.hpp>
 #include <adaptseg/vision/segmentation_backend.hpp>
@@ -52,7 +53,7 @@ class SampleCollector {
         top_gsd_cm_(top_gsd_cm),
         interest_(interest),
         covers_(descent_coverage_info(coverage)),
-        descent_grid_(descent_grid),
+        survey_(SurveyArea::of(field), camera, GridAnchor::corner, descent_grid),
         field_index_(field_index),
         fusion_(fusion),
         sensor_(field, camera),
@@ -152,12 +153,8 @@ class SampleCollector {
       return keep(a) && (!covers_.flies || covers_.flies(r.map.labels(), field_.pixel_rect(a) - r.region.tl(),
                                                          top_gsd_cm_, field_.gsd_cm(), interest_));
     };
-    // The sub-lawnmower as AdaptivePlanner::sub_plan lays it (the field's grid from its corner).
-    const std::optional<Area> on = descent_grid_ == DescentGrid::field
-                                       ? planner_.cells_centred_in(field_.area(), g, top.footprint, field_.area())
-                                       : std::optional<Area>(top.footprint);
-    const auto sub = on ? planner_.plan(*on, g, Eigen::Vector2d(top.position.x(), top.position.y()), keep_cell)
-                        : std::vector<Waypoint>{};
+    // The sub-lawnmower as AdaptivePlanner::sub_plan lays it.
+    const auto sub = survey_.sub_lawnmower(top, g, keep_cell);
     if (sub.empty()) return;
     // Fuse the sub-lawnmower into a map of the region alone (region_map()).
     SemanticMap local = region_map(r);
@@ -319,7 +316,8 @@ class SampleCollector {
   double top_gsd_cm_;
   const std::vector<int>& interest_;
   const DescentCoverageInfo& covers_;
-  DescentGrid descent_grid_;  ///< how each sub-lawnmower is laid (AdaptiveOptions::descent_grid)
+  /// The field as the planner lays its descents (grid from the corner, AdaptiveOptions::descent_grid).
+  SurveyGrid survey_;
   std::size_t field_index_;
   MapFusion fusion_;
   SimulatedSensor sensor_;
