@@ -54,7 +54,7 @@ from .eval_ensemble import load_member
 from .fieldio import IGNORE
 from .proxy_table import spearman
 from .training.fields import lawnmower_rects, load_field
-from .two_looks import GUARD, confidence, painted_log_probabilities
+from .two_looks import GUARD, confidence, factors, iou, painted_log_probabilities
 
 RANKINGS = ("ambiguity", "unsure", "scale", "relabelled")
 
@@ -113,7 +113,7 @@ def field_measures(coarse_lp, top_lp, fine_lp, top_gsd: float, fine_gsd: float, 
     top_sure = confidence(top_lp) > GUARD
     gains = [c["gain"] for c in cells]
     return {
-        "field_gain": iou_of(*np.array([(pooled & t).sum(), (pooled & ~t).sum(), (~pooled & t).sum()], float)) - base,
+        "field_gain": iou(pooled, t) - base,
         "scale_share": float(scale_moved.sum() / max(1, valid.sum())),
         "scale_sure": float(coarse_sure[scale_moved].mean()) if scale_moved.any() else math.nan,
         "sure_changes": float(top_sure[fine_moved].mean()) if fine_moved.any() else math.nan,
@@ -138,14 +138,10 @@ def write_cells(prefix: str, rows, wanted) -> None:
                                     *(f"{c[k]:.6g}" for k in ("gain", "ambiguity", "unsure", "scale", "relabelled"))])
 
 
-def factors(text: str, option: str) -> list[float]:
-    try:
-        out = [float(x) for x in text.split(",")]
-    except ValueError:
-        raise SystemExit(f"{option} {text}: not a list of numbers") from None
-    if not all(f > 0 for f in out):
-        raise SystemExit(f"{option} {text}: each must be above 0")
-    return out
+def mean(values) -> float:
+    """The mean of the values that are not NaN (NaN where none is)."""
+    v = [x for x in values if not math.isnan(x)]
+    return sum(v) / len(v) if v else math.nan
 
 
 def fmt(x: float) -> str:
@@ -207,11 +203,6 @@ def main(argv=None):
     print("| --- | ---: |" + " ---: |" * (2 * len(RANKINGS) - 1))
     for name in wanted:
         rs = [r for n, _, r in rows if n == name]
-
-        def mean(vals):
-            v = [x for x in vals if not math.isnan(x)]
-            return sum(v) / len(v) if v else math.nan
-
         print(f"| {name} | {len(rs)} | " + " | ".join(fmt(mean([r["rho"][k] for r in rs])) for k in RANKINGS) + " | "
               + " | ".join(fmt(mean([r["rho_rel"][k] for r in rs])) for k in RANKINGS[:-1]) + " |")
 

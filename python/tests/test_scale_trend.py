@@ -118,7 +118,7 @@ def main():
 
     check_refused(scale_trend.main, ["--loto", str(loto), "--coarse", "1"], "must be above 1", "a coarser look of 1")
     check_refused(scale_trend.main, ["--loto", str(loto), "--fine", "3"], "below each --top", "a fine look at the top")
-    check_refused(scale_trend.main, ["--loto", str(loto), "--top", "3,x"], "not a list of numbers", "a bad --top")
+    check_refused(scale_trend.main, ["--loto", str(loto), "--top", "3,x"], "comma-separated numbers", "a bad --top")
     check_refused(scale_trend.main, ["--loto", str(loto), "--tiles", "9"], "no model.yaml", "a missing network")
     print("scale_trend: all checks passed")
 
