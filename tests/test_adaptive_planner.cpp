@@ -989,6 +989,59 @@ TEST_CASE(
   }
 }
 
+TEST_CASE("calibration: GainExtent::images counts a descent's field gain as the flight realises it") {
+  for (const auto& row : kGainExtents) {
+    CHECK(parse_gain_extent(row.name) == row.value);
+    CHECK(std::string(to_string(row.value)) == row.name);
+  }
+  CHECK_THROWS_WITH_AS(static_cast<void>(parse_gain_extent("footprint")),
+                       "gain extent must be 'region' or 'images', not 'footprint'", std::invalid_argument);
+  const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
+  OracleSegmenter oracle(f.num_classes());
+  for (MapFusion fusion : {MapFusion::finest, MapFusion::pooled}) {
+    AdaptiveOptions o = options();
+    o.mission.map_fusion = fusion;
+    const CameraModel camera(o.mission.camera);
+    const auto samples = [&](double g, GainExtent extent, DescentCoverage coverage = DescentCoverage::region) {
+      return collect_samples(f, oracle, camera, o.top_gsd_cm, {g}, f.interest(), coverage, 0, fusion, false,
+                             DescentGrid::region, extent);
+    };
+    // 2 cm/px from 3: a 2 x 2 grid of footprints 1.33 regions a side overhangs each region into
+    // its neighbours'; 1 cm/px tiles it exactly.
+    const CalibrationSamples images = samples(2.0, GainExtent::images), region = samples(2.0, GainExtent::region),
+                             tiled = samples(1.0, GainExtent::images), tiled_region = samples(1.0, GainExtent::region),
+                             cells = samples(2.0, GainExtent::images, DescentCoverage::ranked);
+    REQUIRE(images.regions.size() == region.regions.size());
+    REQUIRE(tiled.regions.size() == tiled_region.regions.size());
+    for (std::size_t i = 0; i < tiled.regions.size(); ++i)
+      CHECK(tiled.regions[i].field_gain == tiled_region.regions[i].field_gain);
+    int differ = 0;
+    for (int i : {0, 1, 3, 5}) {
+      CAPTURE(std::string(to_string(fusion)));
+      CAPTURE(i);
+      const auto k = static_cast<std::size_t>(i);
+      REQUIRE(k < images.regions.size());
+      Scripted one{.gsd = 2.0, .which = {i}};
+      const AdaptiveResult flown = run_adaptive_mission(f, oracle, one, o, "one");
+      REQUIRE(flown.realised.size() == 1);
+      const RealisedDescent& d = flown.realised.front();
+      REQUIRE(d.decision == k);
+      // Every pixel the images cover, the neighbours' top-level labels beside them: exactly
+      // what the flight realises, where the region's count misses the overhang.
+      CHECK(images.regions[k].field_gain == doctest::Approx(d.field_gain).epsilon(1e-12));
+      differ += region.regions[k].field_gain != images.regions[k].field_gain ? 1 : 0;
+      // Each cell alone over its whole footprint: the cells (which do not overlap) add up to
+      // the descent's pixels.
+      std::int64_t tp = 0, fp = 0;
+      for (const CellSample& c : cells.cells)
+        if (c.region == k) tp += c.delta_tp, fp += c.delta_fp;
+      CHECK(tp == d.delta_tp);
+      CHECK(fp == d.delta_fp);
+    }
+    CHECK(differ > 0);
+  }
+}
+
 TEST_CASE("AdaptivePlanner: GridAnchor::centred lays the top-level grid centred on the area, every waypoint inside") {
   const Field f = Field::load(t::example_field("weedmap-000"));
   OracleSegmenter oracle(f.num_classes());

@@ -239,6 +239,7 @@ struct CalibrationCli {
   int threshold_steps = 10;
   std::string coverage = "ranked";
   std::string descent_grid = to_string(DescentGrid::region);
+  std::string gain_extent = to_string(GainExtent::region);
   std::string gain_inputs = "delta-sigma-height";
   std::vector<double> confidences = kDefaultConfidences;
   std::string sigma_prior = to_string(CalibrationOptions::kDefaultSigmaPrior);
@@ -283,6 +284,12 @@ struct CalibrationCli {
                "(the cells of the whole field's lawnmower at the descent's GSD whose centres lie in the region: "
                "no ground flown twice); saved in the model")
             ->check(CLI::IsMember(detail::names_of(kDescentGrids)))
+            ->capture_default_str(),
+        app.add_option("--gain-extent", gain_extent,
+                       "which pixels calibration counts a descent's field gain over: region (its region's, the "
+                       "paper's) or images (every pixel its images cover, fused into the field's map with the "
+                       "neighbouring top-level images: what a flight realises)")
+            ->check(CLI::IsMember(detail::names_of(kGainExtents)))
             ->capture_default_str(),
         app.add_option("--cell-input", cell_inputs,
                        "coverage ranked: the decision inputs tried for ranking and forecasting cells, comma-separated "
@@ -419,6 +426,7 @@ struct CalibrationCli {
     options.sigma_prior = parse_sigma_prior_source(sigma_prior);
     options.adaptive.coverage = parse_descent_coverage(coverage);
     options.adaptive.descent_grid = parse_descent_grid(descent_grid);
+    options.gain_extent = parse_gain_extent(gain_extent);
     options.front_aware.curve = parse_curve_source(curve);
     options.front_aware.field_factor = parse_field_factor_source(field_factor);
     options.gain_ratios = gain_ratios;

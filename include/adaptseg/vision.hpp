@@ -19,6 +19,7 @@
 #include <adaptseg/vision/field.hpp>
 #include <adaptseg/vision/field_geo.hpp>
 #include <adaptseg/vision/front_aware_rule.hpp>
+#include <adaptseg/vision/gain_extent.hpp>
 #include <adaptseg/vision/gp_io.hpp>
 #include <adaptseg/vision/grid_inputs.hpp>
 #include <adaptseg/vision/image.hpp>

@@ -34,10 +34,10 @@ struct RealisedDescent {
   /// images labelled them: the descent's contribution to the mission's result.
   double field_gain = 0.0;
   /// field_gain counting only the pixels inside the descent's region (its top-level footprint):
-  /// what the forecast models, since calibration re-maps a region's cells within the region
-  /// (region_samples.hpp). The rest of field_gain comes from where the descent's images overhang
-  /// the region (a sub-lawnmower whose footprints do not divide the region's: 12.5 or 10 cm/px
-  /// from 15) and lands in the neighbours' map.
+  /// what the forecast models where calibration counts a descent's gain within its region
+  /// (GainExtent::region; with GainExtent::images it models field_gain). The rest of field_gain
+  /// comes from where the descent's images overhang the region (a sub-lawnmower whose footprints
+  /// do not divide the region's: 12.5 or 10 cm/px from 15) and lands in the neighbours' map.
   double field_gain_region = 0.0;
   /// The same comparison in pixels, summed over the classes of L: how many more true positives,
   /// false positives and false negatives the field's map holds with this descent than without

@@ -187,9 +187,9 @@ template <SegmentationBackend Backend>
   const std::vector<double> alternative_tops = ranked ? alternative_top_gsds(options) : std::vector<double>{};
   TrainingSamples t;
   for (std::size_t k = 0; k < fields.size(); ++k) {
-    CalibrationSamples c =
-        collect_samples(fields[k], *backends[k], camera, adaptive.top_gsd_cm, adaptive.candidate_gsd_cm, interest,
-                        adaptive.coverage, k, adaptive.mission.map_fusion, options.frame_check, adaptive.descent_grid);
+    CalibrationSamples c = collect_samples(
+        fields[k], *backends[k], camera, adaptive.top_gsd_cm, adaptive.candidate_gsd_cm, interest, adaptive.coverage, k,
+        adaptive.mission.map_fusion, options.frame_check, adaptive.descent_grid, options.gain_extent);
     t.by_field.push_back(std::move(c.regions));
     require(!t.by_field.back().empty(), "calibrate: the training field gave no region sample", fields[k].name());
     t.samples.insert(t.samples.end(), t.by_field.back().begin(), t.by_field.back().end());
@@ -200,7 +200,7 @@ template <SegmentationBackend Backend>
         if (g < top) below.push_back(g);
       CalibrationSamples alt =
           collect_samples(fields[k], *backends[k], camera, top, below, interest, adaptive.coverage, k,
-                          adaptive.mission.map_fusion, options.frame_check, adaptive.descent_grid);
+                          adaptive.mission.map_fusion, options.frame_check, adaptive.descent_grid, options.gain_extent);
       t.cells_by_field.back().insert(t.cells_by_field.back().end(), alt.cells.begin(), alt.cells.end());
     }
   }

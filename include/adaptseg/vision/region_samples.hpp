@@ -11,6 +11,7 @@
 #include <adaptseg/vision/adaptive_options.hpp>
 #include <adaptseg/vision/descent_coverage.hpp>
 #include <adaptseg/vision/detail/survey_grid.hpp>
+#include <adaptseg/vision/gain_extent.hpp>
 #include <adaptseg/vision/grid_inputs.hpp>
 #include <adaptseg/vision/metrics.hpp>
 #include <adaptseg/vision/segmentation_backend.hpp>
@@ -46,7 +47,7 @@ class SampleCollector {
  public:
   SampleCollector(const Field& field, Backend& backend, const CameraModel& camera, double top_gsd_cm,
                   const std::vector<int>& interest, DescentCoverage coverage, std::size_t field_index, MapFusion fusion,
-                  bool frame_check, DescentGrid descent_grid)
+                  bool frame_check, DescentGrid descent_grid, GainExtent gain_extent)
       : field_(field),
         backend_(backend),
         camera_(camera),
@@ -62,6 +63,7 @@ class SampleCollector {
         ranked_(covers_.ranks_cells),
         frame_check_(ranked_ && frame_check),
         pooled_(pools_probabilities(fusion)),
+        whole_images_(gain_extent == GainExtent::images),
         field_map_(field.labels().size(), field.ignore_label(), fusion, interest),
         field_cm_(n_),
         field_px_total_(std::max(1, field.valid_pixels())),
@@ -103,14 +105,20 @@ class SampleCollector {
   /// without it.
   struct TopRegion {
     std::size_t index = 0;
-    cv::Rect region, inside;        ///< the footprint on the field's grid; its part on the grid
-    Image local;                    ///< the top-level image, pixel frame shifted to the region
-    SemanticMap map;                ///< its segmentation on the map grid
-    cv::Mat field_px;               ///< the region's field pixels: where relabelling is counted
-    ConfusionMatrix field_without;  ///< the field's confusion without this region's top-level map
-    GridInputs inputs;              ///< the decision inputs over the region's map grid (ranked only)
-    ConfusionMatrix cm;             ///< the top-level image's own confusion
-    double sigma = 0.0;             ///< its semantic ratio
+    cv::Rect region, inside;       ///< the footprint on the field's grid; its part on the grid
+    Image local;                   ///< the top-level image, pixel frame shifted to the region
+    SemanticMap map;               ///< its segmentation on the map grid
+    cv::Mat field_px;              ///< the region's field pixels: where relabelling is counted
+    ConfusionMatrix field_before;  ///< the field's confusion over the region, before a descent
+    GridInputs inputs;             ///< the decision inputs over the region's map grid (ranked only)
+    ConfusionMatrix cm;            ///< the top-level image's own confusion
+    double sigma = 0.0;            ///< its semantic ratio
+  };
+
+  /// A finer image of the current descent, on the field's grid, and its segmentation.
+  struct Look {
+    Image image;
+    Segmentation segmentation;
   };
 
   [[nodiscard]] bool keep(const Area& a) const { return field_.has_valid(a); }
@@ -131,16 +139,14 @@ class SampleCollector {
                 top_image,
                 SemanticMap(region.size(), field_.ignore_label(), fusion_, interest_),
                 cv::Mat(region.size(), CV_8UC1, cv::Scalar(0)),
-                field_cm_,
+                ConfusionMatrix(n_),
                 {},
                 image_confusion(top_image, top_segmentation.labels, n_),
                 semantic_ratio(top_segmentation.labels, interest_, top_image.ignore_label)};
     r.local.footprint_px -= region.tl();
     r.map.fuse(r.local, top_segmentation);
     field_.valid_mask()(r.inside).copyTo(r.field_px(r.inside - region.tl()));
-    ConfusionMatrix here(n_);
-    here.add(field_.labels()(r.inside), field_map_.labels()(r.inside), field_.ignore_label());
-    r.field_without -= here;
+    r.field_before.add(field_.labels()(r.inside), field_map_.labels()(r.inside), field_.ignore_label());
     if (ranked_)
       r.inputs.assign(top_image, top_segmentation, interest_, field_.ignore_label(), region, kEveryDecisionInputList);
     return r;
@@ -160,9 +166,11 @@ class SampleCollector {
     SemanticMap local = region_map(r);
     // Ranked: each finer image's own decision inputs over its cell (the scene check's proxy).
     std::vector<CellInputs> fine_inputs;
+    looks_.clear();
     for (const auto& w : sub) {
       Image img = sensor_.capture(w);
       const Segmentation seg = segment(img);
+      if (whole_images_) looks_.push_back({img, seg});
       img.footprint_px -= r.region.tl();
       local.fuse(img, seg);
       if (!ranked_) continue;
@@ -187,9 +195,9 @@ class SampleCollector {
     s.relabelled = relabelling(r.map.labels(), after, r.field_px, interest_);
     s.region_share = cv::countNonZero(r.field_px) / field_px_total_;
     s.field_sigma = field_sigma_;
-    ConfusionMatrix with = r.field_without;
-    with.add(field_.labels()(r.inside), after(r.inside - r.region.tl()), field_.ignore_label());
-    s.field_gain = with.miou(interest_).value_or(0.0) - field_miou_;
+    ConfusionMatrix region_after(n_);
+    region_after.add(field_.labels()(r.inside), after(r.inside - r.region.tl()), field_.ignore_label());
+    s.field_gain = (whole_images_ ? field_change(looks_) : field_change(r.field_before, region_after)).gain;
     if (ranked_) cell_samples(r, g, sub, fine_inputs, after, out);
     s.top_gsd_cm = top_gsd_cm_;
     s.sub_gsd_cm = g;
@@ -224,22 +232,58 @@ class SampleCollector {
       c.removed = changed.removed_share;
       c.right =
           agreeing_changes(r.map.labels()(cell), after(cell), {field_.labels()(cell_in)}, r.field_px(cell), interest_);
-      ConfusionMatrix cell_cm = field_cm_;
       ConfusionMatrix before_cell(n_), after_cell(n_);
       before_cell.add(field_.labels()(cell_in), field_map_.labels()(cell_in), field_.ignore_label());
       after_cell.add(field_.labels()(cell_in), after(cell), field_.ignore_label());
-      cell_cm -= before_cell;
-      cell_cm += after_cell;
-      c.field_gain = cell_cm.miou(interest_).value_or(0.0) - field_miou_;
-      const PixelCounts now = after_cell.counts(interest_), was = before_cell.counts(interest_);
-      c.delta_tp = now.tp - was.tp;
-      c.delta_fp = now.fp - was.fp;
+      const FieldChange change =
+          whole_images_ ? field_change(std::span(looks_).subspan(k, 1)) : field_change(before_cell, after_cell);
+      c.field_gain = change.gain;
+      c.delta_tp = change.delta_tp;
+      c.delta_fp = change.delta_fp;
       c.field_tp = field_counts_.tp;
       c.field_fp = field_counts_.fp;
       c.field_fn = field_counts_.fn;
       out.cells.push_back(c);
       cell_rects_.push_back(cell);
     }
+  }
+
+  /// What a change of the field's top-level map, over some of its pixels from `before` to
+  /// `after` (their confusion matrices), does to the field over L.
+  struct FieldChange {
+    double gain = 0.0;  ///< field mIoU over L after, minus before
+    std::int64_t delta_tp = 0, delta_fp = 0;
+  };
+  [[nodiscard]] FieldChange field_change(const ConfusionMatrix& before, const ConfusionMatrix& after) const {
+    ConfusionMatrix cm = field_cm_;
+    cm -= before;
+    cm += after;
+    const PixelCounts now = after.counts(interest_), was = before.counts(interest_);
+    return {cm.miou(interest_).value_or(0.0) - field_miou_, now.tp - was.tp, now.fp - was.fp};
+  }
+
+  /// GainExtent::images: the change of the field's map over every pixel `looks` (finer images
+  /// on the field's grid) cover, fused into it as a flight fuses them: with every top-level image
+  /// over those pixels, the neighbouring regions' included.
+  [[nodiscard]] FieldChange field_change(std::span<const Look> looks) const {
+    cv::Rect box;
+    for (const Look& l : looks) box = box.area() == 0 ? l.image.footprint_px : (box | l.image.footprint_px);
+    box &= grid_;
+    if (box.area() == 0) return {};
+    SemanticMap map(box.size(), field_.ignore_label(), fusion_, interest_);
+    const auto fuse = [&](Image image, const Segmentation& seg) {
+      image.footprint_px -= box.tl();
+      map.fuse(image, seg);
+    };
+    for (std::size_t t = 0; t < tops_.size(); ++t)  // in the field map's order: the same sums
+      if ((top_images_[t].footprint_px & box).area() > 0) fuse(top_images_[t], top_segmentations_[t]);
+    for (const Look& l : looks) fuse(l.image, l.segmentation);
+    cv::Mat labels = field_map_.labels()(box).clone();
+    map.labels().copyTo(labels, map.labels() != field_.ignore_label());
+    ConfusionMatrix before(n_), after(n_);
+    before.add(field_.labels()(box), field_map_.labels()(box), field_.ignore_label());
+    after.add(field_.labels()(box), labels, field_.ignore_label());
+    return field_change(before, after);
   }
 
   /// The mission's map of region `r` after the sub-lawnmower `sub` shifted half a footprint
@@ -324,6 +368,8 @@ class SampleCollector {
   LawnmowerPlanner planner_;
   int n_;
   bool ranked_, frame_check_, pooled_;
+  bool whole_images_;        ///< GainExtent::images
+  std::vector<Look> looks_;  ///< GainExtent::images: the current descent's
   std::vector<Waypoint> tops_;
   std::vector<Image> top_images_;
   std::vector<Segmentation> top_segmentations_;
@@ -359,7 +405,7 @@ class SampleCollector {
 /// probabilities and a descent's region map pools the top-level image with the finer ones, as the
 /// mission's map does. `frame_check`: CalibrationOptions::frame_check (cells only).
 /// `descent_grid`: how each sub-lawnmower is laid, as AdaptivePlanner::sub_plan lays it
-/// (AdaptiveOptions::descent_grid).
+/// (AdaptiveOptions::descent_grid). `gain_extent`: which pixels the field gains count.
 /// @throws std::invalid_argument for a top GSD finer than the field's or candidates not finer
 ///         than the top, or an empty `interest`.
 template <SegmentationBackend Backend>
@@ -369,7 +415,8 @@ template <SegmentationBackend Backend>
                                                  DescentCoverage coverage = DescentCoverage::region,
                                                  std::size_t field_index = 0, MapFusion fusion = MapFusion::finest,
                                                  bool frame_check = false,
-                                                 DescentGrid descent_grid = DescentGrid::region) {
+                                                 DescentGrid descent_grid = DescentGrid::region,
+                                                 GainExtent gain_extent = GainExtent::region) {
   detail::require(top_gsd_cm >= field.gsd_cm() * (1.0 - 1e-9),
                   "collect_region_samples: top_gsd_cm is finer than the field's GSD", top_gsd_cm);
   detail::require(!interest.empty(), "collect_region_samples: no labels of interest", 0);
@@ -377,7 +424,7 @@ template <SegmentationBackend Backend>
     detail::require(std::isfinite(g) && g > 0.0 && g < top_gsd_cm,
                     "collect_region_samples: candidate GSDs must be finer than top_gsd_cm", g);
   return detail::SampleCollector<Backend>(field, backend, camera, top_gsd_cm, interest, coverage, field_index, fusion,
-                                          frame_check, descent_grid)
+                                          frame_check, descent_grid, gain_extent)
       .collect(candidate_gsd_cm);
 }
 
