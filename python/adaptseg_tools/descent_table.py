@@ -14,7 +14,7 @@ Where decisions.csv has it (adaptseg_evaluate since 2026-12-06), also the realis
 the descent's pixels inside its region alone (realised_field_gain_region: what the forecast
 models, calibration re-mapping a region's cells within the region) and, over all descents, the
 forecast's correlation with it and how much of the realised gain came from where the images
-overhang the region.
+overhang the region. Then the same sums per descent GSD and number of images.
 
 With --curve, per descent also the lawnmower curve it had to beat: the rise the rule predicted
 over the descent's extra time (forecast_curve_rise) against the rise of the field's real curve
@@ -275,7 +275,28 @@ def main(argv: list[str] | None = None) -> int:
         print(f"inside the regions alone: forecast and realised correlate at "
               f"{correlation(forecast, realised_inside):+.2f}; realised {sum(realised_inside):+.4f} of "
               f"{sum(realised):+.4f} in all (where the images overhang: {sum(realised) - sum(realised_inside):+.4f})")
+    group_sums(rows, inside)
     return 0
+
+
+def group_sums(rows, inside: bool) -> None:
+    """The descents' forecast and realised field gains summed per descent GSD and number of images
+    (and the realised gain inside the regions, where decisions.csv has it): where the forecast's
+    level is right, and whether it depends on how far a descent's images reach beyond its region."""
+    groups: dict[tuple[float, int], list[list[float]]] = {}
+    for _, d in rows:
+        fg, rg = number(d["forecast_field_gain"]), number(d["realised_field_gain"])
+        if not (math.isfinite(fg) and math.isfinite(rg)):
+            continue
+        rgi = number(d["realised_field_gain_region"]) if inside else math.nan
+        groups.setdefault((number(d["gsd_cm"]), int(d["images"])), []).append([fg, rg, rgi])
+    print()
+    print("| GSD [cm/px] | images | descents | Σ forecast | Σ realised |" + (" Σ inside the regions |" if inside else ""))
+    print("| ---: | ---: | ---: | ---: | ---: |" + (" ---: |" if inside else ""))
+    for (gsd, images), g in sorted(groups.items()):
+        sums = [sum(column) for column in zip(*g)]
+        print(f"| {gsd:g} | {images} | {len(g)} | {sums[0]:+.4f} | {sums[1]:+.4f} |"
+              + (f" {sums[2]:+.4f} |" if inside else ""))
 
 
 if __name__ == "__main__":

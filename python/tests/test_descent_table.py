@@ -77,6 +77,10 @@ def main():
             sys.exit(f"table with the gain inside the region: no row for the first descent:\n{split}")
         if "realised +0.0100 of +0.0210 in all (where the images overhang: +0.0110)" not in split:
             sys.exit(f"table with the gain inside the region: summary:\n{split}")
+        if "| 10 | 2 | 2 | +0.0210 | +0.0210 | +0.0100 |" not in split:
+            sys.exit(f"table with the gain inside the region: the sums of the two 10 cm/px descents:\n{split}")
+        if "| 10 | 2 | 2 | +0.0210 | +0.0210 |" not in plain or "Σ inside" in plain:
+            sys.exit(f"table: the sums of the two 10 cm/px descents, without the gain inside the region:\n{plain}")
         if "of which inside the region" in plain:
             sys.exit("table: a column for the gain inside the region where decisions.csv has none")
         hindsight = table(["--hindsight", run])
