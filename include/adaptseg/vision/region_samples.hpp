@@ -101,8 +101,8 @@ class SampleCollector {
   }
 
  private:
-  /// What the UAV knows of top-level region `t` when it plans the descent, and the field terms
-  /// without it.
+  /// What the UAV knows of top-level region `t` when it plans the descent, and the field's
+  /// confusion over it.
   struct TopRegion {
     std::size_t index = 0;
     cv::Rect region, inside;       ///< the footprint on the field's grid; its part on the grid
@@ -369,7 +369,7 @@ class SampleCollector {
   int n_;
   bool ranked_, frame_check_, pooled_;
   bool whole_images_;        ///< GainExtent::images
-  std::vector<Look> looks_;  ///< GainExtent::images: the current descent's
+  std::vector<Look> looks_;  ///< GainExtent::images: the current descent's finer images
   std::vector<Waypoint> tops_;
   std::vector<Image> top_images_;
   std::vector<Segmentation> top_segmentations_;
