@@ -101,18 +101,16 @@ class SampleCollector {
   }
 
  private:
-  /// What the UAV knows of top-level region `t` when it plans the descent, and the field's
-  /// confusion over it.
+  /// What the UAV knows of top-level region `t` when it plans the descent.
   struct TopRegion {
     std::size_t index = 0;
-    cv::Rect region, inside;       ///< the footprint on the field's grid; its part on the grid
-    Image local;                   ///< the top-level image, pixel frame shifted to the region
-    SemanticMap map;               ///< its segmentation on the map grid
-    cv::Mat field_px;              ///< the region's field pixels: where relabelling is counted
-    ConfusionMatrix field_before;  ///< the field's confusion over the region, before a descent
-    GridInputs inputs;             ///< the decision inputs over the region's map grid (ranked only)
-    ConfusionMatrix cm;            ///< the top-level image's own confusion
-    double sigma = 0.0;            ///< its semantic ratio
+    cv::Rect region, inside;  ///< the footprint on the field's grid; its part on the grid
+    Image local;              ///< the top-level image, pixel frame shifted to the region
+    SemanticMap map;          ///< its segmentation on the map grid
+    cv::Mat field_px;         ///< the region's field pixels: where relabelling is counted
+    GridInputs inputs;        ///< the decision inputs over the region's map grid (ranked only)
+    ConfusionMatrix cm;       ///< the top-level image's own confusion
+    double sigma = 0.0;       ///< its semantic ratio
   };
 
   /// A finer image of the current descent, on the field's grid, and its segmentation.
@@ -139,14 +137,12 @@ class SampleCollector {
                 top_image,
                 SemanticMap(region.size(), field_.ignore_label(), fusion_, interest_),
                 cv::Mat(region.size(), CV_8UC1, cv::Scalar(0)),
-                ConfusionMatrix(n_),
                 {},
                 image_confusion(top_image, top_segmentation.labels, n_),
                 semantic_ratio(top_segmentation.labels, interest_, top_image.ignore_label)};
     r.local.footprint_px -= region.tl();
     r.map.fuse(r.local, top_segmentation);
     field_.valid_mask()(r.inside).copyTo(r.field_px(r.inside - region.tl()));
-    r.field_before.add(field_.labels()(r.inside), field_map_.labels()(r.inside), field_.ignore_label());
     if (ranked_)
       r.inputs.assign(top_image, top_segmentation, interest_, field_.ignore_label(), region, kEveryDecisionInputList);
     return r;
@@ -195,9 +191,8 @@ class SampleCollector {
     s.relabelled = relabelling(r.map.labels(), after, r.field_px, interest_);
     s.region_share = cv::countNonZero(r.field_px) / field_px_total_;
     s.field_sigma = field_sigma_;
-    ConfusionMatrix region_after(n_);
-    region_after.add(field_.labels()(r.inside), after(r.inside - r.region.tl()), field_.ignore_label());
-    s.field_gain = (whole_images_ ? field_change(looks_) : field_change(r.field_before, region_after)).gain;
+    s.field_gain =
+        (whole_images_ ? field_change(looks_) : field_change(r.inside, after(r.inside - r.region.tl()))).gain;
     if (ranked_) cell_samples(r, g, sub, fine_inputs, after, out);
     s.top_gsd_cm = top_gsd_cm_;
     s.sub_gsd_cm = g;
@@ -232,11 +227,8 @@ class SampleCollector {
       c.removed = changed.removed_share;
       c.right =
           agreeing_changes(r.map.labels()(cell), after(cell), {field_.labels()(cell_in)}, r.field_px(cell), interest_);
-      ConfusionMatrix before_cell(n_), after_cell(n_);
-      before_cell.add(field_.labels()(cell_in), field_map_.labels()(cell_in), field_.ignore_label());
-      after_cell.add(field_.labels()(cell_in), after(cell), field_.ignore_label());
       const FieldChange change =
-          whole_images_ ? field_change(std::span(looks_).subspan(k, 1)) : field_change(before_cell, after_cell);
+          whole_images_ ? field_change(std::span(looks_).subspan(k, 1)) : field_change(cell_in, after(cell));
       c.field_gain = change.gain;
       c.delta_tp = change.delta_tp;
       c.delta_fp = change.delta_fp;
@@ -248,13 +240,16 @@ class SampleCollector {
     }
   }
 
-  /// What a change of the field's top-level map, over some of its pixels from `before` to
-  /// `after` (their confusion matrices), does to the field over L.
+  /// What the field's top-level map gains over L where the rectangle `on` (on the field's grid)
+  /// takes the labels `labels` instead of its own.
   struct FieldChange {
     double gain = 0.0;  ///< field mIoU over L after, minus before
     std::int64_t delta_tp = 0, delta_fp = 0;
   };
-  [[nodiscard]] FieldChange field_change(const ConfusionMatrix& before, const ConfusionMatrix& after) const {
+  [[nodiscard]] FieldChange field_change(const cv::Rect& on, const cv::Mat& labels) const {
+    ConfusionMatrix before(n_), after(n_);
+    before.add(field_.labels()(on), field_map_.labels()(on), field_.ignore_label());
+    after.add(field_.labels()(on), labels, field_.ignore_label());
     ConfusionMatrix cm = field_cm_;
     cm -= before;
     cm += after;
@@ -280,10 +275,7 @@ class SampleCollector {
     for (const Look& l : looks) fuse(l.image, l.segmentation);
     cv::Mat labels = field_map_.labels()(box).clone();
     map.labels().copyTo(labels, map.labels() != field_.ignore_label());
-    ConfusionMatrix before(n_), after(n_);
-    before.add(field_.labels()(box), field_map_.labels()(box), field_.ignore_label());
-    after.add(field_.labels()(box), labels, field_.ignore_label());
-    return field_change(before, after);
+    return field_change(box, labels);
   }
 
   /// The mission's map of region `r` after the sub-lawnmower `sub` shifted half a footprint
