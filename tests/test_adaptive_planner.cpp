@@ -56,6 +56,15 @@ AdaptiveOptions options() {
   o.candidate_gsd_cm = {1.0, 1.5, 2.0, 2.5};
   return o;
 }
+
+/// Every name of a table of named values (`rows`) parses back to its value and prints as itself.
+template <class Rows, class Parse>
+void check_names_round_trip(const Rows& rows, Parse&& parse) {
+  for (const auto& row : rows) {
+    CHECK(parse(row.name) == row.value);
+    CHECK(std::string(to_string(row.value)) == row.name);
+  }
+}
 }  // namespace
 
 namespace {
@@ -230,10 +239,7 @@ TEST_CASE("descent coverages: each rule says which cells it flies and whether it
 }
 
 TEST_CASE("adaptive planner: grid anchors by name, as the programs' --grid reads them") {
-  for (const auto& row : kGridAnchors) {
-    CHECK(parse_grid_anchor(row.name) == row.value);
-    CHECK(std::string(to_string(row.value)) == row.name);
-  }
+  check_names_round_trip(kGridAnchors, [](const char* n) { return parse_grid_anchor(n); });
   CHECK(parse_grid_anchor("centred") == GridAnchor::centred);
   CHECK(std::string(to_string(GridAnchor::corner)) == "corner");
   CHECK_THROWS_WITH_AS(static_cast<void>(parse_grid_anchor("centered")),
@@ -241,10 +247,7 @@ TEST_CASE("adaptive planner: grid anchors by name, as the programs' --grid reads
 }
 
 TEST_CASE("adaptive planner: descent grids by name, as the programs' --descent-grid and model files read them") {
-  for (const auto& row : kDescentGrids) {
-    CHECK(parse_descent_grid(row.name) == row.value);
-    CHECK(std::string(to_string(row.value)) == row.name);
-  }
+  check_names_round_trip(kDescentGrids, [](const char* n) { return parse_descent_grid(n); });
   CHECK_THROWS_WITH_AS(static_cast<void>(parse_descent_grid("shared")),
                        "descent grid must be 'region' or 'field', not 'shared'", std::invalid_argument);
 }
@@ -990,10 +993,7 @@ TEST_CASE(
 }
 
 TEST_CASE("calibration: GainExtent::images counts a descent's field gain as the flight realises it") {
-  for (const auto& row : kGainExtents) {
-    CHECK(parse_gain_extent(row.name) == row.value);
-    CHECK(std::string(to_string(row.value)) == row.name);
-  }
+  check_names_round_trip(kGainExtents, [](const char* n) { return parse_gain_extent(n); });
   CHECK_THROWS_WITH_AS(static_cast<void>(parse_gain_extent("footprint")),
                        "gain extent must be 'region' or 'images', not 'footprint'", std::invalid_argument);
   const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
@@ -1039,6 +1039,69 @@ TEST_CASE("calibration: GainExtent::images counts a descent's field gain as the 
       CHECK(fp == d.delta_fp);
     }
     CHECK(differ > 0);
+  }
+}
+
+TEST_CASE(
+    "AdaptivePlanner: with GainExtent::images each ranked cell is forecast for the field pixels its calibration "
+    "sample counts") {
+  const Field f = t::blob_field(3000, 2200, 1.0, 5, 40);
+  OracleSegmenter oracle(f.num_classes());
+  AdaptiveOptions o = options();
+  o.candidate_gsd_cm = {2.0};
+  o.coverage = DescentCoverage::ranked;
+  o.cell_input = DecisionInput::expected_error;
+  // Never descends; keeps the candidates each decision was offered.
+  struct Offered {
+    std::vector<std::vector<Candidate>> offered{};
+    std::string name() const { return "offered"; }
+    void begin_mission() { offered.clear(); }
+    Decision decide(const DecisionContext& c) {
+      offered.emplace_back(c.candidates.begin(), c.candidates.end());
+      return {};
+    }
+    void observe(const DescentOutcome&) {}
+  };
+  static_assert(DecisionPolicy<Offered>);
+  const CameraModel camera(o.mission.camera);
+  const CalibrationSamples samples =
+      collect_samples(f, oracle, camera, o.top_gsd_cm, {2.0}, f.interest(), o.coverage, 0, MapFusion::finest, false,
+                      DescentGrid::region, GainExtent::images);
+  const double field_px = f.valid_pixels();
+  for (GainExtent extent : {GainExtent::region, GainExtent::images}) {
+    CAPTURE(std::string(to_string(extent)));
+    o.gain_extent = extent;
+    Offered policy;
+    (void)run_adaptive_mission(f, oracle, policy, o, "offered");
+    std::size_t compared = 0, overhang = 0;
+    for (std::size_t k = 0; k < policy.offered.size(); ++k) {
+      if (policy.offered[k].empty()) continue;
+      // The option with the most cells holds every ranked cell of the region.
+      const Candidate& all = policy.offered[k].back();
+      for (const CellInputs& c : all.cells) {
+        CAPTURE(k);
+        if (extent == GainExtent::region) {
+          CHECK(c.footprint_px == 0.0);
+          CHECK(c.gain_px() == c.field_px);
+          continue;
+        }
+        // The same cell in calibration: its pixels in the region, those of its whole footprint,
+        // and the field share its gain was normalised by.
+        const auto same = std::find_if(samples.cells.begin(), samples.cells.end(), [&](const CellSample& s) {
+          return s.region == k && s.top.field_px == c.field_px && s.top.footprint_px == c.footprint_px;
+        });
+        REQUIRE(same != samples.cells.end());
+        CHECK(same->field_share == doctest::Approx(c.footprint_px / field_px).epsilon(1e-12));
+        CHECK(c.gain_px() == c.footprint_px);
+        ++compared;
+        overhang += c.footprint_px > c.field_px ? 1 : 0;
+      }
+    }
+    // 2 cm/px from 3: the footprints overhang their regions, and the flight weighs them so.
+    if (extent == GainExtent::images) {
+      CHECK(compared > 4);
+      CHECK(overhang > 0);
+    }
   }
 }
 

@@ -75,6 +75,18 @@ TEST_CASE("cell gain model: slopes and noise per pair of GSDs, forecasts of a se
   const auto g = m.forecast(15.0, 10.0, cells, 4000.0);
   CHECK(g.gain_var == doctest::Approx(m.at(15.0, 10.0).gain_noise * (0.0625 * 0.2 + 0.015625 * 0.4)));
   CHECK(m.cell_gain(15.0, 5.0, a) == doctest::Approx(0.18));
+  // GainExtent::images: a cell whose image overhangs the region is forecast a gain over its
+  // whole footprint's field pixels (gain_px), and still relabels only its pixels in the region.
+  CellInputs wide = a;
+  wide.footprint_px = 1500.0;
+  CHECK(a.gain_px() == 1000.0);
+  CHECK(wide.gain_px() == 1500.0);
+  const auto w = m.forecast(15.0, 10.0, std::vector<CellInputs>{wide, b}, 4000.0);
+  CHECK(w.gain == doctest::Approx(m.at(15.0, 10.0).gain_slope * (0.375 * 0.2 + 0.125 * 0.4)));
+  CHECK(w.gain_var == doctest::Approx(m.at(15.0, 10.0).gain_noise * (0.140625 * 0.2 + 0.015625 * 0.4)));
+  CHECK(w.input == doctest::Approx(0.375 * 0.2 + 0.125 * 0.4));
+  CHECK(w.relabelled == doctest::Approx(g.relabelled));
+  CHECK(w.relabelled_var == doctest::Approx(g.relabelled_var));
   // An unknown input value (a labels-only backend) holds nothing.
   CellInputs unknown;
   unknown.values.fill(NAN);

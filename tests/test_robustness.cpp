@@ -888,7 +888,7 @@ TEST_CASE("robustness: decision model: refit count out of range") {
                        std::invalid_argument);
 }
 
-TEST_CASE("robustness: decision model: unknown descent coverage or grid") {
+TEST_CASE("robustness: decision model: unknown descent coverage, grid or gain extent") {
   const t::TempDir dir;
   const std::string text = replaced(model_text(), "descent_coverage: region", "descent_coverage: everywhere");
   CHECK_THROWS_WITH_AS((void)load_model_text(dir, text), Contains("'region', 'interest' or 'ranked'"),
@@ -905,6 +905,18 @@ TEST_CASE("robustness: decision model: unknown descent coverage or grid") {
   m.save(dir.path() / "again.yaml");
   CHECK(DecisionModel::load(dir.path() / "again.yaml").descent_grid == DescentGrid::field);
   CHECK(load_model_text(dir, model_text()).descent_grid == DescentGrid::region);
+  // The gain extent likewise: it tells the missions over which pixels each cell is forecast.
+  const auto with_extent = [&](const std::string& e) {
+    return replaced(model_text(), "descent_coverage: region", "descent_coverage: region\ngain_extent: " + e);
+  };
+  CHECK_THROWS_WITH_AS((void)load_model_text(dir, with_extent("footprint")),
+                       Contains("gain extent must be 'region' or 'images', not 'footprint'"), std::invalid_argument);
+  const DecisionModel images = load_model_text(dir, with_extent("images"));
+  CHECK(images.gain_extent == GainExtent::images);
+  CHECK(images.adaptive_options({}).gain_extent == GainExtent::images);
+  images.save(dir.path() / "extent.yaml");
+  CHECK(DecisionModel::load(dir.path() / "extent.yaml").gain_extent == GainExtent::images);
+  CHECK(load_model_text(dir, model_text()).gain_extent == GainExtent::region);
 }
 
 TEST_CASE("robustness: decision model: I with three inputs") {

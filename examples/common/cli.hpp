@@ -286,9 +286,10 @@ struct CalibrationCli {
             ->check(CLI::IsMember(detail::names_of(kDescentGrids)))
             ->capture_default_str(),
         app.add_option("--gain-extent", gain_extent,
-                       "which pixels calibration counts a descent's field gain over: region (its region's, the "
-                       "paper's) or images (every pixel its images cover, fused into the field's map with the "
-                       "neighbouring top-level images: what a flight realises)")
+                       "which pixels a descent's field gain is counted over: region (its region's, the paper's) or "
+                       "images (every pixel its images cover, fused into the field's map with the neighbouring "
+                       "top-level images: what a flight realises; each ranked cell is then forecast for its whole "
+                       "footprint); saved in the model")
             ->check(CLI::IsMember(detail::names_of(kGainExtents)))
             ->capture_default_str(),
         app.add_option("--cell-input", cell_inputs,
@@ -426,7 +427,7 @@ struct CalibrationCli {
     options.sigma_prior = parse_sigma_prior_source(sigma_prior);
     options.adaptive.coverage = parse_descent_coverage(coverage);
     options.adaptive.descent_grid = parse_descent_grid(descent_grid);
-    options.gain_extent = parse_gain_extent(gain_extent);
+    options.adaptive.gain_extent = parse_gain_extent(gain_extent);
     options.front_aware.curve = parse_curve_source(curve);
     options.front_aware.field_factor = parse_field_factor_source(field_factor);
     options.gain_ratios = gain_ratios;

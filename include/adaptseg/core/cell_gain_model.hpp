@@ -166,21 +166,23 @@ inline std::vector<GsdGroup> group_by_gsds(std::span<const CellSample> samples) 
 ///
 /// A descent re-mapping a set S of cells of a region of R field pixels forecasts (as shares of
 /// the region: the same units as GainModel's relabelled share)
-/// gain = β·Σ_S w_c·x_c, Var = κ·Σ_S w_c²·x_c, and likewise the relabelled share, w_c = px_c / R.
+/// gain = β·Σ_S v_c·x_c, Var = κ·Σ_S v_c²·x_c, v_c = CellInputs::gain_px / R (the pixels ν_c was
+/// normalised by: with GainExtent::images the cell's whole footprint, which may overhang the
+/// region), and the relabelled share α·Σ_S w_c·x_c, w_c = px_c / R (its pixels in the region).
 ///
 /// What a descent shows, without ground truth (the scene check, FrontAwarePolicy::observe): the
 /// finer images' own value of the input over the same cells, x'_c. Where the finer look is surer
 /// (x' < x) the re-mapping corrected something, where it is less sure it likely did harm:
 /// ν_c ≈ γ·(x_c − x'_c) on the training cells (γ by least squares through the origin), so
-/// y = γ·Σ_S w_c·(x_c − x'_c) estimates the descent's realised gain. As a measurement of the
-/// forecast β·Σ_S w_c·x_c its spread is κ_p·Σ_S w_c²·x_c, κ_p the weighted mean squared
+/// y = γ·Σ_S v_c·(x_c − x'_c) estimates the descent's realised gain. As a measurement of the
+/// forecast β·Σ_S v_c·x_c its spread is κ_p·Σ_S v_c²·x_c, κ_p the weighted mean squared
 /// difference per unit of x over the training cells: it holds how far the proxy misses and how
 /// far the training fields' own gains scatter, so that the scene check learns no faster than the
 /// training fields show it can. And the proxy's slope is a property of the field, not only of
 /// the network: fitted on each training field alone, γ_f may even change sign between fields
 /// (MobileNetV2's water: negative on three of the tiles it was trained on, positive on the one it
 /// never saw). τ_γ, the spread of the γ_f about γ, adds τ_γ²·d² to the measurement's variance,
-/// d = Σ_S w_c·(x_c − x'_c): a scene check on a field whose slope is any of the training fields'
+/// d = Σ_S v_c·(x_c − x'_c): a scene check on a field whose slope is any of the training fields'
 /// is trusted no further than they agree. With one training field τ_γ = |γ| (how far the slope
 /// transfers to another field is unknown). γ = κ_p = τ_γ = 0 where no fine inputs were known
 /// (labels-only backends).
@@ -218,8 +220,8 @@ class CellGainModel {
     double gain_var = 0.0;
     double relabelled = 0.0;  ///< relabelled share of the region with L involved
     double relabelled_var = 0.0;
-    double input = 0.0;      ///< Σ w_c·x_c: the cells' input, what the finer look is compared with
-    double proxy_var = 0.0;  ///< κ_p·Σ w_c²·x_c: the spread of the scene check's measurement
+    double input = 0.0;      ///< Σ v_c·x_c: the cells' input, what the finer look is compared with
+    double proxy_var = 0.0;  ///< κ_p·Σ v_c²·x_c: the spread of the scene check's measurement
   };
 
   /// @throws std::invalid_argument for no point, GSDs that are not finite and positive with the
@@ -277,14 +279,16 @@ class CellGainModel {
                                   double region_px) const {
     detail::require(region_px > 0.0, "CellGainModel::forecast: region_px must be > 0", region_px);
     const Point p = at(top_gsd_cm, sub_gsd_cm);
-    double sx = 0.0, sxx = 0.0;
+    double sx = 0.0, sxx = 0.0, gx = 0.0, gxx = 0.0;
     for (const CellInputs& c : cells) {
-      const double w = c.field_px / region_px;
+      const double w = c.field_px / region_px, v = c.gain_px() / region_px;
       sx += w * x_of(c);
       sxx += w * w * x_of(c);
+      gx += v * x_of(c);
+      gxx += v * v * x_of(c);
     }
-    return {p.gain_slope * sx,  p.gain_noise * sxx, std::max(0.0, p.relabel_slope * sx), p.relabel_noise * sxx, sx,
-            p.proxy_noise * sxx};
+    return {p.gain_slope * gx,  p.gain_noise * gxx, std::max(0.0, p.relabel_slope * sx), p.relabel_noise * sxx, gx,
+            p.proxy_noise * gxx};
   }
 
   /// The scene check's estimate of a descent's normalised gain (in shares of its region) from

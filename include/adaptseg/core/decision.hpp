@@ -149,9 +149,9 @@ struct DescentOutcome {
   /// What the descent changed in the region's map (field pixels; no ground truth needed).
   Relabelling relabelled{};
   /// DescentCoverage::ranked: the ranking input over the re-mapped cells as the top-level image
-  /// saw it, and as the finer images see the same ground (Σ_c value_c·px_c / the region's field
-  /// pixels, as Candidate::cells' forecasts); NaN where unknown (the finer images came without
-  /// probabilities). The scene check compares them (CellGainModel::proxy_gain).
+  /// saw it, and as the finer images see the same ground (Σ_c value_c·CellInputs::gain_px / the
+  /// region's field pixels, as Candidate::cells' forecasts); NaN where unknown (the finer images
+  /// came without probabilities). The scene check compares them (CellGainModel::proxy_gain).
   double top_input = std::numeric_limits<double>::quiet_NaN();
   double fine_input = std::numeric_limits<double>::quiet_NaN();
   /// Which descent this is: 0, 1, ... in the order the policy chose them. The planner flies

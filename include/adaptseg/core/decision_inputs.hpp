@@ -285,7 +285,12 @@ inline void pixel_input_rows(std::size_t n, const Label* labels, std::span<const
 struct CellInputs {
   DecisionInputValues values{};
   double field_px = 0.0;  ///< map pixels of field in the cell that the top-level image saw
+  /// Field pixels of the cell's whole image footprint, where it overhangs its region too (its
+  /// gain counted over every pixel its image covers: GainExtent::images); 0: `field_px`.
+  double footprint_px = 0.0;
   [[nodiscard]] double value(DecisionInput i) const noexcept { return values[index_of(i)]; }
+  /// The field pixels the cell's gain is counted over and forecast for (CellGainModel::forecast).
+  [[nodiscard]] double gain_px() const noexcept { return footprint_px > 0.0 ? footprint_px : field_px; }
   /// value(i) · field_px, 0 where unknown: how much of input i the cell holds (how cells rank).
   [[nodiscard]] double mass(DecisionInput i) const noexcept {
     const double v = value(i);

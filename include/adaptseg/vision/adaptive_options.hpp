@@ -13,6 +13,7 @@
 #include <adaptseg/core/lawnmower_planner.hpp>
 #include <adaptseg/core/mission_options.hpp>
 #include <adaptseg/vision/descent_coverage.hpp>
+#include <adaptseg/vision/gain_extent.hpp>
 
 #include <opencv2/core.hpp>
 
@@ -114,6 +115,10 @@ struct AdaptiveOptions {
   /// How each descent's sub-lawnmower is laid (DescentGrid). A decision model must be calibrated
   /// with the same (its samples are flown so; DecisionModel::descent_grid).
   DescentGrid descent_grid = DescentGrid::region;
+  /// Which pixels a descent's gain is counted over (GainExtent): in calibration its samples'
+  /// field gains, in flight the pixels each ranked cell is forecast for. A decision model must
+  /// be calibrated with the same (DecisionModel::gain_extent).
+  GainExtent gain_extent = GainExtent::region;
 };
 
 /// The decision taken at one top-level waypoint.

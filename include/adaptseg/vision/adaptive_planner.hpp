@@ -378,7 +378,7 @@ class AdaptivePlanner {
                                    : nullptr;
     std::vector<detail::CostedPlan> plans = costing().cost(
         detail::RegionSummary::options(grid_, region, candidates_, coverage_.ranks_cells, inputs, options_.cell_input,
-                                       [&](double g) { return descent_plan(i, g); }),
+                                       options_.gain_extent, [&](double g) { return descent_plan(i, g); }),
         i, ahead, rec);
     const std::vector<LawnmowerForecast> forecasts = lawnmower_forecasts();
     const detail::DecisionInputsAt at{route_.top()[i], region, inputs, options_.cell_input, entropy};

@@ -189,7 +189,7 @@ template <SegmentationBackend Backend>
   for (std::size_t k = 0; k < fields.size(); ++k) {
     CalibrationSamples c = collect_samples(
         fields[k], *backends[k], camera, adaptive.top_gsd_cm, adaptive.candidate_gsd_cm, interest, adaptive.coverage, k,
-        adaptive.mission.map_fusion, options.frame_check, adaptive.descent_grid, options.gain_extent);
+        adaptive.mission.map_fusion, options.frame_check, adaptive.descent_grid, adaptive.gain_extent);
     t.by_field.push_back(std::move(c.regions));
     require(!t.by_field.back().empty(), "calibrate: the training field gave no region sample", fields[k].name());
     t.samples.insert(t.samples.end(), t.by_field.back().begin(), t.by_field.back().end());
@@ -198,9 +198,9 @@ template <SegmentationBackend Backend>
       std::vector<double> below;
       for (double g : adaptive.candidate_gsd_cm)
         if (g < top) below.push_back(g);
-      CalibrationSamples alt =
-          collect_samples(fields[k], *backends[k], camera, top, below, interest, adaptive.coverage, k,
-                          adaptive.mission.map_fusion, options.frame_check, adaptive.descent_grid, options.gain_extent);
+      CalibrationSamples alt = collect_samples(fields[k], *backends[k], camera, top, below, interest, adaptive.coverage,
+                                               k, adaptive.mission.map_fusion, options.frame_check,
+                                               adaptive.descent_grid, adaptive.gain_extent);
       t.cells_by_field.back().insert(t.cells_by_field.back().end(), alt.cells.begin(), alt.cells.end());
     }
   }
@@ -364,6 +364,7 @@ template <SegmentationBackend Backend>
                   .candidate_gsd_cm = options.adaptive.candidate_gsd_cm,
                   .coverage = options.adaptive.coverage,
                   .descent_grid = options.adaptive.descent_grid,
+                  .gain_extent = options.adaptive.gain_extent,
                   .decision_function = calibration.decision_function,
                   .linear = calibration.linear,
                   .samples = calibration.samples.size(),

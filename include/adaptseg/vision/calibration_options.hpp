@@ -74,9 +74,6 @@ struct CalibrationOptions {
   /// (CellSample::reframed; what a forward overlap of one half would show in flight). About
   /// twice the descents' segmentations; the model is the same either way.
   bool frame_check = false;
-  /// Which pixels the samples' field gains count (GainExtent): the region's (the default) or every
-  /// pixel the descent's images cover, as a flight realises them.
-  GainExtent gain_extent = GainExtent::region;
   GainModel::FitOptions fit{};  ///< what I predicts from, hyperparameter restarts
   int refit_every = 0;          ///< O's scheduled re-optimisation (GainModel)
 

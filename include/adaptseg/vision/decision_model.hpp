@@ -16,6 +16,7 @@
 #include <adaptseg/core/timing.hpp>
 #include <adaptseg/vision/adaptive_options.hpp>
 #include <adaptseg/vision/decision_rules.hpp>
+#include <adaptseg/vision/detail/cell_model_io.hpp>
 #include <adaptseg/vision/detail/number_text.hpp>
 #include <adaptseg/vision/detail/yaml_io.hpp>
 #include <adaptseg/vision/field.hpp>
@@ -45,29 +46,6 @@ using ModelGp = GainModel::Gp;
 
 }  // namespace detail
 
-/// The keys of the cell gain model's points in a model file (`gain_model.cells`), one list each.
-/// The last, `proxy_slope_sd` (since 2026-11-27), may be missing: 0, the scene check as before it.
-inline constexpr std::array<std::pair<const char*, double CellGainModel::Point::*>, 9> kCellPointKeys{{
-    {"top_gsd_cm", &CellGainModel::Point::top_gsd_cm},
-    {"sub_gsd_cm", &CellGainModel::Point::sub_gsd_cm},
-    {"gain_slope", &CellGainModel::Point::gain_slope},
-    {"gain_noise", &CellGainModel::Point::gain_noise},
-    {"relabel_slope", &CellGainModel::Point::relabel_slope},
-    {"relabel_noise", &CellGainModel::Point::relabel_noise},
-    {"proxy_slope", &CellGainModel::Point::proxy_slope},
-    {"proxy_noise", &CellGainModel::Point::proxy_noise},
-    {"proxy_slope_sd", &CellGainModel::Point::proxy_slope_sd},
-}};
-
-/// The keys of β's dependence on the field's entropy (SlopePooling::field_entropy), written and
-/// required with that pooling only.
-inline constexpr std::array<std::pair<const char*, double CellGainModel::Point::*>, 4> kCellEntropyKeys{{
-    {"entropy_slope", &CellGainModel::Point::entropy_slope},
-    {"entropy_reference", &CellGainModel::Point::entropy_reference},
-    {"entropy_low", &CellGainModel::Point::entropy_low},
-    {"entropy_high", &CellGainModel::Point::entropy_high},
-}};
-
 /// A calibrated decision model and its provenance.
 struct DecisionModel {
   std::vector<std::string> calibration_fields;  ///< names of the training fields (with regions)
@@ -85,6 +63,7 @@ struct DecisionModel {
   /// `region`, the paper's.
   DescentCoverage coverage = DescentCoverage::region;
   DescentGrid descent_grid = DescentGrid::region;  ///< how its descents were laid; files without the key: region
+  GainExtent gain_extent = GainExtent::region;     ///< what its gains count; files without the key: region
   DecisionFunction decision_function;
   LinearDecision::Params linear{};
   std::size_t samples = 0;          ///< region samples the GPs were fitted to
@@ -98,7 +77,7 @@ struct DecisionModel {
   MapFusion map_fusion = MapFusion::finest;
 
   /// The planner options of a mission flown with this model: its camera, timing, top and
-  /// candidate GSDs, descent coverage and grid and map fusion, with `mission`'s labels of interest and
+  /// candidate GSDs, descent coverage, grid and gain extent and map fusion, with `mission`'s labels of interest and
   /// fixed times.
   [[nodiscard]] AdaptiveOptions adaptive_options(MissionOptions mission,
                                                  std::optional<double> budget_s = std::nullopt) const {
@@ -107,6 +86,7 @@ struct DecisionModel {
     mission.map_fusion = map_fusion;
     AdaptiveOptions o{std::move(mission), top_gsd_cm, candidate_gsd_cm, budget_s, coverage};
     o.descent_grid = descent_grid;
+    o.gain_extent = gain_extent;
     if (const auto& cells = decision_function.model().cells()) o.cell_input = cells->input();
     return o;
   }
@@ -245,6 +225,7 @@ struct DecisionModel {
     e << YAML::Key << "descent_coverage" << YAML::Value << to_string(coverage);
     // Written only when not the paper's, so that earlier models keep their bytes.
     if (descent_grid != DescentGrid::region) e << YAML::Key << "descent_grid" << YAML::Value << to_string(descent_grid);
+    if (gain_extent != GainExtent::region) e << YAML::Key << "gain_extent" << YAML::Value << to_string(gain_extent);
     if (map_fusion != MapFusion::finest) e << YAML::Key << "map_fusion" << YAML::Value << to_string(map_fusion);
     e << YAML::Key << "linear" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "sigma_low" << YAML::Value
       << num(linear.sigma_low) << YAML::Key << "sigma_high" << YAML::Value << num(linear.sigma_high) << YAML::EndMap;
@@ -274,21 +255,8 @@ struct DecisionModel {
       e << YAML::EndMap;
     }
     if (const auto& cells = gm.cells()) {
-      e << YAML::Key << "cells" << YAML::Value << YAML::BeginMap;
-      e << YAML::Key << "input" << YAML::Value << to_string(cells->input());
-      if (cells->pooling() != SlopePooling::cells)
-        e << YAML::Key << "slope_pooling" << YAML::Value << to_string(cells->pooling());
-      const auto emit_points = [&](const auto& keys) {
-        for (const auto& [key, member] : keys) {
-          std::vector<double> v;
-          for (const auto& p : cells->points()) v.push_back(p.*member);
-          e << YAML::Key << key << YAML::Value;
-          emit_numbers(e, v);
-        }
-      };
-      emit_points(kCellPointKeys);
-      if (cells->pooling() == SlopePooling::field_entropy) emit_points(kCellEntropyKeys);
-      e << YAML::EndMap;
+      e << YAML::Key << "cells" << YAML::Value;
+      detail::emit_cell_model(e, *cells);
     }
     e << YAML::EndMap;
   }
@@ -311,6 +279,7 @@ struct DecisionModel {
     m.candidate_gsd_cm = r.numbers("candidate_gsd_cm");
     if (r.has("descent_coverage")) m.coverage = parse_descent_coverage(r.text("descent_coverage"));
     if (r.has("descent_grid")) m.descent_grid = parse_descent_grid(r.text("descent_grid"));
+    if (r.has("gain_extent")) m.gain_extent = parse_gain_extent(r.text("gain_extent"));
     if (r.has("map_fusion")) m.map_fusion = parse_map_fusion(r.text("map_fusion"));
     const auto lin = r.map("linear");
     m.linear = {lin.number("sigma_low"), lin.number("sigma_high")};
@@ -340,46 +309,8 @@ struct DecisionModel {
     GainModel model(gp("O", 2), gp("I", inputs == "delta-sigma" ? 1 : 2),
                     with_c ? std::optional(gp("C", 2)) : std::nullopt, std::move(efficiency),
                     static_cast<int>(gm.integer("refit_every", 0, 1'000'000'000)));
-    if (gm.has("cells")) model.set_cells(read_cells(r, gm.map("cells")));
+    if (gm.has("cells")) model.set_cells(detail::read_cell_model(r.where(), gm.map("cells")));
     return model;
-  }
-
-  /// read_gain_model's cell gain model (`gain_model.cells`).
-  static CellGainModel read_cells(const detail::YamlReader& r, const detail::YamlReader& c) {
-    const DecisionInput input = parse_decision_input(c.text("input"));
-    std::vector<CellGainModel::Point> points;
-    for (const auto& [key, member] : kCellPointKeys) {
-      if (member == &CellGainModel::Point::proxy_slope_sd && !c.has(key)) continue;
-      const auto v = c.numbers(key);
-      if (points.empty()) points.resize(v.size());
-      if (v.empty() || v.size() != points.size())
-        detail::yaml_error(r.where(),
-                           "'gain_model.cells' needs one top_gsd_cm, sub_gsd_cm, gain_slope, gain_noise, "
-                           "relabel_slope, relabel_noise, proxy_slope, proxy_noise and (optional) "
-                           "proxy_slope_sd value per point (>= 1 point)");
-      for (std::size_t j = 0; j < v.size(); ++j) points[j].*member = v[j];
-    }
-    // Absent (files of adaptseg before 2026-11-27, or pooled over the cells): cells.
-    SlopePooling pooling = SlopePooling::cells;
-    if (c.has("slope_pooling")) {
-      const std::string name = c.text("slope_pooling");
-      try {
-        pooling = parse_slope_pooling(name);
-      } catch (const std::invalid_argument&) {
-        detail::yaml_error(
-            r.where(), "'gain_model.cells.slope_pooling' must be cells, fields or field-entropy (got '" + name + "')");
-      }
-    }
-    if (pooling == SlopePooling::field_entropy)
-      for (const auto& [key, member] : kCellEntropyKeys) {
-        const auto v = c.numbers(key);
-        if (v.size() != points.size())
-          detail::yaml_error(r.where(),
-                             "'gain_model.cells' with slope_pooling field-entropy needs one entropy_slope, "
-                             "entropy_reference, entropy_low and entropy_high value per point");
-        for (std::size_t j = 0; j < v.size(); ++j) points[j].*member = v[j];
-      }
-    return CellGainModel(input, std::move(points), pooling);
   }
 
   // The reader reads keys in the order of the model's members: a file with several faults

@@ -148,8 +148,8 @@ inline std::optional<double> field_scale(const GainModel& model, bool cells, std
   double num = 0.0, den = 0.0;
   if (cells) {
     for (const CellSample& c : cell_samples) {
-      const double f = model.cells()->cell_gain(c.top_gsd_cm, c.sub_gsd_cm, c.top) * c.top.field_px;
-      num += f * c.normalized_gain() * c.top.field_px;
+      const double f = model.cells()->cell_gain(c.top_gsd_cm, c.sub_gsd_cm, c.top) * c.top.gain_px();
+      num += f * c.normalized_gain() * c.top.gain_px();
       den += f * f;
     }
   } else {

@@ -218,8 +218,11 @@ class SampleCollector {
       c.sub_gsd_cm = g;
       c.top = r.inputs.cell(r.field_px, cell);
       if (!(c.top.field_px > 0.0)) continue;
+      // GainExtent::images: the gain is counted over the cell's whole footprint, and normalised
+      // by it (the planner forecasts the same pixels: CellInputs::gain_px).
+      if (whole_images_) c.top.footprint_px = field_.valid_pixels(sub[k].footprint);
       c.fine = fine_inputs[k];
-      c.field_share = c.top.field_px / field_px_total_;
+      c.field_share = c.top.gain_px() / field_px_total_;
       c.field_sigma = field_sigma_;
       const Relabelling changed = relabelling(r.map.labels()(cell), after(cell), r.field_px(cell), interest_);
       c.relabelled = changed.interest_share;

@@ -91,7 +91,7 @@ class DescentInProgress {
     if (!trusted)
       end_here();
     else if (input && cell.area() > 0)
-      watch_.add_fine_image(image, segmentation, interest, ignore_label, cell, valid_mask, *input);
+      watch_.add_fine_image(step, image, segmentation, interest, ignore_label, cell, valid_mask, *input);
   }
 
   /// After one of its images was reported, with waypoints left: ends it there where `costing`

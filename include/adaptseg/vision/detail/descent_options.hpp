@@ -28,15 +28,18 @@ struct DescentOption {
 /// Appends to `out` the options of a coverage that ranks cells at `gsd_cm`: the cells of the
 /// sub-lawnmower `all` ranked by their mass of `input` in the region's `inputs` (each cell's
 /// rectangle in the region's pixels from `cell_rect(footprint)`, its field from `field`, the
-/// region's valid mask), one option per number k of the best cells (cells without any of the
-/// input left out; ties in the sub-lawnmower's order), each flown in the sub-lawnmower's order.
-template <class CellRect>
+/// region's valid mask; CellInputs::footprint_px from `footprint_px(footprint)`), one option
+/// per number k of the best cells (cells without any of the input left out; ties in the
+/// sub-lawnmower's order), each flown in the sub-lawnmower's order.
+template <class CellRect, class FootprintPx>
 void append_ranked_options(std::vector<DescentOption>& out, double gsd_cm, const std::vector<Waypoint>& all,
-                           const GridInputs& inputs, const cv::Mat& field, DecisionInput input, CellRect&& cell_rect) {
+                           const GridInputs& inputs, const cv::Mat& field, DecisionInput input, CellRect&& cell_rect,
+                           FootprintPx&& footprint_px) {
   std::vector<CellInputs> cells;
   std::vector<std::size_t> ranked;
   for (std::size_t k = 0; k < all.size(); ++k) {
     cells.push_back(inputs.cell(field, cell_rect(all[k].footprint)));
+    cells.back().footprint_px = footprint_px(all[k].footprint);
     if (cells.back().mass(input) > 0.0) ranked.push_back(k);
   }
   std::stable_sort(ranked.begin(), ranked.end(),

@@ -14,6 +14,8 @@
 #include <cmath>
 #include <cstddef>
 #include <span>
+#include <utility>
+#include <vector>
 
 namespace adaptseg::detail {
 
@@ -25,18 +27,19 @@ class DescentWatch {
   /// The descent's first image is about to be fused; `region_labels` is the region's map before it.
   void begin(const cv::Mat& region_labels) {
     before_ = region_labels.clone();
-    fine_mass_ = 0.0;
+    fine_mass_.clear();
     fine_known_ = true;
   }
 
-  /// Ranked cells: adds the descent image's (`image`, `segmentation`) mass of `input` over its
-  /// `cell` of the map grid (non-empty), whose field is `valid_mask(cell)`.
-  void add_fine_image(const Image& image, const Segmentation& segmentation, std::span<const int> interest,
-                      int ignore_label, const cv::Rect& cell, const cv::Mat& valid_mask, DecisionInput input) {
+  /// Ranked cells: adds the mass of `input` of the descent's image at `step` (`image`,
+  /// `segmentation`) over its `cell` of the map grid (non-empty), whose field is `valid_mask(cell)`.
+  void add_fine_image(std::size_t step, const Image& image, const Segmentation& segmentation,
+                      std::span<const int> interest, int ignore_label, const cv::Rect& cell, const cv::Mat& valid_mask,
+                      DecisionInput input) {
     scene_inputs_.assign(image, segmentation, interest, ignore_label, cell, std::array{input}, GridInputs::Cells::one);
     const CellInputs c = scene_inputs_.cell(valid_mask(cell), cv::Rect(0, 0, cell.width, cell.height));
     fine_known_ = fine_known_ && (c.field_px == 0.0 || std::isfinite(c.value(input)));
-    fine_mass_ += c.mass(input);
+    fine_mass_.emplace_back(step, c.mass(input));
   }
 
   /// After the descent's last image: σ of the `region` of the fused map `labels` at h' (an
@@ -54,20 +57,30 @@ class DescentWatch {
 
   /// Ranked cells: the ranking input's mass per field pixel of the region (`region_px`) over
   /// the `flown` first cells of `chosen` as the top-level image saw them, and as the finer
-  /// images saw them where every one gave it, into `out`.
+  /// images saw them where every one gave it, into `out`; each cell's mass over the pixels its
+  /// gain is counted over (CellInputs::gain_px, as CellGainModel::Forecast::input weighs it).
   void input_outcome(DescentOutcome& out, const Candidate& chosen, std::size_t flown, double region_px,
                      DecisionInput input) const {
+    const auto to_gain_px = [&](std::size_t k) {
+      const CellInputs& c = chosen.cells[k];
+      return c.field_px > 0.0 ? c.gain_px() / c.field_px : 1.0;
+    };
     double top_mass = 0.0;  // over the cells flown (a descent cut short flew the first ones)
-    for (std::size_t k = 0; k < chosen.cells.size() && k < flown; ++k) top_mass += chosen.cells[k].mass(input);
+    for (std::size_t k = 0; k < chosen.cells.size() && k < flown; ++k)
+      top_mass += chosen.cells[k].mass(input) * to_gain_px(k);
+    double fine_mass = 0.0;
+    for (const auto& [step, mass] : fine_mass_)
+      fine_mass += step < chosen.cells.size() ? mass * to_gain_px(step) : mass;
     if (region_px > 0.0) {
       out.top_input = top_mass / region_px;
-      if (fine_known_) out.fine_input = fine_mass_ / region_px;
+      if (fine_known_) out.fine_input = fine_mass / region_px;
     }
   }
 
  private:
-  cv::Mat before_;           ///< the region's map before the descent
-  double fine_mass_ = 0.0;   ///< Σ over its images so far of the finer look's input mass
+  cv::Mat before_;  ///< the region's map before the descent
+  /// Per image so far, its step and the finer look's input mass over its cell.
+  std::vector<std::pair<std::size_t, double>> fine_mass_;
   bool fine_known_ = true;   ///< ... every image of it gave the input
   GridInputs scene_inputs_;  ///< the last descent image's inputs over its cell (buffers reused)
 };

@@ -8,6 +8,7 @@
 #include <adaptseg/core/lawnmower_planner.hpp>
 #include <adaptseg/vision/detail/descent_options.hpp>
 #include <adaptseg/vision/detail/survey_grid.hpp>
+#include <adaptseg/vision/gain_extent.hpp>
 #include <adaptseg/vision/grid_inputs.hpp>
 #include <adaptseg/vision/image.hpp>
 
@@ -52,12 +53,13 @@ class RegionSummary {
   /// Every descent a decision over `region` may choose from, per GSD of `candidates`: the
   /// sub-lawnmower `plan_of(gsd)` (AdaptivePlanner::descent_plan), or where cells are ranked
   /// (`inputs` given, inputs()) its cells ranked by their mass of `cell_input`
-  /// (append_ranked_options; none for an empty region or without inputs).
+  /// (append_ranked_options; none for an empty region or without inputs), each with the field
+  /// pixels of its whole footprint where `extent` counts a gain there (GainExtent::images).
   template <class PlanOf>
   [[nodiscard]] static std::vector<DescentOption> options(const SurveyGrid& grid, const cv::Rect& region,
                                                           std::span<const double> candidates, bool ranks_cells,
                                                           const GridInputs* inputs, DecisionInput cell_input,
-                                                          PlanOf&& plan_of) {
+                                                          GainExtent extent, PlanOf&& plan_of) {
     std::vector<DescentOption> out;
     if (!ranks_cells) {
       for (double g : candidates) out.push_back({g, plan_of(g), {}});
@@ -66,7 +68,11 @@ class RegionSummary {
     if (region.area() == 0 || !inputs) return out;
     const cv::Mat field = grid.area().valid_mask(region);
     const auto cell_rect = [&](const Area& a) { return (grid.pixel_rect(a) & region) - region.tl(); };
-    for (double g : candidates) append_ranked_options(out, g, plan_of(g), *inputs, field, cell_input, cell_rect);
+    const auto footprint_px = [&](const Area& a) {
+      return extent == GainExtent::images ? static_cast<double>(grid.valid_pixels(a)) : 0.0;
+    };
+    for (double g : candidates)
+      append_ranked_options(out, g, plan_of(g), *inputs, field, cell_input, cell_rect, footprint_px);
     return out;
   }
 
