@@ -48,6 +48,28 @@ struct Scripted {
 };
 static_assert(DecisionPolicy<Scripted>);
 
+// Keeps the candidates each decision was offered, and descends to the one at index `pick`
+// (clamped) wherever there is one, unless `descend` is false.
+struct Pick {
+  std::size_t pick = 0;
+  bool descend = true;
+  std::vector<std::vector<Candidate>> offered{};
+  std::string name() const { return "pick"; }
+  void begin_mission() { offered.clear(); }
+  Decision decide(const DecisionContext& c) {
+    offered.emplace_back(c.candidates.begin(), c.candidates.end());
+    Decision d;
+    if (!descend || c.candidates.empty()) return d;
+    d.descend = true;
+    d.candidate = std::min(pick, c.candidates.size() - 1);
+    d.gsd_cm = c.candidates[d.candidate].gsd_cm;
+    d.scores.resize(c.candidates.size());
+    return d;
+  }
+  void observe(const DescentOutcome&) {}
+};
+static_assert(DecisionPolicy<Pick>);
+
 AdaptiveOptions options() {
   AdaptiveOptions o;
   o.mission.fixed_segmentation_time_s = 0.1;
@@ -266,25 +288,6 @@ TEST_CASE("adaptive planner: coverage 'ranked' offers the best k cells by their 
   o.candidate_gsd_cm = {1.0};
   o.coverage = DescentCoverage::ranked;
   o.cell_input = DecisionInput::expected_error;
-  // Descends to the candidate at index `pick` (clamped), wherever there is one.
-  struct Pick {
-    std::size_t pick = 0;
-    std::vector<std::vector<Candidate>> offered{};
-    std::string name() const { return "pick"; }
-    void begin_mission() { offered.clear(); }
-    Decision decide(const DecisionContext& c) {
-      offered.emplace_back(c.candidates.begin(), c.candidates.end());
-      Decision d;
-      if (c.candidates.empty()) return d;
-      d.descend = true;
-      d.candidate = std::min(pick, c.candidates.size() - 1);
-      d.gsd_cm = c.candidates[d.candidate].gsd_cm;
-      d.scores.resize(c.candidates.size());
-      return d;
-    }
-    void observe(const DescentOutcome&) {}
-  };
-  static_assert(DecisionPolicy<Pick>);
   Pick best_one{.pick = 0};
   const AdaptiveResult one = run_adaptive_mission(f, oracle, best_one, o, "one");
   REQUIRE(best_one.offered.size() == 2);
@@ -1051,18 +1054,6 @@ TEST_CASE(
   o.candidate_gsd_cm = {2.0};
   o.coverage = DescentCoverage::ranked;
   o.cell_input = DecisionInput::expected_error;
-  // Never descends; keeps the candidates each decision was offered.
-  struct Offered {
-    std::vector<std::vector<Candidate>> offered{};
-    std::string name() const { return "offered"; }
-    void begin_mission() { offered.clear(); }
-    Decision decide(const DecisionContext& c) {
-      offered.emplace_back(c.candidates.begin(), c.candidates.end());
-      return {};
-    }
-    void observe(const DescentOutcome&) {}
-  };
-  static_assert(DecisionPolicy<Offered>);
   const CameraModel camera(o.mission.camera);
   const CalibrationSamples samples =
       collect_samples(f, oracle, camera, o.top_gsd_cm, {2.0}, f.interest(), o.coverage, 0, MapFusion::finest, false,
@@ -1071,7 +1062,7 @@ TEST_CASE(
   for (GainExtent extent : {GainExtent::region, GainExtent::images}) {
     CAPTURE(std::string(to_string(extent)));
     o.gain_extent = extent;
-    Offered policy;
+    Pick policy{.descend = false};
     (void)run_adaptive_mission(f, oracle, policy, o, "offered");
     std::size_t compared = 0, overhang = 0;
     for (std::size_t k = 0; k < policy.offered.size(); ++k) {

@@ -893,30 +893,28 @@ TEST_CASE("robustness: decision model: unknown descent coverage, grid or gain ex
   const std::string text = replaced(model_text(), "descent_coverage: region", "descent_coverage: everywhere");
   CHECK_THROWS_WITH_AS((void)load_model_text(dir, text), Contains("'region', 'interest' or 'ranked'"),
                        std::invalid_argument);
-  const auto with_grid = [&](const std::string& g) {
-    return replaced(model_text(), "descent_coverage: region", "descent_coverage: region\ndescent_grid: " + g);
+  // An optional setup key (`key`): an unknown name (`bad`) is refused with `refusal`; a known one
+  // (`good`, `value`) is read, handed to the missions' options and written back; a file without
+  // the key reads the paper's `region`.
+  const auto check_key = [&](const std::string& key, const std::string& bad, const std::string& refusal,
+                             const std::string& good, auto member, auto option, auto value) {
+    CAPTURE(key);
+    const auto with = [&](const std::string& v) {
+      return replaced(model_text(), "descent_coverage: region", "descent_coverage: region\n" + key + ": " + v);
+    };
+    CHECK_THROWS_WITH_AS((void)load_model_text(dir, with(bad)), Contains(refusal.c_str()), std::invalid_argument);
+    const DecisionModel m = load_model_text(dir, with(good));
+    CHECK(m.*member == value);
+    CHECK(m.adaptive_options({}).*option == value);
+    m.save(dir.path() / "again.yaml");
+    CHECK(DecisionModel::load(dir.path() / "again.yaml").*member == value);
+    CHECK(load_model_text(dir, model_text()).*member == decltype(value)::region);
   };
-  CHECK_THROWS_WITH_AS((void)load_model_text(dir, with_grid("shared")),
-                       Contains("descent grid must be 'region' or 'field', not 'shared'"), std::invalid_argument);
-  // A known grid is read, handed to the missions' options, and written back (a file without the key: region).
-  const DecisionModel m = load_model_text(dir, with_grid("field"));
-  CHECK(m.descent_grid == DescentGrid::field);
-  CHECK(m.adaptive_options({}).descent_grid == DescentGrid::field);
-  m.save(dir.path() / "again.yaml");
-  CHECK(DecisionModel::load(dir.path() / "again.yaml").descent_grid == DescentGrid::field);
-  CHECK(load_model_text(dir, model_text()).descent_grid == DescentGrid::region);
-  // The gain extent likewise: it tells the missions over which pixels each cell is forecast.
-  const auto with_extent = [&](const std::string& e) {
-    return replaced(model_text(), "descent_coverage: region", "descent_coverage: region\ngain_extent: " + e);
-  };
-  CHECK_THROWS_WITH_AS((void)load_model_text(dir, with_extent("footprint")),
-                       Contains("gain extent must be 'region' or 'images', not 'footprint'"), std::invalid_argument);
-  const DecisionModel images = load_model_text(dir, with_extent("images"));
-  CHECK(images.gain_extent == GainExtent::images);
-  CHECK(images.adaptive_options({}).gain_extent == GainExtent::images);
-  images.save(dir.path() / "extent.yaml");
-  CHECK(DecisionModel::load(dir.path() / "extent.yaml").gain_extent == GainExtent::images);
-  CHECK(load_model_text(dir, model_text()).gain_extent == GainExtent::region);
+  check_key("descent_grid", "shared", "descent grid must be 'region' or 'field', not 'shared'", "field",
+            &DecisionModel::descent_grid, &AdaptiveOptions::descent_grid, DescentGrid::field);
+  // The gain extent tells the missions over which pixels each ranked cell is forecast.
+  check_key("gain_extent", "footprint", "gain extent must be 'region' or 'images', not 'footprint'", "images",
+            &DecisionModel::gain_extent, &AdaptiveOptions::gain_extent, GainExtent::images);
 }
 
 TEST_CASE("robustness: decision model: I with three inputs") {
