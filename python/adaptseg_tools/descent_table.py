@@ -22,7 +22,9 @@ over the descent's extra time (forecast_curve_rise) against the rise of the fiel
 front margin reads it) over the same seconds, ending at the forecast end (forecast_end_s), and
 each descent's margin, forecast (forecast gain − predicted rise) and realised (realised gain −
 real rise). Where the rule predicts the rise too steep it keeps descents that would have paid;
-too flat, it takes descents that the curve outruns.
+too flat, it takes descents that the curve outruns. Below the table, the sums of both rises and of
+both margins and their correlations over the descents: the rule decides on the forecast margin,
+so whether it ranks the descents as the realised margins do is what its decisions rest on.
 
 With --hindsight, per run: what the mission would have ended at had it flown only its best
 descents, known in hindsight. Its descents sorted by realised gain per second, the prefix whose
@@ -86,7 +88,7 @@ def curve_table(rows: list[tuple[str, dict]], curves: dict[tuple[str, str], list
     print("| run | decision | GSD [cm/px] | extra time [s] | forecast end [s] | forecast gain | predicted rise | "
           "real rise | forecast margin | realised margin |")
     print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
-    predicted, real, paid, without = [], [], 0, 0
+    predicted, real, forecast_margin, realised_margin, paid, without = [], [], [], [], 0, 0
     for run, d in rows:
         if d.get("forecast_curve_rise", "") in ("", None) or d.get("forecast_end_s", "") in ("", None):
             without += 1  # the utility rule, or a file written before 2026-11-30
@@ -99,6 +101,8 @@ def curve_table(rows: list[tuple[str, dict]], curves: dict[tuple[str, str], list
               f"{rise:+.4f} | {real_rise:+.4f} | {fg - rise:+.4f} | {rg - real_rise:+.4f} |")
         predicted.append(rise)
         real.append(real_rise)
+        forecast_margin.append(fg - rise)
+        realised_margin.append(rg - real_rise)
         paid += rg > real_rise
     print()
     if without:
@@ -108,6 +112,9 @@ def curve_table(rows: list[tuple[str, dict]], curves: dict[tuple[str, str], list
         print(f"{len(predicted)} descents: predicted rise {sum(predicted):+.4f} in all against the real curve's "
               f"{sum(real):+.4f} (correlation {correlation(predicted, real):+.2f}); {paid} of {len(predicted)} "
               f"gained more than the real curve rose in their seconds")
+        # What the rule decides on: the margin, gain less rise, both halves' errors together.
+        print(f"margins: forecast {sum(forecast_margin):+.4f} in all against realised {sum(realised_margin):+.4f} "
+              f"(correlation {correlation(forecast_margin, realised_margin):+.2f})")
 
 
 def hindsight_table(runs: list[str], rows: list[tuple[str, dict]], strategy: str, gsd: float | None) -> None:

@@ -101,6 +101,9 @@ def main():
             sys.exit(f"curve: no row {want}:\n{curve}")
         if "1 of 2 gained more than the real curve rose in their seconds" not in curve:
             sys.exit(f"curve summary:\n{curve}")
+        # The second descent: forecast 0.006 − 0.005, realised 0.001 − 0.020 over [110, 130] s.
+        if "margins: forecast +0.0120 in all against realised -0.0090" not in curve:
+            sys.exit(f"curve margins:\n{curve}")
         images = table(["--images", run])
         rows = [line for line in images.splitlines() if line.startswith("| run |") and "σ" not in line]
         if rows != ["| run | 2 | 10 | 0.600 | 0.100 | +0.500 | 0.000 | 0.050 |",
