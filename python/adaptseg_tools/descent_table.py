@@ -32,7 +32,10 @@ top-level lawnmower (results.csv: the lawnmower at the mission's top GSD) plus t
 gains and extra times ends highest above the real curve: whether the descents a rule took hold
 any that pay (selection) or none (the candidates themselves). Gains taken as additive. With
 --gsd G also the margin of its descents to G cm/px alone, in the order flown: what the mission
-would have ended at had it descended to G only where it did.
+would have ended at had it descended to G only where it did; with --max-extra S, of its descents
+of at most S seconds of extra time alone (both: those that are both). Gains taken as additive:
+what a cap on a descent's seconds could earn on the descents a rule chose, not what a rule with
+the cap would choose.
 
 With --images, per image of a descent (per_image.csv): its σ (the share of L in its labels)
 against its region's top-level σ (the level-0 image before it), the jump between the two, and
@@ -46,7 +49,7 @@ variance of the logarithm of the first ratio within the runs (about each run's m
 run) and over all: how far one descent's relabelled share says what its field's does
 (docs/method.md, "The field factor from what a descent relabelled").
 
-Usage: descent_table.py [--strategy adaptive] [--curve | --hindsight [--gsd G] | --images | --relabelled] RUN_DIR [RUN_DIR ...]
+Usage: descent_table.py [--strategy adaptive] [--curve | --hindsight [--gsd G] [--max-extra S] | --images | --relabelled] RUN_DIR [RUN_DIR ...]
 """
 
 from __future__ import annotations
@@ -117,10 +120,19 @@ def curve_table(rows: list[tuple[str, dict]], curves: dict[tuple[str, str], list
               f"(correlation {correlation(forecast_margin, realised_margin):+.2f})")
 
 
-def hindsight_table(runs: list[str], rows: list[tuple[str, dict]], strategy: str, gsd: float | None) -> None:
-    only = f" | descents to {gsd:g} cm/px alone: margin" if gsd is not None else ""
+def hindsight_table(runs: list[str], rows: list[tuple[str, dict]], strategy: str, gsd: float | None,
+                    max_extra: float | None = None) -> None:
+    words = ([f"to {gsd:g} cm/px"] if gsd is not None else []) + \
+        ([f"of at most {max_extra:g} s"] if max_extra is not None else [])
+    alone_words = "descents " + " and ".join(words) if words else ""
+
+    def kept_alone(d: dict) -> bool:
+        return ((gsd is None or abs(number(d["gsd_cm"]) - gsd) < 1e-6)
+                and (max_extra is None or number(d["extra_time_s"]) <= max_extra))
+
+    only = f" | {alone_words} alone: margin" if words else ""
     print("| run | descents | margin flown | best prefix: descents | its margin" + only + " |")
-    print("| --- | ---: | ---: | ---: | ---: |" + (" ---: |" if gsd is not None else ""))
+    print("| --- | ---: | ---: | ---: | ---: |" + (" ---: |" if words else ""))
     flown_above = best_above = only_above = 0
     for run in runs:
         path = Path(run)
@@ -135,8 +147,8 @@ def hindsight_table(runs: list[str], rows: list[tuple[str, dict]], strategy: str
             descents = sorted(((number(d["realised_field_gain"]), number(d["extra_time_s"])) for d in flown_descents),
                               key=lambda gt: -gt[0] / max(gt[1], 1e-9))
             cell = ""
-            if gsd is not None:
-                kept = [d for d in flown_descents if abs(number(d["gsd_cm"]) - gsd) < 1e-6]
+            if words:
+                kept = [d for d in flown_descents if kept_alone(d)]
                 t_only = t + sum(number(d["extra_time_s"]) for d in kept)
                 m_only = m + sum(number(d["realised_field_gain"]) for d in kept) - envelope_at(env, t_only)
                 only_above += m_only > 0.001
@@ -151,7 +163,7 @@ def hindsight_table(runs: list[str], rows: list[tuple[str, dict]], strategy: str
             best_above += best > 0.001
             print(f"| {path.name} | {len(descents)} | {flown:+.4f} | {best_k} | {best:+.4f} |{cell}")
     print()
-    alone = f", {only_above} with their descents to {gsd:g} cm/px alone" if gsd is not None else ""
+    alone = f", {only_above} with their {alone_words} alone" if words else ""
     print(f"{len(runs)} runs: {flown_above} above +0.001 as flown, {best_above} with their best descents only{alone}")
 
 
@@ -223,6 +235,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--hindsight", action="store_true",
                     help="per run, the margin of its best descents only, chosen in hindsight")
     ap.add_argument("--gsd", type=float, help="with --hindsight: the margin of the descents to this GSD alone")
+    ap.add_argument("--max-extra", type=float, metavar="S",
+                    help="with --hindsight: the margin of the descents of at most S seconds of extra time alone")
     ap.add_argument("--images", action="store_true",
                     help="each descent image's σ against its region's top-level σ, and the ground truth's")
     ap.add_argument("--relabelled", action="store_true",
@@ -246,7 +260,7 @@ def main(argv: list[str] | None = None) -> int:
         relabelled_table(rows)
         return 0
     if args.hindsight:
-        hindsight_table(args.runs, rows, args.strategy, args.gsd)
+        hindsight_table(args.runs, rows, args.strategy, args.gsd, args.max_extra)
         return 0
     if args.curve:
         curves = {(Path(run).name, field): env for run in args.runs for field, env in real_curves(Path(run)).items()}

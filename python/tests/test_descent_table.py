@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Self-test of descent_table.py's plain table, --curve, --hindsight, --images and --relabelled on a synthetic
-run (run by CTest; exit code != 0 on failure).
+"""Self-test of descent_table.py's plain table, --curve, --hindsight (--gsd, --max-extra), --images
+and --relabelled on a synthetic run (run by CTest; exit code != 0 on failure).
 
 Each descent's row: its gains, pixels and the change of its region's σ. One field whose
 lawnmowers map L at 0.50 in 100 s and 0.60 in 200 s (the real curve rises 0.001 per second),
@@ -94,6 +94,15 @@ def main():
             sys.exit(f"hindsight --gsd 10: the descents to 10 cm/px alone should end at -0.0090:\n{alone}")
         if "| run | 2 | -0.0090 | 1 | +0.0100 | +0.0000 |" not in table(["--hindsight", "--gsd", "5", run]):
             sys.exit("hindsight --gsd 5: no descent to 5 cm/px should leave the top-level lawnmower, margin 0")
+        # The first descent took 10 s, the second 20 s: a cap of 10 s keeps the first alone.
+        capped = table(["--hindsight", "--max-extra", "10", run])
+        if "| run | 2 | -0.0090 | 1 | +0.0100 | +0.0100 |" not in capped:
+            sys.exit(f"hindsight --max-extra 10: the first descent alone should end at +0.0100:\n{capped}")
+        if "1 with their descents of at most 10 s alone" not in capped:
+            sys.exit(f"hindsight --max-extra summary:\n{capped}")
+        both = table(["--hindsight", "--gsd", "10", "--max-extra", "5", run])
+        if "| run | 2 | -0.0090 | 1 | +0.0100 | +0.0000 |" not in both:
+            sys.exit(f"hindsight --gsd 10 --max-extra 5: no descent is that short, margin 0:\n{both}")
         curve = table(["--curve", run])
         # decision, GSD, extra time, end, forecast gain, predicted rise, real rise, margins
         want = "| run | 0 | 10 | 10.0 | 110.0 | +0.0150 | +0.0040 | +0.0100 | +0.0110 | +0.0100 |"
