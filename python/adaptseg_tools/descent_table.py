@@ -243,6 +243,10 @@ def main(argv: list[str] | None = None) -> int:
                     help="each descent's relabelled share against its forecast, and its spread within the runs")
     ap.add_argument("runs", nargs="+")
     args = ap.parse_args(argv)
+    if (args.gsd is not None or args.max_extra is not None) and not args.hindsight:
+        ap.error("--gsd and --max-extra belong to --hindsight")
+    if args.max_extra is not None and not args.max_extra >= 0:
+        ap.error(f"--max-extra must be seconds >= 0; got {args.max_extra:g}")
     if args.images:
         images_table(args.runs, args.strategy)
         return 0

@@ -10,6 +10,8 @@ the curve (0.52 at 110 s against 0.51), both together −0.0090; the first's rea
 seconds is 0.0100, against a predicted 0.0040. The first relabels twice its forecast share, the
 second half of it: log ratios ±0.693, variance 0.961 within the run.
 """
+import contextlib
+import io
 import os
 import sys
 import tempfile
@@ -103,6 +105,14 @@ def main():
         both = table(["--hindsight", "--gsd", "10", "--max-extra", "5", run])
         if "| run | 2 | -0.0090 | 1 | +0.0100 | +0.0000 |" not in both:
             sys.exit(f"hindsight --gsd 10 --max-extra 5: no descent is that short, margin 0:\n{both}")
+        for wrong in (["--max-extra", "10", run], ["--hindsight", "--max-extra", "-1", run]):
+            try:
+                with contextlib.redirect_stderr(io.StringIO()):
+                    descent_table.main(wrong)
+                sys.exit(f"{wrong}: should be refused")
+            except SystemExit as e:
+                if e.code != 2:
+                    raise
         curve = table(["--curve", run])
         # decision, GSD, extra time, end, forecast gain, predicted rise, real rise, margins
         want = "| run | 0 | 10 | 10.0 | 110.0 | +0.0150 | +0.0040 | +0.0100 | +0.0110 | +0.0100 |"
