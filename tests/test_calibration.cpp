@@ -651,7 +651,7 @@ TEST_CASE("calibration: the finest descent GSD tried with the setting kept, the 
   // A GSD named twice, or a negative one, is refused up front.
   options.finest_descent_gsd_cm = {0.0, 0.0};
   CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
-                       doctest::Contains("finest_descent_gsd_cm names a GSD twice"), std::invalid_argument);
+                       doctest::Contains("finest_descent_gsd_cm names a limit twice"), std::invalid_argument);
   options.finest_descent_gsd_cm = {-1.0};
   CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
                        doctest::Contains("finest_descent_gsd_cm must hold finite GSDs >= 0"), std::invalid_argument);
@@ -661,6 +661,54 @@ TEST_CASE("calibration: the finest descent GSD tried with the setting kept, the 
   CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
                        doctest::Contains("finest_descent_gsd_cm belongs to the front-aware rule"),
                        std::invalid_argument);
+}
+
+TEST_CASE(
+    "calibration: the longest descent tried with every z and the setting kept, the first kept unless another "
+    "is better") {
+  const std::vector<Field> fields = two_blob_fields();
+  OracleSegmenter oracle(fields.front().num_classes());
+  CalibrationOptions options = ranked_options();
+  options.slope_poolings = {SlopePooling::cells};
+  const std::size_t zs = options.confidences.size();
+  // Every z with the first (no limit), then every z again with the other.
+  const double cap = 1.0;  // shorter than any descent of these fields: none is taken
+  options.longest_descent_s = {0.0, cap};
+  const CalibrationResult cal = calibrate(std::span<const Field>(fields), oracle, options);
+  REQUIRE(cal.trials.size() == 2 * zs);
+  std::vector<const RuleTrial*> unlimited, limited;
+  for (const auto& trial : cal.trials) {
+    if (trial.description.ends_with(" longest=any")) unlimited.push_back(&trial);
+    if (trial.description.ends_with(" longest=1")) limited.push_back(&trial);
+  }
+  REQUIRE(unlimited.size() == zs);
+  REQUIRE(limited.size() == zs);
+  for (const RuleTrial* t : limited) CHECK(t->descents == 0);
+  CHECK(std::any_of(unlimited.begin(), unlimited.end(), [](const RuleTrial* t) { return t->descents > 0; }));
+  // Among the limited trials the largest z is kept (all tie: none descends); against the
+  // unlimited one kept, the one-standard-error rule decides, and the model flies its limit.
+  const FrontAwarePolicy& rule = std::get<FrontAwarePolicy>(cal.decision_function.rule());
+  const bool kept_limit = cal.trials.front().description.ends_with(" longest=1");
+  CHECK(rule.params().longest_descent_s == (kept_limit ? cap : 0.0));
+  if (kept_limit) CHECK(rule.params().confidence == options.confidences.back());
+  // One limit: no name in the trials, no second search, and the rule flies it.
+  options.longest_descent_s = {cap};
+  const CalibrationResult one = calibrate(std::span<const Field>(fields), oracle, options);
+  CHECK(one.trials.size() == zs);
+  CHECK(one.trials.front().description.find("longest=") == std::string::npos);
+  CHECK(std::get<FrontAwarePolicy>(one.decision_function.rule()).params().longest_descent_s == cap);
+  for (const auto& trial : one.trials) CHECK(trial.descents == 0);
+  // A limit named twice, or a negative one, is refused up front; the utility rule refuses it.
+  options.longest_descent_s = {30.0, 30.0};
+  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
+                       doctest::Contains("longest_descent_s names a limit twice"), std::invalid_argument);
+  options.longest_descent_s = {-1.0};
+  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
+                       doctest::Contains("longest_descent_s must hold finite seconds >= 0"), std::invalid_argument);
+  options.longest_descent_s = {0.0, 30.0};
+  options.rule = "utility";
+  CHECK_THROWS_WITH_AS((void)calibrate(std::span<const Field>(fields), oracle, options),
+                       doctest::Contains("longest_descent_s belongs to the front-aware rule"), std::invalid_argument);
 }
 
 TEST_CASE(
@@ -1034,6 +1082,16 @@ TEST_CASE("calibration: several training fields pool their samples and keep ever
                                                         "finest_descent_gsd_cm: -2", "wrong_finest.yaml")),
                        doctest::Contains("finest_descent_gsd_cm must be finite and >= 0"), std::invalid_argument);
   p.finest_descent_gsd_cm = 0.0;
+  // The longest descent: kept (files without the key: 0, no limit); a negative one refused.
+  CHECK(rule_of(back).longest_descent_s == 0.0);
+  p.longest_descent_s = 45.0;
+  policy.set_params(p);
+  corrected.save(tmp.path() / "longest.yaml");
+  CHECK(rule_of(DecisionModel::load(tmp.path() / "longest.yaml")).longest_descent_s == 45.0);
+  CHECK_THROWS_WITH_AS((void)DecisionModel::load(edited("longest.yaml", "longest_descent_s: 45",
+                                                        "longest_descent_s: -45", "wrong_longest.yaml")),
+                       doctest::Contains("longest_descent_s must be finite and >= 0"), std::invalid_argument);
+  p.longest_descent_s = 0.0;
   // The jump guard's bound: kept (files without the key: none, infinity).
   CHECK(std::isinf(rule_of(back).jump_bound));
   p.jump_bound = 0.25;

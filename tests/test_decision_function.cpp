@@ -601,6 +601,27 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
     CHECK_THROWS_WITH_AS(FrontAwarePolicy(with_cells(1.0), reference, {.finest_descent_gsd_cm = -1.0}),
                          doctest::Contains("finest_descent_gsd_cm must be finite and >= 0"), std::invalid_argument);
   }
+  SUBCASE("the longest descent: no descent that costs more extra seconds, which is still assessed") {
+    // The offers cost 50 s and 90 s. A limit at the chosen one's seconds (up to rounding) or
+    // none keeps it; one below both takes none and still reports both.
+    const Decision free = decided(4.0, reference, {});
+    REQUIRE(free.descend);
+    const double t = s.offers[free.candidate].extra_time_s;
+    for (const double cap : {0.0, t, t * (1.0 - 1e-12)}) {
+      const Decision d = decided(4.0, reference, {.longest_descent_s = cap});
+      CHECK(d.descend);
+      CHECK(d.candidate == free.candidate);
+    }
+    const Decision shorter = decided(4.0, reference, {.longest_descent_s = 50.0});
+    CHECK((!shorter.descend || s.offers[shorter.candidate].extra_time_s == 50.0));
+    const Decision none = decided(4.0, reference, {.longest_descent_s = 40.0});
+    CHECK_FALSE(none.descend);
+    REQUIRE(none.scores.size() == 2);
+    CHECK(none.scores[free.candidate].predicted_field_gain > 0.0);
+    for (const double wrong : {-1.0, std::numeric_limits<double>::quiet_NaN()})
+      CHECK_THROWS_WITH_AS(FrontAwarePolicy(with_cells(1.0), reference, {.longest_descent_s = wrong}),
+                           doctest::Contains("longest_descent_s must be finite and >= 0"), std::invalid_argument);
+  }
   SUBCASE("against the field's own predicted curve, the forecasts' scale cancels") {
     // The training curve rises by 0.2 mIoU over 145 s: against it, a descent of twice the cells'
     // gain looks better than one of half of it. Against the curve the same model predicts for

@@ -260,6 +260,7 @@ struct CalibrationCli {
   bool frozen_folds = false;
   double curve_agreement = 0.0;
   std::vector<double> finest_descent_factors;
+  std::vector<double> longest_descent_s;
 
   void add_to(CLI::App& app) {
     options_ = {
@@ -397,6 +398,13 @@ struct CalibrationCli {
                        "beats it beyond the folds' noise (one standard error), and the one kept is saved in the "
                        "model (default: no limit, not searched)")
             ->delimiter(','),
+        app.add_option("--longest-descent", longest_descent_s,
+                       "front-aware rule: the most extra seconds a descent may cost (0: no limit), "
+                       "comma-separated; every setting is searched with the first, then each other is tried on "
+                       "the training fields' folds with every --confidence and the setting the rest of the search "
+                       "kept; the first is kept unless another beats it beyond the folds' noise (one standard "
+                       "error), and the one kept is saved in the model (default: no limit, not searched)")
+            ->delimiter(','),
         app.add_option("--sigma-prior", sigma_prior,
                        "front-aware rule with several training fields: the prior of the field's share of L "
                        "(sigma-hat): given (weight 0.25 fields, no spread), spread (its spread over the training "
@@ -450,6 +458,17 @@ struct CalibrationCli {
         throw std::invalid_argument("--finest-descent names the factor " + fmt(f, 3) +
                                     " twice: give each limit once (0: no limit)");
       options.finest_descent_gsd_cm.push_back(f * field_gsd_cm);
+    }
+    options.longest_descent_s.clear();
+    for (const double s : longest_descent_s) {
+      if (!(std::isfinite(s) && s >= 0.0))
+        throw std::invalid_argument("--longest-descent " + fmt(s, 3) +
+                                    " is not a number of seconds: give seconds >= 0, 0 for no limit");
+      if (std::find(options.longest_descent_s.begin(), options.longest_descent_s.end(), s) !=
+          options.longest_descent_s.end())
+        throw std::invalid_argument("--longest-descent names " + fmt(s, 3) +
+                                    " s twice: give each limit once (0: no limit)");
+      options.longest_descent_s.push_back(s);
     }
     options.top_levels.clear();
     for (const auto& name : top_levels) options.top_levels.push_back(parse_top_level_choice(name));

@@ -54,9 +54,10 @@ import sys
 
 from .fold_choice import choose as select, runs_of, tried_settings
 
-# A trial's name (detail::z_text): its z, and its slope pooling, top level and finest descent GSD
-# where the search tried several.
-SETTING = re.compile(r"front-aware z=(\S+?)(?: slopes=(\S+?))?(?: top=(\S+?))?(?: (finest=\S+))?$")
+# A trial's name (detail::z_text): its z, and its slope pooling, top level, finest descent GSD and
+# longest descent where the search tried several.
+SETTING = re.compile(r"front-aware z=(\S+?)(?: slopes=(\S+?))?(?: top=(\S+?))?"
+                     r"(?: (finest=\S+?))?(?: (longest=\S+))?$")
 CALIBRATING = re.compile(r"calibrating on (.*) \.\.\.$")
 
 
@@ -77,14 +78,15 @@ def fold_grounds(log):
 
 class Trial:
     """One setting tried: z, pooling and top level (None where the search tried one alone and the
-    log does not name it), the finest descent GSD where it tried several ("finest=G"), mean fold
-    margin, fold margins."""
+    log does not name it), the finest descent GSD and the longest descent where it tried several
+    ("finest=G", "longest=S"), mean fold margin, fold margins."""
 
     def __init__(self, log, name, mean, folds):
         m = SETTING.fullmatch(name)
         if not m:
             sys.exit(f"{log}: a setting tried that is not the front-aware rule's: {name!r}")
-        self.z, self.pooling, self.top, self.finest = float(m.group(1)), m.group(2), m.group(3), m.group(4)
+        self.z, self.pooling, self.top = float(m.group(1)), m.group(2), m.group(3)
+        self.finest, self.longest = m.group(4), m.group(5)
         self.mean, self.folds = mean, folds
 
     def setting(self):
@@ -98,8 +100,8 @@ class Trial:
 def read_trials(log):
     """The settings a run's log lists as tried, the kept one first."""
     out = [Trial(log, name, mean, folds) for name, mean, _, folds in tried_settings(log)]
-    if any(t.finest for t in out):
-        sys.exit(f"{log}: the search also tried the finest descent GSD: not replayed")
+    if any(t.finest or t.longest for t in out):
+        sys.exit(f"{log}: the search also tried the finest descent GSD or the longest descent: not replayed")
     if not out or any(t.pooling is None or t.top is None for t in out):
         sys.exit(f"{log}: no 'tried front-aware z=.. slopes=.. top=..' line (a run still calibrating, or one "
                  "whose search tried a single slope pooling or top level?)")
@@ -110,13 +112,13 @@ def flew(log, trial):
     """Whether a flown run's log kept `trial`'s setting: its first `tried` line names the same z
     and, where it names them, the same pooling and top level (a search that tried one alone omits
     it), with the same mean and fold margins (the same setting flies the same folds), and no finest
-    descent GSD chosen beside them."""
+    descent GSD or longest descent chosen beside them."""
     name, mean, _, folds = next(tried_settings(log), (None, None, None, None))
     if name is None:
         return False
     kept = Trial(log, name, mean, folds)
     return (kept.z == trial.z and kept.pooling in (None, trial.pooling) and kept.top in (None, trial.top)
-            and not kept.finest and kept.mean == trial.mean and kept.folds == trial.folds)
+            and not kept.finest and not kept.longest and kept.mean == trial.mean and kept.folds == trial.folds)
 
 
 def flown_order(trials, attribute):

@@ -54,6 +54,10 @@ adaptseg_calibrate)
     --field "$weedmap" --out "$work/m.yaml" --finest-descent 0,2,2
   expect_error "--finest-descent -1.000 is not a GSD factor: give multiples of the field's GSD, 0 for no limit" \
     --field "$weedmap" --out "$work/m.yaml" --finest-descent 0,-1
+  expect_error "--longest-descent names 30.000 s twice: give each limit once (0: no limit)" \
+    --field "$weedmap" --out "$work/m.yaml" --longest-descent 0,30,30
+  expect_error "--longest-descent -1.000 is not a number of seconds: give seconds >= 0, 0 for no limit" \
+    --field "$weedmap" --out "$work/m.yaml" --longest-descent 0,-1
   expect_error "max_vertical_speed_mps must be finite and >= 0" --field "$weedmap" --out "$work/m.yaml" \
     --vertical-speed -1
   expect_error "--map-fusion: mean not in {finest,pooled,pooled-interest,pooled-guarded}" --field "$weedmap" --out "$work/m.yaml" \

@@ -63,8 +63,9 @@ namespace adaptseg {
 ///   With `curve_agreement` q > 0, only to a GSD g whose lawnmower mapped better than the top
 ///   level's on at least a share q of the training fields (finer_lawnmower_share(): where
 ///   flying finer lost on the fields, the cells' forecast of a gain is not trusted).
-///   With `finest_descent_gsd_cm` > 0, to no GSD finer than it (a limit chosen on the training
-///   folds: CalibrationOptions::finest_descent_gsd_cm).
+///   With `finest_descent_gsd_cm` > 0, to no GSD finer than it; with `longest_descent_s` > 0, by
+///   no candidate that costs more extra seconds (limits chosen on the training folds:
+///   CalibrationOptions::finest_descent_gsd_cm, longest_descent_s).
 ///
 /// Field correction (`online`; beyond the paper, §3.2.3's idea applied to what is observable):
 /// a descent's relabelled share χ (Relabelling::interest_share, the region's field pixels whose
@@ -164,7 +165,7 @@ class FrontAwarePolicy {
         assessed.back().lower =
             f.gain > 0.0 ? std::min(assessed.back().lower, f.lower) : -std::numeric_limits<double>::infinity();
       }
-      if (assessed.back().gain > 0.0 && assessed.back().lower > best && agreed(c.top_gsd_cm, c.candidates[k].gsd_cm)) {
+      if (assessed.back().gain > 0.0 && assessed.back().lower > best && agreed(c.top_gsd_cm, c.candidates[k])) {
         best = assessed.back().lower;
         best_index = k;
       }
@@ -358,10 +359,12 @@ class FrontAwarePolicy {
     return a;
   }
 
-  /// Whether a descent to `gsd` may be taken from top level `top` (Params::curve_agreement and
-  /// Params::finest_descent_gsd_cm, up to rounding of the GSDs).
-  [[nodiscard]] bool agreed(double top, double gsd) const {
+  /// Whether descent `cand` may be taken from top level `top` (Params::curve_agreement,
+  /// Params::finest_descent_gsd_cm and Params::longest_descent_s, up to rounding).
+  [[nodiscard]] bool agreed(double top, const Candidate& cand) const {
+    const double gsd = cand.gsd_cm;
     if (gsd < params_.finest_descent_gsd_cm * (1.0 - 1e-9)) return false;
+    if (params_.longest_descent_s > 0.0 && cand.extra_time_s > params_.longest_descent_s * (1.0 + 1e-9)) return false;
     return params_.curve_agreement <= 0.0 || finer_lawnmower_share(reference_, top, gsd) >= params_.curve_agreement;
   }
 

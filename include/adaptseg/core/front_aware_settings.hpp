@@ -268,6 +268,9 @@ struct FrontAwareParams {
   /// training folds' choice); candidates finer than it are assessed and reported, never taken.
   /// 0: any candidate.
   double finest_descent_gsd_cm = 0.0;
+  /// The most extra seconds a descent may cost (CalibrationOptions::longest_descent_s, the
+  /// training folds' choice); longer candidates are assessed and reported, never taken. 0: any.
+  double longest_descent_s = 0.0;
   /// The jump guard's bound (JumpGuard; adaptive and non-adaptive alike; infinity: none):
   /// after a descent image beyond it the UAV descends no more (trusts_descent_image()).
   double jump_bound = std::numeric_limits<double>::infinity();
@@ -321,6 +324,8 @@ struct FrontAwareParams {
                     "FrontAwarePolicy::Params::curve_agreement must be in [0, 1]", curve_agreement);
     detail::require(std::isfinite(finest_descent_gsd_cm) && finest_descent_gsd_cm >= 0.0,
                     "FrontAwarePolicy::Params::finest_descent_gsd_cm must be finite and >= 0", finest_descent_gsd_cm);
+    detail::require(std::isfinite(longest_descent_s) && longest_descent_s >= 0.0,
+                    "FrontAwarePolicy::Params::longest_descent_s must be finite and >= 0", longest_descent_s);
     detail::require(!std::isnan(jump_bound), "FrontAwarePolicy::Params::jump_bound must not be NaN", jump_bound);
     detail::require(std::isfinite(relabel_transfer) && relabel_transfer >= 0.0 && relabel_transfer <= 1.0,
                     "FrontAwarePolicy::Params::relabel_transfer must be in [0, 1]", relabel_transfer);

@@ -121,6 +121,16 @@ struct CalibrationOptions {
   /// forecast (docs/method.md, "The finest descent chosen by the folds"). Empty (the
   /// default): `front_aware.finest_descent_gsd_cm` alone, no such trial. 0 in the list: no limit.
   std::vector<double> finest_descent_gsd_cm{};
+  /// Front-aware rule: the most extra seconds a descent may cost
+  /// (FrontAwarePolicy::Params::longest_descent_s) [s], tried on the folds last: every setting
+  /// above is flown with the first, and with the setting kept (its pooling, top level and finest
+  /// descent GSD) each other one is flown with every z of `confidences`, its z of best mean front
+  /// margin kept (ties to the larger z); the first is kept unless another beats it by more than
+  /// one standard error of their paired margins (detail::select_pooling's rule). So a limit may
+  /// bring a smaller z with it: on new ground the long descents lost where the short ones won
+  /// (docs/method.md, "The longest descent chosen by the folds"). Empty (the default):
+  /// `front_aware.longest_descent_s` alone, no such trial. 0 in the list: no limit.
+  std::vector<double> longest_descent_s{};
   /// Front-aware rule, several training fields: per training field, the index of its ground
   /// (the first field of that ground), equal for the fields that are one field segmented by
   /// several networks (the programs' --calibration-network-each: each a look of a network on

@@ -54,6 +54,7 @@ struct FrontAwareRule {
     if (p.curve_agreement > 0.0) e << YAML::Key << "curve_agreement" << YAML::Value << num(p.curve_agreement);
     if (p.finest_descent_gsd_cm > 0.0)
       e << YAML::Key << "finest_descent_gsd_cm" << YAML::Value << num(p.finest_descent_gsd_cm);
+    if (p.longest_descent_s > 0.0) e << YAML::Key << "longest_descent_s" << YAML::Value << num(p.longest_descent_s);
     if (std::isfinite(p.jump_bound)) e << YAML::Key << "jump_bound" << YAML::Value << num(p.jump_bound);
     if (p.field_factor != FieldFactorSource::scene_check)
       e << YAML::Key << "field_factor" << YAML::Value << to_string(p.field_factor);
@@ -129,6 +130,7 @@ struct FrontAwareRule {
          .sigma_prior_sd = rule.has("sigma_prior_sd") ? rule.number("sigma_prior_sd") : 0.0,
          .curve_agreement = rule.has("curve_agreement") ? rule.number("curve_agreement") : 0.0,
          .finest_descent_gsd_cm = rule.has("finest_descent_gsd_cm") ? rule.number("finest_descent_gsd_cm") : 0.0,
+         .longest_descent_s = rule.has("longest_descent_s") ? rule.number("longest_descent_s") : 0.0,
          .jump_bound = rule.has("jump_bound") ? rule.number("jump_bound") : std::numeric_limits<double>::infinity(),
          .curve = read_curve(rule),
          .top_level =
@@ -213,8 +215,9 @@ struct FrontAwareRule {
 
   /// Refuses options its search cannot use (before calibrate() samples anything).
   /// @throws std::invalid_argument if `confidences` or `slope_poolings` is empty,
-  ///         `slope_poolings`, `top_levels` or `finest_descent_gsd_cm` names a value twice,
-  ///         `finest_descent_gsd_cm` holds a negative or non-finite GSD, `field_grounds` names a
+  ///         `slope_poolings`, `top_levels`, `finest_descent_gsd_cm` or `longest_descent_s` names
+  ///         a value twice, `finest_descent_gsd_cm` or `longest_descent_s` holds a negative or
+  ///         non-finite limit, `field_grounds` names a
   ///         ground that is not the first field of its own, or `relabel_transfer`,
   ///         `relabel_region_spread` or `relabel_field_spread` is asked without the relabelled
   ///         field factor.
@@ -229,14 +232,18 @@ struct FrontAwareRule {
       for (std::size_t j = 0; j < k; ++j)
         detail::require(options.top_levels[j] != options.top_levels[k],
                         "calibrate: top_levels names a choice twice:", to_string(options.top_levels[k]));
-    for (std::size_t k = 0; k < options.finest_descent_gsd_cm.size(); ++k) {
-      const double g = options.finest_descent_gsd_cm[k];
-      detail::require(std::isfinite(g) && g >= 0.0,
-                      "calibrate: finest_descent_gsd_cm must hold finite GSDs >= 0 (0: no limit); got", g);
-      for (std::size_t j = 0; j < k; ++j)
-        detail::require(options.finest_descent_gsd_cm[j] != g,
-                        "calibrate: finest_descent_gsd_cm names a GSD twice:", g);
-    }
+    const auto check_limits = [](const std::vector<double>& limits, const char* name, const char* what) {
+      for (std::size_t k = 0; k < limits.size(); ++k) {
+        detail::require(std::isfinite(limits[k]) && limits[k] >= 0.0,
+                        "calibrate: " + std::string(name) + " must hold finite " + what + " >= 0 (0: no limit); got",
+                        limits[k]);
+        for (std::size_t j = 0; j < k; ++j)
+          detail::require(limits[j] != limits[k],
+                          "calibrate: " + std::string(name) + " names a limit twice:", limits[k]);
+      }
+    };
+    check_limits(options.finest_descent_gsd_cm, "finest_descent_gsd_cm", "GSDs");
+    check_limits(options.longest_descent_s, "longest_descent_s", "seconds");
     for (std::size_t k = 0; k < options.field_grounds.size(); ++k)
       detail::require(
           options.field_grounds[k] <= k && options.field_grounds[options.field_grounds[k]] == options.field_grounds[k],

@@ -2,15 +2,14 @@
 /// @file
 /// The front-aware rule's calibration search (FrontAwareRule::search, front_aware_rule.hpp):
 /// its settings (the confidence level z, the cell gain model's slope pooling, the top-level
-/// choice, the finest descent GSD) tried on the training fields, each field flown with a model
-/// fitted without it, with σ̂'s prior estimated from their top-level images (sigma_prior.hpp)
-/// and, where asked for, the jump guard's bound from the other fields' cells. docs/method.md,
+/// choice, the finest descent GSD, the longest descent) tried on the training fields, each
+/// field flown with a model fitted without it, with σ̂'s prior estimated from their top-level
+/// images (sigma_prior.hpp) and, where asked for, the jump guard's bound from the other fields'
+/// cells. docs/method.md,
 /// "The front-aware rule".
 
 #include <adaptseg/core/front_aware_policy.hpp>
-#include <adaptseg/core/jump_guard.hpp>
 #include <adaptseg/core/lawnmower_curve.hpp>
-#include <adaptseg/core/relabel_transfer.hpp>
 #include <adaptseg/vision/adaptive_mission.hpp>
 #include <adaptseg/vision/calibration_options.hpp>
 #include <adaptseg/vision/detail/fold_corrections.hpp>
@@ -21,7 +20,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -43,16 +41,6 @@ struct FrontAwareFold {
   std::vector<CellSample> cells;          ///< the other fields' (ranked, several fields)
 };
 
-/// What the search tries beyond z: the slope poolings (several only where the cell gain model
-/// pools several fields) and the top-level choices (several only with ranked cells, which
-/// predict each field's curve at every top level).
-struct FrontAwareGrid {
-  std::vector<SlopePooling> poolings;
-  std::vector<TopLevelChoice> top_levels;
-  bool ranked = false;  ///< DescentCoverage::ranked
-  bool pools = false;   ///< ranked with several training fields
-};
-
 /// The slope poolings of `poolings` that are not another under a second name: `field-entropy`
 /// is left out where its line is flat at every pair of GSDs on the training fields' cells
 /// `cells` (fewer than three fields count, or their mean entropies do not spread), where it is
@@ -68,15 +56,6 @@ inline std::vector<SlopePooling> distinct_poolings(std::vector<SlopePooling> poo
     poolings.erase(entropy);
   return poolings;
 }
-
-/// One setting tried: its pooling and top level (indices into FrontAwareGrid), z, the
-/// parameters flown.
-struct FrontAwareSetting {
-  std::size_t pooling = 0;
-  std::size_t top_level = 0;
-  double z = 0.0;
-  FrontAwarePolicy::Params params;
-};
 
 /// `p` with σ̂'s prior `prior` as `source` says (`given`, or no estimate: unchanged).
 inline void apply_sigma_prior(FrontAwarePolicy::Params& p, const std::optional<SigmaPrior>& prior,
@@ -221,35 +200,6 @@ std::vector<AdaptiveResult> measuring_flights(const RuleSearchInputs& in, std::s
   return flights;
 }
 
-/// The setting kept (an index into `trials` and `settings`, in the same order): per pooling and
-/// top level, its z of best mean front margin (ties to the larger z); per top level, the first
-/// pooling's unless another beats it by more than the folds' noise (select_pooling); of the
-/// top levels' so kept, the first's unless another beats it by more than the folds' noise
-/// (select_pooling again, the same grounds). Until 2026-12-05 any larger mean front margin took
-/// another top level, and `hull` was kept for building on tile 1 for a gain on one training
-/// field alone (docs/journal/2026-12-loto.md, forty-second session).
-inline std::size_t choose_setting(std::span<const RuleTrial> trials, std::span<const FrontAwareSetting> settings,
-                                  const FrontAwareGrid& grid, std::span<const std::size_t> grounds = {}) {
-  const std::size_t none = trials.size();
-  std::vector<std::vector<std::size_t>> best(grid.top_levels.size(),
-                                             std::vector<std::size_t>(grid.poolings.size(), none));
-  for (std::size_t k = 0; k < trials.size(); ++k) {
-    std::size_t& b = best[settings[k].top_level][settings[k].pooling];
-    if (b == none || trials[k].front_margin > trials[b].front_margin ||
-        (trials[k].front_margin == trials[b].front_margin && settings[k].z > settings[b].z))
-      b = k;
-  }
-  std::vector<std::size_t> of_levels;
-  std::vector<const RuleTrial*> levels;
-  for (const std::vector<std::size_t>& of_level : best) {
-    std::vector<const RuleTrial*> candidates;
-    for (std::size_t b : of_level) candidates.push_back(&trials[b]);
-    of_levels.push_back(of_level[select_pooling(candidates, grounds)]);
-    levels.push_back(&trials[of_levels.back()]);
-  }
-  return of_levels[select_pooling(levels, grounds)];
-}
-
 /// The search's grid beyond z from the calibration options: the slope poolings (distinct ones,
 /// several only where the cell gain model pools several fields) and the top-level choices
 /// (several only with ranked cells).
@@ -265,49 +215,6 @@ inline std::size_t choose_setting(std::span<const RuleTrial> trials, std::span<c
       options.top_levels.empty() ? std::vector<TopLevelChoice>{options.front_aware.top_level} : options.top_levels;
   if (!grid.ranked) grid.top_levels.resize(1);
   return grid;
-}
-
-/// What one fold's trials fly with beyond the setting tried (FrontAwarePolicy::Params' own
-/// fields of the same names): the gain ratios and margin biases measured on the other folds'
-/// flights, the jump guard's bound and the relabelled factor's b, τ_r and ω_χ measured on the other
-/// fields' cells; each the search's base parameters' where its option is off.
-struct FoldCorrection {
-  std::vector<GainRatio> gain_ratios;
-  std::vector<MarginBias> margin_biases;
-  double jump_bound = std::numeric_limits<double>::infinity();  ///< the jump guard's (CalibrationOptions::jump_guard)
-  double relabel_transfer = 1.0;                                ///< b (CalibrationOptions::relabel_transfer)
-  double relabel_region_sd = 0.0;                               ///< τ_r (CalibrationOptions::relabel_region_spread)
-  double relabel_field_sd = 0.0;                                ///< ω_χ (CalibrationOptions::relabel_field_spread)
-
-  /// `p`'s own: the correction that changes nothing (a default one: that of default Params).
-  [[nodiscard]] static FoldCorrection of(const FrontAwarePolicy::Params& p) {
-    return {p.gain_ratios, p.margin_biases, p.jump_bound, p.relabel_transfer, p.relabel_region_sd, p.relabel_field_sd};
-  }
-  void apply_to(FrontAwarePolicy::Params& p) const {
-    p.gain_ratios = gain_ratios;
-    p.margin_biases = margin_biases;
-    p.jump_bound = jump_bound;
-    p.relabel_transfer = relabel_transfer;
-    p.relabel_region_sd = relabel_region_sd;
-    p.relabel_field_sd = relabel_field_sd;
-  }
-};
-
-/// Whether `options` asks for anything measured on the cells (measure_on_cells()).
-[[nodiscard]] inline bool measures_on_cells(const CalibrationOptions& options) noexcept {
-  return options.jump_guard || options.relabel_transfer || options.relabel_region_spread ||
-         options.relabel_field_spread;
-}
-
-/// The jump guard's bound and the relabelled factor's b, τ_r and ω_χ measured on `cells` into
-/// `c`, each where `options` asks for it (with ranked cells: the callers' test): a fold's from
-/// the other fields' cells, the calibrated model's from every field's.
-inline void measure_on_cells(FoldCorrection& c, std::span<const CellSample> cells, const CalibrationOptions& options,
-                             DecisionInput input) {
-  if (options.jump_guard) c.jump_bound = jump_bound(cells);
-  if (options.relabel_transfer) c.relabel_transfer = relabel_transfer(cells, input);
-  if (options.relabel_region_spread) c.relabel_region_sd = relabel_region_sd(cells, input);
-  if (options.relabel_field_spread) c.relabel_field_sd = relabel_field_sd(cells, input);
 }
 
 /// Every fold's correction: the gain ratios and margin biases measured on the other folds'
@@ -354,6 +261,21 @@ void fly_trial(const RuleSearchInputs& in, std::span<const FrontAwareFold> folds
   }
 }
 
+/// Setting `s` flown over `folds` (their `models` of its pooling, their `corrections`) as a
+/// trial appended to `trials`, and `s` to `settings`; returns its index.
+template <class Fly>
+std::size_t add_trial(const RuleSearchInputs& in, std::span<const FrontAwareFold> folds,
+                      std::span<const GainModel> models, std::span<const FoldCorrection> corrections,
+                      const FrontAwareGrid& grid, std::vector<RuleTrial>& trials,
+                      std::vector<FrontAwareSetting>& settings, FrontAwareSetting s, Fly& fly) {
+  RuleTrial t;
+  t.description = setting_text(in, grid, s);
+  fly_trial(in, folds, models, corrections, s.params, t, fly);
+  trials.push_back(std::move(t));
+  settings.push_back(std::move(s));
+  return trials.size() - 1;
+}
+
 /// The finest descent GSD kept (CalibrationOptions::finest_descent_gsd_cm, two or more): the
 /// setting kept, `trials[best]` (flown with the first GSD of the list), flown over the same
 /// `folds` (their `models` of its pooling, their `corrections`) with each other GSD, each a
@@ -373,25 +295,54 @@ std::size_t choose_finest_descent(const RuleSearchInputs& in, std::span<const Fr
   for (std::size_t g = 1; g < finest.size(); ++g) {
     FrontAwareSetting s = settings[best];
     s.params.finest_descent_gsd_cm = finest[g];
-    RuleTrial t;
-    t.description = z_text(s.z, grid.poolings.size() > 1 ? &grid.poolings[s.pooling] : nullptr,
-                           grid.top_levels.size() > 1 ? &grid.top_levels[s.top_level] : nullptr, &finest[g]);
-    fly_trial(in, folds, models, corrections, s.params, t, fly);
-    trials.push_back(std::move(t));
-    settings.push_back(std::move(s));
-    tried.push_back(trials.size() - 1);
+    tried.push_back(add_trial(in, folds, models, corrections, grid, trials, settings, std::move(s), fly));
   }
   std::vector<const RuleTrial*> candidates;
   for (std::size_t k : tried) candidates.push_back(&trials[k]);
   return tried[select_pooling(candidates, fold_grounds(in))];
 }
 
+/// The longest descent kept (CalibrationOptions::longest_descent_s, two or more): with the
+/// setting kept, `trials[best]` (flown with the first limit), each other limit flown over the
+/// same `folds` with every z of the options' confidences, each a trial and a setting appended
+/// to `trials` and `settings`, its z of best mean front margin kept (ties to the larger z); of
+/// those and `trials[best]`, the first unless another beats it by more than one standard error
+/// of their paired margins (select_pooling's rule). Returns the index kept. z is chosen again
+/// with each limit: a limit that drops the long descents may pay with more of the short ones,
+/// which only a smaller z takes (docs/method.md, "The longest descent chosen by the folds").
+template <class Fly>
+std::size_t choose_longest_descent(const RuleSearchInputs& in, std::span<const FrontAwareFold> folds,
+                                   std::span<const GainModel> models, std::span<const FoldCorrection> corrections,
+                                   const FrontAwareGrid& grid, std::vector<RuleTrial>& trials,
+                                   std::vector<FrontAwareSetting>& settings, std::size_t best, Fly& fly) {
+  const std::vector<double>& longest = in.options.longest_descent_s;
+  std::vector<std::size_t> kept{best};
+  for (std::size_t g = 1; g < longest.size(); ++g) {
+    std::size_t of_limit = trials.size();
+    for (double z : in.options.confidences) {
+      FrontAwareSetting s = settings[best];
+      s.z = z;
+      s.params.confidence = z;
+      s.params.longest_descent_s = longest[g];
+      const std::size_t k = add_trial(in, folds, models, corrections, grid, trials, settings, std::move(s), fly);
+      if (k == of_limit || trials[k].front_margin > trials[of_limit].front_margin ||
+          (trials[k].front_margin == trials[of_limit].front_margin && settings[k].z > settings[of_limit].z))
+        of_limit = k;
+    }
+    kept.push_back(of_limit);
+  }
+  std::vector<const RuleTrial*> candidates;
+  for (std::size_t k : kept) candidates.push_back(&trials[k]);
+  return kept[select_pooling(candidates, fold_grounds(in))];
+}
+
 }  // namespace detail
 
 /// The front-aware rule's calibration search (FrontAwareRule::search, which documents it):
 /// every setting of `in.options` flown over the folds by `fly` (then, with several finest
-/// descent GSDs, the one kept with each: detail::choose_finest_descent), the one kept first in
-/// the trials, the rule with it over the model of every field.
+/// descent GSDs, the one kept with each: detail::choose_finest_descent; with several longest
+/// descents, each with every z: detail::choose_longest_descent), the one kept first in the
+/// trials, the rule with it over the model of every field.
 template <class Fly>
 [[nodiscard]] RuleSearchResult search_front_aware(const RuleSearchInputs& in, Fly&& fly) {
   const CalibrationOptions& options = in.options;
@@ -401,9 +352,8 @@ template <class Fly>
   const std::vector<detail::FrontAwareFold> folds = detail::front_aware_folds(in, reference, traces, grid.ranked);
   FrontAwarePolicy::Params base = options.front_aware;
   base.online = true;
-  const std::vector<double>& finest = options.finest_descent_gsd_cm;
-  if (!finest.empty()) base.finest_descent_gsd_cm = finest.front();
-  const double* finest_named = finest.size() > 1 ? &finest.front() : nullptr;
+  if (!options.finest_descent_gsd_cm.empty()) base.finest_descent_gsd_cm = options.finest_descent_gsd_cm.front();
+  if (!options.longest_descent_s.empty()) base.longest_descent_s = options.longest_descent_s.front();
   detail::apply_sigma_prior(base, estimate_sigma_prior(traces), options.sigma_prior);
   const std::vector<detail::FoldCorrection> corrections = detail::fold_corrections(in, folds, grid, base, fly);
   std::vector<RuleTrial> trials;
@@ -417,18 +367,17 @@ template <class Fly>
         FrontAwarePolicy::Params p = pooled;
         p.confidence = z;
         p.top_level = grid.top_levels[ti];
-        RuleTrial t;
-        t.description = detail::z_text(z, grid.poolings.size() > 1 ? &grid.poolings[pi] : nullptr,
-                                       grid.top_levels.size() > 1 ? &grid.top_levels[ti] : nullptr, finest_named);
-        detail::fly_trial(in, folds, models_of_pooling.back(), corrections, p, t, fly);
-        trials.push_back(std::move(t));
-        settings.push_back({pi, ti, z, p});
+        (void)detail::add_trial(in, folds, models_of_pooling.back(), corrections, grid, trials, settings,
+                                {pi, ti, z, p}, fly);
       }
   }
   std::size_t best = detail::choose_setting(trials, settings, grid, detail::fold_grounds(in));
-  if (finest.size() > 1)
+  if (options.finest_descent_gsd_cm.size() > 1)
     best = detail::choose_finest_descent(in, folds, models_of_pooling[settings[best].pooling], corrections, grid,
                                          trials, settings, best, fly);
+  if (options.longest_descent_s.size() > 1)
+    best = detail::choose_longest_descent(in, folds, models_of_pooling[settings[best].pooling], corrections, grid,
+                                          trials, settings, best, fly);
   std::rotate(trials.begin(), trials.begin() + static_cast<std::ptrdiff_t>(best),
               trials.begin() + static_cast<std::ptrdiff_t>(best) + 1);
   // The model of every field, its cell gain model pooled as chosen.

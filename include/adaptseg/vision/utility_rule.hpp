@@ -69,13 +69,16 @@ struct UtilityRule {
 
   /// Refuses options its search cannot use (before calibrate() samples anything).
   /// @throws std::invalid_argument if `threshold_steps` < 1, or for the front-aware rule's
-  ///         `gain_ratios`, `margin_biases`, `finest_descent_gsd_cm` or `frozen_folds`.
+  ///         `gain_ratios`, `margin_biases`, `finest_descent_gsd_cm`, `longest_descent_s` or
+  ///         `frozen_folds`.
   static void check_options(const CalibrationOptions& options) {
     detail::require(options.threshold_steps >= 1, "calibrate: threshold_steps must be >= 1", options.threshold_steps);
     detail::require(!options.gain_ratios && !options.margin_biases,
                     "calibrate: gain_ratios and margin_biases belong to the front-aware rule; rule", kName);
     detail::require(options.finest_descent_gsd_cm.empty(),
                     "calibrate: finest_descent_gsd_cm belongs to the front-aware rule; rule", kName);
+    detail::require(options.longest_descent_s.empty(),
+                    "calibrate: longest_descent_s belongs to the front-aware rule; rule", kName);
     detail::require(!options.frozen_folds, "calibrate: frozen_folds belongs to the front-aware rule; rule", kName);
   }
 

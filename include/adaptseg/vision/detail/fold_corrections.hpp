@@ -3,16 +3,21 @@
 /// What descents realised against their forecast on the calibration folds, per descent GSD
 /// (the front-aware search, front_aware_search.hpp): the gain ratios and the margin biases of
 /// CalibrationOptions::gain_ratios and margin_biases (docs/method.md, "Gain ratios measured on
-/// the folds", "Margin biases measured on the folds").
+/// the folds", "Margin biases measured on the folds"), and what else a fold's trials fly with
+/// beyond the setting tried (FoldCorrection: those, the jump bound, b, τ_r and ω_χ).
 
 #include <adaptseg/core/decision.hpp>
 #include <adaptseg/core/front_aware_settings.hpp>
+#include <adaptseg/core/jump_guard.hpp>
 #include <adaptseg/core/lawnmower_curve.hpp>
+#include <adaptseg/core/relabel_transfer.hpp>
 #include <adaptseg/vision/adaptive_mission.hpp>
+#include <adaptseg/vision/calibration_options.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -107,6 +112,49 @@ inline std::vector<MarginBias> fold_margin_biases(std::span<const AdaptiveResult
   std::vector<MarginBias> out;
   for (const Sums& s : sums) out.push_back({s.gsd_cm, s.error / (s.seconds + 2.0 * s.seconds / s.n)});
   return out;
+}
+
+/// What one fold's trials fly with beyond the setting tried (FrontAwareParams' own
+/// fields of the same names): the gain ratios and margin biases measured on the other folds'
+/// flights, the jump guard's bound and the relabelled factor's b, τ_r and ω_χ measured on the other
+/// fields' cells; each the search's base parameters' where its option is off.
+struct FoldCorrection {
+  std::vector<GainRatio> gain_ratios;
+  std::vector<MarginBias> margin_biases;
+  double jump_bound = std::numeric_limits<double>::infinity();  ///< the jump guard's (CalibrationOptions::jump_guard)
+  double relabel_transfer = 1.0;                                ///< b (CalibrationOptions::relabel_transfer)
+  double relabel_region_sd = 0.0;                               ///< τ_r (CalibrationOptions::relabel_region_spread)
+  double relabel_field_sd = 0.0;                                ///< ω_χ (CalibrationOptions::relabel_field_spread)
+
+  /// `p`'s own: the correction that changes nothing (a default one: that of default Params).
+  [[nodiscard]] static FoldCorrection of(const FrontAwareParams& p) {
+    return {p.gain_ratios, p.margin_biases, p.jump_bound, p.relabel_transfer, p.relabel_region_sd, p.relabel_field_sd};
+  }
+  void apply_to(FrontAwareParams& p) const {
+    p.gain_ratios = gain_ratios;
+    p.margin_biases = margin_biases;
+    p.jump_bound = jump_bound;
+    p.relabel_transfer = relabel_transfer;
+    p.relabel_region_sd = relabel_region_sd;
+    p.relabel_field_sd = relabel_field_sd;
+  }
+};
+
+/// Whether `options` asks for anything measured on the cells (measure_on_cells()).
+[[nodiscard]] inline bool measures_on_cells(const CalibrationOptions& options) noexcept {
+  return options.jump_guard || options.relabel_transfer || options.relabel_region_spread ||
+         options.relabel_field_spread;
+}
+
+/// The jump guard's bound and the relabelled factor's b, τ_r and ω_χ measured on `cells` into
+/// `c`, each where `options` asks for it (with ranked cells: the callers' test): a fold's from
+/// the other fields' cells, the calibrated model's from every field's.
+inline void measure_on_cells(FoldCorrection& c, std::span<const CellSample> cells, const CalibrationOptions& options,
+                             DecisionInput input) {
+  if (options.jump_guard) c.jump_bound = jump_bound(cells);
+  if (options.relabel_transfer) c.relabel_transfer = relabel_transfer(cells, input);
+  if (options.relabel_region_spread) c.relabel_region_sd = relabel_region_sd(cells, input);
+  if (options.relabel_field_spread) c.relabel_field_sd = relabel_field_sd(cells, input);
 }
 
 }  // namespace adaptseg::detail

@@ -1,7 +1,8 @@
 #pragma once
 /// @file
-/// The front-aware search's trials (front_aware_search.hpp): a trial's name, and which of
-/// several settings flown over the same folds to keep, by the one-standard-error rule.
+/// The front-aware search's trials (front_aware_search.hpp): the grid and the settings it
+/// tries, a trial's name, and which of several settings flown over the same folds to keep, by
+/// the one-standard-error rule.
 
 #include <adaptseg/core/cell_gain_model.hpp>
 #include <adaptseg/core/front_aware_settings.hpp>
@@ -74,16 +75,77 @@ inline std::size_t select_pooling(std::span<const RuleTrial* const> trials, std:
   return in.options.field_grounds;
 }
 
-/// A trial's name: its z, its slope pooling, its top-level choice and its finest descent GSD
-/// (`finest=G` in cm/px, `finest=any` for no limit) where the search tried several.
+/// A trial's name: its z, its slope pooling, its top-level choice, its finest descent GSD
+/// (`finest=G` in cm/px, `finest=any` for no limit) and its longest descent (`longest=S` in s,
+/// `longest=any`) where the search tried several.
 inline std::string z_text(double z, const SlopePooling* pooling = nullptr, const TopLevelChoice* top_level = nullptr,
-                          const double* finest_descent_gsd_cm = nullptr) {
+                          const double* finest_descent_gsd_cm = nullptr, const double* longest_descent_s = nullptr) {
   std::string s = "front-aware z=" + format_number(z);
   if (pooling) s += " slopes=" + to_string(*pooling);
   if (top_level) s += " top=" + to_string(*top_level);
   if (finest_descent_gsd_cm)
     s += " finest=" + (*finest_descent_gsd_cm > 0.0 ? format_number(*finest_descent_gsd_cm) : std::string("any"));
+  if (longest_descent_s)
+    s += " longest=" + (*longest_descent_s > 0.0 ? format_number(*longest_descent_s) : std::string("any"));
   return s;
+}
+
+/// What the search tries beyond z: the slope poolings (several only where the cell gain model
+/// pools several fields) and the top-level choices (several only with ranked cells, which
+/// predict each field's curve at every top level).
+struct FrontAwareGrid {
+  std::vector<SlopePooling> poolings;
+  std::vector<TopLevelChoice> top_levels;
+  bool ranked = false;  ///< DescentCoverage::ranked
+  bool pools = false;   ///< ranked with several training fields
+};
+
+/// One setting tried: its pooling and top level (indices into FrontAwareGrid), z, the
+/// parameters flown.
+struct FrontAwareSetting {
+  std::size_t pooling = 0;
+  std::size_t top_level = 0;
+  double z = 0.0;
+  FrontAwareParams params;
+};
+
+/// The setting kept (an index into `trials` and `settings`, in the same order): per pooling and
+/// top level, its z of best mean front margin (ties to the larger z); per top level, the first
+/// pooling's unless another beats it by more than the folds' noise (select_pooling); of the
+/// top levels' so kept, the first's unless another beats it by more than the folds' noise
+/// (select_pooling again, the same grounds). Until 2026-12-05 any larger mean front margin took
+/// another top level, and `hull` was kept for building on tile 1 for a gain on one training
+/// field alone (docs/journal/2026-12-loto.md, forty-second session).
+inline std::size_t choose_setting(std::span<const RuleTrial> trials, std::span<const FrontAwareSetting> settings,
+                                  const FrontAwareGrid& grid, std::span<const std::size_t> grounds = {}) {
+  const std::size_t none = trials.size();
+  std::vector<std::vector<std::size_t>> best(grid.top_levels.size(),
+                                             std::vector<std::size_t>(grid.poolings.size(), none));
+  for (std::size_t k = 0; k < trials.size(); ++k) {
+    std::size_t& b = best[settings[k].top_level][settings[k].pooling];
+    if (b == none || trials[k].front_margin > trials[b].front_margin ||
+        (trials[k].front_margin == trials[b].front_margin && settings[k].z > settings[b].z))
+      b = k;
+  }
+  std::vector<std::size_t> of_levels;
+  std::vector<const RuleTrial*> levels;
+  for (const std::vector<std::size_t>& of_level : best) {
+    std::vector<const RuleTrial*> candidates;
+    for (std::size_t b : of_level) candidates.push_back(&trials[b]);
+    of_levels.push_back(of_level[select_pooling(candidates, grounds)]);
+    levels.push_back(&trials[of_levels.back()]);
+  }
+  return of_levels[select_pooling(levels, grounds)];
+}
+
+/// Setting `s`'s trial name (z_text): its pooling, top level, finest descent GSD and longest
+/// descent named where the search tries several of them.
+[[nodiscard]] inline std::string setting_text(const RuleSearchInputs& in, const FrontAwareGrid& grid,
+                                              const FrontAwareSetting& s) {
+  return z_text(s.z, grid.poolings.size() > 1 ? &grid.poolings[s.pooling] : nullptr,
+                grid.top_levels.size() > 1 ? &grid.top_levels[s.top_level] : nullptr,
+                in.options.finest_descent_gsd_cm.size() > 1 ? &s.params.finest_descent_gsd_cm : nullptr,
+                in.options.longest_descent_s.size() > 1 ? &s.params.longest_descent_s : nullptr);
 }
 
 }  // namespace adaptseg::detail
