@@ -136,6 +136,12 @@ def main():
         check_refused(grid_replay.main, ["--out", out, a], "not empty", "a filled OUT")
         check_refused(grid_replay.main, ["--slope-pooling", "cells", a], "was not tried", "a pooling never tried")
         check_refused(grid_replay.main, ["--z", "", a], "an empty list", "an empty --z")
+        # A search that also tried the longest descent (--longest-descent, trials named
+        # "... top=T longest=S") is not replayed.
+        e = os.path.join(tmp, "e")
+        write_run(e, "net-road-tile-2", [(z, pooling, f"{top} longest={'any' if z else 20}", folds)
+                                         for z, pooling, top, folds in road])
+        check_refused(grid_replay.main, [e], "longest descent", "a search with the longest descent")
     print("ok: grid_replay.py keeps what a smaller search would keep")
     return 0
 

@@ -5,8 +5,7 @@
 /// choice, the finest descent GSD, the longest descent) tried on the training fields, each
 /// field flown with a model fitted without it, with σ̂'s prior estimated from their top-level
 /// images (sigma_prior.hpp) and, where asked for, the jump guard's bound from the other fields'
-/// cells. docs/method.md,
-/// "The front-aware rule".
+/// cells. docs/method.md, "The front-aware rule".
 
 #include <adaptseg/core/front_aware_policy.hpp>
 #include <adaptseg/core/lawnmower_curve.hpp>
