@@ -604,20 +604,20 @@ TEST_CASE("front-aware policy with cells: gain from the cells' input, the field'
   SUBCASE("the longest descent: no descent that costs more extra seconds, which is still assessed") {
     // The offers cost 50 s and 90 s. A limit at the chosen one's seconds (up to rounding) or
     // none keeps it; one below both takes none and still reports both.
-    const Decision free = decided(4.0, reference, {});
-    REQUIRE(free.descend);
-    const double t = s.offers[free.candidate].extra_time_s;
+    const Decision unlimited = decided(4.0, reference, {});
+    REQUIRE(unlimited.descend);
+    const double t = s.offers[unlimited.candidate].extra_time_s;
     for (const double cap : {0.0, t, t * (1.0 - 1e-12)}) {
       const Decision d = decided(4.0, reference, {.longest_descent_s = cap});
       CHECK(d.descend);
-      CHECK(d.candidate == free.candidate);
+      CHECK(d.candidate == unlimited.candidate);
     }
     const Decision shorter = decided(4.0, reference, {.longest_descent_s = 50.0});
     CHECK((!shorter.descend || s.offers[shorter.candidate].extra_time_s == 50.0));
     const Decision none = decided(4.0, reference, {.longest_descent_s = 40.0});
     CHECK_FALSE(none.descend);
     REQUIRE(none.scores.size() == 2);
-    CHECK(none.scores[free.candidate].predicted_field_gain > 0.0);
+    CHECK(none.scores[unlimited.candidate].predicted_field_gain > 0.0);
     for (const double wrong : {-1.0, std::numeric_limits<double>::quiet_NaN()})
       CHECK_THROWS_WITH_AS(FrontAwarePolicy(with_cells(1.0), reference, {.longest_descent_s = wrong}),
                            doctest::Contains("longest_descent_s must be finite and >= 0"), std::invalid_argument);
