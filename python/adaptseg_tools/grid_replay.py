@@ -20,6 +20,10 @@ looks of one field as one ground, as the programs' CalibrationOptions::field_gro
                         default: as flown
   --top-level A,B       the top-level choices, likewise
   --z A,B               the z values, likewise (their order does not matter)
+  --z-rule RULE         how the replay keeps z per pooling and top level: `mean` (default), the
+                        z of best mean fold margin, ties to the larger z; `se`, the largest z
+                        unless another beats it by more than one standard error of their paired
+                        fold margins (select_pooling's rule, in the order of z from the largest)
   --out OUT             one link per run (folder and log) to a flown run that kept the replayed
                         setting, from DIR or the LABEL=DIRs after it (each flown with the same
                         flags but the search's lists), so that `adaptseg_tools.loto_targets
@@ -112,13 +116,15 @@ def flew(log, trial):
     """Whether a flown run's log kept `trial`'s setting: its first `tried` line names the same z
     and, where it names them, the same pooling and top level (a search that tried one alone omits
     it), with the same mean and fold margins (the same setting flies the same folds), and no finest
-    descent GSD or longest descent chosen beside them."""
+    descent GSD or longest descent kept beside them (a search that tried several and kept none,
+    "finest=any" or "longest=any", flies as one that tried none)."""
     name, mean, _, folds = next(tried_settings(log), (None, None, None, None))
     if name is None:
         return False
     kept = Trial(log, name, mean, folds)
     return (kept.z == trial.z and kept.pooling in (None, trial.pooling) and kept.top in (None, trial.top)
-            and not kept.finest and not kept.longest and kept.mean == trial.mean and kept.folds == trial.folds)
+            and kept.finest in (None, "finest=any") and kept.longest in (None, "longest=any")
+            and kept.mean == trial.mean and kept.folds == trial.folds)
 
 
 def flown_order(trials, attribute):
@@ -129,8 +135,11 @@ def flown_order(trials, attribute):
     return order if kept in order else [kept] + order
 
 
-def choose(trials, poolings, tops, zs=None, grounds=None):
-    """detail::choose_setting over the trials within the lists: (Trial kept, near)."""
+def choose(trials, poolings, tops, zs=None, grounds=None, z_rule="mean"):
+    """detail::choose_setting over the trials within the lists: (Trial kept, near). `z_rule`:
+    "mean", per pooling and top level the z of best mean (ties to the larger z); "se", the largest
+    z unless another beats it by more than one standard error (select(), in the order of z from the
+    largest)."""
     near, of_levels = False, []
     for top in tops:
         of_level = []
@@ -138,11 +147,17 @@ def choose(trials, poolings, tops, zs=None, grounds=None):
             group = [t for t in trials if t.pooling == pooling and t.top == top and (zs is None or t.z in zs)]
             if not group:
                 continue
-            best = group[0]
-            for t in group[1:]:
-                if t.mean > best.mean or (t.mean == best.mean and t.z > best.z):
-                    best = t
-            near |= any(t is not best and t.mean == best.mean and t.folds != best.folds for t in group)
+            if z_rule == "se":
+                group = sorted(group, key=lambda t: -t.z)
+                k, n = select([t.as_tuple() for t in group], grounds)
+                best = group[k]
+                near |= n
+            else:
+                best = group[0]
+                for t in group[1:]:
+                    if t.mean > best.mean or (t.mean == best.mean and t.z > best.z):
+                        best = t
+                near |= any(t is not best and t.mean == best.mean and t.folds != best.folds for t in group)
             of_level.append(best)
         if of_level:
             k, n = select([t.as_tuple() for t in of_level], grounds)
@@ -167,7 +182,8 @@ def parse_list(text, option):
 
 
 def main(argv):
-    options = {"--slope-pooling": None, "--top-level": None, "--z": None, "--out": None, "--to-fly": None}
+    options = {"--slope-pooling": None, "--top-level": None, "--z": None, "--z-rule": "mean", "--out": None,
+               "--to-fly": None}
     rest = []
     k = 0
     while k < len(argv):
@@ -193,6 +209,8 @@ def main(argv):
             zs = {float(v) for v in parse_list(options["--z"], "--z")}
         except ValueError:
             sys.exit(f"--z: numbers, got {options['--z']!r}")
+    if options["--z-rule"] not in ("mean", "se"):
+        sys.exit(f"--z-rule: mean or se, got {options['--z-rule']!r}")
     flown = [("", rest[0])]
     for c in rest[1:]:
         label, _, d = c.partition("=")
@@ -224,7 +242,7 @@ def main(argv):
         for t in want_t:
             if t not in flown_t:
                 sys.exit(f"{runs[0][2][key]}: top level {t!r} was not tried")
-        kept, near = choose(trials, want_p, want_t, zs, grounds)
+        kept, near = choose(trials, want_p, want_t, zs, grounds, options["--z-rule"])
         if kept is None:
             sys.exit(f"{runs[0][2][key]}: no setting tried within the lists")
         where = None

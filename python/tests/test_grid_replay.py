@@ -12,9 +12,11 @@ first, then the search's order):
   fold_choice marks it): field-entropy kept.
 - water, tile 3: the log claims (0, fields, undominated), which its margins do not keep: a
   MISMATCH. Replayed with field-entropy alone it keeps a setting no row flew: "to fly".
-Then a run calibrated on two looks of each of three fields (--calibration-network-each): the
-looks of one field are one ground, so a difference the six looks would call beyond the noise is
-not (and is, where the six are six fields).
+With `--z-rule se` a z = 0 that wins on the folds' mean alone gives way to z = 2 (flown by a row
+whose search kept no longest descent, which stands in). Then a run calibrated on two looks of
+each of three fields (--calibration-network-each): the looks of one field are one ground, so a
+difference the six looks would call beyond the noise is not (and is, where the six are six
+fields).
 """
 import os
 import sys
@@ -131,6 +133,27 @@ def main():
         text = printed(grid_replay.main, [d])[1]
         check("| building | 4 | z=0 fields undominated | z=0 fields undominated" in text,
               f"six grounds not counted as six:\n{text}")
+
+        # --z-rule se: z = 0 beats z = 2 on the mean of three folds (+0.0007) but not beyond one
+        # standard error of the paired margins, so the rule keeps z = 2, as a search that kept no
+        # limit among several flew it (its trials named "longest=any"), which stands in for it;
+        # where z = 0 beats z = 2 on every fold (water, tile 3) the rule keeps z = 0 as well.
+        f, g = (os.path.join(tmp, n) for n in ("f", "g"))
+        noisy = grid({("field-entropy", "undominated"): (0.024, -0.019, -0.003), ("field-entropy", "hull"): ZERO,
+                      ("fields", "undominated"): ZERO, ("fields", "hull"): ZERO})
+        write_run(f, "net-vegetation-tile-5", kept_first(noisy, (0, "field-entropy", "undominated")))
+        write_run(f, "net-water-tile-3", kept_first(water, (0, "field-entropy", "undominated")))
+        write_run(g, "net-vegetation-tile-5", [(z, pooling, f"{top} longest=any", folds) for z, pooling, top, folds
+                                              in kept_first(noisy, (2, "field-entropy", "undominated"))])
+        text = printed(grid_replay.main, [f])[1]
+        check("| vegetation | 5 | z=0 field-entropy undominated | z=0 field-entropy undominated (+0.0007) | DIR |"
+              in text, f"the mean rule does not keep z = 0:\n{text}")
+        text = printed(grid_replay.main, ["--z-rule", "se", f, f"g={g}"])[1]
+        for row in ("| vegetation | 5 | z=0 field-entropy undominated | z=2 field-entropy undominated (+0.0000) "
+                    "(changed) | g |",
+                    "| water | 3 | z=0 field-entropy undominated | z=0 field-entropy undominated (+0.0040) | DIR |"):
+            check(row in text, f"no row {row!r}:\n{text}")
+        check_refused(grid_replay.main, ["--z-rule", "median", f], "mean or se", "an unknown --z-rule")
 
         # Nothing overwritten; a pooling never tried, or an empty list, refused.
         check_refused(grid_replay.main, ["--out", out, a], "not empty", "a filled OUT")
