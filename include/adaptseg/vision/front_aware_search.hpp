@@ -8,7 +8,9 @@
 /// cells. docs/method.md, "The front-aware rule".
 
 #include <adaptseg/core/front_aware_policy.hpp>
+#include <adaptseg/core/jump_guard.hpp>
 #include <adaptseg/core/lawnmower_curve.hpp>
+#include <adaptseg/core/relabel_transfer.hpp>
 #include <adaptseg/vision/adaptive_mission.hpp>
 #include <adaptseg/vision/calibration_options.hpp>
 #include <adaptseg/vision/detail/fold_corrections.hpp>
@@ -28,6 +30,23 @@
 namespace adaptseg {
 
 namespace detail {
+
+/// Whether `options` asks for anything measured on the cells (measure_on_cells()).
+[[nodiscard]] inline bool measures_on_cells(const CalibrationOptions& options) noexcept {
+  return options.jump_guard || options.relabel_transfer || options.relabel_region_spread ||
+         options.relabel_field_spread;
+}
+
+/// The jump guard's bound and the relabelled factor's b, τ_r and ω_χ measured on `cells` into
+/// `c`, each where `options` asks for it (with ranked cells: the callers' test): a fold's from
+/// the other fields' cells, the calibrated model's from every field's.
+inline void measure_on_cells(FoldCorrection& c, std::span<const CellSample> cells, const CalibrationOptions& options,
+                             DecisionInput input) {
+  if (options.jump_guard) c.jump_bound = jump_bound(cells);
+  if (options.relabel_transfer) c.relabel_transfer = relabel_transfer(cells, input);
+  if (options.relabel_region_spread) c.relabel_region_sd = relabel_region_sd(cells, input);
+  if (options.relabel_field_spread) c.relabel_field_sd = relabel_field_sd(cells, input);
+}
 
 /// One fold of the search: a training field flown with a model fitted without it (one field:
 /// the field or one of its halves, with the whole field's model).
@@ -304,7 +323,7 @@ std::size_t choose_finest_descent(const RuleSearchInputs& in, std::span<const Fr
 /// The longest descent kept (CalibrationOptions::longest_descent_s, two or more): with the
 /// setting kept, `trials[best]` (flown with the first limit), each other limit flown over the
 /// same `folds` with every z of the options' confidences, each a trial and a setting appended
-/// to `trials` and `settings`, its z of best mean front margin kept (ties to the larger z); of
+/// to `trials` and `settings`, its z of best mean front margin kept (keeps_z_over); of
 /// those and `trials[best]`, the first unless another beats it by more than one standard error
 /// of their paired margins (select_pooling's rule). Returns the index kept. z is chosen again
 /// with each limit: a limit that drops the long descents may pay with more of the short ones,
@@ -324,9 +343,7 @@ std::size_t choose_longest_descent(const RuleSearchInputs& in, std::span<const F
       s.params.confidence = z;
       s.params.longest_descent_s = longest[g];
       const std::size_t k = add_trial(in, folds, models, corrections, grid, trials, settings, std::move(s), fly);
-      if (k == of_limit || trials[k].front_margin > trials[of_limit].front_margin ||
-          (trials[k].front_margin == trials[of_limit].front_margin && settings[k].z > settings[of_limit].z))
-        of_limit = k;
+      if (k == of_limit || keeps_z_over(trials, settings, k, of_limit)) of_limit = k;
     }
     kept.push_back(of_limit);
   }

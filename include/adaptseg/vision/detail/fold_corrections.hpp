@@ -8,11 +8,8 @@
 
 #include <adaptseg/core/decision.hpp>
 #include <adaptseg/core/front_aware_settings.hpp>
-#include <adaptseg/core/jump_guard.hpp>
 #include <adaptseg/core/lawnmower_curve.hpp>
-#include <adaptseg/core/relabel_transfer.hpp>
 #include <adaptseg/vision/adaptive_mission.hpp>
-#include <adaptseg/vision/calibration_options.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -139,22 +136,5 @@ struct FoldCorrection {
     p.relabel_field_sd = relabel_field_sd;
   }
 };
-
-/// Whether `options` asks for anything measured on the cells (measure_on_cells()).
-[[nodiscard]] inline bool measures_on_cells(const CalibrationOptions& options) noexcept {
-  return options.jump_guard || options.relabel_transfer || options.relabel_region_spread ||
-         options.relabel_field_spread;
-}
-
-/// The jump guard's bound and the relabelled factor's b, τ_r and ω_χ measured on `cells` into
-/// `c`, each where `options` asks for it (with ranked cells: the callers' test): a fold's from
-/// the other fields' cells, the calibrated model's from every field's.
-inline void measure_on_cells(FoldCorrection& c, std::span<const CellSample> cells, const CalibrationOptions& options,
-                             DecisionInput input) {
-  if (options.jump_guard) c.jump_bound = jump_bound(cells);
-  if (options.relabel_transfer) c.relabel_transfer = relabel_transfer(cells, input);
-  if (options.relabel_region_spread) c.relabel_region_sd = relabel_region_sd(cells, input);
-  if (options.relabel_field_spread) c.relabel_field_sd = relabel_field_sd(cells, input);
-}
 
 }  // namespace adaptseg::detail

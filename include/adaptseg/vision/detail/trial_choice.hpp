@@ -109,8 +109,17 @@ struct FrontAwareSetting {
   FrontAwareParams params;
 };
 
+/// Whether trial `k` is kept over trial `b` among the z of one pooling, top level and limits
+/// (indices into `trials` and `settings`, in the same order): a larger mean front margin, ties to
+/// the larger z, the more cautious of settings that fly the training fields alike.
+[[nodiscard]] inline bool keeps_z_over(std::span<const RuleTrial> trials, std::span<const FrontAwareSetting> settings,
+                                       std::size_t k, std::size_t b) {
+  return trials[k].front_margin > trials[b].front_margin ||
+         (trials[k].front_margin == trials[b].front_margin && settings[k].z > settings[b].z);
+}
+
 /// The setting kept (an index into `trials` and `settings`, in the same order): per pooling and
-/// top level, its z of best mean front margin (ties to the larger z); per top level, the first
+/// top level, its z of best mean front margin (keeps_z_over); per top level, the first
 /// pooling's unless another beats it by more than the folds' noise (select_pooling); of the
 /// top levels' so kept, the first's unless another beats it by more than the folds' noise
 /// (select_pooling again, the same grounds). Until 2026-12-05 any larger mean front margin took
@@ -123,9 +132,7 @@ inline std::size_t choose_setting(std::span<const RuleTrial> trials, std::span<c
                                              std::vector<std::size_t>(grid.poolings.size(), none));
   for (std::size_t k = 0; k < trials.size(); ++k) {
     std::size_t& b = best[settings[k].top_level][settings[k].pooling];
-    if (b == none || trials[k].front_margin > trials[b].front_margin ||
-        (trials[k].front_margin == trials[b].front_margin && settings[k].z > settings[b].z))
-      b = k;
+    if (b == none || keeps_z_over(trials, settings, k, b)) b = k;
   }
   std::vector<std::size_t> of_levels;
   std::vector<const RuleTrial*> levels;
