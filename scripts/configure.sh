@@ -5,14 +5,16 @@
 # tests/cli/test_scripts_configure.sh configures one folder with all of them in the README's order.
 
 # configure_for PURPOSE DIR [CMAKE ARGS...]: PURPOSE demo (the example programs), test (everything,
-# warnings as errors), bench (the benchmarks), results (the example programs).
+# warnings as errors, built to check and not to time: ADAPTSEG_CHECK_BUILD), bench (the
+# benchmarks), results (the example programs).
 configure_for() {
   local purpose=$1 dir=$2
   shift 2
-  local -a opts=(-DCMAKE_BUILD_TYPE=Release -DADAPTSEG_SANITIZE=OFF -DADAPTSEG_BUILD_EXAMPLES=ON)
+  local -a opts=(-DCMAKE_BUILD_TYPE=Release -DADAPTSEG_SANITIZE=OFF -DADAPTSEG_BUILD_EXAMPLES=ON -DADAPTSEG_CHECK_BUILD=OFF)
   case "$purpose" in
     demo | results) ;;
-    test) opts+=(-DADAPTSEG_BUILD_TESTS=ON -DADAPTSEG_TEST_SUITES=ON -DADAPTSEG_BUILD_BENCHMARKS=ON -DADAPTSEG_WARNINGS_AS_ERRORS=ON) ;;
+    test) opts+=(-DADAPTSEG_BUILD_TESTS=ON -DADAPTSEG_TEST_SUITES=ON -DADAPTSEG_BUILD_BENCHMARKS=ON -DADAPTSEG_WARNINGS_AS_ERRORS=ON
+                 -DADAPTSEG_CHECK_BUILD=ON) ;;
     bench) opts+=(-DADAPTSEG_BUILD_BENCHMARKS=ON) ;;
     *) echo "configure_for: unknown purpose '$purpose'" >&2; return 2 ;;
   esac

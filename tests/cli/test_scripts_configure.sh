@@ -26,7 +26,12 @@ has_targets test test_metrics test_calibration adaptseg_evaluate bench_decision
 n=$(ctest --test-dir "$dir" -N | sed -n 's/^Total Tests: //p')
 [ "${n:-0}" -gt 0 ] || fail "after configure_for test, ctest finds no test"
 echo "ok: ctest lists $n tests before any build"
+# test.sh builds the benchmarks to check them (-O0), bench.sh to time them: the option it cached
+# must not follow them there.
+grep -q '^ADAPTSEG_CHECK_BUILD:BOOL=ON$' "$dir/CMakeCache.txt" || fail "configure_for test: ADAPTSEG_CHECK_BUILD not on"
 has_targets bench bench_gaussian_process bench_decision bench_erfnet bench_geotiff
+grep -q '^ADAPTSEG_CHECK_BUILD:BOOL=OFF$' "$dir/CMakeCache.txt" ||
+  fail "configure_for bench after test: the benchmarks still built to check, not to time"
 has_targets results adaptseg_evaluate adaptseg_calibrate adaptseg_cell_study
 # And the demo again, after all of them.
 has_targets demo adaptseg_mission adaptseg_evaluate
